@@ -1,0 +1,1 @@
+//! cutroute-alns (being written).

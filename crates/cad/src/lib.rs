@@ -1,0 +1,1 @@
+//! cutroute-cad (being written).

@@ -1,0 +1,1 @@
+//! cutroute-ccp (being written).

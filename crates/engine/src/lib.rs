@@ -1,0 +1,1 @@
+//! cutroute-engine (being written).

@@ -1,0 +1,1 @@
+//! cutroute-formats (being written).

@@ -1,0 +1,1 @@
+//! cutroute-protocol (being written).
