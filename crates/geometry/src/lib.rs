@@ -19,6 +19,8 @@
 //! ```
 #![deny(missing_docs)]
 
+mod route;
 mod types;
 
+pub use route::{ContourRef, CutStep, Route};
 pub use types::{Contour, Nest, Part, Point, Vertex};
