@@ -1,0 +1,2 @@
+//! Benchmark: ccp solver (being written).
+fn main() {}

@@ -1,0 +1,2 @@
+//! Benchmark: exact solver (being written).
+fn main() {}

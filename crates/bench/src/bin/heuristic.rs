@@ -1,0 +1,2 @@
+//! Benchmark: heuristic solver (being written).
+fn main() {}

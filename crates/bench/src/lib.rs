@@ -1,0 +1,1 @@
+//! Shared helpers of the benchmark commands in `src/bin/` (each prints a Markdown table).
