@@ -1,0 +1,112 @@
+//! Shared helpers for the integration tests: real data files, read loudly.
+#![allow(dead_code)]
+
+use cutroute_pcgtsp::Instance;
+use std::path::PathBuf;
+
+/// `shared/data/` beside the checkout.
+pub fn data_dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data")
+}
+
+/// Reads a file under `shared/data/`, panicking with the path if it is missing.
+pub fn read_data(relative: &str) -> String {
+    let path = data_dir().join(relative);
+    std::fs::read_to_string(&path)
+        .unwrap_or_else(|e| panic!("required test data {} is missing: {e}", path.display()))
+}
+
+/// One row of `pcgtsp/reference.csv`.
+#[derive(Clone, Debug)]
+pub struct Reference {
+    pub set: String,
+    pub instance: String,
+    pub nodes: usize,
+    pub clusters: usize,
+    pub pcglns_cost: f64,
+    pub pcglns_tour: Vec<usize>,
+    pub best_lb: Option<f64>,
+    pub known_optimum: Option<f64>,
+}
+
+impl Reference {
+    /// Path relative to `shared/data/`.
+    pub fn relative_path(&self) -> String {
+        format!("pcgtsp/{}/{}.pcglns", self.set, self.instance)
+    }
+
+    pub fn load(&self) -> Instance {
+        Instance::parse(&read_data(&self.relative_path()))
+            .unwrap_or_else(|e| panic!("{}: {e}", self.instance))
+    }
+}
+
+fn split_csv(line: &str) -> Vec<String> {
+    let mut fields = Vec::new();
+    let mut current = String::new();
+    let mut quoted = false;
+    for ch in line.chars() {
+        match ch {
+            '"' => quoted = !quoted,
+            ',' if !quoted => fields.push(std::mem::take(&mut current)),
+            _ => current.push(ch),
+        }
+    }
+    fields.push(current);
+    fields
+}
+
+/// All rows of `pcgtsp/reference.csv`.
+pub fn references() -> Vec<Reference> {
+    let text = read_data("pcgtsp/reference.csv");
+    let mut lines = text.lines();
+    let header = split_csv(lines.next().expect("reference.csv is empty"));
+    let col = |name: &str| {
+        header
+            .iter()
+            .position(|h| h == name)
+            .unwrap_or_else(|| panic!("column {name}"))
+    };
+    let (set, instance, nodes, clusters) =
+        (col("set"), col("instance"), col("nodes"), col("clusters"));
+    let (cost, tour, best_lb, optimum) = (
+        col("pcglns_cost"),
+        col("pcglns_tour"),
+        col("best_lb"),
+        col("known_optimum"),
+    );
+    let opt = |s: &str| {
+        if s.trim().is_empty() {
+            None
+        } else {
+            Some(s.trim().parse::<f64>().unwrap())
+        }
+    };
+    lines
+        .filter(|l| !l.trim().is_empty())
+        .map(|l| {
+            let f = split_csv(l);
+            Reference {
+                set: f[set].clone(),
+                instance: f[instance].clone(),
+                nodes: f[nodes].parse().unwrap(),
+                clusters: f[clusters].parse().unwrap(),
+                pcglns_cost: f[cost].parse().unwrap(),
+                pcglns_tour: f[tour]
+                    .split(',')
+                    .map(|t| t.trim().parse::<usize>().unwrap() - 1)
+                    .collect(),
+                best_lb: opt(&f[best_lb]),
+                known_optimum: opt(&f[optimum]),
+            }
+        })
+        .collect()
+}
+
+/// The reference row of one instance.
+pub fn reference(name: &str) -> Reference {
+    references()
+        .into_iter()
+        .find(|r| r.instance == name)
+        .unwrap_or_else(|| panic!("{name} not in reference.csv"))
+}
