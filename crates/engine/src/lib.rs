@@ -1,1 +1,99 @@
-//! cutroute-engine (being written).
+//! The job engine: turns a [`JobRequest`] into a running solver and advances it in time slices.
+//!
+//! A browser worker has one thread: a solver that ran to its end in one call would block the
+//! worker's message loop, so a Cancel message could not arrive until it finished. Every job is
+//! therefore a [`Job`] that does a bounded slice of work per [`Job::step`] call; the worker yields
+//! to its event loop between slices, and the CLI simply loops.
+//!
+//! ```
+//! use cutroute_engine::{run_to_end, start_job};
+//! use cutroute_geometry::{Contour, Nest, Part, Point, Vertex};
+//! use cutroute_protocol::{JobRequest, Problem, SolverKind, SolverParams};
+//!
+//! let square = |x: f64| Contour::new(vec![
+//!     Vertex::line(x, 0.0), Vertex::line(x, 10.0), Vertex::line(x + 10.0, 10.0), Vertex::line(x + 10.0, 0.0),
+//! ]);
+//! let nest = Nest { sheet: None, parts: vec![
+//!     Part { name: "far".into(), contours: vec![square(100.0)] },
+//!     Part { name: "near".into(), contours: vec![square(20.0)] },
+//! ]};
+//! let request = JobRequest {
+//!     job_id: 1,
+//!     problem: Problem::Nest { nest, start: Point::new(0.0, 0.0), finish: None },
+//!     solver: SolverKind::NearestNeighbour,
+//!     params: SolverParams::default(),
+//! };
+//! let mut job = start_job(&request).unwrap();
+//! let result = run_to_end(job.as_mut(), &mut |_| {});
+//! let route = result.route.unwrap();
+//! assert_eq!(route.steps[0].contour.part, 1); // the nearer part is cut first
+//! assert_eq!(result.upper_bound, Some(20.0 + 80.0));
+//! ```
+#![deny(missing_docs)]
+
+mod nearest;
+
+use cutroute_protocol::{JobRequest, Problem, Progress, SolverKind};
+use web_time::Duration;
+
+pub use nearest::NearestNeighbourJob;
+
+/// How long one [`Job::step`] may run before it returns, so cancel requests are seen quickly.
+pub const DEFAULT_SLICE: Duration = Duration::from_millis(40);
+
+/// What a step left behind.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum JobStatus {
+    /// More work to do: call `step` again.
+    Running,
+    /// The solver ended (finished its search or reached its time limit).
+    Done,
+}
+
+/// A solver run that advances in slices.
+pub trait Job {
+    /// Work for about `budget` (solvers check the clock every few hundred operations), then return.
+    fn step(&mut self, budget: Duration) -> JobStatus;
+    /// The current state: bounds, best route or tour, phase.
+    fn progress(&self) -> Progress;
+}
+
+/// Why a job could not start.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum EngineError {
+    /// The solver does not accept this kind of problem.
+    #[error("the {solver} solver cannot solve {problem}")]
+    UnsupportedProblem {
+        /// The solver's short name.
+        solver: &'static str,
+        /// What the problem was, in words.
+        problem: &'static str,
+    },
+    /// The problem has nothing to cut.
+    #[error("the nest has no contours to cut")]
+    EmptyNest,
+}
+
+/// Build the job a request asks for.
+pub fn start_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
+    match (&request.problem, request.solver) {
+        (Problem::Nest { nest, start, finish }, SolverKind::NearestNeighbour) => Ok(Box::new(
+            NearestNeighbourJob::new(request.job_id, nest.clone(), *start, *finish)?,
+        )),
+        (problem, solver) => Err(EngineError::UnsupportedProblem {
+            solver: solver.name(),
+            problem: match problem {
+                Problem::Nest { .. } => "a nest",
+                Problem::PcgtspText { .. } => "a PCGTSP instance",
+            },
+        }),
+    }
+}
+
+/// Step a job until it is done, reporting progress after every slice; returns the final state.
+pub fn run_to_end(job: &mut dyn Job, on_progress: &mut dyn FnMut(&Progress)) -> Progress {
+    while job.step(DEFAULT_SLICE) == JobStatus::Running {
+        on_progress(&job.progress());
+    }
+    job.progress()
+}

@@ -1,1 +1,286 @@
-//! cutroute-protocol (being written).
+//! The job protocol: every message that crosses the boundary between the UI, the solver worker
+//! and the command-line tool.
+//!
+//! The UI sends [`ToWorker`] messages; the worker answers with [`FromWorker`] messages. A job is
+//! started with a [`JobRequest`], reports [`Progress`] while it runs (the improving route, the
+//! upper and lower bounds, the gap), and ends with exactly one of `Finished`, `Cancelled` or
+//! `Failed`. The same types serialise to JSON for the CLI.
+//!
+//! The worker transport (gloo-worker) encodes messages with bincode, which has no self-describing
+//! format: keep these types plain (no untagged enums, no skipped fields).
+//!
+//! ```
+//! use cutroute_protocol::{JobRequest, Problem, SolverKind, SolverParams, ToWorker};
+//! use cutroute_geometry::{Nest, Point};
+//!
+//! let request = ToWorker::Start(JobRequest {
+//!     job_id: 1,
+//!     problem: Problem::Nest { nest: Nest::default(), start: Point::new(0.0, 0.0), finish: None },
+//!     solver: SolverKind::NearestNeighbour,
+//!     params: SolverParams::default(),
+//! });
+//! assert!(matches!(request, ToWorker::Start(ref job) if job.job_id == 1));
+//! ```
+#![deny(missing_docs)]
+
+use cutroute_geometry::{Nest, Point, Route};
+use serde::{Deserialize, Serialize};
+
+/// Identifies one job for the lifetime of a worker; chosen by the sender, echoed in every answer.
+pub type JobId = u64;
+
+/// A message to the solver worker.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum ToWorker {
+    /// Start a job. A job already running keeps running: jobs are independent.
+    Start(JobRequest),
+    /// Stop a job as soon as possible; the worker answers `Cancelled` with the best result so far.
+    Cancel {
+        /// The job to stop.
+        job_id: JobId,
+    },
+    /// Read a file (large files are parsed here, off the UI thread); answered by `Opened` or
+    /// `OpenFailed` with the same `request_id`.
+    Open {
+        /// Chosen by the sender; echoed in the answer.
+        request_id: u64,
+        /// The file's name (its extension is a hint; the format is detected from the content).
+        file_name: String,
+        /// The file's bytes.
+        bytes: Vec<u8>,
+    },
+}
+
+/// A file the worker has read.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Document {
+    /// The file's name.
+    pub file_name: String,
+    /// The detected format, in words (e.g. "DBS binary").
+    pub format: String,
+    /// What the file describes, ready to be solved.
+    pub problem: Problem,
+}
+
+/// A message from the solver worker.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum FromWorker {
+    /// The job is running; sent after every improvement and at least every few hundred ms.
+    Progress(Progress),
+    /// The job ran to its end (solver finished or time limit reached).
+    Finished(Progress),
+    /// The job was cancelled; the progress is the best state reached.
+    Cancelled(Progress),
+    /// A file was read.
+    Opened {
+        /// The `request_id` of the `Open` message.
+        request_id: u64,
+        /// What was read.
+        document: Document,
+    },
+    /// A file could not be read.
+    OpenFailed {
+        /// The `request_id` of the `Open` message.
+        request_id: u64,
+        /// What is wrong and where, in plain words.
+        message: String,
+    },
+    /// The job could not run.
+    Failed {
+        /// The job that failed.
+        job_id: JobId,
+        /// What went wrong, in plain words.
+        message: String,
+    },
+}
+
+/// What to solve.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Problem {
+    /// A cutting plan: route the tool over every contour of the nest.
+    Nest {
+        /// The parts to cut.
+        nest: Nest,
+        /// The machine's home point, where the tool head starts.
+        start: Point,
+        /// Where the tool head must end, if anywhere.
+        finish: Option<Point>,
+    },
+    /// A PCGTSP instance in PCGLNS or PCGTSPLIB text format.
+    PcgtspText {
+        /// The file's text.
+        text: String,
+    },
+}
+
+/// The solvers a job can run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum SolverKind {
+    /// Greedy: cut the nearest contour whose inner contours are done, pierce at its nearest vertex.
+    NearestNeighbour,
+    /// CCP-Relax: pierce points anywhere on the contours, VNS over the order.
+    Ccp,
+    /// Discretised pierce points, adaptive large neighbourhood search (upper bounds only).
+    Heuristic,
+    /// Discretised pierce points, exact dynamic programming with lower bounds.
+    Exact,
+}
+
+impl SolverKind {
+    /// Every solver, in the order the UI lists them.
+    pub const ALL: [SolverKind; 4] =
+        [SolverKind::NearestNeighbour, SolverKind::Ccp, SolverKind::Heuristic, SolverKind::Exact];
+
+    /// The short name used on the command line and in links.
+    pub fn name(self) -> &'static str {
+        match self {
+            SolverKind::NearestNeighbour => "nearest",
+            SolverKind::Ccp => "ccp",
+            SolverKind::Heuristic => "heuristic",
+            SolverKind::Exact => "exact",
+        }
+    }
+
+    /// The solver with the given short name.
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|kind| kind.name() == name)
+    }
+}
+
+/// Solver settings; every field has a sensible default.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SolverParams {
+    /// Wall-clock limit in seconds.
+    pub time_limit_s: f64,
+    /// Seed of the solver's random choices (runs with one seed are repeatable).
+    pub seed: u64,
+    /// Spacing of candidate pierce points along contours for the discrete solvers, in mm.
+    pub discretisation_step_mm: f64,
+    /// An upper bound known in advance (the exact solver prunes with it).
+    pub initial_upper_bound: Option<f64>,
+}
+
+impl Default for SolverParams {
+    fn default() -> Self {
+        Self { time_limit_s: 10.0, seed: 1, discretisation_step_mm: 50.0, initial_upper_bound: None }
+    }
+}
+
+/// Start a job.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct JobRequest {
+    /// Chosen by the sender; echoed in every answer.
+    pub job_id: JobId,
+    /// What to solve.
+    pub problem: Problem,
+    /// Which solver.
+    pub solver: SolverKind,
+    /// Its settings.
+    pub params: SolverParams,
+}
+
+/// The state of a running (or ended) job.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Progress {
+    /// The job this is about.
+    pub job_id: JobId,
+    /// Seconds since the job started.
+    pub elapsed_s: f64,
+    /// The cost of the best solution so far (idle length in mm for nests), if any.
+    pub upper_bound: Option<f64>,
+    /// A proven lower bound on the optimal cost, if the solver computes one.
+    pub lower_bound: Option<f64>,
+    /// What the solver is doing, in a few words.
+    pub phase: String,
+    /// The best route so far (nest problems).
+    pub route: Option<Route>,
+    /// The best tour so far as 0-based node ids, depot first (PCGTSP problems).
+    pub tour: Option<Vec<usize>>,
+    /// Whether the best solution is proven optimal.
+    pub proven_optimal: bool,
+}
+
+impl Progress {
+    /// The relative gap `(UB − LB) / UB`, when both bounds are known.
+    pub fn gap(&self) -> Option<f64> {
+        match (self.upper_bound, self.lower_bound) {
+            (Some(ub), Some(lb)) if ub > 0.0 => Some(((ub - lb) / ub).max(0.0)),
+            (Some(_), Some(_)) => Some(0.0),
+            _ => None,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use cutroute_geometry::{ContourRef, CutStep, Vertex};
+
+    fn sample_request() -> ToWorker {
+        let nest = Nest {
+            sheet: None,
+            parts: vec![cutroute_geometry::Part {
+                name: "A".into(),
+                contours: vec![cutroute_geometry::Contour::new(vec![
+                    Vertex::line(0.0, 0.0),
+                    Vertex::arc(1.0, 0.0, 0.5),
+                ])],
+            }],
+        };
+        ToWorker::Start(JobRequest {
+            job_id: 7,
+            problem: Problem::Nest { nest, start: Point::new(1.0, 2.0), finish: Some(Point::default()) },
+            solver: SolverKind::Ccp,
+            params: SolverParams { initial_upper_bound: Some(3.5), ..SolverParams::default() },
+        })
+    }
+
+    #[test]
+    fn messages_survive_the_worker_codec() {
+        let request = sample_request();
+        let bytes = bincode::serialize(&request).unwrap();
+        assert_eq!(bincode::deserialize::<ToWorker>(&bytes).unwrap(), request);
+
+        let progress = FromWorker::Progress(Progress {
+            job_id: 7,
+            elapsed_s: 0.25,
+            upper_bound: Some(10.0),
+            lower_bound: Some(8.0),
+            phase: "layer 3".into(),
+            route: Some(Route {
+                start: Point::default(),
+                steps: vec![CutStep {
+                    contour: ContourRef { part: 0, contour: 0 },
+                    pierce_point: Point::new(0.0, 0.0),
+                }],
+                finish: None,
+            }),
+            tour: Some(vec![0, 3, 2]),
+            proven_optimal: false,
+        });
+        let bytes = bincode::serialize(&progress).unwrap();
+        assert_eq!(bincode::deserialize::<FromWorker>(&bytes).unwrap(), progress);
+    }
+
+    #[test]
+    fn messages_survive_json() {
+        let request = sample_request();
+        let text = serde_json::to_string(&request).unwrap();
+        assert_eq!(serde_json::from_str::<ToWorker>(&text).unwrap(), request);
+    }
+
+    #[test]
+    fn gap_is_relative_to_the_upper_bound() {
+        let p = Progress { upper_bound: Some(200.0), lower_bound: Some(150.0), ..Progress::default() };
+        assert_eq!(p.gap(), Some(0.25));
+        assert_eq!(Progress::default().gap(), None);
+    }
+
+    #[test]
+    fn solver_names_round_trip() {
+        for kind in SolverKind::ALL {
+            assert_eq!(SolverKind::from_name(kind.name()), Some(kind));
+        }
+        assert_eq!(SolverKind::from_name("magic"), None);
+    }
+}

@@ -1,0 +1,105 @@
+//! The nearest-neighbour route: the baseline every real solver must beat.
+
+use cutroute_geometry::{ContourRef, CutStep, Nest, Point, Route};
+use cutroute_protocol::{JobId, Progress};
+use web_time::{Duration, Instant};
+
+use crate::{EngineError, Job, JobStatus};
+
+/// Greedy routing: from the current tool position, cut the nearest contour that may be cut now
+/// (a part's outer contour only after all its holes), piercing at its nearest vertex.
+pub struct NearestNeighbourJob {
+    job_id: JobId,
+    nest: Nest,
+    start: Point,
+    finish: Option<Point>,
+    started: Instant,
+    route: Option<Route>,
+    idle_length: f64,
+}
+
+impl NearestNeighbourJob {
+    /// Prepare the job; fails on a nest with no contours.
+    pub fn new(
+        job_id: JobId,
+        nest: Nest,
+        start: Point,
+        finish: Option<Point>,
+    ) -> Result<Self, EngineError> {
+        if nest.parts.iter().all(|part| part.contours.is_empty()) {
+            return Err(EngineError::EmptyNest);
+        }
+        Ok(Self { job_id, nest, start, finish, started: Instant::now(), route: None, idle_length: 0.0 })
+    }
+
+    fn solve(&mut self) {
+        let mut remaining: Vec<ContourRef> = Vec::new();
+        for (part_index, part) in self.nest.parts.iter().enumerate() {
+            for contour_index in 0..part.contours.len() {
+                remaining.push(ContourRef { part: part_index, contour: contour_index });
+            }
+        }
+        // Holes left to cut per part: its outer contour waits for them (inner before outer).
+        let mut holes_left: Vec<usize> =
+            self.nest.parts.iter().map(|part| part.contours.len().saturating_sub(1)).collect();
+        let mut position = self.start;
+        let mut steps = Vec::with_capacity(remaining.len());
+        let mut idle_length = 0.0;
+        while !remaining.is_empty() {
+            let mut best: Option<(usize, Point, f64)> = None;
+            for (index, contour_ref) in remaining.iter().enumerate() {
+                if contour_ref.contour == 0 && holes_left[contour_ref.part] > 0 {
+                    continue;
+                }
+                let contour = &self.nest.parts[contour_ref.part].contours[contour_ref.contour];
+                for vertex in &contour.vertices {
+                    let d = distance(position, vertex.point);
+                    if best.is_none_or(|(_, _, best_d)| d < best_d) {
+                        best = Some((index, vertex.point, d));
+                    }
+                }
+            }
+            let Some((index, pierce_point, d)) = best else {
+                break; // only contours without vertices remain
+            };
+            let contour_ref = remaining.swap_remove(index);
+            if contour_ref.contour > 0 {
+                holes_left[contour_ref.part] -= 1;
+            }
+            idle_length += d;
+            position = pierce_point;
+            steps.push(CutStep { contour: contour_ref, pierce_point });
+        }
+        if let Some(finish) = self.finish {
+            idle_length += distance(position, finish);
+        }
+        self.idle_length = idle_length;
+        self.route = Some(Route { start: self.start, steps, finish: self.finish });
+    }
+}
+
+fn distance(a: Point, b: Point) -> f64 {
+    (a.x - b.x).hypot(a.y - b.y)
+}
+
+impl Job for NearestNeighbourJob {
+    fn step(&mut self, _budget: Duration) -> JobStatus {
+        if self.route.is_none() {
+            self.solve();
+        }
+        JobStatus::Done
+    }
+
+    fn progress(&self) -> Progress {
+        Progress {
+            job_id: self.job_id,
+            elapsed_s: self.started.elapsed().as_secs_f64(),
+            upper_bound: self.route.as_ref().map(|_| self.idle_length),
+            lower_bound: None,
+            phase: if self.route.is_some() { "done".into() } else { "starting".into() },
+            route: self.route.clone(),
+            tour: None,
+            proven_optimal: false,
+        }
+    }
+}
