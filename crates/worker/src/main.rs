@@ -8,7 +8,7 @@
 mod web {
     use std::collections::HashMap;
 
-    use cutroute_engine::{start_job, Job, JobStatus, DEFAULT_SLICE};
+    use cutroute_engine::{open_document, start_job, Job, JobStatus, DEFAULT_SLICE};
     use cutroute_protocol::{FromWorker, JobId, ToWorker};
     use gloo_worker::{HandlerId, Worker, WorkerScope};
     use web_time::{Duration, Instant};
@@ -99,6 +99,13 @@ mod web {
                         FromWorker::Failed { job_id: request.job_id, message: error.to_string() },
                     ),
                 },
+                ToWorker::Open { request_id, file_name, bytes } => {
+                    let answer = match open_document(&file_name, &bytes) {
+                        Ok(document) => FromWorker::Opened { request_id, document },
+                        Err(message) => FromWorker::OpenFailed { request_id, message },
+                    };
+                    scope.respond(requester, answer);
+                }
                 ToWorker::Cancel { job_id } => {
                     if let Some(running) = self.jobs.remove(&job_id) {
                         let mut progress = running.job.progress();

@@ -1,0 +1,9 @@
+#!/usr/bin/env bash
+# Release build for static hosting: writes dist/ with relative asset URLs, so the folder works
+# served from any path (https://host/, https://host/cutroute/, …).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+scripts/setup.sh
+source scripts/wasm-env.sh
+trunk build --release --public-url ./ "$@"
+ls -l dist/*.wasm | awk '{print "[build] " $5 " bytes  " $9}' >&2

@@ -1,0 +1,23 @@
+#!/usr/bin/env bash
+# Every test: native unit/integration/doc tests, the engine as wasm in headless Chromium, and the
+# end-to-end tests of the release build in headless Chromium. Installs what is missing first.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+scripts/setup.sh
+export PATH="$HOME/.cargo/bin:$PATH"
+
+echo "== native tests (web-free crates and the CLI)"
+cargo test --release
+
+echo "== wasm tests in headless Chromium"
+(
+  source scripts/wasm-env.sh
+  export CARGO_TARGET_WASM32_UNKNOWN_UNKNOWN_RUNNER=wasm-bindgen-test-runner
+  export CHROMEDRIVER=/usr/bin/chromedriver
+  export WASM_BINDGEN_TEST_TIMEOUT=300
+  cargo test --release --target wasm32-unknown-unknown -p cutroute-engine --test wasm
+)
+
+echo "== end-to-end tests (release build served from a sub-path)"
+scripts/build-release.sh
+(cd tests/e2e && npm test)

@@ -1,0 +1,58 @@
+// Shared by the end-to-end tests: a static file server for the release build (mounted under a
+// sub-path, as on a static host) and the system's headless Chromium.
+import http from 'node:http';
+import fs from 'node:fs';
+import path from 'node:path';
+import { fileURLToPath } from 'node:url';
+import { chromium } from 'playwright-core';
+
+const here = path.dirname(fileURLToPath(import.meta.url));
+export const projectRoot = path.resolve(here, '..', '..');
+export const distDir = process.env.CUTROUTE_DIST ?? path.join(projectRoot, 'dist');
+export const screenshotDir = path.join(projectRoot, 'target', 'e2e');
+export const SUB_PATH = '/cutroute/';
+
+const MIME = {
+  '.html': 'text/html; charset=utf-8', '.js': 'text/javascript', '.wasm': 'application/wasm',
+  '.css': 'text/css', '.json': 'application/json', '.svg': 'image/svg+xml', '.png': 'image/png',
+};
+
+/** Serves `distDir` under SUB_PATH on a free loopback port; resolves to { server, baseUrl }. */
+export async function startServer() {
+  if (!fs.existsSync(path.join(distDir, 'index.html'))) {
+    throw new Error(`no release build at ${distDir}: run scripts/build-release.sh first`);
+  }
+  const server = http.createServer((req, res) => {
+    const url = new URL(req.url, 'http://localhost');
+    if (!url.pathname.startsWith(SUB_PATH)) { res.writeHead(404); res.end('outside the app'); return; }
+    let rel = decodeURIComponent(url.pathname.slice(SUB_PATH.length)) || 'index.html';
+    const file = path.resolve(distDir, rel);
+    if (!file.startsWith(path.resolve(distDir))) { res.writeHead(403); res.end(); return; }
+    fs.readFile(file, (err, data) => {
+      if (err) { res.writeHead(404); res.end('not found'); return; }
+      res.writeHead(200, { 'content-type': MIME[path.extname(file)] ?? 'application/octet-stream' });
+      res.end(data);
+    });
+  });
+  await new Promise((resolve) => server.listen(0, '127.0.0.1', resolve));
+  const { port } = server.address();
+  return { server, baseUrl: `http://127.0.0.1:${port}${SUB_PATH}` };
+}
+
+/** The Debian Chromium, headless, with the flags this closed network needs. */
+export async function launchBrowser() {
+  return chromium.launch({
+    executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium',
+    headless: true,
+    args: ['--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
+      '--disable-background-networking', '--disable-component-update', '--disable-sync'],
+  });
+}
+
+/** Collects page errors so a test can assert the app never threw. */
+export function watchErrors(page) {
+  const errors = [];
+  page.on('pageerror', (e) => errors.push(String(e)));
+  page.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
+  return errors;
+}
