@@ -18,9 +18,27 @@
 //! assert_eq!(square.vertices[2].point, Point::new(10.0, 10.0));
 //! ```
 #![deny(missing_docs)]
+// `!(x <= tol)` is deliberate throughout: it is true for NaN, so bad input fails checks
+// instead of slipping through them.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+mod bbox;
+mod contour;
+mod forest;
+mod generator;
+mod point;
 mod route;
+mod span;
+mod transform;
 mod types;
 
-pub use route::{ContourRef, CutStep, Route};
+pub use bbox::BoundingBox;
+pub use contour::{
+    ClosureError, ContourError, ContourPosition, ContourProjection, SelfIntersection,
+};
+pub use forest::ContainmentForest;
+pub use generator::{generate_nest, SplitMix64};
+pub use route::{ContourRef, CutStep, MachineParameters, Route, RouteError};
+pub use span::{tan_half_arg, Span, SpanIntersection, SpanProjection};
+pub use transform::Transform;
 pub use types::{Contour, Nest, Part, Point, Vertex};
