@@ -1,0 +1,1 @@
+//! T-FLEX nesting projects (stub).
