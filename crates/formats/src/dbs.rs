@@ -278,6 +278,12 @@ pub enum DbsWriteError {
         /// Vertex index.
         vertex: usize,
     },
+    /// The part's area or perimeter (record 27, dm², dm) overflows float32.
+    #[error("part {part} area or perimeter is beyond float32 range")]
+    DimensionsNotRepresentable {
+        /// Part index (the sheet is 0 when present).
+        part: usize,
+    },
     /// The name does not fit 8 single-byte characters.
     #[error("part {part} name {name:?} does not fit 8 single-byte characters")]
     NameNotRepresentable {
@@ -850,7 +856,9 @@ pub fn write_dbs_with(nest: &Nest, options: &DbsWriteOptions) -> Result<Vec<u8>,
             }
             for (vertex, p) in points.iter().enumerate() {
                 for v in p {
-                    let f = *v as f32;
+                    // `+ 0.0` turns −0.0 into +0.0: the reader's identity transform does the
+                    // same, so a rewrite would otherwise flip sign bits.
+                    let f = *v as f32 + 0.0;
                     if !f.is_finite() {
                         return Err(DbsWriteError::NotRepresentable {
                             part: index,
@@ -869,8 +877,13 @@ pub fn write_dbs_with(nest: &Nest, options: &DbsWriteOptions) -> Result<Vec<u8>,
         put_header(&mut out, 8, TYPE_NAME, part_id);
         out.extend_from_slice(&name);
         put_header(&mut out, 8, TYPE_DIMENSIONS, part_id);
-        out.extend_from_slice(&((geom::part_area(part) * 1e-4) as f32).to_le_bytes());
-        out.extend_from_slice(&((geom::part_perimeter(part) * 1e-2) as f32).to_le_bytes());
+        let area = (geom::part_area(part) * 1e-4) as f32 + 0.0;
+        let perimeter = (geom::part_perimeter(part) * 1e-2) as f32 + 0.0;
+        if !area.is_finite() || !perimeter.is_finite() {
+            return Err(DbsWriteError::DimensionsNotRepresentable { part: index });
+        }
+        out.extend_from_slice(&area.to_le_bytes());
+        out.extend_from_slice(&perimeter.to_le_bytes());
         seq = part_id as usize;
     }
     out.extend_from_slice(&END_MARKER);
