@@ -54,8 +54,8 @@ pub(crate) fn closed_contour(
         }
     };
     let gap = (first[0] - last[0]).hypot(first[1] - last[1]);
-    // `!(gap <= tol)` also rejects a NaN gap from overflowing coordinates.
-    if !(gap <= tolerance) {
+    // A NaN gap (from overflowing coordinates) must be rejected too, hence not `gap > tolerance`.
+    if gap.is_nan() || gap > tolerance {
         return Err(ContourProblem::Unclosed { gap });
     }
     let vertices: Vec<Vertex> = points[..points.len() - 1]

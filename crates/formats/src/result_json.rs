@@ -400,8 +400,7 @@ impl RmResult {
             name: "sheet".into(),
             contours: vec![closed(&self.job.list, "job.list".into())?],
         };
-        let mut groups: Vec<(i64, Option<String>, Vec<(i64, cutroute_geometry::Contour)>)> =
-            Vec::new();
+        let mut groups: Vec<PartGroup> = Vec::new();
         for (i, p) in self.job.paths.iter().enumerate() {
             let contour = closed(&p.points, format!("job.paths[{i}].points"))?;
             match groups.iter_mut().find(|g| g.0 == p.part_id) {
@@ -454,6 +453,9 @@ impl RmResult {
         }
     }
 }
+
+/// Contours of one `part.id` collected from `job.paths`: (part.id, partid, [(id, contour)]).
+type PartGroup = (i64, Option<String>, Vec<(i64, cutroute_geometry::Contour)>);
 
 /// A clockwise rectangle around every part, used as `list` when the nest has no sheet.
 fn bounding_rectangle(nest: &Nest) -> Vec<[f64; 3]> {
