@@ -11,8 +11,8 @@ use cutroute_geometry::Point;
 
 use crate::shape::{angle_in_sweep, dist, distance_to_segment, Span};
 
-/// Highest spline degree accepted; real files use 2–5, higher ones are hostile or broken.
-pub(crate) const MAX_SPLINE_DEGREE: usize = 31;
+/// Highest spline degree accepted (AutoCAD allows up to 11); each evaluation costs degree².
+pub(crate) const MAX_SPLINE_DEGREE: usize = 11;
 /// Bisection depth limit per piece: 2^-40 of a knot interval is far below any tolerance.
 const MAX_DEPTH: u32 = 40;
 /// Samples checked against each candidate arc.

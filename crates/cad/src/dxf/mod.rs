@@ -40,7 +40,7 @@ impl Default for DxfOptions {
         Self {
             approximation_tolerance: 0.01,
             join_tolerance: 0.05,
-            max_spans: 2_000_000,
+            max_spans: 500_000,
         }
     }
 }
