@@ -121,15 +121,17 @@ impl Cycle {
     }
 }
 
-/// Real roots of `a·s² + b·s + c = 0`, robust for `a → 0` (then one root goes to infinity and
-/// is dropped) and for a slightly negative discriminant (a tangent touch blurred by rounding).
+/// Real roots of `a·s² + b·s + c = 0`, robust for `a → 0` (then one root runs off to infinity,
+/// to be rejected by the caller) and for a slightly negative discriminant (a tangent touch blurred by rounding).
 fn quadratic_roots(a: f64, b: f64, c: f64) -> Vec<f64> {
     let scale = a.abs().max(b.abs()).max(c.abs());
     if !(scale > 0.0) || !scale.is_finite() {
         return Vec::new();
     }
     let (a, b, c) = (a / scale, b / scale, c / scale);
-    if a.abs() < 1e-14 * b.abs() || a == 0.0 {
+    // Even a tiny `a` is kept: the small root c/q below stays exact, while dropping a·s²
+    // would cost precision when s is large (nearly straight arcs).
+    if a == 0.0 {
         if b == 0.0 {
             return Vec::new();
         }
@@ -405,10 +407,17 @@ impl Span {
         if self.bulge.abs() < PROJECTION_PARAMETER_BULGE {
             return (p - self.start).dot(d) / l2;
         }
-        // Tangent–chord angle: the chord A→P makes half of its arc's angle with the start tangent.
         let phi = self.sweep();
         let tangent = d.rotated(-0.5 * phi);
         let v = p - self.start;
+        if phi.abs() < 1.0 {
+            // Chord ratio: |P − A| = L·sin(tφ/2)/sin(φ/2), monotone here. Going through the
+            // angle instead would multiply its rounding error by 2/φ.
+            let ratio = (v.norm() / l2.sqrt() * (0.5 * phi.abs()).sin()).min(1.0);
+            let t = 2.0 * ratio.asin() / phi.abs();
+            return if tangent.dot(v) < 0.0 { -t } else { t };
+        }
+        // Tangent–chord angle: the chord A→P makes half of its arc's angle with the start tangent.
         let psi = tangent.cross(v).atan2(tangent.dot(v));
         let psi = if phi > 0.0 && psi < 0.0 {
             psi + std::f64::consts::TAU
