@@ -14,7 +14,7 @@ fn bulge() -> impl Strategy<Value = f64> {
         1 => Just(0.0),
         1 => Just(1.0),
         1 => Just(-1.0),
-        1 => (-1e-6..1e-6f64),
+        1 => -1e-6..1e-6f64,
         1 => prop_oneof![Just(1e-12), Just(-1e-9), Just(5.0), Just(-20.0)],
     ]
 }
