@@ -175,3 +175,64 @@ pub fn overlapping_pairs(solids: &[Solid], tolerance: f64) -> Vec<(usize, usize)
     }
     pairs
 }
+
+/// Centre, radius, start angle and signed sweep of an arc span (`None` for a straight one).
+fn arc_of(a: Point, b: Point, bulge: f64) -> Option<(Point, f64, f64, f64)> {
+    if bulge == 0.0 {
+        return None;
+    }
+    let chord = ((b.x - a.x).powi(2) + (b.y - a.y).powi(2)).sqrt();
+    let radius = chord * (1.0 + bulge * bulge) / (4.0 * bulge.abs());
+    let d = chord * (1.0 - bulge * bulge) / (4.0 * bulge);
+    let (ux, uy) = ((b.x - a.x) / chord, (b.y - a.y) / chord);
+    let c = Point::new((a.x + b.x) / 2.0 - uy * d, (a.y + b.y) / 2.0 + ux * d);
+    Some((c, radius, (a.y - c.y).atan2(a.x - c.x), 4.0 * bulge.atan()))
+}
+
+fn on_sweep(angle: f64, start: f64, sweep: f64) -> bool {
+    let tau = std::f64::consts::TAU;
+    let rel = if sweep >= 0.0 { (angle - start).rem_euclid(tau) } else { (start - angle).rem_euclid(tau) };
+    rel <= sweep.abs()
+}
+
+/// Exact bounding box of a contour, arc extremes included.
+pub fn exact_bounds(contour: &Contour) -> (Point, Point) {
+    let n = contour.vertices.len();
+    let mut pts: Vec<Point> = contour.vertices.iter().map(|v| v.point).collect();
+    for i in 0..n {
+        let (a, b) = (contour.vertices[i].point, contour.vertices[(i + 1) % n].point);
+        if let Some((c, r, start, sweep)) = arc_of(a, b, contour.vertices[i].bulge) {
+            for k in 0..4 {
+                let t = k as f64 * std::f64::consts::FRAC_PI_2;
+                if on_sweep(t, start, sweep) {
+                    pts.push(Point::new(c.x + r * t.cos(), c.y + r * t.sin()));
+                }
+            }
+        }
+    }
+    bounds(&pts)
+}
+
+/// Exact distance from `p` to a contour made of segments and arcs.
+pub fn distance_to_contour(p: Point, contour: &Contour) -> f64 {
+    let n = contour.vertices.len();
+    let mut best = f64::INFINITY;
+    for i in 0..n {
+        let (a, b) = (contour.vertices[i].point, contour.vertices[(i + 1) % n].point);
+        let d = match arc_of(a, b, contour.vertices[i].bulge) {
+            None => distance_to_boundary(p, &[a, b]),
+            Some((c, r, start, sweep)) => {
+                let angle = (p.y - c.y).atan2(p.x - c.x);
+                if on_sweep(angle, start, sweep) {
+                    (((p.x - c.x).powi(2) + (p.y - c.y).powi(2)).sqrt() - r).abs()
+                } else {
+                    let da = ((p.x - a.x).powi(2) + (p.y - a.y).powi(2)).sqrt();
+                    let db = ((p.x - b.x).powi(2) + (p.y - b.y).powi(2)).sqrt();
+                    da.min(db)
+                }
+            }
+        };
+        best = best.min(d);
+    }
+    best
+}
