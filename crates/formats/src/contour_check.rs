@@ -4,8 +4,6 @@
 
 use cutroute_geometry::{Contour, Vertex};
 
-use crate::geom;
-
 /// How far apart (mm) the first and last stored points may be for the contour to count as closed.
 pub const DEFAULT_CLOSURE_TOLERANCE: f64 = 1e-3;
 
@@ -31,8 +29,17 @@ pub enum ContourProblem {
         index: usize,
     },
     /// The contour crosses or touches itself.
-    #[error("contour intersects itself")]
-    SelfIntersecting,
+    #[error("contour intersects itself: spans {first_span} and {second_span} meet at ({x}, {y})")]
+    SelfIntersecting {
+        /// The lower span index (span i runs from vertex i to vertex i+1).
+        first_span: usize,
+        /// The higher span index.
+        second_span: usize,
+        /// Where they meet, x.
+        x: f64,
+        /// Where they meet, y.
+        y: f64,
+    },
 }
 
 /// Checks a stored point list `(x, y, bulge)` whose last point repeats the first, and returns the
@@ -68,8 +75,15 @@ pub(crate) fn closed_contour(
         });
     }
     let contour = Contour::new(vertices);
-    if check_self_intersection && geom::is_self_intersecting(&contour) {
-        return Err(ContourProblem::SelfIntersecting);
+    if check_self_intersection {
+        if let Some(hit) = contour.first_self_intersection() {
+            return Err(ContourProblem::SelfIntersecting {
+                first_span: hit.first_span,
+                second_span: hit.second_span,
+                x: hit.point.x,
+                y: hit.point.y,
+            });
+        }
     }
     Ok(contour)
 }

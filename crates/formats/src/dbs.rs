@@ -751,35 +751,16 @@ fn reversed(v: &[Vertex]) -> Vec<Vertex> {
         .collect()
 }
 
-/// Bounding box of a contour, arcs' zeniths included (enough to compare sheets and parts).
-fn bbox(c: &Contour) -> [f64; 4] {
-    let mut b = [
-        f64::INFINITY,
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-        f64::NEG_INFINITY,
-    ];
-    for (a, z, bulge) in geom::spans(c) {
-        for p in [a, geom::span_midpoint(a, z, bulge)] {
-            b = [b[0].min(p.x), b[1].min(p.y), b[2].max(p.x), b[3].max(p.y)];
-        }
-    }
-    b
-}
-
 /// Does the first part's outer contour enclose the bounding box of every other part?
 fn encloses_others(parts: &[Part]) -> bool {
-    let Some(sheet) = parts[0].contours.first().map(bbox) else {
+    let Some(sheet) = parts[0].contours.first().map(Contour::bounding_box) else {
         return false;
     };
-    let tol = 1e-3;
-    parts[1..].iter().flat_map(|p| p.contours.first()).all(|c| {
-        let b = bbox(c);
-        b[0] >= sheet[0] - tol
-            && b[1] >= sheet[1] - tol
-            && b[2] <= sheet[2] + tol
-            && b[3] <= sheet[3] + tol
-    })
+    let sheet = sheet.expanded(1e-3);
+    parts[1..]
+        .iter()
+        .flat_map(|p| p.contours.first())
+        .all(|c| sheet.contains_box(&c.bounding_box()))
 }
 
 /// Writes a nest as DBS with [`DbsWriteOptions::default`].

@@ -323,7 +323,7 @@ impl RmResult {
             let vertices = cut_vertices(nest, step, cut)?;
             idle += geom::dist(at, vertices[0].point);
             for w in vertices.windows(2) {
-                cut_len += geom::span_length(w[0].point, w[1].point, w[0].bulge);
+                cut_len += geom::span(w[0].point, w[1].point, w[0].bulge).length();
                 push(
                     MoveKind::Cut,
                     w[0].point,

@@ -99,8 +99,8 @@ fn contour_data(mut data: Data, contour: &Contour) -> Data {
         return data;
     };
     data = data.move_to((first.point.x, first.point.y));
-    for (a, z, b) in geom::spans(contour) {
-        data = span_data(data, a, z, b);
+    for s in contour.spans() {
+        data = span_data(data, s.start, s.end, s.bulge);
     }
     data.close()
 }
@@ -118,7 +118,7 @@ fn span_data(data: Data, a: Point, z: Point, b: f64) -> Data {
     }
     if b.abs() >= 1.0 {
         // ≥ 180°: halve at the zenith so each piece is below 180° and needs no large-arc flag.
-        let m = geom::span_midpoint(a, z, b);
+        let m = geom::span(a, z, b).midpoint();
         let h = geom::half_bulge(b);
         return arc(arc(data, a, m, h), m, z, h);
     }
@@ -126,7 +126,7 @@ fn span_data(data: Data, a: Point, z: Point, b: f64) -> Data {
 }
 
 fn arc(data: Data, a: Point, z: Point, b: f64) -> Data {
-    let r = geom::arc_radius(a, z, b);
+    let r = geom::span(a, z, b).radius();
     // Inside the y-flipped group a counter-clockwise arc (b > 0) has sweep flag 1.
     let sweep = if b > 0.0 { 1 } else { 0 };
     data.elliptical_arc_to((r, r, 0, 0, sweep, z.x, z.y))
@@ -195,9 +195,10 @@ fn extent(nest: &Nest, moves: &[ToolMove]) -> (Point, Point) {
         .chain(&nest.parts)
         .flat_map(|p| &p.contours)
     {
-        for (a, z, b) in geom::spans(contour) {
-            add(a);
-            add(geom::span_midpoint(a, z, b));
+        let b = contour.bounding_box();
+        if !b.is_empty() {
+            add(b.min);
+            add(b.max);
         }
     }
     for m in moves {

@@ -358,7 +358,12 @@ fn a_self_intersecting_contour_is_rejected() {
         DbsError::BadContour {
             offset: 0,
             id: 1,
-            problem: ContourProblem::SelfIntersecting
+            problem: ContourProblem::SelfIntersecting {
+                first_span: 0,
+                second_span: 2,
+                x: 5.0,
+                y: 5.0
+            }
         }
     );
     assert!(e.to_string().contains("intersects itself"));
@@ -664,7 +669,12 @@ fn geometry_json_bad_contours_give_their_path() {
         read_geometry_json(bow).unwrap_err(),
         JsonError::BadContour {
             path: "[0].paths[0]".into(),
-            problem: ContourProblem::SelfIntersecting
+            problem: ContourProblem::SelfIntersecting {
+                first_span: 0,
+                second_span: 2,
+                x: 5.0,
+                y: 5.0
+            }
         }
     );
 }
