@@ -836,3 +836,17 @@ fn read_nest_reports_formats_it_does_not_own() {
         Err(ReadError::Dbs(DbsError::RecordOverrun { offset: 0, .. }))
     ));
 }
+
+#[test]
+fn json_has_no_nan_or_infinity() {
+    for bad in ["NaN", "Infinity", "-Infinity", "nan"] {
+        let text = format!(r#"[{{"partid": "A", "paths": [[[0, {bad}], [1, 1], [0, 0]]]}}]"#);
+        assert!(
+            matches!(
+                read_geometry_json(text.as_bytes()).unwrap_err(),
+                JsonError::Syntax { line: 1, .. }
+            ),
+            "{bad}"
+        );
+    }
+}
