@@ -259,38 +259,14 @@ impl Contour {
     /// Winding number of the contour around `p` (+1 inside a counter-clockwise contour, −1
     /// inside a clockwise one, 0 outside), with true arcs.
     ///
-    /// It is the winding number of the chord polygon plus, for each arc, ±1 when `p` lies in
-    /// the circular segment between chord and arc (the loop arc + reversed chord winds once
-    /// around it, counter-clockwise for β > 0). The segment test uses the β-multiplied circle
-    /// equation, so nearly straight arcs are exact too. Points on the boundary get either value.
+    /// Counts signed crossings of the ray from `p` towards +x, with the half-open rule of
+    /// Sunday's algorithm (an upward piece counts when it starts at or below `p` and ends above
+    /// it). Arcs are first cut into pieces monotone in y; whether a piece passes east of `p` is
+    /// decided from the piece's chord and the β-multiplied circle equation, so nearly straight
+    /// arcs are exact too and no centre is needed. Points on the boundary get either value;
+    /// NaN gives 0.
     pub fn winding_number(&self, p: Point) -> i32 {
-        let mut winding = 0i32;
-        for s in self.spans() {
-            let (a, z) = (s.start, s.end);
-            // Chord crossing of the upward ray convention (Sunday's algorithm).
-            if a.y <= p.y {
-                if z.y > p.y && (z - a).cross(p - a) > 0.0 {
-                    winding += 1;
-                }
-            } else if z.y <= p.y && (z - a).cross(p - a) < 0.0 {
-                winding -= 1;
-            }
-            if s.bulge != 0.0 && s.bounding_box().contains_point(p) {
-                let d = z - a;
-                let q = p - a.midpoint(z);
-                let b = s.bulge;
-                // β·(|q|² − L²/4) − ((1 − β²)/2)·cross(d, q) equals β times the power of p
-                // with respect to the circle (|p − C|² − R²), which is negative inside.
-                let power_times_beta = b * (q.norm_squared() - 0.25 * d.norm_squared())
-                    - 0.5 * (1.0 - b * b) * d.cross(q);
-                let inside_circle = power_times_beta * b < 0.0;
-                let arc_side = d.cross(p - a) * b < 0.0;
-                if inside_circle && arc_side {
-                    winding += if b > 0.0 { 1 } else { -1 };
-                }
-            }
-        }
-        winding
+        self.spans().map(|s| span_crossings(&s, p)).sum()
     }
 
     /// `p` lies inside the region the contour bounds (either orientation).
@@ -456,6 +432,108 @@ impl Contour {
     }
 }
 
+/// Signed crossings of the ray from `p` towards +x with one span (see
+/// [`Contour::winding_number`]).
+fn span_crossings(s: &Span, p: Point) -> i32 {
+    if s.is_line() {
+        return piece_crossing(s.start, s.end, p, None);
+    }
+    let bbox = s.bounding_box();
+    if !(p.y >= bbox.min.y && p.y <= bbox.max.y && p.x <= bbox.max.x) {
+        return 0;
+    }
+    // Inside the circle ⇔ β·(power of p) < 0, with the power taken in the robust form
+    // β·(|q|² − L²/4) − ((1 − β²)/2)·cross(d, q), q = p − chord midpoint.
+    let d = s.chord();
+    let q = p - s.start.midpoint(s.end);
+    let b = s.bulge;
+    let power_times_beta =
+        b * (q.norm_squared() - 0.25 * d.norm_squared()) - 0.5 * (1.0 - b * b) * d.cross(q);
+    let inside_circle = power_times_beta * b < 0.0;
+    let curve = Some((b > 0.0, inside_circle));
+    // Cut at the points with a horizontal tangent: θ_d − φ/2 + tφ ≡ 0 (mod π).
+    let phi = s.sweep();
+    let theta = d.y.atan2(d.x);
+    let pi = std::f64::consts::PI;
+    let mut cuts = [0.0f64; 5];
+    let mut count = 1;
+    let r = (0.5 * phi - theta).rem_euclid(pi);
+    for k in 0..3 {
+        let t = if phi > 0.0 {
+            (r + k as f64 * pi) / phi
+        } else {
+            (r - pi - k as f64 * pi) / phi
+        };
+        if t > 0.0 && t < 1.0 {
+            cuts[count] = t;
+            count += 1;
+        }
+    }
+    cuts[count] = 1.0;
+    count += 1;
+    cuts[1..count - 1].sort_by(f64::total_cmp);
+    let mut total = 0;
+    let mut previous = s.start;
+    for &t in &cuts[1..count] {
+        let next = if t == 1.0 { s.end } else { s.point_at(t) };
+        total += piece_crossing(previous, next, p, curve);
+        previous = next;
+    }
+    total
+}
+
+/// Crossing of the ray from `p` towards +x with a piece from `a` to `b`, monotone in y: a
+/// segment (`curve == None`) or a circular arc given by (turns counter-clockwise, `p` strictly
+/// inside its circle).
+fn piece_crossing(a: Point, b: Point, p: Point, curve: Option<(bool, bool)>) -> i32 {
+    let upward = a.y <= p.y && p.y < b.y;
+    let downward = b.y <= p.y && p.y < a.y;
+    if !upward && !downward {
+        return 0;
+    }
+    let side = (b - a).cross(p - a);
+    // `p` strictly west of the chord (the chord crosses the ray east of p).
+    let west = if upward { side > 0.0 } else { side < 0.0 };
+    let east_crossing = match curve {
+        None => west,
+        Some((ccw, inside_circle)) => {
+            // A counter-clockwise arc bulges to the right of its chord: east when going up.
+            let bulges_east = ccw == upward;
+            if bulges_east {
+                west || side == 0.0 || inside_circle
+            } else {
+                west && !inside_circle
+            }
+        }
+    };
+    match (east_crossing, upward) {
+        (false, _) => 0,
+        (true, true) => 1,
+        (true, false) => -1,
+    }
+}
+
+/// Reverses each contour whose orientation does not match its depth's parity (even depth
+/// clockwise); returns how many were reversed.
+pub(crate) fn orient_by_depth<'a>(
+    contours: impl Iterator<Item = (&'a mut Contour, usize)>,
+) -> usize {
+    let mut reversed = 0;
+    for (c, depth) in contours {
+        let area = c.signed_area();
+        let wrong = if depth % 2 == 0 {
+            area > 0.0
+        } else {
+            area < 0.0
+        };
+        if wrong {
+            *c = c.reversed();
+            reversed += 1;
+        }
+    }
+    reversed
+}
+
 /// How many equal pieces keep the sagitta `R·(1 − cos(φ/2n))` within `tolerance`.
 fn arc_pieces(s: &Span, tolerance: f64) -> usize {
     const MAX_PIECES: usize = 1024;
@@ -482,6 +560,27 @@ impl Part {
         self.contours
             .iter()
             .fold(BoundingBox::EMPTY, |b, c| b.union(c.bounding_box()))
+    }
+
+    /// Reverses the contours that break the DBS convention (material on the right): a contour
+    /// inside an even number of the part's other contours (the outer one, an island in a hole)
+    /// runs clockwise, one inside an odd number (a hole) counter-clockwise. Returns how many
+    /// were reversed. Real files do break the convention (`test0`/`test1` of the shared data
+    /// store every hole clockwise).
+    pub fn normalize_orientation(&mut self) -> usize {
+        let single = crate::Nest {
+            sheet: None,
+            parts: vec![self.clone()],
+        };
+        let forest = crate::ContainmentForest::brute_force(&single);
+        let depths: Vec<usize> = (0..self.contours.len())
+            .map(|contour| {
+                forest
+                    .depth(crate::ContourRef { part: 0, contour })
+                    .unwrap_or(0)
+            })
+            .collect();
+        orient_by_depth(self.contours.iter_mut().zip(depths))
     }
 
     /// The part mapped by `transform` (see [`Contour::transformed`]).

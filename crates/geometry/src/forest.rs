@@ -29,6 +29,24 @@ impl Nest {
             .fold(BoundingBox::EMPTY, |b, p| b.union(p.bounding_box()))
     }
 
+    /// Orients every part contour by its depth in the nest's containment forest: even depth
+    /// (outer contours, parts placed in holes) clockwise, odd depth (holes) counter-clockwise,
+    /// as the DBS convention "material on the right" requires. The sheet is left alone.
+    /// Returns how many contours were reversed.
+    pub fn normalize_orientation(&mut self) -> usize {
+        let forest = self.containment_forest();
+        let depths: Vec<usize> = self
+            .contour_refs()
+            .map(|r| forest.depth(r).unwrap_or(0))
+            .collect();
+        crate::contour::orient_by_depth(
+            self.parts
+                .iter_mut()
+                .flat_map(|p| p.contours.iter_mut())
+                .zip(depths),
+        )
+    }
+
     /// The contour a reference points at, if it exists.
     pub fn contour(&self, r: ContourRef) -> Option<&Contour> {
         self.parts.get(r.part)?.contours.get(r.contour)

@@ -151,6 +151,18 @@ fn point_in_contour_with_arcs() {
             && !disc.contains(p(0.72, 0.72))
     );
     assert!(!disc.contains(p(f64::NAN, 0.0)));
+    // Points on the chords of the two semicircles (the diameter) are inside.
+    for x in [-0.9, -0.5, 0.0, 0.5, 0.9] {
+        assert!(disc.contains(p(x, 0.0)), "{x}");
+        assert!(disc.contains(p(0.0, x)), "{x}");
+    }
+    assert!(
+        st.contains(p(0.0, 5.0)) && st.contains(p(20.0, 5.0)),
+        "on the caps' chords"
+    );
+    assert!(
+        !st.contains(p(-6.0, 0.0)) && !st.contains(p(-6.0, 5.0)) && !st.contains(p(26.0, 10.0))
+    );
 }
 
 #[test]

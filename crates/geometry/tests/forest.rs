@@ -145,3 +145,62 @@ fn twenty_thousand_contours_fast() {
     assert_eq!(forest.precedence_pairs().len(), holes + inlays);
     eprintln!("generate {generated:?}, forest {built:?}");
 }
+
+#[test]
+fn generated_nests_follow_the_conventions() {
+    let a = generate_nest(2_000, 9);
+    assert_eq!(a, generate_nest(2_000, 9), "deterministic");
+    assert_ne!(a, generate_nest(2_000, 10));
+    let forest = a.containment_forest();
+    let sheet = a.sheet.as_ref().unwrap().contours[0].clone();
+    assert!(sheet.bounding_box().contains_box(&a.bounding_box()));
+    let mut kinds = std::collections::BTreeSet::new();
+    for (pi, part) in a.parts.iter().enumerate() {
+        kinds.insert(part.name.split('-').next().unwrap().to_string());
+        for (ci, c) in part.contours.iter().enumerate() {
+            let r = r(pi, ci);
+            assert_eq!(c.validate(), Ok(()), "{r:?}");
+            assert_eq!(
+                c.is_clockwise(),
+                ci == 0,
+                "outer clockwise, holes counter-clockwise"
+            );
+            let depth = forest.depth(r).unwrap();
+            assert_eq!(depth % 2 == 0, ci == 0, "{r:?}");
+            if ci == 0 {
+                // A part is either free or sits in a hole of another part.
+                if let Some(parent) = forest.parent(r) {
+                    assert_ne!(parent.part, pi);
+                    assert_ne!(parent.contour, 0, "parts never overlap");
+                }
+            }
+        }
+    }
+    // No two parts' contours touch: check every pair whose boxes meet.
+    let boxes: Vec<_> = a.parts.iter().map(|p| p.bounding_box()).collect();
+    for i in 0..a.parts.len() {
+        for j in i + 1..a.parts.len() {
+            if !boxes[i].intersects(&boxes[j]) {
+                continue;
+            }
+            for ci in &a.parts[i].contours {
+                for cj in &a.parts[j].contours {
+                    for si in ci.spans() {
+                        assert!(
+                            cj.spans().all(|sj| si.intersections(&sj).is_empty()),
+                            "parts {i} and {j} touch"
+                        );
+                    }
+                }
+            }
+        }
+    }
+    assert_eq!(a.clone().normalize_orientation(), 0);
+    assert!(a.arc_count() > 0);
+    for kind in ["flange", "frame", "inlay", "ring", "angle", "plate"] {
+        assert!(kinds.contains(kind), "{kind} missing");
+    }
+    for n in [0, 1, 2, 3, 4, 5, 7] {
+        assert_eq!(generate_nest(n, 1).contour_count(), n);
+    }
+}

@@ -216,6 +216,20 @@ proptest! {
     }
 
     #[test]
+    fn point_in_contour_on_grid_points(
+        raw in prop::collection::vec((-20i32..20, -20i32..20, prop_oneof![Just(0.0), Just(1.0), Just(-1.0), Just(0.5), Just(-0.25), Just(2.0)]), 2..7),
+        qx in -40i32..40, qy in -40i32..40,
+    ) {
+        // Vertices and query points on a grid: the query often sits exactly on a chord's line
+        // or at a vertex's height, the degenerate cases of ray casting.
+        let c = Contour::new(raw.iter().map(|&(x, y, b)| Vertex::arc(x as f64, y as f64, b)).collect());
+        let q = Point::new(qx as f64 * 0.5, qy as f64 * 0.5);
+        prop_assume!(c.distance_to(q) > 1e-3);
+        let poly: Vec<Point> = c.flatten(1e-6);
+        prop_assert_eq!(c.winding_number(q), polygon_winding(&poly, q));
+    }
+
+    #[test]
     fn reverse_twice_is_identity(c in contour()) {
         let r = c.reversed();
         prop_assert_eq!(r.reversed(), c.clone());
