@@ -521,7 +521,7 @@ pub(crate) fn orient_by_depth<'a>(
     let mut reversed = 0;
     for (c, depth) in contours {
         let area = c.signed_area();
-        let wrong = if depth % 2 == 0 {
+        let wrong = if depth.is_multiple_of(2) {
             area > 0.0
         } else {
             area < 0.0

@@ -166,7 +166,7 @@ fn generated_nests_follow_the_conventions() {
                 "outer clockwise, holes counter-clockwise"
             );
             let depth = forest.depth(r).unwrap();
-            assert_eq!(depth % 2 == 0, ci == 0, "{r:?}");
+            assert_eq!(depth.is_multiple_of(2), ci == 0, "{r:?}");
             if ci == 0 {
                 // A part is either free or sits in a hole of another part.
                 if let Some(parent) = forest.parent(r) {

@@ -124,7 +124,7 @@ fn real_nests_are_valid_and_nest_as_expected() {
                 assert_eq!(c.validate(), Ok(()), "{file} {r:?}");
                 // Material on the right: even depth clockwise, odd depth counter-clockwise.
                 let depth = forest.depth(r).unwrap();
-                assert_eq!(c.is_clockwise(), depth % 2 == 0, "{file} {r:?}");
+                assert_eq!(c.is_clockwise(), depth.is_multiple_of(2), "{file} {r:?}");
                 if ci > 0 {
                     // Usually the outer contour is the parent; test0 has a hole in a hole.
                     assert!(
