@@ -609,7 +609,19 @@ pub fn read_dbs_with(bytes: &[u8], options: &DbsReadOptions) -> Result<DbsFile, 
                 });
             }
             vertex_budget -= base.vertices.len();
-            part.contours.push(transform(base, &resolved));
+            let contour = transform(base, &resolved);
+            // Chained copies can scale coordinates past f64 range; refuse rather than return ∞.
+            if contour
+                .vertices
+                .iter()
+                .any(|v| !v.point.x.is_finite() || !v.point.y.is_finite())
+            {
+                return Err(DbsError::NonFinite {
+                    offset: contours[&cid].offset,
+                    what: "contour point after the copy transformation",
+                });
+            }
+            part.contours.push(contour);
         }
         records.push(DbsPartRecord {
             id,

@@ -456,6 +456,29 @@ fn a_copy_with_the_wrong_matrix_count_is_rejected() {
 }
 
 #[test]
+fn copies_scaling_past_f64_range_are_rejected() {
+    // Each copy scales its original by 1e38; nine levels overflow f64 (max ≈ 1.8e308).
+    let big = [1e38, 0.0, 0.0, 1e38, 0.0, 0.0];
+    let mut records = vec![geometry(1, -2, &square(1.0, 1.0)), part(2, &[1])];
+    for id in 3..12 {
+        records.push(copy(id, -20, id - 1 - i16::from(id == 3), 0, big));
+    }
+    let offset = records[..records.len() - 1]
+        .iter()
+        .map(Vec::len)
+        .sum::<usize>();
+    records.push(part(20, &[11]));
+    let e = dbs_err(&file(&records));
+    assert_eq!(
+        e,
+        DbsError::NonFinite {
+            offset,
+            what: "contour point after the copy transformation"
+        }
+    );
+}
+
+#[test]
 fn a_singular_matrix_is_rejected() {
     let sq = geometry(1, -2, &square(0.0, 0.0));
     let offset = sq.len();
