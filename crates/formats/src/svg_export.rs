@@ -210,3 +210,58 @@ fn extent(nest: &Nest, moves: &[ToolMove]) -> (Point, Point) {
     }
     (lo, hi)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use cutroute_geometry::Vertex;
+
+    /// Listing 4.1/4.2 of the thesis: a 700 × 500 sheet and a ring of radii 200 and 100.
+    fn listing_4_1() -> Nest {
+        let rect = Contour::new(vec![
+            Vertex::line(0.0, 0.0),
+            Vertex::line(0.0, 500.0),
+            Vertex::line(700.0, 500.0),
+            Vertex::line(700.0, 0.0),
+        ]);
+        let outer = Contour::new(vec![
+            Vertex::arc(205.0, 405.0, -1.0),
+            Vertex::arc(205.0, 5.0, -1.0),
+        ]);
+        let hole = Contour::new(vec![
+            Vertex::arc(205.0, 305.0, 1.0),
+            Vertex::arc(205.0, 105.0, 1.0),
+        ]);
+        Nest {
+            sheet: Some(Part {
+                name: "LIST".into(),
+                contours: vec![rect],
+            }),
+            parts: vec![Part {
+                name: "RING".into(),
+                contours: vec![outer, hole],
+            }],
+        }
+    }
+
+    #[test]
+    fn listing_4_2_half_circles_become_quarter_arcs() {
+        let svg = nest_svg(
+            &listing_4_1(),
+            None,
+            &SvgOptions {
+                embed_style: false,
+                margin: 0.0,
+                ..Default::default()
+            },
+        );
+        // The sheet: V/H commands only, as in the listing.
+        assert!(svg.contains("M0,0 V500 H700 V0 H0 z"), "{svg}");
+        // Each half circle is drawn as two quarter arcs: 4 arcs of radius 200 (clockwise,
+        // sweep 0) and 4 of radius 100 (counter-clockwise, sweep 1).
+        assert_eq!(svg.matches("A200,200,0,0,0,").count(), 4, "{svg}");
+        assert_eq!(svg.matches("A100,100,0,0,1,").count(), 4, "{svg}");
+        assert!(svg.contains("viewBox=\"0 -500 700 500\""), "{svg}");
+        assert!(svg.contains("transform=\"scale(1,-1)\""));
+    }
+}
