@@ -37,7 +37,7 @@ const XSI: &str = "http://www.w3.org/2001/XMLSchema-instance";
 const MAX_MAGNITUDE: f64 = 1e9;
 /// Most vertices all placed parts together may have: placements multiply part definitions, so
 /// a small hostile file could otherwise ask for billions.
-const MAX_PLACED_VERTICES: usize = 20_000_000;
+const MAX_PLACED_VERTICES: usize = 5_000_000;
 /// Largest gap (mm) between one contour object's end and the next one's beginning.
 const CONTINUITY_TOLERANCE: f64 = 0.01;
 
@@ -179,21 +179,36 @@ pub struct TflexProject {
 
 /// Reads a T-FLEX nesting project: one nest per sheet layout (sheet contour included).
 pub fn read_tfnesting(bytes: &[u8]) -> Result<Vec<Nest>, TflexError> {
-    Ok(read_tfnesting_project(bytes)?.layouts.into_iter().map(|l| l.nest).collect())
+    Ok(read_tfnesting_project(bytes)?
+        .layouts
+        .into_iter()
+        .map(|l| l.nest)
+        .collect())
 }
 
 /// Reads a T-FLEX nesting project with its sheet and placement details.
 pub fn read_tfnesting_project(bytes: &[u8]) -> Result<TflexProject, TflexError> {
-    let text = std::str::from_utf8(bytes)
-        .map_err(|e| TflexError::NotUtf8 { byte: e.valid_up_to() })?;
+    let text = std::str::from_utf8(bytes).map_err(|e| TflexError::NotUtf8 {
+        byte: e.valid_up_to(),
+    })?;
     let text = text.strip_prefix('\u{FEFF}').unwrap_or(text);
     let doc = Document::parse(text).map_err(|e| {
-        let pos = e.pos();
-        TflexError::Xml { message: e.to_string(), line: pos.row, column: pos.col }
+        let (line, column) = match e {
+            // The parser places this at the start; the truncation is at the end of the text.
+            roxmltree::Error::UnclosedRootNode => end_position(text),
+            _ => (e.pos().row, e.pos().col),
+        };
+        TflexError::Xml {
+            message: e.to_string(),
+            line,
+            column,
+        }
     })?;
     let root = doc.root_element();
     if root.tag_name().name() != "Project" {
-        return Err(TflexError::NotAProject { found: root.tag_name().name().to_owned() });
+        return Err(TflexError::NotAProject {
+            found: root.tag_name().name().to_owned(),
+        });
     }
     let r = Reader { doc: &doc };
 
@@ -221,49 +236,93 @@ pub fn read_tfnesting_project(bytes: &[u8]) -> Result<TflexProject, TflexError> 
         }
     }
 
-    let name = child(root, "Name").map(text_of).unwrap_or_default().to_owned();
+    let name = child(root, "Name")
+        .map(text_of)
+        .unwrap_or_default()
+        .to_owned();
     let mut layouts = Vec::new();
     let mut vertex_total = 0usize;
     let results = child(root, "Results");
-    let results_iter = results.into_iter().flat_map(|n| children(n, "NestingResult"));
+    let results_iter = results
+        .into_iter()
+        .flat_map(|n| children(n, "NestingResult"));
     for result in results_iter {
-        let Some(layouts_node) = child(result, "Layouts") else { continue };
+        let Some(layouts_node) = child(result, "Layouts") else {
+            continue;
+        };
         for layout in children(layouts_node, "SheetLayout") {
             let sheet_id = r.int(r.child(layout, "SheetID")?)?;
-            let sheet_index = child(layout, "SheetIndex").map(|n| r.int(n)).transpose()?.unwrap_or(0);
-            let (sheet_name, sheet_contours) =
-                sheets.get(&sheet_id).ok_or_else(|| r.unknown_reference(layout, "sheet", sheet_id))?;
+            let sheet_index = child(layout, "SheetIndex")
+                .map(|n| r.int(n))
+                .transpose()?
+                .unwrap_or(0);
+            let (sheet_name, sheet_contours) = sheets
+                .get(&sheet_id)
+                .ok_or_else(|| r.unknown_reference(layout, "sheet", sheet_id))?;
             let mut placements = Vec::new();
             let mut placed = Vec::new();
             if let Some(positions) = child(layout, "PartPositions") {
                 for pos in children(positions, "PartPosition") {
                     let part_id = r.int(r.child(pos, "PartID")?)?;
-                    let angle_deg = child(pos, "AngleDeg").map(|n| r.real(n)).transpose()?.unwrap_or(0.0);
-                    let mirrored = child(pos, "Inverted").map(|n| r.boolean(n)).transpose()?.unwrap_or(false);
+                    let angle_deg = child(pos, "AngleDeg")
+                        .map(|n| r.real(n))
+                        .transpose()?
+                        .unwrap_or(0.0);
+                    let mirrored = child(pos, "Inverted")
+                        .map(|n| r.boolean(n))
+                        .transpose()?
+                        .unwrap_or(false);
                     let position = r.point(r.child(pos, "Position")?)?;
-                    let (part_name, contours) =
-                        parts.get(&part_id).ok_or_else(|| r.unknown_reference(pos, "part", part_id))?;
+                    let (part_name, contours) = parts
+                        .get(&part_id)
+                        .ok_or_else(|| r.unknown_reference(pos, "part", part_id))?;
                     vertex_total = vertex_total
                         .saturating_add(contours.iter().map(|c| c.vertices.len()).sum::<usize>());
                     if vertex_total > MAX_PLACED_VERTICES {
-                        return Err(TflexError::TooLarge { limit: MAX_PLACED_VERTICES });
+                        return Err(TflexError::TooLarge {
+                            limit: MAX_PLACED_VERTICES,
+                        });
                     }
-                    let placement = Placement { part_id, angle_deg, mirrored, position };
-                    placed.push(Part { name: part_name.clone(), contours: place(contours, &placement) });
+                    let placement = Placement {
+                        part_id,
+                        angle_deg,
+                        mirrored,
+                        position,
+                    };
+                    placed.push(Part {
+                        name: part_name.clone(),
+                        contours: place(contours, &placement),
+                    });
                     placements.push(placement);
                 }
             }
-            let sheet = Part { name: sheet_name.clone(), contours: orient(sheet_contours.clone()) };
+            let sheet = Part {
+                name: sheet_name.clone(),
+                contours: orient(sheet_contours.clone()),
+            };
             layouts.push(SheetLayout {
                 sheet_id,
                 sheet_index,
                 sheet_name: sheet_name.clone(),
                 placements,
-                nest: Nest { sheet: Some(sheet), parts: placed },
+                nest: Nest {
+                    sheet: Some(sheet),
+                    parts: placed,
+                },
             });
         }
     }
     Ok(TflexProject { name, layouts })
+}
+
+/// 1-based line and column just past the end of `text`.
+fn end_position(text: &str) -> (u32, u32) {
+    let line = text.bytes().filter(|&b| b == b'\n').count() + 1;
+    let column = text.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+    (
+        u32::try_from(line).unwrap_or(u32::MAX),
+        u32::try_from(column).unwrap_or(u32::MAX),
+    )
 }
 
 /// Applies a placement to a part definition's contours and re-orients them.
@@ -298,7 +357,8 @@ fn place(contours: &[Contour], placement: &Placement) -> Vec<Contour> {
 
 /// Largest contour first and clockwise, the others counter-clockwise.
 fn orient(contours: Vec<Contour>) -> Vec<Contour> {
-    let mut with_area: Vec<(f64, Contour)> = contours.into_iter().map(|c| (signed_area(&c), c)).collect();
+    let mut with_area: Vec<(f64, Contour)> =
+        contours.into_iter().map(|c| (signed_area(&c), c)).collect();
     let outer = with_area
         .iter()
         .enumerate()
@@ -323,11 +383,16 @@ fn orient(contours: Vec<Contour>) -> Vec<Contour> {
 }
 
 fn child<'a, 'i>(node: Node<'a, 'i>, name: &str) -> Option<Node<'a, 'i>> {
-    node.children().find(|n| n.is_element() && n.tag_name().name() == name)
+    node.children()
+        .find(|n| n.is_element() && n.tag_name().name() == name)
 }
 
-fn children<'a, 'i: 'a>(node: Node<'a, 'i>, name: &'a str) -> impl Iterator<Item = Node<'a, 'i>> + 'a {
-    node.children().filter(move |n| n.is_element() && n.tag_name().name() == name)
+fn children<'a, 'i: 'a>(
+    node: Node<'a, 'i>,
+    name: &'a str,
+) -> impl Iterator<Item = Node<'a, 'i>> + 'a {
+    node.children()
+        .filter(move |n| n.is_element() && n.tag_name().name() == name)
 }
 
 fn text_of<'a>(node: Node<'a, '_>) -> &'a str {
@@ -369,10 +434,19 @@ impl<'d, 'i> Reader<'d, 'i> {
         format!("/{}", segments.join("/"))
     }
 
-    fn child<'a>(&self, node: Node<'a, 'i>, element: &'static str) -> Result<Node<'a, 'i>, TflexError> {
+    fn child<'a>(
+        &self,
+        node: Node<'a, 'i>,
+        element: &'static str,
+    ) -> Result<Node<'a, 'i>, TflexError> {
         child(node, element).ok_or_else(|| {
             let (line, column) = self.position(node);
-            TflexError::MissingElement { path: self.path(node), element, line, column }
+            TflexError::MissingElement {
+                path: self.path(node),
+                element,
+                line,
+                column,
+            }
         })
     }
 
@@ -389,17 +463,33 @@ impl<'d, 'i> Reader<'d, 'i> {
 
     fn unknown_type(&self, node: Node<'_, '_>, found: &str) -> TflexError {
         let (line, column) = self.position(node);
-        TflexError::UnknownType { path: self.path(node), found: found.to_owned(), line, column }
+        TflexError::UnknownType {
+            path: self.path(node),
+            found: found.to_owned(),
+            line,
+            column,
+        }
     }
 
     fn unknown_reference(&self, node: Node<'_, '_>, what: &'static str, id: i64) -> TflexError {
         let (line, column) = self.position(node);
-        TflexError::UnknownReference { path: self.path(node), what, id, line, column }
+        TflexError::UnknownReference {
+            path: self.path(node),
+            what,
+            id,
+            line,
+            column,
+        }
     }
 
     fn invalid(&self, node: Node<'_, '_>, reason: impl Into<String>) -> TflexError {
         let (line, column) = self.position(node);
-        TflexError::InvalidGeometry { path: self.path(node), reason: reason.into(), line, column }
+        TflexError::InvalidGeometry {
+            path: self.path(node),
+            reason: reason.into(),
+            line,
+            column,
+        }
     }
 
     fn real(&self, node: Node<'_, '_>) -> Result<f64, TflexError> {
@@ -410,7 +500,9 @@ impl<'d, 'i> Reader<'d, 'i> {
     }
 
     fn int(&self, node: Node<'_, '_>) -> Result<i64, TflexError> {
-        text_of(node).parse::<i64>().map_err(|_| self.bad_value(node, "an integer"))
+        text_of(node)
+            .parse::<i64>()
+            .map_err(|_| self.bad_value(node, "an integer"))
     }
 
     fn boolean(&self, node: Node<'_, '_>) -> Result<bool, TflexError> {
@@ -422,7 +514,10 @@ impl<'d, 'i> Reader<'d, 'i> {
     }
 
     fn point(&self, node: Node<'_, '_>) -> Result<Point, TflexError> {
-        Ok(Point::new(self.real(self.child(node, "X")?)?, self.real(self.child(node, "Y")?)?))
+        Ok(Point::new(
+            self.real(self.child(node, "X")?)?,
+            self.real(self.child(node, "Y")?)?,
+        ))
     }
 
     fn positive(&self, node: Node<'_, '_>, what: &str) -> Result<f64, TflexError> {
@@ -464,7 +559,10 @@ impl<'d, 'i> Reader<'d, 'i> {
             Some("CircleContour") => {
                 let c = self.point(self.child(node, "Center")?)?;
                 let r = self.positive(self.child(node, "Radius")?, "radius")?;
-                Ok(Contour::new(vec![Vertex::arc(c.x + r, c.y, 1.0), Vertex::arc(c.x - r, c.y, 1.0)]))
+                Ok(Contour::new(vec![
+                    Vertex::arc(c.x + r, c.y, 1.0),
+                    Vertex::arc(c.x - r, c.y, 1.0),
+                ]))
             }
             Some("RectangularContour") => self.rectangle(node),
             other => Err(self.unknown_type(node, other.unwrap_or("(none)"))),
@@ -491,13 +589,19 @@ impl<'d, 'i> Reader<'d, 'i> {
                 }
             }
             match object.attribute((XSI, "type")) {
-                Some("ContourLine") => vertices.push(Vertex { point: begin, bulge: 0.0 }),
+                Some("ContourLine") => vertices.push(Vertex {
+                    point: begin,
+                    bulge: 0.0,
+                }),
                 Some("ContourArc") => {
                     let center = self.point(self.child(object, "Center")?)?;
                     let angle_node = self.child(object, "Angle")?;
                     let sweep = self.real(angle_node)?;
                     if sweep == 0.0 || sweep.abs() > std::f64::consts::TAU + 1e-9 {
-                        return Err(self.invalid(angle_node, format!("arc angle {sweep} rad is not in (0, 2π]")));
+                        return Err(self.invalid(
+                            angle_node,
+                            format!("arc angle {sweep} rad is not in (0, 2π]"),
+                        ));
                     }
                     if dist(center, begin) == 0.0 {
                         return Err(self.invalid(object, "arc of zero radius"));
@@ -506,12 +610,22 @@ impl<'d, 'i> Reader<'d, 'i> {
                         // Split large arcs: a single span's bulge tends to infinity at 2π.
                         let (s, c) = (sweep / 2.0).sin_cos();
                         let (dx, dy) = (begin.x - center.x, begin.y - center.y);
-                        let middle = Point::new(center.x + c * dx - s * dy, center.y + s * dx + c * dy);
+                        let middle =
+                            Point::new(center.x + c * dx - s * dy, center.y + s * dx + c * dy);
                         let bulge = (sweep / 8.0).tan();
-                        vertices.push(Vertex { point: begin, bulge });
-                        vertices.push(Vertex { point: middle, bulge });
+                        vertices.push(Vertex {
+                            point: begin,
+                            bulge,
+                        });
+                        vertices.push(Vertex {
+                            point: middle,
+                            bulge,
+                        });
                     } else {
-                        vertices.push(Vertex { point: begin, bulge: (sweep / 4.0).tan() });
+                        vertices.push(Vertex {
+                            point: begin,
+                            bulge: (sweep / 4.0).tan(),
+                        });
                     }
                 }
                 other => return Err(self.unknown_type(object, other.unwrap_or("(none)"))),

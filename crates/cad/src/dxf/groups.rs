@@ -66,6 +66,9 @@ pub(crate) fn split_groups(bytes: &[u8]) -> Result<Vec<Group<'_>>, DxfError> {
         return Err(DxfError::BinaryDxf);
     }
     let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
+    // The newline that ends the last line does not start another (empty) line: without this a
+    // file cut right after a group code would pair the code with a phantom empty value.
+    let bytes = bytes.strip_suffix(b"\n").unwrap_or(bytes);
     let mut lines = bytes.split(|&b| b == b'\n').enumerate();
     let mut groups = Vec::new();
     while let Some((index, code_line)) = lines.next() {

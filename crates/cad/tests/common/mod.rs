@@ -7,7 +7,9 @@ use cutroute_geometry::{Contour, Point};
 
 /// A file of the shared reference data; panics loudly when it is missing.
 pub fn shared_file(relative: &str) -> Vec<u8> {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data").join(relative);
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/data")
+        .join(relative);
     std::fs::read(&path).unwrap_or_else(|e| {
         panic!("reference file {} is missing or unreadable ({e}); the tests need ../shared/data beside the repository", path.display())
     })
@@ -15,10 +17,17 @@ pub fn shared_file(relative: &str) -> Vec<u8> {
 
 /// Every file of a shared-data folder with the extension, sorted; panics if the folder is missing.
 pub fn shared_dir_files(relative: &str, extension: &str) -> Vec<String> {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data").join(relative);
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/data")
+        .join(relative);
     let mut names: Vec<String> = std::fs::read_dir(&path)
         .unwrap_or_else(|e| panic!("reference folder {} is missing ({e})", path.display()))
-        .map(|e| e.expect("directory entry").file_name().to_string_lossy().into_owned())
+        .map(|e| {
+            e.expect("directory entry")
+                .file_name()
+                .to_string_lossy()
+                .into_owned()
+        })
         .filter(|n| n.ends_with(extension))
         .collect();
     names.sort();
@@ -55,7 +64,13 @@ pub fn polygon(contour: &Contour) -> Vec<Point> {
 
 pub fn area(polygon: &[Point]) -> f64 {
     let n = polygon.len();
-    (0..n).map(|i| { let (a, b) = (polygon[i], polygon[(i + 1) % n]); a.x * b.y - b.x * a.y }).sum::<f64>() / 2.0
+    (0..n)
+        .map(|i| {
+            let (a, b) = (polygon[i], polygon[(i + 1) % n]);
+            a.x * b.y - b.x * a.y
+        })
+        .sum::<f64>()
+        / 2.0
 }
 
 pub fn inside(p: Point, polygon: &[Point]) -> bool {
@@ -76,7 +91,11 @@ pub fn distance_to_boundary(p: Point, polygon: &[Point]) -> f64 {
     for i in 0..n {
         let (a, b) = (polygon[i], polygon[(i + 1) % n]);
         let l2 = (b.x - a.x).powi(2) + (b.y - a.y).powi(2);
-        let t = if l2 == 0.0 { 0.0 } else { (((p.x - a.x) * (b.x - a.x) + (p.y - a.y) * (b.y - a.y)) / l2).clamp(0.0, 1.0) };
+        let t = if l2 == 0.0 {
+            0.0
+        } else {
+            (((p.x - a.x) * (b.x - a.x) + (p.y - a.y) * (b.y - a.y)) / l2).clamp(0.0, 1.0)
+        };
         let q = Point::new(a.x + (b.x - a.x) * t, a.y + (b.y - a.y) * t);
         best = best.min(((p.x - q.x).powi(2) + (p.y - q.y).powi(2)).sqrt());
     }
@@ -86,8 +105,16 @@ pub fn distance_to_boundary(p: Point, polygon: &[Point]) -> f64 {
 /// Bounding box (min, max) of a polygon.
 pub fn bounds(polygon: &[Point]) -> (Point, Point) {
     polygon.iter().fold(
-        (Point::new(f64::INFINITY, f64::INFINITY), Point::new(f64::NEG_INFINITY, f64::NEG_INFINITY)),
-        |(lo, hi), p| (Point::new(lo.x.min(p.x), lo.y.min(p.y)), Point::new(hi.x.max(p.x), hi.y.max(p.y))),
+        (
+            Point::new(f64::INFINITY, f64::INFINITY),
+            Point::new(f64::NEG_INFINITY, f64::NEG_INFINITY),
+        ),
+        |(lo, hi), p| {
+            (
+                Point::new(lo.x.min(p.x), lo.y.min(p.y)),
+                Point::new(hi.x.max(p.x), hi.y.max(p.y)),
+            )
+        },
     )
 }
 
@@ -103,7 +130,12 @@ impl Solid {
     pub fn new(contours: &[Contour]) -> Self {
         let outer = polygon(&contours[0]);
         let (lo, hi) = bounds(&outer);
-        Self { outer, holes: contours[1..].iter().map(polygon).collect(), lo, hi }
+        Self {
+            outer,
+            holes: contours[1..].iter().map(polygon).collect(),
+            lo,
+            hi,
+        }
     }
 
     /// Whether `p` lies in the material farther than `tolerance` from every boundary.
@@ -113,7 +145,10 @@ impl Solid {
         }
         inside(p, &self.outer)
             && distance_to_boundary(p, &self.outer) > tolerance
-            && self.holes.iter().all(|h| !inside(p, h) && distance_to_boundary(p, h) > tolerance)
+            && self
+                .holes
+                .iter()
+                .all(|h| !inside(p, h) && distance_to_boundary(p, h) > tolerance)
     }
 
     /// Points on the outer boundary at most `spacing` apart, plus one point inside the material.
@@ -191,7 +226,11 @@ fn arc_of(a: Point, b: Point, bulge: f64) -> Option<(Point, f64, f64, f64)> {
 
 fn on_sweep(angle: f64, start: f64, sweep: f64) -> bool {
     let tau = std::f64::consts::TAU;
-    let rel = if sweep >= 0.0 { (angle - start).rem_euclid(tau) } else { (start - angle).rem_euclid(tau) };
+    let rel = if sweep >= 0.0 {
+        (angle - start).rem_euclid(tau)
+    } else {
+        (start - angle).rem_euclid(tau)
+    };
     rel <= sweep.abs()
 }
 
@@ -200,7 +239,10 @@ pub fn exact_bounds(contour: &Contour) -> (Point, Point) {
     let n = contour.vertices.len();
     let mut pts: Vec<Point> = contour.vertices.iter().map(|v| v.point).collect();
     for i in 0..n {
-        let (a, b) = (contour.vertices[i].point, contour.vertices[(i + 1) % n].point);
+        let (a, b) = (
+            contour.vertices[i].point,
+            contour.vertices[(i + 1) % n].point,
+        );
         if let Some((c, r, start, sweep)) = arc_of(a, b, contour.vertices[i].bulge) {
             for k in 0..4 {
                 let t = k as f64 * std::f64::consts::FRAC_PI_2;
@@ -218,7 +260,10 @@ pub fn distance_to_contour(p: Point, contour: &Contour) -> f64 {
     let n = contour.vertices.len();
     let mut best = f64::INFINITY;
     for i in 0..n {
-        let (a, b) = (contour.vertices[i].point, contour.vertices[(i + 1) % n].point);
+        let (a, b) = (
+            contour.vertices[i].point,
+            contour.vertices[(i + 1) % n].point,
+        );
         let d = match arc_of(a, b, contour.vertices[i].bulge) {
             None => distance_to_boundary(p, &[a, b]),
             Some((c, r, start, sweep)) => {
