@@ -367,13 +367,20 @@ impl Contour {
                 if best.is_some_and(|b| (b.first_span, b.second_span) <= (lo, hi)) {
                     continue;
                 }
-                let next_of_lo = hi == lo + 1;
-                let closing = lo == 0 && hi == n - 1;
+                // Adjacent spans share a vertex (the end of one is the start of the other).
+                // Meeting points next to it are rounding, e.g. of a line tangent to an arc.
+                // A contour of two spans shares both its vertices between them.
+                let shared = [
+                    (hi == lo + 1).then_some(spans[hi].start),
+                    (lo == 0 && hi == n - 1).then_some(spans[lo].start),
+                ];
+                // A line tangent to an arc at the shared vertex, once rounded, cuts the circle
+                // again about √(2·R·rounding) away: that far is still "at the vertex".
+                let lengths = spans[lo].length() + spans[hi].length();
+                let magnitude = spans[lo].start.x.abs().max(spans[lo].start.y.abs());
+                let near = 1e-5 * lengths + (1e-14 * (1.0 + magnitude) * lengths).sqrt();
                 for x in spans[lo].intersections(&spans[hi]) {
-                    // Adjacent spans share a vertex: the end of one is the start of the other.
-                    let shared = (next_of_lo && x.t_self == 1.0 && x.t_other == 0.0)
-                        || (closing && x.t_self == 0.0 && x.t_other == 1.0);
-                    if !shared {
+                    if !shared.iter().flatten().any(|v| v.distance(x.point) <= near) {
                         best = Some(SelfIntersection {
                             first_span: lo,
                             second_span: hi,

@@ -233,7 +233,9 @@ impl Route {
                 problems.push(RouteError::NotCut { contour });
             }
         }
-        for (inner, outer) in forest.precedence_pairs() {
+        // All ancestors, not just parents: a contour left uncut must not hide a violation
+        // between its child and its parent.
+        for (inner, outer) in forest.all_precedence_pairs() {
             let (Some(i), Some(o)) = (forest.index_of(inner), forest.index_of(outer)) else {
                 continue;
             };

@@ -273,3 +273,81 @@ fn flattening_stays_within_tolerance() {
     assert_eq!(square_cw().flatten(0.1).len(), 4);
     assert!(stadium_ccw().flatten(f64::NAN).len() <= 4 + 2 * 1024);
 }
+
+#[test]
+fn tangent_arcs_are_not_self_intersections() {
+    // Rounded rectangles (lines tangent to quarter arcs) far from the origin, rotated.
+    let q = (PI / 8.0).tan();
+    for k in 0..200 {
+        let (w, h, r) = (
+            10.0 + k as f64 * 7.3,
+            5.0 + k as f64 * 3.1,
+            0.5 + (k % 7) as f64,
+        );
+        let c = Contour::new(vec![
+            Vertex::line(r, 0.0),
+            Vertex::arc(w - r, 0.0, q),
+            Vertex::line(w, r),
+            Vertex::arc(w, h - r, q),
+            Vertex::line(w - r, h),
+            Vertex::arc(r, h, q),
+            Vertex::line(0.0, h - r),
+            Vertex::arc(0.0, r, q),
+        ]);
+        let t = Transform::rotation(k as f64 * 0.37).then(&Transform::translation(
+            6000.0 - k as f64,
+            2000.0 + k as f64,
+        ));
+        let c = c.transformed(&t);
+        assert_eq!(c.validate(), Ok(()), "{k}");
+        assert_eq!(c.reversed().validate(), Ok(()), "{k}");
+    }
+}
+
+#[test]
+fn nan_contours_do_not_panic() {
+    let bad = Contour::new(vec![
+        Vertex::line(0.0, 0.0),
+        Vertex::arc(f64::NAN, 1.0, 0.5),
+        Vertex::arc(1.0, 0.0, f64::NAN),
+    ]);
+    let _ = (
+        bad.perimeter(),
+        bad.signed_area(),
+        bad.is_clockwise(),
+        bad.bounding_box(),
+    );
+    let _ = (
+        bad.contains(p(0.5, 0.5)),
+        bad.nearest_point(p(0.0, 1.0)),
+        bad.point_at_length(1.0),
+    );
+    let _ = (
+        bad.first_self_intersection(),
+        bad.flatten(0.1),
+        bad.reversed(),
+        bad.length_at(ContourPosition { span: 1, t: 0.5 }),
+    );
+    assert!(matches!(
+        bad.validate(),
+        Err(ContourError::NonFinite { index: 1 })
+    ));
+    let nest = cutroute_geometry::Nest {
+        sheet: None,
+        parts: vec![
+            cutroute_geometry::Part {
+                name: "bad".into(),
+                contours: vec![bad],
+            },
+            cutroute_geometry::Part {
+                name: "disc".into(),
+                contours: vec![Contour::circle(p(0.0, 0.0), 5.0, true)],
+            },
+        ],
+    };
+    let forest = nest.containment_forest();
+    assert_eq!(forest.roots().len(), 2);
+    let _ = nest.bounding_box();
+    let _ = nest.clone().normalize_orientation();
+    let _ = cutroute_geometry::generate_nest(3, u64::MAX);
+}

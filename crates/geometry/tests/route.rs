@@ -173,6 +173,34 @@ fn inner_first_route_on_a_generated_nest_is_valid() {
         .all(|e| matches!(e, RouteError::PrecedenceViolated { .. })));
     assert_eq!(
         backwards.problems(&n, &forest, 1e-9).len(),
-        forest.precedence_pairs().len()
+        forest.all_precedence_pairs().len()
     );
+    // Leaving out a hole that holds an inlay still reports the inlay cut after the frame.
+    let frame = n
+        .parts
+        .iter()
+        .position(|p| p.name.starts_with("frame"))
+        .expect("a frame");
+    let (frame_outer, frame_hole) = (r(frame, 0), r(frame, 1));
+    let mut skipping = route.clone();
+    skipping.steps.retain(|s| s.contour != frame_hole);
+    let outer_step = skipping
+        .steps
+        .iter()
+        .position(|s| s.contour == frame_outer)
+        .unwrap();
+    let inlay = skipping
+        .steps
+        .iter()
+        .position(|s| forest.parent(s.contour) == Some(frame_hole))
+        .unwrap();
+    let moved = skipping.steps.remove(inlay);
+    skipping.steps.insert(outer_step, moved); // now just after the frame's outer contour
+    let problems = skipping.problems(&n, &forest, 1e-9);
+    assert!(problems.contains(&RouteError::NotCut {
+        contour: frame_hole
+    }));
+    assert!(problems.iter().any(
+        |e| matches!(e, RouteError::PrecedenceViolated { outer, .. } if *outer == frame_outer)
+    ));
 }
