@@ -1,6 +1,7 @@
 //! Whole-contour geometry: orientation, area, perimeter, point-in-contour with true arcs,
 //! nearest point, length parameterisation, self-intersection and flattening.
 
+use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use crate::{BoundingBox, Contour, Part, Point, Span, SpanProjection, Transform, Vertex};
@@ -74,7 +75,7 @@ pub enum ContourError {
 }
 
 /// A place on a contour: span index and arc-length parameter on that span.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct ContourPosition {
     /// Index of the span (= index of its start vertex).
     pub span: usize,
@@ -91,6 +92,17 @@ pub struct ContourProjection {
     pub point: Point,
     /// Its distance to the query point.
     pub distance: f64,
+}
+
+/// A point where a straight segment meets a contour.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContourCrossing {
+    /// Where on the contour.
+    pub position: ContourPosition,
+    /// The common point.
+    pub point: Point,
+    /// Its parameter along the segment (0 at its start, 1 at its end).
+    pub segment_t: f64,
 }
 
 /// The first pair of spans (in index order) found crossing each other.
@@ -340,6 +352,33 @@ impl Contour {
     /// contour.
     pub fn point_at_length(&self, s: f64) -> Option<Point> {
         self.position_at_length(s).and_then(|p| self.point_at(p))
+    }
+
+    /// Every point where the segment `a → b` meets the contour, ordered along the segment
+    /// (CCP step 4 takes the last one). A meeting at a vertex is reported once.
+    pub fn segment_crossings(&self, a: Point, b: Point) -> Vec<ContourCrossing> {
+        let segment = Span::line(a, b);
+        let reach = BoundingBox::from_corners(a, b);
+        let mut found: Vec<ContourCrossing> = Vec::new();
+        for (span, s) in self.spans().enumerate() {
+            if !s
+                .bounding_box()
+                .intersects(&reach.expanded(1e-9 * (1.0 + segment.length())))
+            {
+                continue;
+            }
+            for x in s.intersections(&segment) {
+                found.push(ContourCrossing {
+                    position: ContourPosition { span, t: x.t_self },
+                    point: x.point,
+                    segment_t: x.t_other,
+                });
+            }
+        }
+        found.sort_by(|p, q| p.segment_t.total_cmp(&q.segment_t));
+        let tolerance = 1e-9 * (1.0 + segment.length() + a.x.abs().max(a.y.abs()));
+        found.dedup_by(|later, earlier| later.point.distance(earlier.point) <= tolerance);
+        found
     }
 
     /// The first crossing of two spans (lowest span pair in lexicographic order), ignoring the

@@ -351,3 +351,23 @@ fn nan_contours_do_not_panic() {
     let _ = nest.clone().normalize_orientation();
     let _ = cutroute_geometry::generate_nest(3, u64::MAX);
 }
+
+#[test]
+fn segment_crossings_in_order() {
+    let st = stadium_ccw();
+    // A horizontal line through the middle crosses both caps.
+    let x = st.segment_crossings(p(-10.0, 5.0), p(30.0, 5.0));
+    assert_eq!(x.len(), 2);
+    assert!(x[0].point.distance(p(-5.0, 5.0)) < 1e-12 && x[1].point.distance(p(25.0, 5.0)) < 1e-12);
+    assert!(x[0].segment_t < x[1].segment_t);
+    assert_eq!((x[0].position.span, x[1].position.span), (3, 1));
+    // Through a vertex: reported once.
+    let x = st.segment_crossings(p(0.0, -5.0), p(0.0, 5.0));
+    assert_eq!(x.len(), 1, "{x:?}");
+    assert!(x[0].point.distance(p(0.0, 0.0)) < 1e-12);
+    // Along an edge: its ends.
+    assert_eq!(st.segment_crossings(p(-1.0, 0.0), p(30.0, 0.0)).len(), 2);
+    assert!(st
+        .segment_crossings(p(100.0, 0.0), p(200.0, 0.0))
+        .is_empty());
+}
