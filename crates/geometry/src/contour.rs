@@ -161,6 +161,37 @@ impl Contour {
         Ok(Contour { vertices })
     }
 
+    /// Builds a contour from vertices already known to be closed (say a DXF polyline with its
+    /// "closed" flag), which may or may not repeat the first point at the end. Every vertex
+    /// within `tolerance` of the next one (cyclically) is dropped, as its span has no length:
+    /// that removes a repeated closing point and doubled points alike.
+    pub fn from_closed_vertices(
+        vertices: &[Vertex],
+        tolerance: f64,
+    ) -> Result<Contour, ClosureError> {
+        if let Some(index) = vertices
+            .iter()
+            .position(|v| !v.point.is_finite() || !v.bulge.is_finite())
+        {
+            return Err(ClosureError::NonFinite { index });
+        }
+        let mut kept: Vec<Vertex> = Vec::with_capacity(vertices.len());
+        for v in vertices {
+            match kept.last_mut() {
+                // The earlier vertex's span would have no length: the later one takes its place.
+                Some(last) if last.point.distance(v.point) <= tolerance => *last = *v,
+                _ => kept.push(*v),
+            }
+        }
+        while kept.len() > 1 && kept[kept.len() - 1].point.distance(kept[0].point) <= tolerance {
+            kept.pop();
+        }
+        if kept.len() < 2 {
+            return Err(ClosureError::TooFewPoints { count: kept.len() });
+        }
+        Ok(Contour { vertices: kept })
+    }
+
     /// A circle of the given radius as two semicircular spans (β = ±1), starting at the
     /// rightmost point; `clockwise` as outer contours run.
     pub fn circle(centre: Point, radius: f64, clockwise: bool) -> Contour {

@@ -371,3 +371,31 @@ fn segment_crossings_in_order() {
         .segment_crossings(p(100.0, 0.0), p(200.0, 0.0))
         .is_empty());
 }
+
+#[test]
+fn closed_vertices_lose_repeats() {
+    let raw = [
+        Vertex::line(0.0, 0.0),
+        Vertex::line(10.0, 0.0),
+        Vertex::arc(10.0, 0.0, 0.5),
+        Vertex::line(10.0, 10.0),
+        Vertex::line(0.0, 10.0),
+        Vertex::line(0.0, 0.0),
+    ];
+    let c = Contour::from_closed_vertices(&raw, 1e-9).unwrap();
+    assert_eq!(
+        c.vertices,
+        vec![
+            Vertex::line(0.0, 0.0),
+            Vertex::arc(10.0, 0.0, 0.5),
+            Vertex::line(10.0, 10.0),
+            Vertex::line(0.0, 10.0)
+        ]
+    );
+    assert_eq!(Contour::from_closed_vertices(&raw[..5], 1e-9).unwrap(), c);
+    assert!(c.validate().is_ok());
+    assert!(matches!(
+        Contour::from_closed_vertices(&[Vertex::line(1.0, 1.0), Vertex::line(1.0, 1.0)], 0.0),
+        Err(ClosureError::TooFewPoints { count: 1 })
+    ));
+}
