@@ -377,7 +377,7 @@ fn group_into_parts(
     // Parts in file order of their outer contours; holes in file order too.
     let mut part_of: Vec<Option<usize>> = vec![None; placed.len()];
     let mut outers: Vec<usize> = (0..placed.len())
-        .filter(|&i| !duplicate[i] && depth[i] % 2 == 0)
+        .filter(|&i| !duplicate[i] && depth[i].is_multiple_of(2))
         .collect();
     outers.sort_by_key(|&i| placed[i].source.line);
     for (k, &i) in outers.iter().enumerate() {

@@ -71,7 +71,8 @@ impl Nurbs {
                 points.len()
             ));
         }
-        if weights.iter().any(|w| !(*w > 0.0)) {
+        // Values are finite (the readers check), so `<= 0` catches every non-positive weight.
+        if weights.iter().any(|&w| w <= 0.0) {
             return Err("a weight is not positive".into());
         }
         let n = points.len();
@@ -124,8 +125,9 @@ impl Nurbs {
                 let lo = self.knots[j + k - p];
                 let hi = self.knots[j + 1 + k - r];
                 let alpha = if hi > lo { (t - lo) / (hi - lo) } else { 0.0 };
-                for c in 0..3 {
-                    d[j][c] = (1.0 - alpha) * d[j - 1][c] + alpha * d[j][c];
+                let previous = d[j - 1];
+                for (value, prev) in d[j].iter_mut().zip(previous) {
+                    *value = (1.0 - alpha) * prev + alpha * *value;
                 }
             }
         }

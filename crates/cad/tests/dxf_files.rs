@@ -265,8 +265,15 @@ fn cone_fillets_of_several_arcs() {
     );
 }
 
+/// A non-rational B-spline as the file stores it.
+struct FileSpline {
+    degree: usize,
+    knots: Vec<f64>,
+    points: Vec<Point>,
+}
+
 /// The two SPLINEs of splines.dxf, read straight from the file, and the offset of their block.
-fn splines_of_the_file() -> (Vec<(usize, Vec<f64>, Vec<Point>)>, Point) {
+fn splines_of_the_file() -> (Vec<FileSpline>, Point) {
     let text = String::from_utf8_lossy(&shared_file("nests/dxf/splines.dxf")).replace('\r', "");
     let lines: Vec<&str> = text.lines().map(str::trim).collect();
     let pairs: Vec<(i32, &str)> = lines
@@ -297,7 +304,11 @@ fn splines_of_the_file() -> (Vec<(usize, Vec<f64>, Vec<Point>)>, Point) {
                 .zip(real(20))
                 .map(|(x, y)| Point::new(x, y))
                 .collect();
-            splines.push((degree, real(40), points));
+            splines.push(FileSpline {
+                degree,
+                knots: real(40),
+                points,
+            });
         }
         if value == "INSERT" && body.iter().any(|p| p.0 == 2 && p.1 == "SE") {
             offset = Some(Point::new(real(10)[0], real(20)[0]));
@@ -347,7 +358,12 @@ fn splines_are_approximated_within_the_tolerance() {
         let imported = read_dxf(&bytes, &options).unwrap();
         assert_eq!(imported.nest.parts.len(), 1);
         let outer = &imported.nest.parts[0].contours[0];
-        for (degree, knots, points) in &splines {
+        for FileSpline {
+            degree,
+            knots,
+            points,
+        } in &splines
+        {
             assert_eq!((*degree, knots.len(), points.len()), (3, 15, 11));
             let (t0, t1) = (knots[*degree], knots[points.len()]);
             let mut worst: f64 = 0.0;

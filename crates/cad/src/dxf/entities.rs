@@ -341,10 +341,12 @@ fn read_header(
                     *codepage = Codepage::Utf8;
                 }
             }
-            b"$DWGCODEPAGE" if g.code == 3 && *codepage != Codepage::Utf8 => {
-                if g.value.eq_ignore_ascii_case(b"ANSI_1251") {
-                    *codepage = Codepage::Ansi1251;
-                }
+            b"$DWGCODEPAGE"
+                if g.code == 3
+                    && *codepage != Codepage::Utf8
+                    && g.value.eq_ignore_ascii_case(b"ANSI_1251") =>
+            {
+                *codepage = Codepage::Ansi1251;
             }
             b"$INSUNITS" if g.code == 70 => {
                 let units = g.int()?;
@@ -457,7 +459,7 @@ impl Expander<'_, '_> {
     fn layer(&self, record: &Record<'_>, inherited: &str) -> String {
         match record.first(8) {
             // Entities on layer 0 inside a block take the insert's layer.
-            Some(g) if !(g.value == b"0" && !inherited.is_empty()) => {
+            Some(g) if g.value != b"0" || inherited.is_empty() => {
                 decode_text(g.value, self.codepage)
             }
             _ if !inherited.is_empty() => inherited.to_owned(),
@@ -509,7 +511,7 @@ impl Expander<'_, '_> {
                 };
                 let center = record.point(10, "centre")?;
                 let radius = record.real(40, "radius")?;
-                if !(radius > 0.0) {
+                if radius <= 0.0 {
                     self.warn(record.line, format!("{kind} with radius {radius} skipped"));
                     return Ok(());
                 }
@@ -539,7 +541,7 @@ impl Expander<'_, '_> {
                 let major = record.point(11, "major axis end")?;
                 let ratio = record.real(40, "axis ratio")?;
                 let nz = record.real_or(230, 1.0)?;
-                if !(ratio > 0.0) || (major.x == 0.0 && major.y == 0.0) {
+                if ratio <= 0.0 || (major.x == 0.0 && major.y == 0.0) {
                     self.warn(record.line, "degenerate ELLIPSE skipped");
                     return Ok(());
                 }
