@@ -397,7 +397,7 @@ impl Span {
     }
 
     /// The arc-length parameter of a point lying on (or very near) the span's line or circle;
-    /// not clamped. Points on the rest of the circle map beyond 1 (up to `2π/|φ|`).
+    /// not clamped: points of the line or circle outside the span map outside `[0, 1]`.
     pub fn parameter_of(&self, p: Point) -> f64 {
         let d = self.chord();
         let l2 = d.norm_squared();
