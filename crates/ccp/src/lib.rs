@@ -1,1 +1,90 @@
-//! cutroute-ccp (being written).
+//! CCP-Relax: the continuous cutting problem solver of cutroute.
+//!
+//! Each contour of a nest is cut whole from a pierce point that may lie **anywhere** on it; the
+//! solver chooses the order of the contours and the pierce points to minimise the idle (air)
+//! length of the route. It follows Ukolov (2021), Chapter 3:
+//!
+//! 1. remove the "outer" contours (those containing others): every order of the remaining
+//!    innermost contours is feasible;
+//! 2. for a fixed order, move one pierce point at a time to the minimiser of
+//!    `|M(i−1) M| + |M M(i+1)|` over its contour (exact on segments and arcs) until a sweep gains
+//!    less than δ;
+//! 3. optimise the order by variable neighbourhood search (block shift, block reversal, swaps,
+//!    block exchange, 3- and 4-cycles in a window, rotation of equal blocks, optimal block
+//!    re-insertion; candidate lists from the k nearest contours; shaking and restarts);
+//! 4. restore the removed contours at the route's last crossing with each of them, which keeps
+//!    "inner before outer" and adds no length.
+//!
+//! The route is then certified per pierce point by Conditions 1 and 2 (sufficient conditions for
+//! the global optimum of the pierce points for the order). [`CcpSolver`] is a resumable anytime
+//! solver for time-sliced callers; [`solve`] runs it to the end. [`build_pcgtsp`] builds the
+//! discrete (PCGTSP) alternative of a nest.
+//!
+//! ```
+//! use cutroute_ccp::{solve, CcpOptions};
+//! use cutroute_geometry::{Contour, Nest, Part, Point, Vertex};
+//!
+//! let square = |x: f64| Part {
+//!     name: format!("square at {x}"),
+//!     contours: vec![Contour::new(vec![
+//!         Vertex::line(x, 0.0),
+//!         Vertex::line(x, 10.0),
+//!         Vertex::line(x + 10.0, 10.0),
+//!         Vertex::line(x + 10.0, 0.0),
+//!     ])],
+//! };
+//! let nest = Nest { sheet: None, parts: vec![square(40.0), square(0.0), square(20.0)] };
+//! let options = CcpOptions { start: Point::new(-10.0, 5.0), ..CcpOptions::default() };
+//! let result = solve(&nest, options, &mut |_| {}).unwrap();
+//! // The straight line from the start through the squares: 10 + 20 + 20 mm.
+//! assert!((result.metrics.idle_length - 50.0).abs() < 1e-6);
+//! assert!(result.certified_optimal_for_order);
+//! ```
+//!
+//! # Geometry to merge into `cutroute-geometry`
+//! The solver carries private geometry (module `geom`): bulge arcs with centre/radius/sweep,
+//! span length, point at parameter, nearest point, segment–span intersection, exact span bounding
+//! boxes, contour signed area/perimeter, point-in-contour, convexity, the containment forest
+//! with precedence pairs, and a uniform box grid with k-nearest queries.
+#![deny(missing_docs)]
+
+mod discrete;
+mod geom;
+mod problem;
+mod relax;
+mod rng;
+mod route;
+mod search;
+mod solver;
+
+pub use discrete::{build_pcgtsp, DiscreteInstance, DiscreteNode, DiscretisationOptions};
+pub use route::{idle_length, route_certificates, route_metrics, ContourCertificate, MachineSpeeds, RouteMetrics};
+pub use solver::{solve, solve_with_cancel, CcpOptions, CcpPhase, CcpProgress, CcpResult, CcpSolver, SolverStatus};
+
+use cutroute_geometry::{ContourRef, Nest};
+
+/// What can go wrong.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum CcpError {
+    /// An option is out of range.
+    #[error("invalid option: {0}")]
+    InvalidOption(String),
+    /// A route names a contour the nest does not have.
+    #[error("the nest has no contour {contour} in part {part}")]
+    UnknownContour {
+        /// Part index.
+        part: usize,
+        /// Contour index within the part.
+        contour: usize,
+    },
+    /// A PCGTSP node tour does not describe a route.
+    #[error("invalid tour: {0}")]
+    InvalidTour(String),
+}
+
+/// The containment forest of a nest's contours: pairs `(inner, outer)` for every contour lying
+/// inside another (transitively closed), in "inner before outer" precedence form.
+pub fn containment_pairs(nest: &Nest) -> Vec<(ContourRef, ContourRef)> {
+    let prob = problem::Problem::new(nest, geom::V::default(), None);
+    prob.precedence_pairs().into_iter().map(|(a, b)| (prob.refs[a], prob.refs[b])).collect()
+}

@@ -5,8 +5,25 @@
 //! angle φ (positive = counter-clockwise). The closing span runs from the last vertex back to the
 //! first: the duplicated closing point that files store is dropped by the readers.
 //!
+//! What the kernel offers, bottom up:
+//! - [`Span`]: length, area, points and tangents by arc-length parameter, exact bounding box,
+//!   splitting and joining, nearest point, intersections, arc through three points — stable
+//!   for β → 0 and right for semicircles (β = ±1) and larger arcs (|β| > 1).
+//! - [`Contour`]: closing raw file points ([`Contour::close_points`]), orientation, area,
+//!   perimeter, reversal by the DBS rule, [`Transform`]s, point-in-contour with true arcs,
+//!   nearest point, length parameterisation, self-intersection check, flattening.
+//! - [`Nest`] and [`ContainmentForest`]: which contour lies inside which, hence the cutting
+//!   precedence "inner before outer".
+//! - [`Route`]: idle and cut length, time and cost under [`MachineParameters`], and an
+//!   independent validity check.
+//! - [`generate_nest`]: deterministic synthetic nests of up to tens of thousands of contours.
+//!
+//! Sign conventions: [`Contour::signed_area`] is positive for counter-clockwise contours (the
+//! dissertation's Appendix Б uses the opposite sign); outer contours run clockwise and holes
+//! counter-clockwise (material on the right), see [`Nest::normalize_orientation`].
+//!
 //! ```
-//! use cutroute_geometry::{Contour, Point, Vertex};
+//! use cutroute_geometry::{Contour, ContourRef, CutStep, Nest, Part, Point, Route, Vertex};
 //! // A 10 × 10 square, clockwise as outer contours are.
 //! let square = Contour::new(vec![
 //!     Vertex::line(0.0, 0.0),
@@ -16,11 +33,54 @@
 //! ]);
 //! assert_eq!(square.vertices.len(), 4);
 //! assert_eq!(square.vertices[2].point, Point::new(10.0, 10.0));
+//! assert!(square.is_clockwise());
+//! assert_eq!(square.signed_area(), -100.0);
+//!
+//! // A round hole of radius 2: two semicircles (bulge +1 = counter-clockwise).
+//! let hole = Contour::circle(Point::new(5.0, 5.0), 2.0, false);
+//! assert!((hole.perimeter() - 4.0 * std::f64::consts::PI).abs() < 1e-12);
+//! assert!(hole.contains(Point::new(6.5, 5.0)) && !hole.contains(Point::new(6.5, 6.5)));
+//!
+//! // The hole must be cut before the square that contains it.
+//! let nest = Nest { sheet: None, parts: vec![Part { name: "plate".into(), contours: vec![square, hole] }] };
+//! let forest = nest.containment_forest();
+//! let (outer, inner) = (ContourRef { part: 0, contour: 0 }, ContourRef { part: 0, contour: 1 });
+//! assert_eq!(forest.parent(inner), Some(outer));
+//! assert_eq!(forest.precedence_pairs(), vec![(inner, outer)]);
+//!
+//! let route = Route {
+//!     start: Point::new(0.0, -10.0),
+//!     steps: vec![
+//!         CutStep { contour: inner, pierce_point: Point::new(7.0, 5.0) },
+//!         CutStep { contour: outer, pierce_point: Point::new(10.0, 5.0) },
+//!     ],
+//!     finish: None,
+//! };
+//! assert!(route.validate(&nest, 1e-9).is_ok());
+//! assert!((route.idle_length() - (7.0f64.hypot(15.0) + 3.0)).abs() < 1e-12);
 //! ```
 #![deny(missing_docs)]
+// `!(x <= tol)` is deliberate throughout: it is true for NaN, so bad input fails checks
+// instead of slipping through them.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+mod bbox;
+mod contour;
+mod forest;
+mod generator;
+mod point;
 mod route;
+mod span;
+mod transform;
 mod types;
 
-pub use route::{ContourRef, CutStep, Route};
+pub use bbox::BoundingBox;
+pub use contour::{
+    ClosureError, ContourError, ContourPosition, ContourProjection, SelfIntersection,
+};
+pub use forest::ContainmentForest;
+pub use generator::{generate_nest, SplitMix64};
+pub use route::{ContourRef, CutStep, MachineParameters, Route, RouteError};
+pub use span::{tan_half_arg, Span, SpanIntersection, SpanProjection};
+pub use transform::Transform;
 pub use types::{Contour, Nest, Part, Point, Vertex};

@@ -30,12 +30,18 @@ pub struct Vertex {
 impl Vertex {
     /// A vertex followed by a straight segment.
     pub const fn line(x: f64, y: f64) -> Self {
-        Self { point: Point::new(x, y), bulge: 0.0 }
+        Self {
+            point: Point::new(x, y),
+            bulge: 0.0,
+        }
     }
 
     /// A vertex followed by an arc of the given bulge.
     pub const fn arc(x: f64, y: f64, bulge: f64) -> Self {
-        Self { point: Point::new(x, y), bulge }
+        Self {
+            point: Point::new(x, y),
+            bulge,
+        }
     }
 }
 

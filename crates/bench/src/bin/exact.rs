@@ -1,2 +1,140 @@
-//! Benchmark: exact solver (being written).
-fn main() {}
+//! Benchmark: the exact PCGTSP solver on every instance of `shared/data/pcgtsp`.
+//!
+//! `cargo run --release -p cutroute-bench --bin exact -- [--time-limit 60] [--filter NAME]
+//! [--no-l2] [--no-heuristic] [--memory-mb 2048] [--data DIR]`
+//!
+//! Prints a Markdown table: instance size, number of order ideals, our upper and lower bounds,
+//! gap, proven optimality and time, next to the reference values of `reference.csv`.
+
+use cutroute_pcgtsp::{check_tour, solve, ExactOptions, Instance, PrecedenceOrder};
+use std::path::PathBuf;
+use std::time::Duration;
+
+struct Row {
+    set: String,
+    instance: String,
+    pcglns_cost: String,
+    best_lb: String,
+    known_optimum: String,
+}
+
+fn split_csv(line: &str) -> Vec<String> {
+    let mut fields = Vec::new();
+    let mut current = String::new();
+    let mut quoted = false;
+    for ch in line.chars() {
+        match ch {
+            '"' => quoted = !quoted,
+            ',' if !quoted => fields.push(std::mem::take(&mut current)),
+            _ => current.push(ch),
+        }
+    }
+    fields.push(current);
+    fields
+}
+
+pub fn main() {
+    let mut time_limit = 60.0f64;
+    let mut filter: Option<String> = None;
+    let mut options = ExactOptions::default();
+    let mut data = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/pcgtsp");
+    let mut args = std::env::args().skip(1);
+    while let Some(arg) = args.next() {
+        match arg.as_str() {
+            "--time-limit" => {
+                time_limit = args
+                    .next()
+                    .and_then(|v| v.parse().ok())
+                    .expect("--time-limit SECONDS")
+            }
+            "--filter" => filter = args.next(),
+            "--no-l2" => options.use_l2 = false,
+            "--no-heuristic" => options.heuristic = false,
+            "--memory-mb" => {
+                options.memory_limit_bytes = args
+                    .next()
+                    .and_then(|v| v.parse::<usize>().ok())
+                    .expect("--memory-mb MB")
+                    << 20
+            }
+            "--data" => data = PathBuf::from(args.next().expect("--data DIR")),
+            other => panic!("unknown argument {other}"),
+        }
+    }
+    let reference = std::fs::read_to_string(data.join("reference.csv"))
+        .unwrap_or_else(|e| panic!("{}: {e}", data.join("reference.csv").display()));
+    let mut lines = reference.lines();
+    let header = split_csv(lines.next().expect("header"));
+    let col = |name: &str| header.iter().position(|h| h == name).expect(name);
+    let rows: Vec<Row> = lines
+        .filter(|l| !l.trim().is_empty())
+        .map(|l| {
+            let f = split_csv(l);
+            Row {
+                set: f[col("set")].clone(),
+                instance: f[col("instance")].clone(),
+                pcglns_cost: f[col("pcglns_cost")].clone(),
+                best_lb: f[col("best_lb")].clone(),
+                known_optimum: f[col("known_optimum")].clone(),
+            }
+        })
+        .collect();
+    println!("| set | instance | nodes | clusters | ideals | UB | LB | gap % | proven | time s | states | pcglns | best_lb | known_opt |");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    for row in rows {
+        if let Some(f) = &filter {
+            if !row.instance.contains(f.as_str()) {
+                continue;
+            }
+        }
+        let path = data.join(&row.set).join(format!("{}.pcglns", row.instance));
+        let text =
+            std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let instance = Instance::parse(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let ideals = PrecedenceOrder::new(&instance)
+            .ok()
+            .and_then(|o| o.count_ideals(20_000_000))
+            .map_or(">2e7".to_string(), |c| c.to_string());
+        let limit = if row.instance == "e1x_2" {
+            time_limit.max(600.0)
+        } else {
+            time_limit
+        };
+        let mut opts = options.clone();
+        opts.time_limit = Some(Duration::from_secs_f64(limit));
+        let result = solve(&instance, opts, &mut |_| {}).expect("solver");
+        let p = &result.progress;
+        if let Some(tour) = &p.best_tour {
+            let cost = check_tour(&instance, tour).expect("solver returned an infeasible tour");
+            assert!(
+                (cost - p.upper_bound).abs() < 1e-6,
+                "reported cost differs from checked cost"
+            );
+        }
+        if let Ok(opt) = row.known_optimum.parse::<f64>() {
+            assert!(
+                p.lower_bound <= opt + 1e-6,
+                "{}: bound {} above optimum {opt}",
+                row.instance,
+                p.lower_bound
+            );
+        }
+        println!(
+            "| {} | {} | {} | {} | {} | {} | {} | {:.2} | {} | {:.2} | {} | {} | {} | {} |",
+            row.set,
+            row.instance,
+            instance.node_count,
+            instance.clusters.len(),
+            ideals,
+            p.upper_bound,
+            p.lower_bound,
+            p.gap * 100.0,
+            if result.proven_optimal() { "yes" } else { "no" },
+            p.elapsed.as_secs_f64(),
+            result.states_created,
+            row.pcglns_cost,
+            row.best_lb,
+            row.known_optimum,
+        );
+    }
+}

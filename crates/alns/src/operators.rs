@@ -1,0 +1,393 @@
+//! Destroy (removal) and repair (insertion) operators on node tours.
+//!
+//! A tour is a `Vec<usize>` of nodes with the depot cluster's node first. Removing clusters from a
+//! precedence-feasible tour keeps it feasible; inserting a cluster anywhere between its last
+//! present predecessor and its first present successor keeps it feasible, and that interval is
+//! never empty because the closure orders every predecessor before every successor.
+
+use crate::problem::{Problem, ABSENT};
+use crate::rng::Rng;
+
+/// How clusters are chosen for removal.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Removal {
+    /// Uniformly random clusters.
+    Random,
+    /// Clusters whose removal saves most (randomised order).
+    Worst,
+    /// A contiguous run of the tour.
+    Segment,
+    /// Shaw removal: clusters whose chosen nodes are close to already removed ones.
+    Related,
+    /// A precedence-repaired reversal of a random run (done by the solver), then random removal.
+    Reverse,
+}
+
+/// All removal operators, in weight-vector order.
+pub(crate) const REMOVALS: [Removal; 5] = [
+    Removal::Random,
+    Removal::Worst,
+    Removal::Segment,
+    Removal::Related,
+    Removal::Reverse,
+];
+
+/// Which pending cluster is inserted next.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Selection {
+    /// The cluster with the cheapest best insertion.
+    Cheapest,
+    /// The cluster nearest to the partial tour.
+    Nearest,
+    /// The cluster whose best insertion is most expensive (farthest insertion).
+    Farthest,
+    /// A random cluster.
+    Random,
+}
+
+/// A repair operator: a selection rule with or without noise on insertion costs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Insertion {
+    /// The selection rule.
+    pub selection: Selection,
+    /// Whether insertion costs are perturbed.
+    pub noisy: bool,
+}
+
+/// All insertion operators, in weight-vector order.
+pub(crate) const INSERTIONS: [Insertion; 8] = [
+    Insertion {
+        selection: Selection::Cheapest,
+        noisy: false,
+    },
+    Insertion {
+        selection: Selection::Cheapest,
+        noisy: true,
+    },
+    Insertion {
+        selection: Selection::Nearest,
+        noisy: false,
+    },
+    Insertion {
+        selection: Selection::Nearest,
+        noisy: true,
+    },
+    Insertion {
+        selection: Selection::Farthest,
+        noisy: false,
+    },
+    Insertion {
+        selection: Selection::Farthest,
+        noisy: true,
+    },
+    Insertion {
+        selection: Selection::Random,
+        noisy: false,
+    },
+    Insertion {
+        selection: Selection::Random,
+        noisy: true,
+    },
+];
+
+/// The best known insertion of a pending cluster into the partial tour.
+#[derive(Clone, Copy, Debug)]
+struct Candidate {
+    /// Cost increase (noise included when the operator is noisy).
+    delta: f64,
+    /// The node of the cluster to insert.
+    node: usize,
+    /// Insert before index `edge` (between `tour[edge-1]` and `tour[edge % len]`).
+    edge: usize,
+    /// The feasible edge interval `lo..=hi`.
+    lo: usize,
+    hi: usize,
+}
+
+const NO_CANDIDATE: Candidate = Candidate {
+    delta: f64::INFINITY,
+    node: 0,
+    edge: 1,
+    lo: 1,
+    hi: 1,
+};
+
+/// Reusable buffers of the destroy / repair operators.
+#[derive(Default, Clone, Debug)]
+pub(crate) struct Operators {
+    pos: Vec<usize>,
+    pending: Vec<usize>,
+    candidate: Vec<Candidate>,
+    nearest: Vec<f64>,
+    removed: Vec<bool>,
+    scratch: Vec<(f64, usize)>,
+    indices: Vec<usize>,
+}
+
+impl Operators {
+    /// Removes `count` non-depot clusters from `t` with operator `how`; the removed clusters are
+    /// remembered for the next [`Operators::repair`].
+    pub(crate) fn destroy(
+        &mut self,
+        p: &Problem,
+        t: &mut Vec<usize>,
+        how: Removal,
+        count: usize,
+        rng: &mut Rng,
+    ) {
+        let len = t.len();
+        let count = count.min(len - 1);
+        self.removed.clear();
+        self.removed.resize(len, false);
+        match how {
+            Removal::Random | Removal::Reverse => {
+                self.indices.clear();
+                self.indices.extend(1..len);
+                for k in 0..count {
+                    let j = rng.between(k, self.indices.len() - 1);
+                    self.indices.swap(k, j);
+                    self.removed[self.indices[k]] = true;
+                }
+            }
+            Removal::Worst => {
+                self.scratch.clear();
+                for i in 1..len {
+                    let (a, v, b) = (t[i - 1], t[i], t[(i + 1) % len]);
+                    let gain = p.d(a, v) + p.d(v, b) - p.d(a, b);
+                    self.scratch.push((gain, i));
+                }
+                self.scratch.sort_by(|x, y| y.0.total_cmp(&x.0));
+                for _ in 0..count {
+                    // Randomised: strongly biased towards the front of the sorted list.
+                    let u = rng.unit();
+                    let k = ((u * u * u) * self.scratch.len() as f64) as usize;
+                    let (_, i) = self.scratch.remove(k.min(self.scratch.len() - 1));
+                    self.removed[i] = true;
+                }
+            }
+            Removal::Segment => {
+                let start = rng.between(1, len - count);
+                for r in &mut self.removed[start..start + count] {
+                    *r = true;
+                }
+            }
+            Removal::Related => {
+                self.indices.clear();
+                self.indices.extend(1..len);
+                let seed = rng.below(self.indices.len());
+                let first = self.indices.swap_remove(seed);
+                self.removed[first] = true;
+                let mut taken = vec![first];
+                while taken.len() < count {
+                    let reference = t[taken[rng.below(taken.len())]];
+                    self.scratch.clear();
+                    for &i in &self.indices {
+                        let v = t[i];
+                        let relatedness = p.d(reference, v).min(p.d(v, reference));
+                        self.scratch.push((relatedness, i));
+                    }
+                    self.scratch.sort_by(|x, y| x.0.total_cmp(&y.0));
+                    let u = rng.unit();
+                    let k = ((u * u * u) * self.scratch.len() as f64) as usize;
+                    let i = self.scratch[k.min(self.scratch.len() - 1)].1;
+                    self.removed[i] = true;
+                    taken.push(i);
+                    self.indices.retain(|&x| x != i);
+                }
+            }
+        }
+        self.pending.clear();
+        let mut w = 0;
+        for r in 0..len {
+            if self.removed[r] {
+                self.pending.push(p.cl(t[r]));
+            } else {
+                t[w] = t[r];
+                w += 1;
+            }
+        }
+        t.truncate(w);
+    }
+
+    /// Prepares a repair that inserts every non-depot cluster into the tour `[depot node]`.
+    pub(crate) fn destroy_all(&mut self, p: &Problem, t: &mut Vec<usize>) {
+        t.clear();
+        t.push(p.clusters[p.depot][0]);
+        self.pending.clear();
+        self.pending.extend((0..p.m).filter(|&c| c != p.depot));
+    }
+
+    /// Inserts every pending cluster back into `t` with operator `how`; `noise` is the
+    /// amplitude of the additive noise of noisy operators.
+    pub(crate) fn repair(
+        &mut self,
+        p: &Problem,
+        t: &mut Vec<usize>,
+        how: Insertion,
+        noise: f64,
+        rng: &mut Rng,
+    ) {
+        let noise = if how.noisy { noise } else { 0.0 };
+        self.pos.clear();
+        self.pos.resize(p.m, ABSENT);
+        for (i, &v) in t.iter().enumerate() {
+            self.pos[p.cl(v)] = i;
+        }
+        self.candidate.clear();
+        self.candidate.resize(p.m, NO_CANDIDATE);
+        if how.selection == Selection::Random {
+            rng.shuffle(&mut self.pending);
+        }
+        let pending = std::mem::take(&mut self.pending);
+        for &c in &pending {
+            self.candidate[c] = self.full_candidate(p, t, c, noise, rng);
+        }
+        if how.selection == Selection::Nearest {
+            self.nearest.clear();
+            self.nearest.resize(p.m, f64::INFINITY);
+            for &c in &pending {
+                let mut best = f64::INFINITY;
+                for &u in &p.clusters[c] {
+                    for &v in t.iter() {
+                        best = best.min(p.d(u, v)).min(p.d(v, u));
+                    }
+                }
+                self.nearest[c] = best;
+            }
+        }
+        let mut pending = pending;
+        while !pending.is_empty() {
+            let pick = match how.selection {
+                Selection::Random => pending.len() - 1,
+                Selection::Cheapest => arg_best(&pending, |c| -self.candidate[c].delta),
+                Selection::Farthest => arg_best(&pending, |c| self.candidate[c].delta),
+                Selection::Nearest => arg_best(&pending, |c| -self.nearest[c]),
+            };
+            let c = pending.swap_remove(pick);
+            let Candidate {
+                node: v, edge: e, ..
+            } = self.candidate[c];
+            t.insert(e, v);
+            for (k, &u) in t.iter().enumerate().skip(e) {
+                self.pos[p.cl(u)] = k;
+            }
+            let (a, b) = (t[e - 1], t[(e + 1) % t.len()]);
+            for &c2 in &pending {
+                let old = self.candidate[c2];
+                if p.related(c, c2) || old.edge == e {
+                    self.candidate[c2] = self.full_candidate(p, t, c2, noise, rng);
+                } else {
+                    // Unrelated to the inserted cluster: only indices shift and the split edge
+                    // (a, b) became (a, v), (v, b).
+                    let mut cand = old;
+                    if cand.edge > e {
+                        cand.edge += 1;
+                    }
+                    if cand.lo > e {
+                        cand.lo += 1;
+                    }
+                    if cand.hi >= e {
+                        cand.hi += 1;
+                    }
+                    if old.lo <= e && e <= old.hi {
+                        for &u in &p.clusters[c2] {
+                            let d1 = p.d(a, u) + p.d(u, v) - p.d(a, v) + jitter(noise, rng);
+                            if d1 < cand.delta {
+                                cand.delta = d1;
+                                cand.node = u;
+                                cand.edge = e;
+                            }
+                            let d2 = p.d(v, u) + p.d(u, b) - p.d(v, b) + jitter(noise, rng);
+                            if d2 < cand.delta {
+                                cand.delta = d2;
+                                cand.node = u;
+                                cand.edge = e + 1;
+                            }
+                        }
+                    }
+                    self.candidate[c2] = cand;
+                }
+                if how.selection == Selection::Nearest {
+                    let mut best = self.nearest[c2];
+                    for &u in &p.clusters[c2] {
+                        best = best.min(p.d(u, v)).min(p.d(v, u));
+                    }
+                    self.nearest[c2] = best;
+                }
+            }
+        }
+        self.pending = pending;
+    }
+
+    /// Best insertion of cluster `c` over its whole feasible interval.
+    fn full_candidate(
+        &self,
+        p: &Problem,
+        t: &[usize],
+        c: usize,
+        noise: f64,
+        rng: &mut Rng,
+    ) -> Candidate {
+        let len = t.len();
+        let mut lo = 1;
+        for &a in &p.preds[c] {
+            let q = self.pos[a];
+            if q != ABSENT && q + 1 > lo {
+                lo = q + 1;
+            }
+        }
+        let mut hi = len;
+        for &b in &p.succs[c] {
+            let q = self.pos[b];
+            if q != ABSENT && q < hi {
+                hi = q;
+            }
+        }
+        debug_assert!(lo <= hi, "precedence interval empty");
+        let mut best = Candidate {
+            delta: f64::INFINITY,
+            node: p.clusters[c][0],
+            edge: lo,
+            lo,
+            hi,
+        };
+        for e in lo..=hi {
+            let (a, b) = (t[e - 1], t[e % len]);
+            let base = p.d(a, b);
+            for &u in &p.clusters[c] {
+                let delta = p.d(a, u) + p.d(u, b) - base + jitter(noise, rng);
+                if delta < best.delta {
+                    best.delta = delta;
+                    best.node = u;
+                    best.edge = e;
+                }
+            }
+        }
+        best
+    }
+}
+
+/// Symmetric additive noise of amplitude `noise` (no random draw when the operator is exact).
+#[inline]
+fn jitter(noise: f64, rng: &mut Rng) -> f64 {
+    if noise == 0.0 {
+        0.0
+    } else {
+        noise * (2.0 * rng.unit() - 1.0)
+    }
+}
+
+/// Index in `items` of the cluster with the largest `key` (first one on ties).
+#[inline]
+fn arg_best(items: &[usize], key: impl Fn(usize) -> f64) -> usize {
+    let mut best = 0;
+    let mut best_key = f64::NEG_INFINITY;
+    for (i, &c) in items.iter().enumerate() {
+        let k = key(c);
+        if k > best_key {
+            best_key = k;
+            best = i;
+        }
+    }
+    best
+}

@@ -1,0 +1,360 @@
+//! The resumable ALNS driver: operator selection, acceptance, restarts and bookkeeping.
+
+use std::time::Duration;
+
+use cutroute_pcgtsp::Instance;
+use web_time::Instant;
+
+use crate::local_search::{eps, LocalSearch};
+use crate::nodes::NodeChoice;
+use crate::operators::{Insertion, Operators, Removal, Selection, INSERTIONS, REMOVALS};
+use crate::problem::Problem;
+use crate::rng::Rng;
+use crate::{AlnsError, AlnsOptions, AlnsProgress, SolverStatus, StopReason};
+
+/// Adaptive weights of one family of operators (Ropke & Pisinger's segment scheme).
+#[derive(Clone, Debug)]
+struct Adaptive<const N: usize> {
+    weight: [f64; N],
+    score: [f64; N],
+    uses: [u32; N],
+}
+
+impl<const N: usize> Adaptive<N> {
+    fn new() -> Self {
+        Adaptive {
+            weight: [1.0; N],
+            score: [0.0; N],
+            uses: [0; N],
+        }
+    }
+
+    /// Roulette-wheel choice proportional to weight.
+    fn pick(&mut self, rng: &mut Rng) -> usize {
+        let total: f64 = self.weight.iter().sum();
+        let mut x = rng.unit() * total;
+        for (i, w) in self.weight.iter().enumerate() {
+            if x < *w {
+                self.uses[i] += 1;
+                return i;
+            }
+            x -= w;
+        }
+        self.uses[N - 1] += 1;
+        N - 1
+    }
+
+    /// Ends a segment: blends the mean score of each used operator into its weight. A floor
+    /// keeps every operator alive (what works changes during a run).
+    fn end_segment(&mut self, reaction: f64) {
+        for i in 0..N {
+            if self.uses[i] > 0 {
+                let mean = self.score[i] / self.uses[i] as f64;
+                self.weight[i] = (1.0 - reaction) * self.weight[i] + reaction * mean;
+            }
+            self.score[i] = 0.0;
+            self.uses[i] = 0;
+        }
+        let top = self.weight.iter().cloned().fold(0.0, f64::max);
+        for w in &mut self.weight {
+            *w = w.max(0.05 * top).max(1e-3);
+        }
+    }
+}
+
+/// Anytime ALNS for PCGTSP / GTSP that can be advanced in slices (see [`AlnsSolver::step`]).
+///
+/// The search trajectory depends only on the seed and the number of iterations: time only
+/// decides where it stops, so the same seed and iteration limit always give the same tour.
+#[derive(Clone, Debug)]
+pub struct AlnsSolver {
+    problem: Problem,
+    options: AlnsOptions,
+    rng: Rng,
+    operators: Operators,
+    local_search: LocalSearch,
+    node_choice: NodeChoice,
+    removal: Adaptive<5>,
+    insertion: Adaptive<8>,
+    current: Vec<usize>,
+    current_cost: f64,
+    candidate: Vec<usize>,
+    best: Vec<usize>,
+    best_cost: f64,
+    started: bool,
+    stop: Option<StopReason>,
+    iterations: u64,
+    improvements: u64,
+    restarts: u64,
+    epoch_iteration: u64,
+    epoch_length: u64,
+    elapsed: Duration,
+}
+
+impl AlnsSolver {
+    /// Prepares a solver (validates the instance and closes its precedence relation); no search
+    /// happens until [`AlnsSolver::step`].
+    pub fn new(instance: &Instance, options: AlnsOptions) -> Result<Self, AlnsError> {
+        let problem = Problem::new(instance)?;
+        let epoch_length = options.parameters.epoch_iterations.max(1);
+        Ok(AlnsSolver {
+            rng: Rng::new(options.seed),
+            problem,
+            options,
+            operators: Operators::default(),
+            local_search: LocalSearch::default(),
+            node_choice: NodeChoice::default(),
+            removal: Adaptive::new(),
+            insertion: Adaptive::new(),
+            current: Vec::new(),
+            current_cost: f64::INFINITY,
+            candidate: Vec::new(),
+            best: Vec::new(),
+            best_cost: f64::INFINITY,
+            started: false,
+            stop: None,
+            iterations: 0,
+            improvements: 0,
+            restarts: 0,
+            epoch_iteration: 0,
+            epoch_length,
+            elapsed: Duration::ZERO,
+        })
+    }
+
+    /// Searches for about `budget` of time (at least one iteration unless already finished) and
+    /// reports whether the search can go on.
+    pub fn step(&mut self, budget: Duration) -> SolverStatus {
+        self.step_with(budget, &mut |_| {})
+    }
+
+    /// Like [`AlnsSolver::step`], calling `on_improvement` after every new best tour.
+    pub fn step_with(
+        &mut self,
+        budget: Duration,
+        on_improvement: &mut dyn FnMut(&AlnsProgress),
+    ) -> SolverStatus {
+        let slice_start = Instant::now();
+        let base = self.elapsed;
+        loop {
+            if let Some(reason) = self.stop_reason() {
+                self.stop = Some(reason);
+                return SolverStatus::Finished;
+            }
+            let improved = if self.started {
+                self.iterate()
+            } else {
+                self.start()
+            };
+            self.elapsed = base + slice_start.elapsed();
+            if improved && self.best().is_some() {
+                self.improvements += 1;
+                on_improvement(&self.progress());
+            }
+            if slice_start.elapsed() >= budget {
+                if let Some(reason) = self.stop_reason() {
+                    self.stop = Some(reason);
+                    return SolverStatus::Finished;
+                }
+                return SolverStatus::Running;
+            }
+        }
+    }
+
+    /// Stops the search: later calls to `step` return [`SolverStatus::Finished`] at once.
+    pub fn cancel(&mut self) {
+        if self.stop.is_none() {
+            self.stop = Some(StopReason::Cancelled);
+        }
+    }
+
+    /// The best tour found (nodes, depot first; the closing arc back to the first node is
+    /// implied) and its cost. `None` until a tour without forbidden arcs is found.
+    pub fn best(&self) -> Option<(&[usize], f64)> {
+        if self.best.is_empty() || !self.problem.uses_no_forbidden_arc(&self.best) {
+            return None;
+        }
+        Some((&self.best, self.best_cost))
+    }
+
+    /// Counters of the search so far.
+    pub fn progress(&self) -> AlnsProgress {
+        AlnsProgress {
+            elapsed: self.elapsed,
+            best_cost: self.best().map(|(_, c)| c),
+            current_cost: self.current_cost.is_finite().then_some(self.current_cost),
+            iterations: self.iterations,
+            improvements: self.improvements,
+            restarts: self.restarts,
+            stop_reason: self.stop,
+        }
+    }
+
+    fn stop_reason(&self) -> Option<StopReason> {
+        if self.stop.is_some() {
+            return self.stop;
+        }
+        if self.started {
+            if let (Some(target), Some((_, cost))) = (self.options.target_cost, self.best()) {
+                if cost <= target + eps(&self.problem) {
+                    return Some(StopReason::TargetReached);
+                }
+            }
+            if self.problem.m <= 3 && self.best().is_some() {
+                return Some(StopReason::Exhausted);
+            }
+        }
+        if let Some(limit) = self.options.time_limit {
+            if self.elapsed >= limit && self.started {
+                return Some(StopReason::TimeLimit);
+            }
+        }
+        if let Some(limit) = self.options.max_iterations {
+            if self.iterations >= limit && self.started {
+                return Some(StopReason::IterationLimit);
+            }
+        }
+        None
+    }
+
+    /// Builds the first tour: cheapest insertion from the depot, then local search.
+    fn start(&mut self) -> bool {
+        self.started = true;
+        let p = &self.problem;
+        let mut tour = Vec::with_capacity(p.m);
+        self.operators.destroy_all(p, &mut tour);
+        let how = Insertion {
+            selection: Selection::Cheapest,
+            noisy: false,
+        };
+        self.operators.repair(p, &mut tour, how, 0.0, &mut self.rng);
+        let cost = self.improve(&mut tour);
+        self.current.clone_from(&tour);
+        self.current_cost = cost;
+        self.best = tour;
+        self.best_cost = cost;
+        true
+    }
+
+    /// Node-choice DP followed by local search until neither changes anything.
+    fn improve(&mut self, tour: &mut Vec<usize>) -> f64 {
+        let p = &self.problem;
+        let mut cost = self.node_choice.optimise(p, tour);
+        // Every local-search move strictly improves and the DP never worsens, so this ends.
+        loop {
+            let mut changed = self.local_search.two_opt(p, tour);
+            changed |= self.local_search.or_opt(p, tour);
+            changed |= self.local_search.reinsert(p, tour);
+            if !changed {
+                let max_len = self.options.parameters.block_reverse_length;
+                if !self.local_search.block_reverse(p, tour, max_len) {
+                    break;
+                }
+            }
+            cost = self.node_choice.optimise(p, tour);
+        }
+        debug_assert!(p.order_is_valid(tour));
+        cost
+    }
+
+    /// The temperature for the current point of the epoch (exponential cooling).
+    fn temperature(&self) -> f64 {
+        let params = &self.options.parameters;
+        let reference = if self.best().is_some() {
+            self.best_cost.abs()
+        } else {
+            self.problem.mean_arc * self.problem.m as f64
+        }
+        .max(self.problem.mean_arc);
+        let start = params.start_temperature * reference;
+        let end = params.end_temperature * reference;
+        let frac = self.epoch_iteration as f64 / self.epoch_length as f64;
+        start * (end / start).powf(frac.min(1.0))
+    }
+
+    /// One destroy–repair–improve–accept iteration; returns whether the best tour improved.
+    fn iterate(&mut self) -> bool {
+        self.iterations += 1;
+        let params = self.options.parameters.clone();
+        let p = &self.problem;
+        let m = p.m;
+        let removal = self.removal.pick(&mut self.rng);
+        let insertion = self.insertion.pick(&mut self.rng);
+        let movable = m - 1;
+        let max_remove = ((params.max_removal_fraction * movable as f64).round() as usize)
+            .clamp(1, params.max_removal.max(1))
+            .min(movable);
+        let min_remove = params.min_removal.clamp(1, max_remove);
+        let count = self.rng.between(min_remove, max_remove);
+
+        self.candidate.clone_from(&self.current);
+        let mut candidate = std::mem::take(&mut self.candidate);
+        if REMOVALS[removal] == Removal::Reverse && m >= 4 {
+            let i = self.rng.between(1, m - 2);
+            let last = (m - 1).min(i + params.block_reverse_length);
+            let j = self.rng.between(i + 1, last);
+            self.local_search.reverse_repaired(p, &mut candidate, i, j);
+        }
+        self.operators
+            .destroy(p, &mut candidate, REMOVALS[removal], count, &mut self.rng);
+        let arc_scale = if self.current_cost < p.penalty {
+            (self.current_cost / m as f64).abs().max(p.mean_arc * 1e-3)
+        } else {
+            p.mean_arc
+        };
+        self.operators.repair(
+            p,
+            &mut candidate,
+            INSERTIONS[insertion],
+            params.noise * arc_scale,
+            &mut self.rng,
+        );
+        let mut cost = self.node_choice.optimise(p, &mut candidate);
+        let gate = self.current_cost + params.local_search_gate * self.current_cost.abs();
+        if cost < gate || cost < self.best_cost {
+            cost = self.improve(&mut candidate);
+        }
+
+        let eps = eps(&self.problem);
+        let delta = cost - self.current_cost;
+        let temperature = self.temperature();
+        let accepted =
+            delta <= 0.0 || (temperature > 0.0 && self.rng.unit() < (-delta / temperature).exp());
+        let mut score = 0.0;
+        let mut new_best = false;
+        if cost < self.best_cost - eps {
+            score = params.score_new_best;
+            new_best = true;
+            self.best.clone_from(&candidate);
+            self.best_cost = cost;
+        } else if delta < -eps {
+            score = params.score_better;
+        } else if accepted && delta > eps {
+            score = params.score_accepted;
+        }
+        self.removal.score[removal] += score;
+        self.insertion.score[insertion] += score;
+        if accepted {
+            std::mem::swap(&mut self.current, &mut candidate);
+            self.current_cost = cost;
+        }
+        self.candidate = candidate;
+
+        if self.iterations % params.segment_iterations.max(1) == 0 {
+            self.removal.end_segment(params.reaction);
+            self.insertion.end_segment(params.reaction);
+        }
+        self.epoch_iteration += 1;
+        if self.epoch_iteration >= self.epoch_length {
+            // Restart: back to the best tour, reheat, and cool more slowly next time.
+            self.restarts += 1;
+            self.epoch_iteration = 0;
+            self.epoch_length = ((self.epoch_length as f64) * params.epoch_growth)
+                .min(params.max_epoch_iterations as f64)
+                .max(1.0) as u64;
+            self.current.clone_from(&self.best);
+            self.current_cost = self.best_cost;
+        }
+        new_best
+    }
+}

@@ -1,0 +1,464 @@
+//! Loose pieces of a drawing → closed contours → parts.
+//!
+//! Pieces (lines, arcs, open polylines, approximated splines) are joined end to end when their
+//! end points lie within the join tolerance. End points live in a uniform grid whose cells are
+//! as wide as the tolerance, so a neighbour search looks at 3 × 3 cells and the whole join is
+//! linear in the number of pieces for real drawings. Where more than two ends meet, the nearest
+//! wins; what cannot be closed is reported as an open chain. Closed contours are then nested by
+//! containment: even depth (not inside anything, or inside a hole) starts a part, odd depth is a
+//! hole of its container's part. Outer contours are made clockwise, holes counter-clockwise.
+
+use std::collections::HashMap;
+
+use cutroute_geometry::{Contour, Part, Point, Vertex};
+
+use crate::shape::{
+    contour_bounds, dist, distance_to_polygon, flatten, point_in_polygon, reversed, signed_area,
+    Span,
+};
+
+/// Where a piece of geometry came from in the file.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct EntityRef {
+    /// Entity type (`LINE`, `ARC`, `SPLINE`, …).
+    pub entity: String,
+    /// 1-based line of the entity's `0` group (of the entity inside its block for inserts).
+    pub line: usize,
+    /// Layer name, decoded.
+    pub layer: String,
+}
+
+pub(crate) type SourceRef = EntityRef;
+
+/// A chain of spans from one entity, in world coordinates.
+#[derive(Clone, Debug)]
+pub(crate) struct Piece {
+    pub spans: Vec<Span>,
+    /// Closed by construction (circle, closed polyline): the last span ends at the first start.
+    pub closed: bool,
+    pub source: SourceRef,
+}
+
+/// A chain of entities that does not close within the join tolerance.
+#[derive(Clone, Debug, PartialEq)]
+pub struct OpenChain {
+    /// Where the chain starts.
+    pub start: Point,
+    /// Where the chain ends.
+    pub end: Point,
+    /// Length along the chain, mm.
+    pub length: f64,
+    /// The entities of the chain, in chain order.
+    pub entities: Vec<EntityRef>,
+}
+
+impl std::fmt::Display for OpenChain {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "open chain of {} entit", self.entities.len())?;
+        f.write_str(if self.entities.len() == 1 { "y" } else { "ies" })?;
+        write!(
+            f,
+            " from ({:.4}, {:.4}) to ({:.4}, {:.4})",
+            self.start.x, self.start.y, self.end.x, self.end.y
+        )?;
+        write!(f, ", {:.3} mm long:", self.length)?;
+        for (i, e) in self.entities.iter().take(5).enumerate() {
+            let sep = if i == 0 { " " } else { ", " };
+            write!(
+                f,
+                "{sep}{} at line {} (layer {})",
+                e.entity, e.line, e.layer
+            )?;
+        }
+        if self.entities.len() > 5 {
+            write!(f, ", …")?;
+        }
+        Ok(())
+    }
+}
+
+/// Tolerances of the assembly.
+pub(crate) struct AssembleLimits {
+    pub join_tolerance: f64,
+    /// Chord deviation used when flattening arcs for containment tests.
+    pub flatten_tolerance: f64,
+}
+
+/// A contour dropped during assembly, with why.
+pub(crate) struct Dropped {
+    pub line: usize,
+    pub message: String,
+}
+
+pub(crate) struct Assembled {
+    pub parts: Vec<Part>,
+    pub open_chains: Vec<OpenChain>,
+    pub dropped: Vec<Dropped>,
+}
+
+/// Most live candidates examined per end-point search: bounds the work on hostile piles of
+/// coincident ends without changing the result for real drawings (which have 1–3 per node).
+const MAX_CANDIDATES: usize = 64;
+
+struct EndGrid {
+    cell: f64,
+    cells: HashMap<(i64, i64), Vec<u32>>,
+}
+
+impl EndGrid {
+    fn key(&self, p: Point) -> (i64, i64) {
+        (
+            (p.x / self.cell).floor() as i64,
+            (p.y / self.cell).floor() as i64,
+        )
+    }
+
+    /// The nearest end within `tolerance` of `p` whose piece is unused. End id = piece·2 + side
+    /// (0 = start, 1 = end). Entries of used pieces are removed as they are met.
+    fn nearest(
+        &mut self,
+        p: Point,
+        tolerance: f64,
+        ends: &[Point],
+        used: &[bool],
+    ) -> Option<(u32, f64)> {
+        let (kx, ky) = self.key(p);
+        let mut best: Option<(u32, f64)> = None;
+        let mut examined = 0;
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                let Some(cell) = self
+                    .cells
+                    .get_mut(&(kx.saturating_add(dx), ky.saturating_add(dy)))
+                else {
+                    continue;
+                };
+                let mut i = 0;
+                while i < cell.len() {
+                    let id = cell[i];
+                    if used[(id / 2) as usize] {
+                        cell.swap_remove(i);
+                        continue;
+                    }
+                    i += 1;
+                    examined += 1;
+                    let d = dist(p, ends[id as usize]);
+                    if d <= tolerance && best.is_none_or(|(_, bd)| d < bd) {
+                        best = Some((id, d));
+                    }
+                    if examined >= MAX_CANDIDATES {
+                        return best;
+                    }
+                }
+            }
+        }
+        best
+    }
+}
+
+/// Joins, orients and groups the pieces.
+pub(crate) fn assemble(pieces: Vec<Piece>, limits: &AssembleLimits) -> Assembled {
+    let tolerance = limits.join_tolerance;
+    let mut contours: Vec<(Contour, SourceRef)> = Vec::new();
+    let mut open_chains = Vec::new();
+    let mut dropped = Vec::new();
+
+    let ends: Vec<Point> = pieces
+        .iter()
+        .flat_map(|p| [p.spans[0].start, p.spans[p.spans.len() - 1].end])
+        .collect();
+    let mut used: Vec<bool> = pieces.iter().map(|p| p.closed).collect();
+    let mut grid = EndGrid {
+        cell: tolerance,
+        cells: HashMap::new(),
+    };
+    for (i, p) in pieces.iter().enumerate() {
+        if p.closed {
+            contours.push((chain_contour(&[(i, false)], &pieces), p.source.clone()));
+            continue;
+        }
+        for side in 0..2u32 {
+            let id = i as u32 * 2 + side;
+            let key = grid.key(ends[id as usize]);
+            grid.cells.entry(key).or_default().push(id);
+        }
+    }
+
+    for first in 0..pieces.len() {
+        if used[first] {
+            continue;
+        }
+        used[first] = true;
+        // Chain of (piece, reversed) in order.
+        let mut chain: std::collections::VecDeque<(usize, bool)> = [(first, false)].into();
+        let mut closed = false;
+        for forward in [true, false] {
+            loop {
+                let (head, tail) = chain_ends(&chain, &ends);
+                let (from, to_close) = if forward { (tail, head) } else { (head, tail) };
+                let candidate = grid.nearest(from, tolerance, &ends, &used);
+                let closing = dist(from, to_close);
+                if closing <= tolerance && candidate.is_none_or(|(_, d)| closing <= d) {
+                    // A chain of one straight span cannot close on itself.
+                    closed = chain.len() > 1
+                        || pieces[first].spans.len() > 1
+                        || pieces[first].spans[0].bulge != 0.0;
+                    if closed {
+                        break;
+                    }
+                }
+                let Some((id, _)) = candidate else { break };
+                let piece = (id / 2) as usize;
+                let at_start = id % 2 == 0;
+                used[piece] = true;
+                if forward {
+                    chain.push_back((piece, !at_start));
+                } else {
+                    chain.push_front((piece, at_start));
+                }
+            }
+            if closed {
+                break;
+            }
+        }
+        let links: Vec<(usize, bool)> = chain.into_iter().collect();
+        if closed {
+            contours.push((
+                chain_contour(&links, &pieces),
+                pieces[links[0].0].source.clone(),
+            ));
+        } else {
+            let spans: Vec<Span> = chain_spans(&links, &pieces).collect();
+            let length = spans.iter().map(span_length).sum();
+            open_chains.push(OpenChain {
+                start: spans[0].start,
+                end: spans[spans.len() - 1].end,
+                length,
+                entities: links
+                    .iter()
+                    .map(|&(p, _)| pieces[p].source.clone())
+                    .collect(),
+            });
+        }
+    }
+
+    let parts = group_into_parts(contours, limits, &mut dropped);
+    Assembled {
+        parts,
+        open_chains,
+        dropped,
+    }
+}
+
+fn chain_ends(chain: &std::collections::VecDeque<(usize, bool)>, ends: &[Point]) -> (Point, Point) {
+    let &(p, rev) = chain.front().expect("chains are never empty");
+    let head = ends[p * 2 + usize::from(rev)];
+    let &(q, rev) = chain.back().expect("chains are never empty");
+    let tail = ends[q * 2 + usize::from(!rev)];
+    (head, tail)
+}
+
+fn chain_spans<'a>(
+    links: &'a [(usize, bool)],
+    pieces: &'a [Piece],
+) -> impl Iterator<Item = Span> + 'a {
+    links.iter().flat_map(move |&(p, rev)| {
+        let spans = &pieces[p].spans;
+        let n = spans.len();
+        (0..n).map(move |k| {
+            if rev {
+                spans[n - 1 - k].reversed()
+            } else {
+                spans[k]
+            }
+        })
+    })
+}
+
+fn chain_contour(links: &[(usize, bool)], pieces: &[Piece]) -> Contour {
+    // Each span starts at its own start point: gaps within the tolerance close implicitly.
+    Contour::new(
+        chain_spans(links, pieces)
+            .map(|s| Vertex {
+                point: s.start,
+                bulge: s.bulge,
+            })
+            .collect(),
+    )
+}
+
+fn span_length(s: &Span) -> f64 {
+    match s.arc_center() {
+        None => dist(s.start, s.end),
+        Some((_, r)) => r * (4.0 * s.bulge.atan()).abs(),
+    }
+}
+
+struct Placed {
+    contour: Contour,
+    source: SourceRef,
+    area: f64,
+    lo: Point,
+    hi: Point,
+    polygon: Vec<Point>,
+}
+
+fn group_into_parts(
+    contours: Vec<(Contour, SourceRef)>,
+    limits: &AssembleLimits,
+    dropped: &mut Vec<Dropped>,
+) -> Vec<Part> {
+    let tolerance = limits.join_tolerance;
+    let mut placed: Vec<Placed> = Vec::with_capacity(contours.len());
+    for (contour, source) in contours {
+        let area = signed_area(&contour);
+        if area.abs() <= tolerance * tolerance {
+            dropped.push(Dropped {
+                line: source.line,
+                message: format!(
+                    "closed chain starting with {} encloses no area (duplicate entities?); dropped",
+                    source.entity
+                ),
+            });
+            continue;
+        }
+        let (lo, hi) = contour_bounds(&contour);
+        let polygon = flatten(&contour, limits.flatten_tolerance.min(tolerance));
+        placed.push(Placed {
+            contour,
+            source,
+            area,
+            lo,
+            hi,
+            polygon,
+        });
+    }
+    // Largest first: every container comes before what it contains.
+    placed.sort_by(|a, b| b.area.abs().total_cmp(&a.area.abs()));
+
+    let mut parent: Vec<Option<usize>> = vec![None; placed.len()];
+    let mut depth: Vec<usize> = vec![0; placed.len()];
+    let mut duplicate = vec![false; placed.len()];
+    for i in 0..placed.len() {
+        for j in (0..i).rev() {
+            if duplicate[j] {
+                continue;
+            }
+            let (inner, outer) = (&placed[i], &placed[j]);
+            if inner.lo.x < outer.lo.x - tolerance
+                || inner.lo.y < outer.lo.y - tolerance
+                || inner.hi.x > outer.hi.x + tolerance
+                || inner.hi.y > outer.hi.y + tolerance
+            {
+                continue;
+            }
+            match containment(inner, outer, tolerance) {
+                Containment::Inside => {
+                    parent[i] = Some(j);
+                    depth[i] = depth[j] + 1;
+                    break;
+                }
+                Containment::Same => {
+                    duplicate[i] = true;
+                    dropped.push(Dropped {
+                        line: inner.source.line,
+                        message: format!(
+                            "closed contour starting with {} duplicates the one at line {}; dropped",
+                            inner.source.entity, outer.source.line
+                        ),
+                    });
+                    break;
+                }
+                Containment::Outside => {}
+            }
+        }
+    }
+
+    // Parts in file order of their outer contours; holes in file order too.
+    let mut part_of: Vec<Option<usize>> = vec![None; placed.len()];
+    let mut outers: Vec<usize> = (0..placed.len())
+        .filter(|&i| !duplicate[i] && depth[i].is_multiple_of(2))
+        .collect();
+    outers.sort_by_key(|&i| placed[i].source.line);
+    for (k, &i) in outers.iter().enumerate() {
+        part_of[i] = Some(k);
+    }
+    let mut holes: Vec<usize> = (0..placed.len())
+        .filter(|&i| !duplicate[i] && depth[i] % 2 == 1)
+        .collect();
+    holes.sort_by_key(|&i| placed[i].source.line);
+
+    let mut parts: Vec<Part> = outers
+        .iter()
+        .enumerate()
+        .map(|(k, &i)| {
+            let p = &placed[i];
+            let contour = if p.area > 0.0 {
+                reversed(&p.contour)
+            } else {
+                p.contour.clone()
+            };
+            Part {
+                name: format!("{}#{}", p.source.layer, k + 1),
+                contours: vec![contour],
+            }
+        })
+        .collect();
+    for i in holes {
+        let p = &placed[i];
+        let Some(owner) = parent[i].and_then(|j| part_of[j]) else {
+            continue;
+        };
+        let contour = if p.area < 0.0 {
+            reversed(&p.contour)
+        } else {
+            p.contour.clone()
+        };
+        parts[owner].contours.push(contour);
+    }
+    parts
+}
+
+enum Containment {
+    Inside,
+    Outside,
+    /// Every sample lies on the other's boundary: the same contour twice.
+    Same,
+}
+
+/// Votes over the inner contour's vertices and span midpoints, ignoring samples on the outer
+/// boundary: contours that touch stay decidable, identical ones are recognised.
+fn containment(inner: &Placed, outer: &Placed, tolerance: f64) -> Containment {
+    let n = inner.polygon.len();
+    let stride = (n / 32).max(1);
+    let (mut inside, mut outside) = (0usize, 0usize);
+    let mut k = 0;
+    while k < n {
+        let a = inner.polygon[k];
+        let b = inner.polygon[(k + 1) % n];
+        for p in [a, Point::new((a.x + b.x) / 2.0, (a.y + b.y) / 2.0)] {
+            if distance_to_polygon(p, &outer.polygon) <= tolerance {
+                continue;
+            }
+            if point_in_polygon(p, &outer.polygon) {
+                inside += 1;
+            } else {
+                outside += 1;
+            }
+        }
+        k += stride;
+    }
+    if inside == 0 && outside == 0 {
+        if (inner.area.abs() - outer.area.abs()).abs()
+            <= tolerance * (inner.polygon.len() as f64).max(1.0) * 10.0
+        {
+            Containment::Same
+        } else {
+            Containment::Outside
+        }
+    } else if inside > outside {
+        Containment::Inside
+    } else {
+        Containment::Outside
+    }
+}

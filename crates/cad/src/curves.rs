@@ -1,0 +1,383 @@
+//! Free-form curves of CAD files (NURBS splines, elliptical arcs) and their approximation by
+//! circular arcs within a tolerance.
+//!
+//! The approximation splits the curve at its knots (where it may lose smoothness) and then
+//! bisects each piece until the circular arc through the piece's start, middle and end points
+//! stays within the tolerance of the curve at 15 evenly spread samples. The result is a G0 chain
+//! of arcs (straight spans where the three points are collinear); far fewer spans than chords
+//! would need for the same tolerance, which keeps the route optimizer's input small.
+
+use cutroute_geometry::Point;
+
+use crate::shape::{angle_in_sweep, dist, distance_to_segment, Span};
+
+/// Highest spline degree accepted (AutoCAD allows up to 11); each evaluation costs degree².
+pub(crate) const MAX_SPLINE_DEGREE: usize = 11;
+/// Bisection depth limit per piece: 2^-40 of a knot interval is far below any tolerance.
+const MAX_DEPTH: u32 = 40;
+/// Samples checked against each candidate arc.
+const CHECK_SAMPLES: usize = 16;
+
+/// Why a curve could not be approximated.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum ApproxFailure {
+    /// More spans would be produced than the caller's budget allows.
+    BudgetExceeded,
+}
+
+/// A NURBS curve in the plane, validated on construction.
+#[derive(Debug, Clone)]
+pub(crate) struct Nurbs {
+    degree: usize,
+    knots: Vec<f64>,
+    /// Control points in homogeneous form `(w·x, w·y, w)`.
+    control: Vec<[f64; 3]>,
+}
+
+impl Nurbs {
+    /// Checks counts, ordering and weights; the message says what is wrong.
+    pub fn new(
+        degree: usize,
+        knots: Vec<f64>,
+        points: &[Point],
+        weights: &[f64],
+    ) -> Result<Self, String> {
+        if degree == 0 || degree > MAX_SPLINE_DEGREE {
+            return Err(format!(
+                "degree {degree} is outside 1..={MAX_SPLINE_DEGREE}"
+            ));
+        }
+        if points.len() < degree + 1 {
+            return Err(format!(
+                "{} control points are too few for degree {degree}",
+                points.len()
+            ));
+        }
+        if knots.len() != points.len() + degree + 1 {
+            return Err(format!(
+                "{} knots do not match {} control points of degree {degree} (expected {})",
+                knots.len(),
+                points.len(),
+                points.len() + degree + 1
+            ));
+        }
+        if knots.windows(2).any(|w| w[1] < w[0]) {
+            return Err("knots are not in non-decreasing order".into());
+        }
+        if !weights.is_empty() && weights.len() != points.len() {
+            return Err(format!(
+                "{} weights do not match {} control points",
+                weights.len(),
+                points.len()
+            ));
+        }
+        // Values are finite (the readers check), so `<= 0` catches every non-positive weight.
+        if weights.iter().any(|&w| w <= 0.0) {
+            return Err("a weight is not positive".into());
+        }
+        let n = points.len();
+        if knots[degree] >= knots[n] {
+            return Err("the knot vector spans an empty parameter range".into());
+        }
+        let control = points
+            .iter()
+            .enumerate()
+            .map(|(i, p)| {
+                let w = weights.get(i).copied().unwrap_or(1.0);
+                [p.x * w, p.y * w, w]
+            })
+            .collect();
+        Ok(Self {
+            degree,
+            knots,
+            control,
+        })
+    }
+
+    /// Parameter range over which the curve is defined.
+    pub fn domain(&self) -> (f64, f64) {
+        (self.knots[self.degree], self.knots[self.control.len()])
+    }
+
+    /// Distinct knots strictly inside the domain: the curve is only piecewise smooth across them.
+    pub fn breaks(&self) -> Vec<f64> {
+        let (a, b) = self.domain();
+        let mut out: Vec<f64> = Vec::new();
+        for &k in &self.knots {
+            if k > a && k < b && out.last().is_none_or(|&l| k > l) {
+                out.push(k);
+            }
+        }
+        out
+    }
+
+    /// The curve point at `t` by de Boor's algorithm (in homogeneous coordinates).
+    pub fn point_at(&self, t: f64) -> Point {
+        let p = self.degree;
+        let n = self.control.len();
+        let (a, b) = self.domain();
+        let t = t.clamp(a, b);
+        // The knot span k with knots[k] ≤ t < knots[k+1], kept inside [p, n-1].
+        let k = (self.knots.partition_point(|&u| u <= t).saturating_sub(1)).clamp(p, n - 1);
+        let mut d: Vec<[f64; 3]> = (0..=p).map(|j| self.control[j + k - p]).collect();
+        for r in 1..=p {
+            for j in (r..=p).rev() {
+                let lo = self.knots[j + k - p];
+                let hi = self.knots[j + 1 + k - r];
+                let alpha = if hi > lo { (t - lo) / (hi - lo) } else { 0.0 };
+                let previous = d[j - 1];
+                for (value, prev) in d[j].iter_mut().zip(previous) {
+                    *value = (1.0 - alpha) * prev + alpha * *value;
+                }
+            }
+        }
+        let [x, y, w] = d[p];
+        Point::new(x / w, y / w)
+    }
+}
+
+/// An elliptical arc `center + u·cos t + v·sin t` for `t` from `t0` to `t1` (either direction).
+///
+/// Circular arcs are the special case `|u| = |v|`, `u ⊥ v`; an affine image of either is again
+/// of this form, which is how block inserts with uneven scales are handled.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct EllipticArc {
+    pub center: Point,
+    pub u: Point,
+    pub v: Point,
+    pub t0: f64,
+    pub t1: f64,
+}
+
+impl EllipticArc {
+    pub fn point_at(&self, t: f64) -> Point {
+        let (s, c) = t.sin_cos();
+        Point::new(
+            self.center.x + self.u.x * c + self.v.x * s,
+            self.center.y + self.u.y * c + self.v.y * s,
+        )
+    }
+
+    /// The arc as exact circular spans when it is circular, `None` otherwise.
+    pub fn as_circular_spans(&self) -> Option<Vec<Span>> {
+        let ru = self.u.x.hypot(self.u.y);
+        let rv = self.v.x.hypot(self.v.y);
+        let dot = self.u.x * self.v.x + self.u.y * self.v.y;
+        let scale = ru.max(rv);
+        if scale == 0.0 || (ru - rv).abs() > 1e-9 * scale || dot.abs() > 1e-9 * scale * scale {
+            return None;
+        }
+        // Increasing t runs counter-clockwise when v is u turned left.
+        let orientation = (self.u.x * self.v.y - self.u.y * self.v.x).signum();
+        let sweep = (self.t1 - self.t0) * orientation;
+        // At most a half turn per span keeps |bulge| ≤ 1, far from the ill-conditioned ∞.
+        let pieces = ((sweep.abs() / std::f64::consts::PI).ceil() as usize).max(1);
+        let bulge = (sweep / pieces as f64 / 4.0).tan();
+        Some(
+            (0..pieces)
+                .map(|i| {
+                    let ta = self.t0 + (self.t1 - self.t0) * i as f64 / pieces as f64;
+                    let tb = self.t0 + (self.t1 - self.t0) * (i + 1) as f64 / pieces as f64;
+                    Span {
+                        start: self.point_at(ta),
+                        end: self.point_at(tb),
+                        bulge,
+                    }
+                })
+                .collect(),
+        )
+    }
+}
+
+/// The circular arc through `a`, `m`, `b` (in that order) as a span from `a` to `b`.
+pub(crate) fn arc_through(a: Point, m: Point, b: Point) -> Span {
+    let cross = (b.x - a.x) * (m.y - a.y) - (b.y - a.y) * (m.x - a.x);
+    let ma = Point::new(a.x - m.x, a.y - m.y);
+    let mb = Point::new(b.x - m.x, b.y - m.y);
+    let la = ma.x.hypot(ma.y);
+    let lb = mb.x.hypot(mb.y);
+    if la == 0.0 || lb == 0.0 {
+        return Span::line(a, b);
+    }
+    let cos_amb = ((ma.x * mb.x + ma.y * mb.y) / (la * lb)).clamp(-1.0, 1.0);
+    // The inscribed angle at m is π − φ/2, so φ/4 = (π − ∠amb)/2.
+    let quarter = (std::f64::consts::PI - cos_amb.acos()) / 2.0;
+    let magnitude = quarter.tan();
+    // m to the right of a→b means the arc turns counter-clockwise.
+    let bulge = if cross < 0.0 { magnitude } else { -magnitude };
+    if !bulge.is_finite() || magnitude < 1e-12 {
+        return Span::line(a, b);
+    }
+    Span {
+        start: a,
+        end: b,
+        bulge,
+    }
+}
+
+/// Distance from `p` to the span (segment or arc).
+pub(crate) fn distance_to_span(p: Point, span: &Span) -> f64 {
+    match span.arc_center() {
+        None => distance_to_segment(p, span.start, span.end),
+        Some((c, r)) => {
+            let a0 = (span.start.y - c.y).atan2(span.start.x - c.x);
+            let sweep = 4.0 * span.bulge.atan();
+            let a = (p.y - c.y).atan2(p.x - c.x);
+            if angle_in_sweep(a, a0, sweep) {
+                (dist(p, c) - r).abs()
+            } else {
+                dist(p, span.start).min(dist(p, span.end))
+            }
+        }
+    }
+}
+
+/// Approximates `curve` on `[t0, t1]` by arcs within `tolerance`, splitting first at `breaks`.
+///
+/// `budget` is the number of spans the caller still allows; it is decreased by the spans made.
+pub(crate) fn approximate(
+    curve: &dyn Fn(f64) -> Point,
+    t0: f64,
+    t1: f64,
+    breaks: &[f64],
+    tolerance: f64,
+    budget: &mut usize,
+) -> Result<Vec<Span>, ApproxFailure> {
+    let mut cuts: Vec<f64> = Vec::with_capacity(breaks.len() + 2);
+    cuts.push(t0);
+    cuts.extend(breaks.iter().copied().filter(|&k| k > t0 && k < t1));
+    cuts.push(t1);
+    let mut out = Vec::new();
+    for w in cuts.windows(2) {
+        // Bisection without recursion: `a` is where the next span starts, `pending` holds the
+        // right ends still to reach (innermost last), so spans come out in curve order.
+        let mut a = w[0];
+        let mut pending: Vec<(f64, u32)> = vec![(w[1], 0)];
+        while let Some(&(b, depth)) = pending.last() {
+            let m = (a + b) / 2.0;
+            let pa = curve(a);
+            let pb = curve(b);
+            let span = arc_through(pa, curve(m), pb);
+            let fits = depth >= MAX_DEPTH
+                || (1..CHECK_SAMPLES).all(|k| {
+                    let t = a + (b - a) * k as f64 / CHECK_SAMPLES as f64;
+                    distance_to_span(curve(t), &span) <= tolerance
+                });
+            if fits {
+                if *budget == 0 {
+                    return Err(ApproxFailure::BudgetExceeded);
+                }
+                *budget -= 1;
+                out.push(span);
+                pending.pop();
+                a = b;
+            } else {
+                pending.push((m, depth + 1));
+            }
+        }
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn arc_through_three_points_of_a_circle() {
+        let s = arc_through(
+            Point::new(1.0, 0.0),
+            Point::new(0.0, 1.0),
+            Point::new(-1.0, 0.0),
+        );
+        assert!((s.bulge - 1.0).abs() < 1e-12);
+        let s = arc_through(
+            Point::new(-1.0, 0.0),
+            Point::new(0.0, 1.0),
+            Point::new(1.0, 0.0),
+        );
+        assert!((s.bulge + 1.0).abs() < 1e-12);
+        let s = arc_through(
+            Point::new(0.0, 0.0),
+            Point::new(1.0, 0.0),
+            Point::new(2.0, 0.0),
+        );
+        assert_eq!(s.bulge, 0.0);
+    }
+
+    #[test]
+    fn clamped_quadratic_bezier_is_a_parabola() {
+        let pts = [
+            Point::new(0.0, 0.0),
+            Point::new(1.0, 2.0),
+            Point::new(2.0, 0.0),
+        ];
+        let n = Nurbs::new(2, vec![0.0, 0.0, 0.0, 1.0, 1.0, 1.0], &pts, &[]).unwrap();
+        let p = n.point_at(0.5);
+        assert!((p.x - 1.0).abs() < 1e-12 && (p.y - 1.0).abs() < 1e-12);
+        assert_eq!(n.point_at(1.0), Point::new(2.0, 0.0));
+    }
+
+    #[test]
+    fn rational_quadratic_is_an_exact_quarter_circle() {
+        let w = std::f64::consts::FRAC_1_SQRT_2;
+        let pts = [
+            Point::new(1.0, 0.0),
+            Point::new(1.0, 1.0),
+            Point::new(0.0, 1.0),
+        ];
+        let n = Nurbs::new(2, vec![0.0, 0.0, 0.0, 1.0, 1.0, 1.0], &pts, &[1.0, w, 1.0]).unwrap();
+        for k in 0..=10 {
+            let p = n.point_at(k as f64 / 10.0);
+            assert!((p.x.hypot(p.y) - 1.0).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn invalid_splines_are_refused() {
+        let pts = [Point::new(0.0, 0.0), Point::new(1.0, 0.0)];
+        assert!(Nurbs::new(0, vec![0.0, 1.0, 2.0], &pts, &[]).is_err());
+        assert!(Nurbs::new(1, vec![0.0, 0.0, 1.0], &pts, &[]).is_err());
+        assert!(Nurbs::new(1, vec![0.0, 1.0, 0.5, 1.0], &pts, &[]).is_err());
+        assert!(Nurbs::new(1, vec![0.0, 0.0, 1.0, 1.0], &pts, &[1.0, -1.0]).is_err());
+        assert!(Nurbs::new(1, vec![1.0, 1.0, 1.0, 1.0], &pts, &[]).is_err());
+    }
+
+    #[test]
+    fn approximation_of_an_ellipse_stays_within_tolerance() {
+        let e = EllipticArc {
+            center: Point::new(5.0, -3.0),
+            u: Point::new(100.0, 20.0),
+            v: Point::new(-6.0, 30.0),
+            t0: 0.3,
+            t1: 5.0,
+        };
+        let tol = 0.01;
+        let mut budget = 10_000;
+        let spans = approximate(&|t| e.point_at(t), e.t0, e.t1, &[], tol, &mut budget).unwrap();
+        assert!(spans.len() < 200, "{} spans", spans.len());
+        for i in 0..=2000 {
+            let t = e.t0 + (e.t1 - e.t0) * i as f64 / 2000.0;
+            let p = e.point_at(t);
+            let d = spans
+                .iter()
+                .map(|s| distance_to_span(p, s))
+                .fold(f64::INFINITY, f64::min);
+            assert!(d <= tol * 1.01, "deviation {d} at t = {t}");
+        }
+    }
+
+    #[test]
+    fn budget_stops_runaway_approximation() {
+        let e = EllipticArc {
+            center: Point::new(0.0, 0.0),
+            u: Point::new(1e6, 0.0),
+            v: Point::new(0.0, 1.0),
+            t0: 0.0,
+            t1: 6.0,
+        };
+        let mut budget = 5;
+        let r = approximate(&|t| e.point_at(t), e.t0, e.t1, &[], 1e-6, &mut budget);
+        assert_eq!(r, Err(ApproxFailure::BudgetExceeded));
+    }
+}

@@ -1,0 +1,155 @@
+//! The discrete alternative: a PCGTSP instance whose nodes are candidate pierce points every ε mm
+//! along each contour (plus its vertices), and the way back from a node tour to a `Route`.
+
+use cutroute_geometry::{ContourRef, CutStep, Nest, Point, Route};
+use cutroute_pcgtsp::Instance;
+
+use crate::geom::{Shape, V};
+use crate::problem::Problem;
+use crate::CcpError;
+
+/// How the contours are discretised.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DiscretisationOptions {
+    /// Where the tool starts: the depot cluster's only node.
+    pub start: Point,
+    /// Where the closed tour's last arc goes instead of the depot (`None`: an open route, the
+    /// return arc costs nothing).
+    pub finish: Option<Point>,
+    /// Step ε between candidate pierce points along a contour, mm.
+    pub step: f64,
+    /// Add every contour vertex as a candidate too.
+    pub include_vertices: bool,
+    /// Round costs to integers (as PCGTSPLIB files do).
+    pub round_costs: bool,
+}
+
+impl Default for DiscretisationOptions {
+    fn default() -> Self {
+        DiscretisationOptions { start: Point::new(0.0, 0.0), finish: None, step: 25.0, include_vertices: true, round_costs: false }
+    }
+}
+
+/// What one node of the instance stands for.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum DiscreteNode {
+    /// The start point (depot cluster).
+    Depot(Point),
+    /// A candidate pierce point on a contour.
+    Pierce {
+        /// The contour.
+        contour: ContourRef,
+        /// The point on it.
+        point: Point,
+    },
+}
+
+/// A PCGTSP instance built from a nest, with the meaning of its nodes.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DiscreteInstance {
+    /// The instance: cluster 0 is the depot, cluster `1 + i` the `i`-th contour of the nest in
+    /// part/contour order.
+    pub instance: Instance,
+    /// Node `v` ↦ what it stands for.
+    pub nodes: Vec<DiscreteNode>,
+    /// The start point.
+    pub start: Point,
+    /// The finish point, if the route is closed by an idle move.
+    pub finish: Option<Point>,
+}
+
+/// Candidate points every `step` mm of arc length along a contour, plus vertices if asked.
+fn candidates(shape: &Shape, step: f64, vertices: bool) -> Vec<V> {
+    let mut out = Vec::new();
+    let mut next_at = 0.0;
+    let mut walked = 0.0;
+    for span in &shape.spans {
+        let len = span.length();
+        if vertices && !out.last().is_some_and(|p: &V| p.dist(span.a()) < 1e-9) {
+            out.push(span.a());
+        }
+        while next_at <= walked + len && len > 0.0 {
+            let x = span.point_at((next_at - walked) / len);
+            if !out.last().is_some_and(|p: &V| p.dist(x) < 1e-9) {
+                out.push(x);
+            }
+            next_at += step;
+        }
+        walked += len;
+    }
+    if out.is_empty() {
+        out.push(shape.spans[0].a());
+    }
+    out
+}
+
+/// Builds the PCGTSP instance of a nest: clusters are the contours plus the depot, costs are
+/// Euclidean idle distances, precedence is "inner before outer" for every containment pair.
+/// The cost matrix is dense: meant for nests of up to a few thousand candidate points.
+pub fn build_pcgtsp(nest: &Nest, options: &DiscretisationOptions) -> Result<DiscreteInstance, CcpError> {
+    if !(options.step > 0.0 && options.step.is_finite()) {
+        return Err(CcpError::InvalidOption("step must be positive".into()));
+    }
+    let start = V::from(options.start);
+    let finish = options.finish.map(V::from);
+    let prob = Problem::new(nest, start, finish);
+    let mut nodes = vec![DiscreteNode::Depot(options.start)];
+    let mut points = vec![start];
+    let mut clusters = vec![vec![0usize]];
+    let mut node_cluster = vec![0usize];
+    for (i, shape) in prob.shapes.iter().enumerate() {
+        let mut cl = Vec::new();
+        for x in candidates(shape, options.step, options.include_vertices) {
+            cl.push(points.len());
+            node_cluster.push(i + 1);
+            points.push(x);
+            nodes.push(DiscreteNode::Pierce { contour: prob.refs[i], point: x.into() });
+        }
+        clusters.push(cl);
+    }
+    let n = points.len();
+    if n.checked_mul(n).is_none_or(|nn| nn > 400_000_000) {
+        return Err(CcpError::InvalidOption(format!("{n} candidate points: the dense cost matrix is too large")));
+    }
+    let mut cost = vec![f64::INFINITY; n * n];
+    for a in 0..n {
+        for b in 0..n {
+            if node_cluster[a] == node_cluster[b] {
+                continue;
+            }
+            let d = if b == 0 {
+                finish.map_or(0.0, |f| points[a].dist(f))
+            } else {
+                points[a].dist(points[b])
+            };
+            cost[a * n + b] = if options.round_costs { d.round() } else { d };
+        }
+    }
+    let precedence = prob.precedence_pairs().into_iter().map(|(inner, outer)| (inner + 1, outer + 1)).collect();
+    let instance = Instance { name: "ccp-discretised".into(), node_count: n, cost, clusters, node_cluster, precedence, depot: 0 };
+    Ok(DiscreteInstance { instance, nodes, start: options.start, finish: options.finish })
+}
+
+impl DiscreteInstance {
+    /// Turns a closed node tour (any rotation; it must contain the depot node once and one node
+    /// of every cluster) into a route.
+    pub fn tour_to_route(&self, tour: &[usize]) -> Result<Route, CcpError> {
+        let depot_at = tour.iter().position(|&v| v == 0).ok_or(CcpError::InvalidTour("the tour misses the depot".into()))?;
+        let mut seen = vec![false; self.instance.clusters.len()];
+        let mut steps = Vec::with_capacity(tour.len().saturating_sub(1));
+        for t in 0..tour.len() {
+            let v = tour[(depot_at + t) % tour.len()];
+            let cl = *self.instance.node_cluster.get(v).ok_or(CcpError::InvalidTour(format!("node {v} does not exist")))?;
+            if std::mem::replace(&mut seen[cl], true) {
+                return Err(CcpError::InvalidTour(format!("cluster {cl} visited twice")));
+            }
+            if let DiscreteNode::Pierce { contour, point } = self.nodes[v] {
+                steps.push(CutStep { contour, pierce_point: point });
+            }
+        }
+        if let Some(cl) = seen.iter().position(|s| !s) {
+            return Err(CcpError::InvalidTour(format!("cluster {cl} not visited")));
+        }
+        Ok(Route { start: self.start, steps, finish: self.finish })
+    }
+}

@@ -1,0 +1,273 @@
+//! Step 1 and the spatial structures: the flattened contour list of a nest, its containment
+//! forest, the kept (innermost) and removed (outer) contours, a uniform grid, k-nearest
+//! candidate lists and the nearest-neighbour construction.
+
+use cutroute_geometry::{ContourRef, Nest};
+
+use crate::geom::{BBox, Shape, V};
+
+/// A uniform grid of boxes: each cell lists the items whose box overlaps it.
+pub(crate) struct Grid {
+    min: V,
+    cell: f64,
+    nx: usize,
+    ny: usize,
+    cells: Vec<Vec<u32>>,
+}
+
+impl Grid {
+    /// A grid over `bounds` with about `per_cell` items per cell for `n` items.
+    pub fn new(bounds: BBox, n: usize, per_cell: f64) -> Grid {
+        let w = (bounds.max.x - bounds.min.x).max(1e-6);
+        let h = (bounds.max.y - bounds.min.y).max(1e-6);
+        let cells_wanted = (n as f64 / per_cell).clamp(1.0, 4.0e6);
+        let cell = (w * h / cells_wanted).sqrt().max(1e-6);
+        let nx = ((w / cell).ceil() as usize).clamp(1, 4096);
+        let ny = ((h / cell).ceil() as usize).clamp(1, 4096);
+        let cell = (w / nx as f64).max(h / ny as f64);
+        Grid { min: bounds.min, cell, nx, ny, cells: vec![Vec::new(); nx * ny] }
+    }
+    fn ix(&self, x: f64) -> usize {
+        (((x - self.min.x) / self.cell).floor().max(0.0) as usize).min(self.nx - 1)
+    }
+    fn iy(&self, y: f64) -> usize {
+        (((y - self.min.y) / self.cell).floor().max(0.0) as usize).min(self.ny - 1)
+    }
+    fn range(&self, b: &BBox) -> (usize, usize, usize, usize) {
+        (self.ix(b.min.x), self.iy(b.min.y), self.ix(b.max.x), self.iy(b.max.y))
+    }
+    pub fn insert(&mut self, id: u32, b: &BBox) {
+        let (x0, y0, x1, y1) = self.range(b);
+        for y in y0..=y1 {
+            for x in x0..=x1 {
+                self.cells[y * self.nx + x].push(id);
+            }
+        }
+    }
+    /// The items of the cell holding `p`.
+    pub fn at(&self, p: V) -> &[u32] {
+        &self.cells[self.iy(p.y) * self.nx + self.ix(p.x)]
+    }
+    /// Visits the cells of ring `r` around the cell range of `b` (ring 0 = the range itself);
+    /// returns false when the ring lies wholly outside the grid.
+    pub fn ring(&self, b: &BBox, r: usize, mut f: impl FnMut(&[u32])) -> bool {
+        let (bx0, by0, bx1, by1) = self.range(b);
+        let (nx, ny) = (self.nx as isize, self.ny as isize);
+        let r = r as isize;
+        let (x0, y0, x1, y1) = (bx0 as isize - r, by0 as isize - r, bx1 as isize + r, by1 as isize + r);
+        if r > 0 && x0 < 0 && y0 < 0 && x1 > nx - 1 && y1 > ny - 1 && x0 + 1 <= 0 && y0 + 1 <= 0 && x1 - 1 >= nx - 1 && y1 - 1 >= ny - 1 {
+            return false;
+        }
+        for y in y0.max(0)..=y1.min(ny - 1) {
+            let row = y as usize * self.nx;
+            if r == 0 || y == y0 || y == y1 {
+                for x in x0.max(0)..=x1.min(nx - 1) {
+                    f(&self.cells[row + x as usize]);
+                }
+            } else {
+                if x0 >= 0 {
+                    f(&self.cells[row + x0 as usize]);
+                }
+                if x1 < nx {
+                    f(&self.cells[row + x1 as usize]);
+                }
+            }
+        }
+        true
+    }
+    /// Width of a cell.
+    pub fn cell(&self) -> f64 {
+        self.cell
+    }
+}
+
+/// The contours of a nest prepared for CCP-Relax.
+pub(crate) struct Problem {
+    /// Every contour of the nest's parts (the sheet excluded), flattened.
+    pub refs: Vec<ContourRef>,
+    pub shapes: Vec<Shape>,
+    /// The smallest contour containing each contour (the containment forest).
+    pub parent: Vec<Option<usize>>,
+    /// Flat ids of the innermost contours (step 1 keeps these).
+    pub kept: Vec<usize>,
+    /// Flat ids of the outer contours (restored in step 4).
+    pub removed: Vec<usize>,
+    /// Bounds of all contours, the start and the finish.
+    pub bounds: BBox,
+}
+
+impl Problem {
+    pub fn new(nest: &Nest, start: V, finish: Option<V>) -> Problem {
+        let mut refs = Vec::new();
+        let mut shapes = Vec::new();
+        for (pi, part) in nest.parts.iter().enumerate() {
+            for (ci, c) in part.contours.iter().enumerate() {
+                if c.vertices.is_empty() {
+                    continue;
+                }
+                refs.push(ContourRef { part: pi, contour: ci });
+                shapes.push(Shape::new(c));
+            }
+        }
+        let mut bounds = BBox::empty();
+        for s in &shapes {
+            bounds.union(&s.bbox);
+        }
+        bounds.add(start);
+        if let Some(f) = finish {
+            bounds.add(f);
+        }
+        let parent = containment_parents(&shapes, bounds);
+        let mut has_child = vec![false; shapes.len()];
+        for p in parent.iter().flatten() {
+            has_child[*p] = true;
+        }
+        let kept = (0..shapes.len()).filter(|&i| !has_child[i]).collect();
+        let removed = (0..shapes.len()).filter(|&i| has_child[i]).collect();
+        Problem { refs, shapes, parent, kept, removed, bounds }
+    }
+
+    /// All containment pairs `(inner, outer)` of the forest (transitively closed).
+    pub fn precedence_pairs(&self) -> Vec<(usize, usize)> {
+        let mut out = Vec::new();
+        for i in 0..self.shapes.len() {
+            let mut p = self.parent[i];
+            while let Some(a) = p {
+                out.push((i, a));
+                p = self.parent[a];
+            }
+        }
+        out
+    }
+}
+
+/// For each contour, the smallest contour whose region contains it.
+fn containment_parents(shapes: &[Shape], bounds: BBox) -> Vec<Option<usize>> {
+    let mut grid = Grid::new(bounds, shapes.len(), 2.0);
+    for (i, s) in shapes.iter().enumerate() {
+        grid.insert(i as u32, &s.bbox);
+    }
+    let mut parent = vec![None; shapes.len()];
+    for (j, sj) in shapes.iter().enumerate() {
+        // Contours are disjoint: one point of C_j decides whether C_j lies inside C_i.
+        let probe = sj.spans[0].a();
+        let mut best: Option<(f64, usize)> = None;
+        for &i in grid.at(probe) {
+            let i = i as usize;
+            if i == j {
+                continue;
+            }
+            let si = &shapes[i];
+            if si.area.abs() <= sj.area.abs() || !si.bbox.contains_box(&sj.bbox) {
+                continue;
+            }
+            if best.is_some_and(|(a, _)| a <= si.area.abs()) {
+                continue;
+            }
+            if si.contains_point(probe) {
+                best = Some((si.area.abs(), i));
+            }
+        }
+        parent[j] = best.map(|b| b.1);
+    }
+    parent
+}
+
+/// For each item, up to `k` others nearest by box gap (ties by centre distance).
+pub(crate) fn nearest_lists(boxes: &[BBox], bounds: BBox, k: usize) -> Vec<Vec<u32>> {
+    let n = boxes.len();
+    let mut grid = Grid::new(bounds, n, 2.0);
+    for (i, b) in boxes.iter().enumerate() {
+        grid.insert(i as u32, b);
+    }
+    let mut stamp = vec![usize::MAX; n];
+    let mut out = Vec::with_capacity(n);
+    let mut cand: Vec<(f64, f64, u32)> = Vec::new();
+    for (i, bi) in boxes.iter().enumerate() {
+        cand.clear();
+        stamp[i] = i;
+        let mut r = 0;
+        loop {
+            let alive = grid.ring(bi, r, |cell| {
+                for &j in cell {
+                    if stamp[j as usize] != i {
+                        stamp[j as usize] = i;
+                        let bj = &boxes[j as usize];
+                        cand.push((bi.gap(bj), bi.center().dist(bj.center()), j));
+                    }
+                }
+            });
+            // Items first seen in later rings have a gap of at least r·cell.
+            let bound = r as f64 * grid.cell();
+            let enough = cand.iter().filter(|c| c.0 <= bound).count() >= k;
+            if !alive || enough || cand.len() >= n - 1 {
+                break;
+            }
+            r += 1;
+        }
+        cand.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
+        out.push(cand.iter().take(k).map(|c| c.2).collect());
+    }
+    out
+}
+
+/// Nearest-neighbour order of the shapes from `start` (grid-accelerated): each step goes to the
+/// unvisited contour nearest to the current point and pierces it at its nearest point.
+/// `rng` (when given) sometimes takes the second nearest, for restarts.
+pub(crate) fn nearest_neighbour_order(
+    shapes: &[&Shape],
+    bounds: BBox,
+    start: V,
+    mut rng: Option<&mut crate::rng::Rng>,
+) -> (Vec<u32>, Vec<V>) {
+    let n = shapes.len();
+    let mut grid = Grid::new(bounds, n, 2.0);
+    for (i, s) in shapes.iter().enumerate() {
+        grid.insert(i as u32, &s.bbox);
+    }
+    let mut visited = vec![false; n];
+    let mut order = Vec::with_capacity(n);
+    let mut points = vec![V::default(); n];
+    let mut cur = start;
+    let mut stamp = vec![usize::MAX; n];
+    for step in 0..n {
+        let qb = BBox { min: cur, max: cur };
+        let mut best = (f64::INFINITY, usize::MAX, V::default());
+        let mut second = best;
+        let mut r = 0;
+        loop {
+            let alive = grid.ring(&qb, r, |cell| {
+                for &j in cell {
+                    let j = j as usize;
+                    if visited[j] || stamp[j] == step {
+                        continue;
+                    }
+                    stamp[j] = step;
+                    if shapes[j].bbox.dist(cur) >= second.0 {
+                        continue;
+                    }
+                    let x = shapes[j].nearest(cur);
+                    let d = x.dist(cur);
+                    if d < best.0 {
+                        second = best;
+                        best = (d, j, x);
+                    } else if d < second.0 {
+                        second = (d, j, x);
+                    }
+                }
+            });
+            let bound = r as f64 * grid.cell();
+            if !alive || (second.0 <= bound) || (best.0 <= bound && rng.is_none()) {
+                break;
+            }
+            r += 1;
+        }
+        let take_second = second.1 != usize::MAX && rng.as_deref_mut().is_some_and(|g| g.below(4) == 0);
+        let pick = if take_second { second } else { best };
+        visited[pick.1] = true;
+        order.push(pick.1 as u32);
+        points[pick.1] = pick.2;
+        cur = pick.2;
+    }
+    (order, points)
+}

@@ -1,0 +1,257 @@
+//! Step 4 (restoring the removed contours at the route's last crossing), the optimality
+//! certificates (Conditions 1 and 2) and the machine metrics of a route.
+
+use cutroute_geometry::{ContourRef, CutStep, Nest, Point, Route};
+use serde::{Deserialize, Serialize};
+
+use crate::geom::{on_segment, Shape, Span, V};
+use crate::search::Search;
+use crate::CcpError;
+
+/// Builds the full route from the search state: kept contours in order, the exit chain of an
+/// open route, and every removed contour inserted at the last crossing of the air path with it
+/// (ties on one air move ordered by position along the move).
+pub(crate) fn assemble_route(s: &Search, order: &[u32], pts: &[V]) -> Route {
+    let prob = &s.prob;
+    // The air path: start, kept pierce points, exit chain (open routes), finish.
+    let mut poly: Vec<V> = Vec::with_capacity(order.len() + 4);
+    let mut poly_step: Vec<Option<usize>> = Vec::with_capacity(order.len() + 4);
+    poly.push(s.start);
+    poly_step.push(None);
+    for &k in order {
+        poly.push(pts[k as usize]);
+        poly_step.push(Some(prob.kept[k as usize]));
+    }
+    if s.finish.is_none() {
+        if let Some(&last) = order.last() {
+            let mut chain = Vec::new();
+            s.exit_chain(last as usize, pts[last as usize], Some(&mut chain));
+            for x in chain {
+                poly.push(x);
+                poly_step.push(None);
+            }
+        }
+    }
+    if let Some(f) = s.finish {
+        poly.push(f);
+        poly_step.push(None);
+    }
+    let moves = poly.len().saturating_sub(1);
+    let mut inserted: Vec<Vec<(f64, usize, V)>> = vec![Vec::new(); moves.max(1)];
+    let mut leftovers = Vec::new();
+    let mut hits = Vec::new();
+    for &c in &prob.removed {
+        let shape = &prob.shapes[c];
+        let mut found = None;
+        for t in (0..moves).rev() {
+            let (a, b) = (poly[t], poly[t + 1]);
+            if !shape.bbox.overlaps_segment(a, b) {
+                continue;
+            }
+            let mut best: Option<(f64, V)> = None;
+            for (span, bb) in shape.spans.iter().zip(&shape.span_boxes) {
+                if !bb.overlaps_segment(a, b) {
+                    continue;
+                }
+                hits.clear();
+                span.intersect_segment(a, b, &mut hits);
+                for &(lam, ts) in &hits {
+                    if best.is_none_or(|b| lam > b.0) {
+                        best = Some((lam, span.point_at(ts)));
+                    }
+                }
+            }
+            if let Some((lam, x)) = best {
+                found = Some((t, lam, x));
+                break;
+            }
+        }
+        match found {
+            Some((t, lam, x)) => inserted[t].push((lam, c, x)),
+            None => leftovers.push(c),
+        }
+    }
+    let mut steps = Vec::with_capacity(prob.shapes.len());
+    for t in 0..poly.len() {
+        if let Some(c) = poly_step[t] {
+            steps.push(CutStep { contour: prob.refs[c], pierce_point: poly[t].into() });
+        }
+        if t < moves {
+            let list = &mut inserted[t];
+            list.sort_by(|a, b| a.0.total_cmp(&b.0));
+            for &(_, c, x) in list.iter() {
+                steps.push(CutStep { contour: prob.refs[c], pierce_point: x.into() });
+            }
+        }
+    }
+    // Not crossed (only possible through numerical tangency): cut them last, innermost first, from
+    // the nearest point, which keeps precedence at the price of extra idle length.
+    leftovers.sort_by(|a, b| prob.shapes[*a].area.abs().total_cmp(&prob.shapes[*b].area.abs()));
+    let mut cur = steps.last().map_or(s.start, |st| V::from(st.pierce_point));
+    for c in leftovers {
+        let x = prob.shapes[c].nearest(cur);
+        steps.push(CutStep { contour: prob.refs[c], pierce_point: x.into() });
+        cur = x;
+    }
+    Route { start: s.start.into(), steps, finish: s.finish.map(Into::into) }
+}
+
+/// Idle (air) length of a route: start → pierce points in order → finish.
+pub fn idle_length(route: &Route) -> f64 {
+    let mut cur = V::from(route.start);
+    let mut len = 0.0;
+    for st in &route.steps {
+        let p = V::from(st.pierce_point);
+        len += cur.dist(p);
+        cur = p;
+    }
+    if let Some(f) = route.finish {
+        len += cur.dist(V::from(f));
+    }
+    len
+}
+
+/// Machine speeds and pierce time of the time model `T = L_on/V_on + L_off/V_off + N·t_pierce`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct MachineSpeeds {
+    /// Idle (rapid) speed, mm per time unit.
+    pub idle_speed: f64,
+    /// Cutting speed, mm per time unit.
+    pub cut_speed: f64,
+    /// Time of one pierce, in the same time unit.
+    pub pierce_time: f64,
+}
+
+impl Default for MachineSpeeds {
+    /// The values of the RouteManager sample tasks (`ToolIdlingSpeed` 500, `ToolCutSpeed` 10,
+    /// `PiercingDuration` 7).
+    fn default() -> Self {
+        MachineSpeeds { idle_speed: 500.0, cut_speed: 10.0, pierce_time: 7.0 }
+    }
+}
+
+/// Lengths, pierce count and time of a route.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct RouteMetrics {
+    /// Idle (air) length L_off, mm.
+    pub idle_length: f64,
+    /// Cut length L_on (sum of the perimeters of the cut contours), mm.
+    pub cut_length: f64,
+    /// Number of pierces N.
+    pub pierce_count: usize,
+    /// `L_on/V_on + L_off/V_off + N·t_pierce`.
+    pub total_time: f64,
+}
+
+fn contour_of<'a>(nest: &'a Nest, r: ContourRef) -> Result<&'a cutroute_geometry::Contour, CcpError> {
+    nest.parts
+        .get(r.part)
+        .and_then(|p| p.contours.get(r.contour))
+        .ok_or(CcpError::UnknownContour { part: r.part, contour: r.contour })
+}
+
+/// Metrics of a route over a nest under a machine model.
+pub fn route_metrics(nest: &Nest, route: &Route, machine: &MachineSpeeds) -> Result<RouteMetrics, CcpError> {
+    let mut cut_length = 0.0;
+    for st in &route.steps {
+        cut_length += Shape::new(contour_of(nest, st.contour)?).perimeter;
+    }
+    let idle = idle_length(route);
+    let n = route.steps.len();
+    Ok(RouteMetrics {
+        idle_length: idle,
+        cut_length,
+        pierce_count: n,
+        total_time: cut_length / machine.cut_speed + idle / machine.idle_speed + n as f64 * machine.pierce_time,
+    })
+}
+
+/// Which sufficient optimality conditions hold at one pierce point of a route.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ContourCertificate {
+    /// The contour.
+    pub contour: ContourRef,
+    /// Its pierce point.
+    pub pierce_point: Point,
+    /// The pierce point lies on the chord between its route neighbours (Condition 1.1 = 2.1).
+    pub on_chord: bool,
+    /// Condition 1: on the chord, or the tangent of the confocal ellipse through the pierce
+    /// point separates the ellipse from the contour.
+    pub condition1: bool,
+    /// Condition 2 (the visual version): on the chord; or inside an edge whose line leaves the
+    /// whole contour on one side; or at a vertex whose edge rays enclose the contour; or the
+    /// contour bounds a convex region.
+    pub condition2: bool,
+}
+
+/// Checks Conditions 1 and 2 at every pierce point of a route. If Condition 1 holds everywhere,
+/// no shift of pierce points can shorten the route for its order (Proposition 2).
+pub fn route_certificates(nest: &Nest, route: &Route) -> Result<Vec<ContourCertificate>, CcpError> {
+    let n = route.steps.len();
+    let mut out = Vec::with_capacity(n);
+    for (i, st) in route.steps.iter().enumerate() {
+        let shape = Shape::new(contour_of(nest, st.contour)?);
+        let p = if i == 0 { V::from(route.start) } else { V::from(route.steps[i - 1].pierce_point) };
+        let q = if i + 1 < n { Some(V::from(route.steps[i + 1].pierce_point)) } else { route.finish.map(V::from) };
+        let m = V::from(st.pierce_point);
+        let (on_chord, c1, c2) = certify(&shape, p, q, m);
+        out.push(ContourCertificate { contour: st.contour, pierce_point: st.pierce_point, on_chord, condition1: c1, condition2: c2 });
+    }
+    Ok(out)
+}
+
+/// `(on_chord, condition1, condition2)` at pierce point `m` of `shape` between `p` and `q`.
+pub(crate) fn certify(shape: &Shape, p: V, q: Option<V>, m: V) -> (bool, bool, bool) {
+    let scale = shape.bbox.max.dist(shape.bbox.min).max(1.0);
+    let tol = 1e-7 * scale;
+    let on_chord = match q {
+        Some(q) => on_segment(p, q, m, tol),
+        None => m.dist(p) <= tol,
+    };
+    let n = (m - p).unit() + q.map_or(V::default(), |q| (m - q).unit());
+    let c1 = on_chord || n.norm() < 1e-12 || shape.min_dot(n.unit(), m) >= -tol;
+    let c2 = on_chord || condition2_shape(shape, m, tol);
+    (on_chord, c1, c2)
+}
+
+fn condition2_shape(shape: &Shape, m: V, tol: f64) -> bool {
+    let nspan = shape.spans.len();
+    for (si, span) in shape.spans.iter().enumerate() {
+        let Span::Seg { a, b } = *span else { continue };
+        let u = b - a;
+        if u.norm() < 1e-12 {
+            continue;
+        }
+        let on = on_segment(a, b, m, tol);
+        if !on {
+            continue;
+        }
+        if m.dist(a) > tol && m.dist(b) > tol {
+            // Interior of an edge: the contour on one side of its line.
+            let nl = u.perp().unit();
+            if shape.min_dot(nl, m) >= -tol || shape.min_dot(nl * -1.0, m) >= -tol {
+                return true;
+            }
+        } else {
+            // At a vertex: both incident spans must be segments; the contour inside their angle.
+            let (prev, next) = if m.dist(a) <= tol {
+                (shape.spans[(si + nspan - 1) % nspan], *span)
+            } else {
+                (*span, shape.spans[(si + 1) % nspan])
+            };
+            if let (Span::Seg { a: pa, .. }, Span::Seg { b: nb, .. }) = (prev, next) {
+                let e1 = (nb - m).unit();
+                let e2 = (pa - m).unit();
+                let s = e1.cross(e2);
+                if s.abs() > 1e-12 {
+                    let n1 = e1.perp() * s.signum();
+                    let n2 = e2.perp() * -s.signum();
+                    if shape.min_dot(n1, m) >= -tol && shape.min_dot(n2, m) >= -tol {
+                        return true;
+                    }
+                }
+            }
+        }
+    }
+    shape.is_convex()
+}

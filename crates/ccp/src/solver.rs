@@ -1,0 +1,425 @@
+//! The resumable anytime solver: `CcpSolver::step` runs for a time budget and can be called again
+//! (the web worker runs solvers in time slices); `solve` runs it to the end.
+
+use std::time::Duration;
+
+use cutroute_geometry::{Nest, Point, Route};
+use serde::{Deserialize, Serialize};
+use web_time::Instant;
+
+use crate::geom::V;
+use crate::problem::Problem;
+use crate::route::{assemble_route, idle_length, route_certificates, route_metrics, ContourCertificate, MachineSpeeds, RouteMetrics};
+use crate::search::{Search, SearchParams};
+use crate::CcpError;
+
+/// Options of a CCP-Relax run. Plain data: build with `..Default::default()`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CcpOptions {
+    /// Where the tool head starts (outside all contours).
+    pub start: Point,
+    /// Where it must end (`TerminalMotion`); `None` for an open route ending at the last cut.
+    pub finish: Option<Point>,
+    /// Relaxation stops when a full sweep shortens the route by at most this (mm).
+    pub delta: f64,
+    /// Wall-clock budget of the whole run (summed over `step` calls).
+    pub time_limit: Duration,
+    /// Seed of the solver's own PRNG (shaking, restarts).
+    pub seed: u64,
+    /// Size k of each contour's candidate list (k nearest contours).
+    pub neighbours: usize,
+    /// Largest distance in the order between contours of a 3- or 4-cycle.
+    pub cycle_window: usize,
+    /// Longest block moved by block shift and block exchange.
+    pub max_block: usize,
+    /// Longest block of the optimal re-insertion neighbourhood.
+    pub reinsert_block: usize,
+    /// VNS stops (or restarts) after this many shakes in a row without improvement.
+    pub max_non_improving_shakes: usize,
+    /// How many times the search restarts from a new randomised construction.
+    pub restarts: usize,
+    /// Largest shaking strength (number of random moves).
+    pub max_shake_strength: usize,
+    /// Machine speeds of the time model.
+    pub machine: MachineSpeeds,
+}
+
+impl Default for CcpOptions {
+    fn default() -> Self {
+        CcpOptions {
+            start: Point::new(0.0, 0.0),
+            finish: None,
+            delta: 1e-6,
+            time_limit: Duration::from_secs(30),
+            seed: 1,
+            neighbours: 8,
+            cycle_window: 5,
+            max_block: 3,
+            reinsert_block: 10,
+            max_non_improving_shakes: 300,
+            restarts: 1,
+            max_shake_strength: 5,
+            machine: MachineSpeeds::default(),
+        }
+    }
+}
+
+/// Whether the solver has more to do.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum SolverStatus {
+    /// `step` again to improve further.
+    Running,
+    /// Done: VNS ended, time ran out, or the run was cancelled.
+    Finished,
+}
+
+/// Where the solver is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum CcpPhase {
+    /// Nothing computed yet.
+    Start,
+    /// Descending to the first VNS local optimum.
+    LocalSearch,
+    /// Shaking and descending again (VNS proper).
+    Shaking,
+    /// Finished.
+    Done,
+}
+
+/// A snapshot of the run.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CcpProgress {
+    /// Computing time used so far.
+    pub elapsed: Duration,
+    /// Idle length of the best route so far (mm).
+    pub best_idle_length: f64,
+    /// The best route so far, all contours restored.
+    pub route: Route,
+    /// The current phase.
+    pub phase: CcpPhase,
+    /// Time at which the first VNS local optimum was reached.
+    pub local_optimum_time: Option<Duration>,
+    /// Idle length at the first local optimum.
+    pub local_optimum_length: Option<f64>,
+    /// Idle length of the initial (nearest-neighbour, relaxed) route.
+    pub initial_length: Option<f64>,
+    /// Moves evaluated.
+    pub evaluations: u64,
+    /// Moves accepted.
+    pub accepted_moves: u64,
+    /// VNS shakes done.
+    pub shakes: u64,
+    /// Contours kept by step 1 (innermost).
+    pub kept_contours: usize,
+    /// Contours removed by step 1 and restored in step 4.
+    pub removed_contours: usize,
+}
+
+/// The outcome of a run.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CcpResult {
+    /// The route over all contours.
+    pub route: Route,
+    /// Its lengths, pierce count and time.
+    pub metrics: RouteMetrics,
+    /// Conditions 1 and 2 per step of the route.
+    pub certificates: Vec<ContourCertificate>,
+    /// Condition 1 holds at every pierce point: optimal for this order (Proposition 2).
+    pub certified_optimal_for_order: bool,
+    /// The final progress snapshot.
+    pub progress: CcpProgress,
+}
+
+/// CCP-Relax as a resumable anytime solver.
+pub struct CcpSolver {
+    nest: Nest,
+    options: CcpOptions,
+    search: Search,
+    phase: CcpPhase,
+    elapsed: Duration,
+    best: Option<(Vec<u32>, Vec<V>, f64)>,
+    route: Route,
+    route_length: f64,
+    local_optimum_time: Option<Duration>,
+    local_optimum_length: Option<f64>,
+    initial_length: Option<f64>,
+    fails: usize,
+    strength: usize,
+    restarts_left: usize,
+    shakes: u64,
+    cancelled: bool,
+}
+
+impl CcpSolver {
+    /// Prepares a run: step 1 (containment forest, outer contours removed) and candidate lists.
+    pub fn new(nest: &Nest, options: CcpOptions) -> Result<CcpSolver, CcpError> {
+        let finite = |p: Point| p.x.is_finite() && p.y.is_finite();
+        if !finite(options.start) || options.finish.is_some_and(|f| !finite(f)) {
+            return Err(CcpError::InvalidOption("start and finish must be finite".into()));
+        }
+        if !(options.delta > 0.0 && options.delta.is_finite()) {
+            return Err(CcpError::InvalidOption("delta must be positive".into()));
+        }
+        if options.neighbours == 0 || options.max_block == 0 || options.max_block > 5 || options.cycle_window > 14 {
+            return Err(CcpError::InvalidOption(
+                "neighbours ≥ 1, 1 ≤ max_block ≤ 5 and cycle_window ≤ 14 are required".into(),
+            ));
+        }
+        let t0 = Instant::now();
+        let start = V::from(options.start);
+        let finish = options.finish.map(V::from);
+        let prob = Problem::new(nest, start, finish);
+        let params = SearchParams {
+            delta: options.delta,
+            neighbours: options.neighbours,
+            cycle_window: options.cycle_window,
+            max_block: options.max_block,
+            reinsert_block: options.reinsert_block,
+        };
+        let search = Search::new(prob, start, finish, params, options.seed);
+        let restarts_left = options.restarts;
+        Ok(CcpSolver {
+            nest: nest.clone(),
+            route: Route { start: options.start, steps: Vec::new(), finish: options.finish },
+            options,
+            search,
+            phase: CcpPhase::Start,
+            elapsed: t0.elapsed(),
+            best: None,
+            route_length: 0.0,
+            local_optimum_time: None,
+            local_optimum_length: None,
+            initial_length: None,
+            fails: 0,
+            strength: 1,
+            restarts_left,
+            shakes: 0,
+            cancelled: false,
+        })
+    }
+
+    /// Stops the run: the next `step` returns `Finished` and the best route stays available.
+    pub fn cancel(&mut self) {
+        self.cancelled = true;
+    }
+
+    /// Runs for about `budget` (checked between moves) and reports whether more is to be done.
+    pub fn step(&mut self, budget: Duration) -> SolverStatus {
+        let t0 = Instant::now();
+        let result = self.step_inner(t0, budget);
+        self.elapsed += t0.elapsed();
+        if self.phase != CcpPhase::Start {
+            self.refresh_route();
+        }
+        result
+    }
+
+    fn out_of_time(&self, t0: Instant, budget: Duration) -> bool {
+        let used = t0.elapsed();
+        used >= budget || self.elapsed + used >= self.options.time_limit
+    }
+
+    fn step_inner(&mut self, t0: Instant, budget: Duration) -> SolverStatus {
+        if self.cancelled {
+            self.finish_run();
+            return SolverStatus::Finished;
+        }
+        loop {
+            match self.phase {
+                CcpPhase::Done => return SolverStatus::Finished,
+                CcpPhase::Start => {
+                    self.search.construct(false);
+                    self.search.relax_full();
+                    self.initial_length = Some(self.search.total);
+                    self.search.queue_all();
+                    self.phase = CcpPhase::LocalSearch;
+                }
+                CcpPhase::LocalSearch | CcpPhase::Shaking => {
+                    if !self.descend(t0, budget) {
+                        if self.elapsed + t0.elapsed() >= self.options.time_limit {
+                            self.finish_run();
+                            return SolverStatus::Finished;
+                        }
+                        return SolverStatus::Running;
+                    }
+                    // The queue is empty: a local optimum of every neighbourhood.
+                    let before = self.search.total;
+                    self.search.relax_full();
+                    if self.search.total < before - 1e-6 {
+                        self.search.queue_all();
+                        continue;
+                    }
+                    if self.phase == CcpPhase::LocalSearch {
+                        self.local_optimum_time = Some(self.elapsed + t0.elapsed());
+                        self.local_optimum_length = Some(self.search.total);
+                        self.phase = CcpPhase::Shaking;
+                        self.best = Some(self.search.snapshot());
+                    } else {
+                        self.after_shake();
+                    }
+                    if self.phase == CcpPhase::Done {
+                        return SolverStatus::Finished;
+                    }
+                    if self.out_of_time(t0, budget) {
+                        if self.elapsed + t0.elapsed() >= self.options.time_limit {
+                            self.finish_run();
+                            return SolverStatus::Finished;
+                        }
+                        return SolverStatus::Running;
+                    }
+                    self.shake();
+                }
+            }
+        }
+    }
+
+    /// Runs the queue-driven VND; true when the queue emptied, false when time ran out.
+    fn descend(&mut self, t0: Instant, budget: Duration) -> bool {
+        let mut count = 0u32;
+        while let Some(c) = self.search.pop() {
+            for nb in 0..Search::NEIGHBOURHOODS {
+                if self.search.explore(nb, c) {
+                    self.search.push(c);
+                    break;
+                }
+            }
+            count += 1;
+            if count % 32 == 0 && self.out_of_time(t0, budget) {
+                return false;
+            }
+        }
+        true
+    }
+
+    /// Compares the descended shake with the best; keeps or reverts; restarts or stops.
+    fn after_shake(&mut self) {
+        let best_len = self.best.as_ref().map_or(f64::INFINITY, |b| b.2);
+        if self.search.total < best_len - 1e-6 {
+            self.best = Some(self.search.snapshot());
+            self.fails = 0;
+            self.strength = 1;
+        } else {
+            if let Some(b) = &self.best {
+                self.search.restore(b);
+            }
+            self.fails += 1;
+            self.strength = self.strength % self.options.max_shake_strength.max(1) + 1;
+        }
+        if self.fails >= self.options.max_non_improving_shakes {
+            if self.restarts_left > 0 {
+                self.restarts_left -= 1;
+                self.fails = 0;
+                self.search.construct(true);
+                self.search.relax_full();
+                self.search.queue_all();
+                // The restart descends in the shaking phase and is compared with the best.
+            } else {
+                self.finish_run();
+            }
+        }
+    }
+
+    /// VNS shaking: `strength` random moves in a window of the order around a random position.
+    fn shake(&mut self) {
+        self.shakes += 1;
+        let n = self.search.len();
+        if n < 4 {
+            self.fails = self.options.max_non_improving_shakes;
+            return;
+        }
+        let centre = self.search.rng.below(n);
+        let span = 8 + 4 * self.strength;
+        for _ in 0..self.strength {
+            if let Some(m) = self.search.random_move(centre, span) {
+                self.search.force_move(&m);
+            }
+        }
+    }
+
+    fn finish_run(&mut self) {
+        if let Some(b) = &self.best {
+            if b.2 < self.search.total {
+                self.search.restore(b);
+            }
+        }
+        self.phase = CcpPhase::Done;
+    }
+
+    /// Rebuilds the cached route from the best state when it changed.
+    fn refresh_route(&mut self) {
+        let (len, use_best) = match &self.best {
+            Some(b) if b.2 <= self.search.total => (b.2, true),
+            _ => (self.search.total, false),
+        };
+        if !self.route.steps.is_empty() && (len - self.route_length).abs() < 1e-9 {
+            return;
+        }
+        let route = match (&self.best, use_best) {
+            (Some(b), true) => assemble_route(&self.search, &b.0, &b.1),
+            _ => assemble_route(&self.search, &self.search.order, &self.search.pts),
+        };
+        self.route_length = len;
+        self.route = route;
+    }
+
+    /// The current snapshot.
+    pub fn progress(&self) -> CcpProgress {
+        CcpProgress {
+            elapsed: self.elapsed,
+            best_idle_length: idle_length(&self.route),
+            route: self.route.clone(),
+            phase: self.phase,
+            local_optimum_time: self.local_optimum_time,
+            local_optimum_length: self.local_optimum_length,
+            initial_length: self.initial_length,
+            evaluations: self.search.evaluations,
+            accepted_moves: self.search.accepted,
+            shakes: self.shakes,
+            kept_contours: self.search.prob.kept.len(),
+            removed_contours: self.search.prob.removed.len(),
+        }
+    }
+
+    /// Conditions 1 and 2 at every pierce point of the best route.
+    pub fn certificates(&self) -> Vec<ContourCertificate> {
+        route_certificates(&self.nest, &self.route).unwrap_or_default()
+    }
+
+    /// The result for the best route so far.
+    pub fn result(&self) -> CcpResult {
+        let certificates = self.certificates();
+        let metrics = route_metrics(&self.nest, &self.route, &self.options.machine).unwrap_or_default();
+        CcpResult {
+            route: self.route.clone(),
+            metrics,
+            certified_optimal_for_order: certificates.iter().all(|c| c.condition1),
+            certificates,
+            progress: self.progress(),
+        }
+    }
+}
+
+/// Runs CCP-Relax to the end (VNS finished or time limit), reporting progress after each slice.
+pub fn solve(nest: &Nest, options: CcpOptions, on_progress: &mut dyn FnMut(&CcpProgress)) -> Result<CcpResult, CcpError> {
+    solve_with_cancel(nest, options, on_progress, &|| false)
+}
+
+/// Like [`solve`], polling `cancelled` between slices.
+pub fn solve_with_cancel(
+    nest: &Nest,
+    options: CcpOptions,
+    on_progress: &mut dyn FnMut(&CcpProgress),
+    cancelled: &dyn Fn() -> bool,
+) -> Result<CcpResult, CcpError> {
+    let mut solver = CcpSolver::new(nest, options)?;
+    loop {
+        if cancelled() {
+            solver.cancel();
+        }
+        let status = solver.step(Duration::from_millis(100));
+        on_progress(&solver.progress());
+        if status == SolverStatus::Finished {
+            return Ok(solver.result());
+        }
+    }
+}

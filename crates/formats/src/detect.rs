@@ -1,0 +1,131 @@
+//! Recognising a file's format from its content, and reading a nest from any format this crate
+//! owns.
+
+use cutroute_geometry::Nest;
+
+use crate::dbs::{self, DbsError};
+use crate::geometry_json;
+use crate::json::JsonError;
+use crate::result_json;
+
+/// The formats of the cutting world, as far as content tells them apart.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Format {
+    /// Legacy binary DBS.
+    DbsBinary,
+    /// Geometry JSON (`dbs.json`): an array of `{partid, paths}`.
+    GeometryJson,
+    /// RouteManager task JSON (`TaskData` + `Contours`).
+    TaskJson,
+    /// RouteManager result JSON (`job` + `results`).
+    ResultJson,
+    /// DXF drawing (read by the CAD crate).
+    Dxf,
+    /// T-FLEX nesting project, XML (read by the CAD crate).
+    TflexXml,
+    /// PCGLNS / PCGTSPLIB text instance (read by the PCGTSP crate).
+    Pcglns,
+    /// None of the above.
+    Unknown,
+}
+
+/// Why [`read_nest`] failed.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum ReadError {
+    /// A DBS file that does not read.
+    #[error(transparent)]
+    Dbs(#[from] DbsError),
+    /// A JSON file that does not read.
+    #[error(transparent)]
+    Json(#[from] JsonError),
+    /// The format holds no nest geometry (a task lists pierce points only).
+    #[error("a {0:?} file holds no nest geometry")]
+    NoGeometry(Format),
+    /// The format is read by another crate (or not at all).
+    #[error("{0:?} is not read by cutroute-formats")]
+    Unsupported(Format),
+}
+
+/// Guesses the format from the content (never from a file name).
+///
+/// Cheap for text formats (only the start is inspected, plus the top-level keys of JSON
+/// objects); a DBS file is recognised by a consistent first record header.
+pub fn detect(bytes: &[u8]) -> Format {
+    let text_start = bytes
+        .iter()
+        .position(|b| !b.is_ascii_whitespace() && *b != 0xEF && *b != 0xBB && *b != 0xBF)
+        .map_or(&[][..], |i| &bytes[i..]);
+    match text_start.first() {
+        Some(b'[') => return Format::GeometryJson,
+        Some(b'{') => return json_object_kind(bytes),
+        Some(b'<') => {
+            return if contains(bytes, b"Nest")
+                || contains(bytes, b"TFlex")
+                || contains(bytes, b"tfnesting")
+            {
+                Format::TflexXml
+            } else {
+                Format::Unknown
+            }
+        }
+        _ => {}
+    }
+    if looks_like_dbs(bytes) {
+        return Format::DbsBinary;
+    }
+    let head = &bytes[..bytes.len().min(4096)];
+    if text_start.starts_with(b"0") && contains(head, b"SECTION") {
+        return Format::Dxf;
+    }
+    if text_start.starts_with(b"NAME")
+        && (contains(head, b"GTSP_SETS") || contains(head, b"PCGLNS") || contains(head, b"GROUPS"))
+    {
+        return Format::Pcglns;
+    }
+    Format::Unknown
+}
+
+fn contains(hay: &[u8], needle: &[u8]) -> bool {
+    hay.windows(needle.len()).any(|w| w == needle)
+}
+
+fn json_object_kind(bytes: &[u8]) -> Format {
+    // Only the top-level keys matter; deserialising into a map of ignored values is cheap.
+    let Ok(map) =
+        serde_json::from_slice::<std::collections::HashMap<String, serde::de::IgnoredAny>>(bytes)
+    else {
+        return Format::Unknown;
+    };
+    if map.contains_key("TaskData") && map.contains_key("Contours") {
+        Format::TaskJson
+    } else if map.contains_key("job") && map.contains_key("results") {
+        Format::ResultJson
+    } else {
+        Format::Unknown
+    }
+}
+
+/// A DBS file starts with a record header whose `size` equals `size'`, or is just the end
+/// marker.
+fn looks_like_dbs(bytes: &[u8]) -> bool {
+    let i16_at = |at: usize| i16::from_le_bytes([bytes[at], bytes[at + 1]]);
+    if bytes.len() >= 2 && bytes.len() <= 4 && i16_at(0) < 0 {
+        return true;
+    }
+    if bytes.len() < 16 {
+        return false;
+    }
+    let (size, size_copy, record_type) = (i16_at(0), i16_at(4), i16_at(8));
+    size >= 3 && size == size_copy && (1..=255).contains(&record_type) && bytes[6..8] == [0, 0]
+}
+
+/// Reads a nest from DBS, geometry JSON or result JSON (its `job` echo), detected by content.
+pub fn read_nest(bytes: &[u8]) -> Result<Nest, ReadError> {
+    match detect(bytes) {
+        Format::DbsBinary => Ok(dbs::read_dbs(bytes)?.nest),
+        Format::GeometryJson => Ok(geometry_json::read_geometry_json(bytes)?),
+        Format::ResultJson => Ok(result_json::read_result_json(bytes)?.nest()?),
+        Format::TaskJson => Err(ReadError::NoGeometry(Format::TaskJson)),
+        other => Err(ReadError::Unsupported(other)),
+    }
+}

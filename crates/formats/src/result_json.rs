@@ -1,0 +1,491 @@
+//! The RouteManager cutting result (`rm-result.json`, thesis Listing Г.3): an echo of the task
+//! (`job`: the sheet outline and every contour with arc angles in degrees) and the solution
+//! (`results`: lengths, time and the tool path as a list of vertices, each with the mode of the
+//! move that leaves it).
+//!
+//! Real files also use the modes `cut.in` / `cut.out` (lead-in and lead-out) and the fields
+//! `partid` / `pathid`; they are accepted. Our own routes are exported in this format
+//! ([`RmResult::from_route`]) so existing tools can read them, and results are turned into
+//! things the UI can draw ([`RmResult::tool_moves`], [`RmResult::nest`]).
+
+use cutroute_geometry::{ContourRef, CutStep, Nest, Part, Point, Route};
+use serde::{Deserialize, Serialize};
+
+use crate::contour_check::{self, DEFAULT_CLOSURE_TOLERANCE};
+use crate::geom;
+use crate::json::{self, JsonError, JsonWriteError};
+
+/// A cutting result.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RmResult {
+    /// What was solved.
+    pub job: Job,
+    /// The solution.
+    pub results: Results,
+}
+
+/// The task solved, as echoed in the result.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Job {
+    /// Number of contours.
+    #[serde(rename = "paths.count")]
+    pub paths_count: i64,
+    /// Number of parts (the sheet not counted).
+    #[serde(rename = "parts.count")]
+    pub parts_count: i64,
+    /// Number of candidate pierce points.
+    #[serde(rename = "total.points.count")]
+    pub total_points_count: i64,
+    /// Undocumented RouteManager figure, kept as read.
+    #[serde(rename = "total.address.pairs.count")]
+    pub total_address_pairs_count: i64,
+    /// The sheet outline: `[x, y, angle°]` points, closing point repeated.
+    pub list: Vec<[f64; 3]>,
+    /// Every contour of the task.
+    pub paths: Vec<ResultPath>,
+}
+
+/// One contour of the task.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ResultPath {
+    /// 1-based part number (the sheet is not a part).
+    #[serde(rename = "part.id")]
+    pub part_id: i64,
+    /// 0-based contour number within the part; 0 is the outer contour.
+    pub id: i64,
+    /// Extension: the part's designation.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub partid: Option<String>,
+    /// Extension: the contour's id in the source DBS file.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pathid: Option<i64>,
+    /// `[x, y, angle°]` points, closing point repeated.
+    pub points: Vec<[f64; 3]>,
+}
+
+/// The solution.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Results {
+    /// The objective (RouteManager reports the idle time, s).
+    pub result: f64,
+    /// Idle length L_off, mm.
+    #[serde(rename = "route.length.no.contours")]
+    pub route_length_no_contours: f64,
+    /// Total length (idle + cut), mm.
+    #[serde(rename = "route.length")]
+    pub route_length: f64,
+    /// Computation time `HH:MM:SS.mmm`.
+    #[serde(rename = "count.time")]
+    pub count_time: String,
+    /// The tool path, vertex by vertex.
+    pub toolpath: Vec<ToolpathEntry>,
+}
+
+/// What the tool does on the move that leaves a vertex.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum MoveKind {
+    /// Idle (torch off).
+    #[serde(rename = "air")]
+    Air,
+    /// Cutting a contour.
+    #[serde(rename = "cut")]
+    Cut,
+    /// Lead-in: from the pierce point to the contour.
+    #[serde(rename = "cut.in")]
+    CutIn,
+    /// Lead-out: leaving the contour after it is cut.
+    #[serde(rename = "cut.out")]
+    CutOut,
+}
+
+/// One vertex of the tool path.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ToolpathEntry {
+    /// Sequential number.
+    #[serde(rename = "point.id")]
+    pub point_id: i64,
+    /// Mode of the move leaving this vertex.
+    pub mode: MoveKind,
+    /// 1-based part number of the contour being cut.
+    #[serde(rename = "part.id", default, skip_serializing_if = "Option::is_none")]
+    pub part_id: Option<i64>,
+    /// 0-based contour number within the part.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub id: Option<i64>,
+    /// Extension: the part's designation.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub partid: Option<String>,
+    /// Extension: the contour's id in the source DBS file.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pathid: Option<i64>,
+    /// `[x, y, angle°]`: the vertex and the arc angle of the move leaving it (0 = straight).
+    pub point: [f64; 3],
+}
+
+/// One move of the tool, ready to draw.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ToolMove {
+    /// What the tool does.
+    pub kind: MoveKind,
+    /// Where the move starts.
+    pub from: Point,
+    /// Where it ends.
+    pub to: Point,
+    /// Bulge of the move (0 = straight).
+    pub bulge: f64,
+    /// The contour being cut, for cutting moves that name one.
+    pub contour: Option<ContourRef>,
+}
+
+/// Options of [`RmResult::from_route`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct ResultExportOptions {
+    /// Idle speed, mm/s: `result` is the idle time L_off / speed, as RouteManager reports.
+    pub idle_speed: f64,
+    /// Value for `count.time`.
+    pub count_time: String,
+    /// Value for `total.points.count`; `None` writes the number of cut steps.
+    pub total_points_count: Option<i64>,
+    /// Value for `total.address.pairs.count`.
+    pub address_pairs_count: i64,
+    /// Write the `partid` extension (part names) on paths and cutting moves.
+    pub part_names: bool,
+}
+
+impl Default for ResultExportOptions {
+    fn default() -> Self {
+        Self {
+            idle_speed: 500.0,
+            count_time: "00:00:00.000".into(),
+            total_points_count: None,
+            address_pairs_count: 0,
+            part_names: true,
+        }
+    }
+}
+
+/// Why a route cannot be turned into moves or a result file.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum RouteError {
+    /// A step names a contour the nest does not have.
+    #[error("route step {step} cuts part {part} contour {contour}, which the nest does not have")]
+    NoSuchContour {
+        /// Index of the step.
+        step: usize,
+        /// `ContourRef::part`.
+        part: usize,
+        /// `ContourRef::contour`.
+        contour: usize,
+    },
+    /// A step's contour has no vertices.
+    #[error("route step {step} cuts an empty contour")]
+    EmptyContour {
+        /// Index of the step.
+        step: usize,
+    },
+}
+
+/// Reads a result file and checks the schema's minimum lengths.
+pub fn read_result_json(bytes: &[u8]) -> Result<RmResult, JsonError> {
+    let result: RmResult = json::parse(bytes)?;
+    let short = |path: String, len: usize| JsonError::TooShort { path, len, min: 2 };
+    if result.job.list.len() < 2 {
+        return Err(short("job.list".into(), result.job.list.len()));
+    }
+    if let Some((i, p)) = result
+        .job
+        .paths
+        .iter()
+        .enumerate()
+        .find(|(_, p)| p.points.len() < 2)
+    {
+        return Err(short(format!("job.paths[{i}].points"), p.points.len()));
+    }
+    Ok(result)
+}
+
+/// Writes a result file (pretty-printed).
+pub fn write_result_json(result: &RmResult) -> Result<String, JsonWriteError> {
+    json::to_pretty(result)
+}
+
+fn stored_degrees(contour: &cutroute_geometry::Contour) -> Vec<[f64; 3]> {
+    contour_check::stored_points(contour)
+        .into_iter()
+        .map(|[x, y, b]| [x, y, geom::bulge_to_degrees(b)])
+        .collect()
+}
+
+/// The moves of a route over a nest: idle to each pierce point, the full contour from there
+/// (split where the pierce point falls inside a span), and idle to the finish.
+pub fn route_moves(nest: &Nest, route: &Route) -> Result<Vec<ToolMove>, RouteError> {
+    let mut moves = Vec::new();
+    let mut at = route.start;
+    for (step, cut) in route.steps.iter().enumerate() {
+        let vertices = cut_vertices(nest, step, cut)?;
+        let pierce = vertices[0].point;
+        moves.push(ToolMove {
+            kind: MoveKind::Air,
+            from: at,
+            to: pierce,
+            bulge: 0.0,
+            contour: None,
+        });
+        for w in vertices.windows(2) {
+            moves.push(ToolMove {
+                kind: MoveKind::Cut,
+                from: w[0].point,
+                to: w[1].point,
+                bulge: w[0].bulge,
+                contour: Some(cut.contour),
+            });
+        }
+        at = pierce;
+    }
+    if let Some(finish) = route.finish {
+        moves.push(ToolMove {
+            kind: MoveKind::Air,
+            from: at,
+            to: finish,
+            bulge: 0.0,
+            contour: None,
+        });
+    }
+    Ok(moves)
+}
+
+fn cut_vertices(
+    nest: &Nest,
+    step: usize,
+    cut: &CutStep,
+) -> Result<Vec<cutroute_geometry::Vertex>, RouteError> {
+    let ContourRef { part, contour } = cut.contour;
+    let c = nest
+        .parts
+        .get(part)
+        .and_then(|p| p.contours.get(contour))
+        .ok_or(RouteError::NoSuchContour {
+            step,
+            part,
+            contour,
+        })?;
+    geom::cut_from(c, cut.pierce_point).ok_or(RouteError::EmptyContour { step })
+}
+
+impl RmResult {
+    /// Exports a route over a nest in RouteManager's result format. Contours are cut in their
+    /// own direction starting at the pierce point; lengths are computed from the geometry.
+    pub fn from_route(
+        nest: &Nest,
+        route: &Route,
+        options: &ResultExportOptions,
+    ) -> Result<Self, RouteError> {
+        let mut paths = Vec::new();
+        for (i, part) in nest.parts.iter().enumerate() {
+            for (k, contour) in part.contours.iter().enumerate() {
+                paths.push(ResultPath {
+                    part_id: i as i64 + 1,
+                    id: k as i64,
+                    partid: options.part_names.then(|| part.name.clone()),
+                    pathid: None,
+                    points: stored_degrees(contour),
+                });
+            }
+        }
+        let list = match nest.sheet.as_ref().and_then(|s| s.contours.first()) {
+            Some(outline) => stored_degrees(outline),
+            None => bounding_rectangle(nest),
+        };
+        let mut toolpath = Vec::new();
+        let mut push = |mode, point: Point, angle: f64, contour: Option<ContourRef>| {
+            toolpath.push(ToolpathEntry {
+                point_id: toolpath.len() as i64,
+                mode,
+                part_id: contour.map(|c| c.part as i64 + 1),
+                id: contour.map(|c| c.contour as i64),
+                partid: contour
+                    .filter(|_| options.part_names)
+                    .and_then(|c| nest.parts.get(c.part))
+                    .map(|p| p.name.clone()),
+                pathid: None,
+                point: [point.x, point.y, angle],
+            });
+        };
+        push(MoveKind::Air, route.start, 0.0, None);
+        let (mut idle, mut cut_len) = (0.0, 0.0);
+        let mut at = route.start;
+        for (step, cut) in route.steps.iter().enumerate() {
+            let vertices = cut_vertices(nest, step, cut)?;
+            idle += geom::dist(at, vertices[0].point);
+            for w in vertices.windows(2) {
+                cut_len += geom::span(w[0].point, w[1].point, w[0].bulge).length();
+                push(
+                    MoveKind::Cut,
+                    w[0].point,
+                    geom::bulge_to_degrees(w[0].bulge),
+                    Some(cut.contour),
+                );
+            }
+            at = vertices[0].point;
+            push(MoveKind::Air, at, 0.0, None);
+        }
+        if let Some(finish) = route.finish {
+            idle += geom::dist(at, finish);
+            push(MoveKind::Air, finish, 0.0, None);
+        }
+        Ok(RmResult {
+            job: Job {
+                paths_count: paths.len() as i64,
+                parts_count: nest.parts.len() as i64,
+                total_points_count: options
+                    .total_points_count
+                    .unwrap_or(route.steps.len() as i64),
+                total_address_pairs_count: options.address_pairs_count,
+                list,
+                paths,
+            },
+            results: Results {
+                result: idle / options.idle_speed,
+                route_length_no_contours: idle,
+                route_length: idle + cut_len,
+                count_time: options.count_time.clone(),
+                toolpath,
+            },
+        })
+    }
+
+    /// The tool path as drawable moves: each vertex's mode and angle describe the move to the
+    /// next vertex.
+    pub fn tool_moves(&self) -> Vec<ToolMove> {
+        self.results
+            .toolpath
+            .windows(2)
+            .map(|w| {
+                let [x, y, angle] = w[0].point;
+                let contour = match (w[0].part_id, w[0].id) {
+                    (Some(p), Some(c)) if p >= 1 && c >= 0 => Some(ContourRef {
+                        part: (p - 1) as usize,
+                        contour: c as usize,
+                    }),
+                    _ => None,
+                };
+                ToolMove {
+                    kind: w[0].mode,
+                    from: Point::new(x, y),
+                    to: Point::new(w[1].point[0], w[1].point[1]),
+                    bulge: geom::degrees_to_bulge(angle),
+                    contour,
+                }
+            })
+            .collect()
+    }
+
+    /// The nest echoed in `job`: the sheet from `list`, parts from `paths` grouped by `part.id`
+    /// (in order of first appearance, contours sorted by `id`).
+    pub fn nest(&self) -> Result<Nest, JsonError> {
+        let closed = |points: &[[f64; 3]], path: String| {
+            let pts: Vec<[f64; 3]> = points
+                .iter()
+                .map(|&[x, y, a]| [x, y, geom::degrees_to_bulge(a)])
+                .collect();
+            contour_check::closed_contour(&pts, DEFAULT_CLOSURE_TOLERANCE, false)
+                .map_err(|problem| JsonError::BadContour { path, problem })
+        };
+        let sheet = Part {
+            name: "sheet".into(),
+            contours: vec![closed(&self.job.list, "job.list".into())?],
+        };
+        let mut groups: Vec<PartGroup> = Vec::new();
+        for (i, p) in self.job.paths.iter().enumerate() {
+            let contour = closed(&p.points, format!("job.paths[{i}].points"))?;
+            match groups.iter_mut().find(|g| g.0 == p.part_id) {
+                Some(g) => g.2.push((p.id, contour)),
+                None => groups.push((p.part_id, p.partid.clone(), vec![(p.id, contour)])),
+            }
+        }
+        let parts = groups
+            .into_iter()
+            .map(|(part_id, name, mut contours)| {
+                contours.sort_by_key(|c| c.0);
+                Part {
+                    name: name.unwrap_or_else(|| part_id.to_string()),
+                    contours: contours.into_iter().map(|c| c.1).collect(),
+                }
+            })
+            .collect();
+        Ok(Nest {
+            sheet: Some(sheet),
+            parts,
+        })
+    }
+
+    /// The route the tool path describes: the start, one step per cut contour (pierce point =
+    /// where cutting of the contour begins, after any lead-in) and the final point as finish.
+    pub fn route(&self) -> Route {
+        let moves = self.tool_moves();
+        let start = moves.first().map(|m| m.from).unwrap_or_default();
+        let mut steps: Vec<CutStep> = Vec::new();
+        let mut previous: Option<MoveKind> = None;
+        for m in &moves {
+            if m.kind == MoveKind::Cut && previous != Some(MoveKind::Cut) {
+                if let Some(contour) = m.contour {
+                    steps.push(CutStep {
+                        contour,
+                        pierce_point: m.from,
+                    });
+                }
+            }
+            previous = Some(m.kind);
+        }
+        let finish = match moves.last() {
+            Some(m) if m.kind == MoveKind::Air => Some(m.to),
+            _ => None,
+        };
+        Route {
+            start,
+            steps,
+            finish,
+        }
+    }
+}
+
+/// Contours of one `part.id` collected from `job.paths`: (part.id, partid, [(id, contour)]).
+type PartGroup = (i64, Option<String>, Vec<(i64, cutroute_geometry::Contour)>);
+
+/// A clockwise rectangle around every part, used as `list` when the nest has no sheet.
+fn bounding_rectangle(nest: &Nest) -> Vec<[f64; 3]> {
+    let mut b = [
+        f64::INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::NEG_INFINITY,
+    ];
+    for v in nest
+        .parts
+        .iter()
+        .flat_map(|p| &p.contours)
+        .flat_map(|c| &c.vertices)
+    {
+        b = [
+            b[0].min(v.point.x),
+            b[1].min(v.point.y),
+            b[2].max(v.point.x),
+            b[3].max(v.point.y),
+        ];
+    }
+    if !b[0].is_finite() {
+        b = [0.0; 4];
+    }
+    vec![
+        [b[0], b[1], 0.0],
+        [b[0], b[3], 0.0],
+        [b[2], b[3], 0.0],
+        [b[2], b[1], 0.0],
+        [b[0], b[1], 0.0],
+    ]
+}

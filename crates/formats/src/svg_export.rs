@@ -1,0 +1,267 @@
+//! SVG export of a nest and, optionally, a tool path (thesis §4.2).
+//!
+//! One `<path>` per part (all its contours in one `d`, holes shown by `fill-rule: evenodd`),
+//! everything inside `<g transform="scale(1,-1)">` so CAD's y-up coordinates display upright,
+//! arcs as `A` commands split at their zenith when they reach 180° (so the large-arc flag is
+//! always 0). Styling is by CSS class, so the app's themes restyle it: `sheet`, `part`, `idle`,
+//! `cut`, `lead` (lead-in/out), `pierce`, `start`, `finish`.
+
+use cutroute_geometry::{Contour, Nest, Part, Point};
+use svg::node::element::path::Data;
+use svg::node::element::{Circle, Group, Path, Style, Title};
+use svg::Document;
+
+use crate::geom;
+use crate::result_json::{MoveKind, ToolMove};
+
+/// The default theme embedded when [`SvgOptions::embed_style`] is on.
+pub const DEFAULT_STYLE: &str = "\
+path{fill-rule:evenodd;stroke-linejoin:round;vector-effect:non-scaling-stroke;stroke-width:1px}\
+path.sheet{fill:none;stroke:#555}\
+path.part{fill:#cdff00;fill-opacity:.6;stroke:black}\
+path.cut{fill:none;stroke:#d00;stroke-width:2px}\
+path.lead{fill:none;stroke:#f80;stroke-width:2px}\
+path.idle{fill:none;stroke:#06c;stroke-dasharray:4 3}\
+circle.pierce{fill:#0f0;stroke:navy;vector-effect:non-scaling-stroke}\
+circle.start,circle.finish{fill:#fc0;stroke:black;vector-effect:non-scaling-stroke}";
+
+/// Options of [`nest_svg`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct SvgOptions {
+    /// Margin around the drawing as a fraction of its larger side.
+    pub margin: f64,
+    /// Embed [`DEFAULT_STYLE`]; switch off when the page supplies its own theme.
+    pub embed_style: bool,
+    /// Radius of pierce/start/finish markers as a fraction of the drawing's larger side.
+    pub marker_radius: f64,
+}
+
+impl Default for SvgOptions {
+    fn default() -> Self {
+        Self {
+            margin: 0.01,
+            embed_style: true,
+            marker_radius: 0.002,
+        }
+    }
+}
+
+/// Renders a nest, and the tool moves when given, as a standalone SVG document.
+pub fn nest_svg(nest: &Nest, moves: Option<&[ToolMove]>, options: &SvgOptions) -> String {
+    let (min, max) = extent(nest, moves.unwrap_or(&[]));
+    let side = (max.x - min.x).max(max.y - min.y).max(1e-9);
+    let margin = side * options.margin;
+    let mut doc = Document::new().set("class", "cutroute-nest").set(
+        "viewBox",
+        (
+            min.x - margin,
+            -(max.y + margin),
+            max.x - min.x + 2.0 * margin,
+            max.y - min.y + 2.0 * margin,
+        ),
+    );
+    if options.embed_style {
+        doc = doc.add(Style::new(DEFAULT_STYLE));
+    }
+    let mut flipped = Group::new().set("transform", "scale(1,-1)");
+    let mut parts = Group::new().set("class", "nest");
+    if let Some(sheet) = &nest.sheet {
+        parts = parts.add(part_path(sheet, "sheet"));
+    }
+    for part in &nest.parts {
+        parts = parts.add(part_path(part, "part"));
+    }
+    flipped = flipped.add(parts);
+    if let Some(moves) = moves {
+        flipped = flipped.add(route_group(moves, side * options.marker_radius));
+    }
+    doc.add(flipped).to_string()
+}
+
+fn part_path(part: &Part, class: &str) -> Path {
+    let mut data = Data::new();
+    for contour in &part.contours {
+        data = contour_data(data, contour);
+    }
+    Path::new()
+        .set("class", class)
+        .set("data-partid", part.name.as_str())
+        .set("d", data)
+        .add(Title::new(format!(
+            "Part: {} / Contours: {}",
+            part.name,
+            part.contours.len()
+        )))
+}
+
+fn contour_data(mut data: Data, contour: &Contour) -> Data {
+    let Some(first) = contour.vertices.first() else {
+        return data;
+    };
+    data = data.move_to((first.point.x, first.point.y));
+    for s in contour.spans() {
+        data = span_data(data, s.start, s.end, s.bulge);
+    }
+    data.close()
+}
+
+/// Appends one span; `V`/`H`/`L` for straight spans, one or two `A` for arcs.
+fn span_data(data: Data, a: Point, z: Point, b: f64) -> Data {
+    if b == 0.0 || a == z {
+        return if a.x == z.x {
+            data.vertical_line_to(z.y)
+        } else if a.y == z.y {
+            data.horizontal_line_to(z.x)
+        } else {
+            data.line_to((z.x, z.y))
+        };
+    }
+    if b.abs() >= 1.0 {
+        // ≥ 180°: halve at the zenith so each piece is below 180° and needs no large-arc flag.
+        let m = geom::span(a, z, b).midpoint();
+        let h = geom::half_bulge(b);
+        return arc(arc(data, a, m, h), m, z, h);
+    }
+    arc(data, a, z, b)
+}
+
+fn arc(data: Data, a: Point, z: Point, b: f64) -> Data {
+    let r = geom::span(a, z, b).radius();
+    // Inside the y-flipped group a counter-clockwise arc (b > 0) has sweep flag 1.
+    let sweep = if b > 0.0 { 1 } else { 0 };
+    data.elliptical_arc_to((r, r, 0, 0, sweep, z.x, z.y))
+}
+
+fn route_group(moves: &[ToolMove], marker: f64) -> Group {
+    let mut group = Group::new().set("class", "route");
+    let mut i = 0;
+    // Consecutive moves of one kind form one path, so a contour cut is a single element.
+    while i < moves.len() {
+        let kind = moves[i].kind;
+        let mut data = Data::new().move_to((moves[i].from.x, moves[i].from.y));
+        let mut j = i;
+        while j < moves.len()
+            && moves[j].kind == kind
+            && (j == i || moves[j].from == moves[j - 1].to)
+        {
+            let m = &moves[j];
+            data = span_data(data, m.from, m.to, m.bulge);
+            j += 1;
+        }
+        let class = match kind {
+            MoveKind::Air => "idle",
+            MoveKind::Cut => "cut",
+            MoveKind::CutIn | MoveKind::CutOut => "lead",
+        };
+        group = group.add(Path::new().set("class", class).set("d", data));
+        i = j;
+    }
+    let circle = |p: Point, class: &str| {
+        Circle::new()
+            .set("class", class)
+            .set("cx", p.x)
+            .set("cy", p.y)
+            .set("r", marker)
+    };
+    for (k, m) in moves.iter().enumerate() {
+        let after_idle = k == 0 || moves[k - 1].kind == MoveKind::Air;
+        if m.kind != MoveKind::Air && after_idle {
+            let title = Title::new(format!("Pierce ({:.3}, {:.3})", m.from.x, m.from.y));
+            group = group.add(circle(m.from, "pierce").add(title));
+        }
+    }
+    if let (Some(first), Some(last)) = (moves.first(), moves.last()) {
+        group = group.add(circle(first.from, "start"));
+        if last.kind == MoveKind::Air {
+            group = group.add(circle(last.to, "finish"));
+        }
+    }
+    group
+}
+
+/// Bounding box of everything drawn (arc zeniths included).
+fn extent(nest: &Nest, moves: &[ToolMove]) -> (Point, Point) {
+    let mut lo = Point::new(f64::INFINITY, f64::INFINITY);
+    let mut hi = Point::new(f64::NEG_INFINITY, f64::NEG_INFINITY);
+    let mut add = |p: Point| {
+        if p.x.is_finite() && p.y.is_finite() {
+            lo = Point::new(lo.x.min(p.x), lo.y.min(p.y));
+            hi = Point::new(hi.x.max(p.x), hi.y.max(p.y));
+        }
+    };
+    for contour in nest
+        .sheet
+        .iter()
+        .chain(&nest.parts)
+        .flat_map(|p| &p.contours)
+    {
+        let b = contour.bounding_box();
+        if !b.is_empty() {
+            add(b.min);
+            add(b.max);
+        }
+    }
+    for m in moves {
+        add(m.from);
+        add(m.to);
+    }
+    if !lo.x.is_finite() {
+        return (Point::default(), Point::new(1.0, 1.0));
+    }
+    (lo, hi)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use cutroute_geometry::Vertex;
+
+    /// Listing 4.1/4.2 of the thesis: a 700 × 500 sheet and a ring of radii 200 and 100.
+    fn listing_4_1() -> Nest {
+        let rect = Contour::new(vec![
+            Vertex::line(0.0, 0.0),
+            Vertex::line(0.0, 500.0),
+            Vertex::line(700.0, 500.0),
+            Vertex::line(700.0, 0.0),
+        ]);
+        let outer = Contour::new(vec![
+            Vertex::arc(205.0, 405.0, -1.0),
+            Vertex::arc(205.0, 5.0, -1.0),
+        ]);
+        let hole = Contour::new(vec![
+            Vertex::arc(205.0, 305.0, 1.0),
+            Vertex::arc(205.0, 105.0, 1.0),
+        ]);
+        Nest {
+            sheet: Some(Part {
+                name: "LIST".into(),
+                contours: vec![rect],
+            }),
+            parts: vec![Part {
+                name: "RING".into(),
+                contours: vec![outer, hole],
+            }],
+        }
+    }
+
+    #[test]
+    fn listing_4_2_half_circles_become_quarter_arcs() {
+        let svg = nest_svg(
+            &listing_4_1(),
+            None,
+            &SvgOptions {
+                embed_style: false,
+                margin: 0.0,
+                ..Default::default()
+            },
+        );
+        // The sheet: V/H commands only, as in the listing.
+        assert!(svg.contains("M0,0 V500 H700 V0 H0 z"), "{svg}");
+        // Each half circle is drawn as two quarter arcs: 4 arcs of radius 200 (clockwise,
+        // sweep 0) and 4 of radius 100 (counter-clockwise, sweep 1).
+        assert_eq!(svg.matches("A200,200,0,0,0,").count(), 4, "{svg}");
+        assert_eq!(svg.matches("A100,100,0,0,1,").count(), 4, "{svg}");
+        assert!(svg.contains("viewBox=\"0 -500 700 500\""), "{svg}");
+        assert!(svg.contains("transform=\"scale(1,-1)\""));
+    }
+}

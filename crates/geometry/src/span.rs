@@ -1,0 +1,635 @@
+//! One span of a contour: a straight segment or a circular arc given by its ends and bulge.
+//!
+//! The formulas follow Appendix Б of the dissertation (complex-plane arc geometry): with chord
+//! `d = Z − A`, length `L = |d|` and bulge `β = tan(φ/4)`, the arc length is
+//! `L·(1 + β²)·atan(β)/β`, the radius `L·(1 + β²)/(4|β|)`, and so on. Wherever a formula would
+//! divide by β, a series or a form without the division is used, so nearly straight arcs
+//! (β → 0) lose no precision and β = 0 needs no special case in the callers.
+//!
+//! Points on a span are addressed by `t ∈ [0, 1]`, proportional to arc length (not the τ of
+//! formula Б.2, whose speed varies along the arc).
+
+use serde::{Deserialize, Serialize};
+
+use crate::{BoundingBox, Point, Transform};
+
+/// Below this |β| the nearest-point search refines a projection instead of going through the
+/// centre, which lies ~L/(4β) away and would cost that many ulps of precision.
+const NEAR_STRAIGHT_BULGE: f64 = 1e-3;
+
+/// Below this |β| a point's parameter is taken from its projection onto the chord: the relative
+/// error is O(β²), far below anything measurable.
+const PROJECTION_PARAMETER_BULGE: f64 = 1e-6;
+
+/// A segment or circular arc from `start` to `end`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Span {
+    /// Where the span starts (A).
+    pub start: Point,
+    /// Where the span ends (Z).
+    pub end: Point,
+    /// `tan(φ/4)` of the swept angle φ; 0 for a segment, positive for counter-clockwise.
+    pub bulge: f64,
+}
+
+/// The point of a span nearest to some query point.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SpanProjection {
+    /// Arc-length parameter of the nearest point, in `[0, 1]`.
+    pub t: f64,
+    /// The nearest point.
+    pub point: Point,
+    /// Its distance to the query point.
+    pub distance: f64,
+}
+
+/// A point where two spans meet.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SpanIntersection {
+    /// The common point.
+    pub point: Point,
+    /// Its arc-length parameter on the first span (the receiver).
+    pub t_self: f64,
+    /// Its arc-length parameter on the second span (the argument).
+    pub t_other: f64,
+}
+
+/// `tan(arg(z)/2)` without trigonometry (formula Б.6); `z` is given as `(re, im)`.
+///
+/// Returns `None` for `z = 0` and for the negative real axis, where the result is infinite.
+pub fn tan_half_arg(re: f64, im: f64) -> Option<f64> {
+    let r = re.hypot(im);
+    let value = if re < 0.0 {
+        if im == 0.0 {
+            return None;
+        }
+        (r - re) / im
+    } else {
+        if r == 0.0 {
+            return None;
+        }
+        im / (r + re)
+    };
+    value.is_finite().then_some(value)
+}
+
+/// `sin(t·x)/sin(x)` for `|x| < π`, stable as `x → 0` (where it tends to `t`).
+fn sin_ratio(t: f64, x: f64) -> f64 {
+    if x.abs() < 1e-4 {
+        // sin(tx)/sin(x) = t·(1 + (1 − t²)·x²/6 + O(x⁴))
+        t * (1.0 + (1.0 - t * t) * x * x / 6.0)
+    } else {
+        (t * x).sin() / x.sin()
+    }
+}
+
+/// `atan(β)/β`, stable as `β → 0`.
+fn atan_over(beta: f64) -> f64 {
+    let b2 = beta * beta;
+    if beta.abs() < 1e-2 {
+        // 1 − β²/3 + β⁴/5 − β⁶/7 + β⁸/9 − …; the next term is below 1e-20.
+        1.0 - b2 * (1.0 / 3.0 - b2 * (1.0 / 5.0 - b2 * (1.0 / 7.0 - b2 / 9.0)))
+    } else {
+        beta.atan() / beta
+    }
+}
+
+/// Circular-segment area factor: signed area between chord and arc divided by `L²`
+/// (positive for β > 0, i.e. when the arc bulges to the right of the chord).
+fn segment_area_factor(beta: f64) -> f64 {
+    let b2 = beta * beta;
+    if beta.abs() < 1e-2 {
+        // Series of Б.4 with the sign flipped to the counter-clockwise-positive convention.
+        beta * (1.0 / 3.0
+            + b2 * (1.0 / 15.0 - b2 * (1.0 / 105.0 - b2 * (1.0 / 315.0 - b2 / 693.0))))
+    } else {
+        ((1.0 + b2) * (1.0 + b2) * beta.atan() - (1.0 - b2) * beta) / (8.0 * b2)
+    }
+}
+
+/// A cycle (circle or line) `a·|q|² + g·q + h = 0` in coordinates relative to some origin.
+#[derive(Clone, Copy, Debug)]
+struct Cycle {
+    a: f64,
+    g: Point,
+    h: f64,
+}
+
+impl Cycle {
+    fn value(&self, q: Point) -> f64 {
+        self.a * q.norm_squared() + self.g.dot(q) + self.h
+    }
+}
+
+/// Real roots of `a·s² + b·s + c = 0`, robust for `a → 0` (then one root runs off to infinity,
+/// to be rejected by the caller) and for a slightly negative discriminant (a tangent touch blurred by rounding).
+fn quadratic_roots(a: f64, b: f64, c: f64) -> Vec<f64> {
+    let scale = a.abs().max(b.abs()).max(c.abs());
+    if !(scale > 0.0) || !scale.is_finite() {
+        return Vec::new();
+    }
+    let (a, b, c) = (a / scale, b / scale, c / scale);
+    // Even a tiny `a` is kept: the small root c/q below stays exact, while dropping a·s²
+    // would cost precision when s is large (nearly straight arcs).
+    if a == 0.0 {
+        if b == 0.0 {
+            return Vec::new();
+        }
+        return vec![-c / b];
+    }
+    let mut disc = b * b - 4.0 * a * c;
+    if disc < 0.0 {
+        if disc > -1e-12 * (b * b + (4.0 * a * c).abs()) {
+            disc = 0.0;
+        } else {
+            return Vec::new();
+        }
+    }
+    if disc == 0.0 {
+        return vec![-b / (2.0 * a)];
+    }
+    let q = -0.5 * (b + b.signum() * disc.sqrt());
+    let q = if q == 0.0 { -0.5 * disc.sqrt() } else { q };
+    vec![q / a, c / q]
+}
+
+impl Span {
+    /// A span from `start` to `end` with the given bulge.
+    pub const fn new(start: Point, end: Point, bulge: f64) -> Self {
+        Span { start, end, bulge }
+    }
+
+    /// A straight segment.
+    pub const fn line(start: Point, end: Point) -> Self {
+        Span {
+            start,
+            end,
+            bulge: 0.0,
+        }
+    }
+
+    /// The arc from `start` to `end` passing through `via` (section 5.5): its bulge is
+    /// `tan(arg(conj(via − start)·(end − via))/2)`.
+    ///
+    /// `None` when `via` coincides with an end, or lies on the chord's line outside the chord
+    /// (no finite arc passes through it); a `via` on the chord gives a straight segment.
+    pub fn through_points(start: Point, via: Point, end: Point) -> Option<Span> {
+        let u = via - start;
+        let v = end - via;
+        if u.norm_squared() == 0.0 || v.norm_squared() == 0.0 {
+            return None;
+        }
+        // conj(u)·v = (u.x − i·u.y)(v.x + i·v.y)
+        let re = u.dot(v);
+        let im = u.cross(v);
+        tan_half_arg(re, im).map(|bulge| Span::new(start, end, bulge))
+    }
+
+    /// True for a straight segment (`bulge == 0`).
+    pub fn is_line(&self) -> bool {
+        self.bulge == 0.0
+    }
+
+    /// The chord vector `end − start`.
+    pub fn chord(&self) -> Point {
+        self.end - self.start
+    }
+
+    /// Length of the chord.
+    pub fn chord_length(&self) -> f64 {
+        self.chord().norm()
+    }
+
+    /// Signed swept angle φ = 4·atan(β), in `(−2π, 2π)`; positive counter-clockwise.
+    pub fn sweep(&self) -> f64 {
+        4.0 * self.bulge.atan()
+    }
+
+    /// Radius `L·(1 + β²)/(4|β|)`; infinite for a segment.
+    pub fn radius(&self) -> f64 {
+        if self.is_line() {
+            return f64::INFINITY;
+        }
+        self.chord_length() * (1.0 + self.bulge * self.bulge) / (4.0 * self.bulge.abs())
+    }
+
+    /// Signed curvature `1/R` (positive for counter-clockwise arcs, 0 for segments), finite
+    /// for every finite bulge and non-degenerate chord.
+    pub fn curvature(&self) -> f64 {
+        let l = self.chord_length();
+        if l == 0.0 {
+            return 0.0;
+        }
+        4.0 * self.bulge / (l * (1.0 + self.bulge * self.bulge))
+    }
+
+    /// Centre of the arc: the chord midpoint plus `i·d·(1 − β²)/(4β)`; `None` for a segment.
+    ///
+    /// For tiny β the centre is far away and imprecise in absolute terms; the other methods
+    /// avoid it for that reason.
+    pub fn centre(&self) -> Option<Point> {
+        if self.is_line() {
+            return None;
+        }
+        let b = self.bulge;
+        let c = self.start.midpoint(self.end)
+            + self.chord().rotated_quarter() * ((1.0 - b * b) / (4.0 * b));
+        c.is_finite().then_some(c)
+    }
+
+    /// The arc's midpoint, the "zenith" `(A + Z)/2 − i·d·β/2`.
+    pub fn midpoint(&self) -> Point {
+        self.start.midpoint(self.end) - self.chord().rotated_quarter() * (0.5 * self.bulge)
+    }
+
+    /// Arc length `(1 + β²)·atan(β)/β·L` (formula Б.3, series near β = 0).
+    pub fn length(&self) -> f64 {
+        let b = self.bulge;
+        (1.0 + b * b) * atan_over(b) * self.chord_length()
+    }
+
+    /// Signed area between the chord and the arc, positive when it adds to the area of a
+    /// counter-clockwise contour (β > 0). Formula Б.4 with the opposite (CCW-positive) sign.
+    pub fn segment_area(&self) -> f64 {
+        segment_area_factor(self.bulge) * self.chord().norm_squared()
+    }
+
+    /// This span's contribution to the signed area of a closed contour, taken about `origin`:
+    /// the shoelace triangle (origin, A, Z) plus the circular segment. Summing it over a
+    /// contour's spans gives the contour's area, positive for counter-clockwise contours.
+    /// Passing a point near the contour as `origin` avoids cancellation far from (0, 0).
+    pub fn area_term(&self, origin: Point) -> f64 {
+        0.5 * (self.start - origin).cross(self.end - origin) + self.segment_area()
+    }
+
+    /// The point at arc-length fraction `t` (0 = start, 1 = end); `t` outside `[0, 1]` walks on
+    /// along the circle (or line).
+    ///
+    /// Computed as `A + d·sin(tφ/2)/sin(φ/2)` turned by `(t − 1)·φ/2`: no centre involved, so it
+    /// is exact for segments and stable for nearly straight arcs.
+    pub fn point_at(&self, t: f64) -> Point {
+        if t == 0.0 {
+            return self.start;
+        }
+        if t == 1.0 {
+            return self.end;
+        }
+        let d = self.chord();
+        if self.is_line() {
+            return self.start + d * t;
+        }
+        let half = 0.5 * self.sweep();
+        self.start + d.rotated((t - 1.0) * half) * sin_ratio(t, half)
+    }
+
+    /// Unit tangent (direction of travel) at arc-length fraction `t`; zero for a zero-length span.
+    pub fn tangent_at(&self, t: f64) -> Point {
+        let d = self.chord().normalized();
+        if self.is_line() {
+            return d;
+        }
+        d.rotated((2.0 * t - 1.0) * 0.5 * self.sweep())
+    }
+
+    /// The same span run backwards (ends swapped, bulge negated).
+    pub fn reversed(&self) -> Span {
+        Span::new(self.end, self.start, -self.bulge)
+    }
+
+    /// The span mapped by `transform`; a reflection negates the bulge.
+    pub fn transformed(&self, transform: &Transform) -> Span {
+        let bulge = if transform.is_reflection() {
+            -self.bulge
+        } else {
+            self.bulge
+        };
+        Span::new(
+            transform.apply(self.start),
+            transform.apply(self.end),
+            bulge,
+        )
+    }
+
+    /// Exact bounding box: the ends plus every axis extreme (leftmost, topmost, …) of the
+    /// circle that lies inside the sweep.
+    pub fn bounding_box(&self) -> BoundingBox {
+        let mut bbox = BoundingBox::from_corners(self.start, self.end);
+        if self.is_line() {
+            return bbox;
+        }
+        let phi = self.sweep();
+        let d = self.chord();
+        if d.norm_squared() == 0.0 || !phi.is_finite() {
+            return bbox;
+        }
+        let theta = d.y.atan2(d.x);
+        let tau = std::f64::consts::TAU;
+        // The outward radius at fraction t points at θ + (2t − 1)φ/2 ∓ π/2 (− for CCW arcs,
+        // whose centre is on the left); it points along axis direction α when
+        // t·φ ≡ α − θ + φ/2 ± π/2 (mod 2π).
+        let side = if phi > 0.0 {
+            std::f64::consts::FRAC_PI_2
+        } else {
+            -std::f64::consts::FRAC_PI_2
+        };
+        for k in 0..4 {
+            let alpha = k as f64 * std::f64::consts::FRAC_PI_2;
+            let delta = (alpha - theta + 0.5 * phi + side).rem_euclid(tau);
+            let delta = if phi < 0.0 && delta > 0.0 {
+                delta - tau
+            } else {
+                delta
+            };
+            let t = delta / phi;
+            if (0.0..=1.0).contains(&t) {
+                bbox = bbox.including(self.point_at(t));
+            }
+        }
+        bbox
+    }
+
+    /// The two spans `start → point_at(t)` and `point_at(t) → end`, with bulges
+    /// `tan(tφ/4)` and `tan((1 − t)φ/4)`. `t` is clamped to `[0, 1]`.
+    pub fn split_at(&self, t: f64) -> (Span, Span) {
+        let t = if t.is_nan() { 0.0 } else { t.clamp(0.0, 1.0) };
+        let p = self.point_at(t);
+        if self.is_line() {
+            return (Span::line(self.start, p), Span::line(p, self.end));
+        }
+        let phi = self.sweep();
+        let first = Span::new(self.start, p, (0.25 * t * phi).tan());
+        let second = Span::new(p, self.end, (0.25 * (1.0 - t) * phi).tan());
+        (first, second)
+    }
+
+    /// The sub-span between arc-length fractions `t0` and `t1` (`t0 ≤ t1` not required: a
+    /// reversed range gives the reversed piece).
+    pub fn sub_span(&self, t0: f64, t1: f64) -> Span {
+        let a = self.point_at(t0);
+        let b = self.point_at(t1);
+        if self.is_line() {
+            return Span::line(a, b);
+        }
+        Span::new(a, b, (0.25 * (t1 - t0) * self.sweep()).tan())
+    }
+
+    /// Merges `self` with the following span `next` into one span when they are pieces of the
+    /// same line or circle meeting end to start; the bulge is `tan((φ₁ + φ₂)/4)`, i.e.
+    /// `(β₁ + β₂)/(1 − β₁β₂)`. `None` when they do not continue each other within
+    /// `tolerance` (a length), or when the union would sweep a full circle or more.
+    pub fn joined(&self, next: &Span, tolerance: f64) -> Option<Span> {
+        if !(self.end.distance(next.start) <= tolerance) {
+            return None;
+        }
+        let total = self.sweep() + next.sweep();
+        if !(total.abs() < std::f64::consts::TAU) {
+            return None;
+        }
+        let merged = if self.is_line() && next.is_line() {
+            Span::line(self.start, next.end)
+        } else {
+            Span::new(self.start, next.end, (0.25 * total).tan())
+        };
+        // Both pieces must lie on the merged span: test each one's midpoint.
+        let on = |s: &Span| merged.nearest_point(s.midpoint()).distance <= tolerance;
+        let turns_consistently = self.sweep().signum() * next.sweep().signum() >= 0.0;
+        (turns_consistently && on(self) && on(next)).then_some(merged)
+    }
+
+    /// The arc-length parameter of a point lying on (or very near) the span's line or circle;
+    /// not clamped: points of the line or circle outside the span map outside `[0, 1]`.
+    pub fn parameter_of(&self, p: Point) -> f64 {
+        let d = self.chord();
+        let l2 = d.norm_squared();
+        if l2 == 0.0 {
+            return 0.0;
+        }
+        if self.bulge.abs() < PROJECTION_PARAMETER_BULGE {
+            return (p - self.start).dot(d) / l2;
+        }
+        let phi = self.sweep();
+        let tangent = d.rotated(-0.5 * phi);
+        let v = p - self.start;
+        if phi.abs() < 1.0 {
+            // Chord ratio: |P − A| = L·sin(tφ/2)/sin(φ/2), monotone here. Going through the
+            // angle instead would multiply its rounding error by 2/φ.
+            let ratio = (v.norm() / l2.sqrt() * (0.5 * phi.abs()).sin()).min(1.0);
+            let t = 2.0 * ratio.asin() / phi.abs();
+            return if tangent.dot(v) < 0.0 { -t } else { t };
+        }
+        // Tangent–chord angle: the chord A→P makes half of its arc's angle with the start tangent.
+        let psi = tangent.cross(v).atan2(tangent.dot(v));
+        let psi = if phi > 0.0 && psi < 0.0 {
+            psi + std::f64::consts::TAU
+        } else if phi < 0.0 && psi > 0.0 {
+            psi - std::f64::consts::TAU
+        } else {
+            psi
+        };
+        2.0 * psi / phi
+    }
+
+    /// The point of the span nearest to `p`, its parameter and distance.
+    ///
+    /// A NaN input gives a NaN distance (never a panic).
+    pub fn nearest_point(&self, p: Point) -> SpanProjection {
+        let at = |t: f64| {
+            let point = self.point_at(t);
+            SpanProjection {
+                t,
+                point,
+                distance: point.distance(p),
+            }
+        };
+        let better =
+            |a: SpanProjection, b: SpanProjection| if b.distance < a.distance { b } else { a };
+        let ends = better(at(0.0), at(1.0));
+        let d = self.chord();
+        let l2 = d.norm_squared();
+        if l2 == 0.0 {
+            return at(0.0);
+        }
+        let projection_t = ((p - self.start).dot(d) / l2).clamp(0.0, 1.0);
+        if self.is_line() {
+            return if projection_t.is_nan() {
+                ends
+            } else {
+                at(projection_t)
+            };
+        }
+        let radius = self.radius();
+        let far = p.distance(self.start.midpoint(self.end)) > 0.25 * radius;
+        if self.bulge.abs() >= NEAR_STRAIGHT_BULGE || far {
+            // Radial projection onto the circle; the centre is precise enough here.
+            let Some(c) = self.centre() else { return ends };
+            let v = p - c;
+            let n = v.norm();
+            if !(n > 1e-12 * radius) {
+                return ends; // p at the centre: every point is equally near
+            }
+            let x = c + v * (radius / n);
+            // On the arc iff on the zenith side of the chord (cross(d, x − A)·β ≤ 0).
+            if d.cross(x - self.start) * self.bulge <= 0.0 {
+                let t = self.parameter_of(x).clamp(0.0, 1.0);
+                return better(ends, at(t));
+            }
+            return ends;
+        }
+        // Nearly straight and p nearby: Newton on t from the chord projection. The true second
+        // derivative differs from length² by a factor (1 ± κ·dist) with κ·dist < 1/4 here, so
+        // the iteration contracts.
+        let length = self.length();
+        let mut t = projection_t;
+        for _ in 0..60 {
+            let q = self.point_at(t);
+            let g = (q - p).dot(self.tangent_at(t)) * length;
+            let next = (t - g / (length * length)).clamp(0.0, 1.0);
+            let step = (next - t).abs();
+            t = next;
+            if !(step > 1e-15) {
+                break;
+            }
+        }
+        if t.is_nan() {
+            return ends;
+        }
+        better(ends, at(t))
+    }
+
+    /// Distance from `p` to the span.
+    pub fn distance_to(&self, p: Point) -> f64 {
+        self.nearest_point(p).distance
+    }
+
+    /// The span's circle (or line) as `a·|q|² + g·q + h = 0` with `q = p − origin`.
+    ///
+    /// From `|q' − c|² = R²` around the chord midpoint, multiplied by β so that nothing is
+    /// divided by β: `β(|q'|² − L²/4) − ((1 − β²)/2)·cross(d, q') = 0`. At β = 0 it is the line.
+    fn cycle(&self, origin: Point) -> Cycle {
+        let b = self.bulge;
+        let d = self.chord();
+        let m = self.start.midpoint(self.end) - origin;
+        let k = 0.5 * (1.0 - b * b);
+        let l2 = d.norm_squared();
+        let normal = d.rotated_quarter(); // cross(d, q) = normal · q
+        Cycle {
+            a: b,
+            g: m * (-2.0 * b) - normal * k,
+            h: b * (m.norm_squared() - 0.25 * l2) + k * d.cross(m),
+        }
+    }
+
+    /// The arc-length parameter of `p` if it lies on the span within `tolerance`.
+    fn locate(&self, p: Point, tolerance: f64) -> Option<f64> {
+        if self.start.distance(p) <= tolerance {
+            return Some(0.0);
+        }
+        if self.end.distance(p) <= tolerance {
+            return Some(1.0);
+        }
+        let t = self.parameter_of(p);
+        if !(-1e-9..=1.0 + 1e-9).contains(&t) {
+            return None;
+        }
+        let t = t.clamp(0.0, 1.0);
+        (self.point_at(t).distance(p) <= tolerance).then_some(t)
+    }
+
+    /// Tolerance for deciding that a computed point lies on both spans: relative to the size
+    /// and position of the pair, so that it survives the rounding of the cycle coefficients.
+    fn pair_tolerance(&self, other: &Span) -> f64 {
+        let magnitude = [self.start, self.end, other.start, other.end]
+            .iter()
+            .map(|p| p.x.abs().max(p.y.abs()))
+            .fold(0.0, f64::max);
+        1e-9 * (1.0 + magnitude + self.chord_length() + other.chord_length())
+    }
+
+    /// All points where this span meets `other` (at most two, except for overlapping pieces of
+    /// the same line or circle, where the overlap's end points are reported).
+    pub fn intersections(&self, other: &Span) -> Vec<SpanIntersection> {
+        let tolerance = self.pair_tolerance(other);
+        if !tolerance.is_finite()
+            || !self
+                .bounding_box()
+                .expanded(tolerance)
+                .intersects(&other.bounding_box())
+        {
+            return Vec::new();
+        }
+        let mut candidates: Vec<Point> = Vec::new();
+        let zero_self = self.chord().norm_squared() == 0.0;
+        let zero_other = other.chord().norm_squared() == 0.0;
+        if zero_self || zero_other {
+            candidates.push(if zero_self { self.start } else { other.start });
+        } else if self.is_line() && other.is_line() {
+            candidates.extend(segment_segment(self, other, tolerance));
+        } else {
+            let origin = self.start.midpoint(self.end);
+            let c1 = self.cycle(origin);
+            let c2 = other.cycle(origin);
+            // Radical line: a₂·(cycle 1) − a₁·(cycle 2), linear in q.
+            let normal = c1.g * c2.a - c2.g * c1.a;
+            let offset = c2.a * c1.h - c1.a * c2.h;
+            let scale = (c1.g * c2.a).norm() + (c2.g * c1.a).norm();
+            if normal.norm() <= 1e-12 * scale {
+                // Same centre: either disjoint circles or the same circle (overlap).
+                candidates.extend([self.start, self.end, other.start, other.end]);
+            } else {
+                let n2 = normal.norm_squared();
+                let q0 = normal * (-offset / n2);
+                let dir = normal.rotated_quarter();
+                let c = if c1.a.abs() >= c2.a.abs() { c1 } else { c2 };
+                let roots = quadratic_roots(
+                    c.a * dir.norm_squared(),
+                    2.0 * c.a * q0.dot(dir) + c.g.dot(dir),
+                    c.value(q0),
+                );
+                candidates.extend(roots.into_iter().map(|s| origin + q0 + dir * s));
+            }
+        }
+        let mut found: Vec<SpanIntersection> = Vec::new();
+        for point in candidates {
+            let (Some(t_self), Some(t_other)) = (
+                self.locate(point, tolerance),
+                other.locate(point, tolerance),
+            ) else {
+                continue;
+            };
+            if found.iter().any(|f| f.point.distance(point) <= tolerance) {
+                continue;
+            }
+            found.push(SpanIntersection {
+                point,
+                t_self,
+                t_other,
+            });
+        }
+        found.sort_by(|a, b| a.t_self.total_cmp(&b.t_self));
+        found
+    }
+
+    /// Where the straight segment `a → b` meets this span.
+    pub fn intersect_segment(&self, a: Point, b: Point) -> Vec<SpanIntersection> {
+        self.intersections(&Span::line(a, b))
+    }
+}
+
+/// Candidate meeting points of two straight segments: the crossing, or for collinear
+/// overlapping segments all four end points (filtered by the caller).
+fn segment_segment(s: &Span, o: &Span, tolerance: f64) -> Vec<Point> {
+    let r = s.chord();
+    let q = o.chord();
+    let denom = r.cross(q);
+    let w = o.start - s.start;
+    if denom.abs() > 1e-12 * r.norm() * q.norm() {
+        let t = w.cross(q) / denom;
+        return vec![s.start + r * t];
+    }
+    // Parallel: collinear only if o.start is on s's line.
+    if (r.cross(w)).abs() <= tolerance * r.norm() {
+        vec![s.start, s.end, o.start, o.end]
+    } else {
+        Vec::new()
+    }
+}

@@ -1,0 +1,271 @@
+//! Property tests: span and contour maths against dense polyline approximations.
+
+use proptest::prelude::*;
+
+use cutroute_geometry::{Contour, Point, Span, Transform, Vertex};
+
+fn point() -> impl Strategy<Value = Point> {
+    (-100.0..100.0f64, -100.0..100.0f64).prop_map(|(x, y)| Point::new(x, y))
+}
+
+fn bulge() -> impl Strategy<Value = f64> {
+    prop_oneof![
+        3 => -3.0..3.0f64,
+        1 => Just(0.0),
+        1 => Just(1.0),
+        1 => Just(-1.0),
+        1 => -1e-6..1e-6f64,
+        1 => prop_oneof![Just(1e-12), Just(-1e-9), Just(5.0), Just(-20.0)],
+    ]
+}
+
+fn span() -> impl Strategy<Value = Span> {
+    (point(), point(), bulge())
+        .prop_filter("non-degenerate chord", |(a, z, _)| a.distance(*z) > 0.1)
+        .prop_map(|(a, z, b)| Span::new(a, z, b))
+}
+
+/// A star-shaped polygon around the origin with arcs of moderate bulge; may self-intersect
+/// (area and winding number do not need simplicity).
+fn contour() -> impl Strategy<Value = Contour> {
+    prop::collection::vec((0.0..1.0f64, 5.0..50.0f64, -0.6..0.6f64), 3..12).prop_map(|mut raw| {
+        raw.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let n = raw.len() as f64;
+        let vertices = raw
+            .iter()
+            .enumerate()
+            // Spread the angles so no two vertices coincide.
+            .map(|(i, &(a, r, b))| {
+                let angle = std::f64::consts::TAU * (i as f64 + 0.8 * a) / n;
+                Vertex::arc(r * angle.cos(), r * angle.sin(), b)
+            })
+            .collect();
+        Contour::new(vertices)
+    })
+}
+
+fn samples(s: &Span, n: usize) -> Vec<Point> {
+    (0..=n).map(|k| s.point_at(k as f64 / n as f64)).collect()
+}
+
+fn polyline_length(points: &[Point]) -> f64 {
+    points.windows(2).map(|w| w[0].distance(w[1])).sum()
+}
+
+/// Dense closed polygon of a contour (closing point not repeated).
+fn dense(c: &Contour, per_span: usize) -> Vec<Point> {
+    c.spans()
+        .flat_map(|s| (0..per_span).map(move |k| s.point_at(k as f64 / per_span as f64)))
+        .collect()
+}
+
+fn shoelace(poly: &[Point]) -> f64 {
+    let o = poly[0];
+    (0..poly.len())
+        .map(|i| 0.5 * (poly[i] - o).cross(poly[(i + 1) % poly.len()] - o))
+        .sum()
+}
+
+fn polygon_winding(poly: &[Point], p: Point) -> i32 {
+    let mut w = 0;
+    for i in 0..poly.len() {
+        let (a, b) = (poly[i], poly[(i + 1) % poly.len()]);
+        if a.y <= p.y {
+            if b.y > p.y && (b - a).cross(p - a) > 0.0 {
+                w += 1;
+            }
+        } else if b.y <= p.y && (b - a).cross(p - a) < 0.0 {
+            w -= 1;
+        }
+    }
+    w
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 200, ..ProptestConfig::default() })]
+
+    #[test]
+    fn span_length_matches_dense_polyline(s in span()) {
+        let poly = polyline_length(&samples(&s, 4000));
+        let l = s.length();
+        prop_assert!(poly <= l * (1.0 + 1e-12) + 1e-12);
+        prop_assert!((l - poly).abs() <= 1e-5 * l.max(1.0), "{} vs {}", l, poly);
+        // Samples are equally spaced along the arc (arc-length parameter).
+        let a = s.point_at(0.25).distance(s.point_at(0.0));
+        let b = s.point_at(0.5).distance(s.point_at(0.25));
+        prop_assert!((a - b).abs() <= 1e-9 * l.max(1.0));
+    }
+
+    #[test]
+    fn span_points_and_tangents_agree(s in span(), t in 0.0..1.0f64) {
+        let h = 1e-6;
+        let (t0, t1) = ((t - h).max(0.0), (t + h).min(1.0));
+        let numeric = (s.point_at(t1) - s.point_at(t0)).normalized();
+        prop_assert!(numeric.distance(s.tangent_at(t)) < 1e-4);
+        if let Some(c) = s.centre() {
+            if s.radius() < 1e6 {
+                prop_assert!((s.point_at(t).distance(c) - s.radius()).abs() < 1e-9 * s.radius().max(1.0));
+            }
+        }
+        prop_assert!((s.parameter_of(s.point_at(t)) - t).abs() < 1e-7);
+    }
+
+    #[test]
+    fn span_bounding_box_is_exact(s in span()) {
+        let b = s.bounding_box();
+        let pts = samples(&s, 4000);
+        let eps = 1e-9 * (1.0 + s.length());
+        prop_assert!(pts.iter().all(|p| b.expanded(eps).contains_point(*p)));
+        let sampled = cutroute_geometry::BoundingBox::from_points(pts);
+        let slack = 1e-5 * s.length().max(1.0);
+        prop_assert!((sampled.min.x - b.min.x).abs() < slack && (sampled.max.x - b.max.x).abs() < slack);
+        prop_assert!((sampled.min.y - b.min.y).abs() < slack && (sampled.max.y - b.max.y).abs() < slack);
+    }
+
+    #[test]
+    fn split_then_merge_is_identity(s in span(), t in 0.01..0.99f64) {
+        let (a, b) = s.split_at(t);
+        prop_assert!((a.length() + b.length() - s.length()).abs() < 1e-9 * s.length().max(1.0));
+        prop_assert!(a.end.distance(s.point_at(t)) < 1e-12 * (1.0 + s.length()));
+        prop_assert!(a.point_at(0.5).distance(s.point_at(0.5 * t)) < 1e-9 * s.length().max(1.0));
+        let merged = a.joined(&b, 1e-7 * s.length().max(1.0));
+        prop_assert!(merged.is_some(), "{:?} {:?}", a, b);
+        let m = merged.unwrap();
+        prop_assert_eq!(m.start, s.start);
+        prop_assert_eq!(m.end, s.end);
+        prop_assert!((m.bulge - s.bulge).abs() <= 1e-9 * (1.0 + s.bulge.abs() * s.bulge.abs()));
+    }
+
+    #[test]
+    fn arc_through_its_own_point(s in span(), t in 0.05..0.95f64) {
+        let via = s.point_at(t);
+        if let Some(r) = Span::through_points(s.start, via, s.end) {
+            prop_assert!((r.sweep() - s.sweep()).abs() < 1e-6, "{:?} vs {:?}", r, s);
+        } else {
+            prop_assert!(false, "no arc through {:?}", via);
+        }
+    }
+
+    #[test]
+    fn nearest_point_beats_samples(s in span(), q in point()) {
+        let n = s.nearest_point(q);
+        prop_assert!((0.0..=1.0).contains(&n.t));
+        prop_assert!((s.point_at(n.t).distance(q) - n.distance).abs() < 1e-9 * (1.0 + n.distance));
+        let best_sample = samples(&s, 2000).into_iter().map(|p| p.distance(q)).fold(f64::INFINITY, f64::min);
+        prop_assert!(n.distance <= best_sample + 1e-9 * (1.0 + best_sample), "{} > {}", n.distance, best_sample);
+    }
+
+    #[test]
+    fn intersections_are_on_both_and_complete(s in span(), o in span()) {
+        let found = s.intersections(&o);
+        for x in &found {
+            prop_assert!(s.point_at(x.t_self).distance(x.point) < 1e-6);
+            prop_assert!(o.point_at(x.t_other).distance(x.point) < 1e-6);
+        }
+        // Every crossing of the dense polylines is near a reported intersection, unless all
+        // possible intersections were found already (at near-tangent crossings a polyline's
+        // crossing can drift far from the true one).
+        let most = if s.is_line() && o.is_line() { 1 } else { 2 };
+        prop_assume!(found.len() < most);
+        let (ps, po) = (samples(&s, 600), samples(&o, 600));
+        let mut misses = 0;
+        for a in ps.windows(2) {
+            for b in po.windows(2) {
+                let (r, q) = (a[1] - a[0], b[1] - b[0]);
+                let den = r.cross(q);
+                if den.abs() < 1e-12 { continue; }
+                let w = b[0] - a[0];
+                let (t, u) = (w.cross(q) / den, w.cross(r) / den);
+                if (0.0..=1.0).contains(&t) && (0.0..=1.0).contains(&u) {
+                    let hit = a[0] + r * t;
+                    if !found.iter().any(|x| x.point.distance(hit) < 0.05) { misses += 1; }
+                }
+            }
+        }
+        prop_assert_eq!(misses, 0, "{:?}", found);
+    }
+
+    #[test]
+    fn contour_area_and_perimeter_match_dense_polygon(c in contour()) {
+        let poly = dense(&c, 800);
+        let area = shoelace(&poly);
+        // The inscribed polygon misses n·R²(θ − sin θ)/2 ≤ n·R²·θ³/12 per arc, θ = |φ|/n.
+        let missed: f64 = c
+            .spans()
+            .filter(|s| !s.is_line())
+            .map(|s| {
+                let theta = s.sweep().abs() / 800.0;
+                800.0 * s.radius() * s.radius() * theta.powi(3) / 12.0
+            })
+            .sum();
+        let tolerance = 1.01 * missed + 1e-9 * c.perimeter() * c.perimeter();
+        prop_assert!((c.signed_area() - area).abs() <= tolerance, "{} vs {} (tol {})", c.signed_area(), area, tolerance);
+        let mut closed = poly.clone();
+        closed.push(poly[0]);
+        let per = polyline_length(&closed);
+        prop_assert!((c.perimeter() - per).abs() <= 1e-5 * per);
+        prop_assert_eq!(c.is_clockwise(), area < 0.0);
+    }
+
+    #[test]
+    fn point_in_contour_matches_dense_winding(c in contour(), q in (-60.0..60.0f64, -60.0..60.0f64)) {
+        let q = Point::new(q.0, q.1);
+        prop_assume!(c.distance_to(q) > 1e-2);
+        let poly: Vec<Point> = c.flatten(1e-5);
+        prop_assert_eq!(c.winding_number(q), polygon_winding(&poly, q));
+    }
+
+    #[test]
+    fn point_in_contour_on_grid_points(
+        raw in prop::collection::vec((-20i32..20, -20i32..20, prop_oneof![Just(0.0), Just(1.0), Just(-1.0), Just(0.5), Just(-0.25), Just(2.0)]), 2..7),
+        qx in -40i32..40, qy in -40i32..40,
+    ) {
+        // Vertices and query points on a grid: the query often sits exactly on a chord's line
+        // or at a vertex's height, the degenerate cases of ray casting.
+        let c = Contour::new(raw.iter().map(|&(x, y, b)| Vertex::arc(x as f64, y as f64, b)).collect());
+        let q = Point::new(qx as f64 * 0.5, qy as f64 * 0.5);
+        prop_assume!(c.distance_to(q) > 1e-3);
+        let poly: Vec<Point> = c.flatten(1e-6);
+        prop_assert_eq!(c.winding_number(q), polygon_winding(&poly, q));
+    }
+
+    #[test]
+    fn reverse_twice_is_identity(c in contour()) {
+        let r = c.reversed();
+        prop_assert_eq!(r.reversed(), c.clone());
+        prop_assert!((r.signed_area() + c.signed_area()).abs() < 1e-9 * c.area().max(1.0));
+        prop_assert!((r.perimeter() - c.perimeter()).abs() < 1e-9 * c.perimeter());
+        // The same point set: reversed contour's samples lie on the original.
+        for p in dense(&r, 5) {
+            prop_assert!(c.distance_to(p) < 1e-9);
+        }
+    }
+
+    #[test]
+    fn transform_then_inverse_is_identity(
+        c in contour(), angle in -7.0..7.0f64, scale in 0.5..2.0f64, mirror: bool, dx in -1e3..1e3f64, dy in -1e3..1e3f64
+    ) {
+        let mut t = Transform::rotation(angle).then(&Transform::scaling(scale));
+        if mirror { t = t.then(&Transform::mirror_y()); }
+        let t = t.then(&Transform::translation(dx, dy));
+        let image = c.transformed(&t);
+        prop_assert!((image.signed_area() - c.signed_area() * t.determinant()).abs() < 1e-6 * c.area().max(1.0) * scale * scale);
+        let inverse = t.inverse().unwrap();
+        let back = image.transformed(&inverse);
+        for (a, b) in back.vertices.iter().zip(&c.vertices) {
+            prop_assert!(a.point.distance(b.point) < 1e-9 * 1e3);
+            prop_assert_eq!(a.bulge, b.bulge);
+        }
+    }
+
+    #[test]
+    fn contour_nearest_and_length_parameterisation(c in contour(), q in point(), s in 0.0..1.0f64) {
+        let n = c.nearest_point(q).unwrap();
+        let best_sample = dense(&c, 300).into_iter().map(|p| p.distance(q)).fold(f64::INFINITY, f64::min);
+        prop_assert!(n.distance <= best_sample + 1e-9);
+        let length = s * c.perimeter();
+        let pos = c.position_at_length(length).unwrap();
+        prop_assert!((c.length_at(pos) - length).abs() < 1e-9 * c.perimeter());
+        prop_assert!(c.point_at_length(length).unwrap().distance(c.point_at(pos).unwrap()) < 1e-12);
+    }
+}

@@ -1,0 +1,128 @@
+//! A simple improvement heuristic for initial upper bounds: for a precedence-feasible cluster
+//! order, choose the best node of every cluster (exact, by a DP along the cycle), and move
+//! clusters or short cluster chains to better precedence-feasible positions (or-opt).
+
+use crate::bounds::Model;
+
+const INF: f64 = f64::INFINITY;
+
+/// Best node choice for a fixed cluster order (first cluster = depot with the model's start
+/// node). Returns the nodes and the closed-tour cost (`INF` if every choice hits a forbidden arc).
+pub(crate) fn best_nodes(model: &Model, clusters: &[usize]) -> (Vec<usize>, f64) {
+    let m = clusters.len();
+    let start = model.start;
+    let mut layers: Vec<Vec<(f64, usize)>> = Vec::with_capacity(m);
+    layers.push(vec![(0.0, usize::MAX)]);
+    let mut prev_nodes: &[usize] = std::slice::from_ref(&model.start);
+    for &c in &clusters[1..] {
+        let nodes = &model.cluster_nodes[c];
+        let prev = layers.last().expect("non-empty");
+        let mut layer = Vec::with_capacity(nodes.len());
+        for &x in nodes {
+            let mut best = (INF, usize::MAX);
+            for (i, &u) in prev_nodes.iter().enumerate() {
+                let v = prev[i].0 + model.arc(u, x);
+                if v < best.0 {
+                    best = (v, i);
+                }
+            }
+            layer.push(best);
+        }
+        layers.push(layer);
+        prev_nodes = nodes;
+    }
+    let last = layers.last().expect("non-empty");
+    let mut best = (INF, usize::MAX);
+    for (i, &u) in prev_nodes.iter().enumerate() {
+        let v = last[i].0 + model.arc(u, start);
+        if v < best.0 {
+            best = (v, i);
+        }
+    }
+    if !best.0.is_finite() {
+        return (Vec::new(), INF);
+    }
+    let mut nodes = vec![0; m];
+    let mut index = best.1;
+    for pos in (0..m).rev() {
+        nodes[pos] = if pos == 0 {
+            start
+        } else {
+            model.cluster_nodes[clusters[pos]][index]
+        };
+        index = layers[pos][index].1;
+    }
+    (nodes, best.0)
+}
+
+/// Improves a feasible node tour in place by or-opt cluster-chain moves (with node re-selection
+/// after every accepted move) until no move helps or `budget_moves` evaluations are used.
+pub(crate) fn improve(model: &Model, tour: &mut Vec<usize>, budget_moves: usize) -> f64 {
+    let m = tour.len();
+    let mut clusters: Vec<usize> = tour.iter().map(|&v| model.node_cluster[v]).collect();
+    let (mut nodes, mut cost) = best_nodes(model, &clusters);
+    if !cost.is_finite() {
+        return INF;
+    }
+    let mut evaluations = 0usize;
+    let mut improved = true;
+    while improved && evaluations < budget_moves {
+        improved = false;
+        'moves: for len in 1..=3usize {
+            for i in 1..m {
+                if i + len > m {
+                    break;
+                }
+                // Chain clusters[i..i+len] moved to after position j (in the remaining order).
+                for j in 0..m {
+                    if j + 1 >= i && j < i + len {
+                        continue;
+                    }
+                    evaluations += 1;
+                    let candidate = moved(&clusters, i, len, j);
+                    if !feasible(model, &candidate) {
+                        continue;
+                    }
+                    let (cand_nodes, cand_cost) = best_nodes(model, &candidate);
+                    if cand_cost < cost - 1e-9 {
+                        clusters = candidate;
+                        nodes = cand_nodes;
+                        cost = cand_cost;
+                        improved = true;
+                        break 'moves;
+                    }
+                    if evaluations >= budget_moves {
+                        break 'moves;
+                    }
+                }
+            }
+        }
+    }
+    *tour = nodes;
+    cost
+}
+
+fn moved(clusters: &[usize], i: usize, len: usize, j: usize) -> Vec<usize> {
+    let chain = &clusters[i..i + len];
+    let mut rest: Vec<usize> = clusters[..i]
+        .iter()
+        .chain(&clusters[i + len..])
+        .copied()
+        .collect();
+    let insert_at = if j < i { j + 1 } else { j + 1 - len };
+    let tail = rest.split_off(insert_at);
+    rest.extend_from_slice(chain);
+    rest.extend(tail);
+    rest
+}
+
+fn feasible(model: &Model, clusters: &[usize]) -> bool {
+    let mut seen = crate::order::ClusterSet::new(model.m);
+    for &c in clusters {
+        if !model.order.predecessors[c].is_subset(&seen) {
+            return false;
+        }
+        seen.insert(c);
+    }
+    true
+}

@@ -1,0 +1,492 @@
+//! The exact solver: an anytime, resumable driver around the DP over order ideals.
+
+use crate::bounds::{Model, ResidualBounder};
+use crate::check::check_tour;
+use crate::dp::{Dp, DpStatus, Incumbent};
+use crate::heuristic;
+use crate::instance::Instance;
+use crate::order::OrderError;
+use std::time::Duration;
+use web_time::Instant;
+
+const INF: f64 = f64::INFINITY;
+
+/// Settings of the exact solver.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ExactOptions {
+    /// Stop after this much time (measured from the first `step`); `None` = no limit.
+    pub time_limit: Option<Duration>,
+    /// Approximate memory the DP may use. When reached, the worst-bounded states are dropped
+    /// (the lower bound stays valid; optimality is then no longer proven).
+    pub memory_limit_bytes: usize,
+    /// Also compute the L2 bound (assignment on the two-step graph H2).
+    pub use_l2: bool,
+    /// Run the beam-search + local-search heuristic first for an initial upper bound.
+    pub heuristic: bool,
+    /// Beam widths tried by the heuristic, in order.
+    pub beam_widths: Vec<usize>,
+    /// Stop as soon as `(UB − LB) / UB` is at most this (0 = prove optimality).
+    pub gap_tolerance: f64,
+}
+
+impl Default for ExactOptions {
+    fn default() -> Self {
+        ExactOptions {
+            time_limit: Some(Duration::from_secs(60)),
+            memory_limit_bytes: 1 << 30,
+            use_l2: true,
+            heuristic: true,
+            beam_widths: vec![64, 1024],
+            gap_tolerance: 0.0,
+        }
+    }
+}
+
+/// Why the solver could not be created.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SolverError {
+    /// The precedence pairs are not a partial order with the depot first.
+    #[error(transparent)]
+    Order(#[from] OrderError),
+    /// The instance has more nodes than the DP's 16-bit node index can hold.
+    #[error("{0} nodes: the exact solver handles at most 65535")]
+    TooManyNodes(usize),
+}
+
+/// What a call of [`ExactSolver::step`] ended with.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SolverStatus {
+    /// Work remains; call `step` again.
+    Running,
+    /// The search is complete. `proven_optimal` is false if states were dropped for memory
+    /// (or the DP could not run), in which case the lower bound is the best proven one.
+    Finished {
+        /// Whether the incumbent is proven optimal.
+        proven_optimal: bool,
+    },
+    /// Stopped by the time limit, the gap tolerance or [`ExactSolver::cancel`].
+    Stopped,
+}
+
+/// A snapshot of the solver's state.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ExactProgress {
+    /// Time spent in `step` so far.
+    pub elapsed: Duration,
+    /// Cost of the best tour known (`INFINITY` if none).
+    pub upper_bound: f64,
+    /// Proven lower bound on the optimum.
+    pub lower_bound: f64,
+    /// `(UB − LB) / UB` (0 when proven, `INFINITY` without a tour).
+    pub gap: f64,
+    /// Current DP layer (clusters in the ideals being expanded).
+    pub layer: usize,
+    /// DP states alive in memory.
+    pub live_states: usize,
+    /// The best tour (0-based nodes, starting in the depot), if any.
+    pub best_tour: Option<Vec<usize>>,
+}
+
+/// The final answer of [`solve`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct ExactResult {
+    /// The final status.
+    pub status: SolverStatus,
+    /// The final progress snapshot (tour, bounds, time).
+    pub progress: ExactProgress,
+    /// DP states created over the whole run.
+    pub states_created: u64,
+    /// The root lower bound (max of L1 and L2 at the root).
+    pub root_bound: f64,
+}
+
+impl ExactResult {
+    /// Whether the returned tour is proven optimal.
+    pub fn proven_optimal(&self) -> bool {
+        matches!(
+            self.status,
+            SolverStatus::Finished {
+                proven_optimal: true
+            }
+        )
+    }
+}
+
+enum Engine {
+    W1(Dp<1>),
+    W2(Dp<2>),
+    W4(Dp<4>),
+    /// Too many clusters for the DP keys: only bounds and the heuristic.
+    Unsupported,
+}
+
+impl Engine {
+    fn new(model: &Model, beam: Option<usize>, memory: usize, use_l2: bool) -> Engine {
+        match model.m {
+            0..=64 => Engine::W1(Dp::new(model, beam, memory, use_l2)),
+            65..=128 => Engine::W2(Dp::new(model, beam, memory, use_l2)),
+            129..=256 => Engine::W4(Dp::new(model, beam, memory, use_l2)),
+            _ => Engine::Unsupported,
+        }
+    }
+
+    fn run(&mut self, model: &Model, incumbent: &mut Incumbent, work: u64) -> DpStatus {
+        match self {
+            Engine::W1(dp) => dp.run(model, incumbent, work),
+            Engine::W2(dp) => dp.run(model, incumbent, work),
+            Engine::W4(dp) => dp.run(model, incumbent, work),
+            Engine::Unsupported => DpStatus::Done,
+        }
+    }
+
+    /// (layer, live states, lower bound, dropped_min, states created)
+    fn stats(&self, model: &Model, ub: f64) -> (usize, usize, f64, f64, u64) {
+        match self {
+            Engine::W1(dp) => (
+                dp.layer,
+                dp.live_states(),
+                dp.lower_bound(model, ub),
+                dp.dropped_min,
+                dp.states_created,
+            ),
+            Engine::W2(dp) => (
+                dp.layer,
+                dp.live_states(),
+                dp.lower_bound(model, ub),
+                dp.dropped_min,
+                dp.states_created,
+            ),
+            Engine::W4(dp) => (
+                dp.layer,
+                dp.live_states(),
+                dp.lower_bound(model, ub),
+                dp.dropped_min,
+                dp.states_created,
+            ),
+            Engine::Unsupported => (0, 0, -INF, -INF, 0),
+        }
+    }
+}
+
+/// One start node of the depot cluster: the DP fixes the start, so a depot with several nodes
+/// gives several runs, and the answer is the best over them.
+struct Run {
+    model: Model,
+    root_bound: f64,
+    engine: Option<Engine>,
+    finished_bound: Option<f64>,
+    states_created: u64,
+}
+
+enum Phase {
+    Heuristic { beam: usize, engine: Option<Engine> },
+    Exact,
+    Done(SolverStatus),
+}
+
+/// The anytime exact solver: construct, then call [`ExactSolver::step`] until it stops
+/// returning [`SolverStatus::Running`]; read [`ExactSolver::progress`] at any time; feed
+/// tours found elsewhere with [`ExactSolver::offer_incumbent`].
+pub struct ExactSolver {
+    instance: Instance,
+    options: ExactOptions,
+    runs: Vec<Run>,
+    current_run: usize,
+    incumbent: Incumbent,
+    phase: Phase,
+    elapsed: Duration,
+    cancelled: bool,
+}
+
+impl ExactSolver {
+    /// Prepares the solver (preprocessing and root bounds; no search yet).
+    pub fn new(instance: &Instance, options: ExactOptions) -> Result<ExactSolver, SolverError> {
+        if instance.node_count > u16::MAX as usize {
+            return Err(SolverError::TooManyNodes(instance.node_count));
+        }
+        let mut runs = Vec::new();
+        let mut bounder = ResidualBounder::default();
+        for &start in &instance.clusters[instance.depot] {
+            let model = Model::new(instance, start)?;
+            let depot = model.depot;
+            let root_bound =
+                model.round_bound(bounder.compute(&model, &|c| c == depot, depot, options.use_l2));
+            runs.push(Run {
+                model,
+                root_bound,
+                engine: None,
+                finished_bound: None,
+                states_created: 0,
+            });
+        }
+        let phase = if options.heuristic {
+            Phase::Heuristic {
+                beam: 0,
+                engine: None,
+            }
+        } else {
+            Phase::Exact
+        };
+        Ok(ExactSolver {
+            instance: instance.clone(),
+            options,
+            runs,
+            current_run: 0,
+            incumbent: Incumbent {
+                upper_bound: INF,
+                tour: None,
+            },
+            phase,
+            elapsed: Duration::ZERO,
+            cancelled: false,
+        })
+    }
+
+    /// The root lower bound (max of L1 and L2 over the empty prefix; min over start nodes).
+    pub fn root_bound(&self) -> f64 {
+        self.runs.iter().map(|r| r.root_bound).fold(INF, f64::min)
+    }
+
+    /// Offers a tour found elsewhere (e.g. by a heuristic in the same job). It is checked with
+    /// [`check_tour`]; if feasible and better, it becomes the incumbent and prunes the search.
+    /// Returns whether it was accepted. The cost is recomputed; `cost` is only a hint.
+    pub fn offer_incumbent(&mut self, tour: &[usize], cost: f64) -> bool {
+        let Ok(checked) = check_tour(&self.instance, tour) else {
+            return false;
+        };
+        let _ = cost;
+        if checked < self.incumbent.upper_bound {
+            self.incumbent.upper_bound = checked;
+            self.incumbent.tour = Some(tour.to_vec());
+            true
+        } else {
+            false
+        }
+    }
+
+    /// Stops the search at the next `step`.
+    pub fn cancel(&mut self) {
+        self.cancelled = true;
+    }
+
+    /// The current lower bound.
+    fn lower_bound(&self) -> f64 {
+        let ub = self.incumbent.upper_bound;
+        let mut lb = INF;
+        for run in &self.runs {
+            let run_lb = if let Some(b) = run.finished_bound {
+                b
+            } else {
+                let dp_lb = run.engine.as_ref().map_or(-INF, |e| {
+                    if matches!(self.phase, Phase::Exact) {
+                        e.stats(&run.model, ub).2
+                    } else {
+                        -INF
+                    }
+                });
+                run.root_bound.max(dp_lb)
+            };
+            lb = lb.min(run_lb);
+        }
+        match self.phase {
+            Phase::Done(SolverStatus::Finished {
+                proven_optimal: true,
+            }) => ub,
+            _ => lb.min(ub),
+        }
+    }
+
+    /// A snapshot of the current state.
+    pub fn progress(&self) -> ExactProgress {
+        let ub = self.incumbent.upper_bound;
+        let lb = self.lower_bound();
+        let (layer, live) = match (&self.phase, self.runs.get(self.current_run)) {
+            (Phase::Exact, Some(run)) => run.engine.as_ref().map_or((0, 0), |e| {
+                let s = e.stats(&run.model, ub);
+                (s.0, s.1)
+            }),
+            _ => (0, 0),
+        };
+        let gap = if ub.is_finite() {
+            if ub > 0.0 {
+                ((ub - lb) / ub).max(0.0)
+            } else {
+                0.0
+            }
+        } else {
+            INF
+        };
+        ExactProgress {
+            elapsed: self.elapsed,
+            upper_bound: ub,
+            lower_bound: lb,
+            gap,
+            layer,
+            live_states: live,
+            best_tour: self.incumbent.tour.clone(),
+        }
+    }
+
+    /// DP states created so far.
+    pub fn states_created(&self) -> u64 {
+        self.runs
+            .iter()
+            .map(|r| r.states_created + r.engine.as_ref().map_or(0, |e| e.stats(&r.model, INF).4))
+            .sum()
+    }
+
+    /// Does at most about `budget` of work and returns the status.
+    pub fn step(&mut self, budget: Duration) -> SolverStatus {
+        if let Phase::Done(status) = self.phase {
+            return status;
+        }
+        let began = Instant::now();
+        let mut deadline = budget;
+        if let Some(limit) = self.options.time_limit {
+            deadline = deadline.min(limit.saturating_sub(self.elapsed));
+        }
+        // Work units between clock reads: small enough to keep steps near their budget.
+        const CHUNK: u64 = 200_000;
+        loop {
+            if self.cancelled {
+                return self.stop(began);
+            }
+            if let Some(limit) = self.options.time_limit {
+                if self.elapsed + began.elapsed() >= limit {
+                    return self.stop(began);
+                }
+            }
+            if began.elapsed() >= deadline {
+                self.elapsed += began.elapsed();
+                return SolverStatus::Running;
+            }
+            match &mut self.phase {
+                Phase::Heuristic { beam, engine } => {
+                    let run = &self.runs[0];
+                    if engine.is_none() {
+                        match self.options.beam_widths.get(*beam) {
+                            Some(&width) => {
+                                *engine = Some(Engine::new(
+                                    &run.model,
+                                    Some(width),
+                                    self.options.memory_limit_bytes,
+                                    self.options.use_l2,
+                                ));
+                            }
+                            None => {
+                                self.phase = Phase::Exact;
+                                continue;
+                            }
+                        }
+                    }
+                    let e = engine.as_mut().expect("engine set above");
+                    // The beam must not prune with its own incumbent's rounding tricks beyond
+                    // what is valid: it uses the same (valid) pruning as the exact DP.
+                    if e.run(&run.model, &mut self.incumbent, CHUNK) == DpStatus::Done {
+                        *engine = None;
+                        *beam += 1;
+                        self.polish_incumbent();
+                    }
+                }
+                Phase::Exact => {
+                    if self.current_run >= self.runs.len() {
+                        let proven = self.runs.iter().all(|r| {
+                            r.finished_bound
+                                .is_some_and(|b| b >= self.incumbent.upper_bound)
+                        });
+                        self.elapsed += began.elapsed();
+                        let status = SolverStatus::Finished {
+                            proven_optimal: proven,
+                        };
+                        self.phase = Phase::Done(status);
+                        return status;
+                    }
+                    let memory = self.options.memory_limit_bytes;
+                    let use_l2 = self.options.use_l2;
+                    let run = &mut self.runs[self.current_run];
+                    let engine = run
+                        .engine
+                        .get_or_insert_with(|| Engine::new(&run.model, None, memory, use_l2));
+                    let layer_before = engine.stats(&run.model, INF).0;
+                    let status = engine.run(&run.model, &mut self.incumbent, CHUNK);
+                    let layer_changed = engine.stats(&run.model, INF).0 != layer_before;
+                    if status == DpStatus::Done {
+                        let (_, _, _, dropped, created) =
+                            engine.stats(&run.model, self.incumbent.upper_bound);
+                        let unsupported = matches!(engine, Engine::Unsupported);
+                        run.states_created += created;
+                        run.finished_bound = Some(if unsupported {
+                            run.root_bound
+                        } else {
+                            run.model.round_bound(dropped).max(run.root_bound)
+                        });
+                        run.engine = None;
+                        self.current_run += 1;
+                    }
+                    let p = self.progress();
+                    if self.options.gap_tolerance > 0.0 && p.gap <= self.options.gap_tolerance {
+                        return self.stop(began);
+                    }
+                    if layer_changed {
+                        // Let the caller report progress after every layer.
+                        self.elapsed += began.elapsed();
+                        return SolverStatus::Running;
+                    }
+                }
+                Phase::Done(status) => {
+                    let status = *status;
+                    self.elapsed += began.elapsed();
+                    return status;
+                }
+            }
+        }
+    }
+
+    fn stop(&mut self, began: Instant) -> SolverStatus {
+        self.elapsed += began.elapsed();
+        self.phase = Phase::Done(SolverStatus::Stopped);
+        SolverStatus::Stopped
+    }
+
+    /// Local search on the incumbent (for the start node it begins with).
+    fn polish_incumbent(&mut self) {
+        let Some(tour) = self.incumbent.tour.clone() else {
+            return;
+        };
+        let Some(run) = self.runs.iter().find(|r| r.model.start == tour[0]) else {
+            return;
+        };
+        let mut improved = tour;
+        let cost = heuristic::improve(&run.model, &mut improved, 200_000);
+        if cost < self.incumbent.upper_bound {
+            if let Ok(checked) = check_tour(&self.instance, &improved) {
+                self.incumbent.upper_bound = checked;
+                self.incumbent.tour = Some(improved);
+            }
+        }
+    }
+}
+
+/// Runs the exact solver to completion (or its time limit), reporting progress at least every
+/// 200 ms and after every DP layer.
+pub fn solve(
+    instance: &Instance,
+    options: ExactOptions,
+    on_progress: &mut dyn FnMut(&ExactProgress),
+) -> Result<ExactResult, SolverError> {
+    let mut solver = ExactSolver::new(instance, options)?;
+    loop {
+        // `step` also returns after every finished layer, so this reports per layer too.
+        let status = solver.step(Duration::from_millis(100));
+        let progress = solver.progress();
+        on_progress(&progress);
+        if status != SolverStatus::Running {
+            return Ok(ExactResult {
+                status,
+                progress,
+                states_created: solver.states_created(),
+                root_bound: solver.root_bound(),
+            });
+        }
+    }
+}
