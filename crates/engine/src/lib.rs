@@ -38,7 +38,7 @@ use cutroute_protocol::{JobRequest, Problem, Progress, SolverKind};
 use web_time::Duration;
 
 pub use nearest::NearestNeighbourJob;
-pub use open::open_document;
+pub use open::{format_name, open_document, OpenError};
 
 /// How long one [`Job::step`] may run before it returns, so cancel requests are seen quickly.
 pub const DEFAULT_SLICE: Duration = Duration::from_millis(40);

@@ -1,45 +1,133 @@
-//! Opening files: bytes in, a solvable [`Document`] out.
+//! Opening files: bytes in, a solvable [`Document`] out, whatever the format.
 
-use cutroute_geometry::{Contour, Nest, Part, Point, Vertex};
+use cutroute_cad::dxf::{read_dxf, DxfOptions};
+use cutroute_cad::tflex::read_tfnesting_project;
+use cutroute_formats::{detect, read_nest, read_result_json, Format};
+use cutroute_geometry::{Nest, Point};
 use cutroute_protocol::{Document, Problem};
+use cutroute_pcgtsp::Instance;
 
-/// Read a file whose format is recognised from its content.
-pub fn open_document(file_name: &str, bytes: &[u8]) -> Result<Document, String> {
-    let text = std::str::from_utf8(bytes).map_err(|e| format!("{file_name}: not a text file ({e})"))?;
-    let parts: Vec<GeometryPart> =
-        serde_json::from_str(text).map_err(|e| format!("{file_name}: {e}"))?;
-    let mut parts: Vec<Part> = parts.into_iter().map(GeometryPart::into_part).collect();
-    let sheet = if parts.is_empty() { None } else { Some(parts.remove(0)) };
-    let nest = Nest { sheet, parts };
+/// Why a file could not be opened; the message names the file and the place in it.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum OpenError {
+    /// The reader of the detected format refused the file.
+    #[error("{file_name} ({format}): {message}")]
+    Unreadable {
+        /// The file's name.
+        file_name: String,
+        /// The detected format.
+        format: &'static str,
+        /// The reader's error, with its location.
+        message: String,
+    },
+    /// A task file lists pierce points for a nest stored elsewhere.
+    #[error("{0}: a cutting task holds no geometry; open its nest (geometry JSON or DBS) first")]
+    TaskWithoutGeometry(String),
+    /// Nothing recognisable.
+    #[error(
+        "{0}: unknown format (expected DBS, geometry/task/result JSON, DXF, T-FLEX or PCGLNS)"
+    )]
+    UnknownFormat(String),
+    /// The file reads but holds nothing to cut.
+    #[error("{0}: the file holds no closed contours to cut")]
+    NothingToCut(String),
+}
+
+/// The format's name for people.
+pub fn format_name(format: Format) -> &'static str {
+    match format {
+        Format::DbsBinary => "DBS binary",
+        Format::GeometryJson => "geometry JSON",
+        Format::TaskJson => "task JSON",
+        Format::ResultJson => "result JSON",
+        Format::Dxf => "DXF",
+        Format::TflexXml => "T-FLEX nesting",
+        Format::Pcglns => "PCGTSP instance",
+        Format::Unknown => "unknown",
+    }
+}
+
+/// Read a file whose format is recognised from its content (the name is only reported).
+///
+/// Nests come back with contours oriented by nesting depth (outer clockwise, holes
+/// counter-clockwise), since some real files store every contour clockwise.
+pub fn open_document(file_name: &str, bytes: &[u8]) -> Result<Document, OpenError> {
+    let format = detect(bytes);
+    let unreadable = |message: String| OpenError::Unreadable {
+        file_name: file_name.to_string(),
+        format: format_name(format),
+        message,
+    };
+    let mut warnings = Vec::new();
+    let mut route = None;
+    let nest = match format {
+        Format::DbsBinary | Format::GeometryJson => {
+            read_nest(bytes).map_err(|e| unreadable(e.to_string()))?
+        }
+        Format::ResultJson => {
+            let result = read_result_json(bytes).map_err(|e| unreadable(e.to_string()))?;
+            route = Some(result.route());
+            result.nest().map_err(|e| unreadable(e.to_string()))?
+        }
+        Format::Dxf => {
+            let import =
+                read_dxf(bytes, &DxfOptions::default()).map_err(|e| unreadable(e.to_string()))?;
+            warnings.extend(import.warnings.iter().map(ToString::to_string));
+            warnings.extend(import.open_chains.iter().map(|chain| format!("open chain left out: {chain:?}")));
+            import.nest
+        }
+        Format::TflexXml => {
+            let project = read_tfnesting_project(bytes).map_err(|e| unreadable(e.to_string()))?;
+            let count = project.layouts.len();
+            let mut layouts = project.layouts.into_iter();
+            let first = layouts.next().ok_or_else(|| OpenError::NothingToCut(file_name.to_string()))?;
+            if count > 1 {
+                warnings.push(format!("the project has {count} sheets; showing the first ({})", first.sheet_name));
+            }
+            first.nest
+        }
+        Format::Pcglns => {
+            let text = std::str::from_utf8(bytes).map_err(|e| unreadable(e.to_string()))?;
+            Instance::parse(text).map_err(|e| unreadable(e.to_string()))?;
+            return Ok(Document {
+                file_name: file_name.to_string(),
+                format: format_name(format).to_string(),
+                problem: Problem::PcgtspText { text: text.to_string() },
+                route: None,
+                warnings,
+            });
+        }
+        Format::TaskJson => return Err(OpenError::TaskWithoutGeometry(file_name.to_string())),
+        Format::Unknown => return Err(OpenError::UnknownFormat(file_name.to_string())),
+    };
+    let nest = oriented(nest);
+    if nest.contour_count() == 0 {
+        return Err(OpenError::NothingToCut(file_name.to_string()));
+    }
+    let start = default_start(&nest);
     Ok(Document {
         file_name: file_name.to_string(),
-        format: "geometry JSON".into(),
-        problem: Problem::Nest { nest, start: Point::new(0.0, 0.0), finish: None },
+        format: format_name(format).to_string(),
+        problem: Problem::Nest { nest, start, finish: None },
+        route,
+        warnings,
     })
 }
 
-#[derive(serde::Deserialize)]
-struct GeometryPart {
-    partid: String,
-    paths: Vec<Vec<Vec<f64>>>,
+fn oriented(mut nest: Nest) -> Nest {
+    nest.normalize_orientation();
+    nest
 }
 
-impl GeometryPart {
-    fn into_part(self) -> Part {
-        let contours = self
-            .paths
-            .into_iter()
-            .map(|path| {
-                let mut vertices: Vec<Vertex> = path
-                    .iter()
-                    .map(|p| Vertex::arc(p[0], p[1], p.get(2).copied().unwrap_or(0.0)))
-                    .collect();
-                if vertices.len() > 1 && vertices.first().map(|v| v.point) == vertices.last().map(|v| v.point) {
-                    vertices.pop();
-                }
-                Contour::new(vertices)
-            })
-            .collect();
-        Part { name: self.partid, contours }
+/// The machine's home point when the file names none: the sheet's lower-left corner (the
+/// origin of the parts' box when there is no sheet).
+fn default_start(nest: &Nest) -> Point {
+    let sheet_box = nest.sheet.as_ref().map(|s| s.bounding_box());
+    match sheet_box.filter(|b| b.min.is_finite()) {
+        Some(b) => b.min,
+        None => {
+            let b = nest.bounding_box();
+            if b.min.is_finite() { b.min } else { Point::new(0.0, 0.0) }
+        }
     }
 }

@@ -60,6 +60,10 @@ pub struct Document {
     pub format: String,
     /// What the file describes, ready to be solved.
     pub problem: Problem,
+    /// A route the file already holds (result files), to show or compare.
+    pub route: Option<Route>,
+    /// What the reader skipped, approximated or could not close, in plain words.
+    pub warnings: Vec<String>,
 }
 
 /// A message from the solver worker.

@@ -102,7 +102,7 @@ mod web {
                 ToWorker::Open { request_id, file_name, bytes } => {
                     let answer = match open_document(&file_name, &bytes) {
                         Ok(document) => FromWorker::Opened { request_id, document },
-                        Err(message) => FromWorker::OpenFailed { request_id, message },
+                        Err(error) => FromWorker::OpenFailed { request_id, message: error.to_string() },
                     };
                     scope.respond(requester, answer);
                 }
