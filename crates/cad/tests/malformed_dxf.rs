@@ -251,10 +251,13 @@ fn invalid_options_are_refused() {
 
 #[test]
 fn coincident_pile_of_lines_stays_fast() {
-    // 20 000 copies of one line: every end meets thousands of others.
+    // 20 000 lines from one point: their starts pile up in one grid cell.
     let mut entities = String::from(SQUARE);
-    for _ in 0..20_000 {
-        entities.push_str("0\nLINE\n10\n50\n20\n50\n11\n60\n21\n50\n");
+    for k in 0..20_000 {
+        entities.push_str(&format!(
+            "0\nLINE\n10\n50\n20\n50\n11\n60\n21\n{}\n",
+            50.0 + k as f64 * 0.1
+        ));
     }
     let started = std::time::Instant::now();
     let import = read(&drawing(&entities)).unwrap();
