@@ -264,3 +264,21 @@ fn coincident_pile_of_lines_stays_fast() {
     assert_eq!(import.nest.parts.len(), 1);
     assert!(started.elapsed().as_secs() < 20);
 }
+
+#[test]
+fn nested_scales_cannot_overflow() {
+    // Each level scales by 1e5: three levels are 1e15, far past any sheet.
+    let blocks = format!(
+        "0\nBLOCK\n2\nA\n{SQUARE}0\nENDBLK\n0\nBLOCK\n2\nB\n0\nINSERT\n2\nA\n41\n1e5\n42\n1e5\n0\nENDBLK\n\
+         0\nBLOCK\n2\nC\n0\nINSERT\n2\nB\n41\n1e5\n42\n1e5\n0\nENDBLK\n"
+    );
+    let text = format!(
+        "0\nSECTION\n2\nBLOCKS\n{blocks}0\nENDSEC\n{}",
+        drawing("0\nINSERT\n2\nC\n41\n1e5\n42\n1e5\n")
+    );
+    let err = read(&text).unwrap_err();
+    assert!(
+        matches!(err, DxfError::InvalidEntity { ref entity, .. } if entity == "INSERT"),
+        "{err}"
+    );
+}
