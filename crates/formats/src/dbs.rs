@@ -815,6 +815,12 @@ pub fn write_dbs_with(nest: &Nest, options: &DbsWriteOptions) -> Result<Vec<u8>,
             return Err(DbsWriteError::TooManyRecords { needed: part_id });
         }
         let part_id = part_id as i16;
+        // Record 27 is computed from the coordinates as stored (float32), not from the f64
+        // input: otherwise a second rewrite could round the dimensions differently.
+        let mut as_stored = Part {
+            name: String::new(),
+            contours: Vec::with_capacity(part.contours.len()),
+        };
         for (k, contour) in part.contours.iter().enumerate() {
             let id = (seq + k + 1) as i16;
             let points = contour_check::stored_points(contour);
@@ -862,6 +868,18 @@ pub fn write_dbs_with(nest: &Nest, options: &DbsWriteOptions) -> Result<Vec<u8>,
                     out.extend_from_slice(&f.to_le_bytes());
                 }
             }
+            as_stored.contours.push(Contour::new(
+                points[..points.len() - 1]
+                    .iter()
+                    .map(|p| {
+                        Vertex::arc(
+                            f64::from(p[0] as f32),
+                            f64::from(p[1] as f32),
+                            f64::from(p[2] as f32),
+                        )
+                    })
+                    .collect(),
+            ));
         }
         put_header(&mut out, 4 * part.contours.len(), TYPE_PART, part_id);
         for k in 0..part.contours.len() {
@@ -870,8 +888,8 @@ pub fn write_dbs_with(nest: &Nest, options: &DbsWriteOptions) -> Result<Vec<u8>,
         put_header(&mut out, 8, TYPE_NAME, part_id);
         out.extend_from_slice(&name);
         put_header(&mut out, 8, TYPE_DIMENSIONS, part_id);
-        let area = (geom::part_area(part) * 1e-4) as f32 + 0.0;
-        let perimeter = (geom::part_perimeter(part) * 1e-2) as f32 + 0.0;
+        let area = (geom::part_area(&as_stored) * 1e-4) as f32 + 0.0;
+        let perimeter = (geom::part_perimeter(&as_stored) * 1e-2) as f32 + 0.0;
         if !area.is_finite() || !perimeter.is_finite() {
             return Err(DbsWriteError::DimensionsNotRepresentable { part: index });
         }
