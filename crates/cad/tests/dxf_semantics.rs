@@ -218,3 +218,20 @@ fn ten_thousand_loose_squares_join_quickly() {
     assert_eq!(import.nest.parts.len(), 10_000);
     assert!(started.elapsed().as_secs() < 30, "{:?}", started.elapsed());
 }
+
+#[test]
+fn unevenly_scaled_bulge_polyline_within_tolerance() {
+    // A closed LWPOLYLINE circle of radius 10 (two half-circle bulges, clockwise) scaled (2, 1).
+    let circle = "0\nLWPOLYLINE\n70\n1\n10\n10\n20\n0\n42\n-1\n10\n-10\n20\n0\n42\n-1\n";
+    let blocks = format!("0\nBLOCK\n2\nP\n10\n0\n20\n0\n{circle}0\nENDBLK\n");
+    let import = read(&with_blocks(&blocks, "0\nINSERT\n2\nP\n41\n2\n42\n1\n"));
+    let outer = &import.nest.parts[0].contours[0];
+    assert!(outer.vertices.len() > 2);
+    for k in 0..3600 {
+        let t = k as f64 / 3600.0 * std::f64::consts::TAU;
+        let p = Point::new(20.0 * t.cos(), 10.0 * t.sin());
+        assert!(distance_to_contour(p, outer) <= 0.01 * (1.0 + 1e-6));
+    }
+    let (lo, hi) = exact_bounds(outer);
+    assert!((lo.x + 20.0).abs() < 0.011 && (hi.y - 10.0).abs() < 0.011);
+}
