@@ -7,6 +7,12 @@
 //! type by its size, and writes files the way the reference writer does (contours, 8, 26, 27 per
 //! part; no copies; identity matrices).
 //!
+//! **Record 27.** The reader keeps it as stored ([`DbsPartRecord::area_dm2`],
+//! [`DbsPartRecord::perimeter_dm`]). The writer stores the material area (outer contour minus
+//! holes) and the total perimeter, computed from the float32 coordinates it writes. The
+//! reference writer sums signed contour areas instead, which differs when a file stores holes
+//! clockwise (some parts of `test0.json.dbs` do).
+//!
 //! **The sheet.** DBS has no sheet marker; files written from nests store the sheet as their
 //! first part (named e.g. `LIST` or after its area). [`SheetDetection::Auto`] takes the first part
 //! as the sheet when the file has more than one part and the first part's outer contour encloses
@@ -101,7 +107,7 @@ pub struct DbsFile {
     /// The resolved nest (copies expanded, closing points dropped).
     pub nest: Nest,
     /// Every part record in file order, the sheet (if any) first.
-    pub parts: Vec<DbsPartRecord>,
+    pub part_records: Vec<DbsPartRecord>,
     /// How many records of types this reader does not interpret were skipped.
     pub skipped_records: usize,
 }
@@ -645,7 +651,7 @@ pub fn read_dbs_with(bytes: &[u8], options: &DbsReadOptions) -> Result<DbsFile, 
             sheet,
             parts: all_parts.collect(),
         },
-        parts: records,
+        part_records: records,
         skipped_records,
     })
 }
