@@ -156,12 +156,67 @@ impl EndGrid {
     }
 }
 
+/// Drops pieces drawn twice (same spans, either direction, equal up to the tolerance grid):
+/// CAD drawings often hold overlapping copies, which would otherwise pair up with each other
+/// into zero-area "contours" and leave the real outline open.
+fn without_duplicates(
+    pieces: Vec<Piece>,
+    tolerance: f64,
+    dropped: &mut Vec<Dropped>,
+) -> Vec<Piece> {
+    let quantize = |p: Point| {
+        (
+            (p.x / tolerance).round() as i64,
+            (p.y / tolerance).round() as i64,
+        )
+    };
+    let key = |spans: &mut dyn Iterator<Item = Span>| -> Vec<(i64, i64, i64)> {
+        let mut out = Vec::new();
+        let mut last = None;
+        for s in spans {
+            let (x, y) = quantize(s.start);
+            out.push((x, y, (s.bulge * 1e6).round() as i64));
+            last = Some(s.end);
+        }
+        if let Some(end) = last {
+            let (x, y) = quantize(end);
+            out.push((x, y, 0));
+        }
+        out
+    };
+    let mut seen: HashMap<Vec<(i64, i64, i64)>, usize> = HashMap::new();
+    let mut kept = Vec::with_capacity(pieces.len());
+    for piece in pieces {
+        let forward = key(&mut piece.spans.iter().copied());
+        let backward = key(&mut piece.spans.iter().rev().map(|s| s.reversed()));
+        let canonical = if forward <= backward {
+            forward
+        } else {
+            backward
+        };
+        if let Some(&line) = seen.get(&canonical) {
+            dropped.push(Dropped {
+                line: piece.source.line,
+                message: format!(
+                    "{} duplicates the entity at line {line}; ignored",
+                    piece.source.entity
+                ),
+            });
+            continue;
+        }
+        seen.insert(canonical, piece.source.line);
+        kept.push(piece);
+    }
+    kept
+}
+
 /// Joins, orients and groups the pieces.
 pub(crate) fn assemble(pieces: Vec<Piece>, limits: &AssembleLimits) -> Assembled {
     let tolerance = limits.join_tolerance;
     let mut contours: Vec<(Contour, SourceRef)> = Vec::new();
     let mut open_chains = Vec::new();
     let mut dropped = Vec::new();
+    let pieces = without_duplicates(pieces, tolerance, &mut dropped);
 
     let ends: Vec<Point> = pieces
         .iter()

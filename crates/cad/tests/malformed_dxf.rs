@@ -251,13 +251,34 @@ fn invalid_options_are_refused() {
 
 #[test]
 fn coincident_pile_of_lines_stays_fast() {
-    // 20 000 copies of one line: every end meets thousands of others.
+    // 20 000 lines from one point: their starts pile up in one grid cell.
     let mut entities = String::from(SQUARE);
-    for _ in 0..20_000 {
-        entities.push_str("0\nLINE\n10\n50\n20\n50\n11\n60\n21\n50\n");
+    for k in 0..20_000 {
+        entities.push_str(&format!(
+            "0\nLINE\n10\n50\n20\n50\n11\n60\n21\n{}\n",
+            50.0 + k as f64 * 0.1
+        ));
     }
     let started = std::time::Instant::now();
     let import = read(&drawing(&entities)).unwrap();
     assert_eq!(import.nest.parts.len(), 1);
     assert!(started.elapsed().as_secs() < 20);
+}
+
+#[test]
+fn nested_scales_cannot_overflow() {
+    // Each level scales by 1e5: three levels are 1e15, far past any sheet.
+    let blocks = format!(
+        "0\nBLOCK\n2\nA\n{SQUARE}0\nENDBLK\n0\nBLOCK\n2\nB\n0\nINSERT\n2\nA\n41\n1e5\n42\n1e5\n0\nENDBLK\n\
+         0\nBLOCK\n2\nC\n0\nINSERT\n2\nB\n41\n1e5\n42\n1e5\n0\nENDBLK\n"
+    );
+    let text = format!(
+        "0\nSECTION\n2\nBLOCKS\n{blocks}0\nENDSEC\n{}",
+        drawing("0\nINSERT\n2\nC\n41\n1e5\n42\n1e5\n")
+    );
+    let err = read(&text).unwrap_err();
+    assert!(
+        matches!(err, DxfError::InvalidEntity { ref entity, .. } if entity == "INSERT"),
+        "{err}"
+    );
 }

@@ -218,3 +218,15 @@ fn placements_cannot_multiply_without_bound() {
         Err(TflexError::TooLarge { limit: 5_000_000 })
     );
 }
+
+#[test]
+fn deep_nesting_does_not_overflow_the_stack() {
+    let depth = 100_000;
+    let text = format!(
+        "<Project>{}{}</Project>",
+        "<a>".repeat(depth),
+        "</a>".repeat(depth)
+    );
+    // Either the XML parser refuses the depth or the project lacks its parts: no crash.
+    assert!(read_tfnesting(text.as_bytes()).is_err());
+}

@@ -27,10 +27,12 @@ impl V {
         self.x * o.y - self.y * o.x
     }
     pub fn norm(self) -> f64 {
-        self.x.hypot(self.y)
+        // sqrt, not hypot: libm's hypot is several times slower and coordinates are small.
+        (self.x * self.x + self.y * self.y).sqrt()
     }
     pub fn dist(self, o: V) -> f64 {
-        (self.x - o.x).hypot(self.y - o.y)
+        let (dx, dy) = (self.x - o.x, self.y - o.y);
+        (dx * dx + dy * dy).sqrt()
     }
     /// The unit vector, or zero for the zero vector.
     pub fn unit(self) -> V {
@@ -102,13 +104,13 @@ impl BBox {
     pub fn dist(&self, p: V) -> f64 {
         let dx = (self.min.x - p.x).max(0.0).max(p.x - self.max.x);
         let dy = (self.min.y - p.y).max(0.0).max(p.y - self.max.y);
-        dx.hypot(dy)
+        (dx * dx + dy * dy).sqrt()
     }
     /// Gap between two boxes (0 when they overlap).
     pub fn gap(&self, o: &BBox) -> f64 {
         let dx = (self.min.x - o.max.x).max(0.0).max(o.min.x - self.max.x);
         let dy = (self.min.y - o.max.y).max(0.0).max(o.min.y - self.max.y);
-        dx.hypot(dy)
+        (dx * dx + dy * dy).sqrt()
     }
     pub fn contains_box(&self, o: &BBox) -> bool {
         self.min.x <= o.min.x && self.min.y <= o.min.y && self.max.x >= o.max.x && self.max.y >= o.max.y

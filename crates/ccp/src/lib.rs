@@ -58,7 +58,7 @@ mod search;
 mod solver;
 
 pub use discrete::{build_pcgtsp, DiscreteInstance, DiscreteNode, DiscretisationOptions};
-pub use route::{idle_length, route_certificates, route_metrics, ContourCertificate, MachineSpeeds, RouteMetrics};
+pub use route::{idle_length, route_certificates, route_metrics, ContourCertificate, RouteMetrics};
 pub use solver::{solve, solve_with_cancel, CcpOptions, CcpPhase, CcpProgress, CcpResult, CcpSolver, SolverStatus};
 
 use cutroute_geometry::{ContourRef, Nest};

@@ -45,54 +45,56 @@ pub(crate) fn best_on_span(span: &Span, p: V, q: Option<V>) -> (f64, V) {
             let x = a + u * t;
             (cost(p, Some(q), x), x)
         }
-        Span::Arc { a, b, .. } => {
+        Span::Arc { a, b, center, radius, sweep, .. } => {
             let mut hits = Vec::new();
             span.intersect_segment(p, q, &mut hits);
             if let Some(&(_, t)) = hits.first() {
                 let x = span.point_at(t);
                 return (cost(p, Some(q), x), x);
             }
-            let f = |t: f64| cost(p, Some(q), span.point_at(t));
-            let g = |t: f64| {
-                let x = span.point_at(t);
-                ((x - p).unit() + (x - q).unit()).dot(span.derivative_at(t))
-            };
-            let mut best = (f(0.0), a);
-            let fb = f(1.0);
+            let mut best = (cost(p, Some(q), a), a);
+            let fb = cost(p, Some(q), b);
             if fb < best.0 {
                 best = (fb, b);
             }
-            let sweep = match *span {
-                Span::Arc { sweep, .. } => sweep.abs(),
-                _ => 0.0,
+            // Derivative of f along the arc (up to the positive factor r·|φ|), from the unit
+            // radius vector u: tangent = ±perp(u).
+            let dir = sweep.signum();
+            let g_of = |u: V| {
+                let x = center + u * radius;
+                ((x - p).unit() + (x - q).unit()).dot(u.perp() * dir)
             };
-            let n = ((sweep / (std::f64::consts::PI / 12.0)).ceil() as usize).max(2);
-            let mut t_prev = 0.0;
-            let mut g_prev = g(0.0);
+            let n = ((sweep.abs() / (std::f64::consts::PI / 10.0)).ceil() as usize).max(2);
+            let step = sweep / n as f64;
+            let (sd, cd) = step.sin_cos();
+            let rot = |u: V| V::new(u.x * cd - u.y * sd, u.x * sd + u.y * cd);
+            let u0 = (a - center) * (1.0 / radius);
+            let mut u_prev = u0;
+            let mut g_prev = g_of(u0);
             for k in 1..=n {
-                let t = k as f64 / n as f64;
-                let gk = g(t);
+                // Samples by rotation (no trigonometry per sample); the last is the endpoint.
+                let u = if k == n { (b - center) * (1.0 / radius) } else { rot(u_prev) };
+                let gk = g_of(u);
                 if g_prev < 0.0 && gk > 0.0 {
-                    let (mut lo, mut hi) = (t_prev, t);
-                    for _ in 0..50 {
-                        let mid = 0.5 * (lo + hi);
-                        if g(mid) < 0.0 {
+                    // Bisect the angle inside this sample interval (less than π wide), halving
+                    // by normalised vector sums rather than trigonometry.
+                    let (mut lo, mut hi) = (u_prev, u);
+                    for _ in 0..30 {
+                        let mid = (lo + hi).unit();
+                        if g_of(mid) < 0.0 {
                             lo = mid;
                         } else {
                             hi = mid;
                         }
-                        if hi - lo < 1e-13 {
-                            break;
-                        }
                     }
-                    let tm = 0.5 * (lo + hi);
-                    let x = span.point_at(tm);
+                    let um = (lo + hi).unit();
+                    let x = center + um * radius;
                     let v = cost(p, Some(q), x);
                     if v < best.0 {
                         best = (v, x);
                     }
                 }
-                t_prev = t;
+                u_prev = u;
                 g_prev = gk;
             }
             best

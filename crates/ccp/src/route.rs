@@ -1,7 +1,7 @@
 //! Step 4 (restoring the removed contours at the route's last crossing), the optimality
 //! certificates (Conditions 1 and 2) and the machine metrics of a route.
 
-use cutroute_geometry::{ContourRef, CutStep, Nest, Point, Route};
+use cutroute_geometry::{ContourRef, CutStep, MachineParameters, Nest, Point, Route};
 use serde::{Deserialize, Serialize};
 
 use crate::geom::{on_segment, Shape, Span, V};
@@ -111,25 +111,6 @@ pub fn idle_length(route: &Route) -> f64 {
     len
 }
 
-/// Machine speeds and pierce time of the time model `T = L_on/V_on + L_off/V_off + N·t_pierce`.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct MachineSpeeds {
-    /// Idle (rapid) speed, mm per time unit.
-    pub idle_speed: f64,
-    /// Cutting speed, mm per time unit.
-    pub cut_speed: f64,
-    /// Time of one pierce, in the same time unit.
-    pub pierce_time: f64,
-}
-
-impl Default for MachineSpeeds {
-    /// The values of the RouteManager sample tasks (`ToolIdlingSpeed` 500, `ToolCutSpeed` 10,
-    /// `PiercingDuration` 7).
-    fn default() -> Self {
-        MachineSpeeds { idle_speed: 500.0, cut_speed: 10.0, pierce_time: 7.0 }
-    }
-}
-
 /// Lengths, pierce count and time of a route.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct RouteMetrics {
@@ -151,7 +132,7 @@ fn contour_of<'a>(nest: &'a Nest, r: ContourRef) -> Result<&'a cutroute_geometry
 }
 
 /// Metrics of a route over a nest under a machine model.
-pub fn route_metrics(nest: &Nest, route: &Route, machine: &MachineSpeeds) -> Result<RouteMetrics, CcpError> {
+pub fn route_metrics(nest: &Nest, route: &Route, machine: &MachineParameters) -> Result<RouteMetrics, CcpError> {
     let mut cut_length = 0.0;
     for st in &route.steps {
         cut_length += Shape::new(contour_of(nest, st.contour)?).perimeter;
@@ -162,7 +143,7 @@ pub fn route_metrics(nest: &Nest, route: &Route, machine: &MachineSpeeds) -> Res
         idle_length: idle,
         cut_length,
         pierce_count: n,
-        total_time: cut_length / machine.cut_speed + idle / machine.idle_speed + n as f64 * machine.pierce_time,
+        total_time: machine.time(cut_length, idle, n),
     })
 }
 

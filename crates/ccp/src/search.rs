@@ -87,6 +87,8 @@ pub(crate) struct Search {
     relax_queue: Vec<usize>,
     /// Moves evaluated (fixed-point deltas computed).
     pub evaluations: u64,
+    /// Moves checked exactly (applied, relaxed, kept or undone).
+    pub exact_checks: u64,
     /// Moves accepted.
     pub accepted: u64,
 }
@@ -123,6 +125,7 @@ impl Search {
             saved_slice: Vec::new(),
             relax_queue: Vec::new(),
             evaluations: 0,
+            exact_checks: 0,
             accepted: 0,
         }
     }
@@ -243,10 +246,14 @@ impl Search {
     }
 
     /// One relaxation sweep over the whole order (Algorithm 3.1, lines 5–9); returns the gain.
+    /// Contours whose pierce point moved noticeably are queued for the order search.
     pub fn sweep(&mut self) -> f64 {
         let before = self.total;
         for i in 0..self.order.len() {
-            self.relax_at(i);
+            if self.relax_at(i) > 1e-3 {
+                let k = self.order[i];
+                self.push(k);
+            }
         }
         before - self.total
     }
@@ -515,9 +522,11 @@ impl Search {
                     (a, b) => (at(a).unwrap_or(cur), at(b)),
                 };
                 let here = cost(p, q, cur);
+                // Nothing on the contour beats the distances to its bounding box, nor |PQ|.
+                let bb = &self.shape(c as usize).bbox;
                 let lower = match q {
-                    Some(q) => p.dist(q),
-                    None => self.shape(c as usize).bbox.dist(p),
+                    Some(q) => p.dist(q).max(bb.dist(p) + bb.dist(q)),
+                    None => bb.dist(p),
                 };
                 ub += here - lower;
                 targets[t] = (p, q, c as usize);
@@ -536,6 +545,7 @@ impl Search {
             }
         }
         // Exact check: apply, relax the junctions, keep or undo.
+        self.exact_checks += 1;
         let before = self.total;
         let (lo, hi) = self.range(m);
         self.saved_slice.clear();

@@ -3,13 +3,13 @@
 
 use std::time::Duration;
 
-use cutroute_geometry::{Nest, Point, Route};
+use cutroute_geometry::{MachineParameters, Nest, Point, Route};
 use serde::{Deserialize, Serialize};
 use web_time::Instant;
 
 use crate::geom::V;
 use crate::problem::Problem;
-use crate::route::{assemble_route, idle_length, route_certificates, route_metrics, ContourCertificate, MachineSpeeds, RouteMetrics};
+use crate::route::{assemble_route, idle_length, route_certificates, route_metrics, ContourCertificate, RouteMetrics};
 use crate::search::{Search, SearchParams};
 use crate::CcpError;
 
@@ -41,7 +41,7 @@ pub struct CcpOptions {
     /// Largest shaking strength (number of random moves).
     pub max_shake_strength: usize,
     /// Machine speeds of the time model.
-    pub machine: MachineSpeeds,
+    pub machine: MachineParameters,
 }
 
 impl Default for CcpOptions {
@@ -59,7 +59,7 @@ impl Default for CcpOptions {
             max_non_improving_shakes: 300,
             restarts: 1,
             max_shake_strength: 5,
-            machine: MachineSpeeds::default(),
+            machine: MachineParameters::default(),
         }
     }
 }
@@ -105,6 +105,8 @@ pub struct CcpProgress {
     pub initial_length: Option<f64>,
     /// Moves evaluated.
     pub evaluations: u64,
+    /// Moves checked exactly (applied, relaxed, then kept or undone).
+    pub exact_checks: u64,
     /// Moves accepted.
     pub accepted_moves: u64,
     /// VNS shakes done.
@@ -242,11 +244,10 @@ impl CcpSolver {
                         }
                         return SolverStatus::Running;
                     }
-                    // The queue is empty: a local optimum of every neighbourhood.
-                    let before = self.search.total;
+                    // The queue is empty: a local optimum of every neighbourhood. A full
+                    // relaxation queues the contours whose pierce points still moved.
                     self.search.relax_full();
-                    if self.search.total < before - 1e-6 {
-                        self.search.queue_all();
+                    if !self.search.queue.is_empty() {
                         continue;
                     }
                     if self.phase == CcpPhase::LocalSearch {
@@ -373,6 +374,7 @@ impl CcpSolver {
             local_optimum_length: self.local_optimum_length,
             initial_length: self.initial_length,
             evaluations: self.search.evaluations,
+            exact_checks: self.search.exact_checks,
             accepted_moves: self.search.accepted,
             shakes: self.shakes,
             kept_contours: self.search.prob.kept.len(),

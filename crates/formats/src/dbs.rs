@@ -7,6 +7,12 @@
 //! type by its size, and writes files the way the reference writer does (contours, 8, 26, 27 per
 //! part; no copies; identity matrices).
 //!
+//! **Record 27.** The reader keeps it as stored ([`DbsPartRecord::area_dm2`],
+//! [`DbsPartRecord::perimeter_dm`]). The writer stores the material area (outer contour minus
+//! holes) and the total perimeter, computed from the float32 coordinates it writes. The
+//! reference writer sums signed contour areas instead, which differs when a file stores holes
+//! clockwise (some parts of `test0.json.dbs` do).
+//!
 //! **The sheet.** DBS has no sheet marker; files written from nests store the sheet as their
 //! first part (named e.g. `LIST` or after its area). [`SheetDetection::Auto`] takes the first part
 //! as the sheet when the file has more than one part and the first part's outer contour encloses
@@ -101,7 +107,7 @@ pub struct DbsFile {
     /// The resolved nest (copies expanded, closing points dropped).
     pub nest: Nest,
     /// Every part record in file order, the sheet (if any) first.
-    pub parts: Vec<DbsPartRecord>,
+    pub part_records: Vec<DbsPartRecord>,
     /// How many records of types this reader does not interpret were skipped.
     pub skipped_records: usize,
 }
@@ -645,7 +651,7 @@ pub fn read_dbs_with(bytes: &[u8], options: &DbsReadOptions) -> Result<DbsFile, 
             sheet,
             parts: all_parts.collect(),
         },
-        parts: records,
+        part_records: records,
         skipped_records,
     })
 }
@@ -815,6 +821,12 @@ pub fn write_dbs_with(nest: &Nest, options: &DbsWriteOptions) -> Result<Vec<u8>,
             return Err(DbsWriteError::TooManyRecords { needed: part_id });
         }
         let part_id = part_id as i16;
+        // Record 27 is computed from the coordinates as stored (float32), not from the f64
+        // input: otherwise a second rewrite could round the dimensions differently.
+        let mut as_stored = Part {
+            name: String::new(),
+            contours: Vec::with_capacity(part.contours.len()),
+        };
         for (k, contour) in part.contours.iter().enumerate() {
             let id = (seq + k + 1) as i16;
             let points = contour_check::stored_points(contour);
@@ -862,6 +874,18 @@ pub fn write_dbs_with(nest: &Nest, options: &DbsWriteOptions) -> Result<Vec<u8>,
                     out.extend_from_slice(&f.to_le_bytes());
                 }
             }
+            as_stored.contours.push(Contour::new(
+                points[..points.len() - 1]
+                    .iter()
+                    .map(|p| {
+                        Vertex::arc(
+                            f64::from(p[0] as f32),
+                            f64::from(p[1] as f32),
+                            f64::from(p[2] as f32),
+                        )
+                    })
+                    .collect(),
+            ));
         }
         put_header(&mut out, 4 * part.contours.len(), TYPE_PART, part_id);
         for k in 0..part.contours.len() {
@@ -870,8 +894,8 @@ pub fn write_dbs_with(nest: &Nest, options: &DbsWriteOptions) -> Result<Vec<u8>,
         put_header(&mut out, 8, TYPE_NAME, part_id);
         out.extend_from_slice(&name);
         put_header(&mut out, 8, TYPE_DIMENSIONS, part_id);
-        let area = (geom::part_area(part) * 1e-4) as f32 + 0.0;
-        let perimeter = (geom::part_perimeter(part) * 1e-2) as f32 + 0.0;
+        let area = (geom::part_area(&as_stored) * 1e-4) as f32 + 0.0;
+        let perimeter = (geom::part_perimeter(&as_stored) * 1e-2) as f32 + 0.0;
         if !area.is_finite() || !perimeter.is_finite() {
             return Err(DbsWriteError::DimensionsNotRepresentable { part: index });
         }

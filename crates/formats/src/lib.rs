@@ -32,7 +32,7 @@
 //! let file = read_dbs(&bytes)?;
 //! assert_eq!(file.nest, nest);
 //! let ring_area = std::f64::consts::PI * (200.0f64.powi(2) - 100.0f64.powi(2)) * 1e-4;
-//! assert!((f64::from(file.parts[1].area_dm2.unwrap()) - ring_area).abs() < 1e-3);
+//! assert!((f64::from(file.part_records[1].area_dm2.unwrap()) - ring_area).abs() < 1e-3);
 //!
 //! let svg = nest_svg(&nest, None, &SvgOptions::default());
 //! assert!(svg.contains("class=\"sheet\""));

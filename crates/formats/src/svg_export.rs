@@ -85,6 +85,8 @@ fn part_path(part: &Part, class: &str) -> Path {
     }
     Path::new()
         .set("class", class)
+        // Holes must show as holes even when the page supplies no style sheet.
+        .set("fill-rule", "evenodd")
         .set("data-partid", part.name.as_str())
         .set("d", data)
         .add(Title::new(format!(

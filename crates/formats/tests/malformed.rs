@@ -873,3 +873,15 @@ fn json_has_no_nan_or_infinity() {
         );
     }
 }
+
+#[test]
+fn two_number_points_default_the_bulge_to_zero() {
+    let nest = read_geometry_json(
+        br#"[{"partid": "S", "paths": [[[0, 0], [0, 9, 0], [9, 9], [9, 0], [0, 0]]]}]"#,
+    )
+    .unwrap();
+    let sheet = nest.sheet.unwrap();
+    assert_eq!(sheet.contours[0].vertices.len(), 4);
+    assert!(sheet.contours[0].vertices.iter().all(|v| v.bulge == 0.0));
+    assert!(nest.parts.is_empty());
+}

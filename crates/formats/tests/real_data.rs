@@ -80,7 +80,7 @@ fn dbs_files_have_the_documented_counts() {
     ] {
         let f = read_dbs(&read(&format!("dbs/{file}"))).unwrap_or_else(|e| panic!("{file}: {e}"));
         assert_eq!(
-            f.parts.len(),
+            f.part_records.len(),
             parts,
             "{file}: parts as stored, sheet included"
         );
@@ -165,8 +165,8 @@ fn dbs_areas_and_perimeters_agree_with_record_27() {
     for file in DBS_FILES {
         let f = read_dbs(&read(&format!("dbs/{file}"))).unwrap_or_else(|e| panic!("{file}: {e}"));
         let parts = all_parts(&f.nest);
-        assert_eq!(parts.len(), f.parts.len());
-        for (part, record) in parts.iter().zip(&f.parts) {
+        assert_eq!(parts.len(), f.part_records.len());
+        for (part, record) in parts.iter().zip(&f.part_records) {
             assert_eq!(part.name, record.name);
             let (Some(area), Some(perimeter)) = (record.area_dm2, record.perimeter_dm) else {
                 continue;
@@ -256,7 +256,7 @@ fn geometry_json_files_have_the_documented_counts_and_round_trip() {
     // test0's JSON extension `pathids` matches the DBS ids of the same nest.
     let stored = parse_geometry_json(&read("dbs-json/test0.dbs.json")).unwrap();
     let dbs = read_dbs(&read("dbs/test0.json.dbs")).unwrap();
-    for (json_part, record) in stored.iter().zip(&dbs.parts) {
+    for (json_part, record) in stored.iter().zip(&dbs.part_records) {
         let ids: Vec<i64> = record.contour_ids.iter().map(|&i| i64::from(i)).collect();
         assert_eq!(json_part.pathids.as_ref(), Some(&ids));
     }

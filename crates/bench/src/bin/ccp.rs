@@ -1,2 +1,213 @@
-//! Benchmark: ccp solver (being written).
-fn main() {}
+//! Benchmark of the CCP-Relax solver (`cargo run --release -p cutroute-bench --bin ccp`).
+//!
+//! Prints Markdown tables:
+//! 1. real nests, open routes from the sheet origin: CCP-Relax against the crates.io peer
+//!    `u-nesting-cutting` (arcs flattened at 8 segments per radian, `pierce_candidates = 1`),
+//!    both measured by the same metric (Euclidean idle length of the route they return);
+//! 2. real nests, CCP against the discrete model (PCGTSP at ε = 25 mm and 50 mm solved by
+//!    cutroute's ALNS), same start point and metric;
+//! 3. `E1X_6_01` closed at (0, 0) against the proven discrete optimum 1513;
+//! 4. synthetic nests of 100 … 20,000 contours: time to the first VNS local optimum, idle
+//!    length, and the peer.
+//!
+//! Arguments: `--quick` skips the 20,000-contour nest; `--vns-seconds S` sets CCP's budget
+//! after the local optimum (default 5); `--synthetic N` runs CCP on one synthetic nest only.
+
+use std::time::{Duration, Instant};
+
+use cutroute_ccp::{build_pcgtsp, solve, CcpOptions, CcpResult, DiscretisationOptions};
+use cutroute_geometry::{generate_nest, Nest, Point, Route};
+
+const SHARED: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/nests");
+
+fn read(path: &str) -> Nest {
+    let full = format!("{SHARED}/{path}");
+    let bytes = std::fs::read(&full).unwrap_or_else(|e| panic!("cannot read {full}: {e}"));
+    cutroute_formats::read_nest(&bytes).unwrap_or_else(|e| panic!("cannot parse {full}: {e}"))
+}
+
+fn ccp(nest: &Nest, finish: Option<Point>, time_limit: Duration) -> (CcpResult, Duration) {
+    let options = CcpOptions { start: Point::new(0.0, 0.0), finish, time_limit, ..CcpOptions::default() };
+    let t = Instant::now();
+    let r = solve(nest, options, &mut |_| {}).expect("ccp solves");
+    let route_check = r.route.validate(nest, 1e-6);
+    assert!(route_check.is_ok(), "invalid CCP route: {route_check:?}");
+    (r, t.elapsed())
+}
+
+/// The peer on the same geometry: each part becomes a polygon with holes (arcs flattened at 8
+/// segments per radian), placed where it is; returns (idle length recomputed by our metric,
+/// the peer's own figure, time).
+fn peer(nest: &Nest) -> Option<(f64, f64, Duration)> {
+    use u_nesting_core::{Placement, SolveResult};
+    use u_nesting_d2::Geometry2D;
+    let flatten = |c: &cutroute_geometry::Contour| -> Vec<(f64, f64)> {
+        let mut pts = Vec::new();
+        for span in c.spans() {
+            let sweep = 4.0 * span.bulge.atan();
+            let n = ((sweep.abs() * 8.0).ceil() as usize).max(1);
+            for k in 0..n {
+                let p = span.point_at(k as f64 / n as f64);
+                pts.push((p.x, p.y));
+            }
+        }
+        pts
+    };
+    let mut geometries = Vec::new();
+    let mut result = SolveResult::<f64>::new();
+    for (i, part) in nest.parts.iter().enumerate() {
+        if part.contours.is_empty() {
+            continue;
+        }
+        let id = format!("p{i}");
+        let mut g = Geometry2D::new(id.clone()).with_polygon(flatten(&part.contours[0]));
+        for hole in &part.contours[1..] {
+            g = g.with_hole(flatten(hole));
+        }
+        geometries.push(g);
+        result.placements.push(Placement::new_2d(id, 0, 0.0, 0.0, 0.0));
+    }
+    let config = u_nesting_cutting::CuttingConfig {
+        pierce_candidates: 1,
+        home_position: (0.0, 0.0),
+        time_limit_ms: 60_000,
+        ..u_nesting_cutting::CuttingConfig::default()
+    };
+    let t = Instant::now();
+    let out = match u_nesting_cutting::optimize_cutting_path(&result, &geometries, &config) {
+        Ok(o) => o,
+        Err(e) => {
+            eprintln!("u-nesting-cutting failed: {e}");
+            return None;
+        }
+    };
+    let elapsed = t.elapsed();
+    let mut cur = (0.0f64, 0.0f64);
+    let mut idle = 0.0;
+    for st in &out.sequence {
+        idle += (st.pierce_point.0 - cur.0).hypot(st.pierce_point.1 - cur.1);
+        cur = st.pierce_point;
+    }
+    Some((idle, out.total_rapid_distance, elapsed))
+}
+
+/// Best discrete route at step ε found by cutroute's ALNS in `budget`.
+fn discrete(nest: &Nest, finish: Option<Point>, step: f64, budget: Duration) -> Option<(f64, usize)> {
+    let opts = DiscretisationOptions { start: Point::new(0.0, 0.0), finish, step, ..DiscretisationOptions::default() };
+    let inst = build_pcgtsp(nest, &opts).ok()?;
+    let options = cutroute_alns::AlnsOptions { time_limit: Some(budget), ..cutroute_alns::AlnsOptions::default() };
+    let r = cutroute_alns::solve(&inst.instance, options, &mut |_| {}).ok()?;
+    let route: Route = inst.tour_to_route(r.tour.as_ref()?).ok()?;
+    Some((route.idle_length(), inst.instance.node_count))
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let quick = args.iter().any(|a| a == "--quick");
+    let vns_seconds: f64 = args
+        .iter()
+        .position(|a| a == "--vns-seconds")
+        .and_then(|i| args.get(i + 1))
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(5.0);
+    let budget = Duration::from_secs_f64(vns_seconds);
+    let only: Option<usize> = args.iter().position(|a| a == "--synthetic").and_then(|i| args.get(i + 1)).and_then(|s| s.parse().ok());
+    if let Some(n) = only {
+        let nest = generate_nest(n, 1);
+        let (r, t) = ccp(&nest, None, budget);
+        println!(
+            "{n} contours: initial {:.0}, local optimum {:.0} at {:.2} s, final {:.0} in {:.2} s, {} evaluations, {} exact checks, {} moves, {} shakes",
+            r.progress.initial_length.unwrap_or(f64::NAN),
+            r.progress.local_optimum_length.unwrap_or(f64::NAN),
+            r.progress.local_optimum_time.unwrap_or_default().as_secs_f64(),
+            r.metrics.idle_length,
+            t.as_secs_f64(),
+            r.progress.evaluations,
+            r.progress.exact_checks,
+            r.progress.accepted_moves,
+            r.progress.shakes
+        );
+        return;
+    }
+    let real = [
+        ("nested.dbs", "dbs/nested.dbs"),
+        ("seven.dbs", "dbs/seven.dbs"),
+        ("test0", "dbs-json/test0.dbs.json"),
+        ("test1", "dbs-json/test1.dbs.json"),
+        ("E1X_6_01", "dbs-json/E1X_6_01.dbs.json"),
+    ];
+
+    println!("## CCP-Relax vs u-nesting-cutting (open routes from the sheet origin, idle mm)\n");
+    println!("| nest | contours | kept | CCP idle | CCP time s | local opt. s | certified | peer idle | peer time s | CCP / peer |");
+    println!("|---|---|---|---|---|---|---|---|---|---|");
+    let mut open_results = Vec::new();
+    for (name, path) in real {
+        let nest = read(path);
+        let (r, t) = ccp(&nest, None, budget);
+        let p = peer(&nest);
+        let (pl, pt) = p.map_or((f64::NAN, f64::NAN), |(l, _, t)| (l, t.as_secs_f64()));
+        println!(
+            "| {name} | {} | {} | {:.1} | {:.2} | {:.3} | {}/{} | {:.1} | {:.2} | {:.3} |",
+            r.route.steps.len(),
+            r.progress.kept_contours,
+            r.metrics.idle_length,
+            t.as_secs_f64(),
+            r.progress.local_optimum_time.unwrap_or_default().as_secs_f64(),
+            r.certificates.iter().filter(|c| c.condition1).count(),
+            r.certificates.len(),
+            pl,
+            pt,
+            r.metrics.idle_length / pl,
+        );
+        open_results.push((name, nest, r.metrics.idle_length));
+    }
+
+    println!("\n## CCP-Relax vs the discrete model (PCGTSP solved by cutroute-alns, 10 s each; open routes, idle mm)\n");
+    println!("| nest | CCP | ε = 25 mm (nodes) | ε = 50 mm (nodes) | CCP / d25 | CCP / d50 |");
+    println!("|---|---|---|---|---|---|");
+    for (name, nest, len) in &open_results {
+        let d25 = discrete(nest, None, 25.0, Duration::from_secs(10));
+        let d50 = discrete(nest, None, 50.0, Duration::from_secs(10));
+        let f = |d: Option<(f64, usize)>| d.map_or("n/a".to_string(), |(l, n)| format!("{l:.1} ({n})"));
+        let ratio = |d: Option<(f64, usize)>| d.map_or("n/a".to_string(), |(l, _)| format!("{:.4}", len / l));
+        println!("| {name} | {len:.1} | {} | {} | {} | {} |", f(d25), f(d50), ratio(d25), ratio(d50));
+    }
+
+    println!("\n## E1X_6_01 closed at (0, 0) (the PCGTSP instance e1x_6: proven discrete optimum 1513)\n");
+    let nest = read("dbs-json/E1X_6_01.dbs.json");
+    let (r, t) = ccp(&nest, Some(Point::new(0.0, 0.0)), budget);
+    println!("| CCP idle | time s | certified | discrete optimum | CCP / optimum |");
+    println!("|---|---|---|---|---|");
+    println!(
+        "| {:.2} | {:.2} | {} | 1513 | {:.4} |",
+        r.metrics.idle_length,
+        t.as_secs_f64(),
+        r.certified_optimal_for_order,
+        r.metrics.idle_length / 1513.0
+    );
+
+    println!("\n## Synthetic nests (`generate_nest(n, 1)`, open routes from the origin)\n");
+    println!("| contours | kept | initial (NN) | local optimum | time to local opt. s | after VNS | total s | peer idle | peer s | CCP / peer |");
+    println!("|---|---|---|---|---|---|---|---|---|---|");
+    let sizes: &[usize] = if quick { &[100, 1000, 5000] } else { &[100, 1000, 5000, 20000] };
+    for &n in sizes {
+        let nest = generate_nest(n, 1);
+        // Budget: the local optimum plus `vns_seconds` of VNS (scaled up for big nests).
+        let limit = Duration::from_secs_f64(vns_seconds.max(n as f64 / 1000.0 * vns_seconds)) + Duration::from_secs(if n >= 20000 { 120 } else { 10 });
+        let (r, t) = ccp(&nest, None, limit);
+        let p = if n <= 5000 { peer(&nest) } else { None };
+        let (pl, pt) = p.map_or((f64::NAN, f64::NAN), |(l, _, t)| (l, t.as_secs_f64()));
+        println!(
+            "| {n} | {} | {:.0} | {:.0} | {:.2} | {:.0} | {:.1} | {:.0} | {:.2} | {:.3} |",
+            r.progress.kept_contours,
+            r.progress.initial_length.unwrap_or(f64::NAN),
+            r.progress.local_optimum_length.unwrap_or(f64::NAN),
+            r.progress.local_optimum_time.unwrap_or_default().as_secs_f64(),
+            r.metrics.idle_length,
+            t.as_secs_f64(),
+            pl,
+            pt,
+            r.metrics.idle_length / pl,
+        );
+    }
+}

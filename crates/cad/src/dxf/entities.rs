@@ -170,6 +170,17 @@ impl Affine {
         }
     }
 
+    /// Whether scales stay within 1e6 and offsets within 1e12 mm: with input coordinates
+    /// bounded by 1e9, every transformed point is then finite with room to spare, so nested
+    /// inserts cannot overflow to infinity or NaN.
+    fn is_bounded(&self) -> bool {
+        [self.a, self.b, self.c, self.d]
+            .iter()
+            .all(|v| v.abs() <= 1e6)
+            && self.tx.abs() <= 1e12
+            && self.ty.abs() <= 1e12
+    }
+
     fn determinant(&self) -> f64 {
         self.a * self.d - self.b * self.c
     }
@@ -907,6 +918,10 @@ impl Expander<'_, '_> {
                 let offset = Point::new(column as f64 * column_spacing, row as f64 * row_spacing);
                 let local = Affine::placement(at, scale, rotation, base, offset);
                 let inner = to_world.then_after(&ocs.then_after(&local));
+                if !inner.is_bounded() {
+                    return Err(record
+                        .invalid("nested insert scales and offsets grow beyond 1e6× / 1e12 mm"));
+                }
                 for r in &records {
                     if r.in_paper_space()? {
                         continue;
