@@ -1,1 +1,248 @@
-fn main() {}
+//! `cutroute`: inspect, convert and route cutting plans and PCGTSP instances from the shell.
+//!
+//! ```text
+//! cutroute inspect FILE [--json]
+//! cutroute convert IN OUT            # .dbs, .dbs.json / .json, .svg, chosen by extension
+//! cutroute solve FILE --solver nearest|ccp|heuristic|exact|discrete [--time-limit S] [--seed N]
+//!                     [--ub N] [--step MM] [--json]
+//! ```
+//! Errors go to stderr with the reader's location, and the exit code is 1.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+use cutroute_engine::{open_document, run_to_end, start_job};
+use cutroute_geometry::{Nest, Route};
+use cutroute_protocol::{Document, JobRequest, Problem, Progress, SolverKind, SolverParams};
+use serde_json::{json, Value};
+
+#[derive(Parser)]
+#[command(name = "cutroute", version, about = "Tool-path optimisation for CNC sheet cutting")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Summarise a nest or PCGTSP file (format detected from content).
+    Inspect {
+        /// The file to read.
+        file: PathBuf,
+        /// Print one JSON object instead of text.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Convert a nest between formats chosen by the output's extension (.dbs, .json, .svg).
+    Convert {
+        /// The file to read (any supported nest format).
+        input: PathBuf,
+        /// The file to write.
+        output: PathBuf,
+    },
+    /// Route a nest or solve a PCGTSP instance.
+    Solve {
+        /// A nest file or a PCGTSP instance.
+        file: PathBuf,
+        /// nearest, ccp, heuristic, exact, or discrete (= heuristic on a discretised nest).
+        #[arg(long, default_value = "ccp")]
+        solver: String,
+        /// Wall-clock limit in seconds.
+        #[arg(long, default_value_t = 10.0)]
+        time_limit: f64,
+        /// Seed of the solver's random choices.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// A known upper bound (exact solver).
+        #[arg(long)]
+        ub: Option<f64>,
+        /// Spacing of candidate pierce points for the discrete solvers on nests, mm.
+        #[arg(long, default_value_t = 50.0)]
+        step: f64,
+        /// Print one JSON object instead of text.
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let outcome = match cli.command {
+        Command::Inspect { file, json } => inspect(&file, json),
+        Command::Convert { input, output } => convert(&input, &output),
+        Command::Solve { file, solver, time_limit, seed, ub, step, json } => {
+            let params = SolverParams {
+                time_limit_s: time_limit,
+                seed,
+                discretisation_step_mm: step,
+                initial_upper_bound: ub,
+            };
+            solve(&file, &solver, params, json)
+        }
+    };
+    match outcome {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(message) => {
+            eprintln!("cutroute: {message}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn open(path: &Path) -> Result<Document, String> {
+    let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let name = path.display().to_string();
+    open_document(&name, &bytes).map_err(|e| e.to_string())
+}
+
+fn inspect(path: &Path, as_json: bool) -> Result<(), String> {
+    let document = open(path)?;
+    let summary = match &document.problem {
+        Problem::Nest { nest, .. } => nest_summary(&document.format, nest),
+        Problem::PcgtspText { text } => {
+            let instance = cutroute_pcgtsp::Instance::parse(text).map_err(|e| e.to_string())?;
+            json!({
+                "format": document.format,
+                "nodes": instance.node_count,
+                "clusters": instance.clusters.len(),
+                "precedence_pairs": instance.precedence.len(),
+            })
+        }
+    };
+    if as_json {
+        println!("{summary}");
+    } else {
+        for (key, value) in summary.as_object().into_iter().flatten() {
+            println!("{key:>16}: {value}");
+        }
+        for warning in &document.warnings {
+            println!("         warning: {warning}");
+        }
+    }
+    Ok(())
+}
+
+/// Counts as stored in the file: the sheet counts as a part when the file has one.
+fn nest_summary(format: &str, nest: &Nest) -> Value {
+    let sheet_contours = nest.sheet.as_ref().map_or(0, |s| s.contours.len());
+    let sheet_arcs = nest.sheet.as_ref().map_or(0, |s| s.contours.iter().map(|c| c.arc_count()).sum());
+    let bounds = nest
+        .sheet
+        .as_ref()
+        .map(|s| s.bounding_box())
+        .filter(|b| b.min.is_finite())
+        .unwrap_or_else(|| nest.bounding_box());
+    let forest = nest.containment_forest();
+    json!({
+        "format": format,
+        "parts": nest.parts.len() + usize::from(nest.sheet.is_some()),
+        "contours": nest.contour_count() + sheet_contours,
+        "arcs": nest.arc_count() + sheet_arcs,
+        "sheet": [bounds.min.x, bounds.min.y, bounds.max.x, bounds.max.y],
+        "depth": forest.max_depth(),
+    })
+}
+
+fn convert(input: &Path, output: &Path) -> Result<(), String> {
+    let document = open(input)?;
+    let Problem::Nest { nest, .. } = &document.problem else {
+        return Err(format!("{}: not a nest; only nests can be converted", input.display()));
+    };
+    let name = output.to_string_lossy().to_lowercase();
+    let bytes: Vec<u8> = if name.ends_with(".dbs") {
+        cutroute_formats::write_dbs(nest).map_err(|e| e.to_string())?
+    } else if name.ends_with(".json") {
+        cutroute_formats::write_geometry_json(nest).map_err(|e| e.to_string())?.into_bytes()
+    } else if name.ends_with(".svg") {
+        match &document.route {
+            Some(route) => cutroute_formats::route_svg(nest, route, &cutroute_formats::SvgOptions::default())
+                .map_err(|e| e.to_string())?,
+            None => cutroute_formats::nest_svg(nest, None, &cutroute_formats::SvgOptions::default()),
+        }
+        .into_bytes()
+    } else {
+        return Err(format!("{}: unknown output extension (use .dbs, .dbs.json/.json or .svg)", output.display()));
+    };
+    std::fs::write(output, bytes).map_err(|e| format!("{}: {e}", output.display()))
+}
+
+fn solve(path: &Path, solver_name: &str, params: SolverParams, as_json: bool) -> Result<(), String> {
+    let document = open(path)?;
+    let solver = match solver_name {
+        "discrete" => SolverKind::Heuristic,
+        name => SolverKind::from_name(name).ok_or_else(|| {
+            format!("unknown solver {name:?} (nearest, ccp, heuristic, exact, discrete)")
+        })?,
+    };
+    let request = JobRequest { job_id: 1, problem: document.problem.clone(), solver, params };
+    let mut job = start_job(&request).map_err(|e| e.to_string())?;
+    let mut last_report = -1.0;
+    let result = run_to_end(job.as_mut(), &mut |progress| {
+        if !as_json && progress.elapsed_s - last_report >= 1.0 {
+            last_report = progress.elapsed_s;
+            eprintln!("{:8.2} s  ub {:>12}  lb {:>12}  {}", progress.elapsed_s, fmt(progress.upper_bound), fmt(progress.lower_bound), progress.phase);
+        }
+    });
+    let report = match &document.problem {
+        Problem::PcgtspText { .. } => tour_report(solver_name, &result),
+        Problem::Nest { nest, .. } => route_report(solver_name, nest, &result)?,
+    };
+    if as_json {
+        println!("{report}");
+    } else {
+        for (key, value) in report.as_object().into_iter().flatten() {
+            if key != "route" && key != "tour" {
+                println!("{key:>18}: {value}");
+            }
+        }
+    }
+    Ok(())
+}
+
+fn fmt(value: Option<f64>) -> String {
+    value.map(|v| format!("{v:.1}")).unwrap_or_else(|| "—".into())
+}
+
+/// The PCGTSP report: tour as 1-based node ids of the instance, starting at the depot.
+fn tour_report(solver: &str, result: &Progress) -> Value {
+    json!({
+        "solver": solver,
+        "ub": result.upper_bound,
+        "lb": result.lower_bound,
+        "gap": result.gap(),
+        "proven_optimal": result.proven_optimal,
+        "tour": result.tour.as_ref().map(|t| t.iter().map(|n| n + 1).collect::<Vec<_>>()),
+        "elapsed_s": result.elapsed_s,
+        "states": result.live_states,
+    })
+}
+
+/// The nest report: lengths recomputed from the route itself, not taken from the solver.
+fn route_report(solver: &str, nest: &Nest, result: &Progress) -> Result<Value, String> {
+    let route: &Route = result.route.as_ref().ok_or("the solver found no route")?;
+    route.validate(nest, 1e-6 * nest_scale(nest)).map_err(|e| format!("invalid route: {e}"))?;
+    let machine = cutroute_geometry::MachineParameters::default();
+    let idle_length = route.idle_length();
+    let cut_length = route.cut_length(nest);
+    Ok(json!({
+        "solver": solver,
+        "idle_length": idle_length,
+        "cut_length": cut_length,
+        "pierces": route.pierce_count(),
+        "time_s": machine.time(cut_length, idle_length, route.pierce_count()),
+        "route": route.steps.iter().map(|s| json!({
+            "contour": [s.contour.part, s.contour.contour],
+            "pierce": [s.pierce_point.x, s.pierce_point.y],
+        })).collect::<Vec<_>>(),
+        "certified_contours": result.certified.iter().filter(|c| **c).count(),
+        "ub": result.upper_bound,
+        "lb": result.lower_bound,
+        "elapsed_s": result.elapsed_s,
+    }))
+}
+
+fn nest_scale(nest: &Nest) -> f64 {
+    let b = nest.bounding_box();
+    ((b.max.x - b.min.x).abs() + (b.max.y - b.min.y).abs()).max(1.0)
+}

@@ -100,6 +100,8 @@ impl Job for NearestNeighbourJob {
             route: self.route.clone(),
             tour: None,
             proven_optimal: false,
+            live_states: None,
+            certified: Vec::new(),
         }
     }
 }

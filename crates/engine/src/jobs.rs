@@ -1,0 +1,211 @@
+//! The solver jobs: each wraps one resumable solver (or two that cooperate) behind [`Job`].
+
+use cutroute_alns::{AlnsOptions, AlnsSolver};
+use cutroute_ccp::{CcpOptions, CcpSolver, DiscreteInstance};
+use cutroute_geometry::Route;
+use cutroute_pcgtsp::{ExactOptions, ExactSolver, Instance};
+use cutroute_protocol::{JobId, Progress};
+use web_time::{Duration, Instant};
+
+use crate::{Job, JobStatus};
+
+/// CCP-Relax on a nest.
+pub struct CcpJob {
+    job_id: JobId,
+    solver: CcpSolver,
+    done: bool,
+}
+
+impl CcpJob {
+    /// Wrap a prepared solver.
+    pub fn new(job_id: JobId, solver: CcpSolver) -> Self {
+        Self { job_id, solver, done: false }
+    }
+}
+
+impl Job for CcpJob {
+    fn step(&mut self, budget: Duration) -> JobStatus {
+        if self.done || self.solver.step(budget) == cutroute_ccp::SolverStatus::Finished {
+            self.done = true;
+            return JobStatus::Done;
+        }
+        JobStatus::Running
+    }
+
+    fn progress(&self) -> Progress {
+        let state = self.solver.progress();
+        let has_route = !state.route.steps.is_empty();
+        // Certificates cost a pass over the route: only for the final answer.
+        let certified = if self.done && has_route {
+            let by_contour: std::collections::HashMap<_, _> = self
+                .solver
+                .certificates()
+                .into_iter()
+                .map(|c| (c.contour, c.condition1))
+                .collect();
+            state.route.steps.iter().map(|s| by_contour.get(&s.contour).copied().unwrap_or(false)).collect()
+        } else {
+            Vec::new()
+        };
+        Progress {
+            job_id: self.job_id,
+            elapsed_s: state.elapsed.as_secs_f64(),
+            upper_bound: has_route.then_some(state.best_idle_length),
+            lower_bound: None,
+            phase: format!("{:?}", state.phase).to_lowercase(),
+            route: has_route.then_some(state.route),
+            tour: None,
+            proven_optimal: false,
+            live_states: None,
+            certified,
+        }
+    }
+}
+
+/// How a discrete job searches.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DiscreteMode {
+    /// ALNS only: upper bounds.
+    Heuristic,
+    /// ALNS feeding incumbents to the exact search, which proves lower bounds.
+    Exact,
+}
+
+/// A PCGTSP job: ALNS alone, or ALNS and the exact solver sharing the time (the heuristic gets
+/// a quarter of each slice while the exact search runs, and every improvement it finds is
+/// offered to the exact search as an incumbent).
+pub struct DiscreteJob {
+    job_id: JobId,
+    instance: Instance,
+    discrete: Option<DiscreteInstance>,
+    alns: AlnsSolver,
+    alns_done: bool,
+    exact: Option<ExactSolver>,
+    exact_done: Option<bool>,
+    offered_cost: f64,
+    started: Instant,
+}
+
+impl DiscreteJob {
+    /// Prepare the solvers; `discrete` maps nodes back to pierce points when the instance was
+    /// built from a nest.
+    pub fn new(
+        job_id: JobId,
+        instance: Instance,
+        discrete: Option<DiscreteInstance>,
+        mode: DiscreteMode,
+        time_limit: Duration,
+        seed: u64,
+        initial_upper_bound: Option<f64>,
+    ) -> Result<Self, String> {
+        let alns_options = AlnsOptions { seed, time_limit: Some(time_limit), ..AlnsOptions::default() };
+        let alns = AlnsSolver::new(&instance, alns_options).map_err(|e| e.to_string())?;
+        let exact = match mode {
+            DiscreteMode::Heuristic => None,
+            DiscreteMode::Exact => {
+                let options = ExactOptions { time_limit: Some(time_limit), ..ExactOptions::default() };
+                let _ = initial_upper_bound;
+                Some(ExactSolver::new(&instance, options).map_err(|e| e.to_string())?)
+            }
+        };
+        Ok(Self {
+            job_id,
+            instance,
+            discrete,
+            alns,
+            alns_done: false,
+            exact,
+            exact_done: None,
+            offered_cost: f64::INFINITY,
+            started: Instant::now(),
+        })
+    }
+
+    fn best_tour(&self) -> Option<(Vec<usize>, f64)> {
+        let heuristic = self.alns.best().map(|(tour, cost)| (tour.to_vec(), cost));
+        let exact = self.exact.as_ref().and_then(|e| {
+            let p = e.progress();
+            p.best_tour.map(|t| (t, p.upper_bound))
+        });
+        match (heuristic, exact) {
+            (Some(h), Some(e)) => Some(if e.1 < h.1 { e } else { h }),
+            (h, e) => h.or(e),
+        }
+    }
+}
+
+impl Job for DiscreteJob {
+    fn step(&mut self, budget: Duration) -> JobStatus {
+        let Some(exact) = self.exact.as_mut() else {
+            if self.alns_done || self.alns.step(budget) == cutroute_alns::SolverStatus::Finished {
+                self.alns_done = true;
+                return JobStatus::Done;
+            }
+            return JobStatus::Running;
+        };
+        if !self.alns_done {
+            let share = if self.exact_done.is_some() { budget } else { budget / 4 };
+            self.alns_done = self.alns.step(share) == cutroute_alns::SolverStatus::Finished;
+            if let Some((tour, cost)) = self.alns.best() {
+                if cost < self.offered_cost {
+                    self.offered_cost = cost;
+                    exact.offer_incumbent(tour, cost);
+                }
+            }
+        }
+        if self.exact_done.is_none() {
+            match exact.step(budget - budget / 4) {
+                cutroute_pcgtsp::SolverStatus::Running => {}
+                cutroute_pcgtsp::SolverStatus::Finished { proven_optimal } => {
+                    self.exact_done = Some(proven_optimal)
+                }
+                cutroute_pcgtsp::SolverStatus::Stopped => self.exact_done = Some(false),
+            }
+        }
+        // Once the exact search has ended there is nothing left to prove: stop the heuristic too.
+        if self.exact_done.is_some() {
+            return JobStatus::Done;
+        }
+        JobStatus::Running
+    }
+
+    fn progress(&self) -> Progress {
+        let best = self.best_tour();
+        let exact = self.exact.as_ref().map(|e| e.progress());
+        let route: Option<Route> = match (&self.discrete, &best) {
+            (Some(discrete), Some((tour, _))) => discrete.tour_to_route(tour).ok(),
+            _ => None,
+        };
+        let proven_optimal = self.exact_done == Some(true);
+        let phase = match (&exact, self.exact_done) {
+            (_, Some(true)) => "proven optimal".to_string(),
+            (_, Some(false)) => "stopped".to_string(),
+            (Some(p), None) => format!("layer {} · {} states", p.layer, p.live_states),
+            (None, _) => format!("ALNS · {} iterations", self.alns.progress().iterations),
+        };
+        let lower_bound = exact.as_ref().map(|p| p.lower_bound).filter(|lb| lb.is_finite());
+        let _ = &self.instance;
+        Progress {
+            job_id: self.job_id,
+            elapsed_s: self.started.elapsed().as_secs_f64(),
+            upper_bound: best.as_ref().map(|(_, cost)| *cost),
+            lower_bound: if proven_optimal { best.as_ref().map(|(_, c)| *c) } else { lower_bound },
+            phase,
+            route,
+            tour: best.map(|(tour, _)| tour),
+            proven_optimal,
+            live_states: exact.map(|p| p.live_states as u64),
+            certified: Vec::new(),
+        }
+    }
+}
+
+/// Options of a CCP job from the protocol's parameters.
+pub fn ccp_options(
+    start: cutroute_geometry::Point,
+    finish: Option<cutroute_geometry::Point>,
+    time_limit: Duration,
+    seed: u64,
+) -> CcpOptions {
+    CcpOptions { start, finish, time_limit, seed, ..CcpOptions::default() }
+}
