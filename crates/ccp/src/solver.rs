@@ -9,7 +9,10 @@ use web_time::Instant;
 
 use crate::geom::V;
 use crate::problem::Problem;
-use crate::route::{assemble_route, idle_length, route_certificates, route_metrics, ContourCertificate, RouteMetrics};
+use crate::route::{
+    assemble_route, idle_length, route_certificates, route_metrics, ContourCertificate,
+    RouteMetrics,
+};
 use crate::search::{Search, SearchParams};
 use crate::CcpError;
 
@@ -157,12 +160,18 @@ impl CcpSolver {
     pub fn new(nest: &Nest, options: CcpOptions) -> Result<CcpSolver, CcpError> {
         let finite = |p: Point| p.x.is_finite() && p.y.is_finite();
         if !finite(options.start) || options.finish.is_some_and(|f| !finite(f)) {
-            return Err(CcpError::InvalidOption("start and finish must be finite".into()));
+            return Err(CcpError::InvalidOption(
+                "start and finish must be finite".into(),
+            ));
         }
         if !(options.delta > 0.0 && options.delta.is_finite()) {
             return Err(CcpError::InvalidOption("delta must be positive".into()));
         }
-        if options.neighbours == 0 || options.max_block == 0 || options.max_block > 5 || options.cycle_window > 14 {
+        if options.neighbours == 0
+            || options.max_block == 0
+            || options.max_block > 5
+            || options.cycle_window > 14
+        {
             return Err(CcpError::InvalidOption(
                 "neighbours ≥ 1, 1 ≤ max_block ≤ 5 and cycle_window ≤ 14 are required".into(),
             ));
@@ -182,7 +191,11 @@ impl CcpSolver {
         let restarts_left = options.restarts;
         Ok(CcpSolver {
             nest: nest.clone(),
-            route: Route { start: options.start, steps: Vec::new(), finish: options.finish },
+            route: Route {
+                start: options.start,
+                steps: Vec::new(),
+                finish: options.finish,
+            },
             options,
             search,
             phase: CcpPhase::Start,
@@ -285,7 +298,7 @@ impl CcpSolver {
                 }
             }
             count += 1;
-            if count % 32 == 0 && self.out_of_time(t0, budget) {
+            if count.is_multiple_of(32) && self.out_of_time(t0, budget) {
                 return false;
             }
         }
@@ -390,7 +403,8 @@ impl CcpSolver {
     /// The result for the best route so far.
     pub fn result(&self) -> CcpResult {
         let certificates = self.certificates();
-        let metrics = route_metrics(&self.nest, &self.route, &self.options.machine).unwrap_or_default();
+        let metrics =
+            route_metrics(&self.nest, &self.route, &self.options.machine).unwrap_or_default();
         CcpResult {
             route: self.route.clone(),
             metrics,
@@ -402,7 +416,11 @@ impl CcpSolver {
 }
 
 /// Runs CCP-Relax to the end (VNS finished or time limit), reporting progress after each slice.
-pub fn solve(nest: &Nest, options: CcpOptions, on_progress: &mut dyn FnMut(&CcpProgress)) -> Result<CcpResult, CcpError> {
+pub fn solve(
+    nest: &Nest,
+    options: CcpOptions,
+    on_progress: &mut dyn FnMut(&CcpProgress),
+) -> Result<CcpResult, CcpError> {
     solve_with_cancel(nest, options, on_progress, &|| false)
 }
 
