@@ -11,6 +11,8 @@
 //! parent index of every state, for reconstruction.
 
 use crate::bounds::{Model, ResidualBounder};
+use crate::lattice::{node_completion, Lattice};
+use std::rc::Rc;
 
 const INF: f64 = f64::INFINITY;
 
@@ -20,20 +22,25 @@ pub(crate) struct Key<const W: usize>(pub [u64; W]);
 
 impl<const W: usize> Key<W> {
     #[inline]
-    fn empty() -> Self {
+    pub fn empty() -> Self {
         Key([0; W])
     }
     #[inline]
-    fn contains(&self, c: usize) -> bool {
+    pub fn contains(&self, c: usize) -> bool {
         self.0[c / 64] >> (c % 64) & 1 == 1
     }
     #[inline]
-    fn with(mut self, c: usize) -> Self {
+    pub fn with(mut self, c: usize) -> Self {
         self.0[c / 64] |= 1 << (c % 64);
         self
     }
     #[inline]
-    fn contains_all(&self, other: &Self) -> bool {
+    pub fn without(mut self, c: usize) -> Self {
+        self.0[c / 64] &= !(1 << (c % 64));
+        self
+    }
+    #[inline]
+    pub fn contains_all(&self, other: &Self) -> bool {
         (0..W).all(|i| other.0[i] & !self.0[i] == 0)
     }
 }
@@ -138,6 +145,8 @@ pub(crate) struct Dp<const W: usize> {
     next_record: usize,
     next: Layer<W>,
     next_min_lb: f64,
+    /// The smallest bound in the current layer.
+    current_min_lb: f64,
     /// Keep at most this many states per layer (beam search; `None` = exact).
     beam_width: Option<usize>,
     memory_limit: usize,
@@ -154,6 +163,9 @@ pub(crate) struct Dp<const W: usize> {
     /// Upper bound used when the current layer was pruned last.
     pruned_with: f64,
     done: bool,
+    /// The cluster-DP bound over the whole ideal lattice, when it fits in memory.
+    lattice: Option<Rc<Lattice<W>>>,
+    next_values: Vec<(usize, f64)>,
 }
 
 impl<const W: usize> Dp<W> {
@@ -162,6 +174,7 @@ impl<const W: usize> Dp<W> {
         beam_width: Option<usize>,
         memory_limit: usize,
         use_l2: bool,
+        lattice: Option<Rc<Lattice<W>>>,
     ) -> Self {
         let m = model.m;
         assert!(m <= 64 * W, "cluster count exceeds key width");
@@ -178,9 +191,17 @@ impl<const W: usize> Dp<W> {
         current.group_last.push(model.depot as u16);
         current.node.push(model.start as u16);
         current.cost.push(0.0);
-        current.lb.push(0.0);
+        // With a single cluster the start node alone is the tour (closed by its self-arc).
+        current.lb.push(if m == 1 {
+            model.arc(model.start, model.start)
+        } else {
+            0.0
+        });
         current.parent.push(u32::MAX);
         current.group_states.push(1);
+        let layer_bound = lattice
+            .as_ref()
+            .map_or(0.0, |l| model.round_bound(l.root_bound));
         Dp {
             pred_mask,
             layer: 1,
@@ -192,17 +213,20 @@ impl<const W: usize> Dp<W> {
             next_record: 0,
             next: Layer::new(),
             next_min_lb: INF,
+            current_min_lb: 0.0,
             beam_width,
             memory_limit,
             dropped_min: INF,
-            layer_bound: 0.0,
+            layer_bound,
             bounder: ResidualBounder::default(),
             use_l2,
             costs: Vec::new(),
             parents: Vec::new(),
             states_created: 1,
             pruned_with: INF,
-            done: m == 1,
+            done: false,
+            lattice,
+            next_values: Vec::new(),
         }
     }
 
@@ -223,11 +247,10 @@ impl<const W: usize> Dp<W> {
         }
         // Every improving tour passes through a state of the current layer, or one of the layer
         // being built, or was dropped (pruned states cannot improve on the incumbent).
-        let mut live = self.dropped_min;
-        for &lb in &self.current.lb[..] {
-            live = live.min(lb);
-        }
-        live = live.min(self.next_min_lb);
+        let live = self
+            .dropped_min
+            .min(self.current_min_lb)
+            .min(self.next_min_lb);
         model
             .round_bound(live)
             .min(upper_bound)
@@ -310,15 +333,22 @@ impl<const W: usize> Dp<W> {
         self.costs.resize(width, INF);
         self.parents.clear();
         self.parents.resize(width, u32::MAX);
-        for s in sources.clone() {
-            let g = self.current.cost[s];
-            let u = self.current.node[s] as usize;
-            let row = &block[u * width..(u + 1) * width];
-            for (j, &arc) in row.iter().enumerate() {
-                let c = g + arc;
-                if c < self.costs[j] {
-                    self.costs[j] = c;
-                    self.parents[j] = s as u32;
+        {
+            // Local slices keep the hot loop free of reloads through `self`.
+            let costs = &mut self.costs[..width];
+            let parents = &mut self.parents[..width];
+            let source_cost = &self.current.cost[sources.clone()];
+            let source_node = &self.current.node[sources.clone()];
+            for (offset, (&g, &u)) in source_cost.iter().zip(source_node).enumerate() {
+                let u = u as usize;
+                let row = &block[u * width..(u + 1) * width];
+                let s = (sources.start + offset) as u32;
+                for ((cost, parent), &arc) in costs.iter_mut().zip(parents.iter_mut()).zip(row) {
+                    let c = g + arc;
+                    if c < *cost {
+                        *cost = c;
+                        *parent = s;
+                    }
                 }
             }
         }
@@ -329,8 +359,18 @@ impl<const W: usize> Dp<W> {
         }
         let complete = self.layer + 1 == model.m;
         let group_bound;
+        let mut use_lattice = false;
         if complete {
             group_bound = 0.0;
+            self.bounder.l2 = -INF;
+        } else if let Some(lattice) = &self.lattice {
+            let index = lattice
+                .find(&ideal, self.layer + 1)
+                .expect("every ideal is in the lattice");
+            lattice.next_values(self.layer + 1, index, &mut self.next_values);
+            use_lattice = true;
+            group_bound = 0.0;
+            self.bounder.l2 = -INF;
         } else {
             group_bound = self
                 .bounder
@@ -348,6 +388,8 @@ impl<const W: usize> Dp<W> {
             }
             let lb = if complete {
                 g + model.arc(x, model.start)
+            } else if use_lattice {
+                g + node_completion(model, &self.next_values, x)
             } else {
                 g + self.bounder.node_bound(model, x).max(l2).max(group_bound)
             };
@@ -419,6 +461,7 @@ impl<const W: usize> Dp<W> {
         let layer_min = model.round_bound(self.next_min_lb.min(self.dropped_min));
         self.layer_bound = self.layer_bound.max(layer_min);
         let finished = std::mem::replace(&mut self.current, std::mem::take(&mut self.next));
+        self.current_min_lb = self.next_min_lb;
         self.past_bytes += finished.node.len() * 6;
         self.past_nodes.push(finished.node);
         self.past_parents.push(finished.parent);

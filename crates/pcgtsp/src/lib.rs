@@ -7,6 +7,7 @@ mod check;
 mod dp;
 mod heuristic;
 mod instance;
+mod lattice;
 mod order;
 mod parse;
 mod solver;

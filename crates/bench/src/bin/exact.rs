@@ -1,7 +1,7 @@
 //! Benchmark: the exact PCGTSP solver on every instance of `shared/data/pcgtsp`.
 //!
-//! `cargo run --release -p cutroute-bench --bin exact -- [--time-limit 60] [--filter NAME]
-//! [--no-l2] [--no-heuristic] [--memory-mb 2048] [--data DIR]`
+//! `cargo run --release -p cutroute-bench --bin exact -- [--time-limit 60] [--filter NAME[,NAME…]]
+//! [--skip NAME] [--set industrial|pcgtsplib] [--no-l2] [--no-heuristic] [--memory-mb 2048] [--data DIR]`
 //!
 //! Prints a Markdown table: instance size, number of order ideals, our upper and lower bounds,
 //! gap, proven optimality and time, next to the reference values of `reference.csv`.
@@ -36,6 +36,8 @@ fn split_csv(line: &str) -> Vec<String> {
 pub fn main() {
     let mut time_limit = 60.0f64;
     let mut filter: Option<String> = None;
+    let mut skip: Vec<String> = Vec::new();
+    let mut only_set: Option<String> = None;
     let mut options = ExactOptions::default();
     let mut data = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/pcgtsp");
     let mut args = std::env::args().skip(1);
@@ -48,6 +50,8 @@ pub fn main() {
                     .expect("--time-limit SECONDS")
             }
             "--filter" => filter = args.next(),
+            "--skip" => skip.push(args.next().expect("--skip NAME")),
+            "--set" => only_set = args.next(),
             "--no-l2" => options.use_l2 = false,
             "--no-heuristic" => options.heuristic = false,
             "--memory-mb" => {
@@ -83,9 +87,12 @@ pub fn main() {
     println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     for row in rows {
         if let Some(f) = &filter {
-            if !row.instance.contains(f.as_str()) {
+            if !f.split(',').any(|f| row.instance.contains(f)) {
                 continue;
             }
+        }
+        if skip.contains(&row.instance) || only_set.as_ref().is_some_and(|s| *s != row.set) {
+            continue;
         }
         let path = data.join(&row.set).join(format!("{}.pcglns", row.instance));
         let text =
