@@ -55,6 +55,16 @@ impl Grid {
             }
         }
     }
+    /// Visits every cell overlapping `b`.
+    pub fn cells_in(&self, b: &BBox, mut f: impl FnMut(&[u32])) {
+        let (x0, y0, x1, y1) = self.range(b);
+        for y in y0..=y1 {
+            for x in x0..=x1 {
+                f(&self.cells[y * self.nx + x]);
+            }
+        }
+    }
+
     /// The items of the cell holding `p`.
     pub fn at(&self, p: V) -> &[u32] {
         &self.cells[self.iy(p.y) * self.nx + self.ix(p.x)]

@@ -4,7 +4,8 @@
 use cutroute_geometry::{ContourRef, CutStep, MachineParameters, Nest, Point, Route};
 use serde::{Deserialize, Serialize};
 
-use crate::geom::{on_segment, Shape, Span, V};
+use crate::geom::{on_segment, BBox, Shape, Span, V};
+use crate::problem::Grid;
 use crate::search::Search;
 use crate::CcpError;
 
@@ -40,10 +41,28 @@ pub(crate) fn assemble_route(s: &Search, order: &[u32], pts: &[V]) -> Route {
     let mut inserted: Vec<Vec<(f64, usize, V)>> = vec![Vec::new(); moves.max(1)];
     let mut leftovers = Vec::new();
     let mut hits = Vec::new();
+    // A grid of the air moves: each removed contour only looks at the moves near it.
+    let mut area = prob.bounds;
+    for p in &poly {
+        area.add(*p);
+    }
+    let mut grid = Grid::new(area, moves.max(1), 2.0);
+    for t in 0..moves {
+        let mut bb = BBox::empty();
+        bb.add(poly[t]);
+        bb.add(poly[t + 1]);
+        grid.insert(t as u32, &bb);
+    }
+    let mut candidates: Vec<u32> = Vec::new();
     for &c in &prob.removed {
         let shape = &prob.shapes[c];
+        candidates.clear();
+        grid.cells_in(&shape.bbox, |cell| candidates.extend_from_slice(cell));
+        candidates.sort_unstable_by(|a, b| b.cmp(a));
+        candidates.dedup();
         let mut found = None;
-        for t in (0..moves).rev() {
+        for &t in &candidates {
+            let t = t as usize;
             let (a, b) = (poly[t], poly[t + 1]);
             if !shape.bbox.overlaps_segment(a, b) {
                 continue;

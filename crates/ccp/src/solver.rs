@@ -13,7 +13,7 @@ use crate::route::{
     assemble_route, idle_length, route_certificates, route_metrics, ContourCertificate,
     RouteMetrics,
 };
-use crate::search::{Search, SearchParams};
+use crate::search::{Move, Search, SearchParams};
 use crate::CcpError;
 
 /// Options of a CCP-Relax run. Plain data: build with `..Default::default()`.
@@ -222,10 +222,10 @@ impl CcpSolver {
     pub fn step(&mut self, budget: Duration) -> SolverStatus {
         let t0 = Instant::now();
         let result = self.step_inner(t0, budget);
-        self.elapsed += t0.elapsed();
         if self.phase != CcpPhase::Start {
             self.refresh_route();
         }
+        self.elapsed += t0.elapsed();
         result
     }
 
@@ -259,9 +259,13 @@ impl CcpSolver {
                     }
                     // The queue is empty: a local optimum of every neighbourhood. A full
                     // relaxation queues the contours whose pierce points still moved.
-                    self.search.relax_full();
-                    if !self.search.queue.is_empty() {
-                        continue;
+                    // (After a shake only the neighbourhood of the shake moved: the local
+                    // relaxation of the moves already covers it.)
+                    if self.phase == CcpPhase::LocalSearch {
+                        self.search.relax_full();
+                        if !self.search.queue.is_empty() {
+                            continue;
+                        }
                     }
                     if self.phase == CcpPhase::LocalSearch {
                         self.local_optimum_time = Some(self.elapsed + t0.elapsed());
@@ -339,6 +343,21 @@ impl CcpSolver {
         let n = self.search.len();
         if n < 4 {
             self.fails = self.options.max_non_improving_shakes;
+            return;
+        }
+        if self.strength == self.options.max_shake_strength && n >= 8 {
+            // The strongest shake exchanges two blocks anywhere in the order (a double bridge).
+            let len1 = 1 + self.search.rng.below(3);
+            let len2 = 1 + self.search.rng.below(3);
+            let i = self.search.rng.below(n - len1 - len2 - 1);
+            let k = i + len1 + 1 + self.search.rng.below(n - i - len1 - len2);
+            let m = Move::Exchange {
+                i,
+                j: i + len1 - 1,
+                k,
+                l: k + len2 - 1,
+            };
+            self.search.force_move(&m);
             return;
         }
         let centre = self.search.rng.below(n);
