@@ -105,6 +105,10 @@ pub(crate) struct Search {
     pub exact_checks: u64,
     /// Moves accepted.
     pub accepted: u64,
+    /// Best-improvement mode: `try_move` only collects promising moves with their estimate.
+    collecting: Option<Vec<(f64, Move)>>,
+    /// Explore each neighbourhood fully and apply its best move (instead of the first).
+    pub best_improvement: bool,
 }
 
 impl Search {
@@ -147,6 +151,8 @@ impl Search {
             evaluations: 0,
             exact_checks: 0,
             accepted: 0,
+            collecting: None,
+            best_improvement: false,
         }
     }
 
@@ -558,6 +564,7 @@ impl Search {
                 }
             }
         }
+        let mut estimate = d0;
         if d0 >= -IMPROVE {
             // Estimate what relaxing each junction could win against its new neighbours.
             let mut targets = [(V::default(), None::<V>, 0usize); 12];
@@ -600,6 +607,11 @@ impl Search {
             if d0 - gain >= -IMPROVE {
                 return false;
             }
+            estimate = d0 - gain;
+        }
+        if let Some(list) = self.collecting.as_mut() {
+            list.push((estimate, m.clone()));
+            return false;
         }
         // Exact check: apply, relax the junctions, keep or undo.
         self.exact_checks += 1;
@@ -675,6 +687,9 @@ impl Search {
         let n = self.order.len();
         let i = self.pos[c as usize] as usize;
         let knn = std::mem::take(&mut self.knn[c as usize]);
+        if self.best_improvement {
+            self.collecting = Some(Vec::new());
+        }
         let found = match nb {
             0 => self.nb_relocate(i, &knn, n),
             1 => self.nb_two_opt(i, &knn),
@@ -686,6 +701,11 @@ impl Search {
             _ => self.nb_reinsert(i, n),
         };
         self.knn[c as usize] = knn;
+        if let Some(mut list) = self.collecting.take() {
+            // Best improvement: the most promising moves by estimate, checked exactly.
+            list.sort_by(|a, b| a.0.total_cmp(&b.0));
+            return list.iter().take(3).any(|(_, m)| self.try_move(m));
+        }
         found
     }
 

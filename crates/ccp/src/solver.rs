@@ -43,7 +43,10 @@ pub struct CcpOptions {
     pub restarts: usize,
     /// Largest shaking strength (number of random moves).
     pub max_shake_strength: usize,
-    /// Machine speeds of the time model.
+    /// Apply the best move of a neighbourhood (by estimated gain) instead of the first
+    /// improving one.
+    pub best_improvement: bool,
+    /// Machine speeds and pierce time of the time model.
     pub machine: MachineParameters,
 }
 
@@ -62,6 +65,7 @@ impl Default for CcpOptions {
             max_non_improving_shakes: 300,
             restarts: 1,
             max_shake_strength: 5,
+            best_improvement: false,
             machine: MachineParameters::default(),
         }
     }
@@ -187,7 +191,8 @@ impl CcpSolver {
             max_block: options.max_block,
             reinsert_block: options.reinsert_block,
         };
-        let search = Search::new(prob, start, finish, params, options.seed);
+        let mut search = Search::new(prob, start, finish, params, options.seed);
+        search.best_improvement = options.best_improvement;
         let restarts_left = options.restarts;
         Ok(CcpSolver {
             nest: nest.clone(),

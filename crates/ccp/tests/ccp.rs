@@ -122,9 +122,14 @@ fn concentric_rings_are_optimal() {
 #[test]
 fn synthetic_nest_routes_are_valid_and_lengths_consistent() {
     let nest = generate_nest(300, 5);
-    for finish in [None, Some(Point::new(0.0, 0.0))] {
+    for (finish, best_improvement) in [
+        (None, false),
+        (Some(Point::new(0.0, 0.0)), false),
+        (None, true),
+    ] {
         let mut options = quick(Point::new(0.0, 0.0), finish);
-        options.time_limit = Duration::from_millis(1500);
+        options.time_limit = Duration::from_millis(1000);
+        options.best_improvement = best_improvement;
         let r = solve(&nest, options, &mut |_| {}).unwrap();
         assert_valid(&nest, &r.route);
         assert_eq!(r.route.steps.len(), 300);

@@ -11,7 +11,8 @@
 //!    length, and the peer.
 //!
 //! Arguments: `--quick` skips the 20,000-contour nest; `--vns-seconds S` sets CCP's budget
-//! after the local optimum (default 5); `--synthetic N` runs CCP on one synthetic nest only.
+//! after the local optimum (default 5); `--synthetic N` runs CCP on one synthetic nest only, `--nest PATH` on one real nest (path under
+//! `shared/data/nests`).
 
 use std::time::{Duration, Instant};
 
@@ -31,6 +32,7 @@ fn ccp(nest: &Nest, finish: Option<Point>, time_limit: Duration) -> (CcpResult, 
         start: Point::new(0.0, 0.0),
         finish,
         time_limit,
+        best_improvement: std::env::args().any(|a| a == "--best-improvement"),
         ..CcpOptions::default()
     };
     let t = Instant::now();
@@ -136,6 +138,24 @@ fn main() {
         .position(|a| a == "--synthetic")
         .and_then(|i| args.get(i + 1))
         .and_then(|s| s.parse().ok());
+    if let Some(path) = args
+        .iter()
+        .position(|a| a == "--nest")
+        .and_then(|i| args.get(i + 1))
+    {
+        let nest = read(path);
+        let (r, t) = ccp(&nest, None, budget);
+        println!(
+            "{path}: initial {:.1}, local optimum {:.1} at {:.3} s, final {:.1} in {:.2} s, {} shakes",
+            r.progress.initial_length.unwrap_or(f64::NAN),
+            r.progress.local_optimum_length.unwrap_or(f64::NAN),
+            r.progress.local_optimum_time.unwrap_or_default().as_secs_f64(),
+            r.metrics.idle_length,
+            t.as_secs_f64(),
+            r.progress.shakes
+        );
+        return;
+    }
     if let Some(n) = only {
         let nest = generate_nest(n, 1);
         let (r, t) = ccp(&nest, None, budget);
