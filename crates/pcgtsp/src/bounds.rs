@@ -396,6 +396,7 @@ impl RootBounds {
 /// is built only when the precedence order has at most `max_ideals` order ideals.
 pub fn root_bounds(instance: &Instance, max_ideals: usize) -> Result<RootBounds, OrderError> {
     use crate::lattice::Lattice;
+    const LATTICE_WORK: usize = 300_000_000;
     let mut result = RootBounds {
         l1: INF,
         l2: INF,
@@ -409,12 +410,16 @@ pub fn root_bounds(instance: &Instance, max_ideals: usize) -> Result<RootBounds,
         result.l1 = result.l1.min(bounder.l1);
         result.l2 = result.l2.min(bounder.l2);
         let memory = 1 << 30;
-        let dp = match model.m {
-            0..=64 => Lattice::<1>::build(&model, max_ideals, memory).map(|l| l.root_bound),
-            65..=128 => Lattice::<2>::build(&model, max_ideals, memory).map(|l| l.root_bound),
-            129..=256 => Lattice::<4>::build(&model, max_ideals, memory).map(|l| l.root_bound),
-            _ => None,
-        };
+        let dp =
+            match model.m {
+                0..=64 => Lattice::<1>::build(&model, max_ideals, memory, LATTICE_WORK)
+                    .map(|l| l.root_bound),
+                65..=128 => Lattice::<2>::build(&model, max_ideals, memory, LATTICE_WORK)
+                    .map(|l| l.root_bound),
+                129..=256 => Lattice::<4>::build(&model, max_ideals, memory, LATTICE_WORK)
+                    .map(|l| l.root_bound),
+                _ => None,
+            };
         result.cluster_dp = match (result.cluster_dp, dp) {
             (Some(a), Some(b)) => Some(a.min(b)),
             _ => None,

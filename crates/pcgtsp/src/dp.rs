@@ -11,7 +11,7 @@
 //! parent index of every state, for reconstruction.
 
 use crate::bounds::{Model, ResidualBounder};
-use crate::lattice::{node_completion, Lattice};
+use crate::lattice::Lattice;
 use std::rc::Rc;
 
 const INF: f64 = f64::INFINITY;
@@ -34,10 +34,20 @@ impl<const W: usize> Key<W> {
         self.0[c / 64] |= 1 << (c % 64);
         self
     }
+    /// The clusters in the set, in increasing order.
     #[inline]
-    pub fn without(mut self, c: usize) -> Self {
-        self.0[c / 64] &= !(1 << (c % 64));
-        self
+    pub fn ones(&self) -> impl Iterator<Item = usize> + '_ {
+        (0..W).flat_map(move |i| {
+            let mut w = self.0[i];
+            std::iter::from_fn(move || {
+                if w == 0 {
+                    return None;
+                }
+                let bit = w.trailing_zeros() as usize;
+                w &= w - 1;
+                Some(i * 64 + bit)
+            })
+        })
     }
     #[inline]
     pub fn contains_all(&self, other: &Self) -> bool {
@@ -71,12 +81,6 @@ impl<const W: usize> Layer<W> {
 
     fn state_count(&self) -> usize {
         self.node.len()
-    }
-
-    fn bytes(&self) -> usize {
-        self.node.len() * (2 + 8 + 8 + 4)
-            + self.group_last.len() * 6
-            + self.ideals.len() * (8 * W + 4)
     }
 
     /// The state range of ideal `i`.
@@ -235,11 +239,6 @@ impl<const W: usize> Dp<W> {
         self.current.state_count() + self.next.state_count()
     }
 
-    /// Whether the DP has finished.
-    pub fn is_done(&self) -> bool {
-        self.done
-    }
-
     /// A valid lower bound on every tour better than the incumbent that this DP still represents.
     pub fn lower_bound(&self, model: &Model, upper_bound: f64) -> f64 {
         if self.done {
@@ -388,8 +387,8 @@ impl<const W: usize> Dp<W> {
             }
             let lb = if complete {
                 g + model.arc(x, model.start)
-            } else if use_lattice {
-                g + node_completion(model, &self.next_values, x)
+            } else if let (true, Some(lattice)) = (use_lattice, &self.lattice) {
+                g + lattice.node_completion(model, &self.next_values, x)
             } else {
                 g + self.bounder.node_bound(model, x).max(l2).max(group_bound)
             };
@@ -495,13 +494,5 @@ impl<const W: usize> Dp<W> {
         }
         incumbent.upper_bound = best.0;
         incumbent.tour = Some(tour);
-    }
-
-    /// Approximate memory in use, in bytes.
-    pub fn bytes(&self) -> usize {
-        self.past_bytes
-            + self.current.bytes()
-            + self.next.bytes()
-            + self.records.len() * (8 * W + 8)
     }
 }

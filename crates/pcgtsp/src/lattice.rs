@@ -1,23 +1,18 @@
-//! The lattice of order ideals and the *pierce-consistent cluster DP* bound.
+//! The lattice of order ideals and the *pierce-group DP* bound.
 //!
 //! The assignment bounds (L1, L2) collapse on cutting instances: a contour has many pierce
 //! points, and H1 lets a tour enter a contour at one point and leave from another for free.
-//! This bound keeps the consistency where it matters. Split every arc's cost half to its tail
-//! and half to its head; the node `y` of a cluster then carries `(c(prev, y) + c(y, next)) / 2`,
-//! which is at least
+//! This bound keeps that consistency up to a small tolerance. The pierce points of every
+//! cluster are split into at most `K` groups of consecutive points (consecutive points lie next
+//! to each other along the contour); the *group instance* has one node per group and the arc
+//! cost `min` over the members. Every tour maps to a group tour that is no more expensive, so
+//! the group instance's optimum bounds the original one. It is solved **exactly**, backwards
+//! over the whole ideal lattice, with states `(ideal, group of the last cluster)`: a tour must
+//! enter and leave a cluster through the same group. `K` is chosen from the lattice size (with
+//! `K = |cluster|` the bound is the exact optimum).
 //!
-//! `τ(A, B, C) = min_{b ∈ B} ( min_{a ∈ A} c(a, b) + min_{c ∈ C} c(b, c) ) / 2`
-//!
-//! for the clusters `A, B, C` visited around it: entry and exit share the pierce point `b`.
-//! Minimising the sum of these terms over all precedence-feasible cluster sequences is a DP on
-//! the ideal lattice with cluster-level states `(ideal, last cluster)` (the previous cluster is
-//! enumerated on the fly), orders of magnitude cheaper than the node-level DP and solved
-//! exactly, backwards from the full ideal. Its value at a state bounds every completion, and it
-//! dominates the exact H1 relaxation (`τ(A,B,C) ≥ (d(A,B) + d(B,C)) / 2`).
-//!
-//! For a node-level DP state `(J, x)` with `x ∈ L`, the completion `x → y1 → … → start` costs
-//! at least `min_{Y1} ( c(x, Y1) / 2 + V(J ∪ {Y1}, Y1 | prev = L) )`: the first arc's tail half
-//! is exact, everything else is charged by `τ`, and the last arc's head half goes to the start.
+//! A node-level DP state `(J, x)` with `x` in cluster `L` completes at cost at least
+//! `min_{Y, g ∈ groups(Y)} ( c(x, g) + V(J ∪ {Y}, g) )`.
 
 use crate::bounds::Model;
 use crate::dp::Key;
@@ -32,12 +27,14 @@ struct LatticeLayer<const W: usize> {
     child_start: Vec<u32>,
     child_cluster: Vec<u8>,
     child_index: Vec<u32>,
-    /// Bound values of ideal `i`'s states: `state_start[i]..state_start[i + 1]`.
-    state_start: Vec<u32>,
-    /// The last cluster of every state.
-    state_last: Vec<u8>,
-    /// Bound on the completion from the state, rounded down to `f32`.
-    state_value: Vec<f32>,
+    /// Blocks (one per maximal cluster) of ideal `i`: `block_start[i]..block_start[i + 1]`.
+    block_start: Vec<u32>,
+    /// The maximal cluster of every block.
+    block_cluster: Vec<u8>,
+    /// Where a block's values (one per group of its cluster) begin in `values`.
+    block_value_start: Vec<u32>,
+    /// Completion bounds, rounded down to `f32`.
+    values: Vec<f32>,
 }
 
 /// The full ideal lattice with the cluster-DP bound of every `(ideal, last cluster)`.
@@ -45,8 +42,71 @@ pub(crate) struct Lattice<const W: usize> {
     layers: Vec<LatticeLayer<W>>,
     /// Root bound: the cheapest tour in the relaxation.
     pub root_bound: f64,
-    /// Number of ideals.
-    pub ideal_count: usize,
+    /// The pierce groups the bound was computed with.
+    groups: Groups,
+}
+
+/// Pierce groups: consecutive nodes of a cluster merged into at most `K` groups.
+pub(crate) struct Groups {
+    /// Number of groups.
+    count: usize,
+    /// Groups of every cluster (a range of group ids).
+    cluster_groups: Vec<std::ops::Range<usize>>,
+    /// `count × count`: cheapest arc between the groups' members.
+    cost: Vec<f64>,
+    /// `n × count`: cheapest arc from a node into a group.
+    node_to_group: Vec<f64>,
+}
+
+impl Groups {
+    fn new(model: &Model, k_max: usize) -> Groups {
+        let mut members: Vec<Vec<usize>> = Vec::new();
+        let mut cluster_groups = Vec::with_capacity(model.m);
+        for nodes in &model.cluster_nodes {
+            let k = k_max.min(nodes.len()).max(1);
+            let first = members.len();
+            for t in 0..k {
+                let from = t * nodes.len() / k;
+                let to = (t + 1) * nodes.len() / k;
+                members.push(nodes[from..to].to_vec());
+            }
+            cluster_groups.push(first..members.len());
+        }
+        let count = members.len();
+        let n = model.n;
+        let mut node_to_group = vec![INF; n * count];
+        for x in 0..n {
+            for (g, list) in members.iter().enumerate() {
+                node_to_group[x * count + g] = list
+                    .iter()
+                    .map(|&y| if y == x { INF } else { model.arc(x, y) })
+                    .fold(INF, f64::min);
+            }
+        }
+        let mut cost = vec![INF; count * count];
+        for (g1, list) in members.iter().enumerate() {
+            for g2 in 0..count {
+                cost[g1 * count + g2] = list
+                    .iter()
+                    .map(|&x| node_to_group[x * count + g2])
+                    .fold(INF, f64::min);
+            }
+        }
+        // Groups of one cluster are never consecutive in a tour.
+        for range in &cluster_groups {
+            for g1 in range.clone() {
+                for g2 in range.clone() {
+                    cost[g1 * count + g2] = INF;
+                }
+            }
+        }
+        Groups {
+            count,
+            cluster_groups,
+            cost,
+            node_to_group,
+        }
+    }
 }
 
 /// Rounds `v` down to an `f32` so the stored bound never exceeds the computed one.
@@ -61,15 +121,15 @@ fn down(v: f64) -> f32 {
 
 /// Counts the order ideals of the model's precedence order by building the lattice's keys
 /// layer by layer; `None` if there are more than `limit`.
-pub(crate) fn count_ideals<const W: usize>(model: &Model, limit: usize) -> Option<usize> {
+fn count_ideals_width<const W: usize>(model: &Model, limit: usize) -> Option<usize> {
     let (pred, _) = masks::<W>(model);
     let mut layer = vec![Key::<W>([0; W]).with(model.depot)];
     let mut total = 1usize;
     for _ in 1..model.m {
         let mut next = Vec::new();
         for key in &layer {
-            for c in 0..model.m {
-                if !key.contains(c) && key.contains_all(&pred[c]) {
+            for (c, pred_c) in pred.iter().enumerate() {
+                if !key.contains(c) && key.contains_all(pred_c) {
                     next.push(key.with(c));
                 }
             }
@@ -99,7 +159,12 @@ fn masks<const W: usize>(model: &Model) -> (Vec<Key<W>>, Vec<Key<W>>) {
 impl<const W: usize> Lattice<W> {
     /// Builds the lattice and the bound; `None` if it would exceed `max_ideals` ideals or
     /// `max_bytes` of memory (then the solver falls back to the assignment bounds).
-    pub fn build(model: &Model, max_ideals: usize, max_bytes: usize) -> Option<Lattice<W>> {
+    pub fn build(
+        model: &Model,
+        max_ideals: usize,
+        max_bytes: usize,
+        work_budget: usize,
+    ) -> Option<Lattice<W>> {
         let m = model.m;
         if m > 255 || m > 64 * W {
             return None;
@@ -117,8 +182,8 @@ impl<const W: usize> Lattice<W> {
             let mut records: Vec<(Key<W>, u32, u8)> = Vec::new();
             let layer = &layers[k];
             for (i, key) in layer.keys.iter().enumerate() {
-                for c in 0..m {
-                    if !key.contains(c) && key.contains_all(&pred[c]) {
+                for (c, pred_c) in pred.iter().enumerate() {
+                    if !key.contains(c) && key.contains_all(pred_c) {
                         records.push((key.with(c), i as u32, c as u8));
                     }
                 }
@@ -163,99 +228,103 @@ impl<const W: usize> Lattice<W> {
                 ..Default::default()
             });
         }
-        let forward_done = web_time::Instant::now();
         let last = layers.len() - 1;
         layers[last].child_start = vec![0; layers[last].keys.len() + 1];
-        // τ(A, B, C) over clusters; C = depot means "then back to the start".
-        let tau = tau_table(model);
-        let end: Vec<f64> = (0..m)
-            .map(|b| {
-                model.cluster_nodes[b]
-                    .iter()
-                    .map(|&y| model.arc(y, model.start))
-                    .fold(INF, f64::min)
-                    / 2.0
-            })
-            .collect();
-        // Backward: state values, from the full ideal down to layer 2.
+        // Choose K from the work of the backward pass: ideals × Σ_B k_B × Σ_C k_C.
+        let children_total: usize = layers.iter().map(|l| l.child_cluster.len()).sum();
+        let average_children = (children_total as f64 / ideal_count as f64).max(1.0);
+        let per_ideal = average_children * average_children;
+        let mut k_max = ((work_budget as f64 / (ideal_count as f64 * per_ideal))
+            .sqrt()
+            .floor() as usize)
+            .clamp(1, 64);
+        // Memory: about average_children blocks of k values per ideal.
+        while k_max > 1
+            && ideal_count as f64 * average_children * k_max as f64 * 4.0 + bytes as f64
+                > max_bytes as f64
+        {
+            k_max -= 1;
+        }
+        let groups = Groups::new(model, k_max);
+        let backward_began = web_time::Instant::now();
+        let depot_group = groups.cluster_groups[model.depot].start;
         let mut scratch_max: Vec<usize> = Vec::new();
-        let mut scratch_prev: Vec<usize> = Vec::new();
+        // (group, V) of every child's new last cluster, per ideal.
         let mut child_values: Vec<(usize, f64)> = Vec::new();
         for k in (1..layers.len()).rev() {
             let (lower, upper) = layers.split_at_mut(k + 1);
             let layer = &mut lower[k];
             let child_layer = upper.first();
-            let mut state_start = Vec::with_capacity(layer.keys.len() + 1);
-            let mut state_last = Vec::new();
-            let mut state_value = Vec::new();
-            state_start.push(0u32);
+            let mut block_start = Vec::with_capacity(layer.keys.len() + 1);
+            let mut block_cluster = Vec::new();
+            let mut block_value_start = Vec::new();
+            let mut values: Vec<f32> = Vec::new();
+            block_start.push(0u32);
             for (i, key) in layer.keys.iter().enumerate() {
-                // V(J ∪ {C}, C) of every child, looked up once per ideal.
                 child_values.clear();
                 if let Some(child_layer) = child_layer {
                     for ch in layer.child_start[i] as usize..layer.child_start[i + 1] as usize {
                         let c = layer.child_cluster[ch] as usize;
-                        child_values
-                            .push((c, child_layer.value(layer.child_index[ch] as usize, c)));
+                        let j = layer.child_index[ch] as usize;
+                        let block = child_layer
+                            .block(j, c)
+                            .expect("new last cluster is maximal");
+                        let offset = child_layer.block_value_start[block] as usize;
+                        for (t, g) in groups.cluster_groups[c].clone().enumerate() {
+                            child_values.push((g, child_layer.values[offset + t] as f64));
+                        }
                     }
                 }
                 scratch_max.clear();
-                scratch_max.extend((0..m).filter(|&b| {
-                    b != model.depot && key.contains(b) && !intersects(key, &succ[b])
-                }));
+                scratch_max.extend(
+                    key.ones()
+                        .filter(|&b| b != model.depot && !intersects(key, &succ[b])),
+                );
                 for &b in &scratch_max {
-                    let without = key.without(b);
-                    scratch_prev.clear();
-                    if without == Key([0; W]).with(model.depot) {
-                        scratch_prev.push(model.depot);
-                    } else {
-                        scratch_prev.extend((0..m).filter(|&a| {
-                            a != model.depot
-                                && without.contains(a)
-                                && !intersects(&without, &succ[a])
-                        }));
-                    }
-                    let mut best = INF;
-                    for &a in &scratch_prev {
-                        let row = &tau[(a * m + b) * m..(a * m + b + 1) * m];
-                        if k == m - 1 {
-                            best = best.min(row[model.depot] + end[b]);
+                    block_cluster.push(b as u8);
+                    block_value_start.push(values.len() as u32);
+                    for gb in groups.cluster_groups[b].clone() {
+                        let row = &groups.cost[gb * groups.count..(gb + 1) * groups.count];
+                        let best = if k == m - 1 {
+                            row[depot_group]
                         } else {
-                            for &(c, v) in &child_values {
-                                let w = row[c] + v;
+                            let mut best = INF;
+                            for &(g, v) in &child_values {
+                                let w = row[g] + v;
                                 if w < best {
                                     best = w;
                                 }
                             }
-                        }
+                            best
+                        };
+                        values.push(if best.is_finite() {
+                            down(best)
+                        } else {
+                            f32::INFINITY
+                        });
                     }
-                    state_last.push(b as u8);
-                    state_value.push(if best.is_finite() {
-                        down(best)
-                    } else {
-                        f32::INFINITY
-                    });
                 }
-                state_start.push(state_last.len() as u32);
+                block_start.push(block_cluster.len() as u32);
             }
-            bytes += state_last.len() * 5 + layer.keys.len() * 4;
+            bytes += values.len() * 4 + block_cluster.len() * 5 + layer.keys.len() * 4;
             if bytes > max_bytes {
                 return None;
             }
-            layer.state_start = state_start;
-            layer.state_last = state_last;
-            layer.state_value = state_value;
+            layer.block_start = block_start;
+            layer.block_cluster = block_cluster;
+            layer.block_value_start = block_value_start;
+            layer.values = values;
         }
         if std::env::var_os("PCGTSP_DEBUG").is_some() {
             eprintln!(
-                "[pcgtsp] lattice backward pass {:?}",
-                forward_done.elapsed()
+                "[pcgtsp] lattice: {ideal_count} ideals, K = {k_max}, backward pass {:?}",
+                backward_began.elapsed()
             );
         }
         let mut lattice = Lattice {
             layers,
             root_bound: 0.0,
-            ideal_count,
+            groups,
         };
         lattice.root_bound = if m == 1 {
             model.arc(model.start, model.start)
@@ -270,8 +339,8 @@ impl<const W: usize> Lattice<W> {
         self.layers.get(size - 1)?.keys.binary_search(key).ok()
     }
 
-    /// For ideal number `index` of `size` clusters: fills `out` with `(Y, V(J ∪ {Y}, Y))` for
-    /// every cluster `Y` addable to the ideal.
+    /// For ideal number `index` of `size` clusters: fills `out` with `(g, V(J ∪ {Y}, g))` for
+    /// every group `g` of every cluster `Y` addable to the ideal.
     pub fn next_values(&self, size: usize, index: usize, out: &mut Vec<(usize, f64)>) {
         out.clear();
         let layer = &self.layers[size - 1];
@@ -281,7 +350,13 @@ impl<const W: usize> Lattice<W> {
         for ch in layer.child_start[index] as usize..layer.child_start[index + 1] as usize {
             let c = layer.child_cluster[ch] as usize;
             let j = layer.child_index[ch] as usize;
-            out.push((c, child_layer.value(j, c)));
+            let Some(block) = child_layer.block(j, c) else {
+                continue;
+            };
+            let offset = child_layer.block_value_start[block] as usize;
+            for (t, g) in self.groups.cluster_groups[c].clone().enumerate() {
+                out.push((g, child_layer.values[offset + t] as f64));
+            }
         }
     }
 
@@ -290,36 +365,31 @@ impl<const W: usize> Lattice<W> {
     pub fn completion_bound(&self, model: &Model, size: usize, index: usize, x: usize) -> f64 {
         let mut values = Vec::new();
         self.next_values(size, index, &mut values);
-        node_completion(model, &values, x)
+        self.node_completion(model, &values, x)
     }
-}
 
-/// `min_Y ( c(x, Y) / 2 + V_Y )` over the `(Y, V_Y)` of [`Lattice::next_values`].
-#[inline]
-pub(crate) fn node_completion(model: &Model, values: &[(usize, f64)], x: usize) -> f64 {
-    let row = &model.node_to_cluster[x * model.m..(x + 1) * model.m];
-    let mut best = INF;
-    for &(c, v) in values {
-        let w = row[c] / 2.0 + v;
-        if w < best {
-            best = w;
+    /// `min_g ( c(x, g) + V_g )` over the `(g, V_g)` of [`Lattice::next_values`].
+    #[inline]
+    pub fn node_completion(&self, _model: &Model, values: &[(usize, f64)], x: usize) -> f64 {
+        let count = self.groups.count;
+        let row = &self.groups.node_to_group[x * count..(x + 1) * count];
+        let mut best = INF;
+        for &(g, v) in values {
+            let w = row[g] + v;
+            if w < best {
+                best = w;
+            }
         }
+        best
     }
-    best
 }
 
 impl<const W: usize> LatticeLayer<W> {
-    /// The stored bound of ideal `index` with last cluster `last` (`INF` if absent).
+    /// The block of ideal `index` whose last cluster is `last`.
     #[inline]
-    fn value(&self, index: usize, last: usize) -> f64 {
-        let s0 = self.state_start[index] as usize;
-        let s1 = self.state_start[index + 1] as usize;
-        for s in s0..s1 {
-            if self.state_last[s] as usize == last {
-                return self.state_value[s] as f64;
-            }
-        }
-        INF
+    fn block(&self, index: usize, last: usize) -> Option<usize> {
+        (self.block_start[index] as usize..self.block_start[index + 1] as usize)
+            .find(|&b| self.block_cluster[b] as usize == last)
     }
 }
 
@@ -328,40 +398,19 @@ fn intersects<const W: usize>(a: &Key<W>, b: &Key<W>) -> bool {
     (0..W).any(|i| a.0[i] & b.0[i] != 0)
 }
 
-/// `τ(A, B, C)` for all clusters (`m³`, row-major in A, B, C); `C = depot` closes at the start.
-fn tau_table(model: &Model) -> Vec<f64> {
-    let m = model.m;
-    let n = model.n;
-    // into[A][y] = cheapest arc from cluster A into node y.
-    let mut into = vec![INF; m * n];
-    for (a, nodes) in model.cluster_nodes.iter().enumerate() {
-        for y in 0..n {
-            into[a * n + y] = nodes
-                .iter()
-                .map(|&x| if x == y { INF } else { model.arc(x, y) })
-                .fold(INF, f64::min);
-        }
-    }
-    let mut tau = vec![INF; m * m * m];
-    for a in 0..m {
-        for b in 0..m {
-            if a == b {
-                continue;
-            }
-            for c in 0..m {
-                if c == b || (c == a && c != model.depot) {
-                    continue;
-                }
-                let mut best = INF;
-                for &y in &model.cluster_nodes[b] {
-                    let v = into[a * n + y] + model.node_to_cluster[y * m + c];
-                    if v < best {
-                        best = v;
-                    }
-                }
-                tau[(a * m + b) * m + c] = best / 2.0;
-            }
-        }
-    }
-    tau
+/// Counts the order ideals of an instance's precedence order (the DP's state space over
+/// clusters), layer by layer; `Ok(None)` when there are more than `limit` (or more than 256
+/// clusters).
+pub fn count_ideals(
+    instance: &crate::instance::Instance,
+    limit: usize,
+) -> Result<Option<usize>, crate::order::OrderError> {
+    let start = instance.clusters[instance.depot][0];
+    let model = Model::new(instance, start)?;
+    Ok(match model.m {
+        0..=64 => count_ideals_width::<1>(&model, limit),
+        65..=128 => count_ideals_width::<2>(&model, limit),
+        129..=256 => count_ideals_width::<4>(&model, limit),
+        _ => None,
+    })
 }

@@ -32,18 +32,22 @@ pub struct ExactOptions {
     /// Build the ideal lattice with the cluster-DP bound when the precedence order has at most
     /// this many ideals (0 disables it; the assignment bounds are used instead).
     pub lattice_max_ideals: usize,
+    /// Work budget (elementary steps) of the lattice bound's backward pass; it sets how many
+    /// pierce groups per cluster the bound keeps (more = tighter and slower).
+    pub lattice_work: usize,
 }
 
 impl Default for ExactOptions {
     fn default() -> Self {
         ExactOptions {
             time_limit: Some(Duration::from_secs(60)),
-            memory_limit_bytes: 1 << 30,
+            memory_limit_bytes: 3 << 29,
             use_l2: true,
             heuristic: true,
-            beam_widths: vec![64, 1024],
+            beam_widths: vec![64, 1024, 8192],
             gap_tolerance: 0.0,
             lattice_max_ideals: 8_000_000,
+            lattice_work: 120_000_000,
         }
     }
 }
@@ -134,8 +138,8 @@ impl Engine {
         use_l2: bool,
         store: &mut LatticeStore,
     ) -> Engine {
-        // The lattice bound gets at most a third of the memory; the DP keeps the rest.
-        let dp_memory = memory - memory / 3;
+        // The lattice bound gets at most half of the memory; the DP keeps the rest.
+        let dp_memory = memory - memory / 2;
         match (model.m, store) {
             (0..=64, LatticeStore::W1(l)) => {
                 Engine::W1(Dp::new(model, beam, dp_memory, use_l2, l.clone()))
@@ -197,12 +201,18 @@ enum LatticeStore {
 }
 
 impl LatticeStore {
-    fn build(model: &Model, max_ideals: usize, memory: usize) -> LatticeStore {
-        let budget = memory / 3;
+    fn build(model: &Model, max_ideals: usize, memory: usize, work: usize) -> LatticeStore {
+        let budget = memory / 2;
         match model.m {
-            0..=64 => LatticeStore::W1(Lattice::build(model, max_ideals, budget).map(Rc::new)),
-            65..=128 => LatticeStore::W2(Lattice::build(model, max_ideals, budget).map(Rc::new)),
-            129..=256 => LatticeStore::W4(Lattice::build(model, max_ideals, budget).map(Rc::new)),
+            0..=64 => {
+                LatticeStore::W1(Lattice::build(model, max_ideals, budget, work).map(Rc::new))
+            }
+            65..=128 => {
+                LatticeStore::W2(Lattice::build(model, max_ideals, budget, work).map(Rc::new))
+            }
+            129..=256 => {
+                LatticeStore::W4(Lattice::build(model, max_ideals, budget, work).map(Rc::new))
+            }
             _ => LatticeStore::None,
         }
     }
@@ -236,6 +246,7 @@ impl Run {
             &self.model,
             options.lattice_max_ideals,
             options.memory_limit_bytes,
+            options.lattice_work,
         );
         if let Some(root) = store.root_bound() {
             self.root_bound = self.root_bound.max(self.model.round_bound(root));
@@ -252,7 +263,10 @@ impl Run {
 }
 
 enum Phase {
-    Heuristic { beam: usize, engine: Option<Engine> },
+    Heuristic {
+        beam: usize,
+        engine: Option<Box<Engine>>,
+    },
     Exact,
     Done(SolverStatus),
 }
@@ -441,13 +455,13 @@ impl ExactSolver {
                     if engine.is_none() {
                         match self.options.beam_widths.get(*beam) {
                             Some(&width) => {
-                                *engine = Some(Engine::new(
+                                *engine = Some(Box::new(Engine::new(
                                     &run.model,
                                     Some(width),
                                     self.options.memory_limit_bytes,
                                     self.options.use_l2,
                                     run.lattice.as_mut().expect("built above"),
-                                ));
+                                )));
                             }
                             None => {
                                 self.phase = Phase::Exact;

@@ -2,7 +2,7 @@
 
 mod common;
 
-use common::{reference, references, Reference};
+use common::{reference, references, trusted_optimum, Reference};
 use cutroute_pcgtsp::{
     check_tour, root_bounds, solve, ExactOptions, ExactProgress, ExactSolver, Instance,
     SolverStatus,
@@ -24,7 +24,7 @@ fn check_progress(instance: &Instance, r: &Reference, p: &ExactProgress) {
         p.lower_bound,
         p.upper_bound
     );
-    if let Some(opt) = r.known_optimum {
+    if let Some(opt) = trusted_optimum(r) {
         assert!(
             p.lower_bound <= opt,
             "{}: LB {} above the optimum {opt}",
@@ -45,7 +45,7 @@ fn root_bounds_never_exceed_known_optima() {
     let mut checked = 0;
     for r in references().iter().filter(|r| r.known_optimum.is_some()) {
         let instance = r.load();
-        let opt = r.known_optimum.unwrap();
+        let opt = trusted_optimum(r).unwrap();
         // The cluster DP only where the lattice is small enough for a quick test.
         let b = root_bounds(&instance, 200_000).unwrap();
         assert!(b.l1 <= opt, "{}: L1 {} > {opt}", r.instance, b.l1);
@@ -77,14 +77,14 @@ fn every_reported_bound_is_sound_on_instances_with_known_optima() {
         let result = solve(&instance, options, &mut |p| check_progress(&instance, r, p)).unwrap();
         check_progress(&instance, r, &result.progress);
         assert!(
-            result.root_bound <= r.known_optimum.unwrap(),
+            result.root_bound <= trusted_optimum(r).unwrap(),
             "{}: root bound",
             r.instance
         );
         if result.proven_optimal() {
             assert_eq!(
                 result.progress.upper_bound,
-                r.known_optimum.unwrap(),
+                trusted_optimum(r).unwrap(),
                 "{}",
                 r.instance
             );
@@ -231,4 +231,35 @@ fn memory_cap_degrades_gracefully_with_a_valid_bound() {
         "the capped DP still finds a tour"
     );
     assert!(!result.proven_optimal() || result.progress.upper_bound == 2168.0);
+}
+
+#[test]
+fn bfs_branch_and_bound_variant_proves_small_optima() {
+    use cutroute_pcgtsp::{solve_bnb, BnbOptions};
+    for name in ["ESC07", "e1x_6"] {
+        let r = reference(name);
+        let instance = r.load();
+        let options = BnbOptions {
+            initial_tour: Some(r.pcglns_tour.clone()),
+            ..BnbOptions::default()
+        };
+        let result = solve_bnb(&instance, &options).unwrap();
+        check_progress(&instance, &r, &result.progress);
+        assert!(result.proven_optimal(), "{name}: {:?}", result.progress);
+        assert_eq!(result.progress.upper_bound, r.known_optimum.unwrap());
+    }
+}
+
+#[test]
+fn p43_4_optimum_is_66848_not_the_published_bound_66846() {
+    let r = reference("p43.4");
+    let instance = r.load();
+    let result = solve(&instance, ExactOptions::default(), &mut |p| {
+        check_progress(&instance, &r, p)
+    })
+    .unwrap();
+    assert!(result.proven_optimal());
+    assert_eq!(result.progress.upper_bound, common::P43_4_OPTIMUM);
+    // Consistent with the published lower bound.
+    assert!(result.progress.lower_bound >= r.known_optimum.unwrap());
 }
