@@ -40,7 +40,16 @@ fn assert_well_formed(import: &DxfImport) {
                 part.name
             );
         }
-        for c in &part.contours {
+        for (k, c) in part.contours.iter().enumerate() {
+            // The shared model's own checks: a simple closed curve, oriented by role.
+            c.validate()
+                .unwrap_or_else(|e| panic!("{}: contour {k}: {e}", part.name));
+            assert_eq!(
+                c.is_clockwise(),
+                k == 0,
+                "{}: contour {k} orientation",
+                part.name
+            );
             let n = c.vertices.len();
             for i in 0..n {
                 let (a, b) = (c.vertices[i].point, c.vertices[(i + 1) % n].point);

@@ -78,6 +78,12 @@ fn assert_oriented(project: &TflexProject) {
                     part.name
                 );
             }
+            // The shared model's own checks: a simple closed curve, oriented by role.
+            for (k, c) in part.contours.iter().enumerate() {
+                c.validate()
+                    .unwrap_or_else(|e| panic!("{}: contour {k}: {e}", part.name));
+                assert_eq!(c.is_clockwise(), k == 0, "{}: contour {k}", part.name);
+            }
         }
     }
 }

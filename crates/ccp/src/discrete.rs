@@ -26,7 +26,13 @@ pub struct DiscretisationOptions {
 
 impl Default for DiscretisationOptions {
     fn default() -> Self {
-        DiscretisationOptions { start: Point::new(0.0, 0.0), finish: None, step: 25.0, include_vertices: true, round_costs: false }
+        DiscretisationOptions {
+            start: Point::new(0.0, 0.0),
+            finish: None,
+            step: 25.0,
+            include_vertices: true,
+            round_costs: false,
+        }
     }
 }
 
@@ -86,7 +92,10 @@ fn candidates(shape: &Shape, step: f64, vertices: bool) -> Vec<V> {
 /// Builds the PCGTSP instance of a nest: clusters are the contours plus the depot, costs are
 /// Euclidean idle distances, precedence is "inner before outer" for every containment pair.
 /// The cost matrix is dense: meant for nests of up to a few thousand candidate points.
-pub fn build_pcgtsp(nest: &Nest, options: &DiscretisationOptions) -> Result<DiscreteInstance, CcpError> {
+pub fn build_pcgtsp(
+    nest: &Nest,
+    options: &DiscretisationOptions,
+) -> Result<DiscreteInstance, CcpError> {
     if !(options.step > 0.0 && options.step.is_finite()) {
         return Err(CcpError::InvalidOption("step must be positive".into()));
     }
@@ -103,13 +112,18 @@ pub fn build_pcgtsp(nest: &Nest, options: &DiscretisationOptions) -> Result<Disc
             cl.push(points.len());
             node_cluster.push(i + 1);
             points.push(x);
-            nodes.push(DiscreteNode::Pierce { contour: prob.refs[i], point: x.into() });
+            nodes.push(DiscreteNode::Pierce {
+                contour: prob.refs[i],
+                point: x.into(),
+            });
         }
         clusters.push(cl);
     }
     let n = points.len();
     if n.checked_mul(n).is_none_or(|nn| nn > 400_000_000) {
-        return Err(CcpError::InvalidOption(format!("{n} candidate points: the dense cost matrix is too large")));
+        return Err(CcpError::InvalidOption(format!(
+            "{n} candidate points: the dense cost matrix is too large"
+        )));
     }
     let mut cost = vec![f64::INFINITY; n * n];
     for a in 0..n {
@@ -125,31 +139,62 @@ pub fn build_pcgtsp(nest: &Nest, options: &DiscretisationOptions) -> Result<Disc
             cost[a * n + b] = if options.round_costs { d.round() } else { d };
         }
     }
-    let precedence = prob.precedence_pairs().into_iter().map(|(inner, outer)| (inner + 1, outer + 1)).collect();
-    let instance = Instance { name: "ccp-discretised".into(), node_count: n, cost, clusters, node_cluster, precedence, depot: 0 };
-    Ok(DiscreteInstance { instance, nodes, start: options.start, finish: options.finish })
+    let precedence = prob
+        .precedence_pairs()
+        .into_iter()
+        .map(|(inner, outer)| (inner + 1, outer + 1))
+        .collect();
+    let instance = Instance {
+        name: "ccp-discretised".into(),
+        node_count: n,
+        cost,
+        clusters,
+        node_cluster,
+        precedence,
+        depot: 0,
+    };
+    Ok(DiscreteInstance {
+        instance,
+        nodes,
+        start: options.start,
+        finish: options.finish,
+    })
 }
 
 impl DiscreteInstance {
     /// Turns a closed node tour (any rotation; it must contain the depot node once and one node
     /// of every cluster) into a route.
     pub fn tour_to_route(&self, tour: &[usize]) -> Result<Route, CcpError> {
-        let depot_at = tour.iter().position(|&v| v == 0).ok_or(CcpError::InvalidTour("the tour misses the depot".into()))?;
+        let depot_at = tour
+            .iter()
+            .position(|&v| v == 0)
+            .ok_or(CcpError::InvalidTour("the tour misses the depot".into()))?;
         let mut seen = vec![false; self.instance.clusters.len()];
         let mut steps = Vec::with_capacity(tour.len().saturating_sub(1));
         for t in 0..tour.len() {
             let v = tour[(depot_at + t) % tour.len()];
-            let cl = *self.instance.node_cluster.get(v).ok_or(CcpError::InvalidTour(format!("node {v} does not exist")))?;
+            let cl = *self
+                .instance
+                .node_cluster
+                .get(v)
+                .ok_or(CcpError::InvalidTour(format!("node {v} does not exist")))?;
             if std::mem::replace(&mut seen[cl], true) {
                 return Err(CcpError::InvalidTour(format!("cluster {cl} visited twice")));
             }
             if let DiscreteNode::Pierce { contour, point } = self.nodes[v] {
-                steps.push(CutStep { contour, pierce_point: point });
+                steps.push(CutStep {
+                    contour,
+                    pierce_point: point,
+                });
             }
         }
         if let Some(cl) = seen.iter().position(|s| !s) {
             return Err(CcpError::InvalidTour(format!("cluster {cl} not visited")));
         }
-        Ok(Route { start: self.start, steps, finish: self.finish })
+        Ok(Route {
+            start: self.start,
+            steps,
+            finish: self.finish,
+        })
     }
 }

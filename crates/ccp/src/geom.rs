@@ -88,7 +88,10 @@ pub(crate) struct BBox {
 
 impl BBox {
     pub fn empty() -> Self {
-        BBox { min: V::new(f64::INFINITY, f64::INFINITY), max: V::new(f64::NEG_INFINITY, f64::NEG_INFINITY) }
+        BBox {
+            min: V::new(f64::INFINITY, f64::INFINITY),
+            max: V::new(f64::NEG_INFINITY, f64::NEG_INFINITY),
+        }
     }
     pub fn add(&mut self, p: V) {
         self.min.x = self.min.x.min(p.x);
@@ -113,14 +116,20 @@ impl BBox {
         (dx * dx + dy * dy).sqrt()
     }
     pub fn contains_box(&self, o: &BBox) -> bool {
-        self.min.x <= o.min.x && self.min.y <= o.min.y && self.max.x >= o.max.x && self.max.y >= o.max.y
+        self.min.x <= o.min.x
+            && self.min.y <= o.min.y
+            && self.max.x >= o.max.x
+            && self.max.y >= o.max.y
     }
     pub fn center(&self) -> V {
         (self.min + self.max) * 0.5
     }
     /// Whether the segment `a b` may touch the box (a cheap conservative test).
     pub fn overlaps_segment(&self, a: V, b: V) -> bool {
-        a.x.min(b.x) <= self.max.x && a.x.max(b.x) >= self.min.x && a.y.min(b.y) <= self.max.y && a.y.max(b.y) >= self.min.y
+        a.x.min(b.x) <= self.max.x
+            && a.x.max(b.x) >= self.min.x
+            && a.y.min(b.y) <= self.max.y
+            && a.y.max(b.y) >= self.min.y
     }
 }
 
@@ -130,7 +139,14 @@ pub(crate) enum Span {
     /// From `a` to `b`.
     Seg { a: V, b: V },
     /// From `a` to `b` around `center`: `start` is the angle of `a`, `sweep` the signed swept angle.
-    Arc { a: V, b: V, center: V, radius: f64, start: f64, sweep: f64 },
+    Arc {
+        a: V,
+        b: V,
+        center: V,
+        radius: f64,
+        start: f64,
+        sweep: f64,
+    },
 }
 
 /// Wraps an angle to `[0, 2π)`.
@@ -157,7 +173,14 @@ impl Span {
         let center = (a + b) * 0.5 + chord.unit().perp() * offset;
         let radius = d * (1.0 + bulge * bulge) / (4.0 * bulge.abs());
         let start = (a.y - center.y).atan2(a.x - center.x);
-        Span::Arc { a, b, center, radius, start, sweep }
+        Span::Arc {
+            a,
+            b,
+            center,
+            radius,
+            start,
+            sweep,
+        }
     }
     pub fn a(&self) -> V {
         match *self {
@@ -179,7 +202,14 @@ impl Span {
     pub fn point_at(&self, t: f64) -> V {
         match *self {
             Span::Seg { a, b } => a + (b - a) * t,
-            Span::Arc { a, b, center, radius, start, sweep } => {
+            Span::Arc {
+                a,
+                b,
+                center,
+                radius,
+                start,
+                sweep,
+            } => {
                 if t <= 0.0 {
                     return a;
                 }
@@ -195,7 +225,12 @@ impl Span {
     pub fn derivative_at(&self, t: f64) -> V {
         match *self {
             Span::Seg { a, b } => b - a,
-            Span::Arc { radius, start, sweep, .. } => {
+            Span::Arc {
+                radius,
+                start,
+                sweep,
+                ..
+            } => {
                 let th = start + sweep * t;
                 V::new(-th.sin(), th.cos()) * (radius * sweep)
             }
@@ -203,7 +238,11 @@ impl Span {
     }
     /// The parameter of the point of the circle at angle `theta`, when that point is on the arc.
     fn arc_param(start: f64, sweep: f64, theta: f64) -> Option<f64> {
-        let off = if sweep > 0.0 { wrap(theta - start) } else { wrap(start - theta) };
+        let off = if sweep > 0.0 {
+            wrap(theta - start)
+        } else {
+            wrap(start - theta)
+        };
         let s = sweep.abs();
         if off <= s + 1e-12 {
             Some((off / s).min(1.0))
@@ -218,7 +257,14 @@ impl Span {
         let mut bb = BBox::empty();
         bb.add(self.a());
         bb.add(self.b());
-        if let Span::Arc { center, radius, start, sweep, .. } = *self {
+        if let Span::Arc {
+            center,
+            radius,
+            start,
+            sweep,
+            ..
+        } = *self
+        {
             for k in 0..4 {
                 let th = k as f64 * std::f64::consts::FRAC_PI_2;
                 if Self::arc_param(start, sweep, th).is_some() {
@@ -234,10 +280,21 @@ impl Span {
             Span::Seg { a, b } => {
                 let u = b - a;
                 let uu = u.dot(u);
-                let t = if uu > 0.0 { ((p - a).dot(u) / uu).clamp(0.0, 1.0) } else { 0.0 };
+                let t = if uu > 0.0 {
+                    ((p - a).dot(u) / uu).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
                 (t, a + u * t)
             }
-            Span::Arc { a, b, center, start, sweep, .. } => {
+            Span::Arc {
+                a,
+                b,
+                center,
+                start,
+                sweep,
+                ..
+            } => {
                 let d = p - center;
                 if d.norm() > 0.0 {
                     let th = d.y.atan2(d.x);
@@ -269,7 +326,13 @@ impl Span {
                     out.push((lam.clamp(0.0, 1.0), t.clamp(0.0, 1.0)));
                 }
             }
-            Span::Arc { center, radius, start, sweep, .. } => {
+            Span::Arc {
+                center,
+                radius,
+                start,
+                sweep,
+                ..
+            } => {
                 let ww = w.dot(w);
                 if ww <= 0.0 {
                     return;
@@ -299,7 +362,14 @@ impl Span {
     /// The minimum of `⟨n, X − m⟩` over the span's points `X`.
     pub fn min_dot(&self, n: V, m: V) -> f64 {
         let mut best = n.dot(self.a() - m).min(n.dot(self.b() - m));
-        if let Span::Arc { center, radius, start, sweep, .. } = *self {
+        if let Span::Arc {
+            center,
+            radius,
+            start,
+            sweep,
+            ..
+        } = *self
+        {
             // The arc's extreme point in direction −n.
             let dir = n.unit() * -1.0;
             if dir.norm() > 0.0 && Self::arc_param(start, sweep, dir.y.atan2(dir.x)).is_some() {
@@ -341,7 +411,11 @@ impl Shape {
             spans.push(Span::new(a, b, v.bulge));
         }
         if spans.is_empty() {
-            let a = contour.vertices.first().map(|v| V::from(v.point)).unwrap_or_default();
+            let a = contour
+                .vertices
+                .first()
+                .map(|v| V::from(v.point))
+                .unwrap_or_default();
             spans.push(Span::Seg { a, b: a });
         }
         let span_boxes: Vec<BBox> = spans.iter().map(Span::bbox).collect();
@@ -356,7 +430,9 @@ impl Shape {
             area += 0.5 * s.a().cross(s.b());
             match *s {
                 Span::Seg { a, .. } => polygon.push(a),
-                Span::Arc { a, radius, sweep, .. } => {
+                Span::Arc {
+                    a, radius, sweep, ..
+                } => {
                     // Circular-segment area between chord and arc.
                     area += 0.5 * radius * radius * (sweep - sweep.sin());
                     // Sagitta tolerance ≈ 1e-3·r keeps containment tests exact for disjoint contours.
@@ -368,7 +444,14 @@ impl Shape {
                 }
             }
         }
-        Shape { spans, span_boxes, bbox, perimeter, area, polygon }
+        Shape {
+            spans,
+            span_boxes,
+            bbox,
+            perimeter,
+            area,
+            polygon,
+        }
     }
 
     /// The nearest point of the contour to `p`.
@@ -389,7 +472,11 @@ impl Shape {
 
     /// Whether `p` lies inside the region the contour bounds (even-odd on the fine polygon).
     pub fn contains_point(&self, p: V) -> bool {
-        if p.x < self.bbox.min.x || p.x > self.bbox.max.x || p.y < self.bbox.min.y || p.y > self.bbox.max.y {
+        if p.x < self.bbox.min.x
+            || p.x > self.bbox.max.x
+            || p.y < self.bbox.min.y
+            || p.y > self.bbox.max.y
+        {
             return false;
         }
         let poly = &self.polygon;
@@ -411,7 +498,10 @@ impl Shape {
 
     /// The minimum of `⟨n, X − m⟩` over the whole contour.
     pub fn min_dot(&self, n: V, m: V) -> f64 {
-        self.spans.iter().map(|s| s.min_dot(n, m)).fold(f64::INFINITY, f64::min)
+        self.spans
+            .iter()
+            .map(|s| s.min_dot(n, m))
+            .fold(f64::INFINITY, f64::min)
     }
 
     /// Whether the region is convex (every turn and every arc bends the same way as the area).

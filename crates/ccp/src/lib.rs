@@ -59,7 +59,9 @@ mod solver;
 
 pub use discrete::{build_pcgtsp, DiscreteInstance, DiscreteNode, DiscretisationOptions};
 pub use route::{idle_length, route_certificates, route_metrics, ContourCertificate, RouteMetrics};
-pub use solver::{solve, solve_with_cancel, CcpOptions, CcpPhase, CcpProgress, CcpResult, CcpSolver, SolverStatus};
+pub use solver::{
+    solve, solve_with_cancel, CcpOptions, CcpPhase, CcpProgress, CcpResult, CcpSolver, SolverStatus,
+};
 
 use cutroute_geometry::{ContourRef, Nest};
 
@@ -86,5 +88,8 @@ pub enum CcpError {
 /// inside another (transitively closed), in "inner before outer" precedence form.
 pub fn containment_pairs(nest: &Nest) -> Vec<(ContourRef, ContourRef)> {
     let prob = problem::Problem::new(nest, geom::V::default(), None);
-    prob.precedence_pairs().into_iter().map(|(a, b)| (prob.refs[a], prob.refs[b])).collect()
+    prob.precedence_pairs()
+        .into_iter()
+        .map(|(a, b)| (prob.refs[a], prob.refs[b]))
+        .collect()
 }

@@ -25,7 +25,13 @@ impl Grid {
         let nx = ((w / cell).ceil() as usize).clamp(1, 4096);
         let ny = ((h / cell).ceil() as usize).clamp(1, 4096);
         let cell = (w / nx as f64).max(h / ny as f64);
-        Grid { min: bounds.min, cell, nx, ny, cells: vec![Vec::new(); nx * ny] }
+        Grid {
+            min: bounds.min,
+            cell,
+            nx,
+            ny,
+            cells: vec![Vec::new(); nx * ny],
+        }
     }
     fn ix(&self, x: f64) -> usize {
         (((x - self.min.x) / self.cell).floor().max(0.0) as usize).min(self.nx - 1)
@@ -34,7 +40,12 @@ impl Grid {
         (((y - self.min.y) / self.cell).floor().max(0.0) as usize).min(self.ny - 1)
     }
     fn range(&self, b: &BBox) -> (usize, usize, usize, usize) {
-        (self.ix(b.min.x), self.iy(b.min.y), self.ix(b.max.x), self.iy(b.max.y))
+        (
+            self.ix(b.min.x),
+            self.iy(b.min.y),
+            self.ix(b.max.x),
+            self.iy(b.max.y),
+        )
     }
     pub fn insert(&mut self, id: u32, b: &BBox) {
         let (x0, y0, x1, y1) = self.range(b);
@@ -44,6 +55,16 @@ impl Grid {
             }
         }
     }
+    /// Visits every cell overlapping `b`.
+    pub fn cells_in(&self, b: &BBox, mut f: impl FnMut(&[u32])) {
+        let (x0, y0, x1, y1) = self.range(b);
+        for y in y0..=y1 {
+            for x in x0..=x1 {
+                f(&self.cells[y * self.nx + x]);
+            }
+        }
+    }
+
     /// The items of the cell holding `p`.
     pub fn at(&self, p: V) -> &[u32] {
         &self.cells[self.iy(p.y) * self.nx + self.ix(p.x)]
@@ -54,8 +75,14 @@ impl Grid {
         let (bx0, by0, bx1, by1) = self.range(b);
         let (nx, ny) = (self.nx as isize, self.ny as isize);
         let r = r as isize;
-        let (x0, y0, x1, y1) = (bx0 as isize - r, by0 as isize - r, bx1 as isize + r, by1 as isize + r);
-        if r > 0 && x0 < 0 && y0 < 0 && x1 > nx - 1 && y1 > ny - 1 && x0 + 1 <= 0 && y0 + 1 <= 0 && x1 - 1 >= nx - 1 && y1 - 1 >= ny - 1 {
+        let (x0, y0, x1, y1) = (
+            bx0 as isize - r,
+            by0 as isize - r,
+            bx1 as isize + r,
+            by1 as isize + r,
+        );
+        // Ring r is wholly outside when ring r − 1 already covered the grid.
+        if r > 0 && x0 < 0 && y0 < 0 && x1 >= nx && y1 >= ny {
             return false;
         }
         for y in y0.max(0)..=y1.min(ny - 1) {
@@ -105,7 +132,10 @@ impl Problem {
                 if c.vertices.is_empty() {
                     continue;
                 }
-                refs.push(ContourRef { part: pi, contour: ci });
+                refs.push(ContourRef {
+                    part: pi,
+                    contour: ci,
+                });
                 shapes.push(Shape::new(c));
             }
         }
@@ -124,7 +154,14 @@ impl Problem {
         }
         let kept = (0..shapes.len()).filter(|&i| !has_child[i]).collect();
         let removed = (0..shapes.len()).filter(|&i| has_child[i]).collect();
-        Problem { refs, shapes, parent, kept, removed, bounds }
+        Problem {
+            refs,
+            shapes,
+            parent,
+            kept,
+            removed,
+            bounds,
+        }
     }
 
     /// All containment pairs `(inner, outer)` of the forest (transitively closed).
@@ -262,7 +299,8 @@ pub(crate) fn nearest_neighbour_order(
             }
             r += 1;
         }
-        let take_second = second.1 != usize::MAX && rng.as_deref_mut().is_some_and(|g| g.below(4) == 0);
+        let take_second =
+            second.1 != usize::MAX && rng.as_deref_mut().is_some_and(|g| g.below(4) == 0);
         let pick = if take_second { second } else { best };
         visited[pick.1] = true;
         order.push(pick.1 as u32);

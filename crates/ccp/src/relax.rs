@@ -45,7 +45,14 @@ pub(crate) fn best_on_span(span: &Span, p: V, q: Option<V>) -> (f64, V) {
             let x = a + u * t;
             (cost(p, Some(q), x), x)
         }
-        Span::Arc { a, b, center, radius, sweep, .. } => {
+        Span::Arc {
+            a,
+            b,
+            center,
+            radius,
+            sweep,
+            ..
+        } => {
             let mut hits = Vec::new();
             span.intersect_segment(p, q, &mut hits);
             if let Some(&(_, t)) = hits.first() {
@@ -73,7 +80,11 @@ pub(crate) fn best_on_span(span: &Span, p: V, q: Option<V>) -> (f64, V) {
             let mut g_prev = g_of(u0);
             for k in 1..=n {
                 // Samples by rotation (no trigonometry per sample); the last is the endpoint.
-                let u = if k == n { (b - center) * (1.0 / radius) } else { rot(u_prev) };
+                let u = if k == n {
+                    (b - center) * (1.0 / radius)
+                } else {
+                    rot(u_prev)
+                };
                 let gk = g_of(u);
                 if g_prev < 0.0 && gk > 0.0 {
                     // Bisect the angle inside this sample interval (less than π wide), halving
@@ -130,7 +141,10 @@ mod tests {
 
     #[test]
     fn segment_mirror_and_crossing() {
-        let s = Span::Seg { a: V::new(0.0, 0.0), b: V::new(10.0, 0.0) };
+        let s = Span::Seg {
+            a: V::new(0.0, 0.0),
+            b: V::new(10.0, 0.0),
+        };
         // Opposite sides: the chord crossing.
         let (v, x) = best_on_span(&s, V::new(2.0, 5.0), Some(V::new(6.0, -5.0)));
         assert!((x.x - 4.0).abs() < 1e-12 && x.y.abs() < 1e-12);
@@ -153,7 +167,9 @@ mod tests {
             (V::new(3.0, 15.0), V::new(-4.0, 12.0)),
         ] {
             let (v, _) = best_on_span(&s, p, Some(q));
-            let dense = (0..=20000).map(|k| cost(p, Some(q), s.point_at(k as f64 / 20000.0))).fold(f64::INFINITY, f64::min);
+            let dense = (0..=20000)
+                .map(|k| cost(p, Some(q), s.point_at(k as f64 / 20000.0)))
+                .fold(f64::INFINITY, f64::min);
             assert!(v <= dense + 1e-9, "{v} > {dense}");
         }
     }

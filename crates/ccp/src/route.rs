@@ -4,7 +4,8 @@
 use cutroute_geometry::{ContourRef, CutStep, MachineParameters, Nest, Point, Route};
 use serde::{Deserialize, Serialize};
 
-use crate::geom::{on_segment, Shape, Span, V};
+use crate::geom::{on_segment, BBox, Shape, Span, V};
+use crate::problem::Grid;
 use crate::search::Search;
 use crate::CcpError;
 
@@ -40,10 +41,28 @@ pub(crate) fn assemble_route(s: &Search, order: &[u32], pts: &[V]) -> Route {
     let mut inserted: Vec<Vec<(f64, usize, V)>> = vec![Vec::new(); moves.max(1)];
     let mut leftovers = Vec::new();
     let mut hits = Vec::new();
+    // A grid of the air moves: each removed contour only looks at the moves near it.
+    let mut area = prob.bounds;
+    for p in &poly {
+        area.add(*p);
+    }
+    let mut grid = Grid::new(area, moves.max(1), 2.0);
+    for t in 0..moves {
+        let mut bb = BBox::empty();
+        bb.add(poly[t]);
+        bb.add(poly[t + 1]);
+        grid.insert(t as u32, &bb);
+    }
+    let mut candidates: Vec<u32> = Vec::new();
     for &c in &prob.removed {
         let shape = &prob.shapes[c];
+        candidates.clear();
+        grid.cells_in(&shape.bbox, |cell| candidates.extend_from_slice(cell));
+        candidates.sort_unstable_by(|a, b| b.cmp(a));
+        candidates.dedup();
         let mut found = None;
-        for t in (0..moves).rev() {
+        for &t in &candidates {
+            let t = t as usize;
             let (a, b) = (poly[t], poly[t + 1]);
             if !shape.bbox.overlaps_segment(a, b) {
                 continue;
@@ -74,26 +93,44 @@ pub(crate) fn assemble_route(s: &Search, order: &[u32], pts: &[V]) -> Route {
     let mut steps = Vec::with_capacity(prob.shapes.len());
     for t in 0..poly.len() {
         if let Some(c) = poly_step[t] {
-            steps.push(CutStep { contour: prob.refs[c], pierce_point: poly[t].into() });
+            steps.push(CutStep {
+                contour: prob.refs[c],
+                pierce_point: poly[t].into(),
+            });
         }
         if t < moves {
             let list = &mut inserted[t];
             list.sort_by(|a, b| a.0.total_cmp(&b.0));
             for &(_, c, x) in list.iter() {
-                steps.push(CutStep { contour: prob.refs[c], pierce_point: x.into() });
+                steps.push(CutStep {
+                    contour: prob.refs[c],
+                    pierce_point: x.into(),
+                });
             }
         }
     }
     // Not crossed (only possible through numerical tangency): cut them last, innermost first, from
     // the nearest point, which keeps precedence at the price of extra idle length.
-    leftovers.sort_by(|a, b| prob.shapes[*a].area.abs().total_cmp(&prob.shapes[*b].area.abs()));
+    leftovers.sort_by(|a, b| {
+        prob.shapes[*a]
+            .area
+            .abs()
+            .total_cmp(&prob.shapes[*b].area.abs())
+    });
     let mut cur = steps.last().map_or(s.start, |st| V::from(st.pierce_point));
     for c in leftovers {
         let x = prob.shapes[c].nearest(cur);
-        steps.push(CutStep { contour: prob.refs[c], pierce_point: x.into() });
+        steps.push(CutStep {
+            contour: prob.refs[c],
+            pierce_point: x.into(),
+        });
         cur = x;
     }
-    Route { start: s.start.into(), steps, finish: s.finish.map(Into::into) }
+    Route {
+        start: s.start.into(),
+        steps,
+        finish: s.finish.map(Into::into),
+    }
 }
 
 /// Idle (air) length of a route: start → pierce points in order → finish.
@@ -124,15 +161,22 @@ pub struct RouteMetrics {
     pub total_time: f64,
 }
 
-fn contour_of<'a>(nest: &'a Nest, r: ContourRef) -> Result<&'a cutroute_geometry::Contour, CcpError> {
+fn contour_of(nest: &Nest, r: ContourRef) -> Result<&cutroute_geometry::Contour, CcpError> {
     nest.parts
         .get(r.part)
         .and_then(|p| p.contours.get(r.contour))
-        .ok_or(CcpError::UnknownContour { part: r.part, contour: r.contour })
+        .ok_or(CcpError::UnknownContour {
+            part: r.part,
+            contour: r.contour,
+        })
 }
 
 /// Metrics of a route over a nest under a machine model.
-pub fn route_metrics(nest: &Nest, route: &Route, machine: &MachineParameters) -> Result<RouteMetrics, CcpError> {
+pub fn route_metrics(
+    nest: &Nest,
+    route: &Route,
+    machine: &MachineParameters,
+) -> Result<RouteMetrics, CcpError> {
     let mut cut_length = 0.0;
     for st in &route.steps {
         cut_length += Shape::new(contour_of(nest, st.contour)?).perimeter;
@@ -172,11 +216,25 @@ pub fn route_certificates(nest: &Nest, route: &Route) -> Result<Vec<ContourCerti
     let mut out = Vec::with_capacity(n);
     for (i, st) in route.steps.iter().enumerate() {
         let shape = Shape::new(contour_of(nest, st.contour)?);
-        let p = if i == 0 { V::from(route.start) } else { V::from(route.steps[i - 1].pierce_point) };
-        let q = if i + 1 < n { Some(V::from(route.steps[i + 1].pierce_point)) } else { route.finish.map(V::from) };
+        let p = if i == 0 {
+            V::from(route.start)
+        } else {
+            V::from(route.steps[i - 1].pierce_point)
+        };
+        let q = if i + 1 < n {
+            Some(V::from(route.steps[i + 1].pierce_point))
+        } else {
+            route.finish.map(V::from)
+        };
         let m = V::from(st.pierce_point);
         let (on_chord, c1, c2) = certify(&shape, p, q, m);
-        out.push(ContourCertificate { contour: st.contour, pierce_point: st.pierce_point, on_chord, condition1: c1, condition2: c2 });
+        out.push(ContourCertificate {
+            contour: st.contour,
+            pierce_point: st.pierce_point,
+            on_chord,
+            condition1: c1,
+            condition2: c2,
+        });
     }
     Ok(out)
 }

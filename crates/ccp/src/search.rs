@@ -10,7 +10,7 @@
 use std::collections::VecDeque;
 
 use crate::geom::{Shape, V};
-use crate::problem::{nearest_neighbour_order, nearest_lists, Problem};
+use crate::problem::{nearest_lists, nearest_neighbour_order, Problem};
 use crate::relax::{best_on_shape, cost};
 use crate::rng::Rng;
 
@@ -37,13 +37,27 @@ pub(crate) enum Move {
     /// Reverse positions `i..=j`.
     Reverse { i: usize, j: usize },
     /// Move block `i..=j` to after position `k` (`k = -1`: to the front), reversed if `rev`.
-    Relocate { i: usize, j: usize, k: isize, rev: bool },
+    Relocate {
+        i: usize,
+        j: usize,
+        k: isize,
+        rev: bool,
+    },
     /// Swap the contours at positions `i < j`.
     Swap { i: usize, j: usize },
     /// Exchange the non-adjacent blocks `i..=j` and `k..=l` (`j + 1 < k`).
-    Exchange { i: usize, j: usize, k: usize, l: usize },
+    Exchange {
+        i: usize,
+        j: usize,
+        k: usize,
+        l: usize,
+    },
     /// Rewrite the short window starting at `lo` with `new` (cycles, block rotations).
-    Window { lo: usize, len: usize, new: [u32; 16] },
+    Window {
+        lo: usize,
+        len: usize,
+        new: [u32; 16],
+    },
 }
 
 #[derive(Default)]
@@ -91,10 +105,20 @@ pub(crate) struct Search {
     pub exact_checks: u64,
     /// Moves accepted.
     pub accepted: u64,
+    /// Best-improvement mode: `try_move` only collects promising moves with their estimate.
+    collecting: Option<Vec<(f64, Move)>>,
+    /// Explore each neighbourhood fully and apply its best move (instead of the first).
+    pub best_improvement: bool,
 }
 
 impl Search {
-    pub fn new(prob: Problem, start: V, finish: Option<V>, params: SearchParams, seed: u64) -> Search {
+    pub fn new(
+        prob: Problem,
+        start: V,
+        finish: Option<V>,
+        params: SearchParams,
+        seed: u64,
+    ) -> Search {
         let k = prob.kept.len();
         let mut ancestors = vec![Vec::new(); k];
         for (ki, &c) in prob.kept.iter().enumerate() {
@@ -127,6 +151,8 @@ impl Search {
             evaluations: 0,
             exact_checks: 0,
             accepted: 0,
+            collecting: None,
+            best_improvement: false,
         }
     }
 
@@ -141,10 +167,19 @@ impl Search {
 
     /// Builds the initial order by nearest neighbour (randomised when `randomise`).
     pub fn construct(&mut self, randomise: bool) {
-        let shapes: Vec<&Shape> = self.prob.kept.iter().map(|&c| &self.prob.shapes[c]).collect();
+        let shapes: Vec<&Shape> = self
+            .prob
+            .kept
+            .iter()
+            .map(|&c| &self.prob.shapes[c])
+            .collect();
         let mut rng = self.rng.clone();
-        let (order, pts) =
-            nearest_neighbour_order(&shapes, self.prob.bounds, self.start, if randomise { Some(&mut rng) } else { None });
+        let (order, pts) = nearest_neighbour_order(
+            &shapes,
+            self.prob.bounds,
+            self.start,
+            if randomise { Some(&mut rng) } else { None },
+        );
         self.rng = rng;
         self.order = order;
         self.pts = pts;
@@ -200,7 +235,9 @@ impl Search {
     fn end_target(&self, k: usize, x: V) -> Option<V> {
         match self.finish {
             Some(f) => Some(f),
-            None => self.ancestors[k].first().map(|&a| self.prob.shapes[a].nearest(x)),
+            None => self.ancestors[k]
+                .first()
+                .map(|&a| self.prob.shapes[a].nearest(x)),
         }
     }
 
@@ -216,13 +253,19 @@ impl Search {
 
     pub fn recompute_total(&self) -> f64 {
         let n = self.order.len() as isize;
-        (-1..n).map(|p| self.w(self.node(p), self.node(p + 1))).sum()
+        (-1..n)
+            .map(|p| self.w(self.node(p), self.node(p + 1)))
+            .sum()
     }
 
     /// Moves the pierce point at position `i` to its best place; returns how far it moved.
     fn relax_at(&mut self, i: usize) -> f64 {
         let k = self.order[i] as usize;
-        let p = if i == 0 { self.start } else { self.pts[self.order[i - 1] as usize] };
+        let p = if i == 0 {
+            self.start
+        } else {
+            self.pts[self.order[i - 1] as usize]
+        };
         let cur = self.pts[k];
         let (old, new, x) = if i + 1 < self.order.len() {
             let q = self.pts[self.order[i + 1] as usize];
@@ -231,7 +274,11 @@ impl Search {
         } else {
             let q = self.end_target(k, cur);
             let (_, x) = best_on_shape(self.shape(k), p, q, Some(cur));
-            (p.dist(cur) + self.end_cost(k, cur), p.dist(x) + self.end_cost(k, x), x)
+            (
+                p.dist(cur) + self.end_cost(k, cur),
+                p.dist(x) + self.end_cost(k, x),
+                x,
+            )
         };
         if new < old - 1e-12 {
             if self.recording {
@@ -382,7 +429,13 @@ impl Search {
             Move::Window { lo, len, ref new } => {
                 let lo_i = lo as isize;
                 let old_at = |t: isize| n(lo_i + t);
-                let new_at = |t: isize| if t < 0 || t >= len as isize { n(lo_i + t) } else { new[t as usize] as i64 };
+                let new_at = |t: isize| {
+                    if t < 0 || t >= len as isize {
+                        n(lo_i + t)
+                    } else {
+                        new[t as usize] as i64
+                    }
+                };
                 let same = |a: (i64, i64), b: (i64, i64)| a == b || (a.0 == b.1 && a.1 == b.0);
                 let mut olds = [(0i64, 0i64); 17];
                 let mut news = [(0i64, 0i64); 17];
@@ -449,7 +502,9 @@ impl Search {
                 tmp.extend_from_slice(&self.order[i..=j]);
                 self.order[i..=l].copy_from_slice(&tmp);
             }
-            Move::Window { lo, len, ref new } => self.order[lo..lo + len].copy_from_slice(&new[..len]),
+            Move::Window { lo, len, ref new } => {
+                self.order[lo..lo + len].copy_from_slice(&new[..len])
+            }
         }
         let (lo, hi) = self.range(m);
         self.reindex(lo, hi + 1);
@@ -491,8 +546,14 @@ impl Search {
     pub fn try_move(&mut self, m: &Move) -> bool {
         let Some(e) = self.edges(m) else { return false };
         self.evaluations += 1;
-        let d0: f64 = e.add[..e.na].iter().map(|&(a, b)| self.w(a, b)).sum::<f64>()
-            - e.rem[..e.nr].iter().map(|&(a, b)| self.w(a, b)).sum::<f64>();
+        let d0: f64 = e.add[..e.na]
+            .iter()
+            .map(|&(a, b)| self.w(a, b))
+            .sum::<f64>()
+            - e.rem[..e.nr]
+                .iter()
+                .map(|&(a, b)| self.w(a, b))
+                .sum::<f64>();
         let mut junctions = [0i64; 12];
         let mut nj = 0;
         for &(a, b) in &e.add[..e.na] {
@@ -503,6 +564,7 @@ impl Search {
                 }
             }
         }
+        let mut estimate = d0;
         if d0 >= -IMPROVE {
             // Estimate what relaxing each junction could win against its new neighbours.
             let mut targets = [(V::default(), None::<V>, 0usize); 12];
@@ -518,7 +580,9 @@ impl Search {
                     }
                 };
                 let (p, q) = match (a, b) {
-                    (Some(END), other) | (other, Some(END)) => (at(other).unwrap_or(cur), at(Some(END))),
+                    (Some(END), other) | (other, Some(END)) => {
+                        (at(other).unwrap_or(cur), at(Some(END)))
+                    }
                     (a, b) => (at(a).unwrap_or(cur), at(b)),
                 };
                 let here = cost(p, q, cur);
@@ -543,6 +607,11 @@ impl Search {
             if d0 - gain >= -IMPROVE {
                 return false;
             }
+            estimate = d0 - gain;
+        }
+        if let Some(list) = self.collecting.as_mut() {
+            list.push((estimate, m.clone()));
+            return false;
         }
         // Exact check: apply, relax the junctions, keep or undo.
         self.exact_checks += 1;
@@ -587,8 +656,14 @@ impl Search {
     /// Applies a move unconditionally (for shaking): the length may grow.
     pub fn force_move(&mut self, m: &Move) -> bool {
         let Some(e) = self.edges(m) else { return false };
-        let d0: f64 = e.add[..e.na].iter().map(|&(a, b)| self.w(a, b)).sum::<f64>()
-            - e.rem[..e.nr].iter().map(|&(a, b)| self.w(a, b)).sum::<f64>();
+        let d0: f64 = e.add[..e.na]
+            .iter()
+            .map(|&(a, b)| self.w(a, b))
+            .sum::<f64>()
+            - e.rem[..e.nr]
+                .iter()
+                .map(|&(a, b)| self.w(a, b))
+                .sum::<f64>();
         self.apply_order(m);
         self.total += d0;
         let mut seeds = Vec::new();
@@ -612,6 +687,9 @@ impl Search {
         let n = self.order.len();
         let i = self.pos[c as usize] as usize;
         let knn = std::mem::take(&mut self.knn[c as usize]);
+        if self.best_improvement {
+            self.collecting = Some(Vec::new());
+        }
         let found = match nb {
             0 => self.nb_relocate(i, &knn, n),
             1 => self.nb_two_opt(i, &knn),
@@ -623,6 +701,11 @@ impl Search {
             _ => self.nb_reinsert(i, n),
         };
         self.knn[c as usize] = knn;
+        if let Some(mut list) = self.collecting.take() {
+            // Best improvement: the most promising moves by estimate, checked exactly.
+            list.sort_by(|a, b| a.0.total_cmp(&b.0));
+            return list.iter().take(3).any(|(_, m)| self.try_move(m));
+        }
         found
     }
 
@@ -647,7 +730,12 @@ impl Search {
                                 if len == 1 && rev {
                                     continue;
                                 }
-                                if self.try_move(&Move::Relocate { i: bi, j: bj, k, rev }) {
+                                if self.try_move(&Move::Relocate {
+                                    i: bi,
+                                    j: bj,
+                                    k,
+                                    rev,
+                                }) {
                                     return true;
                                 }
                             }
@@ -666,7 +754,11 @@ impl Search {
     fn nb_two_opt(&mut self, i: usize, knn: &[u32]) -> bool {
         for &b in knn {
             let j = self.pos[b as usize] as usize;
-            let cands = if i < j { [(i + 1, j), (i, j - 1)] } else { [(j + 1, i), (j, i.wrapping_sub(1))] };
+            let cands = if i < j {
+                [(i + 1, j), (i, j - 1)]
+            } else {
+                [(j + 1, i), (j, i.wrapping_sub(1))]
+            };
             for (x, y) in cands {
                 if x < y && y < self.order.len() && self.try_move(&Move::Reverse { i: x, j: y }) {
                     return true;
@@ -675,7 +767,10 @@ impl Search {
         }
         // Reversing the tail lets an open route end elsewhere.
         let n = self.order.len();
-        if self.finish.is_none() && i + 1 < n && self.try_move(&Move::Reverse { i: i + 1, j: n - 1 }) {
+        if self.finish.is_none()
+            && i + 1 < n
+            && self.try_move(&Move::Reverse { i: i + 1, j: n - 1 })
+        {
             return true;
         }
         false
@@ -686,7 +781,13 @@ impl Search {
         for &b in knn {
             let j = self.pos[b as usize] as usize;
             for t in [j.wrapping_sub(1), j + 1] {
-                if t < n && t != i && self.try_move(&Move::Swap { i: i.min(t), j: i.max(t) }) {
+                if t < n
+                    && t != i
+                    && self.try_move(&Move::Swap {
+                        i: i.min(t),
+                        j: i.max(t),
+                    })
+                {
                     return true;
                 }
             }
@@ -714,7 +815,14 @@ impl Search {
                     }
                     // Or block 2 lies before block 1 and starts right after b.
                     let (k2, l2e) = (pb + 1, pb + l2);
-                    if l2e + 1 < i && self.try_move(&Move::Exchange { i: k2, j: l2e, k: i, l: j }) {
+                    if l2e + 1 < i
+                        && self.try_move(&Move::Exchange {
+                            i: k2,
+                            j: l2e,
+                            k: i,
+                            l: j,
+                        })
+                    {
                         return true;
                     }
                 }
@@ -726,7 +834,11 @@ impl Search {
     fn window_move(&self, lo: usize, content: &[u32]) -> Move {
         let mut new = [0u32; 16];
         new[..content.len()].copy_from_slice(content);
-        Move::Window { lo, len: content.len(), new }
+        Move::Window {
+            lo,
+            len: content.len(),
+            new,
+        }
     }
 
     /// Cyclic permutations of 3 contours at most `cycle_window` apart in the order.
@@ -753,7 +865,14 @@ impl Search {
     /// Cyclic permutations of 4 contours at most `cycle_window` apart in the order.
     fn nb_cycle4(&mut self, i: usize, n: usize) -> bool {
         let w = self.params.cycle_window;
-        const CYCLES: [[usize; 4]; 6] = [[1, 2, 3, 0], [3, 0, 1, 2], [1, 3, 0, 2], [2, 0, 3, 1], [2, 3, 1, 0], [3, 2, 0, 1]];
+        const CYCLES: [[usize; 4]; 6] = [
+            [1, 2, 3, 0],
+            [3, 0, 1, 2],
+            [1, 3, 0, 2],
+            [2, 0, 3, 1],
+            [2, 3, 1, 0],
+            [3, 2, 0, 1],
+        ];
         let hi = (i + w).min(n - 1);
         for j in i + 1..=hi {
             for l in j + 1..=hi {
@@ -817,8 +936,14 @@ impl Search {
                         for rev in [false, true] {
                             let m = Move::Relocate { i, j, k, rev };
                             if let Some(ed) = self.edges(&m) {
-                                let d0: f64 = ed.add[..ed.na].iter().map(|&(a, b)| self.w(a, b)).sum::<f64>()
-                                    - ed.rem[..ed.nr].iter().map(|&(a, b)| self.w(a, b)).sum::<f64>();
+                                let d0: f64 = ed.add[..ed.na]
+                                    .iter()
+                                    .map(|&(a, b)| self.w(a, b))
+                                    .sum::<f64>()
+                                    - ed.rem[..ed.nr]
+                                        .iter()
+                                        .map(|&(a, b)| self.w(a, b))
+                                        .sum::<f64>();
                                 if best.as_ref().is_none_or(|b| d0 < b.0) {
                                     best = Some((d0, m));
                                 }
@@ -858,14 +983,24 @@ impl Search {
             0 => Move::Reverse { i: x, j: y },
             1 => {
                 let len = 1 + self.rng.below(3).min(y - x - 1);
-                Move::Relocate { i: x, j: x + len - 1, k: y as isize, rev: self.rng.below(2) == 1 }
+                Move::Relocate {
+                    i: x,
+                    j: x + len - 1,
+                    k: y as isize,
+                    rev: self.rng.below(2) == 1,
+                }
             }
             _ => {
                 let l1 = 1 + self.rng.below(2);
                 if x + l1 + 1 > y {
                     return None;
                 }
-                Move::Exchange { i: x, j: x + l1 - 1, k: y, l: y }
+                Move::Exchange {
+                    i: x,
+                    j: x + l1 - 1,
+                    k: y,
+                    l: y,
+                }
             }
         })
     }
@@ -882,5 +1017,93 @@ impl Search {
         self.total = snap.2;
         self.reindex(0, self.order.len());
         while self.pop().is_some() {}
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn relaxation_never_increases_length() {
+        let nest = cutroute_geometry::generate_nest(150, 11);
+        for finish in [None, Some(V::new(0.0, 0.0))] {
+            let prob = Problem::new(&nest, V::default(), finish);
+            let params = SearchParams {
+                delta: 1e-9,
+                neighbours: 6,
+                cycle_window: 4,
+                max_block: 3,
+                reinsert_block: 6,
+            };
+            let mut s = Search::new(prob, V::default(), finish, params, 3);
+            let n = s.len();
+            // A random order and arbitrary pierce points (first vertices).
+            let mut order: Vec<u32> = (0..n as u32).collect();
+            for i in (1..n).rev() {
+                let j = s.rng.below(i + 1);
+                order.swap(i, j);
+            }
+            s.order = order;
+            s.pts = (0..n).map(|k| s.shape(k).spans[0].a()).collect();
+            s.reindex(0, n);
+            s.total = s.recompute_total();
+            for _ in 0..3000 {
+                let i = s.rng.below(n);
+                let before = s.total;
+                s.relax_at(i);
+                assert!(s.total <= before + 1e-12);
+            }
+            assert!((s.total - s.recompute_total()).abs() < 1e-6);
+            let before = s.total;
+            s.relax_full();
+            assert!(s.total <= before + 1e-12);
+            assert!((s.total - s.recompute_total()).abs() < 1e-6);
+            // Every pierce point lies on its contour.
+            for k in 0..n {
+                let x = s.pts[k];
+                assert!(s.shape(k).nearest(x).dist(x) < 1e-7);
+            }
+        }
+    }
+
+    #[test]
+    fn accepted_moves_keep_the_running_length_exact() {
+        let nest = cutroute_geometry::generate_nest(120, 4);
+        let prob = Problem::new(&nest, V::default(), None);
+        let params = SearchParams {
+            delta: 1e-9,
+            neighbours: 6,
+            cycle_window: 4,
+            max_block: 3,
+            reinsert_block: 6,
+        };
+        let mut s = Search::new(prob, V::default(), None, params, 5);
+        s.construct(false);
+        s.relax_full();
+        s.queue_all();
+        while let Some(c) = s.pop() {
+            for nb in 0..Search::NEIGHBOURHOODS {
+                if s.explore(nb, c) {
+                    s.push(c);
+                    break;
+                }
+            }
+        }
+        assert!(s.accepted > 0);
+        assert!(
+            (s.total - s.recompute_total()).abs() < 1e-6,
+            "{} vs {}",
+            s.total,
+            s.recompute_total()
+        );
+        let mut seen = s.order.clone();
+        seen.sort();
+        assert_eq!(seen, (0..s.len() as u32).collect::<Vec<_>>());
+        assert!(s
+            .order
+            .iter()
+            .enumerate()
+            .all(|(p, &k)| s.pos[k as usize] as usize == p));
     }
 }

@@ -9,8 +9,11 @@ use web_time::Instant;
 
 use crate::geom::V;
 use crate::problem::Problem;
-use crate::route::{assemble_route, idle_length, route_certificates, route_metrics, ContourCertificate, RouteMetrics};
-use crate::search::{Search, SearchParams};
+use crate::route::{
+    assemble_route, idle_length, route_certificates, route_metrics, ContourCertificate,
+    RouteMetrics,
+};
+use crate::search::{Move, Search, SearchParams};
 use crate::CcpError;
 
 /// Options of a CCP-Relax run. Plain data: build with `..Default::default()`.
@@ -40,7 +43,10 @@ pub struct CcpOptions {
     pub restarts: usize,
     /// Largest shaking strength (number of random moves).
     pub max_shake_strength: usize,
-    /// Machine speeds of the time model.
+    /// Apply the best move of a neighbourhood (by estimated gain) instead of the first
+    /// improving one.
+    pub best_improvement: bool,
+    /// Machine speeds and pierce time of the time model.
     pub machine: MachineParameters,
 }
 
@@ -59,6 +65,7 @@ impl Default for CcpOptions {
             max_non_improving_shakes: 300,
             restarts: 1,
             max_shake_strength: 5,
+            best_improvement: false,
             machine: MachineParameters::default(),
         }
     }
@@ -157,12 +164,18 @@ impl CcpSolver {
     pub fn new(nest: &Nest, options: CcpOptions) -> Result<CcpSolver, CcpError> {
         let finite = |p: Point| p.x.is_finite() && p.y.is_finite();
         if !finite(options.start) || options.finish.is_some_and(|f| !finite(f)) {
-            return Err(CcpError::InvalidOption("start and finish must be finite".into()));
+            return Err(CcpError::InvalidOption(
+                "start and finish must be finite".into(),
+            ));
         }
         if !(options.delta > 0.0 && options.delta.is_finite()) {
             return Err(CcpError::InvalidOption("delta must be positive".into()));
         }
-        if options.neighbours == 0 || options.max_block == 0 || options.max_block > 5 || options.cycle_window > 14 {
+        if options.neighbours == 0
+            || options.max_block == 0
+            || options.max_block > 5
+            || options.cycle_window > 14
+        {
             return Err(CcpError::InvalidOption(
                 "neighbours ≥ 1, 1 ≤ max_block ≤ 5 and cycle_window ≤ 14 are required".into(),
             ));
@@ -178,11 +191,16 @@ impl CcpSolver {
             max_block: options.max_block,
             reinsert_block: options.reinsert_block,
         };
-        let search = Search::new(prob, start, finish, params, options.seed);
+        let mut search = Search::new(prob, start, finish, params, options.seed);
+        search.best_improvement = options.best_improvement;
         let restarts_left = options.restarts;
         Ok(CcpSolver {
             nest: nest.clone(),
-            route: Route { start: options.start, steps: Vec::new(), finish: options.finish },
+            route: Route {
+                start: options.start,
+                steps: Vec::new(),
+                finish: options.finish,
+            },
             options,
             search,
             phase: CcpPhase::Start,
@@ -209,10 +227,10 @@ impl CcpSolver {
     pub fn step(&mut self, budget: Duration) -> SolverStatus {
         let t0 = Instant::now();
         let result = self.step_inner(t0, budget);
-        self.elapsed += t0.elapsed();
         if self.phase != CcpPhase::Start {
             self.refresh_route();
         }
+        self.elapsed += t0.elapsed();
         result
     }
 
@@ -246,9 +264,13 @@ impl CcpSolver {
                     }
                     // The queue is empty: a local optimum of every neighbourhood. A full
                     // relaxation queues the contours whose pierce points still moved.
-                    self.search.relax_full();
-                    if !self.search.queue.is_empty() {
-                        continue;
+                    // (After a shake only the neighbourhood of the shake moved: the local
+                    // relaxation of the moves already covers it.)
+                    if self.phase == CcpPhase::LocalSearch {
+                        self.search.relax_full();
+                        if !self.search.queue.is_empty() {
+                            continue;
+                        }
                     }
                     if self.phase == CcpPhase::LocalSearch {
                         self.local_optimum_time = Some(self.elapsed + t0.elapsed());
@@ -285,7 +307,7 @@ impl CcpSolver {
                 }
             }
             count += 1;
-            if count % 32 == 0 && self.out_of_time(t0, budget) {
+            if count.is_multiple_of(32) && self.out_of_time(t0, budget) {
                 return false;
             }
         }
@@ -326,6 +348,21 @@ impl CcpSolver {
         let n = self.search.len();
         if n < 4 {
             self.fails = self.options.max_non_improving_shakes;
+            return;
+        }
+        if self.strength == self.options.max_shake_strength && n >= 8 {
+            // The strongest shake exchanges two blocks anywhere in the order (a double bridge).
+            let len1 = 1 + self.search.rng.below(3);
+            let len2 = 1 + self.search.rng.below(3);
+            let i = self.search.rng.below(n - len1 - len2 - 1);
+            let k = i + len1 + 1 + self.search.rng.below(n - i - len1 - len2);
+            let m = Move::Exchange {
+                i,
+                j: i + len1 - 1,
+                k,
+                l: k + len2 - 1,
+            };
+            self.search.force_move(&m);
             return;
         }
         let centre = self.search.rng.below(n);
@@ -390,7 +427,8 @@ impl CcpSolver {
     /// The result for the best route so far.
     pub fn result(&self) -> CcpResult {
         let certificates = self.certificates();
-        let metrics = route_metrics(&self.nest, &self.route, &self.options.machine).unwrap_or_default();
+        let metrics =
+            route_metrics(&self.nest, &self.route, &self.options.machine).unwrap_or_default();
         CcpResult {
             route: self.route.clone(),
             metrics,
@@ -402,7 +440,11 @@ impl CcpSolver {
 }
 
 /// Runs CCP-Relax to the end (VNS finished or time limit), reporting progress after each slice.
-pub fn solve(nest: &Nest, options: CcpOptions, on_progress: &mut dyn FnMut(&CcpProgress)) -> Result<CcpResult, CcpError> {
+pub fn solve(
+    nest: &Nest,
+    options: CcpOptions,
+    on_progress: &mut dyn FnMut(&CcpProgress),
+) -> Result<CcpResult, CcpError> {
     solve_with_cancel(nest, options, on_progress, &|| false)
 }
 

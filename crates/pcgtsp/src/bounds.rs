@@ -380,25 +380,50 @@ pub struct RootBounds {
     pub l1: f64,
     /// Assignment on the two-step graph H2.
     pub l2: f64,
+    /// The pierce-consistent cluster DP over the ideal lattice (`None` when the order has
+    /// more ideals than allowed, or more than 256 clusters).
+    pub cluster_dp: Option<f64>,
 }
 
 impl RootBounds {
     /// The best of the bounds.
     pub fn best(&self) -> f64 {
-        self.l1.max(self.l2)
+        self.l1.max(self.l2).max(self.cluster_dp.unwrap_or(-INF))
     }
 }
 
-/// Computes the root bounds L1 and L2 (minimum over the start nodes of the depot cluster).
-pub fn root_bounds(instance: &Instance) -> Result<RootBounds, OrderError> {
-    let mut result = RootBounds { l1: INF, l2: INF };
+/// Computes the root bounds (minimum over the start nodes of the depot cluster). The cluster DP
+/// is built only when the precedence order has at most `max_ideals` order ideals.
+pub fn root_bounds(instance: &Instance, max_ideals: usize) -> Result<RootBounds, OrderError> {
+    use crate::lattice::Lattice;
+    const LATTICE_WORK: usize = 300_000_000;
+    let mut result = RootBounds {
+        l1: INF,
+        l2: INF,
+        cluster_dp: Some(INF),
+    };
     let mut bounder = ResidualBounder::default();
     for &start in &instance.clusters[instance.depot] {
         let model = Model::new(instance, start)?;
         let depot = model.depot;
         bounder.compute(&model, &|c| c == depot, depot, true);
         result.l1 = result.l1.min(bounder.l1);
-        result.l2 = result.l2.min(bounder.l2.max(-INF));
+        result.l2 = result.l2.min(bounder.l2);
+        let memory = 1 << 30;
+        let dp =
+            match model.m {
+                0..=64 => Lattice::<1>::build(&model, max_ideals, memory, LATTICE_WORK)
+                    .map(|l| l.root_bound),
+                65..=128 => Lattice::<2>::build(&model, max_ideals, memory, LATTICE_WORK)
+                    .map(|l| l.root_bound),
+                129..=256 => Lattice::<4>::build(&model, max_ideals, memory, LATTICE_WORK)
+                    .map(|l| l.root_bound),
+                _ => None,
+            };
+        result.cluster_dp = match (result.cluster_dp, dp) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            _ => None,
+        };
     }
     Ok(result)
 }

@@ -11,6 +11,8 @@
 //! parent index of every state, for reconstruction.
 
 use crate::bounds::{Model, ResidualBounder};
+use crate::lattice::Lattice;
+use std::rc::Rc;
 
 const INF: f64 = f64::INFINITY;
 
@@ -20,20 +22,35 @@ pub(crate) struct Key<const W: usize>(pub [u64; W]);
 
 impl<const W: usize> Key<W> {
     #[inline]
-    fn empty() -> Self {
+    pub fn empty() -> Self {
         Key([0; W])
     }
     #[inline]
-    fn contains(&self, c: usize) -> bool {
+    pub fn contains(&self, c: usize) -> bool {
         self.0[c / 64] >> (c % 64) & 1 == 1
     }
     #[inline]
-    fn with(mut self, c: usize) -> Self {
+    pub fn with(mut self, c: usize) -> Self {
         self.0[c / 64] |= 1 << (c % 64);
         self
     }
+    /// The clusters in the set, in increasing order.
     #[inline]
-    fn contains_all(&self, other: &Self) -> bool {
+    pub fn ones(&self) -> impl Iterator<Item = usize> + '_ {
+        (0..W).flat_map(move |i| {
+            let mut w = self.0[i];
+            std::iter::from_fn(move || {
+                if w == 0 {
+                    return None;
+                }
+                let bit = w.trailing_zeros() as usize;
+                w &= w - 1;
+                Some(i * 64 + bit)
+            })
+        })
+    }
+    #[inline]
+    pub fn contains_all(&self, other: &Self) -> bool {
         (0..W).all(|i| other.0[i] & !self.0[i] == 0)
     }
 }
@@ -64,12 +81,6 @@ impl<const W: usize> Layer<W> {
 
     fn state_count(&self) -> usize {
         self.node.len()
-    }
-
-    fn bytes(&self) -> usize {
-        self.node.len() * (2 + 8 + 8 + 4)
-            + self.group_last.len() * 6
-            + self.ideals.len() * (8 * W + 4)
     }
 
     /// The state range of ideal `i`.
@@ -138,6 +149,8 @@ pub(crate) struct Dp<const W: usize> {
     next_record: usize,
     next: Layer<W>,
     next_min_lb: f64,
+    /// The smallest bound in the current layer.
+    current_min_lb: f64,
     /// Keep at most this many states per layer (beam search; `None` = exact).
     beam_width: Option<usize>,
     memory_limit: usize,
@@ -154,6 +167,9 @@ pub(crate) struct Dp<const W: usize> {
     /// Upper bound used when the current layer was pruned last.
     pruned_with: f64,
     done: bool,
+    /// The cluster-DP bound over the whole ideal lattice, when it fits in memory.
+    lattice: Option<Rc<Lattice<W>>>,
+    next_values: Vec<(usize, f64)>,
 }
 
 impl<const W: usize> Dp<W> {
@@ -162,6 +178,7 @@ impl<const W: usize> Dp<W> {
         beam_width: Option<usize>,
         memory_limit: usize,
         use_l2: bool,
+        lattice: Option<Rc<Lattice<W>>>,
     ) -> Self {
         let m = model.m;
         assert!(m <= 64 * W, "cluster count exceeds key width");
@@ -178,9 +195,17 @@ impl<const W: usize> Dp<W> {
         current.group_last.push(model.depot as u16);
         current.node.push(model.start as u16);
         current.cost.push(0.0);
-        current.lb.push(0.0);
+        // With a single cluster the start node alone is the tour (closed by its self-arc).
+        current.lb.push(if m == 1 {
+            model.arc(model.start, model.start)
+        } else {
+            0.0
+        });
         current.parent.push(u32::MAX);
         current.group_states.push(1);
+        let layer_bound = lattice
+            .as_ref()
+            .map_or(0.0, |l| model.round_bound(l.root_bound));
         Dp {
             pred_mask,
             layer: 1,
@@ -192,28 +217,26 @@ impl<const W: usize> Dp<W> {
             next_record: 0,
             next: Layer::new(),
             next_min_lb: INF,
+            current_min_lb: 0.0,
             beam_width,
             memory_limit,
             dropped_min: INF,
-            layer_bound: 0.0,
+            layer_bound,
             bounder: ResidualBounder::default(),
             use_l2,
             costs: Vec::new(),
             parents: Vec::new(),
             states_created: 1,
             pruned_with: INF,
-            done: m == 1,
+            done: false,
+            lattice,
+            next_values: Vec::new(),
         }
     }
 
     /// States in the current layer plus the one being built.
     pub fn live_states(&self) -> usize {
         self.current.state_count() + self.next.state_count()
-    }
-
-    /// Whether the DP has finished.
-    pub fn is_done(&self) -> bool {
-        self.done
     }
 
     /// A valid lower bound on every tour better than the incumbent that this DP still represents.
@@ -223,11 +246,10 @@ impl<const W: usize> Dp<W> {
         }
         // Every improving tour passes through a state of the current layer, or one of the layer
         // being built, or was dropped (pruned states cannot improve on the incumbent).
-        let mut live = self.dropped_min;
-        for &lb in &self.current.lb[..] {
-            live = live.min(lb);
-        }
-        live = live.min(self.next_min_lb);
+        let live = self
+            .dropped_min
+            .min(self.current_min_lb)
+            .min(self.next_min_lb);
         model
             .round_bound(live)
             .min(upper_bound)
@@ -310,15 +332,22 @@ impl<const W: usize> Dp<W> {
         self.costs.resize(width, INF);
         self.parents.clear();
         self.parents.resize(width, u32::MAX);
-        for s in sources.clone() {
-            let g = self.current.cost[s];
-            let u = self.current.node[s] as usize;
-            let row = &block[u * width..(u + 1) * width];
-            for (j, &arc) in row.iter().enumerate() {
-                let c = g + arc;
-                if c < self.costs[j] {
-                    self.costs[j] = c;
-                    self.parents[j] = s as u32;
+        {
+            // Local slices keep the hot loop free of reloads through `self`.
+            let costs = &mut self.costs[..width];
+            let parents = &mut self.parents[..width];
+            let source_cost = &self.current.cost[sources.clone()];
+            let source_node = &self.current.node[sources.clone()];
+            for (offset, (&g, &u)) in source_cost.iter().zip(source_node).enumerate() {
+                let u = u as usize;
+                let row = &block[u * width..(u + 1) * width];
+                let s = (sources.start + offset) as u32;
+                for ((cost, parent), &arc) in costs.iter_mut().zip(parents.iter_mut()).zip(row) {
+                    let c = g + arc;
+                    if c < *cost {
+                        *cost = c;
+                        *parent = s;
+                    }
                 }
             }
         }
@@ -329,8 +358,18 @@ impl<const W: usize> Dp<W> {
         }
         let complete = self.layer + 1 == model.m;
         let group_bound;
+        let mut use_lattice = false;
         if complete {
             group_bound = 0.0;
+            self.bounder.l2 = -INF;
+        } else if let Some(lattice) = &self.lattice {
+            let index = lattice
+                .find(&ideal, self.layer + 1)
+                .expect("every ideal is in the lattice");
+            lattice.next_values(self.layer + 1, index, &mut self.next_values);
+            use_lattice = true;
+            group_bound = 0.0;
+            self.bounder.l2 = -INF;
         } else {
             group_bound = self
                 .bounder
@@ -348,6 +387,8 @@ impl<const W: usize> Dp<W> {
             }
             let lb = if complete {
                 g + model.arc(x, model.start)
+            } else if let (true, Some(lattice)) = (use_lattice, &self.lattice) {
+                g + lattice.node_completion(model, &self.next_values, x)
             } else {
                 g + self.bounder.node_bound(model, x).max(l2).max(group_bound)
             };
@@ -419,6 +460,7 @@ impl<const W: usize> Dp<W> {
         let layer_min = model.round_bound(self.next_min_lb.min(self.dropped_min));
         self.layer_bound = self.layer_bound.max(layer_min);
         let finished = std::mem::replace(&mut self.current, std::mem::take(&mut self.next));
+        self.current_min_lb = self.next_min_lb;
         self.past_bytes += finished.node.len() * 6;
         self.past_nodes.push(finished.node);
         self.past_parents.push(finished.parent);
@@ -452,13 +494,5 @@ impl<const W: usize> Dp<W> {
         }
         incumbent.upper_bound = best.0;
         incumbent.tour = Some(tour);
-    }
-
-    /// Approximate memory in use, in bytes.
-    pub fn bytes(&self) -> usize {
-        self.past_bytes
-            + self.current.bytes()
-            + self.next.bytes()
-            + self.records.len() * (8 * W + 8)
     }
 }

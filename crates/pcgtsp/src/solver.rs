@@ -5,7 +5,9 @@ use crate::check::check_tour;
 use crate::dp::{Dp, DpStatus, Incumbent};
 use crate::heuristic;
 use crate::instance::Instance;
+use crate::lattice::Lattice;
 use crate::order::OrderError;
+use std::rc::Rc;
 use std::time::Duration;
 use web_time::Instant;
 
@@ -27,17 +29,25 @@ pub struct ExactOptions {
     pub beam_widths: Vec<usize>,
     /// Stop as soon as `(UB − LB) / UB` is at most this (0 = prove optimality).
     pub gap_tolerance: f64,
+    /// Build the ideal lattice with the cluster-DP bound when the precedence order has at most
+    /// this many ideals (0 disables it; the assignment bounds are used instead).
+    pub lattice_max_ideals: usize,
+    /// Work budget (elementary steps) of the lattice bound's backward pass; it sets how many
+    /// pierce groups per cluster the bound keeps (more = tighter and slower).
+    pub lattice_work: usize,
 }
 
 impl Default for ExactOptions {
     fn default() -> Self {
         ExactOptions {
             time_limit: Some(Duration::from_secs(60)),
-            memory_limit_bytes: 1 << 30,
+            memory_limit_bytes: 3 << 29,
             use_l2: true,
             heuristic: true,
-            beam_widths: vec![64, 1024],
+            beam_widths: vec![64, 1024, 8192],
             gap_tolerance: 0.0,
+            lattice_max_ideals: 8_000_000,
+            lattice_work: 120_000_000,
         }
     }
 }
@@ -121,11 +131,25 @@ enum Engine {
 }
 
 impl Engine {
-    fn new(model: &Model, beam: Option<usize>, memory: usize, use_l2: bool) -> Engine {
-        match model.m {
-            0..=64 => Engine::W1(Dp::new(model, beam, memory, use_l2)),
-            65..=128 => Engine::W2(Dp::new(model, beam, memory, use_l2)),
-            129..=256 => Engine::W4(Dp::new(model, beam, memory, use_l2)),
+    fn new(
+        model: &Model,
+        beam: Option<usize>,
+        memory: usize,
+        use_l2: bool,
+        store: &mut LatticeStore,
+    ) -> Engine {
+        // The lattice bound gets at most half of the memory; the DP keeps the rest.
+        let dp_memory = memory - memory / 2;
+        match (model.m, store) {
+            (0..=64, LatticeStore::W1(l)) => {
+                Engine::W1(Dp::new(model, beam, dp_memory, use_l2, l.clone()))
+            }
+            (65..=128, LatticeStore::W2(l)) => {
+                Engine::W2(Dp::new(model, beam, dp_memory, use_l2, l.clone()))
+            }
+            (129..=256, LatticeStore::W4(l)) => {
+                Engine::W4(Dp::new(model, beam, dp_memory, use_l2, l.clone()))
+            }
             _ => Engine::Unsupported,
         }
     }
@@ -168,18 +192,81 @@ impl Engine {
     }
 }
 
+/// The lattice bound of one run, built once and shared by the beam and exact engines.
+enum LatticeStore {
+    W1(Option<Rc<Lattice<1>>>),
+    W2(Option<Rc<Lattice<2>>>),
+    W4(Option<Rc<Lattice<4>>>),
+    None,
+}
+
+impl LatticeStore {
+    fn build(model: &Model, max_ideals: usize, memory: usize, work: usize) -> LatticeStore {
+        let budget = memory / 2;
+        match model.m {
+            0..=64 => {
+                LatticeStore::W1(Lattice::build(model, max_ideals, budget, work).map(Rc::new))
+            }
+            65..=128 => {
+                LatticeStore::W2(Lattice::build(model, max_ideals, budget, work).map(Rc::new))
+            }
+            129..=256 => {
+                LatticeStore::W4(Lattice::build(model, max_ideals, budget, work).map(Rc::new))
+            }
+            _ => LatticeStore::None,
+        }
+    }
+
+    fn root_bound(&self) -> Option<f64> {
+        match self {
+            LatticeStore::W1(l) => l.as_ref().map(|l| l.root_bound),
+            LatticeStore::W2(l) => l.as_ref().map(|l| l.root_bound),
+            LatticeStore::W4(l) => l.as_ref().map(|l| l.root_bound),
+            LatticeStore::None => None,
+        }
+    }
+}
+
 /// One start node of the depot cluster: the DP fixes the start, so a depot with several nodes
 /// gives several runs, and the answer is the best over them.
 struct Run {
     model: Model,
+    /// Built lazily on the first `step` (it can take a while on large orders).
+    lattice: Option<LatticeStore>,
     root_bound: f64,
     engine: Option<Engine>,
     finished_bound: Option<f64>,
     states_created: u64,
 }
 
+impl Run {
+    fn build_lattice(&mut self, options: &ExactOptions) {
+        let began = Instant::now();
+        let store = LatticeStore::build(
+            &self.model,
+            options.lattice_max_ideals,
+            options.memory_limit_bytes,
+            options.lattice_work,
+        );
+        if let Some(root) = store.root_bound() {
+            self.root_bound = self.root_bound.max(self.model.round_bound(root));
+        }
+        debug_log(|| {
+            format!(
+                "lattice built in {:?}: root bound {:?}",
+                began.elapsed(),
+                store.root_bound()
+            )
+        });
+        self.lattice = Some(store);
+    }
+}
+
 enum Phase {
-    Heuristic { beam: usize, engine: Option<Engine> },
+    Heuristic {
+        beam: usize,
+        engine: Option<Box<Engine>>,
+    },
     Exact,
     Done(SolverStatus),
 }
@@ -213,6 +300,7 @@ impl ExactSolver {
                 model.round_bound(bounder.compute(&model, &|c| c == depot, depot, options.use_l2));
             runs.push(Run {
                 model,
+                lattice: None,
                 root_bound,
                 engine: None,
                 finished_bound: None,
@@ -277,13 +365,10 @@ impl ExactSolver {
             let run_lb = if let Some(b) = run.finished_bound {
                 b
             } else {
-                let dp_lb = run.engine.as_ref().map_or(-INF, |e| {
-                    if matches!(self.phase, Phase::Exact) {
-                        e.stats(&run.model, ub).2
-                    } else {
-                        -INF
-                    }
-                });
+                let dp_lb = run
+                    .engine
+                    .as_ref()
+                    .map_or(-INF, |e| e.stats(&run.model, ub).2);
                 run.root_bound.max(dp_lb)
             };
             lb = lb.min(run_lb);
@@ -362,16 +447,21 @@ impl ExactSolver {
             }
             match &mut self.phase {
                 Phase::Heuristic { beam, engine } => {
-                    let run = &self.runs[0];
+                    if self.runs[0].lattice.is_none() {
+                        self.runs[0].build_lattice(&self.options);
+                        continue;
+                    }
+                    let run = &mut self.runs[0];
                     if engine.is_none() {
                         match self.options.beam_widths.get(*beam) {
                             Some(&width) => {
-                                *engine = Some(Engine::new(
+                                *engine = Some(Box::new(Engine::new(
                                     &run.model,
                                     Some(width),
                                     self.options.memory_limit_bytes,
                                     self.options.use_l2,
-                                ));
+                                    run.lattice.as_mut().expect("built above"),
+                                )));
                             }
                             None => {
                                 self.phase = Phase::Exact;
@@ -383,9 +473,24 @@ impl ExactSolver {
                     // The beam must not prune with its own incumbent's rounding tricks beyond
                     // what is valid: it uses the same (valid) pruning as the exact DP.
                     if e.run(&run.model, &mut self.incumbent, CHUNK) == DpStatus::Done {
+                        debug_log(|| {
+                            format!(
+                                "beam {} done at {:?}: UB {}",
+                                *beam,
+                                self.elapsed + began.elapsed(),
+                                self.incumbent.upper_bound
+                            )
+                        });
                         *engine = None;
                         *beam += 1;
                         self.polish_incumbent();
+                        debug_log(|| {
+                            format!(
+                                "polished at {:?}: UB {}",
+                                self.elapsed + began.elapsed(),
+                                self.incumbent.upper_bound
+                            )
+                        });
                     }
                 }
                 Phase::Exact => {
@@ -403,10 +508,17 @@ impl ExactSolver {
                     }
                     let memory = self.options.memory_limit_bytes;
                     let use_l2 = self.options.use_l2;
+                    let max_ideals = self.options.lattice_max_ideals;
                     let run = &mut self.runs[self.current_run];
-                    let engine = run
-                        .engine
-                        .get_or_insert_with(|| Engine::new(&run.model, None, memory, use_l2));
+                    if run.lattice.is_none() {
+                        run.build_lattice(&self.options);
+                        continue;
+                    }
+                    let _ = max_ideals;
+                    let store = run.lattice.as_mut().expect("built above");
+                    let engine = run.engine.get_or_insert_with(|| {
+                        Engine::new(&run.model, None, memory, use_l2, store)
+                    });
                     let layer_before = engine.stats(&run.model, INF).0;
                     let status = engine.run(&run.model, &mut self.incumbent, CHUNK);
                     let layer_changed = engine.stats(&run.model, INF).0 != layer_before;
@@ -488,5 +600,12 @@ pub fn solve(
                 root_bound: solver.root_bound(),
             });
         }
+    }
+}
+
+/// Debug tracing to stderr when `PCGTSP_DEBUG` is set (never in wasm, where `env::var` fails).
+fn debug_log(message: impl FnOnce() -> String) {
+    if std::env::var_os("PCGTSP_DEBUG").is_some() {
+        eprintln!("[pcgtsp] {}", message());
     }
 }

@@ -11,7 +11,8 @@
 //!    length, and the peer.
 //!
 //! Arguments: `--quick` skips the 20,000-contour nest; `--vns-seconds S` sets CCP's budget
-//! after the local optimum (default 5); `--synthetic N` runs CCP on one synthetic nest only.
+//! after the local optimum (default 5); `--synthetic N` runs CCP on one synthetic nest only, `--nest PATH` on one real nest (path under
+//! `shared/data/nests`).
 
 use std::time::{Duration, Instant};
 
@@ -27,7 +28,13 @@ fn read(path: &str) -> Nest {
 }
 
 fn ccp(nest: &Nest, finish: Option<Point>, time_limit: Duration) -> (CcpResult, Duration) {
-    let options = CcpOptions { start: Point::new(0.0, 0.0), finish, time_limit, ..CcpOptions::default() };
+    let options = CcpOptions {
+        start: Point::new(0.0, 0.0),
+        finish,
+        time_limit,
+        best_improvement: std::env::args().any(|a| a == "--best-improvement"),
+        ..CcpOptions::default()
+    };
     let t = Instant::now();
     let r = solve(nest, options, &mut |_| {}).expect("ccp solves");
     let route_check = r.route.validate(nest, 1e-6);
@@ -65,7 +72,9 @@ fn peer(nest: &Nest) -> Option<(f64, f64, Duration)> {
             g = g.with_hole(flatten(hole));
         }
         geometries.push(g);
-        result.placements.push(Placement::new_2d(id, 0, 0.0, 0.0, 0.0));
+        result
+            .placements
+            .push(Placement::new_2d(id, 0, 0.0, 0.0, 0.0));
     }
     let config = u_nesting_cutting::CuttingConfig {
         pierce_candidates: 1,
@@ -92,10 +101,23 @@ fn peer(nest: &Nest) -> Option<(f64, f64, Duration)> {
 }
 
 /// Best discrete route at step ε found by cutroute's ALNS in `budget`.
-fn discrete(nest: &Nest, finish: Option<Point>, step: f64, budget: Duration) -> Option<(f64, usize)> {
-    let opts = DiscretisationOptions { start: Point::new(0.0, 0.0), finish, step, ..DiscretisationOptions::default() };
+fn discrete(
+    nest: &Nest,
+    finish: Option<Point>,
+    step: f64,
+    budget: Duration,
+) -> Option<(f64, usize)> {
+    let opts = DiscretisationOptions {
+        start: Point::new(0.0, 0.0),
+        finish,
+        step,
+        ..DiscretisationOptions::default()
+    };
     let inst = build_pcgtsp(nest, &opts).ok()?;
-    let options = cutroute_alns::AlnsOptions { time_limit: Some(budget), ..cutroute_alns::AlnsOptions::default() };
+    let options = cutroute_alns::AlnsOptions {
+        time_limit: Some(budget),
+        ..cutroute_alns::AlnsOptions::default()
+    };
     let r = cutroute_alns::solve(&inst.instance, options, &mut |_| {}).ok()?;
     let route: Route = inst.tour_to_route(r.tour.as_ref()?).ok()?;
     Some((route.idle_length(), inst.instance.node_count))
@@ -111,7 +133,29 @@ fn main() {
         .and_then(|s| s.parse().ok())
         .unwrap_or(5.0);
     let budget = Duration::from_secs_f64(vns_seconds);
-    let only: Option<usize> = args.iter().position(|a| a == "--synthetic").and_then(|i| args.get(i + 1)).and_then(|s| s.parse().ok());
+    let only: Option<usize> = args
+        .iter()
+        .position(|a| a == "--synthetic")
+        .and_then(|i| args.get(i + 1))
+        .and_then(|s| s.parse().ok());
+    if let Some(path) = args
+        .iter()
+        .position(|a| a == "--nest")
+        .and_then(|i| args.get(i + 1))
+    {
+        let nest = read(path);
+        let (r, t) = ccp(&nest, None, budget);
+        println!(
+            "{path}: initial {:.1}, local optimum {:.1} at {:.3} s, final {:.1} in {:.2} s, {} shakes",
+            r.progress.initial_length.unwrap_or(f64::NAN),
+            r.progress.local_optimum_length.unwrap_or(f64::NAN),
+            r.progress.local_optimum_time.unwrap_or_default().as_secs_f64(),
+            r.metrics.idle_length,
+            t.as_secs_f64(),
+            r.progress.shakes
+        );
+        return;
+    }
     if let Some(n) = only {
         let nest = generate_nest(n, 1);
         let (r, t) = ccp(&nest, None, budget);
@@ -152,7 +196,10 @@ fn main() {
             r.progress.kept_contours,
             r.metrics.idle_length,
             t.as_secs_f64(),
-            r.progress.local_optimum_time.unwrap_or_default().as_secs_f64(),
+            r.progress
+                .local_optimum_time
+                .unwrap_or_default()
+                .as_secs_f64(),
             r.certificates.iter().filter(|c| c.condition1).count(),
             r.certificates.len(),
             pl,
@@ -168,9 +215,18 @@ fn main() {
     for (name, nest, len) in &open_results {
         let d25 = discrete(nest, None, 25.0, Duration::from_secs(10));
         let d50 = discrete(nest, None, 50.0, Duration::from_secs(10));
-        let f = |d: Option<(f64, usize)>| d.map_or("n/a".to_string(), |(l, n)| format!("{l:.1} ({n})"));
-        let ratio = |d: Option<(f64, usize)>| d.map_or("n/a".to_string(), |(l, _)| format!("{:.4}", len / l));
-        println!("| {name} | {len:.1} | {} | {} | {} | {} |", f(d25), f(d50), ratio(d25), ratio(d50));
+        let f =
+            |d: Option<(f64, usize)>| d.map_or("n/a".to_string(), |(l, n)| format!("{l:.1} ({n})"));
+        let ratio = |d: Option<(f64, usize)>| {
+            d.map_or("n/a".to_string(), |(l, _)| format!("{:.4}", len / l))
+        };
+        println!(
+            "| {name} | {len:.1} | {} | {} | {} | {} |",
+            f(d25),
+            f(d50),
+            ratio(d25),
+            ratio(d50)
+        );
     }
 
     println!("\n## E1X_6_01 closed at (0, 0) (the PCGTSP instance e1x_6: proven discrete optimum 1513)\n");
@@ -189,11 +245,16 @@ fn main() {
     println!("\n## Synthetic nests (`generate_nest(n, 1)`, open routes from the origin)\n");
     println!("| contours | kept | initial (NN) | local optimum | time to local opt. s | after VNS | total s | peer idle | peer s | CCP / peer |");
     println!("|---|---|---|---|---|---|---|---|---|---|");
-    let sizes: &[usize] = if quick { &[100, 1000, 5000] } else { &[100, 1000, 5000, 20000] };
+    let sizes: &[usize] = if quick {
+        &[100, 1000, 5000]
+    } else {
+        &[100, 1000, 5000, 20000]
+    };
     for &n in sizes {
         let nest = generate_nest(n, 1);
         // Budget: the local optimum plus `vns_seconds` of VNS (scaled up for big nests).
-        let limit = Duration::from_secs_f64(vns_seconds.max(n as f64 / 1000.0 * vns_seconds)) + Duration::from_secs(if n >= 20000 { 120 } else { 10 });
+        let limit = Duration::from_secs_f64(vns_seconds.max(n as f64 / 1000.0 * vns_seconds))
+            + Duration::from_secs(if n >= 20000 { 120 } else { 10 });
         let (r, t) = ccp(&nest, None, limit);
         let p = if n <= 5000 { peer(&nest) } else { None };
         let (pl, pt) = p.map_or((f64::NAN, f64::NAN), |(l, _, t)| (l, t.as_secs_f64()));
@@ -202,7 +263,10 @@ fn main() {
             r.progress.kept_contours,
             r.progress.initial_length.unwrap_or(f64::NAN),
             r.progress.local_optimum_length.unwrap_or(f64::NAN),
-            r.progress.local_optimum_time.unwrap_or_default().as_secs_f64(),
+            r.progress
+                .local_optimum_time
+                .unwrap_or_default()
+                .as_secs_f64(),
             r.metrics.idle_length,
             t.as_secs_f64(),
             pl,

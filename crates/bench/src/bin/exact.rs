@@ -1,12 +1,12 @@
 //! Benchmark: the exact PCGTSP solver on every instance of `shared/data/pcgtsp`.
 //!
-//! `cargo run --release -p cutroute-bench --bin exact -- [--time-limit 60] [--filter NAME]
-//! [--no-l2] [--no-heuristic] [--memory-mb 2048] [--data DIR]`
+//! `cargo run --release -p cutroute-bench --bin exact -- [--time-limit 60] [--filter NAME[,NAME…]]
+//! [--skip NAME] [--set industrial|pcgtsplib] [--no-l2] [--no-heuristic] [--memory-mb 2048] [--data DIR]`
 //!
 //! Prints a Markdown table: instance size, number of order ideals, our upper and lower bounds,
 //! gap, proven optimality and time, next to the reference values of `reference.csv`.
 
-use cutroute_pcgtsp::{check_tour, solve, ExactOptions, Instance, PrecedenceOrder};
+use cutroute_pcgtsp::{check_tour, count_ideals, solve, ExactOptions, Instance};
 use std::path::PathBuf;
 use std::time::Duration;
 
@@ -36,6 +36,8 @@ fn split_csv(line: &str) -> Vec<String> {
 pub fn main() {
     let mut time_limit = 60.0f64;
     let mut filter: Option<String> = None;
+    let mut skip: Vec<String> = Vec::new();
+    let mut only_set: Option<String> = None;
     let mut options = ExactOptions::default();
     let mut data = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/pcgtsp");
     let mut args = std::env::args().skip(1);
@@ -48,6 +50,8 @@ pub fn main() {
                     .expect("--time-limit SECONDS")
             }
             "--filter" => filter = args.next(),
+            "--skip" => skip.push(args.next().expect("--skip NAME")),
+            "--set" => only_set = args.next(),
             "--no-l2" => options.use_l2 = false,
             "--no-heuristic" => options.heuristic = false,
             "--memory-mb" => {
@@ -83,17 +87,20 @@ pub fn main() {
     println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     for row in rows {
         if let Some(f) = &filter {
-            if !row.instance.contains(f.as_str()) {
+            if !f.split(',').any(|f| row.instance.contains(f)) {
                 continue;
             }
+        }
+        if skip.contains(&row.instance) || only_set.as_ref().is_some_and(|s| *s != row.set) {
+            continue;
         }
         let path = data.join(&row.set).join(format!("{}.pcglns", row.instance));
         let text =
             std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         let instance = Instance::parse(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-        let ideals = PrecedenceOrder::new(&instance)
+        let ideals = count_ideals(&instance, 20_000_000)
             .ok()
-            .and_then(|o| o.count_ideals(20_000_000))
+            .flatten()
             .map_or(">2e7".to_string(), |c| c.to_string());
         let limit = if row.instance == "e1x_2" {
             time_limit.max(600.0)

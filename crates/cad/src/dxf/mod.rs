@@ -21,7 +21,8 @@ mod groups;
 
 use cutroute_geometry::Nest;
 
-use crate::assemble::{assemble, AssembleLimits, OpenChain, Piece};
+use crate::assemble::{assemble, AssembleLimits, Piece};
+pub use crate::assemble::{EntityRef, OpenChain};
 
 /// Settings of a DXF import.
 #[derive(Clone, Debug, PartialEq)]

@@ -2,7 +2,9 @@
 //! it accepts must survive the writer, and the writer's output must be a fixed point.
 #![no_main]
 
-use cutroute_formats::{detect, read_dbs, read_dbs_with, read_nest, write_dbs, DbsReadOptions, SheetDetection};
+use cutroute_formats::{
+    detect, read_dbs, read_dbs_with, read_nest, write_dbs, DbsReadOptions, SheetDetection,
+};
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
@@ -20,8 +22,12 @@ fuzz_target!(|data: &[u8]| {
             // Rounding to float32 may legitimately make a rewritten contour invalid, but a file
             // the reader accepts must be written back byte for byte.
             if let Ok(again) = read_dbs(&bytes) {
-                let rewritten = write_dbs(&again.nest).expect("a nest read from our own output writes");
-                assert!(rewritten == bytes, "write(read(write(read(f)))) != write(read(f))");
+                let rewritten =
+                    write_dbs(&again.nest).expect("a nest read from our own output writes");
+                assert!(
+                    rewritten == bytes,
+                    "write(read(write(read(f)))) != write(read(f))"
+                );
             }
         }
     }

@@ -103,6 +103,26 @@ pub fn references() -> Vec<Reference> {
         .collect()
 }
 
+/// p43.4: `reference.csv` lists 66846, which is the dissertation's *lower bound* (Table 2.3,
+/// gap printed as 0.00 % although 66848 vs 66846 is 0.003 %). Salman et al. (2017) prove
+/// 66848.40 on the real-valued twin, and our exact DP proves 66848 with a checked tour of that
+/// cost, confirmed by the pierce-group DP with one group per node (= the exact problem). So the
+/// tests use 66848 as the optimum and still check that we never go below the published bound.
+pub const P43_4_OPTIMUM: f64 = 66848.0;
+
+/// The optimum the tests trust (see [`P43_4_OPTIMUM`]).
+pub fn trusted_optimum(r: &Reference) -> Option<f64> {
+    if r.instance == "p43.4" {
+        assert_eq!(
+            r.known_optimum,
+            Some(66846.0),
+            "reference.csv changed: revisit P43_4_OPTIMUM"
+        );
+        return Some(P43_4_OPTIMUM);
+    }
+    r.known_optimum
+}
+
 /// The reference row of one instance.
 pub fn reference(name: &str) -> Reference {
     references()
