@@ -214,7 +214,7 @@ fn tour_report(solver: &str, result: &Progress) -> Value {
         "proven_optimal": result.proven_optimal,
         "tour": result.tour.as_ref().map(|t| t.iter().map(|n| n + 1).collect::<Vec<_>>()),
         "elapsed_s": result.elapsed_s,
-        "states": result.live_states,
+        "states": result.states,
     })
 }
 

@@ -56,7 +56,7 @@ impl Job for CcpJob {
             route: has_route.then_some(state.route),
             tour: None,
             proven_optimal: false,
-            live_states: None,
+            states: None,
             certified,
         }
     }
@@ -194,7 +194,7 @@ impl Job for DiscreteJob {
             route,
             tour: best.map(|(tour, _)| tour),
             proven_optimal,
-            live_states: exact.map(|p| p.live_states as u64),
+            states: self.exact.as_ref().map(|e| e.states_created()),
             certified: Vec::new(),
         }
     }

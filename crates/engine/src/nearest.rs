@@ -1,5 +1,7 @@
 //! The nearest-neighbour route: the baseline every real solver must beat.
 
+use std::collections::HashMap;
+
 use cutroute_geometry::{ContourRef, CutStep, Nest, Point, Route};
 use cutroute_protocol::{JobId, Progress};
 use web_time::{Duration, Instant};
@@ -7,7 +9,7 @@ use web_time::{Duration, Instant};
 use crate::{EngineError, Job, JobStatus};
 
 /// Greedy routing: from the current tool position, cut the nearest contour that may be cut now
-/// (a part's outer contour only after all its holes), piercing at its nearest vertex.
+/// (only once every contour inside it is cut), piercing at its nearest vertex.
 pub struct NearestNeighbourJob {
     job_id: JobId,
     nest: Nest,
@@ -33,22 +35,18 @@ impl NearestNeighbourJob {
     }
 
     fn solve(&mut self) {
-        let mut remaining: Vec<ContourRef> = Vec::new();
-        for (part_index, part) in self.nest.parts.iter().enumerate() {
-            for contour_index in 0..part.contours.len() {
-                remaining.push(ContourRef { part: part_index, contour: contour_index });
-            }
-        }
-        // Holes left to cut per part: its outer contour waits for them (inner before outer).
-        let mut holes_left: Vec<usize> =
-            self.nest.parts.iter().map(|part| part.contours.len().saturating_sub(1)).collect();
+        let forest = self.nest.containment_forest();
+        let mut remaining: Vec<ContourRef> = self.nest.contour_refs().collect();
+        // Contours still to cut inside each contour: it waits for them (inner before outer).
+        let mut inner_left: HashMap<ContourRef, usize> =
+            remaining.iter().map(|&r| (r, forest.children(r).len())).collect();
         let mut position = self.start;
         let mut steps = Vec::with_capacity(remaining.len());
         let mut idle_length = 0.0;
         while !remaining.is_empty() {
             let mut best: Option<(usize, Point, f64)> = None;
             for (index, contour_ref) in remaining.iter().enumerate() {
-                if contour_ref.contour == 0 && holes_left[contour_ref.part] > 0 {
+                if inner_left.get(contour_ref).is_some_and(|&left| left > 0) {
                     continue;
                 }
                 let contour = &self.nest.parts[contour_ref.part].contours[contour_ref.contour];
@@ -63,8 +61,8 @@ impl NearestNeighbourJob {
                 break; // only contours without vertices remain
             };
             let contour_ref = remaining.swap_remove(index);
-            if contour_ref.contour > 0 {
-                holes_left[contour_ref.part] -= 1;
+            if let Some(left) = forest.parent(contour_ref).and_then(|p| inner_left.get_mut(&p)) {
+                *left -= 1;
             }
             idle_length += d;
             position = pierce_point;
@@ -100,7 +98,7 @@ impl Job for NearestNeighbourJob {
             route: self.route.clone(),
             tour: None,
             proven_optimal: false,
-            live_states: None,
+            states: None,
             certified: Vec::new(),
         }
     }

@@ -202,8 +202,8 @@ pub struct Progress {
     pub tour: Option<Vec<usize>>,
     /// Whether the best solution is proven optimal.
     pub proven_optimal: bool,
-    /// States the exact search holds or has created (exact solver only).
-    pub live_states: Option<u64>,
+    /// States the exact search has created so far (exact solver only).
+    pub states: Option<u64>,
     /// Per step of `route`: whether its pierce point is certified optimal for the order
     /// (CCP's Condition 1); empty when the solver does not certify.
     pub certified: Vec<bool>,
@@ -266,7 +266,7 @@ mod tests {
             }),
             tour: Some(vec![0, 3, 2]),
             proven_optimal: false,
-            live_states: Some(12),
+            states: Some(12),
             certified: vec![true],
         });
         let bytes = bincode::serialize(&progress).unwrap();

@@ -1,0 +1,116 @@
+//! Every solver through the engine on real files, with every answer checked independently.
+
+use std::path::PathBuf;
+
+use cutroute_engine::{open_document, run_to_end, start_job, EngineError, Job, JobStatus};
+use cutroute_protocol::{JobRequest, Problem, Progress, SolverKind, SolverParams};
+use web_time::Duration;
+
+fn data(relative: &str) -> (String, Vec<u8>) {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data").join(relative);
+    let bytes = std::fs::read(&path).unwrap_or_else(|e| panic!("missing test file {}: {e}", path.display()));
+    (relative.to_string(), bytes)
+}
+
+fn run(relative: &str, solver: SolverKind, time_limit_s: f64) -> (Problem, Progress) {
+    let (name, bytes) = data(relative);
+    let document = open_document(&name, &bytes).expect("opens");
+    let params = SolverParams { time_limit_s, ..SolverParams::default() };
+    let request = JobRequest { job_id: 9, problem: document.problem.clone(), solver, params };
+    let mut job = start_job(&request).expect("starts");
+    let mut reports = 0;
+    let result = run_to_end(job.as_mut(), &mut |p| {
+        assert_eq!(p.job_id, 9);
+        reports += 1;
+    });
+    (document.problem, result)
+}
+
+fn check_route(problem: &Problem, result: &Progress) -> f64 {
+    let Problem::Nest { nest, .. } = problem else { panic!("a nest") };
+    let route = result.route.as_ref().expect("a route");
+    route.validate(nest, 1e-3).expect("the route passes the independent checker");
+    let idle = route.idle_length();
+    let reported = result.upper_bound.expect("an upper bound");
+    assert!((idle - reported).abs() <= 1e-6 * idle.max(1.0), "reported {reported} vs recomputed {idle}");
+    idle
+}
+
+#[test]
+fn every_nest_solver_returns_a_valid_route() {
+    for file in ["nests/dbs-json/E1X_6_01.dbs.json", "nests/dbs/nested.dbs", "nests/dbs/seven.dbs"] {
+        let (problem, nearest) = run(file, SolverKind::NearestNeighbour, 1.0);
+        let nearest_idle = check_route(&problem, &nearest);
+        let (problem, ccp) = run(file, SolverKind::Ccp, 1.0);
+        let ccp_idle = check_route(&problem, &ccp);
+        assert!(ccp_idle < nearest_idle, "{file}: CCP {ccp_idle} should beat nearest neighbour {nearest_idle}");
+        assert_eq!(ccp.certified.len(), ccp.route.as_ref().unwrap().steps.len());
+    }
+}
+
+#[test]
+fn discrete_solvers_on_a_nest_return_valid_routes() {
+    for solver in [SolverKind::Heuristic, SolverKind::Exact] {
+        let (problem, result) = run("nests/dbs-json/E1X_6_01.dbs.json", solver, 2.0);
+        check_route(&problem, &result);
+    }
+}
+
+#[test]
+fn exact_job_proves_an_industrial_optimum_and_the_tour_checks() {
+    let (problem, result) = run("pcgtsp/industrial/e1x_6.pcglns", SolverKind::Exact, 30.0);
+    let Problem::PcgtspText { text } = problem else { panic!("an instance") };
+    let instance = cutroute_pcgtsp::Instance::parse(&text).unwrap();
+    let tour = result.tour.clone().expect("a tour");
+    let cost = cutroute_pcgtsp::check_tour(&instance, &tour).expect("feasible tour");
+    assert_eq!(cost, 1513.0, "reference.csv: known optimum of e1x_6");
+    assert!(result.proven_optimal);
+    assert_eq!(result.lower_bound, Some(1513.0));
+    assert_eq!(result.gap(), Some(0.0));
+}
+
+#[test]
+fn heuristic_job_tours_are_feasible() {
+    let (problem, result) = run("pcgtsp/pcgtsplib/ESC12.pcglns", SolverKind::Heuristic, 0.5);
+    let Problem::PcgtspText { text } = problem else { panic!("an instance") };
+    let instance = cutroute_pcgtsp::Instance::parse(&text).unwrap();
+    let cost = cutroute_pcgtsp::check_tour(&instance, result.tour.as_ref().unwrap()).unwrap();
+    assert_eq!(Some(cost), result.upper_bound);
+    assert_eq!(result.lower_bound, None);
+}
+
+#[test]
+fn a_long_job_yields_between_slices_so_it_can_be_cancelled() {
+    let (name, bytes) = data("nests/dbs/seven.dbs");
+    let document = open_document(&name, &bytes).unwrap();
+    let params = SolverParams { time_limit_s: 60.0, ..SolverParams::default() };
+    let request = JobRequest { job_id: 3, problem: document.problem, solver: SolverKind::Ccp, params };
+    let mut job: Box<dyn Job> = start_job(&request).unwrap();
+    let started = web_time::Instant::now();
+    assert_eq!(job.step(Duration::from_millis(20)), JobStatus::Running);
+    // One slice must return promptly: this is what lets the worker see a Cancel message.
+    assert!(started.elapsed() < Duration::from_millis(1500), "a slice took {:?}", started.elapsed());
+}
+
+#[test]
+fn solvers_refuse_problems_they_cannot_solve() {
+    let (name, bytes) = data("pcgtsp/industrial/e1x_6.pcglns");
+    let document = open_document(&name, &bytes).unwrap();
+    let request = JobRequest {
+        job_id: 1,
+        problem: document.problem,
+        solver: SolverKind::Ccp,
+        params: SolverParams::default(),
+    };
+    assert!(matches!(start_job(&request).err(), Some(EngineError::UnsupportedProblem { .. })));
+}
+
+#[test]
+fn bad_files_give_located_errors() {
+    let truncated = &data("nests/dbs/nested.dbs").1[..1000];
+    let message = open_document("nested.dbs", truncated).unwrap_err().to_string();
+    assert!(message.contains("nested.dbs"), "{message}");
+    assert!(message.chars().any(|c| c.is_ascii_digit()), "a location in: {message}");
+    let unknown = open_document("x.bin", b"\x01\x02garbage").unwrap_err().to_string();
+    assert!(unknown.contains("unknown format"), "{unknown}");
+}
