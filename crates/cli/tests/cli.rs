@@ -1,0 +1,101 @@
+//! The command-line tool as users call it, on the real files.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+use serde_json::Value;
+
+fn data(relative: &str) -> PathBuf {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data").join(relative);
+    assert!(path.exists(), "missing test file {}", path.display());
+    path
+}
+
+fn cutroute(args: &[&str]) -> (bool, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_cutroute")).args(args).output().expect("runs");
+    (out.status.success(), String::from_utf8_lossy(&out.stdout).into(), String::from_utf8_lossy(&out.stderr).into())
+}
+
+fn json(args: &[&str]) -> Value {
+    let (ok, stdout, stderr) = cutroute(args);
+    assert!(ok, "cutroute {args:?} failed: {stderr}");
+    serde_json::from_str(&stdout).unwrap_or_else(|e| panic!("not JSON ({e}): {stdout}"))
+}
+
+#[test]
+fn inspect_reports_the_stored_facts_of_nests() {
+    let cases = [
+        ("nests/dbs/nested.dbs", 57, 88, 101),
+        ("nests/dbs/seven.dbs", 29, 51, 42),
+        ("nests/dbs-json/E1X_6_01.dbs.json", 9, 17, 27),
+        ("nests/dbs/test0.json.dbs", 15, 21, -1),
+    ];
+    for (file, parts, contours, arcs) in cases {
+        let v = json(&["inspect", data(file).to_str().unwrap(), "--json"]);
+        assert_eq!(v["parts"], parts, "{file}");
+        assert_eq!(v["contours"], contours, "{file}");
+        if arcs >= 0 {
+            assert_eq!(v["arcs"], arcs, "{file}");
+        }
+        assert_eq!(v["sheet"].as_array().unwrap().len(), 4);
+    }
+    let nest02 = json(&["inspect", data("nests/tflex/Nest02.tfnesting").to_str().unwrap(), "--json"]);
+    assert_eq!(nest02["parts"], 407, "406 placed parts and the sheet");
+    assert_eq!(nest02["sheet"], serde_json::json!([0.0, 0.0, 6000.0, 2000.0]));
+}
+
+#[test]
+fn inspect_reports_pcgtsp_instances() {
+    let v = json(&["inspect", data("pcgtsp/industrial/e1x_6.pcglns").to_str().unwrap(), "--json"]);
+    assert_eq!(v["format"], "PCGTSP instance");
+    assert_eq!(v["nodes"], 181);
+    assert_eq!(v["clusters"], 17);
+}
+
+#[test]
+fn bad_input_exits_non_zero_with_the_readers_message() {
+    let dir = std::env::temp_dir().join(format!("cutroute-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let bad = dir.join("broken.dbs");
+    let bytes = std::fs::read(data("nests/dbs/nested.dbs")).unwrap();
+    std::fs::write(&bad, &bytes[..777]).unwrap();
+    let (ok, _, stderr) = cutroute(&["inspect", bad.to_str().unwrap(), "--json"]);
+    assert!(!ok);
+    assert!(stderr.contains("broken.dbs") && stderr.contains("DBS"), "{stderr}");
+}
+
+#[test]
+fn convert_round_trips_through_dbs_and_writes_svg() {
+    let dir = std::env::temp_dir().join(format!("cutroute-convert-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let dbs = dir.join("e1x.dbs");
+    let svg = dir.join("e1x.svg");
+    let source = data("nests/dbs-json/E1X_6_01.dbs.json");
+    assert!(cutroute(&["convert", source.to_str().unwrap(), dbs.to_str().unwrap()]).0);
+    assert!(cutroute(&["convert", dbs.to_str().unwrap(), svg.to_str().unwrap()]).0);
+    let v = json(&["inspect", dbs.to_str().unwrap(), "--json"]);
+    assert_eq!((v["parts"].as_u64(), v["contours"].as_u64()), (Some(9), Some(17)));
+    let text = std::fs::read_to_string(&svg).unwrap();
+    assert!(text.contains("<svg") && text.matches("class=\"part\"").count() == 8, "{}", &text[..200.min(text.len())]);
+}
+
+#[test]
+fn solve_exact_prints_the_documented_keys_and_a_proven_optimum() {
+    let v = json(&["solve", data("pcgtsp/industrial/e1x_6.pcglns").to_str().unwrap(), "--solver", "exact", "--time-limit", "30", "--json"]);
+    for key in ["solver", "ub", "lb", "gap", "proven_optimal", "tour", "elapsed_s", "states"] {
+        assert!(v.get(key).is_some(), "missing {key}");
+    }
+    assert_eq!(v["ub"], 1513.0);
+    assert_eq!(v["proven_optimal"], true);
+    assert_eq!(v["tour"][0], 1, "1-based, depot first");
+}
+
+#[test]
+fn solve_ccp_prints_a_checked_route() {
+    let v = json(&["solve", data("nests/dbs-json/E1X_6_01.dbs.json").to_str().unwrap(), "--solver", "ccp", "--time-limit", "1", "--json"]);
+    for key in ["solver", "idle_length", "cut_length", "pierces", "time_s", "route", "certified_contours", "elapsed_s"] {
+        assert!(v.get(key).is_some(), "missing {key}");
+    }
+    assert_eq!(v["pierces"], 16);
+    assert_eq!(v["route"].as_array().unwrap().len(), 16);
+}
