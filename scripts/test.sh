@@ -7,7 +7,7 @@ scripts/setup.sh
 export PATH="$HOME/.cargo/bin:$PATH"
 
 echo "== native tests (web-free crates and the CLI)"
-cargo test --release
+cargo test
 
 echo "== wasm tests in headless Chromium"
 (
@@ -15,7 +15,7 @@ echo "== wasm tests in headless Chromium"
   export CARGO_TARGET_WASM32_UNKNOWN_UNKNOWN_RUNNER=wasm-bindgen-test-runner
   export CHROMEDRIVER=/usr/bin/chromedriver
   export WASM_BINDGEN_TEST_TIMEOUT=300
-  cargo test --release --target wasm32-unknown-unknown -p cutroute-engine --test wasm
+  cargo test --target wasm32-unknown-unknown -p cutroute-engine --test wasm
 )
 
 echo "== end-to-end tests (release build served from a sub-path)"

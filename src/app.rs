@@ -53,7 +53,9 @@ pub fn App() -> impl IntoView {
 
     let bridge: StoredValue<WorkerBridge<SolverWorker>, LocalStorage> =
         StoredValue::new_local(spawn(move |message| match message {
-            FromWorker::Opened { document: opened, .. } => {
+            FromWorker::Opened {
+                document: opened, ..
+            } => {
                 open_error.set(None);
                 progress.set(None);
                 document.set(Some(opened));
@@ -94,7 +96,13 @@ pub fn App() -> impl IntoView {
         leptos::task::spawn_local(async move {
             let url = format!("./assets/samples/{file_name}");
             match fetch_bytes(&url).await {
-                Ok(bytes) => bridge.with_value(|b| b.send(ToWorker::Open { request_id, file_name, bytes })),
+                Ok(bytes) => bridge.with_value(|b| {
+                    b.send(ToWorker::Open {
+                        request_id,
+                        file_name,
+                        bytes,
+                    })
+                }),
                 Err(message) => open_error.set(Some(format!("{url}: {message}"))),
             }
         });
@@ -102,12 +110,22 @@ pub fn App() -> impl IntoView {
     open_sample(SAMPLES[0].0.to_string());
 
     let start = move |_| {
-        let Some(Document { problem, .. }) = document.get_untracked() else { return };
+        let Some(Document { problem, .. }) = document.get_untracked() else {
+            return;
+        };
         let job_id = take_id();
-        let params = SolverParams { time_limit_s: time_limit.get_untracked(), ..SolverParams::default() };
+        let params = SolverParams {
+            time_limit_s: time_limit.get_untracked(),
+            ..SolverParams::default()
+        };
         progress.set(None);
         job_state.set(JobState::Running(job_id));
-        let request = JobRequest { job_id, problem, solver: solver.get_untracked(), params };
+        let request = JobRequest {
+            job_id,
+            problem,
+            solver: solver.get_untracked(),
+            params,
+        };
         bridge.with_value(|b| b.send(ToWorker::Start(request)));
     };
     let stop = move |_| {
@@ -215,11 +233,16 @@ fn solver_label(kind: SolverKind) -> &'static str {
 }
 
 fn format_bound(value: Option<f64>) -> String {
-    value.map(|v| format!("{v:.1}")).unwrap_or_else(|| "—".into())
+    value
+        .map(|v| format!("{v:.1}"))
+        .unwrap_or_else(|| "—".into())
 }
 
 async fn fetch_bytes(url: &str) -> Result<Vec<u8>, String> {
-    let response = gloo_net::http::Request::get(url).send().await.map_err(|e| e.to_string())?;
+    let response = gloo_net::http::Request::get(url)
+        .send()
+        .await
+        .map_err(|e| e.to_string())?;
     if !response.ok() {
         return Err(format!("HTTP {}", response.status()));
     }
@@ -228,7 +251,10 @@ async fn fetch_bytes(url: &str) -> Result<Vec<u8>, String> {
 
 /// The drawing: sheet, parts, idle moves and pierce points, y axis up.
 #[component]
-fn NestView(document: RwSignal<Option<Document>>, progress: RwSignal<Option<Progress>>) -> impl IntoView {
+fn NestView(
+    document: RwSignal<Option<Document>>,
+    progress: RwSignal<Option<Progress>>,
+) -> impl IntoView {
     let nest = Memo::new(move |_| {
         document.with(|d| match d.as_ref().map(|d| &d.problem) {
             Some(Problem::Nest { nest, .. }) => Some(nest.clone()),
@@ -236,11 +262,18 @@ fn NestView(document: RwSignal<Option<Document>>, progress: RwSignal<Option<Prog
         })
     });
     let view_box = move || {
-        nest.with(|n| n.as_ref().and_then(nest_bounds)).map(|[x0, y0, x1, y1]| {
-            let margin = ((x1 - x0).max(y1 - y0) * 0.03).max(1.0);
-            // The group below flips y, so the box spans [-y1, -y0] vertically.
-            format!("{} {} {} {}", x0 - margin, -y1 - margin, x1 - x0 + 2.0 * margin, y1 - y0 + 2.0 * margin)
-        })
+        nest.with(|n| n.as_ref().and_then(nest_bounds))
+            .map(|[x0, y0, x1, y1]| {
+                let margin = ((x1 - x0).max(y1 - y0) * 0.03).max(1.0);
+                // The group below flips y, so the box spans [-y1, -y0] vertically.
+                format!(
+                    "{} {} {} {}",
+                    x0 - margin,
+                    -y1 - margin,
+                    x1 - x0 + 2.0 * margin,
+                    y1 - y0 + 2.0 * margin
+                )
+            })
     };
     let parts = move || nest.with(|n| n.as_ref().map(part_paths).unwrap_or_default());
     let sheet = move || {

@@ -6,7 +6,10 @@ use cutroute_geometry::{Contour, Nest, Point, Route};
 pub fn nest_bounds(nest: &Nest) -> Option<[f64; 4]> {
     let mut bounds: Option<[f64; 4]> = None;
     let parts = nest.sheet.iter().chain(nest.parts.iter());
-    for vertex in parts.flat_map(|p| p.contours.iter()).flat_map(|c| c.vertices.iter()) {
+    for vertex in parts
+        .flat_map(|p| p.contours.iter())
+        .flat_map(|c| c.vertices.iter())
+    {
         let Point { x, y } = vertex.point;
         if !(x.is_finite() && y.is_finite()) {
             continue;
@@ -38,7 +41,11 @@ pub fn contour_path(contour: &Contour, out: &mut String) {
         }
         let pieces = if from.bulge.abs() > 1.0 { 2 } else { 1 };
         // Halving an arc: the bulge of each half is tan(φ/8) = b / (1 + sqrt(1 + b²)).
-        let bulge = if pieces == 2 { from.bulge / (1.0 + (1.0 + from.bulge * from.bulge).sqrt()) } else { from.bulge };
+        let bulge = if pieces == 2 {
+            from.bulge / (1.0 + (1.0 + from.bulge * from.bulge).sqrt())
+        } else {
+            from.bulge
+        };
         let mid = arc_midpoint(from.point, to, from.bulge);
         let targets = if pieces == 2 { vec![mid, to] } else { vec![to] };
         let mut start = from.point;
@@ -46,7 +53,11 @@ pub fn contour_path(contour: &Contour, out: &mut String) {
             let chord = (target.x - start.x).hypot(target.y - start.y);
             let radius = chord * (1.0 + bulge * bulge) / (4.0 * bulge.abs());
             let sweep = u8::from(bulge > 0.0);
-            let _ = write!(out, "A{radius:.3} {radius:.3} 0 0 {sweep} {:.3} {:.3}", target.x, target.y);
+            let _ = write!(
+                out,
+                "A{radius:.3} {radius:.3} 0 0 {sweep} {:.3} {:.3}",
+                target.x, target.y
+            );
             start = target;
         }
     }
@@ -57,7 +68,10 @@ pub fn contour_path(contour: &Contour, out: &mut String) {
 fn arc_midpoint(a: Point, b: Point, bulge: f64) -> Point {
     // The sagitta is bulge × half-chord, on the right of the chord for counter-clockwise arcs.
     let (cx, cy) = (b.x - a.x, b.y - a.y);
-    Point::new((a.x + b.x) / 2.0 + cy * bulge / 2.0, (a.y + b.y) / 2.0 - cx * bulge / 2.0)
+    Point::new(
+        (a.x + b.x) / 2.0 + cy * bulge / 2.0,
+        (a.y + b.y) / 2.0 - cx * bulge / 2.0,
+    )
 }
 
 /// Path data of the idle (tool-off) moves of a route: start → pierce → … → finish.
@@ -66,7 +80,11 @@ pub fn idle_path(route: &Route) -> String {
     let mut out = String::new();
     let _ = write!(out, "M{:.3} {:.3}", route.start.x, route.start.y);
     for step in &route.steps {
-        let _ = write!(out, "L{:.3} {:.3}", step.pierce_point.x, step.pierce_point.y);
+        let _ = write!(
+            out,
+            "L{:.3} {:.3}",
+            step.pierce_point.x, step.pierce_point.y
+        );
     }
     if let Some(finish) = route.finish {
         let _ = write!(out, "L{:.3} {:.3}", finish.x, finish.y);

@@ -26,5 +26,8 @@ impl gloo_worker::Worker for SolverWorker {
 
 /// Spawn the worker next to the page (relative URL: works from any sub-path of a static host).
 pub fn spawn(on_message: impl Fn(FromWorker) + 'static) -> WorkerBridge<SolverWorker> {
-    SolverWorker::spawner().callback(on_message).as_module(false).spawn("./worker.js")
+    SolverWorker::spawner()
+        .callback(on_message)
+        .as_module(false)
+        .spawn("./worker.js")
 }

@@ -18,7 +18,11 @@ use cutroute_protocol::{Document, JobRequest, Problem, Progress, SolverKind, Sol
 use serde_json::{json, Value};
 
 #[derive(Parser)]
-#[command(name = "cutroute", version, about = "Tool-path optimisation for CNC sheet cutting")]
+#[command(
+    name = "cutroute",
+    version,
+    about = "Tool-path optimisation for CNC sheet cutting"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -71,7 +75,15 @@ fn main() -> ExitCode {
     let outcome = match cli.command {
         Command::Inspect { file, json } => inspect(&file, json),
         Command::Convert { input, output } => convert(&input, &output),
-        Command::Solve { file, solver, time_limit, seed, ub, step, json } => {
+        Command::Solve {
+            file,
+            solver,
+            time_limit,
+            seed,
+            ub,
+            step,
+            json,
+        } => {
             let params = SolverParams {
                 time_limit_s: time_limit,
                 seed,
@@ -126,7 +138,10 @@ fn inspect(path: &Path, as_json: bool) -> Result<(), String> {
 /// Counts as stored in the file: the sheet counts as a part when the file has one.
 fn nest_summary(format: &str, nest: &Nest) -> Value {
     let sheet_contours = nest.sheet.as_ref().map_or(0, |s| s.contours.len());
-    let sheet_arcs = nest.sheet.as_ref().map_or(0, |s| s.contours.iter().map(|c| c.arc_count()).sum());
+    let sheet_arcs = nest
+        .sheet
+        .as_ref()
+        .map_or(0, |s| s.contours.iter().map(|c| c.arc_count()).sum());
     let bounds = nest
         .sheet
         .as_ref()
@@ -147,27 +162,44 @@ fn nest_summary(format: &str, nest: &Nest) -> Value {
 fn convert(input: &Path, output: &Path) -> Result<(), String> {
     let document = open(input)?;
     let Problem::Nest { nest, .. } = &document.problem else {
-        return Err(format!("{}: not a nest; only nests can be converted", input.display()));
+        return Err(format!(
+            "{}: not a nest; only nests can be converted",
+            input.display()
+        ));
     };
     let name = output.to_string_lossy().to_lowercase();
     let bytes: Vec<u8> = if name.ends_with(".dbs") {
         cutroute_formats::write_dbs(nest).map_err(|e| e.to_string())?
     } else if name.ends_with(".json") {
-        cutroute_formats::write_geometry_json(nest).map_err(|e| e.to_string())?.into_bytes()
+        cutroute_formats::write_geometry_json(nest)
+            .map_err(|e| e.to_string())?
+            .into_bytes()
     } else if name.ends_with(".svg") {
         match &document.route {
-            Some(route) => cutroute_formats::route_svg(nest, route, &cutroute_formats::SvgOptions::default())
-                .map_err(|e| e.to_string())?,
-            None => cutroute_formats::nest_svg(nest, None, &cutroute_formats::SvgOptions::default()),
+            Some(route) => {
+                cutroute_formats::route_svg(nest, route, &cutroute_formats::SvgOptions::default())
+                    .map_err(|e| e.to_string())?
+            }
+            None => {
+                cutroute_formats::nest_svg(nest, None, &cutroute_formats::SvgOptions::default())
+            }
         }
         .into_bytes()
     } else {
-        return Err(format!("{}: unknown output extension (use .dbs, .dbs.json/.json or .svg)", output.display()));
+        return Err(format!(
+            "{}: unknown output extension (use .dbs, .dbs.json/.json or .svg)",
+            output.display()
+        ));
     };
     std::fs::write(output, bytes).map_err(|e| format!("{}: {e}", output.display()))
 }
 
-fn solve(path: &Path, solver_name: &str, params: SolverParams, as_json: bool) -> Result<(), String> {
+fn solve(
+    path: &Path,
+    solver_name: &str,
+    params: SolverParams,
+    as_json: bool,
+) -> Result<(), String> {
     let document = open(path)?;
     let solver = match solver_name {
         "discrete" => SolverKind::Heuristic,
@@ -175,13 +207,24 @@ fn solve(path: &Path, solver_name: &str, params: SolverParams, as_json: bool) ->
             format!("unknown solver {name:?} (nearest, ccp, heuristic, exact, discrete)")
         })?,
     };
-    let request = JobRequest { job_id: 1, problem: document.problem.clone(), solver, params };
+    let request = JobRequest {
+        job_id: 1,
+        problem: document.problem.clone(),
+        solver,
+        params,
+    };
     let mut job = start_job(&request).map_err(|e| e.to_string())?;
     let mut last_report = -1.0;
     let result = run_to_end(job.as_mut(), &mut |progress| {
         if !as_json && progress.elapsed_s - last_report >= 1.0 {
             last_report = progress.elapsed_s;
-            eprintln!("{:8.2} s  ub {:>12}  lb {:>12}  {}", progress.elapsed_s, fmt(progress.upper_bound), fmt(progress.lower_bound), progress.phase);
+            eprintln!(
+                "{:8.2} s  ub {:>12}  lb {:>12}  {}",
+                progress.elapsed_s,
+                fmt(progress.upper_bound),
+                fmt(progress.lower_bound),
+                progress.phase
+            );
         }
     });
     let report = match &document.problem {
@@ -201,7 +244,9 @@ fn solve(path: &Path, solver_name: &str, params: SolverParams, as_json: bool) ->
 }
 
 fn fmt(value: Option<f64>) -> String {
-    value.map(|v| format!("{v:.1}")).unwrap_or_else(|| "—".into())
+    value
+        .map(|v| format!("{v:.1}"))
+        .unwrap_or_else(|| "—".into())
 }
 
 /// The PCGTSP report: tour as 1-based node ids of the instance, starting at the depot.
@@ -221,7 +266,9 @@ fn tour_report(solver: &str, result: &Progress) -> Value {
 /// The nest report: lengths recomputed from the route itself, not taken from the solver.
 fn route_report(solver: &str, nest: &Nest, result: &Progress) -> Result<Value, String> {
     let route: &Route = result.route.as_ref().ok_or("the solver found no route")?;
-    route.validate(nest, 1e-6 * nest_scale(nest)).map_err(|e| format!("invalid route: {e}"))?;
+    route
+        .validate(nest, 1e-6 * nest_scale(nest))
+        .map_err(|e| format!("invalid route: {e}"))?;
     let machine = cutroute_geometry::MachineParameters::default();
     let idle_length = route.idle_length();
     let cut_length = route.cut_length(nest);

@@ -6,14 +6,23 @@ use std::process::Command;
 use serde_json::Value;
 
 fn data(relative: &str) -> PathBuf {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data").join(relative);
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/data")
+        .join(relative);
     assert!(path.exists(), "missing test file {}", path.display());
     path
 }
 
 fn cutroute(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_cutroute")).args(args).output().expect("runs");
-    (out.status.success(), String::from_utf8_lossy(&out.stdout).into(), String::from_utf8_lossy(&out.stderr).into())
+    let out = Command::new(env!("CARGO_BIN_EXE_cutroute"))
+        .args(args)
+        .output()
+        .expect("runs");
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into(),
+        String::from_utf8_lossy(&out.stderr).into(),
+    )
 }
 
 fn json(args: &[&str]) -> Value {
@@ -39,14 +48,25 @@ fn inspect_reports_the_stored_facts_of_nests() {
         }
         assert_eq!(v["sheet"].as_array().unwrap().len(), 4);
     }
-    let nest02 = json(&["inspect", data("nests/tflex/Nest02.tfnesting").to_str().unwrap(), "--json"]);
+    let nest02 = json(&[
+        "inspect",
+        data("nests/tflex/Nest02.tfnesting").to_str().unwrap(),
+        "--json",
+    ]);
     assert_eq!(nest02["parts"], 407, "406 placed parts and the sheet");
-    assert_eq!(nest02["sheet"], serde_json::json!([0.0, 0.0, 6000.0, 2000.0]));
+    assert_eq!(
+        nest02["sheet"],
+        serde_json::json!([0.0, 0.0, 6000.0, 2000.0])
+    );
 }
 
 #[test]
 fn inspect_reports_pcgtsp_instances() {
-    let v = json(&["inspect", data("pcgtsp/industrial/e1x_6.pcglns").to_str().unwrap(), "--json"]);
+    let v = json(&[
+        "inspect",
+        data("pcgtsp/industrial/e1x_6.pcglns").to_str().unwrap(),
+        "--json",
+    ]);
     assert_eq!(v["format"], "PCGTSP instance");
     assert_eq!(v["nodes"], 181);
     assert_eq!(v["clusters"], 17);
@@ -61,7 +81,10 @@ fn bad_input_exits_non_zero_with_the_readers_message() {
     std::fs::write(&bad, &bytes[..777]).unwrap();
     let (ok, _, stderr) = cutroute(&["inspect", bad.to_str().unwrap(), "--json"]);
     assert!(!ok);
-    assert!(stderr.contains("broken.dbs") && stderr.contains("DBS"), "{stderr}");
+    assert!(
+        stderr.contains("broken.dbs") && stderr.contains("DBS"),
+        "{stderr}"
+    );
 }
 
 #[test]
@@ -74,15 +97,39 @@ fn convert_round_trips_through_dbs_and_writes_svg() {
     assert!(cutroute(&["convert", source.to_str().unwrap(), dbs.to_str().unwrap()]).0);
     assert!(cutroute(&["convert", dbs.to_str().unwrap(), svg.to_str().unwrap()]).0);
     let v = json(&["inspect", dbs.to_str().unwrap(), "--json"]);
-    assert_eq!((v["parts"].as_u64(), v["contours"].as_u64()), (Some(9), Some(17)));
+    assert_eq!(
+        (v["parts"].as_u64(), v["contours"].as_u64()),
+        (Some(9), Some(17))
+    );
     let text = std::fs::read_to_string(&svg).unwrap();
-    assert!(text.contains("<svg") && text.matches("class=\"part\"").count() == 8, "{}", &text[..200.min(text.len())]);
+    assert!(
+        text.contains("<svg") && text.matches("class=\"part\"").count() == 8,
+        "{}",
+        &text[..200.min(text.len())]
+    );
 }
 
 #[test]
 fn solve_exact_prints_the_documented_keys_and_a_proven_optimum() {
-    let v = json(&["solve", data("pcgtsp/industrial/e1x_6.pcglns").to_str().unwrap(), "--solver", "exact", "--time-limit", "30", "--json"]);
-    for key in ["solver", "ub", "lb", "gap", "proven_optimal", "tour", "elapsed_s", "states"] {
+    let v = json(&[
+        "solve",
+        data("pcgtsp/industrial/e1x_6.pcglns").to_str().unwrap(),
+        "--solver",
+        "exact",
+        "--time-limit",
+        "30",
+        "--json",
+    ]);
+    for key in [
+        "solver",
+        "ub",
+        "lb",
+        "gap",
+        "proven_optimal",
+        "tour",
+        "elapsed_s",
+        "states",
+    ] {
         assert!(v.get(key).is_some(), "missing {key}");
     }
     assert_eq!(v["ub"], 1513.0);
@@ -92,8 +139,25 @@ fn solve_exact_prints_the_documented_keys_and_a_proven_optimum() {
 
 #[test]
 fn solve_ccp_prints_a_checked_route() {
-    let v = json(&["solve", data("nests/dbs-json/E1X_6_01.dbs.json").to_str().unwrap(), "--solver", "ccp", "--time-limit", "1", "--json"]);
-    for key in ["solver", "idle_length", "cut_length", "pierces", "time_s", "route", "certified_contours", "elapsed_s"] {
+    let v = json(&[
+        "solve",
+        data("nests/dbs-json/E1X_6_01.dbs.json").to_str().unwrap(),
+        "--solver",
+        "ccp",
+        "--time-limit",
+        "1",
+        "--json",
+    ]);
+    for key in [
+        "solver",
+        "idle_length",
+        "cut_length",
+        "pierces",
+        "time_s",
+        "route",
+        "certified_contours",
+        "elapsed_s",
+    ] {
         assert!(v.get(key).is_some(), "missing {key}");
     }
     assert_eq!(v["pierces"], 16);

@@ -19,7 +19,11 @@ pub struct CcpJob {
 impl CcpJob {
     /// Wrap a prepared solver.
     pub fn new(job_id: JobId, solver: CcpSolver) -> Self {
-        Self { job_id, solver, done: false }
+        Self {
+            job_id,
+            solver,
+            done: false,
+        }
     }
 }
 
@@ -43,7 +47,12 @@ impl Job for CcpJob {
                 .into_iter()
                 .map(|c| (c.contour, c.condition1))
                 .collect();
-            state.route.steps.iter().map(|s| by_contour.get(&s.contour).copied().unwrap_or(false)).collect()
+            state
+                .route
+                .steps
+                .iter()
+                .map(|s| by_contour.get(&s.contour).copied().unwrap_or(false))
+                .collect()
         } else {
             Vec::new()
         };
@@ -98,12 +107,19 @@ impl DiscreteJob {
         seed: u64,
         initial_upper_bound: Option<f64>,
     ) -> Result<Self, String> {
-        let alns_options = AlnsOptions { seed, time_limit: Some(time_limit), ..AlnsOptions::default() };
+        let alns_options = AlnsOptions {
+            seed,
+            time_limit: Some(time_limit),
+            ..AlnsOptions::default()
+        };
         let alns = AlnsSolver::new(&instance, alns_options).map_err(|e| e.to_string())?;
         let exact = match mode {
             DiscreteMode::Heuristic => None,
             DiscreteMode::Exact => {
-                let options = ExactOptions { time_limit: Some(time_limit), ..ExactOptions::default() };
+                let options = ExactOptions {
+                    time_limit: Some(time_limit),
+                    ..ExactOptions::default()
+                };
                 let _ = initial_upper_bound;
                 Some(ExactSolver::new(&instance, options).map_err(|e| e.to_string())?)
             }
@@ -144,7 +160,11 @@ impl Job for DiscreteJob {
             return JobStatus::Running;
         };
         if !self.alns_done {
-            let share = if self.exact_done.is_some() { budget } else { budget / 4 };
+            let share = if self.exact_done.is_some() {
+                budget
+            } else {
+                budget / 4
+            };
             self.alns_done = self.alns.step(share) == cutroute_alns::SolverStatus::Finished;
             if let Some((tour, cost)) = self.alns.best() {
                 if cost < self.offered_cost {
@@ -183,13 +203,20 @@ impl Job for DiscreteJob {
             (Some(p), None) => format!("layer {} · {} states", p.layer, p.live_states),
             (None, _) => format!("ALNS · {} iterations", self.alns.progress().iterations),
         };
-        let lower_bound = exact.as_ref().map(|p| p.lower_bound).filter(|lb| lb.is_finite());
+        let lower_bound = exact
+            .as_ref()
+            .map(|p| p.lower_bound)
+            .filter(|lb| lb.is_finite());
         let _ = &self.instance;
         Progress {
             job_id: self.job_id,
             elapsed_s: self.started.elapsed().as_secs_f64(),
             upper_bound: best.as_ref().map(|(_, cost)| *cost),
-            lower_bound: if proven_optimal { best.as_ref().map(|(_, c)| *c) } else { lower_bound },
+            lower_bound: if proven_optimal {
+                best.as_ref().map(|(_, c)| *c)
+            } else {
+                lower_bound
+            },
             phase,
             route,
             tour: best.map(|(tour, _)| tour),
@@ -207,5 +234,11 @@ pub fn ccp_options(
     time_limit: Duration,
     seed: u64,
 ) -> CcpOptions {
-    CcpOptions { start, finish, time_limit, seed, ..CcpOptions::default() }
+    CcpOptions {
+        start,
+        finish,
+        time_limit,
+        seed,
+        ..CcpOptions::default()
+    }
 }

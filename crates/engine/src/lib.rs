@@ -91,42 +91,91 @@ pub fn start_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
     let params = &request.params;
     let time_limit = Duration::from_secs_f64(params.time_limit_s.clamp(0.0, 1.0e7));
     let solver = request.solver;
-    let refused = |message: String| EngineError::SolverRefused { solver: solver.name(), message };
+    let refused = |message: String| EngineError::SolverRefused {
+        solver: solver.name(),
+        message,
+    };
     let discrete_mode = match solver {
         SolverKind::Heuristic => Some(DiscreteMode::Heuristic),
         SolverKind::Exact => Some(DiscreteMode::Exact),
         _ => None,
     };
     match (&request.problem, solver) {
-        (Problem::Nest { nest, start, finish }, SolverKind::NearestNeighbour) => Ok(Box::new(
-            NearestNeighbourJob::new(request.job_id, nest.clone(), *start, *finish)?,
-        )),
-        (Problem::Nest { nest, start, finish }, SolverKind::Ccp) => {
+        (
+            Problem::Nest {
+                nest,
+                start,
+                finish,
+            },
+            SolverKind::NearestNeighbour,
+        ) => Ok(Box::new(NearestNeighbourJob::new(
+            request.job_id,
+            nest.clone(),
+            *start,
+            *finish,
+        )?)),
+        (
+            Problem::Nest {
+                nest,
+                start,
+                finish,
+            },
+            SolverKind::Ccp,
+        ) => {
             let options = jobs::ccp_options(*start, *finish, time_limit, params.seed);
-            let solver = cutroute_ccp::CcpSolver::new(nest, options).map_err(|e| refused(e.to_string()))?;
+            let solver =
+                cutroute_ccp::CcpSolver::new(nest, options).map_err(|e| refused(e.to_string()))?;
             Ok(Box::new(CcpJob::new(request.job_id, solver)))
         }
-        (Problem::Nest { nest, start, finish }, _) => {
+        (
+            Problem::Nest {
+                nest,
+                start,
+                finish,
+            },
+            _,
+        ) => {
             let options = cutroute_ccp::DiscretisationOptions {
                 start: *start,
                 finish: *finish,
                 step: params.discretisation_step_mm,
                 ..cutroute_ccp::DiscretisationOptions::default()
             };
-            let discrete = cutroute_ccp::build_pcgtsp(nest, &options).map_err(|e| refused(e.to_string()))?;
+            let discrete =
+                cutroute_ccp::build_pcgtsp(nest, &options).map_err(|e| refused(e.to_string()))?;
             let instance = discrete.instance.clone();
             let mode = discrete_mode.unwrap_or(DiscreteMode::Heuristic);
-            let job = DiscreteJob::new(request.job_id, instance, Some(discrete), mode, time_limit, params.seed, params.initial_upper_bound)
-                .map_err(refused)?;
+            let job = DiscreteJob::new(
+                request.job_id,
+                instance,
+                Some(discrete),
+                mode,
+                time_limit,
+                params.seed,
+                params.initial_upper_bound,
+            )
+            .map_err(refused)?;
             Ok(Box::new(job))
         }
         (Problem::PcgtspText { text }, _) => {
             let Some(mode) = discrete_mode else {
-                return Err(EngineError::UnsupportedProblem { solver: solver.name(), problem: "a PCGTSP instance" });
+                return Err(EngineError::UnsupportedProblem {
+                    solver: solver.name(),
+                    problem: "a PCGTSP instance",
+                });
             };
-            let instance = cutroute_pcgtsp::Instance::parse(text).map_err(|e| refused(e.to_string()))?;
-            let job = DiscreteJob::new(request.job_id, instance, None, mode, time_limit, params.seed, params.initial_upper_bound)
-                .map_err(refused)?;
+            let instance =
+                cutroute_pcgtsp::Instance::parse(text).map_err(|e| refused(e.to_string()))?;
+            let job = DiscreteJob::new(
+                request.job_id,
+                instance,
+                None,
+                mode,
+                time_limit,
+                params.seed,
+                params.initial_upper_bound,
+            )
+            .map_err(refused)?;
             Ok(Box::new(job))
         }
     }

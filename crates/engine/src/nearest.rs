@@ -31,15 +31,25 @@ impl NearestNeighbourJob {
         if nest.parts.iter().all(|part| part.contours.is_empty()) {
             return Err(EngineError::EmptyNest);
         }
-        Ok(Self { job_id, nest, start, finish, started: Instant::now(), route: None, idle_length: 0.0 })
+        Ok(Self {
+            job_id,
+            nest,
+            start,
+            finish,
+            started: Instant::now(),
+            route: None,
+            idle_length: 0.0,
+        })
     }
 
     fn solve(&mut self) {
         let forest = self.nest.containment_forest();
         let mut remaining: Vec<ContourRef> = self.nest.contour_refs().collect();
         // Contours still to cut inside each contour: it waits for them (inner before outer).
-        let mut inner_left: HashMap<ContourRef, usize> =
-            remaining.iter().map(|&r| (r, forest.children(r).len())).collect();
+        let mut inner_left: HashMap<ContourRef, usize> = remaining
+            .iter()
+            .map(|&r| (r, forest.children(r).len()))
+            .collect();
         let mut position = self.start;
         let mut steps = Vec::with_capacity(remaining.len());
         let mut idle_length = 0.0;
@@ -61,18 +71,28 @@ impl NearestNeighbourJob {
                 break; // only contours without vertices remain
             };
             let contour_ref = remaining.swap_remove(index);
-            if let Some(left) = forest.parent(contour_ref).and_then(|p| inner_left.get_mut(&p)) {
+            if let Some(left) = forest
+                .parent(contour_ref)
+                .and_then(|p| inner_left.get_mut(&p))
+            {
                 *left -= 1;
             }
             idle_length += d;
             position = pierce_point;
-            steps.push(CutStep { contour: contour_ref, pierce_point });
+            steps.push(CutStep {
+                contour: contour_ref,
+                pierce_point,
+            });
         }
         if let Some(finish) = self.finish {
             idle_length += distance(position, finish);
         }
         self.idle_length = idle_length;
-        self.route = Some(Route { start: self.start, steps, finish: self.finish });
+        self.route = Some(Route {
+            start: self.start,
+            steps,
+            finish: self.finish,
+        });
     }
 }
 
@@ -94,7 +114,11 @@ impl Job for NearestNeighbourJob {
             elapsed_s: self.started.elapsed().as_secs_f64(),
             upper_bound: self.route.as_ref().map(|_| self.idle_length),
             lower_bound: None,
-            phase: if self.route.is_some() { "done".into() } else { "starting".into() },
+            phase: if self.route.is_some() {
+                "done".into()
+            } else {
+                "starting".into()
+            },
             route: self.route.clone(),
             tour: None,
             proven_optimal: false,

@@ -4,8 +4,8 @@ use cutroute_cad::dxf::{read_dxf, DxfOptions};
 use cutroute_cad::tflex::read_tfnesting_project;
 use cutroute_formats::{detect, read_nest, read_result_json, Format};
 use cutroute_geometry::{Nest, Point};
-use cutroute_protocol::{Document, Problem};
 use cutroute_pcgtsp::Instance;
+use cutroute_protocol::{Document, Problem};
 
 /// Why a file could not be opened; the message names the file and the place in it.
 #[derive(Debug, thiserror::Error, PartialEq)]
@@ -73,16 +73,26 @@ pub fn open_document(file_name: &str, bytes: &[u8]) -> Result<Document, OpenErro
             let import =
                 read_dxf(bytes, &DxfOptions::default()).map_err(|e| unreadable(e.to_string()))?;
             warnings.extend(import.warnings.iter().map(ToString::to_string));
-            warnings.extend(import.open_chains.iter().map(|chain| format!("open chain left out: {chain:?}")));
+            warnings.extend(
+                import
+                    .open_chains
+                    .iter()
+                    .map(|chain| format!("open chain left out: {chain:?}")),
+            );
             import.nest
         }
         Format::TflexXml => {
             let project = read_tfnesting_project(bytes).map_err(|e| unreadable(e.to_string()))?;
             let count = project.layouts.len();
             let mut layouts = project.layouts.into_iter();
-            let first = layouts.next().ok_or_else(|| OpenError::NothingToCut(file_name.to_string()))?;
+            let first = layouts
+                .next()
+                .ok_or_else(|| OpenError::NothingToCut(file_name.to_string()))?;
             if count > 1 {
-                warnings.push(format!("the project has {count} sheets; showing the first ({})", first.sheet_name));
+                warnings.push(format!(
+                    "the project has {count} sheets; showing the first ({})",
+                    first.sheet_name
+                ));
             }
             first.nest
         }
@@ -92,7 +102,9 @@ pub fn open_document(file_name: &str, bytes: &[u8]) -> Result<Document, OpenErro
             return Ok(Document {
                 file_name: file_name.to_string(),
                 format: format_name(format).to_string(),
-                problem: Problem::PcgtspText { text: text.to_string() },
+                problem: Problem::PcgtspText {
+                    text: text.to_string(),
+                },
                 route: None,
                 warnings,
             });
@@ -108,7 +120,11 @@ pub fn open_document(file_name: &str, bytes: &[u8]) -> Result<Document, OpenErro
     Ok(Document {
         file_name: file_name.to_string(),
         format: format_name(format).to_string(),
-        problem: Problem::Nest { nest, start, finish: None },
+        problem: Problem::Nest {
+            nest,
+            start,
+            finish: None,
+        },
         route,
         warnings,
     })
@@ -127,7 +143,11 @@ fn default_start(nest: &Nest) -> Point {
         Some(b) => b.min,
         None => {
             let b = nest.bounding_box();
-            if b.min.is_finite() { b.min } else { Point::new(0.0, 0.0) }
+            if b.min.is_finite() {
+                b.min
+            } else {
+                Point::new(0.0, 0.0)
+            }
         }
     }
 }

@@ -7,16 +7,27 @@ use cutroute_protocol::{JobRequest, Problem, Progress, SolverKind, SolverParams}
 use web_time::Duration;
 
 fn data(relative: &str) -> (String, Vec<u8>) {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data").join(relative);
-    let bytes = std::fs::read(&path).unwrap_or_else(|e| panic!("missing test file {}: {e}", path.display()));
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/data")
+        .join(relative);
+    let bytes = std::fs::read(&path)
+        .unwrap_or_else(|e| panic!("missing test file {}: {e}", path.display()));
     (relative.to_string(), bytes)
 }
 
 fn run(relative: &str, solver: SolverKind, time_limit_s: f64) -> (Problem, Progress) {
     let (name, bytes) = data(relative);
     let document = open_document(&name, &bytes).expect("opens");
-    let params = SolverParams { time_limit_s, ..SolverParams::default() };
-    let request = JobRequest { job_id: 9, problem: document.problem.clone(), solver, params };
+    let params = SolverParams {
+        time_limit_s,
+        ..SolverParams::default()
+    };
+    let request = JobRequest {
+        job_id: 9,
+        problem: document.problem.clone(),
+        solver,
+        params,
+    };
     let mut job = start_job(&request).expect("starts");
     let mut reports = 0;
     let result = run_to_end(job.as_mut(), &mut |p| {
@@ -27,23 +38,37 @@ fn run(relative: &str, solver: SolverKind, time_limit_s: f64) -> (Problem, Progr
 }
 
 fn check_route(problem: &Problem, result: &Progress) -> f64 {
-    let Problem::Nest { nest, .. } = problem else { panic!("a nest") };
+    let Problem::Nest { nest, .. } = problem else {
+        panic!("a nest")
+    };
     let route = result.route.as_ref().expect("a route");
-    route.validate(nest, 1e-3).expect("the route passes the independent checker");
+    route
+        .validate(nest, 1e-3)
+        .expect("the route passes the independent checker");
     let idle = route.idle_length();
     let reported = result.upper_bound.expect("an upper bound");
-    assert!((idle - reported).abs() <= 1e-6 * idle.max(1.0), "reported {reported} vs recomputed {idle}");
+    assert!(
+        (idle - reported).abs() <= 1e-6 * idle.max(1.0),
+        "reported {reported} vs recomputed {idle}"
+    );
     idle
 }
 
 #[test]
 fn every_nest_solver_returns_a_valid_route() {
-    for file in ["nests/dbs-json/E1X_6_01.dbs.json", "nests/dbs/nested.dbs", "nests/dbs/seven.dbs"] {
+    for file in [
+        "nests/dbs-json/E1X_6_01.dbs.json",
+        "nests/dbs/nested.dbs",
+        "nests/dbs/seven.dbs",
+    ] {
         let (problem, nearest) = run(file, SolverKind::NearestNeighbour, 1.0);
         let nearest_idle = check_route(&problem, &nearest);
         let (problem, ccp) = run(file, SolverKind::Ccp, 1.0);
         let ccp_idle = check_route(&problem, &ccp);
-        assert!(ccp_idle < nearest_idle, "{file}: CCP {ccp_idle} should beat nearest neighbour {nearest_idle}");
+        assert!(
+            ccp_idle < nearest_idle,
+            "{file}: CCP {ccp_idle} should beat nearest neighbour {nearest_idle}"
+        );
         assert_eq!(ccp.certified.len(), ccp.route.as_ref().unwrap().steps.len());
     }
 }
@@ -59,7 +84,9 @@ fn discrete_solvers_on_a_nest_return_valid_routes() {
 #[test]
 fn exact_job_proves_an_industrial_optimum_and_the_tour_checks() {
     let (problem, result) = run("pcgtsp/industrial/e1x_6.pcglns", SolverKind::Exact, 30.0);
-    let Problem::PcgtspText { text } = problem else { panic!("an instance") };
+    let Problem::PcgtspText { text } = problem else {
+        panic!("an instance")
+    };
     let instance = cutroute_pcgtsp::Instance::parse(&text).unwrap();
     let tour = result.tour.clone().expect("a tour");
     let cost = cutroute_pcgtsp::check_tour(&instance, &tour).expect("feasible tour");
@@ -72,7 +99,9 @@ fn exact_job_proves_an_industrial_optimum_and_the_tour_checks() {
 #[test]
 fn heuristic_job_tours_are_feasible() {
     let (problem, result) = run("pcgtsp/pcgtsplib/ESC12.pcglns", SolverKind::Heuristic, 0.5);
-    let Problem::PcgtspText { text } = problem else { panic!("an instance") };
+    let Problem::PcgtspText { text } = problem else {
+        panic!("an instance")
+    };
     let instance = cutroute_pcgtsp::Instance::parse(&text).unwrap();
     let cost = cutroute_pcgtsp::check_tour(&instance, result.tour.as_ref().unwrap()).unwrap();
     assert_eq!(Some(cost), result.upper_bound);
@@ -83,13 +112,25 @@ fn heuristic_job_tours_are_feasible() {
 fn a_long_job_yields_between_slices_so_it_can_be_cancelled() {
     let (name, bytes) = data("nests/dbs/seven.dbs");
     let document = open_document(&name, &bytes).unwrap();
-    let params = SolverParams { time_limit_s: 60.0, ..SolverParams::default() };
-    let request = JobRequest { job_id: 3, problem: document.problem, solver: SolverKind::Ccp, params };
+    let params = SolverParams {
+        time_limit_s: 60.0,
+        ..SolverParams::default()
+    };
+    let request = JobRequest {
+        job_id: 3,
+        problem: document.problem,
+        solver: SolverKind::Ccp,
+        params,
+    };
     let mut job: Box<dyn Job> = start_job(&request).unwrap();
     let started = web_time::Instant::now();
     assert_eq!(job.step(Duration::from_millis(20)), JobStatus::Running);
     // One slice must return promptly: this is what lets the worker see a Cancel message.
-    assert!(started.elapsed() < Duration::from_millis(1500), "a slice took {:?}", started.elapsed());
+    assert!(
+        started.elapsed() < Duration::from_millis(1500),
+        "a slice took {:?}",
+        started.elapsed()
+    );
 }
 
 #[test]
@@ -102,15 +143,25 @@ fn solvers_refuse_problems_they_cannot_solve() {
         solver: SolverKind::Ccp,
         params: SolverParams::default(),
     };
-    assert!(matches!(start_job(&request).err(), Some(EngineError::UnsupportedProblem { .. })));
+    assert!(matches!(
+        start_job(&request).err(),
+        Some(EngineError::UnsupportedProblem { .. })
+    ));
 }
 
 #[test]
 fn bad_files_give_located_errors() {
     let truncated = &data("nests/dbs/nested.dbs").1[..1000];
-    let message = open_document("nested.dbs", truncated).unwrap_err().to_string();
+    let message = open_document("nested.dbs", truncated)
+        .unwrap_err()
+        .to_string();
     assert!(message.contains("nested.dbs"), "{message}");
-    assert!(message.chars().any(|c| c.is_ascii_digit()), "a location in: {message}");
-    let unknown = open_document("x.bin", b"\x01\x02garbage").unwrap_err().to_string();
+    assert!(
+        message.chars().any(|c| c.is_ascii_digit()),
+        "a location in: {message}"
+    );
+    let unknown = open_document("x.bin", b"\x01\x02garbage")
+        .unwrap_err()
+        .to_string();
     assert!(unknown.contains("unknown format"), "{unknown}");
 }

@@ -132,8 +132,12 @@ pub enum SolverKind {
 
 impl SolverKind {
     /// Every solver, in the order the UI lists them.
-    pub const ALL: [SolverKind; 4] =
-        [SolverKind::NearestNeighbour, SolverKind::Ccp, SolverKind::Heuristic, SolverKind::Exact];
+    pub const ALL: [SolverKind; 4] = [
+        SolverKind::NearestNeighbour,
+        SolverKind::Ccp,
+        SolverKind::Heuristic,
+        SolverKind::Exact,
+    ];
 
     /// The short name used on the command line and in links.
     pub fn name(self) -> &'static str {
@@ -166,7 +170,12 @@ pub struct SolverParams {
 
 impl Default for SolverParams {
     fn default() -> Self {
-        Self { time_limit_s: 10.0, seed: 1, discretisation_step_mm: 50.0, initial_upper_bound: None }
+        Self {
+            time_limit_s: 10.0,
+            seed: 1,
+            discretisation_step_mm: 50.0,
+            initial_upper_bound: None,
+        }
     }
 }
 
@@ -238,9 +247,16 @@ mod tests {
         };
         ToWorker::Start(JobRequest {
             job_id: 7,
-            problem: Problem::Nest { nest, start: Point::new(1.0, 2.0), finish: Some(Point::default()) },
+            problem: Problem::Nest {
+                nest,
+                start: Point::new(1.0, 2.0),
+                finish: Some(Point::default()),
+            },
             solver: SolverKind::Ccp,
-            params: SolverParams { initial_upper_bound: Some(3.5), ..SolverParams::default() },
+            params: SolverParams {
+                initial_upper_bound: Some(3.5),
+                ..SolverParams::default()
+            },
         })
     }
 
@@ -259,7 +275,10 @@ mod tests {
             route: Some(Route {
                 start: Point::default(),
                 steps: vec![CutStep {
-                    contour: ContourRef { part: 0, contour: 0 },
+                    contour: ContourRef {
+                        part: 0,
+                        contour: 0,
+                    },
                     pierce_point: Point::new(0.0, 0.0),
                 }],
                 finish: None,
@@ -270,7 +289,10 @@ mod tests {
             certified: vec![true],
         });
         let bytes = bincode::serialize(&progress).unwrap();
-        assert_eq!(bincode::deserialize::<FromWorker>(&bytes).unwrap(), progress);
+        assert_eq!(
+            bincode::deserialize::<FromWorker>(&bytes).unwrap(),
+            progress
+        );
     }
 
     #[test]
@@ -282,7 +304,11 @@ mod tests {
 
     #[test]
     fn gap_is_relative_to_the_upper_bound() {
-        let p = Progress { upper_bound: Some(200.0), lower_bound: Some(150.0), ..Progress::default() };
+        let p = Progress {
+            upper_bound: Some(200.0),
+            lower_bound: Some(150.0),
+            ..Progress::default()
+        };
         assert_eq!(p.gap(), Some(0.25));
         assert_eq!(Progress::default().gap(), None);
     }

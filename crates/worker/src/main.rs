@@ -48,7 +48,9 @@ mod web {
         type Output = FromWorker;
 
         fn create(_scope: &WorkerScope<Self>) -> Self {
-            Self { jobs: HashMap::new() }
+            Self {
+                jobs: HashMap::new(),
+            }
         }
 
         fn update(&mut self, scope: &WorkerScope<Self>, msg: Self::Message) {
@@ -66,8 +68,15 @@ mod web {
             }
             let bounds_changed = progress.upper_bound != running.last_upper_bound
                 || progress.lower_bound != running.last_lower_bound;
-            let due = running.last_report.is_none_or(|at| at.elapsed() >= PROGRESS_INTERVAL);
-            if due || (bounds_changed && running.last_report.is_none_or(|at| at.elapsed() >= PROGRESS_INTERVAL / 3)) {
+            let due = running
+                .last_report
+                .is_none_or(|at| at.elapsed() >= PROGRESS_INTERVAL);
+            if due
+                || (bounds_changed
+                    && running
+                        .last_report
+                        .is_none_or(|at| at.elapsed() >= PROGRESS_INTERVAL / 3))
+            {
                 running.last_report = Some(Instant::now());
                 running.last_upper_bound = progress.upper_bound;
                 running.last_lower_bound = progress.lower_bound;
@@ -96,13 +105,26 @@ mod web {
                     }
                     Err(error) => scope.respond(
                         requester,
-                        FromWorker::Failed { job_id: request.job_id, message: error.to_string() },
+                        FromWorker::Failed {
+                            job_id: request.job_id,
+                            message: error.to_string(),
+                        },
                     ),
                 },
-                ToWorker::Open { request_id, file_name, bytes } => {
+                ToWorker::Open {
+                    request_id,
+                    file_name,
+                    bytes,
+                } => {
                     let answer = match open_document(&file_name, &bytes) {
-                        Ok(document) => FromWorker::Opened { request_id, document },
-                        Err(error) => FromWorker::OpenFailed { request_id, message: error.to_string() },
+                        Ok(document) => FromWorker::Opened {
+                            request_id,
+                            document,
+                        },
+                        Err(error) => FromWorker::OpenFailed {
+                            request_id,
+                            message: error.to_string(),
+                        },
                     };
                     scope.respond(requester, answer);
                 }
