@@ -8,6 +8,7 @@ use gloo_worker::WorkerBridge;
 use leptos::prelude::*;
 
 use crate::drawing::{contour_path, idle_path, nest_bounds};
+use crate::pan_zoom::PanZoom;
 use crate::worker_client::{spawn, SolverWorker};
 
 /// Bundled sample nests (files under `assets/samples/`), the first is opened on start.
@@ -109,6 +110,28 @@ pub fn App() -> impl IntoView {
     };
     open_sample(SAMPLES[0].0.to_string());
 
+    // Local files (picker or drag and drop) go to the worker as bytes: parsing happens there.
+    let open_files = move |files: web_sys::FileList| {
+        for index in 0..files.length() {
+            let Some(file) = files.item(index) else {
+                continue;
+            };
+            let request_id = take_id();
+            leptos::task::spawn_local(async move {
+                match read_file(&file).await {
+                    Ok(bytes) => bridge.with_value(|b| {
+                        b.send(ToWorker::Open {
+                            request_id,
+                            file_name: file.name(),
+                            bytes,
+                        })
+                    }),
+                    Err(message) => open_error.set(Some(format!("{}: {message}", file.name()))),
+                }
+            });
+        }
+    };
+
     let start = move |_| {
         let Some(Document { problem, .. }) = document.get_untracked() else {
             return;
@@ -150,6 +173,22 @@ pub fn App() -> impl IntoView {
                         .map(|(file, label)| view! { <option value=*file>{*label}</option> })
                         .collect_view()}
                 </select>
+            </label>
+            <label class="file-button">
+                "Open file… "
+                <input
+                    id="file-input"
+                    type="file"
+                    multiple
+                    aria-label="Open nest or instance files"
+                    on:change=move |ev| {
+                        let input: web_sys::HtmlInputElement = event_target(&ev);
+                        if let Some(files) = input.files() {
+                            open_files(files);
+                        }
+                        input.set_value("");
+                    }
+                />
             </label>
             <label>
                 "Solver "
@@ -193,7 +232,17 @@ pub fn App() -> impl IntoView {
             </button>
         </header>
         <main class="workspace">
-            <section class="view" aria-label="Cutting plan">
+            <section
+                class="view"
+                aria-label="Cutting plan"
+                on:dragover=move |ev: web_sys::DragEvent| ev.prevent_default()
+                on:drop=move |ev: web_sys::DragEvent| {
+                    ev.prevent_default();
+                    if let Some(files) = ev.data_transfer().and_then(|d| d.files()) {
+                        open_files(files);
+                    }
+                }
+            >
                 {move || open_error.get().map(|e| view! { <p class="error" role="alert">{e}</p> })}
                 <NestView document=document progress=progress />
             </section>
@@ -238,6 +287,13 @@ fn format_bound(value: Option<f64>) -> String {
         .unwrap_or_else(|| "—".into())
 }
 
+async fn read_file(file: &web_sys::File) -> Result<Vec<u8>, String> {
+    let buffer = wasm_bindgen_futures::JsFuture::from(file.array_buffer())
+        .await
+        .map_err(|e| format!("{e:?}"))?;
+    Ok(js_sys::Uint8Array::new(&buffer).to_vec())
+}
+
 async fn fetch_bytes(url: &str) -> Result<Vec<u8>, String> {
     let response = gloo_net::http::Request::get(url)
         .send()
@@ -261,19 +317,29 @@ fn NestView(
             _ => None,
         })
     });
-    let view_box = move || {
+    let fit = Signal::derive(move || {
         nest.with(|n| n.as_ref().and_then(nest_bounds))
             .map(|[x0, y0, x1, y1]| {
                 let margin = ((x1 - x0).max(y1 - y0) * 0.03).max(1.0);
                 // The group below flips y, so the box spans [-y1, -y0] vertically.
-                format!(
-                    "{} {} {} {}",
+                [
                     x0 - margin,
                     -y1 - margin,
                     x1 - x0 + 2.0 * margin,
-                    y1 - y0 + 2.0 * margin
-                )
+                    y1 - y0 + 2.0 * margin,
+                ]
             })
+    });
+    let pan_zoom = PanZoom::new(fit);
+    // A new drawing starts fitted.
+    Effect::new(move |_| {
+        nest.track();
+        pan_zoom.reset();
+    });
+    let view_box = move || {
+        pan_zoom
+            .current()
+            .map(|[x, y, w, h]| format!("{x} {y} {w} {h}"))
     };
     let parts = move || nest.with(|n| n.as_ref().map(part_paths).unwrap_or_default());
     let sheet = move || {
@@ -287,7 +353,21 @@ fn NestView(
     };
     let route = move || progress.with(|p| p.as_ref().and_then(|p| p.route.clone()));
     view! {
-        <svg id="nest-view" class="nest" viewBox=view_box preserveAspectRatio="xMidYMid meet">
+        <svg
+            id="nest-view"
+            class="nest"
+            viewBox=view_box
+            preserveAspectRatio="xMidYMid meet"
+            tabindex="0"
+            role="img"
+            aria-label="Nest and route; drag to pan, wheel or + and − to zoom, 0 to fit"
+            on:wheel=move |ev| pan_zoom.on_wheel(ev)
+            on:pointerdown=move |ev| pan_zoom.on_pointer_down(ev)
+            on:pointermove=move |ev| pan_zoom.on_pointer_move(ev)
+            on:pointerup=move |ev| pan_zoom.on_pointer_up(ev)
+            on:pointercancel=move |ev| pan_zoom.on_pointer_up(ev)
+            on:keydown=move |ev| pan_zoom.on_key(ev)
+        >
             <g transform="scale(1,-1)">
                 <path class="sheet" d=sheet />
                 {move || {

@@ -2,6 +2,7 @@
 
 mod app;
 mod drawing;
+mod pan_zoom;
 mod worker_client;
 
 fn main() {

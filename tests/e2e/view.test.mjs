@@ -1,0 +1,84 @@
+// Opening local files (picker), errors in plain words, and the hand-written pan/zoom.
+import { test, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import fs from 'node:fs';
+import os from 'node:os';
+import path from 'node:path';
+import { startServer, launchBrowser, watchErrors, screenshotDir, projectRoot } from './harness.mjs';
+
+const shared = path.resolve(projectRoot, '..', 'shared', 'data', 'nests');
+let server, baseUrl, browser;
+before(async () => {
+  ({ server, baseUrl } = await startServer());
+  browser = await launchBrowser();
+  fs.mkdirSync(screenshotDir, { recursive: true });
+});
+after(async () => {
+  await browser?.close();
+  server?.close();
+});
+
+async function fileShown(page, name) {
+  await page.waitForFunction((n) => document.querySelector('#file-name')?.textContent.includes(n),
+    name, { timeout: 20000 });
+}
+
+test('opens DBS, DXF and T-FLEX files from the picker; a broken file shows a located error', async () => {
+  const page = await browser.newPage({ viewport: { width: 1024, height: 700 } });
+  const errors = watchErrors(page);
+  await page.goto(baseUrl);
+  await fileShown(page, 'E1X_6_01');
+
+  for (const [file, parts] of [['dbs/nested.dbs', 56], ['dxf/propeller.dxf', 1], ['tflex/Nest02.tfnesting', 406]]) {
+    const full = path.join(shared, file);
+    assert.ok(fs.existsSync(full), `missing test file ${full}`);
+    await page.setInputFiles('#file-input', full);
+    await fileShown(page, path.basename(file));
+    assert.equal(await page.locator('#nest-view path.part').count(), parts, file);
+  }
+
+  const broken = path.join(os.tmpdir(), `broken-${process.pid}.dbs`);
+  fs.writeFileSync(broken, fs.readFileSync(path.join(shared, 'dbs/nested.dbs')).subarray(0, 777));
+  await page.setInputFiles('#file-input', broken);
+  const alert = page.locator('.error[role=alert]');
+  await alert.waitFor({ timeout: 10000 });
+  const message = await alert.textContent();
+  assert.match(message, /broken-\d+\.dbs/);
+  assert.match(message, /DBS/);
+  // Still usable: the previous nest stays, and a solver runs on it.
+  await page.selectOption('#solver', 'nearest');
+  await page.click('#start');
+  await page.waitForFunction(() => document.querySelector('#job-status')?.textContent === 'finished',
+    null, { timeout: 20000 });
+  await page.screenshot({ path: path.join(screenshotDir, 'open-error.png') });
+  assert.deepEqual(errors, []);
+});
+
+test('wheel zooms around the cursor, drag pans, 0 fits again', async () => {
+  const page = await browser.newPage({ viewport: { width: 1280, height: 800 } });
+  await page.goto(baseUrl);
+  await fileShown(page, 'E1X_6_01');
+  const view = page.locator('#nest-view');
+  const box = async () => (await view.getAttribute('viewBox')).split(' ').map(Number);
+  const fitted = await box();
+  const rect = await view.boundingBox();
+  await page.mouse.move(rect.x + rect.width / 2, rect.y + rect.height / 2);
+  await page.mouse.wheel(0, -400);
+  await page.waitForFunction((w) => Number(document.querySelector('#nest-view').getAttribute('viewBox').split(' ')[2]) < w,
+    fitted[2]);
+  const zoomed = await box();
+  assert.ok(zoomed[2] < fitted[2] * 0.9, `zoomed in: ${zoomed} vs ${fitted}`);
+
+  await page.mouse.down();
+  await page.mouse.move(rect.x + rect.width / 2 + 100, rect.y + rect.height / 2 + 50, { steps: 5 });
+  await page.mouse.up();
+  const panned = await box();
+  assert.ok(panned[0] < zoomed[0], `dragging right moves the view left: ${panned} vs ${zoomed}`);
+  assert.equal(panned[2], zoomed[2], 'panning keeps the zoom');
+
+  await view.focus();
+  await page.keyboard.press('0');
+  assert.deepEqual(await box(), fitted, '0 fits the sheet again');
+  await page.keyboard.press('+');
+  assert.ok((await box())[2] < fitted[2], '+ zooms in');
+});
