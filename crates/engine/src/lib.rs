@@ -100,6 +100,19 @@ pub fn start_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
         SolverKind::Exact => Some(DiscreteMode::Exact),
         _ => None,
     };
+    let discrete_job = |instance, discrete, mode| -> Result<Box<dyn Job>, EngineError> {
+        let job = DiscreteJob::new(
+            request.job_id,
+            instance,
+            discrete,
+            mode,
+            time_limit,
+            params.seed,
+            params.initial_upper_bound,
+        )
+        .map_err(refused)?;
+        Ok(Box::new(job))
+    };
     match (&request.problem, solver) {
         (
             Problem::Nest {
@@ -144,18 +157,11 @@ pub fn start_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
             let discrete =
                 cutroute_ccp::build_pcgtsp(nest, &options).map_err(|e| refused(e.to_string()))?;
             let instance = discrete.instance.clone();
-            let mode = discrete_mode.unwrap_or(DiscreteMode::Heuristic);
-            let job = DiscreteJob::new(
-                request.job_id,
+            discrete_job(
                 instance,
                 Some(discrete),
-                mode,
-                time_limit,
-                params.seed,
-                params.initial_upper_bound,
+                discrete_mode.unwrap_or(DiscreteMode::Heuristic),
             )
-            .map_err(refused)?;
-            Ok(Box::new(job))
         }
         (Problem::PcgtspText { text }, _) => {
             let Some(mode) = discrete_mode else {
@@ -166,17 +172,7 @@ pub fn start_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
             };
             let instance =
                 cutroute_pcgtsp::Instance::parse(text).map_err(|e| refused(e.to_string()))?;
-            let job = DiscreteJob::new(
-                request.job_id,
-                instance,
-                None,
-                mode,
-                time_limit,
-                params.seed,
-                params.initial_upper_bound,
-            )
-            .map_err(refused)?;
-            Ok(Box::new(job))
+            discrete_job(instance, None, mode)
         }
     }
 }
