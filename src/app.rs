@@ -224,6 +224,7 @@ pub fn App() -> impl IntoView {
                     }
                 />
             </label>
+            <crate::theme::ThemePicker />
             <button id="start" on:click=start disabled=move || running() || document.get().is_none()>
                 "Start"
             </button>

@@ -3,6 +3,7 @@
 mod app;
 mod drawing;
 mod pan_zoom;
+mod theme;
 mod worker_client;
 
 fn main() {

@@ -82,3 +82,20 @@ test('wheel zooms around the cursor, drag pans, 0 fits again', async () => {
   await page.keyboard.press('+');
   assert.ok((await box())[2] < fitted[2], '+ zooms in');
 });
+
+test('the theme switch restyles the page and survives a reload', async () => {
+  const page = await browser.newPage({ viewport: { width: 1024, height: 700 } });
+  await page.goto(baseUrl);
+  await fileShown(page, 'E1X_6_01');
+  const background = () => page.evaluate(() => getComputedStyle(document.body).backgroundColor);
+  const light = await background();
+  await page.selectOption('#theme', 'dark');
+  assert.equal(await page.evaluate(() => document.documentElement.dataset.theme), 'dark');
+  const dark = await background();
+  assert.notEqual(dark, light, 'dark theme changes the background');
+  await page.screenshot({ path: path.join(screenshotDir, 'theme-dark.png') });
+  await page.reload();
+  await fileShown(page, 'E1X_6_01');
+  assert.equal(await page.evaluate(() => document.documentElement.dataset.theme), 'dark', 'remembered');
+  assert.equal(await page.locator('#theme').inputValue(), 'dark');
+});

@@ -12,7 +12,14 @@ wasm_bindgen_test_configure!(run_in_browser);
 
 macro_rules! instance {
     ($name:literal) => {
-        ($name, include_str!(concat!("../../../../shared/data/pcgtsp/industrial/", $name, ".pcglns")))
+        (
+            $name,
+            include_str!(concat!(
+                "../../../../shared/data/pcgtsp/industrial/",
+                $name,
+                ".pcglns"
+            )),
+        )
     };
 }
 
@@ -31,9 +38,14 @@ fn exact_solver_in_the_browser() {
     for (name, text) in SUBSET {
         let request = JobRequest {
             job_id: 1,
-            problem: Problem::PcgtspText { text: text.to_string() },
+            problem: Problem::PcgtspText {
+                text: text.to_string(),
+            },
             solver: SolverKind::Exact,
-            params: SolverParams { time_limit_s: 120.0, ..SolverParams::default() },
+            params: SolverParams {
+                time_limit_s: 120.0,
+                ..SolverParams::default()
+            },
         };
         let mut job = start_job(&request).expect("starts");
         let result = run_to_end(job.as_mut(), &mut |_| {});
