@@ -7,6 +7,7 @@ use cutroute_protocol::{
 use gloo_worker::WorkerBridge;
 use leptos::prelude::*;
 
+use crate::chart::{BoundSample, BoundsChart};
 use crate::drawing::{contour_path, idle_path, nest_bounds};
 use crate::pan_zoom::PanZoom;
 use crate::worker_client::{spawn, SolverWorker};
@@ -47,6 +48,18 @@ pub fn App() -> impl IntoView {
     let document = RwSignal::new(None::<Document>);
     let open_error = RwSignal::new(None::<String>);
     let progress = RwSignal::new(None::<Progress>);
+    let samples = RwSignal::new(Vec::<BoundSample>::new());
+    let log_time = RwSignal::new(false);
+    // Every report of the running job is a point of the bounds chart.
+    let record = move |p: &Progress| {
+        samples.update(|s| {
+            s.push(BoundSample {
+                elapsed_s: p.elapsed_s,
+                upper_bound: p.upper_bound,
+                lower_bound: p.lower_bound,
+            })
+        })
+    };
     let job_state = RwSignal::new(JobState::Idle);
     let solver = RwSignal::new(SolverKind::NearestNeighbour);
     let time_limit = RwSignal::new(10.0_f64);
@@ -64,11 +77,13 @@ pub fn App() -> impl IntoView {
             FromWorker::OpenFailed { message, .. } => open_error.set(Some(message)),
             FromWorker::Progress(update) => {
                 if job_state.get_untracked() == JobState::Running(update.job_id) {
+                    record(&update);
                     progress.set(Some(update));
                 }
             }
             FromWorker::Finished(last) => {
                 if job_state.get_untracked() == JobState::Running(last.job_id) {
+                    record(&last);
                     progress.set(Some(last));
                     job_state.set(JobState::Finished);
                 }
@@ -142,6 +157,7 @@ pub fn App() -> impl IntoView {
             ..SolverParams::default()
         };
         progress.set(None);
+        samples.set(Vec::new());
         job_state.set(JobState::Running(job_id));
         let request = JobRequest {
             job_id,
@@ -268,6 +284,7 @@ pub fn App() -> impl IntoView {
                     <dt>"Elapsed"</dt>
                     <dd id="elapsed">{move || progress.get().map(|p| format!("{:.2} s", p.elapsed_s)).unwrap_or_default()}</dd>
                 </dl>
+                <BoundsChart samples=samples log_time=log_time />
             </aside>
         </main>
     }

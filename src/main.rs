@@ -1,6 +1,7 @@
 //! cutroute's browser application: open a nest, solve it in the worker, watch the route improve.
 
 mod app;
+mod chart;
 mod drawing;
 mod pan_zoom;
 mod theme;

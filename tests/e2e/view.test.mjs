@@ -99,3 +99,24 @@ test('the theme switch restyles the page and survives a reload', async () => {
   assert.equal(await page.evaluate(() => document.documentElement.dataset.theme), 'dark', 'remembered');
   assert.equal(await page.locator('#theme').inputValue(), 'dark');
 });
+
+test('the exact solver reports both bounds and the chart draws them', async () => {
+  const page = await browser.newPage({ viewport: { width: 1280, height: 800 } });
+  const errors = watchErrors(page);
+  await page.goto(baseUrl);
+  await fileShown(page, 'E1X_6_01');
+  await page.selectOption('#solver', 'exact');
+  await page.fill('#time-limit', '20');
+  await page.dispatchEvent('#time-limit', 'change');
+  await page.click('#start');
+  await page.waitForFunction(() => ['finished', 'cancelled'].includes(document.querySelector('#job-status')?.textContent),
+    null, { timeout: 60000 });
+  const upper = Number(await page.locator('#upper-bound').textContent());
+  const lower = Number(await page.locator('#lower-bound').textContent());
+  assert.ok(lower > 0 && lower <= upper + 1e-6, `0 < LB ${lower} <= UB ${upper}`);
+  assert.ok((await page.locator('.chart-ub').getAttribute('d')).startsWith('M'), 'upper bound drawn');
+  assert.ok((await page.locator('.chart-lb').getAttribute('d')).startsWith('M'), 'lower bound drawn');
+  assert.equal(await page.locator('#nest-view .route circle.pierce').count(), 16);
+  await page.screenshot({ path: path.join(screenshotDir, 'exact-bounds.png') });
+  assert.deepEqual(errors, []);
+});
