@@ -146,6 +146,8 @@ pub struct AlnsParameters {
     pub local_search_gate: f64,
     /// Longest segment the block-reversal local search move turns around.
     pub block_reverse_length: usize,
+    /// Block reversal runs on tours whose cost is within this fraction above the best.
+    pub block_reverse_gate: f64,
     /// Iterations between operator-weight updates.
     pub segment_iterations: u64,
     /// Weight-update reaction factor in `[0, 1]`.
@@ -172,6 +174,7 @@ impl Default for AlnsParameters {
             max_epoch_iterations: 200_000,
             local_search_gate: 0.05,
             block_reverse_length: 40,
+            block_reverse_gate: 0.001,
             segment_iterations: 50,
             reaction: 0.2,
             score_new_best: 33.0,
