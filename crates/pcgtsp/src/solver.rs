@@ -47,7 +47,7 @@ impl Default for ExactOptions {
             beam_widths: vec![64, 1024, 8192],
             gap_tolerance: 0.0,
             lattice_max_ideals: 8_000_000,
-            lattice_work: 120_000_000,
+            lattice_work: 500_000_000,
         }
     }
 }
@@ -448,6 +448,21 @@ impl ExactSolver {
             match &mut self.phase {
                 Phase::Heuristic { beam, engine } => {
                     if self.runs[0].lattice.is_none() {
+                        // A quick tour first, so an upper bound exists before the (blocking)
+                        // lattice build.
+                        for r in 0..self.runs.len() {
+                            if let Some(mut tour) = heuristic::greedy(&self.runs[r].model) {
+                                let cost =
+                                    heuristic::improve(&self.runs[r].model, &mut tour, 20_000);
+                                if cost < self.incumbent.upper_bound {
+                                    if let Ok(checked) = check_tour(&self.instance, &tour) {
+                                        self.incumbent.upper_bound = checked;
+                                        self.incumbent.tour = Some(tour);
+                                    }
+                                }
+                            }
+                        }
+                        debug_log(|| format!("greedy: UB {}", self.incumbent.upper_bound));
                         self.runs[0].build_lattice(&self.options);
                         continue;
                     }
