@@ -90,6 +90,22 @@ pub(crate) fn assemble_route(s: &Search, order: &[u32], pts: &[V]) -> Route {
             None => leftovers.push(c),
         }
     }
+    // A contour not crossed (only possible through numerical tangency) is cut at the end; so
+    // must every contour enclosing it, to keep "inner before outer".
+    if !leftovers.is_empty() {
+        let mut late = vec![false; prob.shapes.len()];
+        for &c in &leftovers {
+            let mut p = Some(c);
+            while let Some(a) = p {
+                late[a] = true;
+                p = prob.parent[a];
+            }
+        }
+        for list in &mut inserted {
+            list.retain(|e| !late[e.1]);
+        }
+        leftovers = (0..prob.shapes.len()).filter(|&c| late[c]).collect();
+    }
     let mut steps = Vec::with_capacity(prob.shapes.len());
     for t in 0..poly.len() {
         if let Some(c) = poly_step[t] {
@@ -109,8 +125,8 @@ pub(crate) fn assemble_route(s: &Search, order: &[u32], pts: &[V]) -> Route {
             }
         }
     }
-    // Not crossed (only possible through numerical tangency): cut them last, innermost first, from
-    // the nearest point, which keeps precedence at the price of extra idle length.
+    // Cut them last, innermost (smallest) first, each from the nearest point: precedence holds at
+    // the price of extra idle length.
     leftovers.sort_by(|a, b| {
         prob.shapes[*a]
             .area
