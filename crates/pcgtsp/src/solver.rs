@@ -33,8 +33,20 @@ pub struct ExactOptions {
     /// this many ideals (0 disables it; the assignment bounds are used instead).
     pub lattice_max_ideals: usize,
     /// Work budget (elementary steps) of the lattice bound's backward pass; it sets how many
-    /// pierce groups per cluster the bound keeps (more = tighter and slower).
+    /// pierce groups per cluster the bound keeps (more = tighter and slower). 0 = automatic:
+    /// 40 million steps per second of the time limit, clamped to 0.3–4 billion.
     pub lattice_work: usize,
+}
+
+impl ExactOptions {
+    /// The lattice work budget after resolving the automatic setting.
+    fn effective_lattice_work(&self) -> usize {
+        if self.lattice_work > 0 {
+            return self.lattice_work;
+        }
+        let seconds = self.time_limit.map_or(100.0, |t| t.as_secs_f64());
+        (seconds * 40e6).clamp(3e8, 4e9) as usize
+    }
 }
 
 impl Default for ExactOptions {
@@ -47,7 +59,7 @@ impl Default for ExactOptions {
             beam_widths: vec![64, 1024, 8192],
             gap_tolerance: 0.0,
             lattice_max_ideals: 8_000_000,
-            lattice_work: 500_000_000,
+            lattice_work: 0,
         }
     }
 }
@@ -246,7 +258,7 @@ impl Run {
             &self.model,
             options.lattice_max_ideals,
             options.memory_limit_bytes,
-            options.lattice_work,
+            options.effective_lattice_work(),
         );
         if let Some(root) = store.root_bound() {
             self.root_bound = self.root_bound.max(self.model.round_bound(root));
