@@ -10,7 +10,7 @@
 //! 4. synthetic nests of 100 … 20,000 contours: time to the first VNS local optimum, idle
 //!    length, and the peer.
 //!
-//! Arguments: `--quick` skips the 20,000-contour nest; `--vns-seconds S` sets CCP's budget
+//! Arguments: `--quick` skips the 20,000-contour nest; `--real-only` skips the synthetic nests; `--vns-seconds S` sets CCP's budget
 //! after the local optimum (default 5); `--synthetic N` runs CCP on one synthetic nest only, `--peer-synthetic N` runs only the peer on one synthetic nest, `--nest PATH` CCP on one real nest (path under
 //! `shared/data/nests`).
 
@@ -258,6 +258,9 @@ fn main() {
         r.metrics.idle_length / 1513.0
     );
 
+    if args.iter().any(|a| a == "--real-only") {
+        return;
+    }
     println!("\n## Synthetic nests (`generate_nest(n, 1)`, open routes from the origin)\n");
     println!("| contours | kept | initial (NN) | local optimum | time to local opt. s | after VNS | total s | peer idle | peer s | CCP / peer |");
     println!("|---|---|---|---|---|---|---|---|---|---|");
