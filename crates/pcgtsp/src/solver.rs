@@ -29,8 +29,9 @@ pub struct ExactOptions {
     pub beam_widths: Vec<usize>,
     /// Stop as soon as `(UB − LB) / UB` is at most this (0 = prove optimality).
     pub gap_tolerance: f64,
-    /// Build the ideal lattice with the cluster-DP bound when the precedence order has at most
-    /// this many ideals (0 disables it; the assignment bounds are used instead).
+    /// Build the ideal lattice with the pierce-group DP bound when the precedence order has at
+    /// most this many ideals (0 disables it; the assignment bounds are used instead). Short
+    /// time limits lower it further (60 000 ideals per second of the limit).
     pub lattice_max_ideals: usize,
     /// Work budget (elementary steps) of the lattice bound's backward pass; it sets how many
     /// pierce groups per cluster the bound keeps (more = tighter and slower). 0 = automatic:
@@ -39,6 +40,14 @@ pub struct ExactOptions {
 }
 
 impl ExactOptions {
+    /// The lattice size cap after scaling with the time limit: a failed build (too many
+    /// ideals) costs about a second per million ideals, so short runs try smaller lattices.
+    fn effective_lattice_max_ideals(&self) -> usize {
+        let seconds = self.time_limit.map_or(f64::INFINITY, |t| t.as_secs_f64());
+        self.lattice_max_ideals
+            .min((seconds * 60_000.0).max(100_000.0) as usize)
+    }
+
     /// The lattice work budget after resolving the automatic setting.
     fn effective_lattice_work(&self) -> usize {
         if self.lattice_work > 0 {
@@ -256,7 +265,7 @@ impl Run {
         let began = Instant::now();
         let store = LatticeStore::build(
             &self.model,
-            options.lattice_max_ideals,
+            options.effective_lattice_max_ideals(),
             options.memory_limit_bytes,
             options.effective_lattice_work(),
         );
@@ -480,8 +489,20 @@ impl ExactSolver {
                     }
                     let run = &mut self.runs[0];
                     if engine.is_none() {
-                        match self.options.beam_widths.get(*beam) {
-                            Some(&width) => {
+                        // Without the lattice the beam bounds states by assignments (O(m³)
+                        // per group): wide beams would eat the whole budget.
+                        let has_lattice = run
+                            .lattice
+                            .as_ref()
+                            .is_some_and(|l| l.root_bound().is_some());
+                        let width = self.options.beam_widths.get(*beam).copied();
+                        let width = if has_lattice {
+                            width
+                        } else {
+                            width.filter(|&w| w <= 1024)
+                        };
+                        match width {
+                            Some(width) => {
                                 *engine = Some(Box::new(Engine::new(
                                     &run.model,
                                     Some(width),
