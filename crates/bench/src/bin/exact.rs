@@ -98,10 +98,10 @@ pub fn main() {
         let text =
             std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         let instance = Instance::parse(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-        let ideals = count_ideals(&instance, 20_000_000)
+        let ideals = count_ideals(&instance, 6_000_000)
             .ok()
             .flatten()
-            .map_or(">2e7".to_string(), |c| c.to_string());
+            .map_or(">6e6".to_string(), |c| c.to_string());
         let limit = if row.instance == "e1x_2" {
             time_limit.max(600.0)
         } else {
