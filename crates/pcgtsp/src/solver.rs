@@ -584,6 +584,15 @@ impl ExactSolver {
                         self.current_run += 1;
                     }
                     let p = self.progress();
+                    if p.upper_bound.is_finite() && p.lower_bound >= p.upper_bound {
+                        // Every live state is bounded by the incumbent: nothing can improve.
+                        self.elapsed += began.elapsed();
+                        let status = SolverStatus::Finished {
+                            proven_optimal: true,
+                        };
+                        self.phase = Phase::Done(status);
+                        return status;
+                    }
                     if self.options.gap_tolerance > 0.0 && p.gap <= self.options.gap_tolerance {
                         return self.stop(began);
                     }
