@@ -32,6 +32,7 @@ fn main() {
             "maxrem" => p.max_removal = v.parse().unwrap(),
             "block" => p.block_reverse_length = v.parse().unwrap(),
             "bgate" => p.block_reverse_gate = v.parse().unwrap(),
+            "cycle" => p.temperature_cycle = v.split(',').map(|x| x.parse().unwrap()).collect(),
             "target" => options.target_cost = Some(v.parse().unwrap()),
             _ => panic!("unknown key {k}"),
         }

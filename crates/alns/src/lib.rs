@@ -133,6 +133,8 @@ pub struct AlnsParameters {
     pub noise: f64,
     /// Temperature at the start of an epoch, as a fraction of the best cost.
     pub start_temperature: f64,
+    /// Factors applied to `start_temperature` in successive epochs, cyclically.
+    pub temperature_cycle: Vec<f64>,
     /// Temperature at the end of an epoch, as a fraction of the best cost.
     pub end_temperature: f64,
     /// Iterations of the first annealing epoch; each epoch ends with a restart from the best.
@@ -168,7 +170,8 @@ impl Default for AlnsParameters {
             max_removal: 50,
             noise: 0.3,
             start_temperature: 0.1,
-            end_temperature: 0.002,
+            temperature_cycle: vec![1.0, 0.3, 0.1],
+            end_temperature: 0.0005,
             epoch_iterations: 2000,
             epoch_growth: 1.5,
             max_epoch_iterations: 200_000,

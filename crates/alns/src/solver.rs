@@ -267,8 +267,12 @@ impl AlnsSolver {
             self.problem.mean_arc * self.problem.m as f64
         }
         .max(self.problem.mean_arc);
-        let start = params.start_temperature * reference;
-        let end = params.end_temperature * reference;
+        // Epochs cycle through hotter and cooler schedules: instances differ in which works,
+        // and a portfolio is more robust than any single setting.
+        let scale = params.temperature_cycle
+            [(self.restarts as usize) % params.temperature_cycle.len().max(1)];
+        let start = params.start_temperature * reference * scale;
+        let end = (params.end_temperature * reference).min(start);
         let frac = self.epoch_iteration as f64 / self.epoch_length as f64;
         start * (end / start).powf(frac.min(1.0))
     }
