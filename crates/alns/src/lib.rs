@@ -232,7 +232,8 @@ pub enum StopReason {
     IterationLimit,
     /// A tour at or below the target cost was found.
     TargetReached,
-    /// The instance is so small that the first tour is optimal.
+    /// The instance is so small (at most one cluster besides the depot) that the first tour
+    /// is optimal.
     Exhausted,
     /// [`AlnsSolver::cancel`] was called.
     Cancelled,

@@ -200,7 +200,7 @@ impl AlnsSolver {
                     return Some(StopReason::TargetReached);
                 }
             }
-            if self.problem.m <= 3 && self.best().is_some() {
+            if self.problem.m <= 2 && self.best().is_some() {
                 return Some(StopReason::Exhausted);
             }
         }

@@ -333,3 +333,42 @@ fn rejects_broken_instances_and_reports_no_tour_when_none_exists() {
     assert_eq!(result.tour, None);
     assert_eq!(result.cost, None);
 }
+
+#[test]
+fn handles_instances_with_one_or_two_clusters() {
+    for m in [1, 2] {
+        let instance = random_instance(9 + m as u64, m.max(3), false, 0, 0);
+        // Keep only the first m clusters.
+        let keep: Vec<usize> = instance.clusters[..m].concat();
+        let n = keep.len();
+        let mut cost = vec![0.0; n * n];
+        for (i, &a) in keep.iter().enumerate() {
+            for (j, &b) in keep.iter().enumerate() {
+                cost[i * n + j] = instance.cost[a * instance.node_count + b];
+            }
+        }
+        let small = Instance {
+            name: format!("m{m}"),
+            node_count: n,
+            cost,
+            clusters: {
+                let mut next = 0;
+                instance.clusters[..m]
+                    .iter()
+                    .map(|c| {
+                        let ids = (next..next + c.len()).collect::<Vec<_>>();
+                        next += c.len();
+                        ids
+                    })
+                    .collect()
+            },
+            node_cluster: instance.node_cluster[..n].to_vec(),
+            precedence: Vec::new(),
+            depot: 0,
+        };
+        let result = solve(&small, AlnsOptions::default(), &mut |_| {}).unwrap();
+        let cost = checked(&small, result.tour.as_ref().unwrap(), result.cost.unwrap());
+        assert_eq!(Some(cost), brute_force(&small));
+        assert_eq!(result.progress.stop_reason, Some(StopReason::Exhausted));
+    }
+}
