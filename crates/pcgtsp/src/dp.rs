@@ -371,9 +371,9 @@ impl<const W: usize> Dp<W> {
             use_lattice = true;
             group_bound = 0.0;
             self.bounder.l2 = -INF;
-        } else if self.beam_width.is_some() {
-            // A beam without the lattice ranks by path cost alone: assignments per group
-            // (O(m³)) would make the heuristic slower than the search it seeds.
+        } else if self.beam_width.is_some() && model.m > 60 {
+            // A beam without the lattice on many clusters ranks by path cost alone: assignments
+            // per group (O(m³)) would make the heuristic slower than the search it seeds.
             cheap = true;
             group_bound = 0.0;
             self.bounder.l2 = -INF;
