@@ -142,7 +142,7 @@ pub fn main() {
             _ => "",
         };
         println!(
-            "| {} | {} | {} | {} | {} | {} | {} | {:.2} | {} | {:.2} | {:.2} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {} | {:.2} | {} | {:.2} | {:.2} | {} | {} | {} | {}{} |",
             row.set,
             row.instance,
             instance.node_count,
@@ -157,7 +157,8 @@ pub fn main() {
             result.states_created,
             row.pcglns_cost,
             row.best_lb,
-            format!("{}{flag}", row.known_optimum),
+            row.known_optimum,
+            flag,
         );
     }
 }
