@@ -5,7 +5,7 @@
 
 use std::time::Duration;
 
-use cutroute_alns::{solve, AlnsOptions};
+use cutroute_alns::{AlnsOptions, AlnsSolver, SolverStatus};
 use cutroute_pcgtsp::{check_tour, Instance};
 
 fn main() {
@@ -15,7 +15,7 @@ fn main() {
     let seconds: f64 = args[2].parse().expect("seconds");
     let seeds: u64 = args[3].parse().expect("seeds");
     let mut options = AlnsOptions {
-        time_limit: Some(Duration::from_secs_f64(seconds)),
+        time_limit: None,
         ..AlnsOptions::default()
     };
     for kv in &args[4..] {
@@ -30,6 +30,9 @@ fn main() {
             "frac" => p.max_removal_fraction = v.parse().unwrap(),
             "gate" => p.local_search_gate = v.parse().unwrap(),
             "maxrem" => p.max_removal = v.parse().unwrap(),
+            "block" => p.block_reverse_length = v.parse().unwrap(),
+            "bgate" => p.block_reverse_gate = v.parse().unwrap(),
+            "cycle" => p.temperature_cycle = v.split(',').map(|x| x.parse().unwrap()).collect(),
             "target" => options.target_cost = Some(v.parse().unwrap()),
             _ => panic!("unknown key {k}"),
         }
@@ -37,16 +40,28 @@ fn main() {
     for seed in 1..=seeds {
         options.seed = seed;
         let mut last = String::new();
-        let result = solve(&instance, options.clone(), &mut |p| {
+        let mut solver = AlnsSolver::new(&instance, options.clone()).unwrap();
+        let start = cpu_seconds();
+        while solver.step_with(Duration::from_millis(10), &mut |p| {
             last = format!(
                 "{:.3}s {:?} it {}",
-                p.elapsed.as_secs_f64(),
+                cpu_seconds() - start,
                 p.best_cost,
                 p.iterations
             );
-        })
-        .unwrap();
-        let tour = result.tour.unwrap();
+        }) == SolverStatus::Running
+            && cpu_seconds() - start < seconds
+        {}
+        let (tour, cost) = solver.best().map(|(t, c)| (t.to_vec(), c)).unwrap();
+        let progress = solver.progress();
+        struct R {
+            cost: Option<f64>,
+            progress: cutroute_alns::AlnsProgress,
+        }
+        let result = R {
+            cost: Some(cost),
+            progress,
+        };
         check_tour(&instance, &tour).unwrap();
         if std::env::var("SHOW_TOUR").is_ok() {
             println!("{:?}", tour.iter().map(|v| v + 1).collect::<Vec<_>>());
@@ -56,4 +71,12 @@ fn main() {
             result.cost, result.progress.iterations, result.progress.restarts
         );
     }
+}
+
+/// CPU seconds of this thread (the machine is shared: wall time would mislead comparisons).
+fn cpu_seconds() -> f64 {
+    let stat = std::fs::read_to_string("/proc/thread-self/stat").unwrap();
+    let rest = &stat[stat.rfind(')').unwrap() + 2..];
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    (f[11].parse::<f64>().unwrap() + f[12].parse::<f64>().unwrap()) / 100.0
 }

@@ -133,6 +133,8 @@ pub struct AlnsParameters {
     pub noise: f64,
     /// Temperature at the start of an epoch, as a fraction of the best cost.
     pub start_temperature: f64,
+    /// Factors applied to `start_temperature` in successive epochs, cyclically.
+    pub temperature_cycle: Vec<f64>,
     /// Temperature at the end of an epoch, as a fraction of the best cost.
     pub end_temperature: f64,
     /// Iterations of the first annealing epoch; each epoch ends with a restart from the best.
@@ -146,6 +148,8 @@ pub struct AlnsParameters {
     pub local_search_gate: f64,
     /// Longest segment the block-reversal local search move turns around.
     pub block_reverse_length: usize,
+    /// Block reversal runs on tours whose cost is within this fraction above the best.
+    pub block_reverse_gate: f64,
     /// Iterations between operator-weight updates.
     pub segment_iterations: u64,
     /// Weight-update reaction factor in `[0, 1]`.
@@ -166,12 +170,14 @@ impl Default for AlnsParameters {
             max_removal: 50,
             noise: 0.3,
             start_temperature: 0.1,
-            end_temperature: 0.002,
+            temperature_cycle: vec![1.0, 0.3, 0.1],
+            end_temperature: 0.0005,
             epoch_iterations: 2000,
             epoch_growth: 1.5,
             max_epoch_iterations: 200_000,
             local_search_gate: 0.05,
             block_reverse_length: 40,
+            block_reverse_gate: 0.001,
             segment_iterations: 50,
             reaction: 0.2,
             score_new_best: 33.0,
@@ -226,7 +232,8 @@ pub enum StopReason {
     IterationLimit,
     /// A tour at or below the target cost was found.
     TargetReached,
-    /// The instance is so small that the first tour is optimal.
+    /// The instance is so small (at most one cluster besides the depot) that the first tour
+    /// is optimal.
     Exhausted,
     /// [`AlnsSolver::cancel`] was called.
     Cancelled,

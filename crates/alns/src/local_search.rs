@@ -50,6 +50,7 @@ impl LocalSearch {
 
     /// Asymmetric 2-opt: reverses `t[i..=j]` when that is cheaper and no precedence pair lies
     /// inside the segment. Returns whether the tour improved.
+    #[inline(never)]
     pub(crate) fn two_opt(&mut self, p: &Problem, t: &mut [usize]) -> bool {
         let m = t.len();
         if m < 4 {
@@ -100,17 +101,20 @@ impl LocalSearch {
         }
     }
 
-    /// Or-opt: moves a segment of 1–3 clusters (possibly reversed) elsewhere, passing only
+    /// Or-opt: moves a segment of 2–3 clusters (possibly reversed) elsewhere, passing only
     /// clusters it is not ordered with. Returns whether the tour improved.
-    pub(crate) fn or_opt(&mut self, p: &Problem, t: &mut Vec<usize>) -> bool {
+    #[inline(never)]
+    pub(crate) fn or_opt(&mut self, p: &Problem, t: &mut [usize]) -> bool {
         let m = t.len();
         if m < 3 {
             return false;
         }
         let eps = eps(p);
         let mut improved_any = false;
-        'restart: loop {
-            for len in 1..=3usize.min(m - 2) {
+        // Single segments are covered by `reinsert` (which also re-picks the node).
+        loop {
+            let mut improved = false;
+            for len in 2..=3usize.min(m - 2) {
                 for i in 1..=m - len {
                     let first = t[i];
                     let last = t[i + len - 1];
@@ -173,18 +177,20 @@ impl LocalSearch {
                     }
                     if best.1 != ABSENT {
                         self.move_segment(t, i, len, best.1, best.2);
-                        improved_any = true;
-                        continue 'restart;
+                        improved = true;
                     }
                 }
             }
-            return improved_any;
+            if !improved {
+                return improved_any;
+            }
+            improved_any = true;
         }
     }
 
     /// Moves `t[i..i+len]` to just after the element now at `after` (an index outside the
     /// segment, in the original tour), reversing it if asked.
-    fn move_segment(&mut self, t: &mut Vec<usize>, i: usize, len: usize, after: usize, rev: bool) {
+    fn move_segment(&mut self, t: &mut [usize], i: usize, len: usize, after: usize, rev: bool) {
         self.buffer.clear();
         self.buffer.extend_from_slice(&t[i..i + len]);
         if rev {
@@ -204,7 +210,8 @@ impl LocalSearch {
 
     /// Re-inserts each cluster at its best feasible position with its best node (GLNS's
     /// "move opt"). Returns whether the tour improved.
-    pub(crate) fn reinsert(&mut self, p: &Problem, t: &mut Vec<usize>) -> bool {
+    #[inline(never)]
+    pub(crate) fn reinsert(&mut self, p: &Problem, t: &mut [usize]) -> bool {
         let m = t.len();
         if m < 3 {
             return false;
@@ -261,6 +268,7 @@ impl LocalSearch {
     /// cluster waits only for its own predecessors). On cutting plans this turns the direction
     /// of travel of a run of "hole, then its outer contour" pairs around, which no plain 2-opt
     /// or or-opt move can do. Segments are at most `max_len` long. Returns whether it improved.
+    #[inline(never)]
     pub(crate) fn block_reverse(&mut self, p: &Problem, t: &mut [usize], max_len: usize) -> bool {
         let m = t.len();
         if m < 4 || !p.has_precedence {

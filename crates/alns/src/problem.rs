@@ -208,18 +208,6 @@ impl Problem {
         self.node_cluster[v]
     }
 
-    /// Penalised cost of the closed node tour `t`.
-    pub(crate) fn tour_cost(&self, t: &[usize]) -> f64 {
-        if t.is_empty() {
-            return 0.0;
-        }
-        let mut total = 0.0;
-        for w in t.windows(2) {
-            total += self.d(w[0], w[1]);
-        }
-        total + self.d(t[t.len() - 1], t[0])
-    }
-
     /// Whether the closed tour uses no forbidden arc.
     pub(crate) fn uses_no_forbidden_arc(&self, t: &[usize]) -> bool {
         let last = t.len() - 1;

@@ -200,7 +200,7 @@ impl AlnsSolver {
                     return Some(StopReason::TargetReached);
                 }
             }
-            if self.problem.m <= 3 && self.best().is_some() {
+            if self.problem.m <= 2 && self.best().is_some() {
                 return Some(StopReason::Exhausted);
             }
         }
@@ -228,7 +228,7 @@ impl AlnsSolver {
             noisy: false,
         };
         self.operators.repair(p, &mut tour, how, 0.0, &mut self.rng);
-        let cost = self.improve(&mut tour);
+        let cost = self.improve(&mut tour, f64::INFINITY);
         self.current.clone_from(&tour);
         self.current_cost = cost;
         self.best = tour;
@@ -236,20 +236,21 @@ impl AlnsSolver {
         true
     }
 
-    /// Node-choice DP followed by local search until neither changes anything.
-    fn improve(&mut self, tour: &mut Vec<usize>) -> f64 {
+    /// Node-choice DP followed by local search until nothing changes. The expensive block
+    /// reversal only runs on tours that are about as good as the best (`deep_below`), where
+    /// it is needed to escape "wrong direction of travel" local optima.
+    fn improve(&mut self, tour: &mut [usize], deep_below: f64) -> f64 {
         let p = &self.problem;
+        let max_len = self.options.parameters.block_reverse_length;
         let mut cost = self.node_choice.optimise(p, tour);
         // Every local-search move strictly improves and the DP never worsens, so this ends.
         loop {
             let mut changed = self.local_search.two_opt(p, tour);
             changed |= self.local_search.or_opt(p, tour);
             changed |= self.local_search.reinsert(p, tour);
-            if !changed {
-                let max_len = self.options.parameters.block_reverse_length;
-                if !self.local_search.block_reverse(p, tour, max_len) {
-                    break;
-                }
+            if !changed && (cost > deep_below || !self.local_search.block_reverse(p, tour, max_len))
+            {
+                break;
             }
             cost = self.node_choice.optimise(p, tour);
         }
@@ -266,8 +267,12 @@ impl AlnsSolver {
             self.problem.mean_arc * self.problem.m as f64
         }
         .max(self.problem.mean_arc);
-        let start = params.start_temperature * reference;
-        let end = params.end_temperature * reference;
+        // Epochs cycle through hotter and cooler schedules: instances differ in which works,
+        // and a portfolio is more robust than any single setting.
+        let scale = params.temperature_cycle
+            [(self.restarts as usize) % params.temperature_cycle.len().max(1)];
+        let start = params.start_temperature * reference * scale;
+        let end = (params.end_temperature * reference).min(start);
         let frac = self.epoch_iteration as f64 / self.epoch_length as f64;
         start * (end / start).powf(frac.min(1.0))
     }
@@ -312,7 +317,8 @@ impl AlnsSolver {
         let mut cost = self.node_choice.optimise(p, &mut candidate);
         let gate = self.current_cost + params.local_search_gate * self.current_cost.abs();
         if cost < gate || cost < self.best_cost {
-            cost = self.improve(&mut candidate);
+            let deep_below = self.best_cost + params.block_reverse_gate * self.best_cost.abs();
+            cost = self.improve(&mut candidate, deep_below);
         }
 
         let eps = eps(&self.problem);
@@ -340,7 +346,10 @@ impl AlnsSolver {
         }
         self.candidate = candidate;
 
-        if self.iterations % params.segment_iterations.max(1) == 0 {
+        if self
+            .iterations
+            .is_multiple_of(params.segment_iterations.max(1))
+        {
             self.removal.end_segment(params.reaction);
             self.insertion.end_segment(params.reaction);
         }

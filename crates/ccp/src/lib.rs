@@ -41,6 +41,22 @@
 //! assert!(result.certified_optimal_for_order);
 //! ```
 //!
+//! # Open routes
+//! Without a finish point the route ends at its last cut. If that contour lies inside outer
+//! contours (a hole, or a part in a hole), the route must still leave them to cut them after it:
+//! it exits through the nearest point of each enclosing contour in turn, and the search counts
+//! that exit as part of the idle length.
+//!
+//! # Search details
+//! A move's *fixed-point* delta (pierce points held) is exact in O(1); relaxation can only
+//! shorten, so a negative one is a sure improvement. Otherwise a bound and a one-point relaxation
+//! estimate per junction decide whether to check the move exactly: apply, relax the junctions
+//! with propagation, keep or undo. The VND is driven by a queue of contours whose surroundings
+//! changed (every contour at first), each anchoring all neighbourhoods in turn; a run reaches its
+//! first local optimum, then shakes (random moves in a window of the order, the strongest a
+//! double bridge), descends again and keeps the result only if shorter, and restarts from a
+//! randomised nearest-neighbour order after `max_non_improving_shakes` failures.
+//!
 //! # Geometry to merge into `cutroute-geometry`
 //! The solver carries private geometry (module `geom`): bulge arcs with centre/radius/sweep,
 //! span length, point at parameter, nearest point, segment–span intersection, exact span bounding

@@ -90,6 +90,22 @@ pub(crate) fn assemble_route(s: &Search, order: &[u32], pts: &[V]) -> Route {
             None => leftovers.push(c),
         }
     }
+    // A contour not crossed (only possible through numerical tangency) is cut at the end; so
+    // must every contour enclosing it, to keep "inner before outer".
+    if !leftovers.is_empty() {
+        let mut late = vec![false; prob.shapes.len()];
+        for &c in &leftovers {
+            let mut p = Some(c);
+            while let Some(a) = p {
+                late[a] = true;
+                p = prob.parent[a];
+            }
+        }
+        for list in &mut inserted {
+            list.retain(|e| !late[e.1]);
+        }
+        leftovers = (0..prob.shapes.len()).filter(|&c| late[c]).collect();
+    }
     let mut steps = Vec::with_capacity(prob.shapes.len());
     for t in 0..poly.len() {
         if let Some(c) = poly_step[t] {
@@ -109,8 +125,8 @@ pub(crate) fn assemble_route(s: &Search, order: &[u32], pts: &[V]) -> Route {
             }
         }
     }
-    // Not crossed (only possible through numerical tangency): cut them last, innermost first, from
-    // the nearest point, which keeps precedence at the price of extra idle length.
+    // Cut them last, innermost (smallest) first, each from the nearest point: precedence holds at
+    // the price of extra idle length.
     leftovers.sort_by(|a, b| {
         prob.shapes[*a]
             .area
@@ -293,4 +309,60 @@ fn condition2_shape(shape: &Shape, m: V, tol: f64) -> bool {
         }
     }
     shape.is_convex()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use cutroute_geometry::{Contour, Vertex};
+
+    /// An L: 0..20 × 0..10 plus 0..10 × 10..20 (counter-clockwise).
+    fn ell() -> Shape {
+        Shape::new(&Contour::new(vec![
+            Vertex::line(0.0, 0.0),
+            Vertex::line(20.0, 0.0),
+            Vertex::line(20.0, 10.0),
+            Vertex::line(10.0, 10.0),
+            Vertex::line(10.0, 20.0),
+            Vertex::line(0.0, 20.0),
+        ]))
+    }
+
+    #[test]
+    fn conditions_on_an_l_shape() {
+        let s = ell();
+        // Reflection point on the bottom edge: the bottom line supports the whole contour.
+        let (chord, c1, c2) = certify(
+            &s,
+            V::new(5.0, -10.0),
+            Some(V::new(15.0, -10.0)),
+            V::new(10.0, 0.0),
+        );
+        assert!(!chord && c1 && c2);
+        // At the convex corner (20, 0) seen from outside: the contour lies in its right angle.
+        let (_, c1, c2) = certify(
+            &s,
+            V::new(30.0, -5.0),
+            Some(V::new(25.0, -10.0)),
+            V::new(20.0, 0.0),
+        );
+        assert!(c1 && c2);
+        // In the notch, on the edge x = 10: neither condition holds (the contour is on both sides
+        // of that edge's line, and the ellipse tangent cuts through the L).
+        let (_, c1, c2) = certify(
+            &s,
+            V::new(30.0, 25.0),
+            Some(V::new(30.0, 5.0)),
+            V::new(10.0, 15.0),
+        );
+        assert!(!c1 && !c2);
+        // On the chord between the neighbours.
+        let (chord, c1, c2) = certify(
+            &s,
+            V::new(-5.0, 5.0),
+            Some(V::new(25.0, 5.0)),
+            V::new(0.0, 5.0),
+        );
+        assert!(chord && c1 && c2);
+    }
 }

@@ -85,6 +85,8 @@ pub enum SolverStatus {
 pub enum CcpPhase {
     /// Nothing computed yet.
     Start,
+    /// Relaxing the pierce points of the nearest-neighbour order (sweeps until δ).
+    Relaxing,
     /// Descending to the first VNS local optimum.
     LocalSearch,
     /// Shaking and descending again (VNS proper).
@@ -227,7 +229,9 @@ impl CcpSolver {
     pub fn step(&mut self, budget: Duration) -> SolverStatus {
         let t0 = Instant::now();
         let result = self.step_inner(t0, budget);
-        if self.phase != CcpPhase::Start {
+        if !matches!(self.phase, CcpPhase::Start | CcpPhase::Relaxing)
+            || self.route.steps.is_empty()
+        {
             self.refresh_route();
         }
         self.elapsed += t0.elapsed();
@@ -241,6 +245,10 @@ impl CcpSolver {
 
     fn step_inner(&mut self, t0: Instant, budget: Duration) -> SolverStatus {
         if self.cancelled {
+            if self.phase == CcpPhase::Start {
+                // Even a run cancelled at once reports a complete route.
+                self.search.construct(false);
+            }
             self.finish_run();
             return SolverStatus::Finished;
         }
@@ -249,10 +257,21 @@ impl CcpSolver {
                 CcpPhase::Done => return SolverStatus::Finished,
                 CcpPhase::Start => {
                     self.search.construct(false);
-                    self.search.relax_full();
-                    self.initial_length = Some(self.search.total);
-                    self.search.queue_all();
-                    self.phase = CcpPhase::LocalSearch;
+                    self.phase = CcpPhase::Relaxing;
+                    if self.out_of_time(t0, budget) {
+                        return SolverStatus::Running;
+                    }
+                }
+                CcpPhase::Relaxing => {
+                    // One sweep per iteration so that long relaxations respect time slices.
+                    let gain = self.search.sweep();
+                    if gain <= self.options.delta {
+                        self.initial_length = Some(self.search.total);
+                        self.search.queue_all();
+                        self.phase = CcpPhase::LocalSearch;
+                    } else if self.out_of_time(t0, budget) {
+                        return SolverStatus::Running;
+                    }
                 }
                 CcpPhase::LocalSearch | CcpPhase::Shaking => {
                     if !self.descend(t0, budget) {

@@ -320,3 +320,21 @@ fn real_nests_beat_the_peer_by_ten_percent() {
         );
     }
 }
+
+#[test]
+fn empty_and_single_contour_nests() {
+    let home = Point::new(0.0, 0.0);
+    let empty = Nest::default();
+    let r = solve(&empty, quick(home, Some(Point::new(3.0, 4.0))), &mut |_| {}).unwrap();
+    assert!(r.route.steps.is_empty());
+    assert!((r.metrics.idle_length - 5.0).abs() < 1e-12);
+    let one = Nest {
+        sheet: None,
+        parts: vec![part("sq", vec![square(10.0, 10.0, 10.0)])],
+    };
+    let r = solve(&one, quick(home, Some(home)), &mut |_| {}).unwrap();
+    assert_valid(&one, &r.route);
+    // In to the nearest corner and back.
+    assert!((r.metrics.idle_length - 2.0 * 200f64.sqrt()).abs() < 1e-9);
+    assert!(r.certified_optimal_for_order);
+}

@@ -21,6 +21,9 @@ use crate::order::{OrderError, PrecedenceOrder};
 
 const INF: f64 = f64::INFINITY;
 
+/// Largest residual problem (clusters) the assignment bounds are computed for.
+const MAX_ASSIGNMENT: usize = 1500;
+
 /// The instance prepared for bounding, with the depot restricted to one start node.
 #[derive(Clone, Debug)]
 pub(crate) struct Model {
@@ -116,7 +119,12 @@ impl Model {
             }
         }
         let mut w2 = vec![INF; m * m];
-        for a in 0..m {
+        // H2 costs m²·n: beyond ~10⁹ steps it is skipped (all zero, so L2 stays a valid 0).
+        let h2_affordable = (m as u64) * (m as u64) * (n as u64) <= 1_000_000_000;
+        if !h2_affordable {
+            w2.iter_mut().for_each(|w| *w = 0.0);
+        }
+        for a in (0..m).filter(|_| h2_affordable) {
             for b in 0..m {
                 if a == b {
                     continue;
@@ -200,6 +208,8 @@ pub(crate) struct ResidualBounder {
     pub l1: f64,
     /// The L2 value (`-INF` when not computed).
     pub l2: f64,
+    /// The last problem was too large for the assignment: every bound is 0.
+    skipped: bool,
 }
 
 impl ResidualBounder {
@@ -224,6 +234,15 @@ impl ResidualBounder {
         }
         let remaining = self.clusters.len() - 1;
         let root = last == depot;
+        // The O(k³) assignment is skipped on very large residual problems (bound 0 is valid).
+        self.skipped = remaining > MAX_ASSIGNMENT;
+        if self.skipped {
+            self.l1 = 0.0;
+            self.l2 = -INF;
+            self.last_row.clear();
+            self.base_without_last = 0.0;
+            return 0.0;
+        }
         if !root {
             self.clusters.push(depot);
         }
@@ -350,6 +369,9 @@ impl ResidualBounder {
     /// the last [`ResidualBounder::compute`] (≥ L1). `INF` if `x` has no usable arc.
     #[inline]
     pub fn node_bound(&self, model: &Model, x: usize) -> f64 {
+        if self.skipped {
+            return 0.0;
+        }
         let row = &model.node_to_cluster[x * model.m..(x + 1) * model.m];
         let mut best = INF;
         for &(b, v) in &self.last_row {

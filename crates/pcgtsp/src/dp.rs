@@ -359,6 +359,7 @@ impl<const W: usize> Dp<W> {
         let complete = self.layer + 1 == model.m;
         let group_bound;
         let mut use_lattice = false;
+        let mut cheap = false;
         if complete {
             group_bound = 0.0;
             self.bounder.l2 = -INF;
@@ -368,6 +369,12 @@ impl<const W: usize> Dp<W> {
                 .expect("every ideal is in the lattice");
             lattice.next_values(self.layer + 1, index, &mut self.next_values);
             use_lattice = true;
+            group_bound = 0.0;
+            self.bounder.l2 = -INF;
+        } else if self.beam_width.is_some() && model.m > 60 {
+            // A beam without the lattice on many clusters ranks by path cost alone: assignments
+            // per group (O(m³)) would make the heuristic slower than the search it seeds.
+            cheap = true;
             group_bound = 0.0;
             self.bounder.l2 = -INF;
         } else {
@@ -387,6 +394,8 @@ impl<const W: usize> Dp<W> {
             }
             let lb = if complete {
                 g + model.arc(x, model.start)
+            } else if cheap {
+                g
             } else if let (true, Some(lattice)) = (use_lattice, &self.lattice) {
                 g + lattice.node_completion(model, &self.next_values, x)
             } else {

@@ -126,3 +126,34 @@ fn feasible(model: &Model, clusters: &[usize]) -> bool {
     }
     true
 }
+
+/// Nearest-neighbour construction: from the start node, repeatedly move to the cheapest node
+/// of any cluster whose predecessors are all visited. `None` if it gets stuck on forbidden arcs.
+pub(crate) fn greedy(model: &Model) -> Option<Vec<usize>> {
+    let m = model.m;
+    let mut visited = crate::order::ClusterSet::new(m);
+    visited.insert(model.depot);
+    let mut tour = vec![model.start];
+    let mut current = model.start;
+    for _ in 1..m {
+        let mut best = (INF, usize::MAX, usize::MAX);
+        for c in 0..m {
+            if visited.contains(c) || !model.order.predecessors[c].is_subset(&visited) {
+                continue;
+            }
+            for &x in &model.cluster_nodes[c] {
+                let w = model.arc(current, x);
+                if w < best.0 {
+                    best = (w, c, x);
+                }
+            }
+        }
+        if best.1 == usize::MAX {
+            return None;
+        }
+        visited.insert(best.1);
+        tour.push(best.2);
+        current = best.2;
+    }
+    model.arc(current, model.start).is_finite().then_some(tour)
+}

@@ -230,6 +230,8 @@ impl<const W: usize> Lattice<W> {
         }
         let last = layers.len() - 1;
         layers[last].child_start = vec![0; layers[last].keys.len() + 1];
+        // Small lattices need few groups for strong pruning; more would only slow the build.
+        let work_budget = work_budget.min(ideal_count.saturating_mul(3000).max(300_000_000));
         // Choose K from the work of the backward pass: ideals × Σ_B k_B × Σ_C k_C.
         let children_total: usize = layers.iter().map(|l| l.child_cluster.len()).sum();
         let average_children = (children_total as f64 / ideal_count as f64).max(1.0);

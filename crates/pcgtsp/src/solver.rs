@@ -29,12 +29,33 @@ pub struct ExactOptions {
     pub beam_widths: Vec<usize>,
     /// Stop as soon as `(UB − LB) / UB` is at most this (0 = prove optimality).
     pub gap_tolerance: f64,
-    /// Build the ideal lattice with the cluster-DP bound when the precedence order has at most
-    /// this many ideals (0 disables it; the assignment bounds are used instead).
+    /// Build the ideal lattice with the pierce-group DP bound when the precedence order has at
+    /// most this many ideals (0 disables it; the assignment bounds are used instead). Short
+    /// time limits lower it further (60 000 ideals per second of the limit).
     pub lattice_max_ideals: usize,
     /// Work budget (elementary steps) of the lattice bound's backward pass; it sets how many
-    /// pierce groups per cluster the bound keeps (more = tighter and slower).
+    /// pierce groups per cluster the bound keeps (more = tighter and slower). 0 = automatic:
+    /// 40 million steps per second of the time limit, clamped to 0.3–4 billion.
     pub lattice_work: usize,
+}
+
+impl ExactOptions {
+    /// The lattice size cap after scaling with the time limit: a failed build (too many
+    /// ideals) costs about a second per million ideals, so short runs try smaller lattices.
+    fn effective_lattice_max_ideals(&self) -> usize {
+        let seconds = self.time_limit.map_or(f64::INFINITY, |t| t.as_secs_f64());
+        self.lattice_max_ideals
+            .min((seconds * 60_000.0).max(100_000.0) as usize)
+    }
+
+    /// The lattice work budget after resolving the automatic setting.
+    fn effective_lattice_work(&self) -> usize {
+        if self.lattice_work > 0 {
+            return self.lattice_work;
+        }
+        let seconds = self.time_limit.map_or(100.0, |t| t.as_secs_f64());
+        (seconds * 40e6).clamp(3e8, 4e9) as usize
+    }
 }
 
 impl Default for ExactOptions {
@@ -47,7 +68,7 @@ impl Default for ExactOptions {
             beam_widths: vec![64, 1024, 8192],
             gap_tolerance: 0.0,
             lattice_max_ideals: 8_000_000,
-            lattice_work: 120_000_000,
+            lattice_work: 0,
         }
     }
 }
@@ -244,9 +265,9 @@ impl Run {
         let began = Instant::now();
         let store = LatticeStore::build(
             &self.model,
-            options.lattice_max_ideals,
+            options.effective_lattice_max_ideals(),
             options.memory_limit_bytes,
-            options.lattice_work,
+            options.effective_lattice_work(),
         );
         if let Some(root) = store.root_bound() {
             self.root_bound = self.root_bound.max(self.model.round_bound(root));
@@ -448,13 +469,40 @@ impl ExactSolver {
             match &mut self.phase {
                 Phase::Heuristic { beam, engine } => {
                     if self.runs[0].lattice.is_none() {
+                        // A quick tour first, so an upper bound exists before the (blocking)
+                        // lattice build.
+                        for r in 0..self.runs.len() {
+                            if let Some(mut tour) = heuristic::greedy(&self.runs[r].model) {
+                                let cost =
+                                    heuristic::improve(&self.runs[r].model, &mut tour, 20_000);
+                                if cost < self.incumbent.upper_bound {
+                                    if let Ok(checked) = check_tour(&self.instance, &tour) {
+                                        self.incumbent.upper_bound = checked;
+                                        self.incumbent.tour = Some(tour);
+                                    }
+                                }
+                            }
+                        }
+                        debug_log(|| format!("greedy: UB {}", self.incumbent.upper_bound));
                         self.runs[0].build_lattice(&self.options);
                         continue;
                     }
                     let run = &mut self.runs[0];
                     if engine.is_none() {
-                        match self.options.beam_widths.get(*beam) {
-                            Some(&width) => {
+                        // Without the lattice the beam bounds states by assignments (O(m³)
+                        // per group): wide beams would eat the whole budget.
+                        let has_lattice = run
+                            .lattice
+                            .as_ref()
+                            .is_some_and(|l| l.root_bound().is_some());
+                        let width = self.options.beam_widths.get(*beam).copied();
+                        let width = if has_lattice {
+                            width
+                        } else {
+                            width.filter(|&w| w <= 1024)
+                        };
+                        match width {
+                            Some(width) => {
                                 *engine = Some(Box::new(Engine::new(
                                     &run.model,
                                     Some(width),
@@ -536,6 +584,15 @@ impl ExactSolver {
                         self.current_run += 1;
                     }
                     let p = self.progress();
+                    if p.upper_bound.is_finite() && p.lower_bound >= p.upper_bound {
+                        // Every live state is bounded by the incumbent: nothing can improve.
+                        self.elapsed += began.elapsed();
+                        let status = SolverStatus::Finished {
+                            proven_optimal: true,
+                        };
+                        self.phase = Phase::Done(status);
+                        return status;
+                    }
                     if self.options.gap_tolerance > 0.0 && p.gap <= self.options.gap_tolerance {
                         return self.stop(began);
                     }

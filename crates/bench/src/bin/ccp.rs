@@ -10,8 +10,8 @@
 //! 4. synthetic nests of 100 … 20,000 contours: time to the first VNS local optimum, idle
 //!    length, and the peer.
 //!
-//! Arguments: `--quick` skips the 20,000-contour nest; `--vns-seconds S` sets CCP's budget
-//! after the local optimum (default 5); `--synthetic N` runs CCP on one synthetic nest only, `--nest PATH` on one real nest (path under
+//! Arguments: `--quick` skips the 20,000-contour nest; `--real-only` skips the synthetic nests; `--vns-seconds S` sets CCP's budget
+//! after the local optimum (default 5); `--synthetic N` runs CCP on one synthetic nest only, `--peer-synthetic N` runs only the peer on one synthetic nest, `--nest PATH` CCP on one real nest (path under
 //! `shared/data/nests`).
 
 use std::time::{Duration, Instant};
@@ -156,6 +156,22 @@ fn main() {
         );
         return;
     }
+    if let Some(n) = args
+        .iter()
+        .position(|a| a == "--peer-synthetic")
+        .and_then(|i| args.get(i + 1))
+        .and_then(|s| s.parse::<usize>().ok())
+    {
+        let nest = generate_nest(n, 1);
+        match peer(&nest) {
+            Some((l, own, t)) => println!(
+                "peer on {n} contours: idle {l:.0} (its own figure {own:.0}) in {:.1} s",
+                t.as_secs_f64()
+            ),
+            None => println!("peer on {n} contours failed"),
+        }
+        return;
+    }
     if let Some(n) = only {
         let nest = generate_nest(n, 1);
         let (r, t) = ccp(&nest, None, budget);
@@ -242,6 +258,9 @@ fn main() {
         r.metrics.idle_length / 1513.0
     );
 
+    if args.iter().any(|a| a == "--real-only") {
+        return;
+    }
     println!("\n## Synthetic nests (`generate_nest(n, 1)`, open routes from the origin)\n");
     println!("| contours | kept | initial (NN) | local optimum | time to local opt. s | after VNS | total s | peer idle | peer s | CCP / peer |");
     println!("|---|---|---|---|---|---|---|---|---|---|");
@@ -252,9 +271,9 @@ fn main() {
     };
     for &n in sizes {
         let nest = generate_nest(n, 1);
-        // Budget: the local optimum plus `vns_seconds` of VNS (scaled up for big nests).
-        let limit = Duration::from_secs_f64(vns_seconds.max(n as f64 / 1000.0 * vns_seconds))
-            + Duration::from_secs(if n >= 20000 { 120 } else { 10 });
+        // Budget of the whole run (first local optimum, then VNS): 10 s per 1,000 contours,
+        // at least 10 s and at most 120 s.
+        let limit = Duration::from_secs_f64((n as f64 / 100.0).clamp(10.0, 120.0));
         let (r, t) = ccp(&nest, None, limit);
         let p = if n <= 5000 { peer(&nest) } else { None };
         let (pl, pt) = p.map_or((f64::NAN, f64::NAN), |(l, _, t)| (l, t.as_secs_f64()));

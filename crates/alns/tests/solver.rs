@@ -1,0 +1,374 @@
+//! End-to-end tests of the ALNS solver. Every tour goes through the independent checker
+//! `cutroute_pcgtsp::check_tour`.
+
+use std::path::PathBuf;
+use std::time::Duration;
+
+use cutroute_alns::{solve, AlnsError, AlnsOptions, AlnsSolver, SolverStatus, StopReason};
+use cutroute_pcgtsp::{check_tour, Instance};
+
+/// The reference data directory (`../shared/data/pcgtsp` beside the repository root).
+fn data_dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/pcgtsp")
+}
+
+/// Reads an instance of the reference data; fails loudly if the file is missing.
+fn load(set: &str, name: &str) -> Instance {
+    let path = data_dir().join(set).join(format!("{name}.pcglns"));
+    let text = std::fs::read_to_string(&path)
+        .unwrap_or_else(|e| panic!("missing reference instance {}: {e}", path.display()));
+    Instance::parse(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+/// Checks the result with the independent checker and returns its cost.
+fn checked(instance: &Instance, tour: &[usize], cost: f64) -> f64 {
+    let verified = check_tour(instance, tour)
+        .unwrap_or_else(|e| panic!("{}: infeasible tour {tour:?}: {e}", instance.name));
+    assert!(
+        (verified - cost).abs() <= 1e-6 * (1.0 + cost.abs()),
+        "{}: reported cost {cost} but the checker says {verified}",
+        instance.name
+    );
+    verified
+}
+
+/// A tiny deterministic generator for the random instances of these tests.
+struct TestRng(u64);
+
+impl TestRng {
+    fn next(&mut self) -> u64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        self.0
+    }
+    fn below(&mut self, n: u64) -> u64 {
+        self.next() % n
+    }
+}
+
+/// A random instance: `m` clusters of 1–3 nodes (cluster 0 is the depot), integer costs,
+/// optionally symmetric, some forbidden arcs, and random precedence pairs along a hidden order.
+fn random_instance(
+    seed: u64,
+    m: usize,
+    symmetric: bool,
+    precedence: usize,
+    forbid: u64,
+) -> Instance {
+    let mut rng = TestRng(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1);
+    let mut clusters = Vec::new();
+    let mut node_cluster = Vec::new();
+    for c in 0..m {
+        let size = if c == 0 {
+            1 + rng.below(2) as usize
+        } else {
+            1 + rng.below(3) as usize
+        };
+        let first = node_cluster.len();
+        clusters.push((first..first + size).collect::<Vec<_>>());
+        node_cluster.extend(std::iter::repeat_n(c, size));
+    }
+    let n = node_cluster.len();
+    let mut cost = vec![0.0; n * n];
+    for a in 0..n {
+        for b in 0..n {
+            if a == b {
+                continue;
+            }
+            if symmetric && b < a {
+                cost[a * n + b] = cost[b * n + a];
+                continue;
+            }
+            cost[a * n + b] = if rng.below(100) < forbid {
+                f64::INFINITY
+            } else {
+                (1 + rng.below(100)) as f64
+            };
+        }
+    }
+    let mut pairs = Vec::new();
+    for _ in 0..precedence {
+        let a = 1 + rng.below(m as u64 - 1) as usize;
+        let b = 1 + rng.below(m as u64 - 1) as usize;
+        if a < b {
+            pairs.push((a, b));
+        }
+    }
+    Instance {
+        name: format!("random-{seed}"),
+        node_count: n,
+        cost,
+        clusters,
+        node_cluster,
+        precedence: pairs,
+        depot: 0,
+    }
+}
+
+/// Exhaustive optimum over all cluster orders and node choices (tiny instances only).
+fn brute_force(instance: &Instance) -> Option<f64> {
+    fn extend(instance: &Instance, tour: &mut Vec<usize>, used: &mut [bool], best: &mut f64) {
+        let m = instance.clusters.len();
+        if tour.len() == m {
+            if let Ok(cost) = check_tour(instance, tour) {
+                *best = best.min(cost);
+            }
+            return;
+        }
+        for c in 0..m {
+            if used[c] {
+                continue;
+            }
+            used[c] = true;
+            for &v in &instance.clusters[c] {
+                tour.push(v);
+                extend(instance, tour, used, best);
+                tour.pop();
+            }
+            used[c] = false;
+        }
+    }
+    let mut best = f64::INFINITY;
+    let mut used = vec![false; instance.clusters.len()];
+    used[instance.depot] = true;
+    for &s in &instance.clusters[instance.depot] {
+        extend(instance, &mut vec![s], &mut used, &mut best);
+    }
+    best.is_finite().then_some(best)
+}
+
+#[test]
+fn matches_brute_force_on_small_random_instances() {
+    let mut cases = 0;
+    for seed in 0..60u64 {
+        let m = 3 + (seed % 5) as usize; // 3..=7 clusters
+        let symmetric = seed % 2 == 0;
+        let precedence = (seed % 4) as usize * 2; // 0 = plain GTSP
+        let forbid = [0, 10, 30][(seed % 3) as usize];
+        let instance = random_instance(seed + 1, m, symmetric, precedence, forbid);
+        let optimum = brute_force(&instance);
+        let options = AlnsOptions {
+            seed,
+            time_limit: None,
+            max_iterations: Some(3000),
+            ..AlnsOptions::default()
+        };
+        let result = solve(&instance, options, &mut |_| {}).unwrap();
+        match (optimum, result.tour) {
+            (Some(optimum), Some(tour)) => {
+                let cost = checked(&instance, &tour, result.cost.unwrap());
+                assert_eq!(cost, optimum, "seed {seed}: ALNS {cost}, optimum {optimum}");
+                cases += 1;
+            }
+            (None, None) => {}
+            (optimum, tour) => panic!("seed {seed}: optimum {optimum:?} but ALNS gave {tour:?}"),
+        }
+    }
+    assert!(cases > 40, "too few feasible random cases ({cases})");
+}
+
+#[test]
+fn reaches_known_optimum_on_small_reference_instances() {
+    for (set, name, optimum) in [
+        ("pcgtsplib", "ESC07", 1730.0),
+        ("pcgtsplib", "ESC12", 1390.0),
+        ("pcgtsplib", "br17.12", 43.0),
+        ("pcgtsplib", "ESC25", 1383.0),
+        ("industrial", "e1x_6", 1513.0),
+        ("industrial", "ec_8", 918.0),
+        ("industrial", "e1x_1", 2866.0),
+    ] {
+        let instance = load(set, name);
+        let options = AlnsOptions {
+            seed: 7,
+            time_limit: Some(Duration::from_secs(20)),
+            target_cost: Some(optimum),
+            ..AlnsOptions::default()
+        };
+        let result = solve(&instance, options, &mut |_| {}).unwrap();
+        let cost = checked(
+            &instance,
+            result.tour.as_ref().unwrap(),
+            result.cost.unwrap(),
+        );
+        assert_eq!(cost, optimum, "{name}: got {cost}");
+        assert_eq!(result.progress.stop_reason, Some(StopReason::TargetReached));
+    }
+}
+
+#[test]
+fn feasible_on_every_reference_instance() {
+    let mut count = 0;
+    for set in ["pcgtsplib", "industrial"] {
+        let dir = data_dir().join(set);
+        let mut files: Vec<_> = std::fs::read_dir(&dir)
+            .unwrap_or_else(|e| panic!("missing reference directory {}: {e}", dir.display()))
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.extension().is_some_and(|x| x == "pcglns"))
+            .collect();
+        files.sort();
+        for path in files {
+            let text = std::fs::read_to_string(&path).unwrap();
+            let instance = Instance::parse(&text).unwrap();
+            let options = AlnsOptions {
+                seed: 3,
+                time_limit: None,
+                max_iterations: Some(5),
+                ..AlnsOptions::default()
+            };
+            let result = solve(&instance, options, &mut |_| {}).unwrap();
+            let tour = result
+                .tour
+                .unwrap_or_else(|| panic!("{}: no feasible tour", path.display()));
+            checked(&instance, &tour, result.cost.unwrap());
+            count += 1;
+        }
+    }
+    assert_eq!(count, 59, "expected the 59 reference instances");
+}
+
+#[test]
+fn deterministic_for_a_seed_and_independent_of_slicing() {
+    let instance = load("pcgtsplib", "p43.3");
+    let options = AlnsOptions {
+        seed: 11,
+        time_limit: None,
+        max_iterations: Some(400),
+        ..AlnsOptions::default()
+    };
+    let mut improvements = Vec::new();
+    let first = solve(&instance, options.clone(), &mut |p| {
+        improvements.push(p.best_cost)
+    })
+    .unwrap();
+    let second = solve(&instance, options.clone(), &mut |_| {}).unwrap();
+    assert_eq!(first.tour, second.tour);
+    assert_eq!(first.cost, second.cost);
+    checked(&instance, first.tour.as_ref().unwrap(), first.cost.unwrap());
+    // Streamed improvements decrease and end at the result.
+    assert!(improvements.windows(2).all(|w| w[1] < w[0]));
+    assert_eq!(improvements.last().copied().flatten(), first.cost);
+
+    // Tiny slices, as a web worker would run it: same trajectory.
+    let mut solver = AlnsSolver::new(&instance, options).unwrap();
+    let mut slices = 0;
+    while solver.step(Duration::from_micros(1)) == SolverStatus::Running {
+        slices += 1;
+    }
+    assert!(slices > 10);
+    let (tour, cost) = solver.best().unwrap();
+    assert_eq!(Some(tour), first.tour.as_deref());
+    assert_eq!(Some(cost), first.cost);
+    assert_eq!(
+        solver.progress().stop_reason,
+        Some(StopReason::IterationLimit)
+    );
+}
+
+#[test]
+fn honours_time_limit_and_cancel() {
+    let instance = load("pcgtsplib", "kro124p.1");
+    let options = AlnsOptions {
+        time_limit: Some(Duration::from_millis(300)),
+        ..AlnsOptions::default()
+    };
+    let start = std::time::Instant::now();
+    let result = solve(&instance, options.clone(), &mut |_| {}).unwrap();
+    assert!(
+        start.elapsed() < Duration::from_secs(3),
+        "time limit ignored"
+    );
+    assert_eq!(result.progress.stop_reason, Some(StopReason::TimeLimit));
+    checked(
+        &instance,
+        result.tour.as_ref().unwrap(),
+        result.cost.unwrap(),
+    );
+
+    let mut solver = AlnsSolver::new(&instance, options).unwrap();
+    assert_eq!(
+        solver.step(Duration::from_millis(20)),
+        SolverStatus::Running
+    );
+    solver.cancel();
+    assert_eq!(
+        solver.step(Duration::from_millis(20)),
+        SolverStatus::Finished
+    );
+    assert_eq!(solver.progress().stop_reason, Some(StopReason::Cancelled));
+    let (tour, cost) = solver.best().unwrap();
+    checked(&instance, tour, cost);
+}
+
+#[test]
+fn rejects_broken_instances_and_reports_no_tour_when_none_exists() {
+    let mut instance = random_instance(5, 4, false, 0, 0);
+    instance.precedence = vec![(1, 2), (2, 3), (3, 1)];
+    assert!(matches!(
+        AlnsSolver::new(&instance, AlnsOptions::default()),
+        Err(AlnsError::PrecedenceCycle(_))
+    ));
+    instance.precedence.clear();
+    instance.cost.pop();
+    assert!(matches!(
+        AlnsSolver::new(&instance, AlnsOptions::default()),
+        Err(AlnsError::CostMatrixSize { .. })
+    ));
+
+    // Every arc into cluster 2 is forbidden: no tour exists, and none is returned.
+    let mut instance = random_instance(6, 4, false, 0, 0);
+    let n = instance.node_count;
+    for &v in &instance.clusters[2].clone() {
+        for u in 0..n {
+            instance.cost[u * n + v] = f64::INFINITY;
+        }
+    }
+    let options = AlnsOptions {
+        time_limit: None,
+        max_iterations: Some(50),
+        ..AlnsOptions::default()
+    };
+    let result = solve(&instance, options, &mut |_| {}).unwrap();
+    assert_eq!(result.tour, None);
+    assert_eq!(result.cost, None);
+}
+
+#[test]
+fn handles_instances_with_one_or_two_clusters() {
+    for m in [1, 2] {
+        let instance = random_instance(9 + m as u64, m.max(3), false, 0, 0);
+        // Keep only the first m clusters.
+        let keep: Vec<usize> = instance.clusters[..m].concat();
+        let n = keep.len();
+        let mut cost = vec![0.0; n * n];
+        for (i, &a) in keep.iter().enumerate() {
+            for (j, &b) in keep.iter().enumerate() {
+                cost[i * n + j] = instance.cost[a * instance.node_count + b];
+            }
+        }
+        let small = Instance {
+            name: format!("m{m}"),
+            node_count: n,
+            cost,
+            clusters: {
+                let mut next = 0;
+                instance.clusters[..m]
+                    .iter()
+                    .map(|c| {
+                        let ids = (next..next + c.len()).collect::<Vec<_>>();
+                        next += c.len();
+                        ids
+                    })
+                    .collect()
+            },
+            node_cluster: instance.node_cluster[..n].to_vec(),
+            precedence: Vec::new(),
+            depot: 0,
+        };
+        let result = solve(&small, AlnsOptions::default(), &mut |_| {}).unwrap();
+        let cost = checked(&small, result.tour.as_ref().unwrap(), result.cost.unwrap());
+        assert_eq!(Some(cost), brute_force(&small));
+        assert_eq!(result.progress.stop_reason, Some(StopReason::Exhausted));
+    }
+}
