@@ -21,10 +21,15 @@ use cutroute_geometry::{generate_nest, Nest, Point, Route};
 
 const SHARED: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/nests");
 
+/// Any nest format, read as the app and the CLI read it (orientation normalised).
 fn read(path: &str) -> Nest {
     let full = format!("{SHARED}/{path}");
     let bytes = std::fs::read(&full).unwrap_or_else(|e| panic!("cannot read {full}: {e}"));
-    cutroute_formats::read_nest(&bytes).unwrap_or_else(|e| panic!("cannot parse {full}: {e}"))
+    match cutroute_engine::open_document(path, &bytes) {
+        Ok(cutroute_protocol::Document { problem: cutroute_protocol::Problem::Nest { nest, .. }, .. }) => nest,
+        Ok(_) => panic!("{full} is not a nest"),
+        Err(e) => panic!("cannot parse {full}: {e}"),
+    }
 }
 
 fn ccp(nest: &Nest, finish: Option<Point>, time_limit: Duration) -> (CcpResult, Duration) {
@@ -189,12 +194,21 @@ fn main() {
         );
         return;
     }
+    // Every multi-contour nest of shared/data/nests (single-contour files have nothing to order).
     let real = [
         ("nested.dbs", "dbs/nested.dbs"),
         ("seven.dbs", "dbs/seven.dbs"),
         ("test0", "dbs-json/test0.dbs.json"),
         ("test1", "dbs-json/test1.dbs.json"),
         ("E1X_6_01", "dbs-json/E1X_6_01.dbs.json"),
+        ("Nest01", "tflex/Nest01.tfnesting"),
+        ("Nest02", "tflex/Nest02.tfnesting"),
+        ("Nest03", "tflex/Nest03.tfnesting"),
+        ("Graph_9x15", "dbs/Graph_9x15.DBS"),
+        ("seven_3717", "dbs/seven_3717.dbs"),
+        ("propeller.dxf", "dxf/propeller.dxf"),
+        ("cross.dxf", "dxf/cross.dxf"),
+        ("planka.dxf", "dxf/planka.dxf"),
     ];
 
     println!("## CCP-Relax vs u-nesting-cutting (open routes from the sheet origin, idle mm)\n");
