@@ -26,7 +26,10 @@ fn read(path: &str) -> Nest {
     let full = format!("{SHARED}/{path}");
     let bytes = std::fs::read(&full).unwrap_or_else(|e| panic!("cannot read {full}: {e}"));
     match cutroute_engine::open_document(path, &bytes) {
-        Ok(cutroute_protocol::Document { problem: cutroute_protocol::Problem::Nest { nest, .. }, .. }) => nest,
+        Ok(cutroute_protocol::Document {
+            problem: cutroute_protocol::Problem::Nest { nest, .. },
+            ..
+        }) => nest,
         Ok(_) => panic!("{full} is not a nest"),
         Err(e) => panic!("cannot parse {full}: {e}"),
     }

@@ -18,36 +18,6 @@ struct Row {
     known_optimum: String,
 }
 
-fn split_csv(line: &str) -> Vec<String> {
-    let mut fields = Vec::new();
-    let mut current = String::new();
-    let mut quoted = false;
-    for ch in line.chars() {
-        match ch {
-            '"' => quoted = !quoted,
-            ',' if !quoted => fields.push(std::mem::take(&mut current)),
-            _ => current.push(ch),
-        }
-    }
-    fields.push(current);
-    fields
-}
-
-/// CPU time of this process in seconds (Linux `/proc`; `NaN` elsewhere). Reported beside the
-/// wall time because benchmark machines are often shared.
-fn cpu_seconds() -> f64 {
-    std::fs::read_to_string("/proc/self/stat")
-        .ok()
-        .and_then(|stat| {
-            let after = stat.rsplit_once(')')?.1;
-            let fields: Vec<&str> = after.split_whitespace().collect();
-            let user: f64 = fields.get(11)?.parse().ok()?;
-            let system: f64 = fields.get(12)?.parse().ok()?;
-            Some((user + system) / 100.0)
-        })
-        .unwrap_or(f64::NAN)
-}
-
 pub fn main() {
     let mut time_limit = 60.0f64;
     let mut filter: Option<String> = None;
@@ -83,12 +53,12 @@ pub fn main() {
     let reference = std::fs::read_to_string(data.join("reference.csv"))
         .unwrap_or_else(|e| panic!("{}: {e}", data.join("reference.csv").display()));
     let mut lines = reference.lines();
-    let header = split_csv(lines.next().expect("header"));
+    let header = cutroute_bench::csv_fields(lines.next().expect("header"));
     let col = |name: &str| header.iter().position(|h| h == name).expect(name);
     let rows: Vec<Row> = lines
         .filter(|l| !l.trim().is_empty())
         .map(|l| {
-            let f = split_csv(l);
+            let f = cutroute_bench::csv_fields(l);
             Row {
                 set: f[col("set")].clone(),
                 instance: f[col("instance")].clone(),
@@ -124,9 +94,9 @@ pub fn main() {
         };
         let mut opts = options.clone();
         opts.time_limit = Some(Duration::from_secs_f64(limit));
-        let cpu_before = cpu_seconds();
+        let cpu_before = cutroute_bench::process_cpu_seconds();
         let result = solve(&instance, opts, &mut |_| {}).expect("solver");
-        let cpu = cpu_seconds() - cpu_before;
+        let cpu = cutroute_bench::process_cpu_seconds() - cpu_before;
         let p = &result.progress;
         if let Some(tour) = &p.best_tour {
             let cost = check_tour(&instance, tour).expect("solver returned an infeasible tour");

@@ -30,22 +30,6 @@ struct Reference {
     known_optimum: Option<f64>,
 }
 
-/// Splits a CSV line, honouring double quotes (the tour column holds commas).
-fn csv_fields(line: &str) -> Vec<String> {
-    let mut fields = Vec::new();
-    let mut field = String::new();
-    let mut quoted = false;
-    for ch in line.chars() {
-        match ch {
-            '"' => quoted = !quoted,
-            ',' if !quoted => fields.push(std::mem::take(&mut field)),
-            _ => field.push(ch),
-        }
-    }
-    fields.push(field);
-    fields
-}
-
 fn data_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/pcgtsp")
 }
@@ -55,7 +39,7 @@ fn read_reference() -> Vec<Reference> {
     let text = std::fs::read_to_string(&path)
         .unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
     let mut lines = text.lines();
-    let header = csv_fields(lines.next().expect("reference.csv is empty"));
+    let header = cutroute_bench::csv_fields(lines.next().expect("reference.csv is empty"));
     let column = |name: &str| {
         header
             .iter()
@@ -76,7 +60,7 @@ fn read_reference() -> Vec<Reference> {
     lines
         .filter(|l| !l.trim().is_empty())
         .map(|line| {
-            let f = csv_fields(line);
+            let f = cutroute_bench::csv_fields(line);
             Reference {
                 set: f[set].clone(),
                 instance: f[instance].clone(),
@@ -105,17 +89,6 @@ struct Args {
     wall: bool,
 }
 
-/// CPU time (user + system) of the calling thread, in seconds.
-fn thread_cpu_seconds() -> f64 {
-    let stat = std::fs::read_to_string("/proc/thread-self/stat").expect("/proc/thread-self/stat");
-    let after_name = &stat[stat.rfind(')').expect("stat format") + 2..];
-    let fields: Vec<&str> = after_name.split_whitespace().collect();
-    // Fields 14 and 15 of stat(5), counted from 1 with the name as field 2.
-    let ticks: f64 =
-        fields[11].parse::<f64>().expect("utime") + fields[12].parse::<f64>().expect("stime");
-    ticks / 100.0
-}
-
 /// A clock that measures either the thread's CPU time or wall-clock time.
 struct Clock {
     wall: bool,
@@ -127,7 +100,7 @@ impl Clock {
     fn start(wall: bool) -> Self {
         Clock {
             wall,
-            cpu_start: thread_cpu_seconds(),
+            cpu_start: cutroute_bench::thread_cpu_seconds(),
             wall_start: std::time::Instant::now(),
         }
     }
@@ -136,7 +109,7 @@ impl Clock {
         if self.wall {
             self.wall_start.elapsed().as_secs_f64()
         } else {
-            thread_cpu_seconds() - self.cpu_start
+            cutroute_bench::thread_cpu_seconds() - self.cpu_start
         }
     }
 }

@@ -7,7 +7,14 @@ use cutroute_protocol::{JobRequest, Problem, SolverKind, SolverParams};
 
 macro_rules! instance {
     ($name:literal) => {
-        ($name, include_str!(concat!("../../../../../shared/data/pcgtsp/industrial/", $name, ".pcglns")))
+        (
+            $name,
+            include_str!(concat!(
+                "../../../../../shared/data/pcgtsp/industrial/",
+                $name,
+                ".pcglns"
+            )),
+        )
     };
 }
 
@@ -27,9 +34,14 @@ pub fn run(log: &dyn Fn(String)) {
     for (name, text) in EXACT_SUBSET {
         let request = JobRequest {
             job_id: 1,
-            problem: Problem::PcgtspText { text: text.to_string() },
+            problem: Problem::PcgtspText {
+                text: text.to_string(),
+            },
             solver: SolverKind::Exact,
-            params: SolverParams { time_limit_s: 120.0, ..SolverParams::default() },
+            params: SolverParams {
+                time_limit_s: 120.0,
+                ..SolverParams::default()
+            },
         };
         let mut job = start_job(&request).expect("starts");
         let result = run_to_end(job.as_mut(), &mut |_| {});
@@ -51,7 +63,13 @@ pub fn run(log: &dyn Fn(String)) {
             ..cutroute_ccp::CcpOptions::default()
         };
         let result = cutroute_ccp::solve(&nest, options, &mut |_| {}).expect("solves");
-        let seconds = result.progress.local_optimum_time.map_or(f64::NAN, |t| t.as_secs_f64());
-        log(format!("BENCH ccp:{contours} {seconds:.3} {:.1} -", result.metrics.idle_length));
+        let seconds = result
+            .progress
+            .local_optimum_time
+            .map_or(f64::NAN, |t| t.as_secs_f64());
+        log(format!(
+            "BENCH ccp:{contours} {seconds:.3} {:.1} -",
+            result.metrics.idle_length
+        ));
     }
 }
