@@ -57,3 +57,21 @@ export function watchErrors(page) {
   page.on('response', (r) => { if (r.status() >= 400) errors.push(`HTTP ${r.status()} ${r.url()}`); });
   return errors;
 }
+
+/**
+ * Registers before/after hooks that serve the release build and start Chromium for the tests of
+ * one file; returns an object whose `baseUrl` and `browser` are set once the hooks have run.
+ */
+export function useApp(before, after) {
+  const app = { baseUrl: undefined, browser: undefined, server: undefined };
+  before(async () => {
+    ({ server: app.server, baseUrl: app.baseUrl } = await startServer());
+    app.browser = await launchBrowser();
+    fs.mkdirSync(screenshotDir, { recursive: true });
+  });
+  after(async () => {
+    await app.browser?.close();
+    app.server?.close();
+  });
+  return app;
+}

@@ -4,23 +4,14 @@ import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import fs from 'node:fs';
 import path from 'node:path';
-import { startServer, launchBrowser, watchErrors, screenshotDir } from './harness.mjs';
+import { watchErrors, screenshotDir, useApp } from './harness.mjs';
 
-let server, baseUrl, browser;
-before(async () => {
-  ({ server, baseUrl } = await startServer());
-  browser = await launchBrowser();
-  fs.mkdirSync(screenshotDir, { recursive: true });
-});
-after(async () => {
-  await browser?.close();
-  server?.close();
-});
+const app = useApp(before, after);
 
 test('opens the default sample, solves in the worker, draws the route, cancels', async () => {
-  const page = await browser.newPage({ viewport: { width: 1280, height: 800 } });
+  const page = await app.browser.newPage({ viewport: { width: 1280, height: 800 } });
   const errors = watchErrors(page);
-  await page.goto(baseUrl);
+  await page.goto(app.baseUrl);
 
   // The default sample arrives through the worker (parsed off the UI thread).
   await page.waitForFunction(() => document.querySelector('#file-name')?.textContent.includes('E1X_6_01'),

@@ -4,19 +4,10 @@ import assert from 'node:assert/strict';
 import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
-import { startServer, launchBrowser, watchErrors, screenshotDir, projectRoot } from './harness.mjs';
+import { watchErrors, screenshotDir, projectRoot, useApp } from './harness.mjs';
 
 const shared = path.resolve(projectRoot, '..', 'shared', 'data', 'nests');
-let server, baseUrl, browser;
-before(async () => {
-  ({ server, baseUrl } = await startServer());
-  browser = await launchBrowser();
-  fs.mkdirSync(screenshotDir, { recursive: true });
-});
-after(async () => {
-  await browser?.close();
-  server?.close();
-});
+const app = useApp(before, after);
 
 async function fileShown(page, name) {
   await page.waitForFunction((n) => document.querySelector('#file-name')?.textContent.includes(n),
@@ -24,9 +15,9 @@ async function fileShown(page, name) {
 }
 
 test('opens DBS, DXF and T-FLEX files from the picker; a broken file shows a located error', async () => {
-  const page = await browser.newPage({ viewport: { width: 1024, height: 700 } });
+  const page = await app.browser.newPage({ viewport: { width: 1024, height: 700 } });
   const errors = watchErrors(page);
-  await page.goto(baseUrl);
+  await page.goto(app.baseUrl);
   await fileShown(page, 'E1X_6_01');
 
   for (const [file, parts] of [['dbs/nested.dbs', 56], ['dxf/propeller.dxf', 1], ['tflex/Nest02.tfnesting', 406]]) {
@@ -55,8 +46,8 @@ test('opens DBS, DXF and T-FLEX files from the picker; a broken file shows a loc
 });
 
 test('wheel zooms around the cursor, drag pans, 0 fits again', async () => {
-  const page = await browser.newPage({ viewport: { width: 1280, height: 800 } });
-  await page.goto(baseUrl);
+  const page = await app.browser.newPage({ viewport: { width: 1280, height: 800 } });
+  await page.goto(app.baseUrl);
   await fileShown(page, 'E1X_6_01');
   const view = page.locator('#nest-view');
   const box = async () => (await view.getAttribute('viewBox')).split(' ').map(Number);
@@ -84,8 +75,8 @@ test('wheel zooms around the cursor, drag pans, 0 fits again', async () => {
 });
 
 test('the theme switch restyles the page and survives a reload', async () => {
-  const page = await browser.newPage({ viewport: { width: 1024, height: 700 } });
-  await page.goto(baseUrl);
+  const page = await app.browser.newPage({ viewport: { width: 1024, height: 700 } });
+  await page.goto(app.baseUrl);
   await fileShown(page, 'E1X_6_01');
   const background = () => page.evaluate(() => getComputedStyle(document.body).backgroundColor);
   const light = await background();
@@ -101,9 +92,9 @@ test('the theme switch restyles the page and survives a reload', async () => {
 });
 
 test('the exact solver reports both bounds and the chart draws them', async () => {
-  const page = await browser.newPage({ viewport: { width: 1280, height: 800 } });
+  const page = await app.browser.newPage({ viewport: { width: 1280, height: 800 } });
   const errors = watchErrors(page);
-  await page.goto(baseUrl);
+  await page.goto(app.baseUrl);
   await fileShown(page, 'E1X_6_01');
   await page.selectOption('#solver', 'exact');
   await page.fill('#time-limit', '20');
