@@ -1,6 +1,6 @@
 //! The application shell: sample picker, solver controls, live bounds, and the route drawing.
 
-use cutroute_geometry::{Nest, Point};
+use cutroute_geometry::{MachineParameters, Nest, Point};
 use cutroute_protocol::{
     Document, FromWorker, JobId, JobRequest, Problem, Progress, SolverKind, SolverParams, ToWorker,
 };
@@ -10,6 +10,7 @@ use leptos::prelude::*;
 use crate::chart::{BoundSample, BoundsChart};
 use crate::drawing::{contour_path, idle_path, nest_bounds};
 use crate::pan_zoom::PanZoom;
+use crate::stats::StatsPanel;
 use crate::worker_client::{spawn, SolverWorker};
 
 /// Bundled sample nests (files under `assets/samples/`), the first is opened on start.
@@ -100,6 +101,16 @@ pub fn App() -> impl IntoView {
                 }
             }
         }));
+
+    let machine = RwSignal::new(MachineParameters::default());
+    let shown_nest = Signal::derive(move || {
+        document.with(|d| match d.as_ref().map(|d| &d.problem) {
+            Some(Problem::Nest { nest, .. }) => Some(nest.clone()),
+            _ => None,
+        })
+    });
+    let shown_route =
+        Signal::derive(move || progress.with(|p| p.as_ref().and_then(|p| p.route.clone())));
 
     let take_id = move || {
         let id = next_id.get_value();
@@ -284,6 +295,7 @@ pub fn App() -> impl IntoView {
                     <dt>"Elapsed"</dt>
                     <dd id="elapsed">{move || progress.get().map(|p| format!("{:.2} s", p.elapsed_s)).unwrap_or_default()}</dd>
                 </dl>
+                <StatsPanel nest=shown_nest route=shown_route machine=machine />
                 <BoundsChart samples=samples log_time=log_time />
             </aside>
         </main>

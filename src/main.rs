@@ -4,6 +4,7 @@ mod app;
 mod chart;
 mod drawing;
 mod pan_zoom;
+mod stats;
 mod theme;
 mod worker_client;
 

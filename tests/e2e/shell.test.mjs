@@ -30,6 +30,14 @@ test('opens the default sample, solves in the worker, draws the route, cancels',
   assert.equal((idle.match(/L/g) ?? []).length, 16, 'idle path visits every pierce point');
   const upper = Number(await page.locator('#upper-bound').textContent());
   assert.ok(upper > 0, `upper bound shown (${upper})`);
+  // Statistics of the shown route, recomputed from the geometry, follow the machine parameters.
+  assert.equal(await page.locator('#pierces').textContent(), '16');
+  assert.equal(Number((await page.locator('#idle-length').textContent()).replace(' mm', '')), upper);
+  const timeBefore = await page.locator('#machine-time').textContent();
+  await page.click('.machine summary');
+  await page.fill('#cut-speed', '50');
+  await page.dispatchEvent('#cut-speed', 'change');
+  assert.notEqual(await page.locator('#machine-time').textContent(), timeBefore, 'faster cutting, shorter time');
   await page.screenshot({ path: path.join(screenshotDir, 'shell-route.png') });
 
   // Second job: a long one, cancelled while it runs; the answer must come promptly.
