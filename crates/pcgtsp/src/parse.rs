@@ -428,33 +428,15 @@ impl Reader {
         match upper.as_str() {
             "NAME" => self.name = value.to_string(),
             "COMMENT" => {}
-            "TYPE" => {
-                let v = value.to_ascii_uppercase();
-                if !matches!(v.as_str(), "PCGLNS" | "PCGTSP" | "GTSP" | "PCGTSPLIB") {
-                    return Err(ParseError::Unsupported {
-                        line,
-                        key: "TYPE",
-                        value: value.into(),
-                    });
-                }
-            }
-            "EDGE_WEIGHT_TYPE" => {
-                if !value.eq_ignore_ascii_case("EXPLICIT") {
-                    return Err(ParseError::Unsupported {
-                        line,
-                        key: "EDGE_WEIGHT_TYPE",
-                        value: value.into(),
-                    });
-                }
-            }
+            "TYPE" => accept_only(
+                line,
+                "TYPE",
+                value,
+                &["PCGLNS", "PCGTSP", "GTSP", "PCGTSPLIB"],
+            )?,
+            "EDGE_WEIGHT_TYPE" => accept_only(line, "EDGE_WEIGHT_TYPE", value, &["EXPLICIT"])?,
             "EDGE_WEIGHT_FORMAT" => {
-                if !value.eq_ignore_ascii_case("FULL_MATRIX") {
-                    return Err(ParseError::Unsupported {
-                        line,
-                        key: "EDGE_WEIGHT_FORMAT",
-                        value: value.into(),
-                    });
-                }
+                accept_only(line, "EDGE_WEIGHT_FORMAT", value, &["FULL_MATRIX"])?
             }
             "DIMENSION" => {
                 if self.dimension.is_some() {
@@ -993,6 +975,25 @@ impl PcglnsResult {
                 what: "Tour Ordering",
             })?,
             total_time_s,
+        })
+    }
+}
+
+/// A header whose value must be one of `allowed` (case-insensitive): anything else is a variant
+/// of the format this reader does not support.
+fn accept_only(
+    line: usize,
+    key: &'static str,
+    value: &str,
+    allowed: &[&str],
+) -> Result<(), ParseError> {
+    if allowed.iter().any(|a| value.eq_ignore_ascii_case(a)) {
+        Ok(())
+    } else {
+        Err(ParseError::Unsupported {
+            line,
+            key,
+            value: value.into(),
         })
     }
 }
