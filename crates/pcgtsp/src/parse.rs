@@ -445,13 +445,7 @@ impl Reader {
                         what: "DIMENSION",
                     });
                 }
-                let v = value
-                    .parse::<u64>()
-                    .map_err(|_| ParseError::InvalidNumber {
-                        line,
-                        token: value.chars().take(40).collect(),
-                        expected: "node count",
-                    })?;
+                let v = parse_count(line, value, "node count")?;
                 if v == 0 || v > MAX_NODES as u64 {
                     return Err(ParseError::DimensionOutOfRange {
                         line,
@@ -469,13 +463,7 @@ impl Reader {
                     });
                 }
                 let n = self.need_dimension(line)?;
-                let v = value
-                    .parse::<u64>()
-                    .map_err(|_| ParseError::InvalidNumber {
-                        line,
-                        token: value.chars().take(40).collect(),
-                        expected: "cluster count",
-                    })?;
+                let v = parse_count(line, value, "cluster count")?;
                 if v == 0 || v > n as u64 {
                     return Err(ParseError::ClusterCountOutOfRange {
                         line,
@@ -996,4 +984,13 @@ fn accept_only(
             value: value.into(),
         })
     }
+}
+
+/// A header count (`DIMENSION`, `GTSP_SETS`): a non-negative integer, else a located error.
+fn parse_count(line: usize, value: &str, expected: &'static str) -> Result<u64, ParseError> {
+    value.parse::<u64>().map_err(|_| ParseError::InvalidNumber {
+        line,
+        token: value.chars().take(40).collect(),
+        expected,
+    })
 }
