@@ -15,7 +15,8 @@
 //! - [`Nest`] and [`ContainmentForest`]: which contour lies inside which, hence the cutting
 //!   precedence "inner before outer".
 //! - [`Route`]: idle and cut length, time and cost under [`MachineParameters`], and an
-//!   independent validity check.
+//!   independent validity check; [`Toolpath`] and [`ToolClock`]: the head's moves (idle, pierce,
+//!   cut span by span) on the machine's time axis, for animation, G-code and exports.
 //! - [`generate_nest`]: deterministic synthetic nests of up to tens of thousands of contours.
 //!
 //! Sign conventions: [`Contour::signed_area`] is positive for counter-clockwise contours (the
@@ -71,6 +72,7 @@ mod generator;
 mod point;
 mod route;
 mod span;
+mod toolpath;
 mod transform;
 mod types;
 
@@ -82,5 +84,6 @@ pub use forest::ContainmentForest;
 pub use generator::{generate_nest, SplitMix64};
 pub use route::{ContourRef, CutStep, MachineParameters, Route, RouteError};
 pub use span::{tan_half_arg, Span, SpanIntersection, SpanProjection};
+pub use toolpath::{ToolClock, ToolMove, ToolState, Toolpath};
 pub use transform::Transform;
 pub use types::{Contour, Nest, Part, Point, Vertex};
