@@ -514,7 +514,11 @@ impl<'a> Writer<'a> {
                 let c = self.quantize_point(centre)?;
                 let target = self.quantize_point(span.end)?;
                 let (i, j) = (c.0 - self.at.0, c.1 - self.at.1);
-                let words = self.axis_words(target).unwrap_or_default();
+                // Ends that round to one point would read as a full circle: the piece is
+                // below the resolution (at most 350° pieces, so its radius is a few quanta).
+                let Some(words) = self.axis_words(target) else {
+                    return Ok(());
+                };
                 let f = self.feed_word();
                 let centre_words = format!(" I{} J{}", self.number(i), self.number(j));
                 self.line(format!("{code}{words}{centre_words}{f}"));
