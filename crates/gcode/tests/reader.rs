@@ -319,3 +319,53 @@ proptest! {
         let _ = read_gcode(&text, &ReadOptions::default());
     }
 }
+
+/// A continuous toolpath: idle to the first point, pierce, then cut spans of the given bulges
+/// through the given points.
+fn random_path(points: &[(f64, f64)], bulges: &[f64]) -> Toolpath {
+    let start = Point::new(0.0, 0.0);
+    let first = Point::new(points[0].0, points[0].1);
+    let mut moves = vec![
+        ToolMove::Idle {
+            from: start,
+            to: first,
+        },
+        ToolMove::Pierce { at: first, step: 0 },
+    ];
+    for (w, b) in points.windows(2).zip(bulges) {
+        let (a, z) = (Point::new(w[0].0, w[0].1), Point::new(w[1].0, w[1].1));
+        moves.push(ToolMove::Cut {
+            step: 0,
+            span: Span::new(a, z, *b),
+        });
+    }
+    Toolpath { start, moves }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(300))]
+
+    #[test]
+    fn random_paths_round_trip_in_every_mode(
+        points in proptest::collection::vec((-500.0f64..500.0, -500.0f64..500.0), 2..12),
+        bulges in proptest::collection::vec(-3.0f64..3.0, 11),
+        mode in 0usize..4,
+    ) {
+        // Skip spans too short to be meaningful at six decimals.
+        prop_assume!(points.windows(2).all(|w| (w[0].0 - w[1].0).hypot(w[0].1 - w[1].1) > 1e-2));
+        let path = random_path(&points, &bulges);
+        let options = GcodeOptions {
+            decimals: 6,
+            distance_mode: if mode % 2 == 0 { DistanceMode::Absolute } else { DistanceMode::Incremental },
+            arcs: if mode < 2 { ArcOutput::CentreOffsets } else { ArcOutput::Radius },
+            ..GcodeOptions::default()
+        };
+        let text = write_gcode(&path, &options).unwrap();
+        let program = read_gcode(&text, &ReadOptions::default()).unwrap();
+        prop_assert!((program.cut_length() - path.cut_length()).abs() < 1e-3,
+            "cut {} vs {}", program.cut_length(), path.cut_length());
+        prop_assert!((program.idle_length() - path.idle_length()).abs() < 1e-5);
+        prop_assert_eq!(program.pierce_count(), 1);
+        prop_assert!(program.end.distance(path.end()) < 1e-5);
+    }
+}
