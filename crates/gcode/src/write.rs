@@ -49,7 +49,6 @@ pub enum ArcOutput {
 /// | generic, Mach3 plasma, LinuxCNC | `M03` | `M05` |
 /// | LinuxCNC QtPlasmaC | `M03 $0 S1` | `M05 $0` |
 /// | GRBL in laser mode (power follows speed) | `M04 S1000` | `M05` |
-/// | oxy-fuel / some plasma tables | `M07` | `M08` |
 ///
 /// The reader ([`crate::read_gcode`]) recognises the torch by its M number, so a custom
 /// `torch_on` must start with an M word listed in [`crate::ReadOptions::torch_on`].
