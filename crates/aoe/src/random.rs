@@ -10,8 +10,12 @@ use cutroute_geometry::SplitMix64;
 use crate::embedding::{Embedding, EmbeddingError};
 use crate::graph::{Dart, PlaneGraph};
 
+/// How far along a face boundary a chord may reach, in darts.
+const CHORD_REACH: u64 = 12;
+
 /// A connected plane multigraph with `edge_count ≥ 1` edges; about a third of the moves add
-/// a pendant edge (new vertex), the others split a face.
+/// a pendant edge (new vertex), the others split a face by a chord between a random corner and
+/// one up to 11 corners further along the face (the same corner gives a loop). Linear time.
 pub fn random_plane_multigraph(edge_count: usize, rng: &mut SplitMix64) -> PlaneGraph {
     let edge_count = edge_count.max(1);
     // Rotation as a ccw successor array, built move by move.
@@ -36,14 +40,12 @@ pub fn random_plane_multigraph(edge_count: usize, rng: &mut SplitMix64) -> Plane
             vertex_count += 1;
             insert_after(&mut next_ccw, &mut next_cw, corner, new);
         } else {
-            // The face on the left of `corner`; its corners are its darts' origins.
-            let mut boundary = vec![corner];
-            let mut dart = next_cw[corner ^ 1];
-            while dart != corner {
-                boundary.push(dart);
-                dart = next_cw[dart ^ 1];
+            // Another corner of the face on the left of `corner`, a few steps along its
+            // boundary (walking whole faces would make generation quadratic).
+            let mut other = corner;
+            for _ in 0..rng.below(CHORD_REACH) {
+                other = next_cw[other ^ 1];
             }
-            let other = boundary[rng.below(boundary.len() as u64) as usize];
             origin.extend([origin[corner], origin[other]]);
             insert_after(&mut next_ccw, &mut next_cw, corner, new);
             // With `other == corner` the second dart goes after the first: a loop.
