@@ -15,6 +15,8 @@
 //!   digest's corrections (split rule, per-edge orientation, half-edges, stop at |E|, failure
 //!   reported as an error);
 //! - [`check_chain`]: an independent checker of the Euler, A and OE properties;
+//! - [`PlanGraph`]: the plane graph of a nest's contours (common edges merged, curves split at
+//!   touching and crossing points, rotation by tangent angle and curvature);
 //! - [`random`]: seeded random plane 4-regular graphs (medial graphs of random plane multigraphs).
 //!
 //! ```
@@ -37,6 +39,7 @@ mod check;
 pub mod edge_list;
 mod embedding;
 mod graph;
+mod plan;
 pub mod random;
 
 pub use chain::{
@@ -45,3 +48,4 @@ pub use chain::{
 pub use check::{check_chain, check_route, CheckError};
 pub use embedding::{CutPoint, Embedding, EmbeddingError};
 pub use graph::{Dart, DualGraph, Faces, GraphError, PlaneGraph};
+pub use plan::{PlanComponent, PlanError, PlanGraph, PlanOptions};
