@@ -17,6 +17,9 @@
 //! - [`check_chain`]: an independent checker of the Euler, A and OE properties;
 //! - [`PlanGraph`]: the plane graph of a nest's contours (common edges merged, curves split at
 //!   touching and crossing points, rotation by tangent angle and curvature);
+//! - [`oe_route`]: beyond 4-regular graphs (T-junctions, any degree): non-crossing chains
+//!   joined by idle moves, ordered so the whole route is OE, with few pierces;
+//!   [`PlanGraph::route`] runs it on every component of a nest, inner components first;
 //! - [`random`]: seeded random plane 4-regular graphs (medial graphs of random plane multigraphs).
 //!
 //! ```
@@ -41,6 +44,7 @@ mod embedding;
 mod graph;
 mod plan;
 pub mod random;
+mod route;
 
 pub use chain::{
     aoe_chain, split_cut_points, AoeChain, AoeError, AoeOptions, SplitRule, Transitions,
@@ -48,4 +52,5 @@ pub use chain::{
 pub use check::{check_chain, check_route, CheckError};
 pub use embedding::{CutPoint, Embedding, EmbeddingError};
 pub use graph::{Dart, DualGraph, Faces, GraphError, PlaneGraph};
-pub use plan::{PlanComponent, PlanError, PlanGraph, PlanOptions};
+pub use plan::{CutChain, DirectedEdge, PlanComponent, PlanError, PlanGraph, PlanOptions};
+pub use route::{oe_route, pierce_lower_bound, OeRoute};

@@ -72,6 +72,24 @@ pub struct PlanComponent {
     pub edges: Vec<usize>,
 }
 
+/// An edge of a [`PlanGraph`] with the direction it is cut in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct DirectedEdge {
+    /// The plan edge.
+    pub edge: usize,
+    /// `true` when cut from its first end to its second (along [`PlanGraph::edge_spans`]).
+    pub forward: bool,
+}
+
+/// One pierce's worth of cutting: edges in order and the tool path along them.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CutChain {
+    /// The edges in cutting order.
+    pub edges: Vec<DirectedEdge>,
+    /// The path: every edge's spans in the direction of travel, end to end.
+    pub spans: Vec<Span>,
+}
+
 /// A piece of a span between consecutive split points, as a dart pair at the piece level.
 struct Piece {
     span: Span,
@@ -212,6 +230,55 @@ impl PlanGraph {
         let faces = self.graph.faces();
         let outer = least(&self.face_areas(&faces));
         Embedding::new(self.graph.clone(), outer)
+    }
+
+    /// An OE-route over the whole plan: the components ordered by enclosed area (a component
+    /// inside a face of another one encloses less, so inner components come first), each cut
+    /// by [`crate::oe_route`]; chains carry their geometry.
+    pub fn route(&self) -> Result<Vec<CutChain>, EmbeddingError> {
+        let components = self.components()?;
+        let enclosed: Vec<f64> = components
+            .iter()
+            .map(|c| {
+                let faces = c.embedding.faces();
+                let origin = self.points[c.vertices[0]];
+                let mut area = 0.0;
+                for d in 0..c.embedding.graph().dart_count() {
+                    if faces.left(d) == c.embedding.outer_face() {
+                        for span in self.dart_spans(2 * c.edges[d / 2] + d % 2) {
+                            area -= span.area_term(origin);
+                        }
+                    }
+                }
+                area
+            })
+            .collect();
+        let mut order: Vec<usize> = (0..components.len()).collect();
+        order.sort_by(|&a, &b| enclosed[a].total_cmp(&enclosed[b]));
+        let mut chains = Vec::new();
+        for i in order {
+            let component = &components[i];
+            for darts in crate::route::oe_route(&component.embedding).chains {
+                let plan_darts: Vec<Dart> = darts
+                    .iter()
+                    .map(|&d| 2 * component.edges[d / 2] + d % 2)
+                    .collect();
+                chains.push(CutChain {
+                    edges: plan_darts
+                        .iter()
+                        .map(|&d| DirectedEdge {
+                            edge: d / 2,
+                            forward: d % 2 == 0,
+                        })
+                        .collect(),
+                    spans: plan_darts
+                        .iter()
+                        .flat_map(|&d| self.dart_spans(d))
+                        .collect(),
+                });
+            }
+        }
+        Ok(chains)
     }
 
     /// The connected components, each ranked from its own unbounded face, ordered by vertex.

@@ -3,7 +3,8 @@
 //! [`random_plane_multigraph`] grows a connected plane multigraph by two rotation-preserving
 //! moves (a pendant edge at a random corner, or a chord splitting a random face between two of
 //! its corners, possibly a loop); [`medial_graph`] turns any plane graph into a plane 4-regular
-//! one (one vertex per edge, one edge per corner), loops and double edges included.
+//! one (one vertex per edge, one edge per corner), loops and double edges included;
+//! [`delete_random_edges`] removes non-bridges to make T-junctions.
 
 use cutroute_geometry::SplitMix64;
 
@@ -114,4 +115,58 @@ pub fn random_four_regular(
     let face_count = medial.faces().count();
     let outer = rng.below(face_count as u64) as usize;
     Embedding::new(medial, outer)
+}
+
+/// `graph` without up to `count` random edges, never a bridge, so it stays connected. Deleting
+/// edges of a 4-regular graph leaves T-junctions (degree 3), as common-line cutting plans have.
+pub fn delete_random_edges(graph: &PlaneGraph, count: usize, rng: &mut SplitMix64) -> PlaneGraph {
+    let faces = graph.faces();
+    let mut parent: Vec<usize> = (0..faces.count()).collect();
+    fn find(parent: &mut [usize], mut x: usize) -> usize {
+        while parent[x] != x {
+            parent[x] = parent[parent[x]];
+            x = parent[x];
+        }
+        x
+    }
+    let mut deleted = vec![false; graph.edge_count()];
+    let mut order: Vec<usize> = (0..graph.edge_count()).collect();
+    for i in (1..order.len()).rev() {
+        order.swap(i, rng.below(i as u64 + 1) as usize);
+    }
+    let mut removed = 0;
+    for e in order {
+        if removed == count {
+            break;
+        }
+        // An edge is a bridge exactly when the same face lies on both sides.
+        let (a, b) = (
+            find(&mut parent, faces.left(2 * e)),
+            find(&mut parent, faces.left(2 * e + 1)),
+        );
+        if a != b {
+            parent[a] = b;
+            deleted[e] = true;
+            removed += 1;
+        }
+    }
+    let mut new_id = vec![usize::MAX; graph.edge_count()];
+    let mut edges = Vec::new();
+    for e in 0..graph.edge_count() {
+        if !deleted[e] {
+            new_id[e] = edges.len();
+            edges.push(graph.ends(e));
+        }
+    }
+    let rotations: Vec<Vec<Dart>> = (0..graph.vertex_count())
+        .map(|v| {
+            graph
+                .darts_around(v)
+                .filter(|&d| !deleted[d / 2])
+                .map(|d| 2 * new_id[d / 2] + d % 2)
+                .collect()
+        })
+        .collect();
+    PlaneGraph::from_rotations(graph.vertex_count(), &edges, &rotations)
+        .expect("deleting edges keeps a valid rotation system")
 }
