@@ -130,14 +130,14 @@ pub fn check_route(embedding: &Embedding, chains: &[Vec<Dart>]) -> Result<(), Ch
             passes[graph.origin(from)].push((from, pair[1]));
         }
     }
-    for (vertex, vertex_passes) in passes.iter().enumerate() {
-        if vertex_passes.len() < 2 {
-            continue;
-        }
-        let mut position = vec![usize::MAX; graph.dart_count()];
+    // Position of every dart around its own vertex.
+    let mut position = vec![usize::MAX; graph.dart_count()];
+    for vertex in 0..graph.vertex_count() {
         for (i, dart) in graph.darts_around(vertex).enumerate() {
             position[dart] = i;
         }
+    }
+    for (vertex, vertex_passes) in passes.iter().enumerate() {
         for (i, &a) in vertex_passes.iter().enumerate() {
             for &b in &vertex_passes[i + 1..] {
                 if interleave(
