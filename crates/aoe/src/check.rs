@@ -78,6 +78,20 @@ pub enum CheckError {
         /// Darts of the other pass.
         second: (Dart, Dart),
     },
+    /// A chain of a plan route has no edges or names an edge that does not exist.
+    #[error("chain {chain} of the plan route is empty or names a missing edge")]
+    BadPlanChain {
+        /// Index of the chain.
+        chain: usize,
+    },
+    /// After a chain, a part of the plan not yet cut lies in a region already cut free.
+    #[error("after chain {chain} the plan vertex {vertex}, not cut yet, lies in a region already cut free")]
+    EnclosesComponent {
+        /// Index of the chain.
+        chain: usize,
+        /// A plan vertex of the enclosed component.
+        vertex: usize,
+    },
     /// A prefix encloses an edge that is not cut yet (ordered enclosing fails).
     #[error("after {prefix} edges the cut encloses edge {edge}, which is still uncut")]
     Encloses {
@@ -166,7 +180,7 @@ fn interleave(a: (usize, usize), b: (usize, usize)) -> bool {
 }
 
 /// Darts exist, chains are trails, every edge is cut exactly once.
-fn check_cover(graph: &PlaneGraph, chains: &[&[Dart]]) -> Result<(), CheckError> {
+pub(crate) fn check_cover(graph: &PlaneGraph, chains: &[&[Dart]]) -> Result<(), CheckError> {
     let mut cut_at = vec![usize::MAX; graph.edge_count()];
     let mut position = 0;
     for (index, chain) in chains.iter().enumerate() {

@@ -10,9 +10,10 @@
 
 use std::collections::HashMap;
 
-use cutroute_geometry::{ContourRef, Nest, Point, Span};
+use cutroute_geometry::{Contour, ContourRef, Nest, Point, Span, Vertex};
 use thiserror::Error;
 
+use crate::check::CheckError;
 use crate::embedding::{Embedding, EmbeddingError};
 use crate::graph::{Dart, Faces, PlaneGraph};
 
@@ -279,6 +280,145 @@ impl PlanGraph {
             }
         }
         Ok(chains)
+    }
+
+    /// Checks a route over the whole plan (for example [`PlanGraph::route`]): every edge cut
+    /// once; within each component no crossing pass and no prefix enclosing an uncut edge
+    /// ([`crate::check_route`]); and across components, after every chain, no component with
+    /// uncut edges lies in a region already cut free. The face of another component holding a
+    /// component is found geometrically (winding numbers of face boundaries), then the region
+    /// test is the dual one: that face is cut free once uncut edges no longer join it to the
+    /// component's outer face.
+    pub fn check_route(&self, chains: &[CutChain]) -> Result<(), CheckError> {
+        let graph = &self.graph;
+        let mut plan_chains: Vec<Vec<Dart>> = Vec::with_capacity(chains.len());
+        for (index, chain) in chains.iter().enumerate() {
+            if chain.edges.is_empty() || chain.edges.iter().any(|d| d.edge >= graph.edge_count()) {
+                return Err(CheckError::BadPlanChain { chain: index });
+            }
+            plan_chains.push(
+                chain
+                    .edges
+                    .iter()
+                    .map(|d| 2 * d.edge + usize::from(!d.forward))
+                    .collect(),
+            );
+        }
+        let slices: Vec<&[Dart]> = plan_chains.iter().map(Vec::as_slice).collect();
+        crate::check::check_cover(graph, &slices)?;
+        let components = self
+            .components()
+            .map_err(|_| CheckError::BadPlanChain { chain: 0 })?;
+        let mut component_of_edge = vec![(0, 0); graph.edge_count()];
+        for (c, component) in components.iter().enumerate() {
+            for (local, &edge) in component.edges.iter().enumerate() {
+                component_of_edge[edge] = (c, local);
+            }
+        }
+        // Within components.
+        for (c, component) in components.iter().enumerate() {
+            let local: Vec<Vec<Dart>> = plan_chains
+                .iter()
+                .filter(|chain| component_of_edge[chain[0] / 2].0 == c)
+                .map(|chain| {
+                    chain
+                        .iter()
+                        .map(|&d| 2 * component_of_edge[d / 2].1 + d % 2)
+                        .collect()
+                })
+                .collect();
+            crate::check::check_route(&component.embedding, &local)?;
+        }
+        // Which face of component a holds component b (None: b lies in a's outer face).
+        let holder: Vec<Vec<Option<usize>>> = components
+            .iter()
+            .map(|a| {
+                components
+                    .iter()
+                    .map(|b| self.face_holding(a, self.points[b.vertices[0]]))
+                    .collect()
+            })
+            .collect();
+        let mut cut = vec![false; graph.edge_count()];
+        let mut last_chain = vec![usize::MAX; components.len()];
+        for (index, chain) in plan_chains.iter().enumerate() {
+            for &d in chain {
+                cut[d / 2] = true;
+            }
+            last_chain[component_of_edge[chain[0] / 2].0] = index;
+            for (a, component) in components.iter().enumerate() {
+                let faces = component.embedding.faces();
+                let mut parent: Vec<usize> = (0..faces.count()).collect();
+                fn find(parent: &mut [usize], mut x: usize) -> usize {
+                    while parent[x] != x {
+                        x = parent[x];
+                    }
+                    x
+                }
+                for (local, &edge) in component.edges.iter().enumerate() {
+                    if !cut[edge] {
+                        let (x, y) = (
+                            find(&mut parent, faces.left(2 * local)),
+                            find(&mut parent, faces.right(2 * local)),
+                        );
+                        parent[x] = y;
+                    }
+                }
+                let outer = find(&mut parent, component.embedding.outer_face());
+                for (b, other) in components.iter().enumerate() {
+                    let uncut = other.edges.iter().any(|&e| !cut[e]);
+                    if let (true, Some(face)) = (uncut && a != b, holder[a][b]) {
+                        if find(&mut parent, face) != outer {
+                            return Err(CheckError::EnclosesComponent {
+                                chain: index,
+                                vertex: other.vertices[0],
+                            });
+                        }
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The bounded face of `component` whose region contains `point` (the smallest such), or
+    /// `None` when the point lies in its outer face. `point` must not lie on the component.
+    fn face_holding(&self, component: &PlanComponent, point: Point) -> Option<usize> {
+        let embedding = &component.embedding;
+        let faces = embedding.faces();
+        let graph = embedding.graph();
+        let mut boundary: Vec<Vec<Vertex>> = vec![Vec::new(); faces.count()];
+        let mut seen = vec![false; graph.dart_count()];
+        for start in 0..graph.dart_count() {
+            if seen[start] {
+                continue;
+            }
+            let mut dart = start;
+            while !seen[dart] {
+                seen[dart] = true;
+                for span in self.dart_spans(2 * component.edges[dart / 2] + dart % 2) {
+                    boundary[faces.left(dart)].push(Vertex {
+                        point: span.start,
+                        bulge: span.bulge,
+                    });
+                }
+                dart = graph.next_in_face(dart);
+            }
+        }
+        let mut best: Option<(usize, f64)> = None;
+        for (f, vertices) in boundary.into_iter().enumerate() {
+            if f == embedding.outer_face() {
+                continue;
+            }
+            let contour = Contour::new(vertices);
+            if contour.winding_number(point) != 0 {
+                let area = contour.area();
+                if best.is_none_or(|(_, smallest)| area < smallest) {
+                    best = Some((f, area));
+                }
+            }
+        }
+        best.map(|(f, _)| f)
     }
 
     /// The connected components, each ranked from its own unbounded face, ordered by vertex.

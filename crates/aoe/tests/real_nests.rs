@@ -59,6 +59,9 @@ fn real_nests_give_plane_graphs_that_account_for_every_contour() {
             (covered - perimeters).abs() <= slack,
             "{name}: {covered} vs {perimeters}"
         );
+        let chains = plan.route().unwrap_or_else(|e| panic!("{name}: {e}"));
+        plan.check_route(&chains)
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
         total_common += (0..g.edge_count())
             .filter(|&e| plan.edge_contours(e).len() > 1)
             .count();

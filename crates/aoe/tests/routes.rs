@@ -3,7 +3,9 @@
 use cutroute_aoe::random::{
     delete_random_edges, medial_graph, random_four_regular, random_plane_multigraph,
 };
-use cutroute_aoe::{check_route, oe_route, pierce_lower_bound, Embedding, PlanGraph, PlanOptions};
+use cutroute_aoe::{
+    check_route, oe_route, pierce_lower_bound, CheckError, Embedding, PlanGraph, PlanOptions,
+};
 use cutroute_geometry::{Contour, Nest, Part, Point, SplitMix64, Vertex};
 
 fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> Part {
@@ -118,6 +120,18 @@ fn part_in_a_hole_in_a_part_is_cut_inside_out() {
         .edge_contours(d.edge)
         .iter()
         .any(|r| r.part == 0 && r.contour == 0)));
+    plan.check_route(&chains).unwrap();
+    // The ring's outline first cuts the other parts free before they are cut.
+    let mut wrong = chains.clone();
+    wrong.reverse();
+    assert!(
+        matches!(
+            plan.check_route(&wrong),
+            Err(CheckError::EnclosesComponent { .. })
+        ),
+        "{:?}",
+        plan.check_route(&wrong)
+    );
     for component in plan.components().unwrap() {
         let route = oe_route(&component.embedding);
         check_route(&component.embedding, &route.chains).unwrap();
