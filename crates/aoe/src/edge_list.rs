@@ -100,6 +100,20 @@ pub enum ReadError {
         /// Field name.
         field: &'static str,
     },
+    /// A vertex number exceeds twice the number of edges, so some vertex would have no edge.
+    #[error(
+        "line {line}, field {field}: vertex {vertex} cannot exist with at most {limit} edge ends"
+    )]
+    VertexOutOfRange {
+        /// Line number.
+        line: usize,
+        /// Field name.
+        field: &'static str,
+        /// The vertex written.
+        vertex: usize,
+        /// Twice the number of edges.
+        limit: usize,
+    },
     /// Vertex numbers skip a vertex, which then has no edges.
     #[error(
         "vertex {vertex} has no edges (vertices must be numbered 1..={vertex_count} without gaps)"
@@ -277,6 +291,17 @@ fn build(edges: &[EdgeLine]) -> Result<Embedding, ReadError> {
                 return Err(ReadError::VertexZero {
                     line: edge.line,
                     field,
+                });
+            }
+            // Without isolated vertices there are at most two per edge; larger numbers would
+            // also make the reader allocate for vertices that cannot exist.
+            if vertex > 2 * edges.len() {
+                let (line, limit) = (edge.line, 2 * edges.len());
+                return Err(ReadError::VertexOutOfRange {
+                    line,
+                    field,
+                    vertex,
+                    limit,
                 });
             }
             vertex_count = vertex_count.max(vertex);

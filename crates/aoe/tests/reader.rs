@@ -155,10 +155,19 @@ fn errors_are_located() {
         })
     );
     assert_eq!(
-        edge_list::read("1\n1 3 1 1 1 1 0 0 1\n"),
+        edge_list::read("2\n1 3 2 2 2 2 1 0 1\n1 3 1 1 1 1 0 1 1\n"),
         Err(ReadError::IsolatedVertex {
             vertex: 2,
             vertex_count: 3
+        })
+    );
+    assert_eq!(
+        edge_list::read("1\n1 99999999999 1 1 1 1 0 0 1\n"),
+        Err(ReadError::VertexOutOfRange {
+            line: 2,
+            field: "v2",
+            vertex: 99999999999,
+            limit: 2
         })
     );
     // Faces renumbered without a 0.
