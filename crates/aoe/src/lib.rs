@@ -14,7 +14,8 @@
 //! - [`aoe_chain`]: cut-point splitting and the greedy construction, linear time, with the
 //!   digest's corrections (split rule, per-edge orientation, half-edges, stop at |E|, failure
 //!   reported as an error);
-//! - [`check_chain`]: an independent checker of the Euler, A and OE properties;
+//! - [`check_chain`], [`check_route`], [`PlanGraph::check_route`]: independent checkers of the
+//!   Euler, A / non-crossing and OE properties (for a whole plan, across components too);
 //! - [`PlanGraph`]: the plane graph of a nest's contours (common edges merged, curves split at
 //!   touching and crossing points, rotation by tangent angle and curvature);
 //! - [`oe_route`]: beyond 4-regular graphs (T-junctions, any degree): non-crossing chains

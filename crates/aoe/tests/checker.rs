@@ -155,3 +155,22 @@ fn antiprism_table_row_with_the_duplicate_seven_is_rejected() {
     }
     assert!(check_chain(&e, &darts).is_err());
 }
+
+#[test]
+fn nested_lenses_and_figure_eight_get_aoe_chains() {
+    let e = lenses();
+    // Two ranks, both vertices on the outer face, both cut points of no rank (ranks 1,2,2,1).
+    assert!(e.cut_points().is_empty());
+    for start in 0..2 {
+        let chain = aoe_chain(&e, start, &AoeOptions::default()).unwrap();
+        check_chain(&e, &chain.darts).unwrap();
+        // The inner lens (edges 1, 2) is cut before the outline closes.
+        assert!([1, 2].contains(&(chain.darts[0] / 2)));
+    }
+    let figure_eight =
+        PlaneGraph::from_rotations(1, &[(0, 0), (0, 0)], &[vec![0, 1, 2, 3]]).unwrap();
+    let e = Embedding::with_outer_dart(figure_eight, 1).unwrap();
+    let chain = aoe_chain(&e, 0, &AoeOptions::default()).unwrap();
+    check_chain(&e, &chain.darts).unwrap();
+    assert_eq!(chain.split_vertices, vec![0]);
+}
