@@ -23,6 +23,9 @@
 //!    region; then a curve is split at an edge beside it. OE holds by construction; the
 //!    independent [`crate::check_route`] confirms it in the tests.
 //!
+//! Four pairing variants (block boundaries shifted by one dart at even vertices, the chain end
+//! moved one dart at odd ones) are built and the route with the fewest pierces is kept.
+//!
 //! For a 4-regular graph the single AOE-chain of [`crate::aoe_chain`] is used when it exists.
 
 use crate::chain::{aoe_chain, AoeOptions};
@@ -65,10 +68,21 @@ pub fn oe_route(embedding: &Embedding) -> OeRoute {
             }
         }
     }
-    let partner = merged_transitions(embedding);
-    let curves = trace_curves(graph, &partner);
-    order_enclosing(embedding, curves)
+    // A few pairing variants (which block boundary at even vertices, which end at odd ones);
+    // each gives a valid route, the one with the fewest pierces wins.
+    let mut best: Option<OeRoute> = None;
+    for variant in 0..VARIANTS {
+        let partner = merged_transitions(embedding, variant);
+        let route = order_enclosing(embedding, trace_curves(graph, &partner));
+        if best.as_ref().is_none_or(|b| route.pierces() < b.pierces()) {
+            best = Some(route);
+        }
+    }
+    best.expect("at least one variant")
 }
+
+/// Number of pairing variants [`oe_route`] tries.
+const VARIANTS: usize = 4;
 
 /// Union-find over curve ids with an "open" flag per root.
 struct Curves {
@@ -96,7 +110,7 @@ impl Curves {
 
 /// Steps 1 and 2: the non-crossing pairing, then merging of curves. `partner[x]` is the dart
 /// the walk leaves by after arriving along `twin(x)`, or `None` at a chain end.
-fn merged_transitions(embedding: &Embedding) -> Vec<Option<Dart>> {
+fn merged_transitions(embedding: &Embedding, variant: usize) -> Vec<Option<Dart>> {
     let graph = embedding.graph();
     let mut partner: Vec<Option<Dart>> = vec![None; graph.dart_count()];
     // At an odd vertex the chain end is the edge of least rank (nearest the outside): ends
@@ -105,10 +119,14 @@ fn merged_transitions(embedding: &Embedding) -> Vec<Option<Dart>> {
         .map(|v| {
             let mut darts: Vec<Dart> = graph.darts_around(v).collect();
             if darts.len() % 2 == 1 {
+                // Variants 0, 1: the least-rank edge ends chains; 2, 3: the next one ccw.
                 let end = (0..darts.len())
                     .min_by_key(|&i| (embedding.dart_rank(darts[i]), i))
                     .expect("odd degree ≥ 1");
-                darts.rotate_left(end + 1);
+                let shift = (end + 1 + variant / 2) % darts.len();
+                darts.rotate_left(shift);
+            } else if variant % 2 == 1 && !darts.is_empty() {
+                darts.rotate_left(1);
             }
             darts
         })

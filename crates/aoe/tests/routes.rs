@@ -157,7 +157,7 @@ fn random_plane_multigraphs_of_any_degree() {
         extra += route.pierces() - bound;
     }
     // High degrees (up to ~20 here) make non-neighbour transitions and forced splits common:
-    // measured 235/2000 at the bound, 9,635 extra pierces (BENCHMARKS.md, AOE section).
+    // measured 351/2000 at the bound, 6,786 extra pierces (BENCHMARKS.md, AOE section).
     println!("{at_bound}/{total} routes at the pierce lower bound, {extra} extra pierces in all");
     assert!(at_bound > 0);
 }
@@ -194,7 +194,7 @@ fn t_junction_graphs() {
         }
         extra += route.pierces() - bound;
     }
-    // Measured 1,209/2,000 at the bound and 809 extra pierces; a regression would show here.
+    // Measured 1,252/2,000 at the bound and 748 extra pierces; a regression would show here.
     println!("T-junction graphs: {at_bound}/{total} routes at the pierce lower bound, {extra} extra pierces in all");
     assert!(
         at_bound * 2 > total && extra < total / 2,
