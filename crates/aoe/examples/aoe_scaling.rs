@@ -105,18 +105,15 @@ fn main() {
         }
         let per_edge = |s: f64| s * 1e9 / (graphs * edges) as f64;
         println!(
-            "| {edges} | {graphs} | {:.0} | {:.0} | {:.0} | {:.0} | {:.1} | {} |",
+            "| {edges} | {graphs} | {:.0} | {:.0} | {:.0} | {:.0} | {:.1} | {:.0} / {:.0} / {:.0} |",
             cut_points as f64 / graphs as f64,
             per_edge(rank_s),
             per_edge(chain_s),
             per_edge(check_s),
             (rank_s + chain_s + check_s) * 1e3 / graphs as f64,
-            format!(
-                "{:.0} / {:.0} / {:.0}",
-                per_edge(local[0]),
-                per_edge(local[1]),
-                per_edge(local[2])
-            )
+            per_edge(local[0]),
+            per_edge(local[1]),
+            per_edge(local[2])
         );
     }
 
