@@ -57,11 +57,13 @@
 //! double bridge), descends again and keeps the result only if shorter, and restarts from a
 //! randomised nearest-neighbour order after `max_non_improving_shakes` failures.
 //!
-//! # Geometry to merge into `cutroute-geometry`
-//! The solver carries private geometry (module `geom`): bulge arcs with centre/radius/sweep,
-//! span length, point at parameter, nearest point, segment–span intersection, exact span bounding
-//! boxes, contour signed area/perimeter, point-in-contour, convexity, the containment forest
-//! with precedence pairs, and a uniform box grid with k-nearest queries.
+//! # Geometry
+//! Arc data (centre, radius, sweep), exact span boxes, contour area and perimeter,
+//! point-in-contour and the containment forest all come from `cutroute-geometry`. The solver
+//! only caches each arc's centre, radius and start angle (module `geom`) so that its inner
+//! loops evaluate points, nearest points and chord crossings without trigonometry; those
+//! evaluators are tested against the geometry crate's. The uniform box grid with k-nearest
+//! queries (module `problem`) is the solver's own.
 #![deny(missing_docs)]
 
 mod discrete;
