@@ -416,3 +416,31 @@ fn slice_length_does_not_change_the_route() {
         assert_eq!(sliced.progress.shakes, whole.progress.shakes);
     }
 }
+
+#[test]
+fn outer_contours_touched_but_not_crossed_are_restored_in_place() {
+    // Nest03: a square part pokes 5·10⁻⁵ mm out of the round hole it sits in, so the route can
+    // reach the square's corner without crossing the hole. The hole must still be restored on
+    // the route (at its contact), not appended at the end: that cost ~2,800 mm here. Its half
+    // circles also once failed the shared checker (pierce points just past an arc's start).
+    let nest = read_tflex("tflex/Nest03.tfnesting");
+    let options = CcpOptions {
+        start: Point::new(0.0, 0.0),
+        time_limit: Duration::from_secs(60),
+        max_non_improving_shakes: 10,
+        restarts: 0,
+        ..CcpOptions::default()
+    };
+    let r = solve(&nest, options, &mut |_| {}).unwrap();
+    assert_valid(&nest, &r.route);
+    let local_optimum = r
+        .progress
+        .local_optimum_length
+        .expect("reached a local optimum");
+    // Restoring adds at most 2 µm per touched contour.
+    assert!(
+        r.metrics.idle_length <= local_optimum + 0.01,
+        "{} > local optimum {local_optimum}",
+        r.metrics.idle_length
+    );
+}

@@ -4,15 +4,17 @@
 //! 1. real nests, open routes from the sheet origin: CCP-Relax against the crates.io peer
 //!    `u-nesting-cutting` (arcs flattened at 8 segments per radian, `pierce_candidates = 1`),
 //!    both measured by the same metric (Euclidean idle length of the route they return);
-//! 2. real nests, CCP against the discrete model (PCGTSP at ε = 25 mm and 50 mm solved by
-//!    cutroute's ALNS), same start point and metric;
+//!    with a lower bound on every open route from the origin (the distance to the farthest
+//!    contour: the air path must reach each contour's pierce point);
+//! 2. real nests, CCP against the discrete model (PCGTSP at ε = 25, 50 and 100 mm solved by
+//!    cutroute's ALNS, 10 s each, dense cost matrix), same start point and metric;
 //! 3. `E1X_6_01` closed at (0, 0) against the proven discrete optimum 1513;
 //! 4. synthetic nests of 100 … 20,000 contours: time to the first VNS local optimum, idle
 //!    length, and the peer.
 //!
 //! Arguments: `--quick` skips the 20,000-contour nest; `--real-only` skips the synthetic nests; `--vns-seconds S` sets CCP's budget
 //! after the local optimum (default 5); `--synthetic N` runs CCP on one synthetic nest only, `--peer-synthetic N` runs only the peer on one synthetic nest, `--nest PATH` CCP on one real nest (path under
-//! `shared/data/nests`).
+//! `shared/data/nests`), `--discrete-nest PATH` the discrete model alone on one real nest.
 
 use std::time::{Duration, Instant};
 
@@ -108,7 +110,18 @@ fn peer(nest: &Nest) -> Option<(f64, f64, Duration)> {
     Some((idle, out.total_rapid_distance, elapsed))
 }
 
-/// Best discrete route at step ε found by cutroute's ALNS in `budget`.
+/// A lower bound on the idle length of every open route from `start`: the air path reaches a
+/// pierce point on every contour, so it is at least as long as the distance to the farthest.
+fn farthest_contour(nest: &Nest, start: Point) -> f64 {
+    nest.parts
+        .iter()
+        .flat_map(|p| &p.contours)
+        .filter(|c| !c.vertices.is_empty())
+        .map(|c| c.distance_to(start))
+        .fold(0.0, f64::max)
+}
+
+/// Best discrete route at step ε found by cutroute's ALNS in `budget`: (idle length, nodes).
 fn discrete(
     nest: &Nest,
     finish: Option<Point>,
@@ -146,6 +159,22 @@ fn main() {
         .position(|a| a == "--synthetic")
         .and_then(|i| args.get(i + 1))
         .and_then(|s| s.parse().ok());
+    if let Some(path) = args
+        .iter()
+        .position(|a| a == "--discrete-nest")
+        .and_then(|i| args.get(i + 1))
+    {
+        let nest = read(path);
+        for step in [100.0, 50.0, 25.0] {
+            let t = Instant::now();
+            let d = discrete(&nest, None, step, Duration::from_secs(10));
+            println!(
+                "{path} ε = {step}: {d:?} in {:.1} s",
+                t.elapsed().as_secs_f64()
+            );
+        }
+        return;
+    }
     if let Some(path) = args
         .iter()
         .position(|a| a == "--nest")
@@ -215,8 +244,8 @@ fn main() {
     ];
 
     println!("## CCP-Relax vs u-nesting-cutting (open routes from the sheet origin, idle mm)\n");
-    println!("| nest | contours | kept | CCP idle | CCP time s | local opt. s | certified | peer idle | peer time s | CCP / peer |");
-    println!("|---|---|---|---|---|---|---|---|---|---|");
+    println!("| nest | contours | kept | CCP idle | CCP time s | local opt. s | certified | peer idle | peer time s | CCP / peer | lower bound |");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|");
     let mut open_results = Vec::new();
     for (name, path) in real {
         let nest = read(path);
@@ -224,7 +253,7 @@ fn main() {
         let p = peer(&nest);
         let (pl, pt) = p.map_or((f64::NAN, f64::NAN), |(l, _, t)| (l, t.as_secs_f64()));
         println!(
-            "| {name} | {} | {} | {:.1} | {:.2} | {:.3} | {}/{} | {:.1} | {:.2} | {:.3} |",
+            "| {name} | {} | {} | {:.1} | {:.2} | {:.3} | {}/{} | {:.1} | {:.2} | {:.3} | {:.1} |",
             r.route.steps.len(),
             r.progress.kept_contours,
             r.metrics.idle_length,
@@ -238,27 +267,37 @@ fn main() {
             pl,
             pt,
             r.metrics.idle_length / pl,
+            farthest_contour(&nest, Point::new(0.0, 0.0)),
         );
         open_results.push((name, nest, r.metrics.idle_length));
     }
 
     println!("\n## CCP-Relax vs the discrete model (PCGTSP solved by cutroute-alns, 10 s each; open routes, idle mm)\n");
-    println!("| nest | CCP | ε = 25 mm (nodes) | ε = 50 mm (nodes) | CCP / d25 | CCP / d50 |");
-    println!("|---|---|---|---|---|---|");
+    println!("| nest | CCP | ε = 25 mm (nodes, s) | ε = 50 mm (nodes, s) | ε = 100 mm (nodes, s) | CCP / d25 | CCP / d50 | CCP / d100 |");
+    println!("|---|---|---|---|---|---|---|---|");
     for (name, nest, len) in &open_results {
-        let d25 = discrete(nest, None, 25.0, Duration::from_secs(10));
-        let d50 = discrete(nest, None, 50.0, Duration::from_secs(10));
-        let f =
-            |d: Option<(f64, usize)>| d.map_or("n/a".to_string(), |(l, n)| format!("{l:.1} ({n})"));
-        let ratio = |d: Option<(f64, usize)>| {
-            d.map_or("n/a".to_string(), |(l, _)| format!("{:.4}", len / l))
+        let run = |step: f64| {
+            let t = Instant::now();
+            discrete(nest, None, step, Duration::from_secs(10))
+                .map(|(l, n)| (l, n, t.elapsed().as_secs_f64()))
+        };
+        let (d25, d50, d100) = (run(25.0), run(50.0), run(100.0));
+        let f = |d: Option<(f64, usize, f64)>| {
+            d.map_or("n/a".to_string(), |(l, n, t)| {
+                format!("{l:.1} ({n}, {t:.1})")
+            })
+        };
+        let ratio = |d: Option<(f64, usize, f64)>| {
+            d.map_or("n/a".to_string(), |(l, _, _)| format!("{:.4}", len / l))
         };
         println!(
-            "| {name} | {len:.1} | {} | {} | {} | {} |",
+            "| {name} | {len:.1} | {} | {} | {} | {} | {} | {} |",
             f(d25),
             f(d50),
+            f(d100),
             ratio(d25),
-            ratio(d50)
+            ratio(d50),
+            ratio(d100)
         );
     }
 
