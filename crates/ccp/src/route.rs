@@ -51,7 +51,8 @@ fn last_touch(span: &Span, a: V, b: V) -> Option<(f64, V)> {
 
 /// Builds the full route from the search state: kept contours in order, the exit chain of an
 /// open route, and every removed contour inserted at the last crossing of the air path with it
-/// (ties on one air move ordered by position along the move).
+/// (ties on one air move ordered by position along the move), or at its last contact within
+/// [`TOUCH`] when no move crosses it.
 pub(crate) fn assemble_route(s: &Search, order: &[u32], pts: &[V]) -> Route {
     let prob = &s.prob;
     // The air path: start, kept pierce points, exit chain (open routes), finish.
