@@ -91,7 +91,8 @@ fn candidates(shape: &Shape, step: f64, vertices: bool) -> Vec<V> {
 
 /// Builds the PCGTSP instance of a nest: clusters are the contours plus the depot, costs are
 /// Euclidean idle distances, precedence is "inner before outer" for every containment pair.
-/// The cost matrix is dense: meant for nests of up to a few thousand candidate points.
+/// The cost matrix is dense (n² f64): Nest02/Nest03 at ε = 25 mm give 12,288 nodes, 1.2 GB;
+/// above 20,000 nodes (3.2 GB) the build is refused.
 pub fn build_pcgtsp(
     nest: &Nest,
     options: &DiscretisationOptions,

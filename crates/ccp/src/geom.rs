@@ -1,10 +1,14 @@
-//! Private plane geometry of the solver: vectors, spans (segments and bulge arcs), contour shapes
-//! with bounding boxes, nearest points, segment intersections and point-in-contour tests.
+//! The solver's prepared geometry: contours as [`Shape`]s whose arcs carry their centre, radius,
+//! start angle and sweep, so that the relaxation's inner loops (millions of point, nearest-point
+//! and chord-crossing evaluations) need no trigonometry to recover them.
 //!
-//! These belong in `cutroute-geometry` eventually; they live here so the solver does not depend
-//! on a crate that is being extended concurrently (see the crate docs, "Geometry to merge").
+//! Everything that defines the geometry comes from `cutroute-geometry`: the arc data
+//! ([`cutroute_geometry::Span`]'s centre, radius and sweep), exact span bounding boxes, contour
+//! signed area and perimeter; point-in-contour and the containment forest are the geometry
+//! crate's too (see `problem.rs`). The evaluators kept here work on the cached data and are
+//! tested against the geometry crate's own.
 
-use cutroute_geometry::{Contour, Point};
+use cutroute_geometry::{BoundingBox, Contour, Point, Span as GeoSpan};
 
 /// Tolerance for "lies on" decisions, in millimetres.
 pub(crate) const EPS: f64 = 1e-9;
@@ -79,6 +83,15 @@ impl From<V> for Point {
     }
 }
 
+impl From<BoundingBox> for BBox {
+    fn from(b: BoundingBox) -> BBox {
+        BBox {
+            min: b.min.into(),
+            max: b.max.into(),
+        }
+    }
+}
+
 /// An axis-aligned box.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct BBox {
@@ -114,12 +127,6 @@ impl BBox {
         let dx = (self.min.x - o.max.x).max(0.0).max(o.min.x - self.max.x);
         let dy = (self.min.y - o.max.y).max(0.0).max(o.min.y - self.max.y);
         (dx * dx + dy * dy).sqrt()
-    }
-    pub fn contains_box(&self, o: &BBox) -> bool {
-        self.min.x <= o.min.x
-            && self.min.y <= o.min.y
-            && self.max.x >= o.max.x
-            && self.max.y >= o.max.y
     }
     pub fn center(&self) -> V {
         (self.min + self.max) * 0.5
@@ -161,26 +168,41 @@ fn wrap(t: f64) -> f64 {
 
 impl Span {
     /// The span from `a` to `b` with the given bulge (`tan(φ/4)`); tiny bulges become segments.
+    #[cfg(test)]
     pub fn new(a: V, b: V, bulge: f64) -> Span {
-        let chord = b - a;
-        let d = chord.norm();
-        if bulge.abs() < 1e-9 || d < 1e-12 || !bulge.is_finite() {
-            return Span::Seg { a, b };
+        Span::prepare(&GeoSpan::new(a.into(), b.into(), bulge))
+    }
+
+    /// Caches a geometry span's arc data (centre, radius, sweep from `cutroute-geometry`, plus
+    /// the start angle). Bulges below 1e-9 (sagitta below a nanometre per metre of chord) are
+    /// taken as segments: their centres lie too far away to be precise.
+    pub fn prepare(span: &GeoSpan) -> Span {
+        let (a, b) = (V::from(span.start), V::from(span.end));
+        let arc = span.bulge.abs() >= 1e-9 && span.bulge.is_finite() && a.dist(b) >= 1e-12;
+        match span.centre().filter(|_| arc) {
+            None => Span::Seg { a, b },
+            Some(c) => {
+                let center = V::from(c);
+                Span::Arc {
+                    a,
+                    b,
+                    center,
+                    radius: span.radius(),
+                    start: (a.y - center.y).atan2(a.x - center.x),
+                    sweep: span.sweep(),
+                }
+            }
         }
-        let sweep = 4.0 * bulge.atan();
-        // The centre lies on the chord's bisector, (1 − b²)/(4b)·d to the left of the chord.
-        let offset = d * (1.0 - bulge * bulge) / (4.0 * bulge);
-        let center = (a + b) * 0.5 + chord.unit().perp() * offset;
-        let radius = d * (1.0 + bulge * bulge) / (4.0 * bulge.abs());
-        let start = (a.y - center.y).atan2(a.x - center.x);
-        Span::Arc {
-            a,
-            b,
-            center,
-            radius,
-            start,
-            sweep,
-        }
+    }
+
+    /// The same span in `cutroute-geometry`'s form.
+    #[cfg(test)]
+    pub fn to_geometry(self) -> GeoSpan {
+        let bulge = match self {
+            Span::Seg { .. } => 0.0,
+            Span::Arc { sweep, .. } => (sweep / 4.0).tan(),
+        };
+        GeoSpan::new(self.a().into(), self.b().into(), bulge)
     }
     pub fn a(&self) -> V {
         match *self {
@@ -251,28 +273,6 @@ impl Span {
         } else {
             None
         }
-    }
-    /// The bounding box (exact for arcs: endpoints plus the axis extremes the arc passes).
-    pub fn bbox(&self) -> BBox {
-        let mut bb = BBox::empty();
-        bb.add(self.a());
-        bb.add(self.b());
-        if let Span::Arc {
-            center,
-            radius,
-            start,
-            sweep,
-            ..
-        } = *self
-        {
-            for k in 0..4 {
-                let th = k as f64 * std::f64::consts::FRAC_PI_2;
-                if Self::arc_param(start, sweep, th).is_some() {
-                    bb.add(center + V::new(th.cos(), th.sin()) * radius);
-                }
-            }
-        }
-        bb
     }
     /// The nearest point of the span to `p`: `(t, point)`.
     pub fn nearest(&self, p: V) -> (f64, V) {
@@ -380,7 +380,7 @@ impl Span {
     }
 }
 
-/// A contour prepared for the solver: spans, bounding box, perimeter, signed area.
+/// A contour prepared for the solver: cached spans, their exact boxes, perimeter, signed area.
 #[derive(Clone, Debug)]
 pub(crate) struct Shape {
     pub spans: Vec<Span>,
@@ -389,26 +389,18 @@ pub(crate) struct Shape {
     pub perimeter: f64,
     /// Signed area (positive = counter-clockwise).
     pub area: f64,
-    /// A fine polygonal approximation used for point-in-contour tests.
-    pub polygon: Vec<V>,
 }
 
 impl Shape {
     pub fn new(contour: &Contour) -> Shape {
-        let n = contour.vertices.len();
-        let mut spans = Vec::with_capacity(n);
-        for i in 0..n {
-            let v = contour.vertices[i];
-            let w = contour.vertices[(i + 1) % n];
-            let a = V::from(v.point);
-            let b = V::from(w.point);
-            if n == 1 || a.dist(b) < 1e-12 {
-                if n == 1 {
-                    spans.push(Span::Seg { a, b });
-                }
-                continue;
+        let mut spans = Vec::with_capacity(contour.vertices.len());
+        let mut span_boxes = Vec::with_capacity(contour.vertices.len());
+        for span in contour.spans() {
+            // Zero-length spans (repeated vertices) carry no points of their own.
+            if span.chord_length() >= 1e-12 {
+                spans.push(Span::prepare(&span));
+                span_boxes.push(BBox::from(span.bounding_box()));
             }
-            spans.push(Span::new(a, b, v.bulge));
         }
         if spans.is_empty() {
             let a = contour
@@ -417,40 +409,20 @@ impl Shape {
                 .map(|v| V::from(v.point))
                 .unwrap_or_default();
             spans.push(Span::Seg { a, b: a });
+            let mut bb = BBox::empty();
+            bb.add(a);
+            span_boxes.push(bb);
         }
-        let span_boxes: Vec<BBox> = spans.iter().map(Span::bbox).collect();
         let mut bbox = BBox::empty();
         for b in &span_boxes {
             bbox.union(b);
-        }
-        let perimeter = spans.iter().map(Span::length).sum();
-        let mut area = 0.0;
-        let mut polygon = Vec::new();
-        for s in &spans {
-            area += 0.5 * s.a().cross(s.b());
-            match *s {
-                Span::Seg { a, .. } => polygon.push(a),
-                Span::Arc {
-                    a, radius, sweep, ..
-                } => {
-                    // Circular-segment area between chord and arc.
-                    area += 0.5 * radius * radius * (sweep - sweep.sin());
-                    // Sagitta tolerance ≈ 1e-3·r keeps containment tests exact for disjoint contours.
-                    let steps = ((sweep.abs() / 0.05).ceil() as usize).clamp(2, 256);
-                    polygon.push(a);
-                    for k in 1..steps {
-                        polygon.push(s.point_at(k as f64 / steps as f64));
-                    }
-                }
-            }
         }
         Shape {
             spans,
             span_boxes,
             bbox,
-            perimeter,
-            area,
-            polygon,
+            perimeter: contour.perimeter(),
+            area: contour.signed_area(),
         }
     }
 
@@ -468,32 +440,6 @@ impl Shape {
             }
         }
         best.1
-    }
-
-    /// Whether `p` lies inside the region the contour bounds (even-odd on the fine polygon).
-    pub fn contains_point(&self, p: V) -> bool {
-        if p.x < self.bbox.min.x
-            || p.x > self.bbox.max.x
-            || p.y < self.bbox.min.y
-            || p.y > self.bbox.max.y
-        {
-            return false;
-        }
-        let poly = &self.polygon;
-        let n = poly.len();
-        let mut inside = false;
-        let mut j = n - 1;
-        for i in 0..n {
-            let (a, b) = (poly[i], poly[j]);
-            if (a.y > p.y) != (b.y > p.y) {
-                let x = a.x + (p.y - a.y) * (b.x - a.x) / (b.y - a.y);
-                if p.x < x {
-                    inside = !inside;
-                }
-            }
-            j = i;
-        }
-        inside
     }
 
     /// The minimum of `⟨n, X − m⟩` over the whole contour.
@@ -531,4 +477,87 @@ impl Shape {
 pub(crate) fn on_segment(p: V, q: V, m: V, tol: f64) -> bool {
     let (_, x) = Span::Seg { a: p, b: q }.nearest(m);
     x.dist(m) <= tol
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use cutroute_geometry::SplitMix64;
+
+    /// Segments, small and large arcs of both senses, and a nearly straight arc.
+    fn sample_spans() -> Vec<Span> {
+        let mut rng = SplitMix64::new(11);
+        let mut out = Vec::new();
+        for bulge in [0.0, 1e-4, 0.2, -0.2, 0.7, -1.0, 1.0, 2.5, -3.0] {
+            for _ in 0..6 {
+                let a = V::new(rng.range(-50.0, 50.0), rng.range(-50.0, 50.0));
+                let b = V::new(rng.range(-50.0, 50.0), rng.range(-50.0, 50.0));
+                out.push(Span::new(a, b, bulge));
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn cached_evaluators_agree_with_the_geometry_crate() {
+        let mut rng = SplitMix64::new(5);
+        for span in sample_spans() {
+            let g = span.to_geometry();
+            assert!((span.length() - g.length()).abs() < 1e-9 * (1.0 + g.length()));
+            for k in 0..=10 {
+                let t = k as f64 / 10.0;
+                let (p, q) = (span.point_at(t), V::from(g.point_at(t)));
+                assert!(
+                    p.dist(q) < 1e-9,
+                    "point_at({t}) of {span:?}: {p:?} vs {q:?}"
+                );
+            }
+            for _ in 0..20 {
+                let p = V::new(rng.range(-80.0, 80.0), rng.range(-80.0, 80.0));
+                let (_, x) = span.nearest(p);
+                let own = g.nearest_point(p.into());
+                assert!(
+                    (x.dist(p) - own.distance).abs() < 1e-9,
+                    "nearest to {p:?} on {span:?}: {} vs {}",
+                    x.dist(p),
+                    own.distance
+                );
+                let q = V::new(rng.range(-80.0, 80.0), rng.range(-80.0, 80.0));
+                let mut hits = Vec::new();
+                span.intersect_segment(p, q, &mut hits);
+                let theirs = g.intersect_segment(p.into(), q.into());
+                assert_eq!(
+                    hits.len(),
+                    theirs.len(),
+                    "crossings of {p:?}–{q:?} with {span:?}"
+                );
+                for (&(lam, t), h) in hits.iter().zip(&theirs) {
+                    let x = span.point_at(t);
+                    assert!(x.dist(p + (q - p) * lam) < 1e-7);
+                    assert!(
+                        theirs.iter().any(|h2| x.dist(h2.point.into()) < 1e-7),
+                        "{h:?}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn shapes_take_boxes_area_and_perimeter_from_the_geometry_crate() {
+        use cutroute_geometry::Vertex;
+        // A 20 × 10 slot with round ends (two half circles), counter-clockwise.
+        let slot = Contour::new(vec![
+            Vertex::line(0.0, 0.0),
+            Vertex::arc(20.0, 0.0, 1.0),
+            Vertex::line(20.0, 10.0),
+            Vertex::arc(0.0, 10.0, 1.0),
+        ]);
+        let shape = Shape::new(&slot);
+        let circle = std::f64::consts::PI * 25.0;
+        assert!((shape.area - (200.0 + circle)).abs() < 1e-9);
+        assert!((shape.perimeter - (40.0 + 10.0 * std::f64::consts::PI)).abs() < 1e-9);
+        assert!((shape.bbox.min.x + 5.0).abs() < 1e-9 && (shape.bbox.max.x - 25.0).abs() < 1e-9);
+        assert_eq!(shape.spans.len(), 4);
+    }
 }

@@ -65,10 +65,6 @@ impl Grid {
         }
     }
 
-    /// The items of the cell holding `p`.
-    pub fn at(&self, p: V) -> &[u32] {
-        &self.cells[self.iy(p.y) * self.nx + self.ix(p.x)]
-    }
     /// Visits the cells of ring `r` around the cell range of `b` (ring 0 = the range itself);
     /// returns false when the ring lies wholly outside the grid.
     pub fn ring(&self, b: &BBox, r: usize, mut f: impl FnMut(&[u32])) -> bool {
@@ -147,7 +143,7 @@ impl Problem {
         if let Some(f) = finish {
             bounds.add(f);
         }
-        let parent = containment_parents(&shapes, bounds);
+        let parent = containment_parents(nest, &refs);
         let mut has_child = vec![false; shapes.len()];
         for p in parent.iter().flatten() {
             has_child[*p] = true;
@@ -178,36 +174,29 @@ impl Problem {
     }
 }
 
-/// For each contour, the smallest contour whose region contains it.
-fn containment_parents(shapes: &[Shape], bounds: BBox) -> Vec<Option<usize>> {
-    let mut grid = Grid::new(bounds, shapes.len(), 2.0);
-    for (i, s) in shapes.iter().enumerate() {
-        grid.insert(i as u32, &s.bbox);
+/// For each contour of `refs`, the smallest contour whose region contains it: the geometry
+/// crate's containment forest (exact arc-aware point test), in `refs` numbering.
+fn containment_parents(nest: &Nest, refs: &[ContourRef]) -> Vec<Option<usize>> {
+    let forest = nest.containment_forest();
+    // `refs` skips contours without vertices, so the forest's flat numbering can differ.
+    let mut part_offsets = Vec::with_capacity(nest.parts.len());
+    let mut offset = 0;
+    for part in &nest.parts {
+        part_offsets.push(offset);
+        offset += part.contours.len();
     }
-    let mut parent = vec![None; shapes.len()];
-    for (j, sj) in shapes.iter().enumerate() {
-        // Contours are disjoint: one point of C_j decides whether C_j lies inside C_i.
-        let probe = sj.spans[0].a();
-        let mut best: Option<(f64, usize)> = None;
-        for &i in grid.at(probe) {
-            let i = i as usize;
-            if i == j {
-                continue;
-            }
-            let si = &shapes[i];
-            if si.area.abs() <= sj.area.abs() || !si.bbox.contains_box(&sj.bbox) {
-                continue;
-            }
-            if best.is_some_and(|(a, _)| a <= si.area.abs()) {
-                continue;
-            }
-            if si.contains_point(probe) {
-                best = Some((si.area.abs(), i));
-            }
-        }
-        parent[j] = best.map(|b| b.1);
+    let mut index = vec![usize::MAX; offset];
+    for (i, r) in refs.iter().enumerate() {
+        index[part_offsets[r.part] + r.contour] = i;
     }
-    parent
+    refs.iter()
+        .map(|&r| {
+            forest
+                .parent(r)
+                .map(|p| index[part_offsets[p.part] + p.contour])
+                .filter(|&p| p != usize::MAX)
+        })
+        .collect()
 }
 
 /// For each item, up to `k` others nearest by box gap (ties by centre distance).

@@ -9,9 +9,50 @@ use crate::problem::Grid;
 use crate::search::Search;
 use crate::CcpError;
 
+/// How close an air move must come to a contour to count as touching it (mm): a pierce point
+/// placed there lengthens the route by at most twice this. Real nests need more than rounding
+/// slack: in Nest03 a square part pokes 5·10⁻⁵ mm out of the round hole it sits in, so the route
+/// can cut the square from that corner without ever crossing the hole.
+const TOUCH: f64 = 1e-3;
+
+/// The last point (largest position λ along `a b`) where the move `a b` touches `span` within
+/// [`TOUCH`]: `(λ, point on the span)`. Candidates are the span's ends, the span points nearest
+/// the move's ends, and for an arc the circle point nearest the move's line.
+fn last_touch(span: &Span, a: V, b: V) -> Option<(f64, V)> {
+    let w = b - a;
+    let ww = w.dot(w);
+    let mut cands = [
+        span.a(),
+        span.b(),
+        span.nearest(a).1,
+        span.nearest(b).1,
+        span.a(),
+    ];
+    if let Span::Arc { center, radius, .. } = *span {
+        if ww > 0.0 {
+            let n = w.perp() * (1.0 / ww.sqrt());
+            let side = if n.dot(a - center) >= 0.0 { 1.0 } else { -1.0 };
+            cands[4] = span.nearest(center + n * (side * radius)).1;
+        }
+    }
+    let mut best: Option<(f64, V)> = None;
+    for x in cands {
+        let lam = if ww > 0.0 {
+            ((x - a).dot(w) / ww).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        if (a + w * lam).dist(x) <= TOUCH && best.is_none_or(|b| lam > b.0) {
+            best = Some((lam, x));
+        }
+    }
+    best
+}
+
 /// Builds the full route from the search state: kept contours in order, the exit chain of an
 /// open route, and every removed contour inserted at the last crossing of the air path with it
-/// (ties on one air move ordered by position along the move).
+/// (ties on one air move ordered by position along the move), or at its last contact within
+/// [`TOUCH`] when no move crosses it.
 pub(crate) fn assemble_route(s: &Search, order: &[u32], pts: &[V]) -> Route {
     let prob = &s.prob;
     // The air path: start, kept pierce points, exit chain (open routes), finish.
@@ -77,6 +118,21 @@ pub(crate) fn assemble_route(s: &Search, order: &[u32], pts: &[V]) -> Route {
                 for &(lam, ts) in &hits {
                     if best.is_none_or(|b| lam > b.0) {
                         best = Some((lam, span.point_at(ts)));
+                    }
+                }
+            }
+            if best.is_none() {
+                // No proper crossing: the move may run along an edge or touch a vertex or an
+                // arc (grid-like nests move along the contours' own lines). Its last contact
+                // serves as well: after it the route stays outside the contour.
+                for (span, bb) in shape.spans.iter().zip(&shape.span_boxes) {
+                    if bb.dist(a).min(bb.dist(b)) > TOUCH && !bb.overlaps_segment(a, b) {
+                        continue;
+                    }
+                    if let Some((lam, x)) = last_touch(span, a, b) {
+                        if best.is_none_or(|b| lam > b.0) {
+                            best = Some((lam, x));
+                        }
                     }
                 }
             }

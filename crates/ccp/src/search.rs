@@ -25,6 +25,7 @@ const IMPROVE: f64 = 1e-7;
 #[derive(Clone, Debug)]
 pub(crate) struct SearchParams {
     pub delta: f64,
+    pub max_relaxation_sweeps: usize,
     pub neighbours: usize,
     pub cycle_window: usize,
     pub max_block: usize,
@@ -311,7 +312,7 @@ impl Search {
         loop {
             sweeps += 1;
             let gain = self.sweep();
-            if gain <= self.params.delta || sweeps >= 1000 {
+            if gain <= self.params.delta || sweeps >= self.params.max_relaxation_sweeps {
                 return sweeps;
             }
         }
@@ -1031,6 +1032,7 @@ mod tests {
             let prob = Problem::new(&nest, V::default(), finish);
             let params = SearchParams {
                 delta: 1e-9,
+                max_relaxation_sweeps: 1000,
                 neighbours: 6,
                 cycle_window: 4,
                 max_block: 3,
@@ -1073,6 +1075,7 @@ mod tests {
         let prob = Problem::new(&nest, V::default(), None);
         let params = SearchParams {
             delta: 1e-9,
+            max_relaxation_sweeps: 1000,
             neighbours: 6,
             cycle_window: 4,
             max_block: 3,

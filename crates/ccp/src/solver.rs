@@ -25,6 +25,10 @@ pub struct CcpOptions {
     pub finish: Option<Point>,
     /// Relaxation stops when a full sweep shortens the route by at most this (mm).
     pub delta: f64,
+    /// Relaxation also stops after this many sweeps. Coordinate-wise relaxation can creep: two
+    /// neighbouring pierce points sliding together along parallel edges gain a few µm per sweep
+    /// for tens of thousands of sweeps (Nest02 from the origin), so δ alone does not end it.
+    pub max_relaxation_sweeps: usize,
     /// Wall-clock budget of the whole run (summed over `step` calls).
     pub time_limit: Duration,
     /// Seed of the solver's own PRNG (shaking, restarts).
@@ -56,6 +60,7 @@ impl Default for CcpOptions {
             start: Point::new(0.0, 0.0),
             finish: None,
             delta: 1e-6,
+            max_relaxation_sweeps: 1000,
             time_limit: Duration::from_secs(30),
             seed: 1,
             neighbours: 8,
@@ -158,6 +163,7 @@ pub struct CcpSolver {
     strength: usize,
     restarts_left: usize,
     shakes: u64,
+    relaxation_sweeps: usize,
     cancelled: bool,
 }
 
@@ -172,6 +178,11 @@ impl CcpSolver {
         }
         if !(options.delta > 0.0 && options.delta.is_finite()) {
             return Err(CcpError::InvalidOption("delta must be positive".into()));
+        }
+        if options.max_relaxation_sweeps == 0 {
+            return Err(CcpError::InvalidOption(
+                "max_relaxation_sweeps must be at least 1".into(),
+            ));
         }
         if options.neighbours == 0
             || options.max_block == 0
@@ -188,6 +199,7 @@ impl CcpSolver {
         let prob = Problem::new(nest, start, finish);
         let params = SearchParams {
             delta: options.delta,
+            max_relaxation_sweeps: options.max_relaxation_sweeps,
             neighbours: options.neighbours,
             cycle_window: options.cycle_window,
             max_block: options.max_block,
@@ -216,6 +228,7 @@ impl CcpSolver {
             strength: 1,
             restarts_left,
             shakes: 0,
+            relaxation_sweeps: 0,
             cancelled: false,
         })
     }
@@ -239,8 +252,23 @@ impl CcpSolver {
     }
 
     fn out_of_time(&self, t0: Instant, budget: Duration) -> bool {
-        let used = t0.elapsed();
-        used >= budget || self.elapsed + used >= self.options.time_limit
+        t0.elapsed() >= budget || self.time_is_up(t0)
+    }
+
+    /// The whole run's limit (not just this slice's budget) is used up.
+    fn time_is_up(&self, t0: Instant) -> bool {
+        self.elapsed + t0.elapsed() >= self.options.time_limit
+    }
+
+    /// Ends the slice: `Finished` when the run's time limit is reached (in any phase), else
+    /// `Running`.
+    fn end_slice(&mut self, t0: Instant) -> SolverStatus {
+        if self.time_is_up(t0) {
+            self.finish_run();
+            SolverStatus::Finished
+        } else {
+            SolverStatus::Running
+        }
     }
 
     fn step_inner(&mut self, t0: Instant, budget: Duration) -> SolverStatus {
@@ -259,27 +287,27 @@ impl CcpSolver {
                     self.search.construct(false);
                     self.phase = CcpPhase::Relaxing;
                     if self.out_of_time(t0, budget) {
-                        return SolverStatus::Running;
+                        return self.end_slice(t0);
                     }
                 }
                 CcpPhase::Relaxing => {
                     // One sweep per iteration so that long relaxations respect time slices.
                     let gain = self.search.sweep();
-                    if gain <= self.options.delta {
+                    self.relaxation_sweeps += 1;
+                    if gain <= self.options.delta
+                        || self.relaxation_sweeps >= self.options.max_relaxation_sweeps
+                    {
                         self.initial_length = Some(self.search.total);
                         self.search.queue_all();
                         self.phase = CcpPhase::LocalSearch;
-                    } else if self.out_of_time(t0, budget) {
-                        return SolverStatus::Running;
+                    }
+                    if self.out_of_time(t0, budget) {
+                        return self.end_slice(t0);
                     }
                 }
                 CcpPhase::LocalSearch | CcpPhase::Shaking => {
                     if !self.descend(t0, budget) {
-                        if self.elapsed + t0.elapsed() >= self.options.time_limit {
-                            self.finish_run();
-                            return SolverStatus::Finished;
-                        }
-                        return SolverStatus::Running;
+                        return self.end_slice(t0);
                     }
                     // The queue is empty: a local optimum of every neighbourhood. A full
                     // relaxation queues the contours whose pierce points still moved.
@@ -302,14 +330,13 @@ impl CcpSolver {
                     if self.phase == CcpPhase::Done {
                         return SolverStatus::Finished;
                     }
-                    if self.out_of_time(t0, budget) {
-                        if self.elapsed + t0.elapsed() >= self.options.time_limit {
-                            self.finish_run();
-                            return SolverStatus::Finished;
-                        }
-                        return SolverStatus::Running;
-                    }
+                    // Shake before the time check: a slice that ended here would otherwise
+                    // resume with an empty queue and judge the same state twice, so the run
+                    // would depend on where the slices fall.
                     self.shake();
+                    if self.out_of_time(t0, budget) {
+                        return self.end_slice(t0);
+                    }
                 }
             }
         }

@@ -417,6 +417,22 @@ impl Span {
             let t = 2.0 * ratio.asin() / phi.abs();
             return if tangent.dot(v) < 0.0 { -t } else { t };
         }
+        if let Some(c) = self.centre() {
+            // Central angle from A to P. With |φ| ≥ 1 the radius is at most ~1.05·L, so the
+            // centre is precise; the tangent–chord angle is not used here because, for a point
+            // just past A, it lives in P's offset across the tangent (second order in the
+            // distance), which rounding of P's coordinates erases.
+            let (u, w) = (self.start - c, p - c);
+            let angle = u.cross(w).atan2(u.dot(w));
+            let angle = if phi > 0.0 && angle < 0.0 {
+                angle + std::f64::consts::TAU
+            } else if phi < 0.0 && angle > 0.0 {
+                angle - std::f64::consts::TAU
+            } else {
+                angle
+            };
+            return angle / phi;
+        }
         // Tangent–chord angle: the chord A→P makes half of its arc's angle with the start tangent.
         let psi = tangent.cross(v).atan2(tangent.dot(v));
         let psi = if phi > 0.0 && psi < 0.0 {

@@ -194,3 +194,31 @@ fn nan_does_not_panic() {
     let _ = s.bounding_box();
     let _ = Span::new(p(0.0, 0.0), p(1.0, 1.0), 0.3).nearest_point(p(f64::NAN, 0.0));
 }
+
+#[test]
+fn points_just_past_the_start_of_a_wide_arc_keep_their_parameter() {
+    // A half circle of radius 100 (Nest03, part 197) and the point of it δ = 1.0155e-8 rad past
+    // its start: x moves by 100·δ ≈ 1e-6, y by 50·δ² ≈ 5e-15, below the ulp of 1300. The point
+    // is on the arc to within rounding, so its distance must be ~0, not its 1e-6 offset from A.
+    let s = Span::new(
+        p(1100.0002, 1300.0),
+        p(1100.0002, 1500.0),
+        -0.9999999999999999,
+    );
+    let delta: f64 = 1.0155e-8;
+    let q = p(
+        1100.0002 - 100.0 * delta.sin(),
+        1400.0 - 100.0 * delta.cos(),
+    );
+    assert_eq!(
+        q.y, 1300.0,
+        "the offset across the tangent is lost to rounding"
+    );
+    let t = s.parameter_of(q);
+    assert!(close(t, delta / PI, 1e-12), "t = {t}");
+    let n = s.nearest_point(q);
+    assert!(n.distance < 1e-9, "distance {}", n.distance);
+    // Points of the circle outside the arc still map outside [0, 1].
+    let before = p(1100.0002 + 100.0 * delta.sin(), 1300.0);
+    assert!(s.parameter_of(before) > 1.0);
+}

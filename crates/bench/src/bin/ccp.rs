@@ -4,15 +4,18 @@
 //! 1. real nests, open routes from the sheet origin: CCP-Relax against the crates.io peer
 //!    `u-nesting-cutting` (arcs flattened at 8 segments per radian, `pierce_candidates = 1`),
 //!    both measured by the same metric (Euclidean idle length of the route they return);
-//! 2. real nests, CCP against the discrete model (PCGTSP at ε = 25 mm and 50 mm solved by
-//!    cutroute's ALNS), same start point and metric;
+//!    with a lower bound on every open route from the origin (the distance to the farthest
+//!    contour: the air path must reach each contour's pierce point);
+//!    and, on nests of at most 6 innermost contours, an exact lower bound over every order;
+//! 2. real nests, CCP against the discrete model (PCGTSP at ε = 25, 50 and 100 mm solved by
+//!    cutroute's ALNS, 10 s each, dense cost matrix), same start point and metric;
 //! 3. `E1X_6_01` closed at (0, 0) against the proven discrete optimum 1513;
 //! 4. synthetic nests of 100 … 20,000 contours: time to the first VNS local optimum, idle
 //!    length, and the peer.
 //!
 //! Arguments: `--quick` skips the 20,000-contour nest; `--real-only` skips the synthetic nests; `--vns-seconds S` sets CCP's budget
 //! after the local optimum (default 5); `--synthetic N` runs CCP on one synthetic nest only, `--peer-synthetic N` runs only the peer on one synthetic nest, `--nest PATH` CCP on one real nest (path under
-//! `shared/data/nests`).
+//! `shared/data/nests`), `--discrete-nest PATH` the discrete model alone on one real nest.
 
 use std::time::{Duration, Instant};
 
@@ -108,7 +111,103 @@ fn peer(nest: &Nest) -> Option<(f64, f64, Duration)> {
     Some((idle, out.total_rapid_distance, elapsed))
 }
 
-/// Best discrete route at step ε found by cutroute's ALNS in `budget`.
+/// A lower bound on the idle length of every open route from `start`: the air path reaches a
+/// pierce point on every contour, so it is at least as long as the distance to the farthest.
+fn farthest_contour(nest: &Nest, start: Point) -> f64 {
+    nest.parts
+        .iter()
+        .flat_map(|p| &p.contours)
+        .filter(|c| !c.vertices.is_empty())
+        .map(|c| c.distance_to(start))
+        .fold(0.0, f64::max)
+}
+
+/// A certified lower bound on the idle length of every open route from `start` over a nest with
+/// at most `max_kept` innermost contours (`None` above): over every order of the innermost
+/// contours, the shortest path from `start` through one sample point of each (samples at most
+/// `h` apart along the contour), plus the distance from the last one to its outermost enclosing
+/// contour, which must still be cut after it. Outer contours are otherwise left out, which can
+/// only shorten a path (triangle inequality). Moving a pierce point to its nearest sample
+/// changes the path by at most `h` per contour, so `k·h` is subtracted. Returns (bound, h).
+fn small_nest_lower_bound(nest: &Nest, start: Point, max_kept: usize) -> Option<(f64, f64)> {
+    let forest = nest.containment_forest();
+    let kept: Vec<cutroute_geometry::ContourRef> = forest
+        .leaves()
+        .into_iter()
+        .filter(|&r| nest.contour(r).is_some_and(|c| !c.vertices.is_empty()))
+        .collect();
+    let k = kept.len();
+    if k == 0 || k > max_kept {
+        return None;
+    }
+    let longest = kept
+        .iter()
+        .map(|&r| nest.contour(r).map_or(0.0, |c| c.perimeter()))
+        .fold(0.0, f64::max);
+    // About 1,500 samples on the longest contour (the pairwise layers cost n² per order); one
+    // contour has no pairs and gets 100 times more.
+    let per_contour = if k == 1 { 150_000.0 } else { 1500.0 };
+    let h = (longest / per_contour).max(1e-4);
+    let mut samples: Vec<Vec<Point>> = Vec::with_capacity(k);
+    let mut exit: Vec<Vec<f64>> = Vec::with_capacity(k);
+    for &r in &kept {
+        let c = nest.contour(r)?;
+        let per = c.perimeter();
+        let n = ((per / h).ceil() as usize).max(1);
+        let pts: Vec<Point> = (0..n)
+            .map(|i| c.point_at_length(per * i as f64 / n as f64))
+            .collect::<Option<_>>()?;
+        let outermost = forest.ancestors(r).last().and_then(|a| nest.contour(a));
+        exit.push(
+            pts.iter()
+                .map(|&p| outermost.map_or(0.0, |o| o.distance_to(p)))
+                .collect(),
+        );
+        samples.push(pts);
+    }
+    let mut best = f64::INFINITY;
+    let mut cur: Vec<f64> = Vec::new();
+    let mut next: Vec<f64> = Vec::new();
+    let mut order: Vec<usize> = (0..k).collect();
+    for_each_permutation(&mut order, 0, &mut |order| {
+        cur.clear();
+        cur.extend(samples[order[0]].iter().map(|p| p.distance(start)));
+        for w in 1..k {
+            let (from, to) = (&samples[order[w - 1]], &samples[order[w]]);
+            next.clear();
+            next.extend(to.iter().map(|q| {
+                from.iter()
+                    .zip(&cur)
+                    .map(|(p, d)| d + p.distance(*q))
+                    .fold(f64::INFINITY, f64::min)
+            }));
+            std::mem::swap(&mut cur, &mut next);
+        }
+        let value = cur
+            .iter()
+            .zip(&exit[order[k - 1]])
+            .map(|(d, e)| d + e)
+            .fold(f64::INFINITY, f64::min);
+        best = best.min(value);
+    });
+    // The farthest contour bound holds too; keep the better.
+    Some(((best - k as f64 * h).max(farthest_contour(nest, start)), h))
+}
+
+/// Calls `f` with every permutation of `v[from..]` (prefix fixed).
+fn for_each_permutation(v: &mut [usize], from: usize, f: &mut dyn FnMut(&[usize])) {
+    if from + 1 >= v.len() {
+        f(v);
+        return;
+    }
+    for i in from..v.len() {
+        v.swap(from, i);
+        for_each_permutation(v, from + 1, f);
+        v.swap(from, i);
+    }
+}
+
+/// Best discrete route at step ε found by cutroute's ALNS in `budget`: (idle length, nodes).
 fn discrete(
     nest: &Nest,
     finish: Option<Point>,
@@ -131,6 +230,40 @@ fn discrete(
     Some((route.idle_length(), inst.instance.node_count))
 }
 
+/// Every multi-contour nest of shared/data/nests: (name, path).
+const REAL: [(&str, &str); 13] = [
+    ("nested.dbs", "dbs/nested.dbs"),
+    ("seven.dbs", "dbs/seven.dbs"),
+    ("test0", "dbs-json/test0.dbs.json"),
+    ("test1", "dbs-json/test1.dbs.json"),
+    ("E1X_6_01", "dbs-json/E1X_6_01.dbs.json"),
+    ("Nest01", "tflex/Nest01.tfnesting"),
+    ("Nest02", "tflex/Nest02.tfnesting"),
+    ("Nest03", "tflex/Nest03.tfnesting"),
+    ("Graph_9x15", "dbs/Graph_9x15.DBS"),
+    ("seven_3717", "dbs/seven_3717.dbs"),
+    ("propeller.dxf", "dxf/propeller.dxf"),
+    ("cross.dxf", "dxf/cross.dxf"),
+    ("planka.dxf", "dxf/planka.dxf"),
+];
+
+/// The lower-bound table: (name, nest, CCP idle, peer idle) per nest.
+fn print_lower_bounds<'a>(rows: impl Iterator<Item = (&'a str, &'a Nest, f64, f64)>) {
+    println!("\n## Exact lower bounds on the small real nests (every order of the innermost contours, sampled pierce points, certified margin)\n");
+    println!("| nest | kept | lower bound | sample step h | CCP idle | CCP / bound | 0.9 × peer |");
+    println!("|---|---|---|---|---|---|---|");
+    for (name, nest, len, pl) in rows {
+        if let Some((lb, h)) = small_nest_lower_bound(nest, Point::new(0.0, 0.0), 6) {
+            let kept = nest.containment_forest().leaves().len();
+            println!(
+                "| {name} | {kept} | {lb:.2} | {h:.3} | {len:.2} | {:.4} | {:.1} |",
+                len / lb,
+                0.9 * pl
+            );
+        }
+    }
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let quick = args.iter().any(|a| a == "--quick");
@@ -146,6 +279,22 @@ fn main() {
         .position(|a| a == "--synthetic")
         .and_then(|i| args.get(i + 1))
         .and_then(|s| s.parse().ok());
+    if let Some(path) = args
+        .iter()
+        .position(|a| a == "--discrete-nest")
+        .and_then(|i| args.get(i + 1))
+    {
+        let nest = read(path);
+        for step in [100.0, 50.0, 25.0] {
+            let t = Instant::now();
+            let d = discrete(&nest, None, step, Duration::from_secs(10));
+            println!(
+                "{path} ε = {step}: {d:?} in {:.1} s",
+                t.elapsed().as_secs_f64()
+            );
+        }
+        return;
+    }
     if let Some(path) = args
         .iter()
         .position(|a| a == "--nest")
@@ -197,26 +346,24 @@ fn main() {
         );
         return;
     }
-    // Every multi-contour nest of shared/data/nests (single-contour files have nothing to order).
-    let real = [
-        ("nested.dbs", "dbs/nested.dbs"),
-        ("seven.dbs", "dbs/seven.dbs"),
-        ("test0", "dbs-json/test0.dbs.json"),
-        ("test1", "dbs-json/test1.dbs.json"),
-        ("E1X_6_01", "dbs-json/E1X_6_01.dbs.json"),
-        ("Nest01", "tflex/Nest01.tfnesting"),
-        ("Nest02", "tflex/Nest02.tfnesting"),
-        ("Nest03", "tflex/Nest03.tfnesting"),
-        ("Graph_9x15", "dbs/Graph_9x15.DBS"),
-        ("seven_3717", "dbs/seven_3717.dbs"),
-        ("propeller.dxf", "dxf/propeller.dxf"),
-        ("cross.dxf", "dxf/cross.dxf"),
-        ("planka.dxf", "dxf/planka.dxf"),
-    ];
+    let real = REAL;
+    if args.iter().any(|a| a == "--lower-bounds") {
+        let mut rows = Vec::new();
+        for (name, path) in real {
+            let nest = read(path);
+            if small_nest_lower_bound(&nest, Point::new(0.0, 0.0), 6).is_some() {
+                let (r, _) = ccp(&nest, None, budget);
+                let pl = peer(&nest).map_or(f64::NAN, |p| p.0);
+                rows.push((name, nest, r.metrics.idle_length, pl));
+            }
+        }
+        print_lower_bounds(rows.iter().map(|(n, nest, l, p)| (*n, nest, *l, *p)));
+        return;
+    }
 
     println!("## CCP-Relax vs u-nesting-cutting (open routes from the sheet origin, idle mm)\n");
-    println!("| nest | contours | kept | CCP idle | CCP time s | local opt. s | certified | peer idle | peer time s | CCP / peer |");
-    println!("|---|---|---|---|---|---|---|---|---|---|");
+    println!("| nest | contours | kept | CCP idle | CCP time s | local opt. s | certified | peer idle | peer time s | CCP / peer | lower bound |");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|");
     let mut open_results = Vec::new();
     for (name, path) in real {
         let nest = read(path);
@@ -224,7 +371,7 @@ fn main() {
         let p = peer(&nest);
         let (pl, pt) = p.map_or((f64::NAN, f64::NAN), |(l, _, t)| (l, t.as_secs_f64()));
         println!(
-            "| {name} | {} | {} | {:.1} | {:.2} | {:.3} | {}/{} | {:.1} | {:.2} | {:.3} |",
+            "| {name} | {} | {} | {:.1} | {:.2} | {:.3} | {}/{} | {:.1} | {:.2} | {:.3} | {:.1} |",
             r.route.steps.len(),
             r.progress.kept_contours,
             r.metrics.idle_length,
@@ -238,27 +385,43 @@ fn main() {
             pl,
             pt,
             r.metrics.idle_length / pl,
+            farthest_contour(&nest, Point::new(0.0, 0.0)),
         );
-        open_results.push((name, nest, r.metrics.idle_length));
+        open_results.push((name, nest, r.metrics.idle_length, pl));
     }
 
+    print_lower_bounds(
+        open_results
+            .iter()
+            .map(|(n, nest, l, p)| (*n, nest, *l, *p)),
+    );
+
     println!("\n## CCP-Relax vs the discrete model (PCGTSP solved by cutroute-alns, 10 s each; open routes, idle mm)\n");
-    println!("| nest | CCP | ε = 25 mm (nodes) | ε = 50 mm (nodes) | CCP / d25 | CCP / d50 |");
-    println!("|---|---|---|---|---|---|");
-    for (name, nest, len) in &open_results {
-        let d25 = discrete(nest, None, 25.0, Duration::from_secs(10));
-        let d50 = discrete(nest, None, 50.0, Duration::from_secs(10));
-        let f =
-            |d: Option<(f64, usize)>| d.map_or("n/a".to_string(), |(l, n)| format!("{l:.1} ({n})"));
-        let ratio = |d: Option<(f64, usize)>| {
-            d.map_or("n/a".to_string(), |(l, _)| format!("{:.4}", len / l))
+    println!("| nest | CCP | ε = 25 mm (nodes, s) | ε = 50 mm (nodes, s) | ε = 100 mm (nodes, s) | CCP / d25 | CCP / d50 | CCP / d100 |");
+    println!("|---|---|---|---|---|---|---|---|");
+    for (name, nest, len, _) in &open_results {
+        let run = |step: f64| {
+            let t = Instant::now();
+            discrete(nest, None, step, Duration::from_secs(10))
+                .map(|(l, n)| (l, n, t.elapsed().as_secs_f64()))
+        };
+        let (d25, d50, d100) = (run(25.0), run(50.0), run(100.0));
+        let f = |d: Option<(f64, usize, f64)>| {
+            d.map_or("n/a".to_string(), |(l, n, t)| {
+                format!("{l:.1} ({n}, {t:.1})")
+            })
+        };
+        let ratio = |d: Option<(f64, usize, f64)>| {
+            d.map_or("n/a".to_string(), |(l, _, _)| format!("{:.4}", len / l))
         };
         println!(
-            "| {name} | {len:.1} | {} | {} | {} | {} |",
+            "| {name} | {len:.1} | {} | {} | {} | {} | {} | {} |",
             f(d25),
             f(d50),
+            f(d100),
             ratio(d25),
-            ratio(d50)
+            ratio(d50),
+            ratio(d100)
         );
     }
 
