@@ -46,6 +46,7 @@ mod lattice;
 mod order;
 mod parse;
 mod solver;
+mod subset;
 
 pub use assignment::Assignment;
 pub use bnb::{solve_bnb, BnbOptions};

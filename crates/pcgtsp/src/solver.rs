@@ -7,6 +7,7 @@ use crate::heuristic;
 use crate::instance::Instance;
 use crate::lattice::Lattice;
 use crate::order::OrderError;
+use crate::subset::SubsetBound;
 use std::rc::Rc;
 use std::time::Duration;
 use web_time::Instant;
@@ -46,6 +47,14 @@ impl ExactOptions {
         let seconds = self.time_limit.map_or(f64::INFINITY, |t| t.as_secs_f64());
         self.lattice_max_ideals
             .min((seconds * 60_000.0).max(100_000.0) as usize)
+    }
+
+    /// Work budget (elementary steps) of the subset DP bound's backward pass.
+    fn effective_subset_work(&self) -> f64 {
+        std::env::var("PCGTSP_SUBSET_WORK")
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(4e8)
     }
 
     /// The lattice work budget after resolving the automatic setting.
@@ -172,6 +181,15 @@ impl Engine {
                 Engine::W4(Dp::new(model, beam, dp_memory, use_l2, l.clone()))
             }
             _ => Engine::Unsupported,
+        }
+    }
+
+    fn set_subset_bound(&mut self, model: &Model, subset: Rc<SubsetBound>) {
+        match self {
+            Engine::W1(dp) => dp.set_subset_bound(model, subset),
+            Engine::W2(dp) => dp.set_subset_bound(model, subset),
+            Engine::W4(dp) => dp.set_subset_bound(model, subset),
+            Engine::Unsupported => {}
         }
     }
 
@@ -564,9 +582,32 @@ impl ExactSolver {
                     }
                     let _ = max_ideals;
                     let store = run.lattice.as_mut().expect("built above");
-                    let engine = run.engine.get_or_insert_with(|| {
-                        Engine::new(&run.model, None, memory, use_l2, store)
-                    });
+                    if run.engine.is_none() {
+                        let mut engine = Engine::new(&run.model, None, memory, use_l2, store);
+                        let began = Instant::now();
+                        let tour = self
+                            .incumbent
+                            .tour
+                            .as_deref()
+                            .filter(|t| t[0] == run.model.start);
+                        let work = self.options.effective_subset_work();
+                        if let Some(subset) = SubsetBound::build(&run.model, tour, work) {
+                            let root = run.model.round_bound(subset.root_bound);
+                            run.root_bound = run.root_bound.max(root);
+                            debug_log(|| {
+                                format!(
+                                    "subset bound: {} tracked of {}, {} ideals, root {root}, built in {:?}",
+                                    subset.tracked_count(),
+                                    run.model.m,
+                                    subset.ideal_count(),
+                                    began.elapsed()
+                                )
+                            });
+                            engine.set_subset_bound(&run.model, Rc::new(subset));
+                        }
+                        run.engine = Some(engine);
+                    }
+                    let engine = run.engine.as_mut().expect("created above");
                     let layer_before = engine.stats(&run.model, INF).0;
                     let status = engine.run(&run.model, &mut self.incumbent, CHUNK);
                     let layer_changed = engine.stats(&run.model, INF).0 != layer_before;
