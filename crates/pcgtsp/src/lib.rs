@@ -45,6 +45,7 @@ mod instance;
 mod lattice;
 mod order;
 mod parse;
+mod prepare;
 mod solver;
 mod subset;
 
