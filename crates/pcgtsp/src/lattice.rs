@@ -163,6 +163,9 @@ pub(crate) struct LatticeBuilder<const W: usize> {
     max_ideals: usize,
     max_bytes: usize,
     work_budget: usize,
+    /// Give up when the budget affords fewer groups per cluster than this share of the
+    /// average cluster size (the relaxation would be too coarse to help).
+    min_group_share: f64,
     pred: Vec<Key<W>>,
     succ: Vec<Key<W>>,
     layers: Vec<LatticeLayer<W>>,
@@ -194,12 +197,14 @@ enum LatticeStage {
 }
 
 impl<const W: usize> LatticeBuilder<W> {
-    /// Starts a build; it gives up (result `None`) beyond `max_ideals` ideals or `max_bytes`.
+    /// Starts a build; it gives up (result `None`) beyond `max_ideals` ideals or `max_bytes`,
+    /// or when it could afford fewer than `min_group_share` × the average cluster size groups.
     pub fn new(
         model: &Model,
         max_ideals: usize,
         max_bytes: usize,
         work_budget: usize,
+        min_group_share: f64,
     ) -> LatticeBuilder<W> {
         let (pred, succ) = masks::<W>(model);
         let stage = if model.m > 255 || model.m > 64 * W {
@@ -211,6 +216,7 @@ impl<const W: usize> LatticeBuilder<W> {
             max_ideals,
             max_bytes,
             work_budget,
+            min_group_share,
             pred,
             succ,
             layers: vec![LatticeLayer {
@@ -232,7 +238,10 @@ impl<const W: usize> LatticeBuilder<W> {
             match &mut self.stage {
                 LatticeStage::Finished => return Some(None),
                 LatticeStage::Forward { k, .. } if *k + 1 >= m => {
-                    self.start_backward(model);
+                    if !self.start_backward(model) {
+                        self.stage = LatticeStage::Finished;
+                        return Some(None);
+                    }
                 }
                 LatticeStage::Forward { k, next } => {
                     let layer = &self.layers[*k];
@@ -261,6 +270,11 @@ impl<const W: usize> LatticeBuilder<W> {
                     }
                     records.clear();
                     self.records = records;
+                    if self.groups_affordable(model) < self.min_group_share * average_size(model) {
+                        // Ideals only accumulate: the groups affordable can only shrink.
+                        self.stage = LatticeStage::Finished;
+                        return Some(None);
+                    }
                     self.stage = LatticeStage::Forward { k: k + 1, next: 0 };
                     if Instant::now() >= deadline {
                         return None;
@@ -415,29 +429,46 @@ impl<const W: usize> LatticeBuilder<W> {
         true
     }
 
-    /// Chooses the number of pierce groups from the work budget and starts the backward pass.
-    fn start_backward(&mut self, model: &Model) {
-        let last = self.layers.len() - 1;
-        self.layers[last].child_start = vec![0; self.layers[last].keys.len() + 1];
+    /// The pierce groups per cluster the work budget affords for the ideals generated so far
+    /// (1–64): the backward pass costs about ideals × (children × K)².
+    fn groups_affordable(&self, _model: &Model) -> f64 {
         let ideal_count = self.ideal_count;
         // Small lattices need few groups for strong pruning; more would only slow the build.
         let work_budget = self
             .work_budget
             .min(ideal_count.saturating_mul(3000).max(300_000_000));
-        // Choose K from the work of the backward pass: ideals × Σ_B k_B × Σ_C k_C.
         let children_total: usize = self.layers.iter().map(|l| l.child_cluster.len()).sum();
         let average_children = (children_total as f64 / ideal_count as f64).max(1.0);
         let per_ideal = average_children * average_children;
-        let mut k_max = ((work_budget as f64 / (ideal_count as f64 * per_ideal))
+        (work_budget as f64 / (ideal_count as f64 * per_ideal))
             .sqrt()
-            .floor() as usize)
-            .clamp(1, 64);
+            .floor()
+            .clamp(1.0, 64.0)
+    }
+
+    /// Chooses the number of pierce groups from the work budget and starts the backward pass;
+    /// `false` if the budget affords fewer groups than `min_group_share` asks for.
+    fn start_backward(&mut self, model: &Model) -> bool {
+        let last = self.layers.len() - 1;
+        self.layers[last].child_start = vec![0; self.layers[last].keys.len() + 1];
+        let ideal_count = self.ideal_count;
+        let children_total: usize = self.layers.iter().map(|l| l.child_cluster.len()).sum();
+        let average_children = (children_total as f64 / ideal_count as f64).max(1.0);
+        let mut k_max = self.groups_affordable(model) as usize;
         // Memory: about average_children blocks of k values per ideal.
         while k_max > 1
             && ideal_count as f64 * average_children * k_max as f64 * 4.0 + self.bytes as f64
                 > self.max_bytes as f64
         {
             k_max -= 1;
+        }
+        if (k_max as f64) < self.min_group_share * average_size(model) {
+            if std::env::var_os("PCGTSP_DEBUG").is_some() {
+                eprintln!(
+                    "[pcgtsp] lattice: {ideal_count} ideals, K = {k_max} too coarse, skipped"
+                );
+            }
+            return false;
         }
         self.stage = LatticeStage::Backward {
             k: self.layers.len() - 1,
@@ -449,6 +480,7 @@ impl<const W: usize> LatticeBuilder<W> {
             block_value_start: Vec::new(),
             values: Vec::new(),
         };
+        true
     }
 }
 
@@ -462,7 +494,7 @@ impl<const W: usize> Lattice<W> {
         work_budget: usize,
     ) -> Option<Lattice<W>> {
         let far = Instant::now() + std::time::Duration::from_secs(1 << 30);
-        let mut builder = LatticeBuilder::<W>::new(model, max_ideals, max_bytes, work_budget);
+        let mut builder = LatticeBuilder::<W>::new(model, max_ideals, max_bytes, work_budget, 0.0);
         loop {
             if let Some(result) = builder.advance(model, far) {
                 return result;
@@ -527,6 +559,15 @@ impl<const W: usize> LatticeLayer<W> {
         (self.block_start[index] as usize..self.block_start[index + 1] as usize)
             .find(|&b| self.block_cluster[b] as usize == last)
     }
+}
+
+/// Average number of nodes of the clusters other than the depot.
+fn average_size(model: &Model) -> f64 {
+    let clustered: usize = (0..model.m)
+        .filter(|&c| c != model.depot)
+        .map(|c| model.cluster_nodes[c].len())
+        .sum();
+    clustered as f64 / (model.m.max(2) - 1) as f64
 }
 
 #[inline]

@@ -10,9 +10,13 @@ use crate::subset::{SubsetBound, SubsetBuilder};
 use std::rc::Rc;
 use web_time::Instant;
 
-/// A subset bound whose root is at least this share of the incumbent's cost makes the
-/// pierce-group lattice redundant on large orders: it costs seconds and prunes less.
+/// A subset bound whose root is at least this share of the incumbent's cost prunes more than
+/// a coarse pierce-group lattice ...
 const STRONG_SUBSET_SHARE: f64 = 0.85;
+/// ... one with fewer groups per cluster than this share of the average cluster size (on
+/// large orders with big clusters the lattice affords only 2–3 groups and costs seconds; with
+/// small clusters it is nearly exact and still worth building).
+const COARSE_GROUP_SHARE: f64 = 0.5;
 
 /// Limits of the pierce-group lattice build.
 pub(crate) struct LatticeLimits {
@@ -22,6 +26,8 @@ pub(crate) struct LatticeLimits {
     pub max_bytes: usize,
     /// Work budget of the backward pass.
     pub work: usize,
+    /// Skip the lattice if it affords fewer groups than this share of the average cluster size.
+    pub min_group_share: f64,
 }
 
 enum LatticeJob {
@@ -32,11 +38,16 @@ enum LatticeJob {
 
 impl LatticeJob {
     fn new(model: &Model, limits: &LatticeLimits) -> Option<LatticeJob> {
-        let (i, b, w) = (limits.max_ideals, limits.max_bytes, limits.work);
+        let (i, b, w, g) = (
+            limits.max_ideals,
+            limits.max_bytes,
+            limits.work,
+            limits.min_group_share,
+        );
         match model.m {
-            0..=64 => Some(LatticeJob::W1(LatticeBuilder::new(model, i, b, w))),
-            65..=128 => Some(LatticeJob::W2(LatticeBuilder::new(model, i, b, w))),
-            129..=256 => Some(LatticeJob::W4(LatticeBuilder::new(model, i, b, w))),
+            0..=64 => Some(LatticeJob::W1(LatticeBuilder::new(model, i, b, w, g))),
+            65..=128 => Some(LatticeJob::W2(LatticeBuilder::new(model, i, b, w, g))),
+            129..=256 => Some(LatticeJob::W4(LatticeBuilder::new(model, i, b, w, g))),
             _ => None,
         }
     }
@@ -93,11 +104,13 @@ impl Preparation {
                     let subset = builder.advance(model, deadline)?;
                     let mut limits = LatticeLimits { ..self.limits };
                     if let Some(subset) = &subset {
+                        // Exact (every cluster tracked) or already proving the incumbent
+                        // optimal: nothing left for the lattice to add.
                         let exact = subset.tracked_count() == model.m;
-                        if exact {
+                        if exact || model.round_bound(subset.root_bound) >= self.upper_bound {
                             limits.max_ideals = 0;
                         } else if subset.root_bound >= STRONG_SUBSET_SHARE * self.upper_bound {
-                            limits.max_ideals = limits.max_ideals.min(300_000);
+                            limits.min_group_share = COARSE_GROUP_SHARE;
                         }
                     }
                     self.subset = subset.map(Rc::new);

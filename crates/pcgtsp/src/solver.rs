@@ -281,6 +281,7 @@ impl Run {
                 max_ideals: options.effective_lattice_max_ideals(),
                 max_bytes: options.memory_limit_bytes / 2,
                 work: options.effective_lattice_work(),
+                min_group_share: 0.0,
             };
             Preparation::new(
                 &self.model,
