@@ -12,6 +12,7 @@
 
 use crate::bounds::{Model, ResidualBounder};
 use crate::lattice::Lattice;
+use crate::subset::{SubsetBound, SubsetQuery};
 use std::rc::Rc;
 
 const INF: f64 = f64::INFINITY;
@@ -170,6 +171,9 @@ pub(crate) struct Dp<const W: usize> {
     /// The cluster-DP bound over the whole ideal lattice, when it fits in memory.
     lattice: Option<Rc<Lattice<W>>>,
     next_values: Vec<(usize, f64)>,
+    /// The subset DP bound (exact node-level completion over tracked clusters), if built.
+    subset: Option<Rc<SubsetBound>>,
+    subset_query: SubsetQuery,
 }
 
 impl<const W: usize> Dp<W> {
@@ -231,7 +235,15 @@ impl<const W: usize> Dp<W> {
             done: false,
             lattice,
             next_values: Vec::new(),
+            subset: None,
+            subset_query: SubsetQuery::default(),
         }
+    }
+
+    /// Adds the subset DP bound: every state created from now on is bounded by it too.
+    pub fn set_subset_bound(&mut self, model: &Model, subset: Rc<SubsetBound>) {
+        self.layer_bound = self.layer_bound.max(model.round_bound(subset.root_bound));
+        self.subset = Some(subset);
     }
 
     /// States in the current layer plus the one being built.
@@ -386,6 +398,14 @@ impl<const W: usize> Dp<W> {
             }
         }
         let l2 = self.bounder.l2;
+        let subset = if complete {
+            None
+        } else {
+            self.subset.as_deref()
+        };
+        if let Some(subset) = subset {
+            subset.prepare(|c| ideal.contains(c), v, &mut self.subset_query);
+        }
         let states_before = self.next.node.len();
         for (j, &x) in nodes.iter().enumerate() {
             let g = self.costs[j];
@@ -400,6 +420,10 @@ impl<const W: usize> Dp<W> {
                 g + lattice.node_completion(model, &self.next_values, x)
             } else {
                 g + self.bounder.node_bound(model, x).max(l2).max(group_bound)
+            };
+            let lb = match subset {
+                Some(subset) => lb.max(g + subset.bound(&self.subset_query, j, x)),
+                None => lb,
             };
             if Self::prunable(model, lb, upper_bound) {
                 continue;

@@ -9,8 +9,10 @@
 //!   errors ([`ParseError`]);
 //! - the precedence order's transitive closure and reduction ([`PrecedenceOrder`]);
 //! - an independent tour checker ([`check_tour`]) that every solver result goes through;
-//! - lower bounds: assignment bounds L1 / L2 on the residual problem and the pierce-group DP
-//!   over the lattice of order ideals ([`root_bounds`]);
+//! - lower bounds: assignment bounds L1 / L2 on the residual problem, the pierce-group DP
+//!   over the lattice of order ideals ([`root_bounds`]), and the subset DP (an exact
+//!   node-level backward DP over a subset of the clusters, with penalised walks through the
+//!   others) that bounds every search state's completion;
 //! - the exact solver: a DP over order ideals with node-level states, per-state bounding
 //!   against the incumbent, a memory cap and an anytime, resumable API ([`ExactSolver`],
 //!   [`solve`]); and the breadth-first branch-and-bound variant ([`solve_bnb`]).
@@ -45,7 +47,9 @@ mod instance;
 mod lattice;
 mod order;
 mod parse;
+mod prepare;
 mod solver;
+mod subset;
 
 pub use assignment::Assignment;
 pub use bnb::{solve_bnb, BnbOptions};

@@ -7,6 +7,8 @@ use crate::heuristic;
 use crate::instance::Instance;
 use crate::lattice::Lattice;
 use crate::order::OrderError;
+use crate::prepare::{LatticeLimits, Preparation};
+use crate::subset::SubsetBound;
 use std::rc::Rc;
 use std::time::Duration;
 use web_time::Instant;
@@ -46,6 +48,13 @@ impl ExactOptions {
         let seconds = self.time_limit.map_or(f64::INFINITY, |t| t.as_secs_f64());
         self.lattice_max_ideals
             .min((seconds * 60_000.0).max(100_000.0) as usize)
+    }
+
+    /// Work budget (elementary steps) of the subset DP bound's backward pass.
+    /// 4·10⁸ steps (a fraction of a second), less under short time limits.
+    fn effective_subset_work(&self) -> f64 {
+        let seconds = self.time_limit.map_or(f64::INFINITY, |t| t.as_secs_f64());
+        (seconds * 4e7).clamp(2e7, 4e8)
     }
 
     /// The lattice work budget after resolving the automatic setting.
@@ -175,6 +184,15 @@ impl Engine {
         }
     }
 
+    fn set_subset_bound(&mut self, model: &Model, subset: Rc<SubsetBound>) {
+        match self {
+            Engine::W1(dp) => dp.set_subset_bound(model, subset),
+            Engine::W2(dp) => dp.set_subset_bound(model, subset),
+            Engine::W4(dp) => dp.set_subset_bound(model, subset),
+            Engine::Unsupported => {}
+        }
+    }
+
     fn run(&mut self, model: &Model, incumbent: &mut Incumbent, work: u64) -> DpStatus {
         match self {
             Engine::W1(dp) => dp.run(model, incumbent, work),
@@ -214,7 +232,7 @@ impl Engine {
 }
 
 /// The lattice bound of one run, built once and shared by the beam and exact engines.
-enum LatticeStore {
+pub(crate) enum LatticeStore {
     W1(Option<Rc<Lattice<1>>>),
     W2(Option<Rc<Lattice<2>>>),
     W4(Option<Rc<Lattice<4>>>),
@@ -222,22 +240,6 @@ enum LatticeStore {
 }
 
 impl LatticeStore {
-    fn build(model: &Model, max_ideals: usize, memory: usize, work: usize) -> LatticeStore {
-        let budget = memory / 2;
-        match model.m {
-            0..=64 => {
-                LatticeStore::W1(Lattice::build(model, max_ideals, budget, work).map(Rc::new))
-            }
-            65..=128 => {
-                LatticeStore::W2(Lattice::build(model, max_ideals, budget, work).map(Rc::new))
-            }
-            129..=256 => {
-                LatticeStore::W4(Lattice::build(model, max_ideals, budget, work).map(Rc::new))
-            }
-            _ => LatticeStore::None,
-        }
-    }
-
     fn root_bound(&self) -> Option<f64> {
         match self {
             LatticeStore::W1(l) => l.as_ref().map(|l| l.root_bound),
@@ -252,8 +254,12 @@ impl LatticeStore {
 /// gives several runs, and the answer is the best over them.
 struct Run {
     model: Model,
-    /// Built lazily on the first `step` (it can take a while on large orders).
+    /// Built lazily on the first `step`s, in slices (it can take a while on large orders).
     lattice: Option<LatticeStore>,
+    /// The bounds being built (until `lattice` is set).
+    preparation: Option<Preparation>,
+    /// The subset DP bound, once built.
+    subset: Option<Rc<SubsetBound>>,
     root_bound: f64,
     engine: Option<Engine>,
     finished_bound: Option<f64>,
@@ -261,25 +267,67 @@ struct Run {
 }
 
 impl Run {
-    fn build_lattice(&mut self, options: &ExactOptions) {
+    /// Builds the bounds until `deadline`; sets `lattice` once they are complete.
+    fn build_lattice(
+        &mut self,
+        options: &ExactOptions,
+        tour: Option<&[usize]>,
+        upper_bound: f64,
+        deadline: Instant,
+    ) {
         let began = Instant::now();
-        let store = LatticeStore::build(
-            &self.model,
-            options.effective_lattice_max_ideals(),
-            options.memory_limit_bytes,
-            options.effective_lattice_work(),
-        );
+        let preparation = self.preparation.get_or_insert_with(|| {
+            let limits = LatticeLimits {
+                max_ideals: options.effective_lattice_max_ideals(),
+                max_bytes: options.memory_limit_bytes / 2,
+                work: options.effective_lattice_work(),
+                min_group_share: 0.0,
+            };
+            Preparation::new(
+                &self.model,
+                tour,
+                upper_bound,
+                options.effective_subset_work(),
+                limits,
+            )
+        });
+        let Some(store) = preparation.advance(&self.model, deadline) else {
+            return;
+        };
+        self.subset = preparation.subset.clone();
+        self.preparation = None;
         if let Some(root) = store.root_bound() {
             self.root_bound = self.root_bound.max(self.model.round_bound(root));
         }
+        if let Some(subset) = &self.subset {
+            self.root_bound = self
+                .root_bound
+                .max(self.model.round_bound(subset.root_bound));
+        }
         debug_log(|| {
             format!(
-                "lattice built in {:?}: root bound {:?}",
+                "bounds built (last slice {:?}): lattice root {:?}, subset root {:?} ({} of {} clusters tracked)",
                 began.elapsed(),
-                store.root_bound()
+                store.root_bound(),
+                self.subset.as_ref().map(|s| s.root_bound),
+                self.subset.as_ref().map_or(0, |s| s.tracked_count()),
+                self.model.m,
             )
         });
         self.lattice = Some(store);
+    }
+
+    /// A new DP engine with every bound this run has.
+    fn engine(&mut self, beam: Option<usize>, memory: usize, use_l2: bool) -> Engine {
+        let store = self
+            .lattice
+            .as_mut()
+            .expect("bounds built before the search");
+        let mut engine = Engine::new(&self.model, beam, memory, use_l2, store);
+        if let Some(subset) = &self.subset {
+            engine.set_subset_bound(&self.model, subset.clone());
+        }
+        engine
     }
 }
 
@@ -322,6 +370,8 @@ impl ExactSolver {
             runs.push(Run {
                 model,
                 lattice: None,
+                preparation: None,
+                subset: None,
                 root_bound,
                 engine: None,
                 finished_bound: None,
@@ -469,9 +519,10 @@ impl ExactSolver {
             match &mut self.phase {
                 Phase::Heuristic { beam, engine } => {
                     if self.runs[0].lattice.is_none() {
-                        // A quick tour first, so an upper bound exists before the (blocking)
-                        // lattice build.
-                        for r in 0..self.runs.len() {
+                        // A quick tour first, so an upper bound exists before the bounds are
+                        // built (the subset bound also chooses its clusters from it).
+                        for r in (0..self.runs.len()).filter(|_| self.runs[0].preparation.is_none())
+                        {
                             if let Some(mut tour) = heuristic::greedy(&self.runs[r].model) {
                                 let cost =
                                     heuristic::improve(&self.runs[r].model, &mut tour, 20_000);
@@ -483,8 +534,15 @@ impl ExactSolver {
                                 }
                             }
                         }
-                        debug_log(|| format!("greedy: UB {}", self.incumbent.upper_bound));
-                        self.runs[0].build_lattice(&self.options);
+                        if self.runs[0].preparation.is_none() {
+                            debug_log(|| format!("greedy: UB {}", self.incumbent.upper_bound));
+                        }
+                        self.runs[0].build_lattice(
+                            &self.options,
+                            self.incumbent.tour.as_deref(),
+                            self.incumbent.upper_bound,
+                            began + deadline,
+                        );
                         continue;
                     }
                     let run = &mut self.runs[0];
@@ -503,12 +561,10 @@ impl ExactSolver {
                         };
                         match width {
                             Some(width) => {
-                                *engine = Some(Box::new(Engine::new(
-                                    &run.model,
+                                *engine = Some(Box::new(run.engine(
                                     Some(width),
                                     self.options.memory_limit_bytes,
                                     self.options.use_l2,
-                                    run.lattice.as_mut().expect("built above"),
                                 )));
                             }
                             None => {
@@ -559,14 +615,19 @@ impl ExactSolver {
                     let max_ideals = self.options.lattice_max_ideals;
                     let run = &mut self.runs[self.current_run];
                     if run.lattice.is_none() {
-                        run.build_lattice(&self.options);
+                        run.build_lattice(
+                            &self.options,
+                            self.incumbent.tour.as_deref(),
+                            self.incumbent.upper_bound,
+                            began + deadline,
+                        );
                         continue;
                     }
                     let _ = max_ideals;
-                    let store = run.lattice.as_mut().expect("built above");
-                    let engine = run.engine.get_or_insert_with(|| {
-                        Engine::new(&run.model, None, memory, use_l2, store)
-                    });
+                    if run.engine.is_none() {
+                        run.engine = Some(run.engine(None, memory, use_l2));
+                    }
+                    let engine = run.engine.as_mut().expect("created above");
                     let layer_before = engine.stats(&run.model, INF).0;
                     let status = engine.run(&run.model, &mut self.incumbent, CHUNK);
                     let layer_changed = engine.stats(&run.model, INF).0 != layer_before;

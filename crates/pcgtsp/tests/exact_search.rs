@@ -1,0 +1,194 @@
+//! The exact search against brute force on random small instances, and the resumable bound
+//! build on a large order.
+
+mod common;
+
+use common::references;
+use cutroute_pcgtsp::{check_tour, solve, ExactOptions, ExactSolver, Instance, SolverStatus};
+use std::time::Duration;
+
+/// A small deterministic generator (the test must not depend on an RNG crate's stream).
+struct Lcg(u64);
+
+impl Lcg {
+    fn next(&mut self, bound: u64) -> u64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (self.0 >> 33) % bound
+    }
+}
+
+/// `m` clusters of 1–4 nodes (the depot has 1 or 2), integer asymmetric costs with some
+/// forbidden arcs, random precedence pairs consistent with a random order.
+fn random_instance(seed: u64, m: usize) -> Instance {
+    let mut rng = Lcg(seed.wrapping_mul(7919).wrapping_add(17));
+    let mut clusters = Vec::new();
+    let mut node_cluster = Vec::new();
+    for c in 0..m {
+        let size = if c == 0 {
+            1 + rng.next(2) as usize
+        } else {
+            1 + rng.next(4) as usize
+        };
+        let nodes: Vec<usize> = (node_cluster.len()..node_cluster.len() + size).collect();
+        node_cluster.extend(std::iter::repeat_n(c, size));
+        clusters.push(nodes);
+    }
+    let n = node_cluster.len();
+    let mut cost = vec![f64::INFINITY; n * n];
+    for a in 0..n {
+        for b in 0..n {
+            if a != b && rng.next(8) != 0 {
+                cost[a * n + b] = (5 + rng.next(60)) as f64;
+            }
+        }
+    }
+    let mut order: Vec<usize> = (1..m).collect();
+    for i in (1..order.len()).rev() {
+        order.swap(i, rng.next(i as u64 + 1) as usize);
+    }
+    let mut precedence = Vec::new();
+    for i in 0..order.len() {
+        for j in i + 1..order.len() {
+            if rng.next(4) == 0 {
+                precedence.push((order[i], order[j]));
+            }
+        }
+    }
+    Instance {
+        name: format!("random-{seed}"),
+        node_count: n,
+        cost,
+        clusters,
+        node_cluster,
+        precedence,
+        depot: 0,
+    }
+}
+
+/// The optimum by enumerating every cluster order and node choice (`None` if infeasible).
+fn brute_force(instance: &Instance) -> Option<f64> {
+    fn extend(
+        instance: &Instance,
+        tour: &mut Vec<usize>,
+        visited: &mut Vec<bool>,
+        best: &mut Option<f64>,
+    ) {
+        let m = instance.clusters.len();
+        if tour.len() == m {
+            if let Ok(cost) = check_tour(instance, tour) {
+                if best.is_none_or(|b| cost < b) {
+                    *best = Some(cost);
+                }
+            }
+            return;
+        }
+        for c in 0..m {
+            let ready = instance
+                .precedence
+                .iter()
+                .all(|&(a, b)| b != c || visited[a]);
+            if visited[c] || !ready {
+                continue;
+            }
+            visited[c] = true;
+            for &x in &instance.clusters[c] {
+                tour.push(x);
+                extend(instance, tour, visited, best);
+                tour.pop();
+            }
+            visited[c] = false;
+        }
+    }
+    let mut best = None;
+    let mut visited = vec![false; instance.clusters.len()];
+    visited[instance.depot] = true;
+    for &start in &instance.clusters[instance.depot] {
+        extend(instance, &mut vec![start], &mut visited, &mut best);
+    }
+    best
+}
+
+#[test]
+fn proven_optimum_equals_brute_force_on_random_instances() {
+    let mut feasible = 0;
+    for seed in 0..120u64 {
+        let m = 3 + (seed % 6) as usize;
+        let instance = random_instance(seed, m);
+        let expected = brute_force(&instance);
+        for heuristic in [true, false] {
+            let options = ExactOptions {
+                heuristic,
+                time_limit: Some(Duration::from_secs(30)),
+                ..ExactOptions::default()
+            };
+            let result = solve(&instance, options, &mut |p| {
+                if let Some(opt) = expected {
+                    assert!(
+                        p.lower_bound <= opt + 1e-9,
+                        "seed {seed}: LB above the optimum"
+                    );
+                }
+            })
+            .expect("valid instance");
+            let p = &result.progress;
+            match expected {
+                Some(opt) => {
+                    assert!(result.proven_optimal(), "seed {seed}: not proven");
+                    assert_eq!(p.upper_bound, opt, "seed {seed} (heuristic {heuristic})");
+                    let tour = p.best_tour.as_ref().expect("a tour");
+                    assert_eq!(check_tour(&instance, tour).expect("feasible"), opt);
+                }
+                None => assert!(p.best_tour.is_none(), "seed {seed}: tour for infeasible"),
+            }
+        }
+        feasible += usize::from(expected.is_some());
+    }
+    assert!(
+        feasible > 80,
+        "only {feasible} random instances were feasible"
+    );
+}
+
+#[test]
+fn bounds_are_built_in_slices_and_the_build_can_be_cancelled() {
+    let reference = references()
+        .into_iter()
+        .find(|r| r.instance == "e1x_4")
+        .expect("e1x_4 in reference.csv");
+    let instance = reference.load();
+    let options = ExactOptions {
+        heuristic: false,
+        ..ExactOptions::default()
+    };
+    // With 1 ms slices the build (about a second of work) must span many steps.
+    let mut solver = ExactSolver::new(&instance, options.clone()).unwrap();
+    assert!(solver.offer_incumbent(&reference.pcglns_tour, reference.pcglns_cost));
+    let mut steps = 0;
+    while solver.step(Duration::from_millis(1)) == SolverStatus::Running {
+        steps += 1;
+        assert!(solver.progress().lower_bound <= 3258.0);
+    }
+    assert!(
+        steps > 20,
+        "only {steps} steps: the bounds were built in one block"
+    );
+    assert!(solver.progress().gap == 0.0);
+
+    // Cancelled in the middle of the build: stops with a valid bound.
+    let mut cancelled = ExactSolver::new(&instance, options).unwrap();
+    for _ in 0..3 {
+        assert_eq!(
+            cancelled.step(Duration::from_millis(1)),
+            SolverStatus::Running
+        );
+    }
+    cancelled.cancel();
+    assert_eq!(
+        cancelled.step(Duration::from_secs(60)),
+        SolverStatus::Stopped
+    );
+    assert!(cancelled.progress().lower_bound <= 3258.0);
+}
