@@ -46,6 +46,7 @@ mod lattice;
 mod order;
 mod parse;
 mod solver;
+mod subset;
 
 pub use assignment::Assignment;
 pub use bnb::{solve_bnb, BnbOptions};
@@ -58,3 +59,4 @@ pub use parse::{ParseError, PcglnsResult, MAX_NODES};
 pub use solver::{
     solve, ExactOptions, ExactProgress, ExactResult, ExactSolver, SolverError, SolverStatus,
 };
+pub use subset::{subset_bound, SubsetBound, SubsetBoundError, SubsetBoundOptions};
