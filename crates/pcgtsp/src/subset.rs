@@ -186,7 +186,7 @@ fn farthest_insertion(
     let mut chosen: Vec<usize> = Vec::new();
     while chosen.len() < count {
         // Guide nodes of the subset, in tour order (the tour is closed at guide[0]).
-        let mut best: Option<(f64, usize)> = None;
+        let mut best: Option<((f64, f64), usize)> = None;
         for c in 0..m {
             if in_subset[c] || rejected[c] {
                 continue;
@@ -206,8 +206,12 @@ fn farthest_insertion(
                 increase =
                     increase.min(d[before * n + x] + d[x * n + after] - d[before * n + after]);
             }
-            if best.is_none_or(|(b, _)| increase > b) {
-                best = Some((increase, c));
+            // Ties (common where many arcs cost 0) go to the cluster with the most precedence
+            // relations: on heavily constrained instances those carry the cost.
+            let relations = (order.predecessors[c].len() + order.successors[c].len()) as f64;
+            let score = (increase, relations);
+            if best.is_none_or(|(b, _)| score > b) {
+                best = Some((score, c));
             }
         }
         let Some((_, c)) = best else {
