@@ -10,7 +10,8 @@
 //! - the precedence order's transitive closure and reduction ([`PrecedenceOrder`]);
 //! - an independent tour checker ([`check_tour`]) that every solver result goes through;
 //! - lower bounds: assignment bounds L1 / L2 on the residual problem and the pierce-group DP
-//!   over the lattice of order ideals ([`root_bounds`]);
+//!   over the lattice of order ideals ([`root_bounds`]); the subset bound, an exact solve of a
+//!   subset of the clusters under restricted shortest-path costs ([`subset_bound`]);
 //! - the exact solver: a DP over order ideals with node-level states, per-state bounding
 //!   against the incumbent, a memory cap and an anytime, resumable API ([`ExactSolver`],
 //!   [`solve`]); and the breadth-first branch-and-bound variant ([`solve_bnb`]).
