@@ -10,8 +10,8 @@
 //! - the precedence order's transitive closure and reduction ([`PrecedenceOrder`]);
 //! - an independent tour checker ([`check_tour`]) that every solver result goes through;
 //! - lower bounds: assignment bounds L1 / L2 on the residual problem and the pierce-group DP
-//!   over the lattice of order ideals ([`root_bounds`]); the subset bound, an exact solve of a
-//!   subset of the clusters under restricted shortest-path costs ([`subset_bound`]);
+//!   over the lattice of order ideals ([`root_bounds`]); the restricted bound: an exact solve of a
+//!   subset of the clusters under restricted shortest-path costs ([`restricted_bound`]);
 //! - the exact solver: a DP over order ideals with node-level states, per-state bounding
 //!   against the incumbent, a memory cap and an anytime, resumable API ([`ExactSolver`],
 //!   [`solve`]); and the breadth-first branch-and-bound variant ([`solve_bnb`]).
@@ -46,8 +46,8 @@ mod instance;
 mod lattice;
 mod order;
 mod parse;
+mod restricted;
 mod solver;
-mod subset;
 
 pub use assignment::Assignment;
 pub use bnb::{solve_bnb, BnbOptions};
@@ -57,7 +57,9 @@ pub use instance::Instance;
 pub use lattice::count_ideals;
 pub use order::{ClusterSet, OrderError, PrecedenceOrder};
 pub use parse::{ParseError, PcglnsResult, MAX_NODES};
+pub use restricted::{
+    restricted_bound, RestrictedBound, RestrictedBoundError, RestrictedBoundOptions,
+};
 pub use solver::{
     solve, ExactOptions, ExactProgress, ExactResult, ExactSolver, SolverError, SolverStatus,
 };
-pub use subset::{subset_bound, SubsetBound, SubsetBoundError, SubsetBoundOptions};

@@ -376,7 +376,7 @@ impl ExactSolver {
         }
     }
 
-    /// Offers a lower bound proven elsewhere (e.g. [`crate::subset_bound`]). The caller vouches
+    /// Offers a lower bound proven elsewhere (e.g. [`crate::restricted_bound`]). The caller vouches
     /// for its validity; it raises the reported bound and ends the search once it reaches the
     /// incumbent's cost.
     pub fn offer_lower_bound(&mut self, bound: f64) {

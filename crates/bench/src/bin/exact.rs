@@ -2,19 +2,19 @@
 //!
 //! `cargo run --release -p cutroute-bench --bin exact -- [--time-limit 60] [--filter NAME[,NAME…]]
 //! [--skip NAME] [--set industrial|pcgtsplib] [--no-l2] [--no-heuristic] [--memory-mb 2048] [--data DIR]
-//! [--alns-seconds 0] [--subset-seconds 0]`
+//! [--alns-seconds 0] [--restricted-seconds 0]`
 //!
 //! Within each instance's time limit, optionally runs first the ALNS heuristic
-//! (`--alns-seconds`, its tour seeds the exact search) and then the subset bound
-//! (`--subset-seconds`, guided by the best tour so far); the exact search gets the rest.
+//! (`--alns-seconds`, its tour seeds the exact search) and then the restricted bound
+//! (`--restricted-seconds`, guided by the best tour so far); the exact search gets the rest.
 //!
 //! Prints a Markdown table: instance size, number of order ideals, our upper and lower bounds,
 //! gap, proven optimality and time, next to the reference values of `reference.csv`.
 
 use cutroute_alns::{AlnsOptions, AlnsSolver};
 use cutroute_pcgtsp::{
-    check_tour, count_ideals, subset_bound, ExactOptions, ExactSolver, Instance, SolverStatus,
-    SubsetBoundOptions,
+    check_tour, count_ideals, restricted_bound, ExactOptions, ExactSolver, Instance,
+    RestrictedBoundOptions, SolverStatus,
 };
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
@@ -35,7 +35,7 @@ pub fn main() {
     let mut options = ExactOptions::default();
     let mut data = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/pcgtsp");
     let mut alns_seconds = 0.0f64;
-    let mut subset_seconds = 0.0f64;
+    let mut restricted_seconds = 0.0f64;
     let mut args = std::env::args().skip(1);
     while let Some(arg) = args.next() {
         match arg.as_str() {
@@ -63,11 +63,11 @@ pub fn main() {
                     .and_then(|v| v.parse().ok())
                     .expect("--alns-seconds SECONDS")
             }
-            "--subset-seconds" => {
-                subset_seconds = args
+            "--restricted-seconds" => {
+                restricted_seconds = args
                     .next()
                     .and_then(|v| v.parse().ok())
-                    .expect("--subset-seconds SECONDS")
+                    .expect("--restricted-seconds SECONDS")
             }
             "--data" => data = PathBuf::from(args.next().expect("--data DIR")),
             other => panic!("unknown argument {other}"),
@@ -91,7 +91,7 @@ pub fn main() {
             }
         })
         .collect();
-    println!("| set | instance | nodes | clusters | ideals | UB | LB | gap % | proven | time s | cpu s | states | subset LB (clusters) | pcglns | best_lb | known_opt |");
+    println!("| set | instance | nodes | clusters | ideals | UB | LB | gap % | proven | time s | cpu s | states | restricted LB (clusters) | pcglns | best_lb | known_opt |");
     println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     for row in rows {
         if let Some(f) = &filter {
@@ -117,12 +117,12 @@ pub fn main() {
         };
         let began = Instant::now();
         let cpu_before = cutroute_bench::process_cpu_seconds();
-        let (p, proven, states, subset_lb) = run(
+        let (p, proven, states, restricted_lb) = run(
             &instance,
             &options,
             limit,
             alns_seconds.min(limit),
-            subset_seconds,
+            restricted_seconds,
         );
         let wall = began.elapsed().as_secs_f64();
         let cpu = cutroute_bench::process_cpu_seconds() - cpu_before;
@@ -153,7 +153,7 @@ pub fn main() {
             wall,
             cpu,
             states,
-            subset_lb.unwrap_or_else(|| "–".to_string()),
+            restricted_lb.unwrap_or_else(|| "–".to_string()),
             row.pcglns_cost,
             row.best_lb,
             row.known_optimum,
@@ -162,15 +162,15 @@ pub fn main() {
     }
 }
 
-/// One instance within `limit` seconds: ALNS first, then the subset bound, then the exact
+/// One instance within `limit` seconds: ALNS first, then the restricted bound, then the exact
 /// search seeded with both. Returns the final progress, proven optimality, DP states created and
-/// the subset bound (if run).
+/// the restricted bound (if run).
 fn run(
     instance: &Instance,
     options: &ExactOptions,
     limit: f64,
     alns_seconds: f64,
-    subset_seconds: f64,
+    restricted_seconds: f64,
 ) -> (cutroute_pcgtsp::ExactProgress, bool, u64, Option<String>) {
     let began = Instant::now();
     let mut best: Option<(Vec<usize>, f64)> = None;
@@ -192,28 +192,28 @@ fn run(
     if let Some((tour, cost)) = &best {
         solver.offer_incumbent(tour, *cost);
     }
-    let mut subset_lb = None;
-    if subset_seconds > 0.0 {
-        // The subset bound needs a guide tour: the ALNS tour, or the solver's first one.
+    let mut restricted_lb = None;
+    if restricted_seconds > 0.0 {
+        // The restricted bound needs a guide tour: the ALNS tour, or the solver's first one.
         if best.is_none() {
             solver.step(Duration::from_millis(1));
         }
         if let Some(guide) = solver.progress().best_tour {
             let ub = solver.progress().upper_bound;
-            let seconds = subset_seconds.min(remaining(began));
-            let bound = subset_bound(
+            let seconds = restricted_seconds.min(remaining(began));
+            let bound = restricted_bound(
                 instance,
                 &guide,
                 ub,
-                &SubsetBoundOptions {
+                &RestrictedBoundOptions {
                     time_limit: Duration::from_secs_f64(seconds),
                     known_bound: solver.root_bound(),
-                    ..SubsetBoundOptions::default()
+                    ..RestrictedBoundOptions::default()
                 },
             )
             .expect("subset bound");
             solver.offer_lower_bound(bound.lower_bound);
-            subset_lb = Some(format!("{} ({})", bound.lower_bound, bound.clusters));
+            restricted_lb = Some(format!("{} ({})", bound.lower_bound, bound.clusters));
         }
     }
     let limit_left = remaining(began);
@@ -232,6 +232,6 @@ fn run(
         solver.progress(),
         proven,
         solver.states_created(),
-        subset_lb,
+        restricted_lb,
     )
 }

@@ -1,32 +1,33 @@
-//! The subset bound (metric closure + restriction to a subset of clusters, solved exactly):
+//! The restricted bound (metric closure + restriction to a subset of clusters, solved exactly):
 //! sound against known optima, published tours and brute force on small random instances.
 
 mod common;
 
 use common::{references, trusted_optimum};
 use cutroute_pcgtsp::{
-    check_tour, subset_bound, ExactOptions, ExactSolver, Instance, SolverStatus, SubsetBoundOptions,
+    check_tour, restricted_bound, ExactOptions, ExactSolver, Instance, RestrictedBoundOptions,
+    SolverStatus,
 };
 use std::time::Duration;
 
-fn options(seconds: f64) -> SubsetBoundOptions {
-    SubsetBoundOptions {
+fn options(seconds: f64) -> RestrictedBoundOptions {
+    RestrictedBoundOptions {
         time_limit: Duration::from_secs_f64(seconds),
-        ..SubsetBoundOptions::default()
+        ..RestrictedBoundOptions::default()
     }
 }
 
 /// Every subset bound is at most the known optimum, or the cost of the published PCGLNS tour
 /// where no optimum is known (p43.4: the trusted optimum 66848, see `common`).
 #[test]
-fn subset_bound_never_exceeds_optima_or_known_tours() {
+fn restricted_bound_never_exceeds_optima_or_known_tours() {
     let mut strong = 0;
     for r in references() {
         let instance = r.load();
         let tour_cost = check_tour(&instance, &r.pcglns_tour)
             .unwrap_or_else(|e| panic!("{}: published tour infeasible: {e}", r.instance));
         let limit = trusted_optimum(&r).unwrap_or(tour_cost);
-        let bound = subset_bound(&instance, &r.pcglns_tour, f64::INFINITY, &options(0.5))
+        let bound = restricted_bound(&instance, &r.pcglns_tour, f64::INFINITY, &options(0.5))
             .unwrap_or_else(|e| panic!("{}: {e}", r.instance));
         assert!(
             bound.lower_bound <= limit + 1e-6,
@@ -54,16 +55,16 @@ fn subset_bound_never_exceeds_optima_or_known_tours() {
     );
 }
 
-/// p43.1: the assignment bounds give ~740 against an optimum near 22,500; the subset bound
+/// p43.1: the assignment bounds give ~740 against an optimum near 22,500; the restricted bound
 /// must get within 5 % of the published best tour (22545) quickly.
 #[test]
-fn subset_bound_closes_p43_1() {
+fn restricted_bound_closes_p43_1() {
     let r = references()
         .into_iter()
         .find(|r| r.instance == "p43.1")
         .expect("p43.1 in reference.csv");
     let instance = r.load();
-    let bound = subset_bound(&instance, &r.pcglns_tour, f64::INFINITY, &options(20.0)).unwrap();
+    let bound = restricted_bound(&instance, &r.pcglns_tour, f64::INFINITY, &options(20.0)).unwrap();
     assert!(bound.lower_bound <= r.pcglns_cost);
     assert!(
         bound.lower_bound >= 0.95 * r.pcglns_cost,
@@ -189,7 +190,7 @@ fn brute_force(instance: &Instance) -> Option<(f64, Vec<usize>)> {
 /// Never above the brute-force optimum on random instances (metric or not); equal to it when
 /// the costs are metric and the subset holds every cluster.
 #[test]
-fn subset_bound_matches_brute_force_on_small_random_instances() {
+fn restricted_bound_matches_brute_force_on_small_random_instances() {
     let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
     let mut equal = 0;
     let mut checked = 0;
@@ -201,7 +202,7 @@ fn subset_bound_matches_brute_force_on_small_random_instances() {
             continue;
         };
         checked += 1;
-        let bound = subset_bound(&instance, &tour, f64::INFINITY, &options(5.0)).unwrap();
+        let bound = restricted_bound(&instance, &tour, f64::INFINITY, &options(5.0)).unwrap();
         assert!(
             bound.lower_bound <= optimum + 1e-9,
             "round {round}: bound {} above optimum {optimum}",
@@ -229,18 +230,18 @@ fn subset_bound_matches_brute_force_on_small_random_instances() {
 fn infeasible_guide_is_an_error() {
     let mut rng = Rng(7);
     let instance = random_instance(&mut rng, 4, true);
-    let err = subset_bound(&instance, &[0], f64::INFINITY, &options(1.0)).unwrap_err();
+    let err = restricted_bound(&instance, &[0], f64::INFINITY, &options(1.0)).unwrap_err();
     assert!(
         err.to_string().contains("guide tour is infeasible"),
         "{err}"
     );
 }
 
-/// p43.4: the subset bound proves the optimum 66848 of the file's integer weights, and handed to
+/// p43.4: the restricted bound proves the optimum 66848 of the file's integer weights, and handed to
 /// the exact solver as an external bound it ends the search as proven at once; on p43.1 it
 /// lifts the reported bound from the assignment bounds (~3 % of the optimum) to a gap ≤ 5 %.
 #[test]
-fn external_subset_bound_closes_the_gap_in_the_solver() {
+fn external_restricted_bound_closes_the_gap_in_the_solver() {
     for (name, seconds) in [("p43.4", 20.0), ("p43.1", 20.0)] {
         let r = references()
             .into_iter()
@@ -248,7 +249,7 @@ fn external_subset_bound_closes_the_gap_in_the_solver() {
             .expect("instance in reference.csv");
         let instance = r.load();
         let bound =
-            subset_bound(&instance, &r.pcglns_tour, r.pcglns_cost, &options(seconds)).unwrap();
+            restricted_bound(&instance, &r.pcglns_tour, r.pcglns_cost, &options(seconds)).unwrap();
         let limit = trusted_optimum(&r).unwrap_or(r.pcglns_cost);
         assert!(
             bound.lower_bound <= limit,
@@ -271,7 +272,7 @@ fn external_subset_bound_closes_the_gap_in_the_solver() {
         assert!(progress.lower_bound >= bound.lower_bound.min(progress.upper_bound));
         assert!(progress.lower_bound > root);
         if name == "p43.4" {
-            // The published tour costs 66857; the subset bound alone cannot close that gap, but
+            // The published tour costs 66857; the restricted bound alone cannot close that gap, but
             // it must be the optimum 66848 itself.
             assert_eq!(bound.lower_bound, 66848.0, "{name}");
             assert!(solver.offer_incumbent(&optimal_p43_4_tour(&instance), 66848.0));

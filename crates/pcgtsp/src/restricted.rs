@@ -1,4 +1,4 @@
-//! The subset bound: solve a smaller PCGTSP exactly and use its optimum as a lower bound.
+//! The restricted bound: solve a smaller PCGTSP exactly and use its optimum as a lower bound.
 //!
 //! Keep only a subset `S` of the clusters (always with the depot), ordered by the precedence
 //! relation restricted to `S`, and replace the arc costs by shortest-path distances `d_S` whose
@@ -26,9 +26,9 @@ use web_time::Instant;
 
 const INF: f64 = f64::INFINITY;
 
-/// Settings of [`subset_bound`].
+/// Settings of [`restricted_bound`].
 #[derive(Clone, Debug, PartialEq)]
-pub struct SubsetBoundOptions {
+pub struct RestrictedBoundOptions {
     /// Total time for all rounds.
     pub time_limit: Duration,
     /// Clusters (besides the depot) in the first round.
@@ -45,9 +45,9 @@ pub struct SubsetBoundOptions {
     pub known_bound: f64,
 }
 
-impl Default for SubsetBoundOptions {
+impl Default for RestrictedBoundOptions {
     fn default() -> Self {
-        SubsetBoundOptions {
+        RestrictedBoundOptions {
             time_limit: Duration::from_secs(10),
             first_size: 12,
             growth: 4,
@@ -58,9 +58,9 @@ impl Default for SubsetBoundOptions {
     }
 }
 
-/// Why the subset bound could not be computed.
+/// Why the restricted bound could not be computed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum SubsetBoundError {
+pub enum RestrictedBoundError {
     /// The precedence pairs are not a partial order with the depot first.
     #[error(transparent)]
     Order(#[from] OrderError),
@@ -69,9 +69,9 @@ pub enum SubsetBoundError {
     InfeasibleGuide(String),
 }
 
-/// The outcome of [`subset_bound`].
+/// The outcome of [`restricted_bound`].
 #[derive(Clone, Debug, PartialEq)]
-pub struct SubsetBound {
+pub struct RestrictedBound {
     /// The best lower bound over the rounds (rounded up for integral costs).
     pub lower_bound: f64,
     /// Clusters (besides the depot) of the round that gave it.
@@ -233,17 +233,18 @@ fn farthest_insertion(
     chosen
 }
 
-/// Computes the subset bound within `options.time_limit`, choosing subsets along `guide` (a
+/// Computes the restricted bound within `options.time_limit`, choosing subsets along `guide` (a
 /// feasible tour, 0-based nodes starting in the depot; the incumbent is a good choice).
 /// `stop_at` ends the rounds early once a bound this large is found (e.g. the incumbent's cost).
-pub fn subset_bound(
+pub fn restricted_bound(
     instance: &Instance,
     guide: &[usize],
     stop_at: f64,
-    options: &SubsetBoundOptions,
-) -> Result<SubsetBound, SubsetBoundError> {
+    options: &RestrictedBoundOptions,
+) -> Result<RestrictedBound, RestrictedBoundError> {
     let began = Instant::now();
-    check_tour(instance, guide).map_err(|e| SubsetBoundError::InfeasibleGuide(e.to_string()))?;
+    check_tour(instance, guide)
+        .map_err(|e| RestrictedBoundError::InfeasibleGuide(e.to_string()))?;
     let order = PrecedenceOrder::new(instance)?;
     // For choosing subsets: distances through any node.
     let d = metric_closure(instance, &|_| true);
@@ -252,7 +253,7 @@ pub fn subset_bound(
         .iter()
         .all(|c| !c.is_finite() || c.fract() == 0.0);
     let m = instance.clusters.len();
-    let mut result = SubsetBound {
+    let mut result = RestrictedBound {
         lower_bound: 0.0,
         clusters: 0,
         proven: false,
