@@ -10,9 +10,10 @@
 //! - the precedence order's transitive closure and reduction ([`PrecedenceOrder`]);
 //! - an independent tour checker ([`check_tour`]) that every solver result goes through;
 //! - lower bounds: assignment bounds L1 / L2 on the residual problem, the pierce-group DP
-//!   over the lattice of order ideals ([`root_bounds`]), and the subset DP (an exact
+//!   over the lattice of order ideals ([`root_bounds`]), the subset DP (an exact
 //!   node-level backward DP over a subset of the clusters, with penalised walks through the
-//!   others) that bounds every search state's completion;
+//!   others) that bounds every search state's completion, and the restricted bound: an exact
+//!   solve of a subset of the clusters under restricted shortest-path costs ([`restricted_bound`]);
 //! - the exact solver: a DP over order ideals with node-level states, per-state bounding
 //!   against the incumbent, a memory cap and an anytime, resumable API ([`ExactSolver`],
 //!   [`solve`]); and the breadth-first branch-and-bound variant ([`solve_bnb`]).
@@ -48,6 +49,7 @@ mod lattice;
 mod order;
 mod parse;
 mod prepare;
+mod restricted;
 mod solver;
 mod subset;
 
@@ -59,6 +61,9 @@ pub use instance::Instance;
 pub use lattice::count_ideals;
 pub use order::{ClusterSet, OrderError, PrecedenceOrder};
 pub use parse::{ParseError, PcglnsResult, MAX_NODES};
+pub use restricted::{
+    restricted_bound, RestrictedBound, RestrictedBoundError, RestrictedBoundOptions,
+};
 pub use solver::{
     solve, ExactOptions, ExactProgress, ExactResult, ExactSolver, SolverError, SolverStatus,
 };

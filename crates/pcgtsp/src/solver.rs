@@ -352,6 +352,8 @@ pub struct ExactSolver {
     phase: Phase,
     elapsed: Duration,
     cancelled: bool,
+    /// A lower bound proven outside the DP ([`ExactSolver::offer_lower_bound`]).
+    external_bound: f64,
 }
 
 impl ExactSolver {
@@ -398,6 +400,7 @@ impl ExactSolver {
             phase,
             elapsed: Duration::ZERO,
             cancelled: false,
+            external_bound: -INF,
         })
     }
 
@@ -423,6 +426,13 @@ impl ExactSolver {
         }
     }
 
+    /// Offers a lower bound proven elsewhere (e.g. [`crate::restricted_bound`]). The caller vouches
+    /// for its validity; it raises the reported bound and ends the search once it reaches the
+    /// incumbent's cost.
+    pub fn offer_lower_bound(&mut self, bound: f64) {
+        self.external_bound = self.external_bound.max(bound);
+    }
+
     /// Stops the search at the next `step`.
     pub fn cancel(&mut self) {
         self.cancelled = true;
@@ -444,6 +454,7 @@ impl ExactSolver {
             };
             lb = lb.min(run_lb);
         }
+        let lb = lb.max(self.external_bound);
         match self.phase {
             Phase::Done(SolverStatus::Finished {
                 proven_optimal: true,
@@ -515,6 +526,15 @@ impl ExactSolver {
             if began.elapsed() >= deadline {
                 self.elapsed += began.elapsed();
                 return SolverStatus::Running;
+            }
+            if self.external_bound >= self.incumbent.upper_bound {
+                // A bound from outside already meets the incumbent: it is optimal.
+                self.elapsed += began.elapsed();
+                let status = SolverStatus::Finished {
+                    proven_optimal: true,
+                };
+                self.phase = Phase::Done(status);
+                return status;
             }
             match &mut self.phase {
                 Phase::Heuristic { beam, engine } => {

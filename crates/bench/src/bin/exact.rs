@@ -1,14 +1,23 @@
 //! Benchmark: the exact PCGTSP solver on every instance of `shared/data/pcgtsp`.
 //!
 //! `cargo run --release -p cutroute-bench --bin exact -- [--time-limit 60] [--filter NAME[,NAME…]]
-//! [--skip NAME] [--set industrial|pcgtsplib] [--no-l2] [--no-heuristic] [--memory-mb 2048] [--data DIR]`
+//! [--skip NAME] [--set industrial|pcgtsplib] [--no-l2] [--no-heuristic] [--memory-mb 2048] [--data DIR]
+//! [--alns-seconds 0] [--restricted-seconds 0]`
+//!
+//! Within each instance's time limit, optionally runs first the ALNS heuristic
+//! (`--alns-seconds`, its tour seeds the exact search) and then the restricted bound
+//! (`--restricted-seconds`, guided by the best tour so far); the exact search gets the rest.
 //!
 //! Prints a Markdown table: instance size, number of order ideals, our upper and lower bounds,
 //! gap, proven optimality and time, next to the reference values of `reference.csv`.
 
-use cutroute_pcgtsp::{check_tour, count_ideals, solve, ExactOptions, Instance};
+use cutroute_alns::{AlnsOptions, AlnsSolver};
+use cutroute_pcgtsp::{
+    check_tour, count_ideals, restricted_bound, ExactOptions, ExactSolver, Instance,
+    RestrictedBoundOptions, SolverStatus,
+};
 use std::path::PathBuf;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 struct Row {
     set: String,
@@ -25,6 +34,8 @@ pub fn main() {
     let mut only_set: Option<String> = None;
     let mut options = ExactOptions::default();
     let mut data = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/pcgtsp");
+    let mut alns_seconds = 0.0f64;
+    let mut restricted_seconds = 0.0f64;
     let mut args = std::env::args().skip(1);
     while let Some(arg) = args.next() {
         match arg.as_str() {
@@ -45,6 +56,18 @@ pub fn main() {
                     .and_then(|v| v.parse::<usize>().ok())
                     .expect("--memory-mb MB")
                     << 20
+            }
+            "--alns-seconds" => {
+                alns_seconds = args
+                    .next()
+                    .and_then(|v| v.parse().ok())
+                    .expect("--alns-seconds SECONDS")
+            }
+            "--restricted-seconds" => {
+                restricted_seconds = args
+                    .next()
+                    .and_then(|v| v.parse().ok())
+                    .expect("--restricted-seconds SECONDS")
             }
             "--data" => data = PathBuf::from(args.next().expect("--data DIR")),
             other => panic!("unknown argument {other}"),
@@ -68,8 +91,8 @@ pub fn main() {
             }
         })
         .collect();
-    println!("| set | instance | nodes | clusters | ideals | UB | LB | gap % | proven | time s | cpu s | states | pcglns | best_lb | known_opt |");
-    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    println!("| set | instance | nodes | clusters | ideals | UB | LB | gap % | proven | time s | cpu s | states | restricted LB (clusters) | pcglns | best_lb | known_opt |");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     for row in rows {
         if let Some(f) = &filter {
             if !f.split(',').any(|f| row.instance.contains(f)) {
@@ -92,12 +115,17 @@ pub fn main() {
         } else {
             time_limit
         };
-        let mut opts = options.clone();
-        opts.time_limit = Some(Duration::from_secs_f64(limit));
+        let began = Instant::now();
         let cpu_before = cutroute_bench::process_cpu_seconds();
-        let result = solve(&instance, opts, &mut |_| {}).expect("solver");
+        let (p, proven, states, restricted_lb) = run(
+            &instance,
+            &options,
+            limit,
+            alns_seconds.min(limit),
+            restricted_seconds,
+        );
+        let wall = began.elapsed().as_secs_f64();
         let cpu = cutroute_bench::process_cpu_seconds() - cpu_before;
-        let p = &result.progress;
         if let Some(tour) = &p.best_tour {
             let cost = check_tour(&instance, tour).expect("solver returned an infeasible tour");
             assert!(
@@ -112,7 +140,7 @@ pub fn main() {
             _ => "",
         };
         println!(
-            "| {} | {} | {} | {} | {} | {} | {} | {:.2} | {} | {:.2} | {:.2} | {} | {} | {} | {}{} |",
+            "| {} | {} | {} | {} | {} | {} | {} | {:.2} | {} | {:.2} | {:.2} | {} | {} | {} | {} | {}{} |",
             row.set,
             row.instance,
             instance.node_count,
@@ -121,14 +149,89 @@ pub fn main() {
             p.upper_bound,
             p.lower_bound,
             p.gap * 100.0,
-            if result.proven_optimal() { "yes" } else { "no" },
-            p.elapsed.as_secs_f64(),
+            if proven { "yes" } else { "no" },
+            wall,
             cpu,
-            result.states_created,
+            states,
+            restricted_lb.unwrap_or_else(|| "–".to_string()),
             row.pcglns_cost,
             row.best_lb,
             row.known_optimum,
             flag,
         );
     }
+}
+
+/// One instance within `limit` seconds: ALNS first, then the restricted bound, then the exact
+/// search seeded with both. Returns the final progress, proven optimality, DP states created and
+/// the restricted bound (if run).
+fn run(
+    instance: &Instance,
+    options: &ExactOptions,
+    limit: f64,
+    alns_seconds: f64,
+    restricted_seconds: f64,
+) -> (cutroute_pcgtsp::ExactProgress, bool, u64, Option<String>) {
+    let began = Instant::now();
+    let mut best: Option<(Vec<usize>, f64)> = None;
+    if alns_seconds > 0.0 {
+        let alns_options = AlnsOptions {
+            time_limit: Some(Duration::from_secs_f64(alns_seconds)),
+            ..AlnsOptions::default()
+        };
+        let mut alns = AlnsSolver::new(instance, alns_options).expect("ALNS accepts the instance");
+        while alns.step(Duration::from_millis(50)) == cutroute_alns::SolverStatus::Running {}
+        best = alns.best().map(|(t, c)| (t.to_vec(), c));
+    }
+    // The solver's own beam search still runs after ALNS (unless `--no-heuristic`): with a
+    // short ALNS budget it sometimes finds the better tour (ESC47), and its tours prune the DP.
+    let mut opts = options.clone();
+    let remaining = |began: Instant| (limit - began.elapsed().as_secs_f64()).max(0.0);
+    opts.time_limit = Some(Duration::from_secs_f64(remaining(began)));
+    let mut solver = ExactSolver::new(instance, opts.clone()).expect("solver");
+    if let Some((tour, cost)) = &best {
+        solver.offer_incumbent(tour, *cost);
+    }
+    let mut restricted_lb = None;
+    if restricted_seconds > 0.0 {
+        // The restricted bound needs a guide tour: the ALNS tour, or the solver's first one.
+        if best.is_none() {
+            solver.step(Duration::from_millis(1));
+        }
+        if let Some(guide) = solver.progress().best_tour {
+            let ub = solver.progress().upper_bound;
+            let seconds = restricted_seconds.min(remaining(began));
+            let bound = restricted_bound(
+                instance,
+                &guide,
+                ub,
+                &RestrictedBoundOptions {
+                    time_limit: Duration::from_secs_f64(seconds),
+                    known_bound: solver.root_bound(),
+                    ..RestrictedBoundOptions::default()
+                },
+            )
+            .expect("subset bound");
+            solver.offer_lower_bound(bound.lower_bound);
+            restricted_lb = Some(format!("{} ({})", bound.lower_bound, bound.clusters));
+        }
+    }
+    let limit_left = remaining(began);
+    let step_until = Instant::now() + Duration::from_secs_f64(limit_left);
+    let mut status = SolverStatus::Running;
+    while status == SolverStatus::Running && Instant::now() < step_until {
+        status = solver.step(Duration::from_millis(100));
+    }
+    let proven = matches!(
+        status,
+        SolverStatus::Finished {
+            proven_optimal: true
+        }
+    );
+    (
+        solver.progress(),
+        proven,
+        solver.states_created(),
+        restricted_lb,
+    )
 }
