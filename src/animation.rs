@@ -252,7 +252,7 @@ pub fn AnimationControls(animation: Animation) -> impl IntoView {
                 disabled=absent
                 on:click=move |_| step(false)
             >
-                "⏮"
+                "‹ Prev"
             </button>
             <button
                 id="anim-play"
@@ -261,7 +261,7 @@ pub fn AnimationControls(animation: Animation) -> impl IntoView {
                 disabled=absent
                 on:click=move |_| animation.toggle()
             >
-                {move || if playing.get() { "⏸" } else { "▶" }}
+                {move || if playing.get() { "Pause" } else { "Play" }}
             </button>
             <button
                 id="anim-next"
@@ -270,7 +270,7 @@ pub fn AnimationControls(animation: Animation) -> impl IntoView {
                 disabled=absent
                 on:click=move |_| step(true)
             >
-                "⏭"
+                "Next ›"
             </button>
             <label class="scrub">
                 <span class="visually-hidden">"Machine time"</span>
