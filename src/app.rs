@@ -231,7 +231,6 @@ pub fn App() -> impl IntoView {
     let open_sample = move |file_name: String| {
         let request_id = take_id();
         sample.set(file_name.clone());
-        last_file.set(None);
         leptos::task::spawn_local(async move {
             let url = format!("./assets/samples/{file_name}");
             match fetch_bytes(&url).await {
@@ -425,7 +424,10 @@ pub fn App() -> impl IntoView {
                     id="sample"
                     aria-label="Sample nest"
                     prop:value=move || sample.get()
-                    on:change=move |ev| open_sample(event_target_value(&ev))
+                    on:change=move |ev| {
+                        last_file.set(None);
+                        open_sample(event_target_value(&ev));
+                    }
                 >
                     {SAMPLES
                         .iter()
@@ -552,6 +554,20 @@ pub fn App() -> impl IntoView {
                 }
             >
                 {move || open_error.get().map(|e| view! { <p class="error" role="alert">{e}</p> })}
+                // A local file cannot be reopened without the user: say which one it was.
+                {move || {
+                    last_file
+                        .get()
+                        .filter(|f| file_name.with(|shown| shown.as_ref() != Some(f)))
+                        .map(|f| {
+                            view! {
+                                <p id="last-file" class="note">
+                                    "Last time " <strong>{f}</strong>
+                                    " was open: choose it again with Open files… (the sample is shown meanwhile)"
+                                </p>
+                            }
+                        })
+                }}
                 <NestView
                     nest=shown_nest
                     route=shown_route

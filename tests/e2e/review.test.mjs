@@ -199,6 +199,18 @@ test('settings and layers survive a reload; a link opens a sample with solver se
   assert.equal(await page.inputValue('#step'), '20');
   assert.equal(await page.isChecked('#layer-arrows'), false);
   assert.match(await page.getAttribute('#nest-view', 'class'), /hide-arrows/);
+  assert.equal(await page.locator('#last-file').count(), 0, 'a sample was open: nothing to remind');
+  // A local file is remembered by name (browsers cannot reopen it alone).
+  const local = path.resolve(projectRoot, '..', 'shared', 'data', 'nests', 'dbs', 'nested.dbs');
+  assert.ok(fs.existsSync(local), `missing test file ${local}`);
+  await page.setInputFiles('#file-input', local);
+  await fileShown(page, 'nested.dbs (DBS binary)');
+  await page.reload();
+  await fileShown(page, 'test1');
+  assert.match(await page.locator('#last-file').textContent(), /Last time nested\.dbs was open/);
+  await page.selectOption('#sample', 'E1X_6_01.dbs.json');
+  await fileShown(page, 'E1X_6_01');
+  assert.equal(await page.locator('#last-file').count(), 0, 'choosing a sample forgets the file');
   await context.close();
 
   // A link in a fresh browser profile.
