@@ -2,7 +2,11 @@
 //!
 //! ```text
 //! cutroute inspect FILE [--json]
-//! cutroute convert IN OUT            # .dbs, .dbs.json / .json, .svg, chosen by extension
+//! cutroute convert IN OUT [--to dbs|json|svg|gcode|html]   # default: by OUT's extension
+//!                  [--solver nearest|ccp|heuristic|discrete] [--time-limit S] [--seed N] [--step MM]
+//!                  [--incremental] [--arcs ij|r|lines] [--decimals N] [--line-numbers]
+//!                  [--feed MM_PER_MIN] [--dwell S] [--torch-on CODE] [--torch-off CODE]
+//! cutroute generate --contours N [--seed S] --out FILE   # synthetic nest as geometry JSON
 //! cutroute solve FILE --solver nearest|ccp|heuristic|exact|discrete [--time-limit S] [--seed N]
 //!                     [--ub N] [--step MM] [--json]
 //! ```
@@ -38,12 +42,43 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
-    /// Convert a nest between formats chosen by the output's extension (.dbs, .json, .svg).
+    /// Convert a nest between formats (.dbs, .json, .svg), or route it and write the route as
+    /// G-code (.nc, .gcode, .ngc, .tap) or a standalone HTML page (.html).
     Convert {
         /// The file to read (any supported nest format).
         input: PathBuf,
         /// The file to write.
         output: PathBuf,
+        /// Output format: dbs, json, svg, gcode or html (default: from the output's extension).
+        #[arg(long)]
+        to: Option<String>,
+        /// Solver of the route for gcode/html: nearest, ccp, heuristic or discrete (default: the
+        /// route the file holds, else ccp).
+        #[arg(long)]
+        solver: Option<String>,
+        /// Wall-clock limit of the solver, seconds.
+        #[arg(long, default_value_t = 10.0)]
+        time_limit: f64,
+        /// Seed of the solver's random choices.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Spacing of candidate pierce points for the discrete solvers, mm.
+        #[arg(long, default_value_t = 50.0)]
+        step: f64,
+        #[command(flatten)]
+        gcode: GcodeArgs,
+    },
+    /// Write a seeded synthetic nest (geometry JSON) for tests and benchmarks.
+    Generate {
+        /// Number of contours.
+        #[arg(long)]
+        contours: usize,
+        /// Seed of the generator.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// The file to write.
+        #[arg(long)]
+        out: PathBuf,
     },
     /// Route a nest or solve a PCGTSP instance.
     Solve {
@@ -74,7 +109,36 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let outcome = match cli.command {
         Command::Inspect { file, json } => inspect(&file, json),
-        Command::Convert { input, output } => convert(&input, &output),
+        Command::Convert {
+            input,
+            output,
+            to,
+            solver,
+            time_limit,
+            seed,
+            step,
+            gcode,
+        } => {
+            let params = SolverParams {
+                time_limit_s: time_limit,
+                seed,
+                discretisation_step_mm: step,
+                initial_upper_bound: None,
+            };
+            convert(
+                &input,
+                &output,
+                to.as_deref(),
+                solver.as_deref(),
+                params,
+                &gcode,
+            )
+        }
+        Command::Generate {
+            contours,
+            seed,
+            out,
+        } => generate(contours, seed, &out),
         Command::Solve {
             file,
             solver,
@@ -159,7 +223,76 @@ fn nest_summary(format: &str, nest: &Nest) -> Value {
     })
 }
 
-fn convert(input: &Path, output: &Path) -> Result<(), String> {
+/// G-code settings of `convert --to gcode` (see `cutroute_gcode::GcodeOptions`).
+#[derive(clap::Args)]
+struct GcodeArgs {
+    /// Incremental coordinates (G91) instead of absolute (G90).
+    #[arg(long)]
+    incremental: bool,
+    /// Arcs as G02/G03 with I/J ("ij"), with R ("r"), or as G01 chords ("lines").
+    #[arg(long, default_value = "ij")]
+    arcs: String,
+    /// Largest chord deviation of --arcs lines, mm.
+    #[arg(long, default_value_t = 0.01)]
+    chord_tolerance: f64,
+    /// Decimals of coordinates.
+    #[arg(long, default_value_t = 3)]
+    decimals: usize,
+    /// Number the lines (N10, N20, …).
+    #[arg(long)]
+    line_numbers: bool,
+    /// Cutting feed rate, mm/min (default: the machine's cutting speed).
+    #[arg(long)]
+    feed: Option<f64>,
+    /// Pierce dwell, seconds (default: the machine's pierce time).
+    #[arg(long)]
+    dwell: Option<f64>,
+    /// Torch-on line.
+    #[arg(long, default_value = "M03")]
+    torch_on: String,
+    /// Torch-off line.
+    #[arg(long, default_value = "M05")]
+    torch_off: String,
+}
+
+impl GcodeArgs {
+    fn options(&self) -> Result<cutroute_gcode::GcodeOptions, String> {
+        use cutroute_gcode::{ArcOutput, DistanceMode, GcodeOptions};
+        let defaults = GcodeOptions::default();
+        let arcs = match self.arcs.as_str() {
+            "ij" => ArcOutput::CentreOffsets,
+            "r" => ArcOutput::Radius,
+            "lines" => ArcOutput::Lines {
+                tolerance_mm: self.chord_tolerance,
+            },
+            other => return Err(format!("unknown --arcs {other:?} (ij, r, lines)")),
+        };
+        Ok(GcodeOptions {
+            distance_mode: if self.incremental {
+                DistanceMode::Incremental
+            } else {
+                DistanceMode::Absolute
+            },
+            arcs,
+            decimals: self.decimals,
+            line_numbers: self.line_numbers,
+            cut_feed_mm_per_min: self.feed.unwrap_or(defaults.cut_feed_mm_per_min),
+            pierce_dwell_s: self.dwell.unwrap_or(defaults.pierce_dwell_s),
+            torch_on: self.torch_on.clone(),
+            torch_off: self.torch_off.clone(),
+            ..defaults
+        })
+    }
+}
+
+fn convert(
+    input: &Path,
+    output: &Path,
+    to: Option<&str>,
+    solver: Option<&str>,
+    params: SolverParams,
+    gcode: &GcodeArgs,
+) -> Result<(), String> {
     let document = open(input)?;
     let Problem::Nest { nest, .. } = &document.problem else {
         return Err(format!(
@@ -168,14 +301,46 @@ fn convert(input: &Path, output: &Path) -> Result<(), String> {
         ));
     };
     let name = output.to_string_lossy().to_lowercase();
-    let bytes: Vec<u8> = if name.ends_with(".dbs") {
-        cutroute_formats::write_dbs(nest).map_err(|e| e.to_string())?
-    } else if name.ends_with(".json") {
-        cutroute_formats::write_geometry_json(nest)
+    let format = match to {
+        Some(format) => format.to_string(),
+        None => [
+            (".dbs", "dbs"),
+            (".json", "json"),
+            (".svg", "svg"),
+            (".nc", "gcode"),
+            (".gcode", "gcode"),
+            (".ngc", "gcode"),
+            (".tap", "gcode"),
+            (".html", "html"),
+            (".htm", "html"),
+        ]
+        .iter()
+        .find(|(extension, _)| name.ends_with(extension))
+        .map(|(_, format)| format.to_string())
+        .ok_or_else(|| {
+            format!(
+                "{}: unknown output extension (use .dbs, .dbs.json/.json, .svg, .nc/.gcode/.ngc/.tap, .html or --to)",
+                output.display()
+            )
+        })?,
+    };
+    // The route of the G-code and HTML outputs: solved when asked, else the file's own.
+    let routed = || -> Result<Route, String> {
+        let route = match (solver, &document.route) {
+            (None, Some(route)) => route.clone(),
+            (name, _) => solved_route(&document, name.unwrap_or("ccp"), params.clone())?,
+        };
+        route
+            .validate(nest, 1e-6 * nest_scale(nest))
+            .map_err(|e| format!("invalid route: {e}"))?;
+        Ok(route)
+    };
+    let bytes: Vec<u8> = match format.as_str() {
+        "dbs" => cutroute_formats::write_dbs(nest).map_err(|e| e.to_string())?,
+        "json" => cutroute_formats::write_geometry_json(nest)
             .map_err(|e| e.to_string())?
-            .into_bytes()
-    } else if name.ends_with(".svg") {
-        match &document.route {
+            .into_bytes(),
+        "svg" => match &document.route {
             Some(route) => {
                 cutroute_formats::route_svg(nest, route, &cutroute_formats::SvgOptions::default())
                     .map_err(|e| e.to_string())?
@@ -184,14 +349,62 @@ fn convert(input: &Path, output: &Path) -> Result<(), String> {
                 cutroute_formats::nest_svg(nest, None, &cutroute_formats::SvgOptions::default())
             }
         }
-        .into_bytes()
-    } else {
-        return Err(format!(
-            "{}: unknown output extension (use .dbs, .dbs.json/.json or .svg)",
-            output.display()
-        ));
+        .into_bytes(),
+        "gcode" => {
+            let options = gcode.options()?;
+            cutroute_gcode::route_gcode(nest, &routed()?, &options)
+                .map_err(|e| e.to_string())?
+                .into_bytes()
+        }
+        "html" => {
+            let options = cutroute_formats::HtmlOptions {
+                title: input
+                    .file_name()
+                    .map_or_else(|| "route".into(), |n| n.to_string_lossy().into_owned()),
+                ..Default::default()
+            };
+            cutroute_formats::route_html(nest, &routed()?, &options)
+                .map_err(|e| e.to_string())?
+                .into_bytes()
+        }
+        other => {
+            return Err(format!(
+                "unknown output format {other:?} (dbs, json, svg, gcode, html)"
+            ))
+        }
     };
     std::fs::write(output, bytes).map_err(|e| format!("{}: {e}", output.display()))
+}
+
+/// Routes the document's nest with the named solver and returns the best route found.
+fn solved_route(
+    document: &Document,
+    solver_name: &str,
+    params: SolverParams,
+) -> Result<Route, String> {
+    let solver = match solver_name {
+        "discrete" => SolverKind::Heuristic,
+        name => SolverKind::from_name(name).ok_or_else(|| {
+            format!("unknown solver {name:?} (nearest, ccp, heuristic, discrete)")
+        })?,
+    };
+    let request = JobRequest {
+        job_id: 1,
+        problem: document.problem.clone(),
+        solver,
+        params,
+    };
+    let mut job = start_job(&request).map_err(|e| e.to_string())?;
+    run_to_end(job.as_mut(), &mut |_| {})
+        .route
+        .ok_or_else(|| format!("the {solver_name} solver found no route"))
+}
+
+/// Writes `generate_nest(contours, seed)` as geometry JSON.
+fn generate(contours: usize, seed: u64, out: &Path) -> Result<(), String> {
+    let nest = cutroute_geometry::generate_nest(contours, seed);
+    let text = cutroute_formats::write_geometry_json(&nest).map_err(|e| e.to_string())?;
+    std::fs::write(out, text).map_err(|e| format!("{}: {e}", out.display()))
 }
 
 fn solve(

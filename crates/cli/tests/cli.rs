@@ -163,3 +163,129 @@ fn solve_ccp_prints_a_checked_route() {
     assert_eq!(v["pierces"], 16);
     assert_eq!(v["route"].as_array().unwrap().len(), 16);
 }
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("cutroute-export-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+#[test]
+fn convert_to_gcode_writes_the_solved_route() {
+    let source = data("nests/dbs-json/E1X_6_01.dbs.json");
+    let solved = json(&[
+        "solve",
+        source.to_str().unwrap(),
+        "--solver",
+        "nearest",
+        "--json",
+    ]);
+    for (file, extra) in [
+        ("e1x.nc", vec![]),
+        (
+            "e1x.txt",
+            vec!["--to", "gcode", "--incremental", "--arcs", "r"],
+        ),
+    ] {
+        let out = scratch(file);
+        let mut args = vec![
+            "convert",
+            source.to_str().unwrap(),
+            out.to_str().unwrap(),
+            "--solver",
+            "nearest",
+            "--decimals",
+            "6",
+        ];
+        args.extend(extra);
+        let (ok, _, stderr) = cutroute(&args);
+        assert!(ok, "{stderr}");
+        let text = std::fs::read_to_string(&out).unwrap();
+        // The nest's home point is the origin, where the reader starts by default.
+        let program = cutroute_gcode::read_gcode(&text, &cutroute_gcode::ReadOptions::default())
+            .unwrap_or_else(|e| panic!("{file}: {e}"));
+        assert_eq!(
+            program.pierce_count() as u64,
+            solved["pierces"].as_u64().unwrap()
+        );
+        let idle = solved["idle_length"].as_f64().unwrap();
+        let cut = solved["cut_length"].as_f64().unwrap();
+        assert!(
+            (program.idle_length() - idle).abs() < 1e-3,
+            "{file}: idle {} vs {idle}",
+            program.idle_length()
+        );
+        assert!(
+            (program.cut_length() - cut).abs() < 1e-3,
+            "{file}: cut {} vs {cut}",
+            program.cut_length()
+        );
+        assert!(
+            (program.dwell_time() - 16.0 * 7.0).abs() < 1e-9,
+            "one default dwell per pierce"
+        );
+    }
+}
+
+#[test]
+fn convert_to_html_writes_a_standalone_page() {
+    let source = data("nests/dbs/nested.dbs");
+    let out = scratch("nested.html");
+    let (ok, _, stderr) = cutroute(&[
+        "convert",
+        source.to_str().unwrap(),
+        out.to_str().unwrap(),
+        "--solver",
+        "nearest",
+    ]);
+    assert!(ok, "{stderr}");
+    let page = std::fs::read_to_string(&out).unwrap();
+    assert!(page.starts_with("<!DOCTYPE html>") && page.trim_end().ends_with("</html>"));
+    assert!(!page.contains("http") && !page.contains("src="));
+    // nested.dbs: 57 parts of which one is the sheet, 88 contours of which one is the sheet's.
+    assert_eq!(page.matches("<circle class=\"pierce\"").count(), 87);
+    assert_eq!(page.matches("<path class=\"part\"").count(), 56);
+    assert!(page.contains("id=\"tool-head\""));
+}
+
+#[test]
+fn convert_refuses_unknown_formats_and_solvers() {
+    let source = data("nests/dbs-json/E1X_6_01.dbs.json");
+    let out = scratch("e1x.gcode");
+    let (ok, _, stderr) = cutroute(&[
+        "convert",
+        source.to_str().unwrap(),
+        out.to_str().unwrap(),
+        "--solver",
+        "magic",
+    ]);
+    assert!(!ok && stderr.contains("unknown solver"), "{stderr}");
+    let (ok, _, stderr) = cutroute(&[
+        "convert",
+        source.to_str().unwrap(),
+        out.to_str().unwrap(),
+        "--to",
+        "pdf",
+    ]);
+    assert!(!ok && stderr.contains("unknown output format"), "{stderr}");
+}
+
+#[test]
+fn generate_writes_a_seeded_nest() {
+    let out = scratch("generated.json");
+    let (ok, _, stderr) = cutroute(&[
+        "generate",
+        "--contours",
+        "300",
+        "--seed",
+        "5",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stderr}");
+    let v = json(&["inspect", out.to_str().unwrap(), "--json"]);
+    // Geometry JSON stores the sheet as the first part: 300 contours plus the sheet's.
+    assert_eq!(v["contours"], 301);
+    let expected = cutroute_geometry::generate_nest(300, 5);
+    assert_eq!(v["parts"].as_u64(), Some(expected.parts.len() as u64 + 1));
+}

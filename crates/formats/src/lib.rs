@@ -8,6 +8,7 @@
 //! | RouteManager task (`rm-task.json`, Г.2) | [`read_task_json`] → [`RmTask`] | [`write_task_json`] |
 //! | RouteManager result (`rm-result.json`, Г.3) | [`read_result_json`] → [`RmResult`] | [`write_result_json`], [`RmResult::from_route`] |
 //! | SVG | — | [`nest_svg`] |
+//! | standalone HTML (animated route) | — | [`route_html`], [`toolpath_html`] |
 //!
 //! [`detect`] recognises a format from content and [`read_nest`] reads a nest from whichever
 //! format holds one. Every reader returns a typed error saying what is wrong and where (byte
@@ -45,6 +46,7 @@ mod dbs;
 mod detect;
 mod geom;
 mod geometry_json;
+mod html_export;
 mod json;
 mod result_json;
 mod svg_export;
@@ -64,6 +66,7 @@ pub use geometry_json::{
     parse_geometry_json, read_geometry_json, read_geometry_json_with, write_geometry_json,
     GeometryJsonOptions, GeometryJsonPart,
 };
+pub use html_export::{route_html, toolpath_html, HtmlExportError, HtmlOptions};
 pub use json::{JsonError, JsonWriteError};
 pub use result_json::{
     read_result_json, route_moves, write_result_json, Job, MoveKind, ResultExportOptions,

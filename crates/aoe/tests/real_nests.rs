@@ -1,0 +1,75 @@
+//! Plane graphs of the real nests in `shared/data/nests`: every component is plane, and the
+//! edges account for every contour's perimeter exactly once per contour they belong to.
+
+use cutroute_aoe::{PlanGraph, PlanOptions};
+use cutroute_geometry::Nest;
+use std::path::PathBuf;
+
+fn load(relative: &str) -> Nest {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/data/nests")
+        .join(relative);
+    let bytes = std::fs::read(&path)
+        .unwrap_or_else(|e| panic!("required test data {} is missing: {e}", path.display()));
+    if relative.ends_with(".tfnesting") {
+        cutroute_cad::tflex::read_tfnesting(&bytes)
+            .unwrap()
+            .remove(0)
+    } else {
+        cutroute_formats::read_nest(&bytes).unwrap()
+    }
+}
+
+#[test]
+fn real_nests_give_plane_graphs_that_account_for_every_contour() {
+    let options = PlanOptions::default();
+    let mut total_common = 0;
+    for name in [
+        "dbs/nested.dbs",
+        "dbs/seven.dbs",
+        "dbs/test0.json.dbs",
+        "dbs-json/E1X_6_01.dbs.json",
+        "dbs-json/test1.dbs.json",
+        "tflex/Nest01.tfnesting",
+        "tflex/Nest02.tfnesting",
+        "tflex/Nest03.tfnesting",
+    ] {
+        let nest = load(name);
+        let plan = PlanGraph::from_nest(&nest, &options).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let components = plan.components().unwrap_or_else(|e| panic!("{name}: {e}"));
+        let g = plan.graph();
+        assert_eq!(
+            components.iter().map(|c| c.edges.len()).sum::<usize>(),
+            g.edge_count()
+        );
+        let perimeters: f64 = nest
+            .parts
+            .iter()
+            .flat_map(|p| &p.contours)
+            .map(|c| c.perimeter())
+            .sum();
+        let covered: f64 = (0..g.edge_count())
+            .map(|e| {
+                let length: f64 = plan.edge_spans(e).iter().map(|s| s.length()).sum();
+                length * plan.edge_contours(e).len() as f64
+            })
+            .sum();
+        let slack = 1e-7 * perimeters + 10.0 * options.tolerance * nest.contour_count() as f64;
+        assert!(
+            (covered - perimeters).abs() <= slack,
+            "{name}: {covered} vs {perimeters}"
+        );
+        let chains = plan.route().unwrap_or_else(|e| panic!("{name}: {e}"));
+        plan.check_route(&chains)
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        total_common += (0..g.edge_count())
+            .filter(|&e| plan.edge_contours(e).len() > 1)
+            .count();
+        if name == "tflex/Nest01.tfnesting" {
+            // Five parts in a row touching along y = 0: one connected cluster.
+            assert_eq!(components.len(), 1);
+            assert!((0..g.vertex_count()).all(|v| g.degree(v) == 3));
+        }
+    }
+    assert!(total_common > 0);
+}

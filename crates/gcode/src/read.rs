@@ -1,0 +1,775 @@
+//! The reader: the tool motion of a G-code program.
+//!
+//! It understands what [`crate::write_gcode`] writes and the common variants of hand-written and
+//! other post-processors' programs: `G00`–`G03` (arcs by `I`/`J` or `R`, full circles), `G04`
+//! dwell (`P` or `X` seconds), `G20`/`G21` (inches are converted to mm), `G90`/`G91`,
+//! `G90.1`/`G91.1` (absolute or incremental arc centres), `N` line numbers, `( )` and `;`
+//! comments, `%` tape marks, block delete `/` (the block is executed), modal motion (a line of
+//! bare coordinates continues the last motion). Harmless modal codes (`G17`, `G40`, `G49`,
+//! `G54`–`G59`, `G61`, `G64`, `G80`, `G94`) are accepted; codes that would change the meaning of
+//! the motion (other planes, canned cycles, homing, …) are refused with their location. Z and the
+//! rotary axes are ignored: the motion is the head's path in the sheet's plane.
+
+use std::f64::consts::{PI, TAU};
+
+use cutroute_geometry::{Point, Span, ToolMove, Toolpath};
+use thiserror::Error;
+
+/// Settings of [`read_gcode`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct ReadOptions {
+    /// Where the head stands when the program begins (incremental programs start from here).
+    pub start: Point,
+    /// M numbers that switch the torch on (`M03` = 3).
+    pub torch_on: Vec<u32>,
+    /// M numbers that switch it off.
+    pub torch_off: Vec<u32>,
+    /// Largest difference between an arc's start radius and end radius, mm (arcs written with
+    /// rounded coordinates never match exactly).
+    pub arc_tolerance_mm: f64,
+}
+
+impl Default for ReadOptions {
+    /// Starts at the origin; `M03`/`M04` torch on, `M05` off; arcs tolerate 0.01 mm.
+    fn default() -> Self {
+        ReadOptions {
+            start: Point::new(0.0, 0.0),
+            torch_on: vec![3, 4],
+            torch_off: vec![5],
+            arc_tolerance_mm: 0.01,
+        }
+    }
+}
+
+/// One thing the machine does, with the (1-based) line it comes from.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Motion {
+    /// `G00`: a rapid straight move.
+    Rapid {
+        /// Where it starts.
+        from: Point,
+        /// Where it ends.
+        to: Point,
+        /// Line of the program.
+        line: usize,
+    },
+    /// `G01`/`G02`/`G03`: a move at feed rate, straight or along an arc (an arc of more than
+    /// 180° is given as two spans).
+    Feed {
+        /// The path (bulge > 0 for `G03`, counter-clockwise).
+        span: Span,
+        /// The torch was on.
+        tool_on: bool,
+        /// Feed rate in force, mm/min, if one was set.
+        feed: Option<f64>,
+        /// Line of the program.
+        line: usize,
+    },
+    /// The torch switched on (a pierce).
+    TorchOn {
+        /// Where the head stands.
+        at: Point,
+        /// Line of the program.
+        line: usize,
+    },
+    /// The torch switched off.
+    TorchOff {
+        /// Where the head stands.
+        at: Point,
+        /// Line of the program.
+        line: usize,
+    },
+    /// `G04`: the head waits.
+    Dwell {
+        /// For how long, seconds.
+        seconds: f64,
+        /// Line of the program.
+        line: usize,
+    },
+}
+
+/// The tool motion of a program.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Program {
+    /// Where the head starts.
+    pub start: Point,
+    /// What the machine does, in order.
+    pub motions: Vec<Motion>,
+    /// Where the head ends.
+    pub end: Point,
+}
+
+impl Program {
+    /// Length of the moves with the torch off (rapids and feed moves), mm.
+    pub fn idle_length(&self) -> f64 {
+        self.motions
+            .iter()
+            .map(|m| match m {
+                Motion::Rapid { from, to, .. } => from.distance(*to),
+                Motion::Feed {
+                    span,
+                    tool_on: false,
+                    ..
+                } => span.length(),
+                _ => 0.0,
+            })
+            .sum()
+    }
+
+    /// Length cut with the torch on, mm.
+    pub fn cut_length(&self) -> f64 {
+        self.motions
+            .iter()
+            .map(|m| match m {
+                Motion::Feed {
+                    span,
+                    tool_on: true,
+                    ..
+                } => span.length(),
+                _ => 0.0,
+            })
+            .sum()
+    }
+
+    /// Where the torch was switched on, in order.
+    pub fn pierce_points(&self) -> Vec<Point> {
+        self.motions
+            .iter()
+            .filter_map(|m| match m {
+                Motion::TorchOn { at, .. } => Some(*at),
+                _ => None,
+            })
+            .collect()
+    }
+
+    /// Number of times the torch was switched on.
+    pub fn pierce_count(&self) -> usize {
+        self.pierce_points().len()
+    }
+
+    /// Total dwell time, seconds.
+    pub fn dwell_time(&self) -> f64 {
+        self.motions
+            .iter()
+            .map(|m| match m {
+                Motion::Dwell { seconds, .. } => *seconds,
+                _ => 0.0,
+            })
+            .sum()
+    }
+
+    /// The program as a [`Toolpath`] (for animation and statistics): rapids and torch-off feed
+    /// moves become idle moves (a torch-off arc becomes its chord), each torch-on a pierce that
+    /// starts a new step, torch-on feed moves its cuts. Cuts before the first pierce cannot
+    /// happen: the torch is off then.
+    pub fn toolpath(&self) -> Toolpath {
+        let mut moves = Vec::with_capacity(self.motions.len());
+        let mut step = 0usize;
+        for m in &self.motions {
+            match *m {
+                Motion::Rapid { from, to, .. } => moves.push(ToolMove::Idle { from, to }),
+                Motion::Feed {
+                    span,
+                    tool_on: false,
+                    ..
+                } => moves.push(ToolMove::Idle {
+                    from: span.start,
+                    to: span.end,
+                }),
+                Motion::Feed { span, .. } => moves.push(ToolMove::Cut {
+                    step: step.saturating_sub(1),
+                    span,
+                }),
+                Motion::TorchOn { at, .. } => {
+                    moves.push(ToolMove::Pierce { at, step });
+                    step += 1;
+                }
+                Motion::TorchOff { .. } | Motion::Dwell { .. } => {}
+            }
+        }
+        Toolpath {
+            start: self.start,
+            moves,
+        }
+    }
+}
+
+/// What is wrong with a program, and where (1-based line and column).
+#[derive(Clone, Debug, PartialEq, Error)]
+pub enum GcodeReadError {
+    /// A character that starts no word.
+    #[error("line {line}, column {column}: unexpected character {found:?}")]
+    UnexpectedCharacter {
+        /// Line.
+        line: usize,
+        /// Column.
+        column: usize,
+        /// The character.
+        found: char,
+    },
+    /// A letter without a number after it.
+    #[error("line {line}, column {column}: {letter} has no number")]
+    MissingNumber {
+        /// Line.
+        line: usize,
+        /// Column.
+        column: usize,
+        /// The word's letter.
+        letter: char,
+    },
+    /// A number too large for a machine (above 10⁹ in magnitude).
+    #[error("line {line}, column {column}: the value of {letter} is out of range")]
+    NumberOutOfRange {
+        /// Line.
+        line: usize,
+        /// Column.
+        column: usize,
+        /// The word's letter.
+        letter: char,
+    },
+    /// A `(` comment that does not close on its line.
+    #[error("line {line}, column {column}: comment not closed")]
+    UnclosedComment {
+        /// Line.
+        line: usize,
+        /// Column of the `(`.
+        column: usize,
+    },
+    /// The same letter twice in one block (e.g. two X words).
+    #[error("line {line}, column {column}: {letter} appears twice in the block")]
+    DuplicateWord {
+        /// Line.
+        line: usize,
+        /// Column of the second word.
+        column: usize,
+        /// The letter.
+        letter: char,
+    },
+    /// Two codes of one modal group in one block (e.g. `G00 G01`), or a dwell with axis words.
+    #[error("line {line}, column {column}: {second} conflicts with {first} in the same block")]
+    ConflictingCodes {
+        /// Line.
+        line: usize,
+        /// Column of the second code.
+        column: usize,
+        /// The first code.
+        first: String,
+        /// The second code.
+        second: String,
+    },
+    /// A G code outside the supported subset.
+    #[error("line {line}, column {column}: {code} is not supported")]
+    UnsupportedCode {
+        /// Line.
+        line: usize,
+        /// Column.
+        column: usize,
+        /// The code as read (e.g. `G18`).
+        code: String,
+    },
+    /// Coordinates before any motion code (`G00`–`G03`) was given.
+    #[error("line {line}, column {column}: coordinates without a motion mode (G00–G03)")]
+    MotionWithoutMode {
+        /// Line.
+        line: usize,
+        /// Column of the first coordinate.
+        column: usize,
+    },
+    /// A `G02`/`G03` move with neither `I`/`J` nor `R`.
+    #[error("line {line}, column {column}: arc without centre (I/J) or radius (R)")]
+    ArcWithoutCentre {
+        /// Line.
+        line: usize,
+        /// Column.
+        column: usize,
+    },
+    /// The centre is not equally far from both ends of the arc.
+    #[error("line {line}, column {column}: arc radius {start_radius} at the start but {end_radius} at the end")]
+    ArcRadiusMismatch {
+        /// Line.
+        line: usize,
+        /// Column.
+        column: usize,
+        /// Distance from the centre to the start.
+        start_radius: f64,
+        /// Distance from the centre to the end.
+        end_radius: f64,
+    },
+    /// The radius is too small to reach from the start to the end (or zero).
+    #[error(
+        "line {line}, column {column}: arc radius {radius} cannot span half-chord {half_chord}"
+    )]
+    ArcRadiusTooSmall {
+        /// Line.
+        line: usize,
+        /// Column.
+        column: usize,
+        /// The radius.
+        radius: f64,
+        /// Half the distance between the ends.
+        half_chord: f64,
+    },
+    /// An `R` arc whose ends coincide (its circle is undetermined).
+    #[error("line {line}, column {column}: R arc with coinciding ends")]
+    ZeroLengthRadiusArc {
+        /// Line.
+        line: usize,
+        /// Column.
+        column: usize,
+    },
+    /// `G04` without `P` or `X`, or with a negative time.
+    #[error("line {line}, column {column}: dwell without a non-negative time (P or X seconds)")]
+    InvalidDwell {
+        /// Line.
+        line: usize,
+        /// Column.
+        column: usize,
+    },
+}
+
+impl GcodeReadError {
+    /// The (line, column) of the error, both 1-based.
+    pub fn location(&self) -> (usize, usize) {
+        use GcodeReadError::*;
+        match *self {
+            UnexpectedCharacter { line, column, .. }
+            | MissingNumber { line, column, .. }
+            | NumberOutOfRange { line, column, .. }
+            | UnclosedComment { line, column }
+            | DuplicateWord { line, column, .. }
+            | ConflictingCodes { line, column, .. }
+            | UnsupportedCode { line, column, .. }
+            | MotionWithoutMode { line, column }
+            | ArcWithoutCentre { line, column }
+            | ArcRadiusMismatch { line, column, .. }
+            | ArcRadiusTooSmall { line, column, .. }
+            | ZeroLengthRadiusArc { line, column }
+            | InvalidDwell { line, column } => (line, column),
+        }
+    }
+}
+
+/// Largest magnitude of any number in a program.
+const MAX_VALUE: f64 = 1e9;
+/// Ends closer than this (mm) make a full circle of an `I`/`J` arc.
+const SAME_POINT: f64 = 1e-9;
+
+#[derive(Clone, Copy)]
+struct Word {
+    letter: char,
+    value: f64,
+    column: usize,
+}
+
+/// Reads the tool motion of a G-code program; never panics.
+pub fn read_gcode(text: &str, options: &ReadOptions) -> Result<Program, GcodeReadError> {
+    let mut state = State {
+        options,
+        at: options.start,
+        motion: None,
+        incremental: false,
+        incremental_centres: true,
+        inches: false,
+        tool_on: false,
+        feed: None,
+        motions: Vec::new(),
+    };
+    for (index, raw) in text.lines().enumerate() {
+        let words = tokenize(raw, index + 1)?;
+        state.block(&words, index + 1)?;
+    }
+    Ok(Program {
+        start: options.start,
+        motions: state.motions,
+        end: state.at,
+    })
+}
+
+fn tokenize(raw: &str, line: usize) -> Result<Vec<Word>, GcodeReadError> {
+    let chars: Vec<char> = raw.chars().collect();
+    let mut words = Vec::new();
+    let mut i = 0;
+    while i < chars.len() {
+        let c = chars[i];
+        let column = i + 1;
+        match c {
+            c if c.is_whitespace() => i += 1,
+            '(' => match chars[i..].iter().position(|&d| d == ')') {
+                Some(close) => i += close + 1,
+                None => return Err(GcodeReadError::UnclosedComment { line, column }),
+            },
+            ';' => break,
+            '%' | '/' if words.is_empty() => i += 1,
+            c if c.is_ascii_alphabetic() || c == '$' => {
+                let letter = c.to_ascii_uppercase();
+                i += 1;
+                while i < chars.len() && chars[i] == ' ' {
+                    i += 1;
+                }
+                let begin = i;
+                if i < chars.len() && (chars[i] == '+' || chars[i] == '-') {
+                    i += 1;
+                }
+                let mut digits = 0;
+                while i < chars.len() && (chars[i].is_ascii_digit() || chars[i] == '.') {
+                    digits += usize::from(chars[i].is_ascii_digit());
+                    i += 1;
+                }
+                let text: String = chars[begin..i].iter().collect();
+                if digits == 0 || text.matches('.').count() > 1 {
+                    return Err(GcodeReadError::MissingNumber {
+                        line,
+                        column,
+                        letter,
+                    });
+                }
+                let value: f64 = text.parse().map_err(|_| GcodeReadError::MissingNumber {
+                    line,
+                    column,
+                    letter,
+                })?;
+                if value.is_nan() || value.abs() > MAX_VALUE {
+                    return Err(GcodeReadError::NumberOutOfRange {
+                        line,
+                        column,
+                        letter,
+                    });
+                }
+                words.push(Word {
+                    letter,
+                    value,
+                    column,
+                });
+            }
+            found => {
+                return Err(GcodeReadError::UnexpectedCharacter {
+                    line,
+                    column,
+                    found,
+                })
+            }
+        }
+    }
+    Ok(words)
+}
+
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum MotionMode {
+    Rapid,
+    Linear,
+    Clockwise,
+    CounterClockwise,
+}
+
+struct State<'a> {
+    options: &'a ReadOptions,
+    at: Point,
+    motion: Option<MotionMode>,
+    incremental: bool,
+    incremental_centres: bool,
+    inches: bool,
+    tool_on: bool,
+    feed: Option<f64>,
+    motions: Vec<Motion>,
+}
+
+/// The G codes of one block, sorted by what they change.
+#[derive(Default)]
+struct Codes {
+    motion: Option<(MotionMode, usize, String)>,
+    dwell: Option<usize>,
+    distance: Option<(bool, usize, String)>,
+    centres: Option<(bool, usize, String)>,
+    units: Option<(bool, usize, String)>,
+}
+
+fn set<T>(
+    slot: &mut Option<(T, usize, String)>,
+    value: T,
+    word: &Word,
+    name: String,
+    line: usize,
+) -> Result<(), GcodeReadError> {
+    if let Some((_, _, first)) = slot {
+        return Err(GcodeReadError::ConflictingCodes {
+            line,
+            column: word.column,
+            first: first.clone(),
+            second: name,
+        });
+    }
+    *slot = Some((value, word.column, name));
+    Ok(())
+}
+
+impl State<'_> {
+    fn block(&mut self, words: &[Word], line: usize) -> Result<(), GcodeReadError> {
+        if words.is_empty() {
+            return Ok(());
+        }
+        let mut codes = Codes::default();
+        let mut values: [Option<Word>; 26] = [None; 26];
+        let mut m_codes = Vec::new();
+        for word in words {
+            match word.letter {
+                'G' => self.g_code(word, &mut codes, line)?,
+                'M' => m_codes.push(word.value),
+                '$' => {}
+                letter => {
+                    let slot = &mut values[(letter as u8 - b'A') as usize];
+                    if slot.is_some() {
+                        return Err(GcodeReadError::DuplicateWord {
+                            line,
+                            column: word.column,
+                            letter,
+                        });
+                    }
+                    *slot = Some(*word);
+                }
+            }
+        }
+        let get = |letter: char| values[(letter as u8 - b'A') as usize];
+        // Execution order of RS274/NGC: feed, spindle (torch), dwell, units, distance, motion.
+        if let Some((inches, _, _)) = codes.units {
+            self.inches = inches;
+        }
+        let unit = if self.inches { 25.4 } else { 1.0 };
+        if let Some(f) = get('F') {
+            self.feed = Some(f.value * unit);
+        }
+        for m in m_codes {
+            let number = m.round();
+            if number != m || number < 0.0 {
+                continue;
+            }
+            let number = number as u32;
+            if self.options.torch_off.contains(&number) && self.tool_on {
+                self.tool_on = false;
+                self.motions.push(Motion::TorchOff { at: self.at, line });
+            } else if self.options.torch_on.contains(&number) && !self.tool_on {
+                self.tool_on = true;
+                self.motions.push(Motion::TorchOn { at: self.at, line });
+            }
+        }
+        let axis = ['X', 'Y'].into_iter().filter_map(get).next();
+        if let Some(column) = codes.dwell {
+            if let Some(word) = axis.filter(|w| w.letter == 'Y').or(get('I')).or(get('R')) {
+                return Err(GcodeReadError::ConflictingCodes {
+                    line,
+                    column: word.column,
+                    first: "G04".into(),
+                    second: word.letter.to_string(),
+                });
+            }
+            // Fanuc-style `G04 X<seconds>` is the X word of a dwell block.
+            let seconds = get('P').or(get('X')).map(|w| w.value);
+            match seconds {
+                Some(s) if s >= 0.0 => self.motions.push(Motion::Dwell { seconds: s, line }),
+                _ => return Err(GcodeReadError::InvalidDwell { line, column }),
+            }
+            return Ok(());
+        }
+        if let Some((incremental, _, _)) = codes.distance {
+            self.incremental = incremental;
+        }
+        if let Some((incremental, _, _)) = codes.centres {
+            self.incremental_centres = incremental;
+        }
+        if let Some((mode, _, _)) = codes.motion {
+            self.motion = Some(mode);
+        }
+        let arc_words = ['I', 'J', 'R'].into_iter().filter_map(get).next();
+        let Some(first) = axis.or(arc_words) else {
+            return Ok(());
+        };
+        let Some(mode) = self.motion else {
+            return Err(GcodeReadError::MotionWithoutMode {
+                line,
+                column: first.column,
+            });
+        };
+        let coordinate = |letter: char, current: f64| match get(letter) {
+            Some(w) if self.incremental => current + w.value * unit,
+            Some(w) => w.value * unit,
+            None => current,
+        };
+        let to = Point::new(coordinate('X', self.at.x), coordinate('Y', self.at.y));
+        let column = codes.motion.as_ref().map_or(first.column, |m| m.1);
+        match mode {
+            MotionMode::Rapid => {
+                self.motions.push(Motion::Rapid {
+                    from: self.at,
+                    to,
+                    line,
+                });
+            }
+            MotionMode::Linear => self.feed_span(Span::line(self.at, to), line),
+            MotionMode::Clockwise | MotionMode::CounterClockwise => {
+                let ccw = mode == MotionMode::CounterClockwise;
+                let (sweep, centre) = if let Some(r) = get('R') {
+                    (
+                        self.radius_sweep(to, r.value * unit, ccw, line, column)?,
+                        None,
+                    )
+                } else if get('I').is_some() || get('J').is_some() {
+                    let offset = |letter: char, current: f64| match get(letter) {
+                        Some(w) if self.incremental_centres => current + w.value * unit,
+                        Some(w) => w.value * unit,
+                        None => current,
+                    };
+                    let centre = Point::new(offset('I', self.at.x), offset('J', self.at.y));
+                    (
+                        self.centre_sweep(to, centre, ccw, line, column)?,
+                        Some(centre),
+                    )
+                } else {
+                    return Err(GcodeReadError::ArcWithoutCentre { line, column });
+                };
+                self.arc(to, sweep, centre, line);
+            }
+        }
+        self.at = to;
+        Ok(())
+    }
+
+    fn g_code(&self, word: &Word, codes: &mut Codes, line: usize) -> Result<(), GcodeReadError> {
+        let tenths = (word.value * 10.0).round();
+        let name = if tenths % 10.0 == 0.0 {
+            format!("G{:02}", (tenths / 10.0) as i64)
+        } else {
+            format!("G{}", tenths / 10.0)
+        };
+        if (word.value * 10.0 - tenths).abs() > 1e-6 {
+            return Err(GcodeReadError::UnsupportedCode {
+                line,
+                column: word.column,
+                code: format!("G{}", word.value),
+            });
+        }
+        use MotionMode::*;
+        match tenths as i64 {
+            0 => set(&mut codes.motion, Rapid, word, name, line),
+            10 => set(&mut codes.motion, Linear, word, name, line),
+            20 => set(&mut codes.motion, Clockwise, word, name, line),
+            30 => set(&mut codes.motion, CounterClockwise, word, name, line),
+            40 => {
+                if codes.dwell.is_some() {
+                    return Err(GcodeReadError::ConflictingCodes {
+                        line,
+                        column: word.column,
+                        first: "G04".into(),
+                        second: name,
+                    });
+                }
+                codes.dwell = Some(word.column);
+                Ok(())
+            }
+            200 => set(&mut codes.units, true, word, name, line),
+            210 => set(&mut codes.units, false, word, name, line),
+            900 => set(&mut codes.distance, false, word, name, line),
+            910 => set(&mut codes.distance, true, word, name, line),
+            901 => set(&mut codes.centres, false, word, name, line),
+            911 => set(&mut codes.centres, true, word, name, line),
+            // Plane XY, cutter compensation off, tool length off, work offsets, path control,
+            // canned cycle off, feed per minute: nothing changes for the head's XY path.
+            170 | 400 | 490 | 540..=590 | 610 | 640 | 800 | 940 => Ok(()),
+            _ => Err(GcodeReadError::UnsupportedCode {
+                line,
+                column: word.column,
+                code: name,
+            }),
+        }
+    }
+
+    fn feed_span(&mut self, span: Span, line: usize) {
+        self.motions.push(Motion::Feed {
+            span,
+            tool_on: self.tool_on,
+            feed: self.feed,
+            line,
+        });
+    }
+
+    /// Signed sweep of the arc to `to` about `centre`.
+    fn centre_sweep(
+        &self,
+        to: Point,
+        centre: Point,
+        ccw: bool,
+        line: usize,
+        column: usize,
+    ) -> Result<f64, GcodeReadError> {
+        let (r0, r1) = (self.at.distance(centre), to.distance(centre));
+        if (r0 - r1).abs() > self.options.arc_tolerance_mm {
+            return Err(GcodeReadError::ArcRadiusMismatch {
+                line,
+                column,
+                start_radius: r0,
+                end_radius: r1,
+            });
+        }
+        if r0 <= SAME_POINT {
+            return Err(GcodeReadError::ArcRadiusTooSmall {
+                line,
+                column,
+                radius: r0,
+                half_chord: 0.5 * self.at.distance(to),
+            });
+        }
+        let (a, b) = (self.at - centre, to - centre);
+        let turn = b.y.atan2(b.x) - a.y.atan2(a.x);
+        let sweep = if self.at.distance(to) <= SAME_POINT {
+            TAU
+        } else if ccw {
+            turn.rem_euclid(TAU)
+        } else {
+            (-turn).rem_euclid(TAU)
+        };
+        Ok(if ccw { sweep } else { -sweep })
+    }
+
+    /// Signed sweep of the arc of radius `r` to `to` (negative `r`: the longer arc).
+    fn radius_sweep(
+        &self,
+        to: Point,
+        r: f64,
+        ccw: bool,
+        line: usize,
+        column: usize,
+    ) -> Result<f64, GcodeReadError> {
+        let half_chord = 0.5 * self.at.distance(to);
+        if half_chord <= SAME_POINT {
+            return Err(GcodeReadError::ZeroLengthRadiusArc { line, column });
+        }
+        if r.abs() < half_chord - self.options.arc_tolerance_mm || r == 0.0 {
+            return Err(GcodeReadError::ArcRadiusTooSmall {
+                line,
+                column,
+                radius: r.abs(),
+                half_chord,
+            });
+        }
+        let short = 2.0 * (half_chord / r.abs()).min(1.0).asin();
+        let sweep = if r < 0.0 { TAU - short } else { short };
+        Ok(if ccw { sweep } else { -sweep })
+    }
+
+    /// Appends the arc from the current point to `to`; arcs of more than half a turn are split
+    /// at their middle so no bulge gets large (a full circle would have an infinite one).
+    fn arc(&mut self, to: Point, sweep: f64, centre: Option<Point>, line: usize) {
+        let from = self.at;
+        if sweep.abs() <= PI {
+            self.feed_span(Span::new(from, to, (sweep / 4.0).tan()), line);
+            return;
+        }
+        let middle = match centre {
+            // Turning about the centre also works for a full circle, whose ends coincide.
+            Some(c) => c + (from - c).rotated(0.5 * sweep),
+            // An R arc: the midpoint is the zenith of the whole span.
+            None => Span::new(from, to, (sweep / 4.0).tan()).midpoint(),
+        };
+        let half_bulge = (sweep / 8.0).tan();
+        self.feed_span(Span::new(from, middle, half_bulge), line);
+        self.feed_span(Span::new(middle, to, half_bulge), line);
+    }
+}

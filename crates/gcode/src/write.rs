@@ -1,0 +1,541 @@
+//! The post-processor: a [`Toolpath`] as a G-code program.
+
+use std::f64::consts::PI;
+use std::fmt::Write as _;
+
+use cutroute_geometry::{
+    MachineParameters, Nest, Point, Route, RouteError, Span, ToolMove, Toolpath,
+};
+use thiserror::Error;
+
+/// How coordinates are written.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum DistanceMode {
+    /// `G90`: every X/Y is a position on the machine's coordinate system.
+    #[default]
+    Absolute,
+    /// `G91`: every X/Y is the increment from the previous position. The program then starts
+    /// where the head stands, which is the toolpath's start point.
+    Incremental,
+}
+
+/// How arcs are written.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ArcOutput {
+    /// `G02`/`G03` with `I`/`J`: the centre as an offset from the arc's start (the usual
+    /// incremental-centre convention, `G91.1`, in both distance modes).
+    CentreOffsets,
+    /// `G02`/`G03` with `R`: arcs are split into pieces of at most 150°, so `R` is always
+    /// positive (many controllers do not accept the negative `R` of a long arc) and never close
+    /// to half the chord, where rounding `R` in its last digit would change the sweep by far
+    /// more than the rounding (at 180° a change of 0.5 µm in a 10 mm radius turns the end
+    /// tangent by 0.03°).
+    Radius,
+    /// `G01` chords for machines without circular interpolation: no chord leaves the arc by
+    /// more than `tolerance_mm`.
+    Lines {
+        /// Largest distance between a chord and its arc, mm (> 0).
+        tolerance_mm: f64,
+    },
+}
+
+/// Settings of the post-processor. The defaults suit a LinuxCNC/Mach3-style plasma or laser
+/// controller with the machine parameters of [`MachineParameters::default`].
+///
+/// Torch codes differ between machines; common choices:
+///
+/// | controller | `torch_on` | `torch_off` |
+/// |---|---|---|
+/// | generic, Mach3 plasma, LinuxCNC | `M03` | `M05` |
+/// | LinuxCNC QtPlasmaC | `M03 $0 S1` | `M05 $0` |
+/// | GRBL in laser mode (power follows speed) | `M04 S1000` | `M05` |
+///
+/// The reader ([`crate::read_gcode`]) recognises the torch by its M number, so a custom
+/// `torch_on` must start with an M word listed in [`crate::ReadOptions::torch_on`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct GcodeOptions {
+    /// Absolute (`G90`) or incremental (`G91`) coordinates.
+    pub distance_mode: DistanceMode,
+    /// Digits after the decimal point of coordinates, 0..=9 (3 = micrometres).
+    pub decimals: usize,
+    /// Prefix every line with `N<number>`.
+    pub line_numbers: bool,
+    /// Increment of the line numbers (usually 1, 5 or 10).
+    pub line_number_step: u32,
+    /// How arcs are written.
+    pub arcs: ArcOutput,
+    /// Arcs sweeping more than this many degrees are split into equal pieces (180 for
+    /// controllers that reject longer arcs; at most 350 is used so that an arc never has nearly
+    /// coincident ends, which a controller would read as a full circle).
+    pub max_arc_sweep_deg: f64,
+    /// Feed rate of cutting moves, mm/min (`F`).
+    pub cut_feed_mm_per_min: f64,
+    /// Line that switches the torch (laser, plasma arc) on.
+    pub torch_on: String,
+    /// Line that switches it off.
+    pub torch_off: String,
+    /// Dwell after switching the torch on, seconds (`G04 P<seconds>`; 0 writes no dwell).
+    /// Fanuc-style controllers read `P` in milliseconds: set this in their unit if needed.
+    pub pierce_dwell_s: f64,
+    /// Lines after the units and distance-mode lines (e.g. work offset, torch height).
+    pub header: Vec<String>,
+    /// Lines at the end, after the torch is off.
+    pub footer: Vec<String>,
+    /// Write comments: a summary at the top and the part/contour of every pierce.
+    pub comments: bool,
+}
+
+impl GcodeOptions {
+    /// Defaults with the feed rate and pierce dwell of `machine` (its speeds are mm/s).
+    pub fn for_machine(machine: &MachineParameters) -> GcodeOptions {
+        GcodeOptions {
+            cut_feed_mm_per_min: machine.cut_speed * 60.0,
+            pierce_dwell_s: machine.pierce_time,
+            ..GcodeOptions::base()
+        }
+    }
+
+    fn base() -> GcodeOptions {
+        GcodeOptions {
+            distance_mode: DistanceMode::Absolute,
+            decimals: 3,
+            line_numbers: false,
+            line_number_step: 10,
+            arcs: ArcOutput::CentreOffsets,
+            max_arc_sweep_deg: 360.0,
+            cut_feed_mm_per_min: 600.0,
+            torch_on: "M03".into(),
+            torch_off: "M05".into(),
+            pierce_dwell_s: 0.0,
+            header: Vec::new(),
+            footer: vec!["M30".into()],
+            comments: true,
+        }
+    }
+}
+
+impl Default for GcodeOptions {
+    /// [`GcodeOptions::for_machine`] of [`MachineParameters::default`]: absolute, mm, three
+    /// decimals, `G02`/`G03` with `I`/`J`, `M03`/`M05`, no line numbers, comments on.
+    fn default() -> Self {
+        GcodeOptions::for_machine(&MachineParameters::default())
+    }
+}
+
+/// Why a program could not be written.
+#[derive(Clone, Debug, PartialEq, Error)]
+pub enum GcodeError {
+    /// `decimals` is above 9 (coordinates would exceed the exact range of the writer's integers).
+    #[error("{decimals} decimals requested; at most 9 are supported")]
+    TooManyDecimals {
+        /// The value given.
+        decimals: usize,
+    },
+    /// The cutting feed rate is not a positive number.
+    #[error("cutting feed rate {feed} mm/min is not a positive number")]
+    InvalidFeed {
+        /// The value given.
+        feed: f64,
+    },
+    /// The pierce dwell is negative or not a number.
+    #[error("pierce dwell {seconds} s is not a non-negative number")]
+    InvalidDwell {
+        /// The value given.
+        seconds: f64,
+    },
+    /// The chord tolerance of [`ArcOutput::Lines`] is not a positive number.
+    #[error("arc flattening tolerance {tolerance} mm is not a positive number")]
+    InvalidTolerance {
+        /// The value given.
+        tolerance: f64,
+    },
+    /// The largest arc sweep is not a positive number of degrees.
+    #[error("largest arc sweep {degrees}° is not a positive number")]
+    InvalidMaxSweep {
+        /// The value given.
+        degrees: f64,
+    },
+    /// A configured line (torch code, header, footer) spans several lines.
+    #[error("the {field} line {text:?} contains a line break")]
+    LineBreakInCode {
+        /// Which option.
+        field: &'static str,
+        /// Its text.
+        text: String,
+    },
+    /// A coordinate is not finite or too large to write with the requested decimals.
+    #[error("move {move_index}: coordinate {value} cannot be written")]
+    CoordinateOutOfRange {
+        /// Index of the move in the toolpath.
+        move_index: usize,
+        /// The coordinate.
+        value: f64,
+    },
+    /// A cutting move comes while the torch is off (no pierce before it).
+    #[error("move {move_index} cuts with the torch off (no pierce before it)")]
+    CutWithoutPierce {
+        /// Index of the move in the toolpath.
+        move_index: usize,
+    },
+    /// The route does not fit the nest.
+    #[error("the route does not fit the nest: {0}")]
+    Route(#[from] RouteError),
+}
+
+/// Writes `toolpath` as a G-code program.
+pub fn write_gcode(toolpath: &Toolpath, options: &GcodeOptions) -> Result<String, GcodeError> {
+    write_labelled(toolpath, &|_| None, options)
+}
+
+/// Writes the route's toolpath over `nest`, with a comment naming the part and contour before
+/// every pierce (when [`GcodeOptions::comments`] is on).
+pub fn route_gcode(
+    nest: &Nest,
+    route: &Route,
+    options: &GcodeOptions,
+) -> Result<String, GcodeError> {
+    let toolpath = Toolpath::new(route, nest)?;
+    let label = |step: usize| {
+        let contour = route.steps.get(step)?.contour;
+        let part = nest.parts.get(contour.part)?;
+        Some(format!(
+            "part {} ({}) contour {}",
+            contour.part, part.name, contour.contour
+        ))
+    };
+    write_labelled(&toolpath, &label, options)
+}
+
+/// Arcs whose sagitta is below this many quanta (units of the last written digit) are written
+/// as straight moves: their centre would be far away and rounding would move it by more than
+/// the arc deviates from its chord.
+const FLAT_ARC_QUANTA: f64 = 0.5;
+/// Upper bound on the chords one arc is flattened into, whatever the tolerance.
+const MAX_CHORDS_PER_ARC: f64 = 100_000.0;
+/// No `R` arc longer than this is written in one move (see [`ArcOutput::Radius`]).
+const LONGEST_RADIUS_ARC_DEG: f64 = 150.0;
+/// No arc longer than this is written in one move (see [`GcodeOptions::max_arc_sweep_deg`]).
+const LONGEST_ARC_DEG: f64 = 350.0;
+
+fn write_labelled(
+    toolpath: &Toolpath,
+    label: &dyn Fn(usize) -> Option<String>,
+    options: &GcodeOptions,
+) -> Result<String, GcodeError> {
+    check(options)?;
+    let mut w = Writer::new(options, toolpath.start)?;
+    if options.comments {
+        w.comment(&format!(
+            "cutroute: {} pierces, cut {:.1} mm, idle {:.1} mm",
+            toolpath.pierce_count(),
+            toolpath.cut_length(),
+            toolpath.idle_length()
+        ));
+    }
+    w.line("G21".into());
+    w.line(match options.distance_mode {
+        DistanceMode::Absolute => "G90".into(),
+        DistanceMode::Incremental => "G91".into(),
+    });
+    w.line("G17".into());
+    for line in &options.header {
+        w.line(line.clone());
+    }
+    for (index, m) in toolpath.moves.iter().enumerate() {
+        w.move_index = index;
+        match *m {
+            ToolMove::Idle { to, .. } => {
+                w.torch_off();
+                w.straight("G00", to, false)?;
+            }
+            ToolMove::Pierce { step, .. } => {
+                w.torch_off();
+                if options.comments {
+                    if let Some(text) = label(step) {
+                        w.comment(&text);
+                    }
+                }
+                w.line(options.torch_on.clone());
+                w.tool_on = true;
+                w.feed_written = false;
+                if options.pierce_dwell_s > 0.0 {
+                    w.line(format!("G04 P{:.3}", options.pierce_dwell_s));
+                }
+            }
+            ToolMove::Cut { span, .. } => {
+                if !w.tool_on {
+                    return Err(GcodeError::CutWithoutPierce { move_index: index });
+                }
+                w.span(span)?;
+            }
+        }
+    }
+    w.torch_off();
+    for line in &options.footer {
+        w.line(line.clone());
+    }
+    Ok(w.out)
+}
+
+fn check(options: &GcodeOptions) -> Result<(), GcodeError> {
+    if options.decimals > 9 {
+        return Err(GcodeError::TooManyDecimals {
+            decimals: options.decimals,
+        });
+    }
+    let feed = options.cut_feed_mm_per_min;
+    if !(feed.is_finite() && feed > 0.0) {
+        return Err(GcodeError::InvalidFeed { feed });
+    }
+    let dwell = options.pierce_dwell_s;
+    if !(dwell.is_finite() && dwell >= 0.0) {
+        return Err(GcodeError::InvalidDwell { seconds: dwell });
+    }
+    if let ArcOutput::Lines { tolerance_mm } = options.arcs {
+        if !(tolerance_mm.is_finite() && tolerance_mm > 0.0) {
+            return Err(GcodeError::InvalidTolerance {
+                tolerance: tolerance_mm,
+            });
+        }
+    }
+    let sweep = options.max_arc_sweep_deg;
+    if !(sweep.is_finite() && sweep > 0.0) {
+        return Err(GcodeError::InvalidMaxSweep { degrees: sweep });
+    }
+    let fields = [
+        ("torch_on", &options.torch_on),
+        ("torch_off", &options.torch_off),
+    ];
+    let extra = options
+        .header
+        .iter()
+        .map(|l| ("header", l))
+        .chain(options.footer.iter().map(|l| ("footer", l)));
+    for (field, text) in fields.into_iter().chain(extra) {
+        if text.contains(['\n', '\r']) {
+            return Err(GcodeError::LineBreakInCode {
+                field,
+                text: text.clone(),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Positions are tracked as integers of the last written digit, so incremental programs do not
+/// drift and the centre offsets refer to the start point exactly as written.
+struct Writer<'a> {
+    options: &'a GcodeOptions,
+    out: String,
+    scale: f64,
+    /// Where the head is, in quanta, as written so far.
+    at: (i64, i64),
+    tool_on: bool,
+    feed_written: bool,
+    line_number: u64,
+    move_index: usize,
+}
+
+impl<'a> Writer<'a> {
+    fn new(options: &'a GcodeOptions, start: Point) -> Result<Writer<'a>, GcodeError> {
+        let scale = 10f64.powi(options.decimals as i32);
+        let mut w = Writer {
+            options,
+            out: String::new(),
+            scale,
+            at: (0, 0),
+            tool_on: false,
+            feed_written: false,
+            line_number: 0,
+            move_index: 0,
+        };
+        w.at = w.quantize_point(start)?;
+        Ok(w)
+    }
+
+    fn quantize(&self, value: f64) -> Result<i64, GcodeError> {
+        let q = (value * self.scale).round();
+        // Beyond 2^53 integers are no longer exact in f64.
+        if q.is_finite() && q.abs() < 9.0e15 {
+            Ok(q as i64)
+        } else {
+            Err(GcodeError::CoordinateOutOfRange {
+                move_index: self.move_index,
+                value,
+            })
+        }
+    }
+
+    fn quantize_point(&self, p: Point) -> Result<(i64, i64), GcodeError> {
+        Ok((self.quantize(p.x)?, self.quantize(p.y)?))
+    }
+
+    fn number(&self, q: i64) -> String {
+        let decimals = self.options.decimals;
+        let sign = if q < 0 { "-" } else { "" };
+        let magnitude = q.unsigned_abs();
+        if decimals == 0 {
+            return format!("{sign}{magnitude}");
+        }
+        let unit = 10u64.pow(decimals as u32);
+        format!(
+            "{sign}{}.{:0width$}",
+            magnitude / unit,
+            magnitude % unit,
+            width = decimals
+        )
+    }
+
+    fn line(&mut self, text: String) {
+        if self.options.line_numbers {
+            self.line_number += u64::from(self.options.line_number_step.max(1));
+            let _ = write!(self.out, "N{} ", self.line_number);
+        }
+        self.out.push_str(&text);
+        self.out.push('\n');
+    }
+
+    fn comment(&mut self, text: &str) {
+        // Parentheses cannot nest in G-code comments.
+        let clean: String = text
+            .chars()
+            .map(|c| match c {
+                '(' => '[',
+                ')' => ']',
+                '\n' | '\r' => ' ',
+                c => c,
+            })
+            .collect();
+        self.line(format!("({clean})"));
+    }
+
+    fn torch_off(&mut self) {
+        if self.tool_on {
+            self.line(self.options.torch_off.clone());
+            self.tool_on = false;
+        }
+    }
+
+    /// The X/Y words of a move to `target` (quanta), or `None` when the head does not move.
+    fn axis_words(&self, target: (i64, i64)) -> Option<String> {
+        if target == self.at {
+            return None;
+        }
+        let mut words = String::new();
+        let (dx, dy) = (target.0 - self.at.0, target.1 - self.at.1);
+        let (x, y) = match self.options.distance_mode {
+            DistanceMode::Absolute => (target.0, target.1),
+            DistanceMode::Incremental => (dx, dy),
+        };
+        if dx != 0 {
+            let _ = write!(words, " X{}", self.number(x));
+        }
+        if dy != 0 {
+            let _ = write!(words, " Y{}", self.number(y));
+        }
+        Some(words)
+    }
+
+    fn feed_word(&mut self) -> String {
+        if self.feed_written {
+            return String::new();
+        }
+        self.feed_written = true;
+        let feed = self.options.cut_feed_mm_per_min;
+        let text = format!("{feed:.1}");
+        format!(" F{}", text.trim_end_matches('0').trim_end_matches('.'))
+    }
+
+    fn straight(&mut self, code: &str, to: Point, feed: bool) -> Result<(), GcodeError> {
+        let target = self.quantize_point(to)?;
+        if let Some(words) = self.axis_words(target) {
+            let f = if feed {
+                self.feed_word()
+            } else {
+                String::new()
+            };
+            self.line(format!("{code}{words}{f}"));
+            self.at = target;
+        }
+        Ok(())
+    }
+
+    fn span(&mut self, span: Span) -> Result<(), GcodeError> {
+        if span.is_line() {
+            return self.straight("G01", span.end, true);
+        }
+        let sweep = span.sweep().abs();
+        let sagitta = 0.5 * span.chord_length() * (sweep / 4.0).tan().abs();
+        if sweep < PI && sagitta * self.scale < FLAT_ARC_QUANTA {
+            return self.straight("G01", span.end, true);
+        }
+        let max_sweep = match self.options.arcs {
+            ArcOutput::Radius => self.options.max_arc_sweep_deg.min(LONGEST_RADIUS_ARC_DEG),
+            _ => self.options.max_arc_sweep_deg,
+        }
+        .min(LONGEST_ARC_DEG)
+        .to_radians();
+        let pieces = (sweep / max_sweep).ceil().max(1.0) as usize;
+        for k in 0..pieces {
+            let piece = if pieces == 1 {
+                span
+            } else {
+                span.sub_span(k as f64 / pieces as f64, (k + 1) as f64 / pieces as f64)
+            };
+            self.arc(piece)?;
+        }
+        Ok(())
+    }
+
+    fn arc(&mut self, span: Span) -> Result<(), GcodeError> {
+        let code = if span.bulge > 0.0 { "G03" } else { "G02" };
+        match self.options.arcs {
+            ArcOutput::Lines { tolerance_mm } => {
+                let r = span.radius();
+                let step = if tolerance_mm < r {
+                    2.0 * (1.0 - tolerance_mm / r).acos()
+                } else {
+                    2.0 * PI / 3.0
+                };
+                let chords = (span.sweep().abs() / step)
+                    .ceil()
+                    .clamp(1.0, MAX_CHORDS_PER_ARC) as usize;
+                for k in 1..=chords {
+                    let p = span.point_at(k as f64 / chords as f64);
+                    self.straight("G01", p, true)?;
+                }
+                Ok(())
+            }
+            ArcOutput::CentreOffsets => {
+                let Some(centre) = span.centre() else {
+                    return self.straight("G01", span.end, true);
+                };
+                let c = self.quantize_point(centre)?;
+                let target = self.quantize_point(span.end)?;
+                let (i, j) = (c.0 - self.at.0, c.1 - self.at.1);
+                // Ends that round to one point would read as a full circle: the piece is
+                // below the resolution (at most 350° pieces, so its radius is a few quanta).
+                let Some(words) = self.axis_words(target) else {
+                    return Ok(());
+                };
+                let f = self.feed_word();
+                let centre_words = format!(" I{} J{}", self.number(i), self.number(j));
+                self.line(format!("{code}{words}{centre_words}{f}"));
+                self.at = target;
+                Ok(())
+            }
+            ArcOutput::Radius => {
+                let target = self.quantize_point(span.end)?;
+                let Some(words) = self.axis_words(target) else {
+                    // A radius arc needs distinct ends; this piece is below the resolution.
+                    return Ok(());
+                };
+                let r = self.quantize(span.radius())?;
+                let f = self.feed_word();
+                self.line(format!("{code}{words} R{}{f}", self.number(r)));
+                self.at = target;
+                Ok(())
+            }
+        }
+    }
+}
