@@ -2,12 +2,15 @@
 //! object URL). Nest and result formats come from `cutroute-formats`' writers, so our own readers
 //! parse them back; the SVG is the current view as drawn.
 //!
-//! Not here yet: the standalone HTML file and G-code (their writers, `html_export` and the
-//! `cutroute-gcode` post-processor, are not on main yet); see the README's App section.
+//! The standalone HTML page comes from `cutroute-formats`' `route_html`, G-code from the
+//! `cutroute-gcode` post-processor with the options chosen in the menu (and a preview of the
+//! first lines).
 
 use cutroute_formats::{
-    write_dbs, write_geometry_json, write_result_json, ResultExportOptions, RmResult,
+    route_html, write_dbs, write_geometry_json, write_result_json, HtmlOptions,
+    ResultExportOptions, RmResult,
 };
+use cutroute_gcode::{route_gcode, ArcOutput, DistanceMode, GcodeOptions};
 use cutroute_geometry::{MachineParameters, Nest, Route};
 use leptos::prelude::*;
 use wasm_bindgen::JsCast;
@@ -79,6 +82,78 @@ pub fn dbs(stem: &str, nest: &Nest) -> Result<Download, String> {
         name: format!("{stem}.dbs"),
         mime: "application/octet-stream",
         bytes,
+    })
+}
+
+/// A page that shows and animates the route with no server.
+pub fn standalone_html(
+    stem: &str,
+    nest: &Nest,
+    route: &Route,
+    machine: &MachineParameters,
+) -> Result<Download, String> {
+    let options = HtmlOptions {
+        title: stem.to_string(),
+        machine: *machine,
+        ..HtmlOptions::default()
+    };
+    let text = route_html(nest, route, &options).map_err(|e| e.to_string())?;
+    Ok(Download {
+        name: format!("{stem}.html"),
+        mime: "text/html",
+        bytes: text.into_bytes(),
+    })
+}
+
+/// What the G-code panel lets the user choose.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GcodeChoice {
+    /// `G91` instead of `G90`.
+    pub incremental: bool,
+    /// "ij", "r" or "lines".
+    pub arcs: String,
+    /// Torch on line.
+    pub torch_on: String,
+    /// Torch off line.
+    pub torch_off: String,
+    /// Pierce dwell, s.
+    pub dwell_s: f64,
+}
+
+impl GcodeChoice {
+    /// The post-processor's options for this choice under `machine`'s feed.
+    pub fn options(&self, machine: &MachineParameters) -> GcodeOptions {
+        GcodeOptions {
+            distance_mode: if self.incremental {
+                DistanceMode::Incremental
+            } else {
+                DistanceMode::Absolute
+            },
+            arcs: match self.arcs.as_str() {
+                "r" => ArcOutput::Radius,
+                "lines" => ArcOutput::Lines { tolerance_mm: 0.01 },
+                _ => ArcOutput::CentreOffsets,
+            },
+            torch_on: self.torch_on.clone(),
+            torch_off: self.torch_off.clone(),
+            pierce_dwell_s: self.dwell_s,
+            ..GcodeOptions::for_machine(machine)
+        }
+    }
+}
+
+/// The route as a G-code program.
+pub fn gcode(
+    stem: &str,
+    nest: &Nest,
+    route: &Route,
+    options: &GcodeOptions,
+) -> Result<Download, String> {
+    let text = route_gcode(nest, route, options).map_err(|e| e.to_string())?;
+    Ok(Download {
+        name: format!("{stem}.nc"),
+        mime: "text/plain",
+        bytes: text.into_bytes(),
     })
 }
 
@@ -161,6 +236,35 @@ pub fn ExportMenu(
     };
     let no_nest = move || nest.with(Option::is_none);
     let no_route = move || route.with(Option::is_none);
+    let choice = RwSignal::new(GcodeChoice {
+        incremental: false,
+        arcs: "ij".into(),
+        torch_on: "M03".into(),
+        torch_off: "M05".into(),
+        dwell_s: machine.get_untracked().pierce_time,
+    });
+    let preview = RwSignal::new(String::new());
+    let make_gcode = move || -> Result<Download, String> {
+        let nest = nest.get_untracked().ok_or("no nest")?;
+        let route = route.get_untracked().ok_or("no route yet")?;
+        let options = machine.with_untracked(|m| choice.with_untracked(|c| c.options(m)));
+        gcode(
+            &stem(&file_name.get_untracked().unwrap_or_default()),
+            &nest,
+            &route,
+            &options,
+        )
+    };
+    let show_preview = move || match make_gcode() {
+        Ok(d) => preview.set(
+            String::from_utf8_lossy(&d.bytes)
+                .lines()
+                .take(PREVIEW_LINES)
+                .collect::<Vec<_>>()
+                .join("\n"),
+        ),
+        Err(e) => preview.set(format!("no G-code: {e}")),
+    };
     view! {
         <details class="export">
             <summary>"Export"</summary>
@@ -202,11 +306,121 @@ pub fn ExportMenu(
                 >
                     "SVG of the view"
                 </button>
+                <button
+                    id="export-html"
+                    title="A single HTML file that shows and animates the route, no server needed"
+                    disabled=no_route
+                    on:click=move |_| {
+                        run(&|stem, nest, route| {
+                            let route = route.ok_or("no route yet")?;
+                            machine.with_untracked(|m| standalone_html(stem, nest, route, m))
+                        })
+                    }
+                >
+                    "Standalone HTML"
+                </button>
             </div>
+            <fieldset class="gcode">
+                <legend>"G-code"</legend>
+                <label title="G90: positions; G91: increments from the previous point">
+                    "Coordinates "
+                    <select
+                        id="gcode-distance"
+                        on:change=move |ev| {
+                            let incremental = event_target_value(&ev) == "incremental";
+                            choice.update(|c| c.incremental = incremental);
+                        }
+                    >
+                        <option value="absolute">"absolute (G90)"</option>
+                        <option value="incremental">"incremental (G91)"</option>
+                    </select>
+                </label>
+                <label title="How arcs are written">
+                    "Arcs "
+                    <select
+                        id="gcode-arcs"
+                        on:change=move |ev| {
+                            let arcs = event_target_value(&ev);
+                            choice.update(|c| c.arcs = arcs);
+                        }
+                    >
+                        <option value="ij">"G02/G03 with I, J"</option>
+                        <option value="r">"G02/G03 with R"</option>
+                        <option value="lines">"G01 chords only"</option>
+                    </select>
+                </label>
+                <label title="Line that switches the torch on">
+                    "Torch on "
+                    <input
+                        id="gcode-torch-on"
+                        type="text"
+                        size="8"
+                        prop:value=move || choice.with(|c| c.torch_on.clone())
+                        on:change=move |ev| {
+                            let v = event_target_value(&ev);
+                            choice.update(|c| c.torch_on = v);
+                        }
+                    />
+                </label>
+                <label title="Line that switches the torch off">
+                    "Torch off "
+                    <input
+                        id="gcode-torch-off"
+                        type="text"
+                        size="8"
+                        prop:value=move || choice.with(|c| c.torch_off.clone())
+                        on:change=move |ev| {
+                            let v = event_target_value(&ev);
+                            choice.update(|c| c.torch_off = v);
+                        }
+                    />
+                </label>
+                <label title="Dwell after the torch is switched on (G04), seconds">
+                    "Pierce dwell, s "
+                    <input
+                        id="gcode-dwell"
+                        type="number"
+                        min="0"
+                        step="any"
+                        prop:value=move || choice.with(|c| c.dwell_s.to_string())
+                        on:change=move |ev| {
+                            if let Ok(v) = event_target_value(&ev).parse::<f64>() {
+                                if v >= 0.0 && v.is_finite() {
+                                    choice.update(|c| c.dwell_s = v);
+                                }
+                            }
+                        }
+                    />
+                </label>
+                <button id="gcode-preview-button" disabled=no_route on:click=move |_| show_preview()>
+                    "Preview"
+                </button>
+                <button
+                    id="export-gcode"
+                    disabled=no_route
+                    on:click=move |_| {
+                        show_preview();
+                        let outcome = make_gcode().and_then(|d| {
+                            save(&d)?;
+                            Ok(d.name)
+                        });
+                        message.set(Some(match outcome {
+                            Ok(name) => format!("saved {name}"),
+                            Err(e) => format!("export failed: {e}"),
+                        }));
+                    }
+                >
+                    "G-code"
+                </button>
+                <pre id="gcode-preview" aria-label="First lines of the G-code">{move || preview.get()}</pre>
+            </fieldset>
             <p id="export-status" class="muted" aria-live="polite">{move || message.get()}</p>
         </details>
     }
 }
+
+/// Lines of G-code shown in the preview.
+const PREVIEW_LINES: usize = 12;
 
 #[cfg(test)]
 mod tests {

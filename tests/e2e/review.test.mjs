@@ -331,3 +331,56 @@ test('several files at once: a task JSON is combined with its result file', asyn
   assert.deepEqual(errors, []);
   await context.close();
 });
+
+test('standalone HTML and G-code exports; G-code options and preview', async () => {
+  const { page, errors, context } = await freshPage();
+  await fileShown(page, 'E1X_6_01');
+  await solve(page, 'nearest');
+  const dir = fs.mkdtempSync(path.join(os.tmpdir(), 'cutroute-export-'));
+  await page.click('.export summary');
+  const download = async (button) => {
+    const [file] = await Promise.all([page.waitForEvent('download'), page.click(button)]);
+    const target = path.join(dir, file.suggestedFilename());
+    await file.saveAs(target);
+    return target;
+  };
+  // The HTML page needs nothing but itself: no external script, style or image.
+  const htmlFile = await download('#export-html');
+  const html = fs.readFileSync(htmlFile, 'utf8');
+  assert.match(html, /^<!DOCTYPE html>/i);
+  assert.doesNotMatch(html, /(src|href)\s*=\s*["']?(https?:|\/\/)/i, 'standalone');
+  const viewer = await context.newPage();
+  const viewerErrors = watchErrors(viewer);
+  await viewer.goto(`file://${htmlFile}`);
+  assert.ok(await viewer.locator('svg path').count() > 0, 'the page draws the nest');
+  assert.match(await viewer.title(), /E1X_6_01/);
+  assert.deepEqual(viewerErrors, []);
+  await viewer.close();
+
+  // Preview: the first lines of the program, absolute by default.
+  await page.click('#gcode-preview-button');
+  const preview = await page.locator('#gcode-preview').textContent();
+  const lines = preview.split('\n');
+  assert.ok(lines.length > 3 && lines.length <= 12, `${lines.length} preview lines`);
+  assert.ok(lines.includes('G90'), preview);
+  // Options reach the post-processor: incremental, R arcs, custom torch codes and dwell.
+  await page.selectOption('#gcode-distance', 'incremental');
+  await page.selectOption('#gcode-arcs', 'r');
+  for (const [id, value] of [['#gcode-torch-on', 'M07'], ['#gcode-torch-off', 'M08'], ['#gcode-dwell', '2']]) {
+    await page.fill(id, value);
+    await page.dispatchEvent(id, 'change');
+  }
+  const gcode = fs.readFileSync(await download('#export-gcode'), 'utf8');
+  const program = gcode.split('\n').map((l) => l.trim());
+  assert.ok(program.includes('G91'), 'incremental');
+  assert.ok(!program.includes('G90'), 'not absolute');
+  assert.equal(program.filter((l) => l === 'M07').length, 16, 'torch on once per pierce');
+  assert.equal(program.filter((l) => l === 'M08').length, 16, 'torch off after every contour');
+  assert.equal(program.filter((l) => l === 'G04 P2.000').length, 16, 'pierce dwell');
+  assert.ok(program.some((l) => /^G0[23] .*R[\d.]+/.test(l)), 'arcs with R');
+  assert.ok(!program.some((l) => /^G0[23] .* I/.test(l)), 'no I/J arcs');
+  assert.match(await page.locator('#gcode-preview').textContent(), /G91/, 'preview follows the options');
+  assert.match(await page.locator('#export-status').textContent(), /saved E1X_6_01\.nc/);
+  assert.deepEqual(errors, []);
+  await context.close();
+});
