@@ -429,9 +429,9 @@ mod tests {
         assert_eq!(tl.previous_contour(second), first);
         assert_eq!(tl.previous_contour(first), 0.0);
         assert_eq!(tl.contours_begun(second), 2);
-        // Idle 10 + 40 round the first square + idle 10 + 40 round the second.
-        assert!((tl.travel_length() - 100.0).abs() < 1e-9);
-        assert!((tl.travelled_at(tl.total()) - 100.0).abs() < 1e-9);
+        // Idle 10 in + 40 round the first square + idle 20 across + 40 round the second.
+        assert!((tl.travel_length() - 110.0).abs() < 1e-9);
+        assert!((tl.travelled_at(tl.total()) - 110.0).abs() < 1e-9);
         let mut last = 0.0;
         for k in 0..=50 {
             let d = tl.travelled_at(tl.total() * f64::from(k) / 50.0);
