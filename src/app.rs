@@ -1,15 +1,23 @@
-//! The application shell: sample picker, solver controls, live bounds, and the route drawing.
+//! The application shell: sample picker, solver panel, live bounds, the route drawing with its
+//! layers, the animation, exports, and the comparison of kept results.
 
-use cutroute_geometry::{MachineParameters, Nest, Point};
+use cutroute_geometry::{MachineParameters, Nest, Point, Route};
 use cutroute_protocol::{
     Document, FromWorker, JobId, JobRequest, Problem, Progress, SolverKind, SolverParams, ToWorker,
 };
 use gloo_worker::WorkerBridge;
 use leptos::prelude::*;
+use wasm_bindgen::JsCast;
 
+use crate::animation::{Animation, AnimationControls, AnimationOverlay};
 use crate::chart::{BoundSample, BoundsChart};
-use crate::drawing::{contour_path, idle_path, nest_bounds};
+use crate::compare::{ComparePanel, Kept};
+use crate::drawing::{
+    candidate_dots, contour_path, cut_path, direction_arrows, idle_path, nest_bounds,
+};
+use crate::export::ExportMenu;
 use crate::pan_zoom::PanZoom;
+use crate::settings::{Layer, Settings};
 use crate::stats::StatsPanel;
 use crate::worker_client::{spawn, SolverWorker};
 
@@ -43,14 +51,84 @@ impl JobState {
     }
 }
 
+/// A continued job reports on its own run; the page shows the better of that and the result it
+/// continued from, with the time of both runs added up.
+fn continued(from: &Progress, update: Progress) -> Progress {
+    let improved = match (update.upper_bound, from.upper_bound) {
+        (Some(new), Some(old)) => new < old - 1e-9,
+        (Some(_), None) => true,
+        (None, _) => false,
+    };
+    let lower_bound = match (update.lower_bound, from.lower_bound) {
+        (Some(a), Some(b)) => Some(a.max(b)),
+        (a, b) => a.or(b),
+    };
+    let elapsed_s = from.elapsed_s + update.elapsed_s;
+    if improved {
+        Progress {
+            elapsed_s,
+            lower_bound,
+            ..update
+        }
+    } else {
+        Progress {
+            job_id: update.job_id,
+            elapsed_s,
+            lower_bound,
+            phase: update.phase,
+            states: update.states,
+            ..from.clone()
+        }
+    }
+}
+
 /// The whole page.
 #[component]
 pub fn App() -> impl IntoView {
+    let query = web_sys::window()
+        .and_then(|w| w.location().search().ok())
+        .unwrap_or_default();
+    let initial = Settings::load().with_query(&query);
+
     let document = RwSignal::new(None::<Document>);
     let open_error = RwSignal::new(None::<String>);
     let progress = RwSignal::new(None::<Progress>);
     let samples = RwSignal::new(Vec::<BoundSample>::new());
     let log_time = RwSignal::new(false);
+    let job_state = RwSignal::new(JobState::Idle);
+    let solver = RwSignal::new(
+        SolverKind::from_name(&initial.solver).unwrap_or(SolverKind::NearestNeighbour),
+    );
+    let time_limit = RwSignal::new(initial.time_limit_s);
+    let seed = RwSignal::new(initial.seed);
+    let step_mm = RwSignal::new(initial.step_mm);
+    let sample = RwSignal::new(initial.sample.clone());
+    let last_file = RwSignal::new(initial.last_file.clone());
+    let hidden_layers = RwSignal::new(initial.hidden_layers.clone());
+    let next_id = StoredValue::new(1_u64);
+    // The result a Continue started from, and how many runs the current result took.
+    let continued_from = StoredValue::new(None::<Progress>);
+    // A task file opened with the next document: (its name, start point, finish point).
+    let pending_task = StoredValue::new(None::<(String, Point, Option<Point>)>);
+    let runs = StoredValue::new(0_u64);
+    let kept = RwSignal::new(Vec::<Kept>::new());
+    let machine = RwSignal::new(MachineParameters::default());
+    let presentation = RwSignal::new(false);
+
+    // Everything remembered is saved whenever it changes.
+    Effect::new(move |_| {
+        Settings {
+            sample: sample.get(),
+            last_file: last_file.get(),
+            solver: solver.get().name().to_string(),
+            time_limit_s: time_limit.get(),
+            seed: seed.get(),
+            step_mm: step_mm.get(),
+            hidden_layers: hidden_layers.get(),
+        }
+        .save();
+    });
+
     // Every report of the running job is a point of the bounds chart.
     let record = move |p: &Progress| {
         samples.update(|s| {
@@ -61,29 +139,50 @@ pub fn App() -> impl IntoView {
             })
         })
     };
-    let job_state = RwSignal::new(JobState::Idle);
-    let solver = RwSignal::new(SolverKind::NearestNeighbour);
-    let time_limit = RwSignal::new(10.0_f64);
-    let next_id = StoredValue::new(1_u64);
+    let merged = move |update: Progress| match continued_from.get_value() {
+        Some(from) => continued(&from, update),
+        None => update,
+    };
 
     let bridge: StoredValue<WorkerBridge<SolverWorker>, LocalStorage> =
         StoredValue::new_local(spawn(move |message| match message {
             FromWorker::Opened {
-                document: opened, ..
+                document: mut opened,
+                ..
             } => {
+                if let Some((task_name, task_start, task_finish)) = pending_task.get_value() {
+                    pending_task.set_value(None);
+                    if let Problem::Nest { start, finish, .. } = &mut opened.problem {
+                        *start = task_start;
+                        *finish = task_finish;
+                    }
+                    opened.format = format!("{}) + {task_name} (task JSON", opened.format);
+                }
                 open_error.set(None);
                 progress.set(None);
+                samples.set(Vec::new());
+                continued_from.set_value(None);
+                let same_nest = document
+                    .with_untracked(|d| d.as_ref().map(|d| &d.problem) == Some(&opened.problem));
+                if !same_nest {
+                    kept.set(Vec::new());
+                }
                 document.set(Some(opened));
             }
-            FromWorker::OpenFailed { message, .. } => open_error.set(Some(message)),
+            FromWorker::OpenFailed { message, .. } => {
+                pending_task.set_value(None);
+                open_error.set(Some(message));
+            }
             FromWorker::Progress(update) => {
                 if job_state.get_untracked() == JobState::Running(update.job_id) {
+                    let update = merged(update);
                     record(&update);
                     progress.set(Some(update));
                 }
             }
             FromWorker::Finished(last) => {
                 if job_state.get_untracked() == JobState::Running(last.job_id) {
+                    let last = merged(last);
                     record(&last);
                     progress.set(Some(last));
                     job_state.set(JobState::Finished);
@@ -91,7 +190,7 @@ pub fn App() -> impl IntoView {
             }
             FromWorker::Cancelled(last) => {
                 if job_state.get_untracked() == JobState::Running(last.job_id) {
-                    progress.set(Some(last));
+                    progress.set(Some(merged(last)));
                     job_state.set(JobState::Cancelled);
                 }
             }
@@ -102,15 +201,26 @@ pub fn App() -> impl IntoView {
             }
         }));
 
-    let machine = RwSignal::new(MachineParameters::default());
-    let shown_nest = Signal::derive(move || {
+    let shown_nest = Memo::new(move |_| {
         document.with(|d| match d.as_ref().map(|d| &d.problem) {
             Some(Problem::Nest { nest, .. }) => Some(nest.clone()),
             _ => None,
         })
     });
-    let shown_route =
-        Signal::derive(move || progress.with(|p| p.as_ref().and_then(|p| p.route.clone())));
+    let shown_nest = Signal::from(shown_nest);
+    // The solver's best route, or else the route the file holds (result files).
+    let shown_route = Memo::new(move |_| {
+        progress
+            .with(|p| p.as_ref().and_then(|p| p.route.clone()))
+            .or_else(|| document.with(|d| d.as_ref().and_then(|d| d.route.clone())))
+    });
+    let shown_route = Signal::from(shown_route);
+    let certified = Memo::new(move |_| {
+        progress.with(|p| p.as_ref().map(|p| p.certified.clone()).unwrap_or_default())
+    });
+    let animation = Animation::new(shown_nest, shown_route, machine);
+    let file_name =
+        Signal::derive(move || document.with(|d| d.as_ref().map(|d| d.file_name.clone())));
 
     let take_id = move || {
         let id = next_id.get_value();
@@ -120,6 +230,7 @@ pub fn App() -> impl IntoView {
 
     let open_sample = move |file_name: String| {
         let request_id = take_id();
+        sample.set(file_name.clone());
         leptos::task::spawn_local(async move {
             let url = format!("./assets/samples/{file_name}");
             match fetch_bytes(&url).await {
@@ -134,41 +245,78 @@ pub fn App() -> impl IntoView {
             }
         });
     };
-    open_sample(SAMPLES[0].0.to_string());
+    open_sample(initial.sample.clone());
 
     // Local files (picker or drag and drop) go to the worker as bytes: parsing happens there.
+    // A task JSON opened together with a geometry or result file is combined with it, as the
+    // old viewer did: the task brings the machine's speeds and the start and finish points.
     let open_files = move |files: web_sys::FileList| {
-        for index in 0..files.length() {
-            let Some(file) = files.item(index) else {
-                continue;
-            };
-            let request_id = take_id();
-            leptos::task::spawn_local(async move {
+        let files: Vec<web_sys::File> = (0..files.length()).filter_map(|i| files.item(i)).collect();
+        leptos::task::spawn_local(async move {
+            let mut batch = Vec::new();
+            for file in files {
                 match read_file(&file).await {
-                    Ok(bytes) => bridge.with_value(|b| {
-                        b.send(ToWorker::Open {
-                            request_id,
-                            file_name: file.name(),
-                            bytes,
-                        })
-                    }),
+                    Ok(bytes) => batch.push((file.name(), bytes)),
                     Err(message) => open_error.set(Some(format!("{}: {message}", file.name()))),
                 }
-            });
-        }
+            }
+            let is_task = |bytes: &[u8]| {
+                cutroute_formats::detect(bytes) == cutroute_formats::Format::TaskJson
+            };
+            let has_geometry = batch.iter().any(|(_, b)| !is_task(b.as_slice()));
+            for (file_name, bytes) in batch {
+                if has_geometry && is_task(bytes.as_slice()) {
+                    match cutroute_formats::read_task_json(&bytes) {
+                        Ok(task) => {
+                            let data = &task.task_data;
+                            machine.update(|m| {
+                                m.idle_speed = data.tool_idling_speed;
+                                m.cut_speed = data.tool_cut_speed;
+                                m.pierce_time = data.piercing_duration;
+                            });
+                            pending_task.set_value(Some((file_name, data.start(), data.finish())));
+                        }
+                        Err(e) => open_error.set(Some(format!("{file_name}: {e}"))),
+                    }
+                    continue;
+                }
+                last_file.set(Some(file_name.clone()));
+                let request_id = take_id();
+                bridge.with_value(|b| {
+                    b.send(ToWorker::Open {
+                        request_id,
+                        file_name,
+                        bytes,
+                    })
+                });
+            }
+        });
     };
 
-    let start = move |_| {
+    // Start a job; `from` is the result a Continue restarts from.
+    let launch = move |from: Option<Progress>| {
         let Some(Document { problem, .. }) = document.get_untracked() else {
             return;
         };
         let job_id = take_id();
+        let run = if from.is_some() {
+            runs.get_value() + 1
+        } else {
+            0
+        };
+        runs.set_value(run);
         let params = SolverParams {
             time_limit_s: time_limit.get_untracked(),
-            ..SolverParams::default()
+            // A continued run explores with another seed, pruned by the best cost found.
+            seed: seed.get_untracked().wrapping_add(run),
+            discretisation_step_mm: step_mm.get_untracked(),
+            initial_upper_bound: from.as_ref().and_then(|p| p.upper_bound),
         };
-        progress.set(None);
-        samples.set(Vec::new());
+        if from.is_none() {
+            progress.set(None);
+            samples.set(Vec::new());
+        }
+        continued_from.set_value(from);
         job_state.set(JobState::Running(job_id));
         let request = JobRequest {
             job_id,
@@ -184,6 +332,88 @@ pub fn App() -> impl IntoView {
         }
     };
     let running = move || matches!(job_state.get(), JobState::Running(_));
+    let can_continue = move || {
+        !running()
+            && progress.with(|p| p.as_ref().is_some_and(|p| p.upper_bound.is_some()))
+            && !progress.with(|p| p.as_ref().is_some_and(|p| p.proven_optimal))
+    };
+
+    // Presentation mode: large fonts and the whole screen (F toggles it outside text fields).
+    Effect::new(move |_| {
+        let on = presentation.get();
+        let Some(doc) = web_sys::window().and_then(|w| w.document()) else {
+            return;
+        };
+        if let Some(root) = doc.document_element() {
+            let _ = if on {
+                root.set_attribute("data-presentation", "on")
+            } else {
+                root.remove_attribute("data-presentation")
+            };
+            if on && doc.fullscreen_element().is_none() {
+                request_fullscreen(&root);
+            } else if !on && doc.fullscreen_element().is_some() {
+                doc.exit_fullscreen();
+            }
+        }
+    });
+    let keys = window_event_listener(leptos::ev::keydown, move |ev| {
+        let typing = ev
+            .target()
+            .and_then(|t| t.dyn_into::<web_sys::Element>().ok())
+            .is_some_and(|e| matches!(e.tag_name().as_str(), "INPUT" | "SELECT" | "TEXTAREA"));
+        if typing || ev.ctrl_key() || ev.meta_key() || ev.alt_key() {
+            return;
+        }
+        if ev.key() == "f" || ev.key() == "F" {
+            ev.prevent_default();
+            presentation.update(|p| *p = !*p);
+        }
+    });
+    on_cleanup(move || keys.remove());
+    // Leaving full screen with Esc leaves presentation mode too.
+    let fullscreen = window_event_listener_untyped("fullscreenchange", move |_| {
+        let full = web_sys::window()
+            .and_then(|w| w.document())
+            .is_some_and(|d| d.fullscreen_element().is_some());
+        if !full && presentation.get_untracked() {
+            presentation.set(false);
+        }
+    });
+    on_cleanup(move || fullscreen.remove());
+
+    let share_link = move || {
+        let settings = Settings {
+            sample: sample.get(),
+            solver: solver.get().name().to_string(),
+            time_limit_s: time_limit.get(),
+            seed: seed.get(),
+            step_mm: step_mm.get(),
+            ..Settings::default()
+        };
+        let base = web_sys::window()
+            .and_then(|w| {
+                let l = w.location();
+                Some(format!("{}{}", l.origin().ok()?, l.pathname().ok()?))
+            })
+            .unwrap_or_default();
+        format!("{base}{}", settings.query())
+    };
+
+    let keep = move |_| {
+        let (Some(nest), Some(route)) = (shown_nest.get_untracked(), shown_route.get_untracked())
+        else {
+            return;
+        };
+        let label = progress
+            .with_untracked(|p| p.as_ref().map(|_| solver_label(solver.get_untracked())))
+            .unwrap_or("from the file");
+        let entry = machine.with_untracked(|m| Kept::new(&nest, route, m, label));
+        kept.update(|k| {
+            let id = k.iter().map(|e| e.id).max().unwrap_or(0) + 1;
+            k.push(Kept { id, ..entry });
+        });
+    };
 
     view! {
         <header class="toolbar">
@@ -193,16 +423,26 @@ pub fn App() -> impl IntoView {
                 <select
                     id="sample"
                     aria-label="Sample nest"
-                    on:change=move |ev| open_sample(event_target_value(&ev))
+                    prop:value=move || sample.get()
+                    on:change=move |ev| {
+                        last_file.set(None);
+                        open_sample(event_target_value(&ev));
+                    }
                 >
                     {SAMPLES
                         .iter()
-                        .map(|(file, label)| view! { <option value=*file>{*label}</option> })
+                        .map(|(file, label)| {
+                            view! {
+                                <option value=*file selected=*file == initial.sample>
+                                    {*label}
+                                </option>
+                            }
+                        })
                         .collect_view()}
                 </select>
             </label>
             <label class="file-button">
-                "Open file… "
+                "Open files… "
                 <input
                     id="file-input"
                     type="file"
@@ -217,11 +457,24 @@ pub fn App() -> impl IntoView {
                     }
                 />
             </label>
-            <label>
+            <crate::theme::ThemePicker />
+            <button
+                id="present"
+                aria-pressed=move || presentation.get().to_string()
+                title="Presentation mode: large fonts, full screen (key F)"
+                on:click=move |_| presentation.update(|p| *p = !*p)
+            >
+                "Present"
+            </button>
+            <ExportMenu file_name=file_name nest=shown_nest route=shown_route machine=machine />
+        </header>
+        <section class="solver-panel" aria-label="Solver">
+            <label title="Which algorithm routes the tool">
                 "Solver "
                 <select
                     id="solver"
                     aria-label="Solver"
+                    prop:value=move || solver.get().name()
                     on:change=move |ev| {
                         if let Some(kind) = SolverKind::from_name(&event_target_value(&ev)) {
                             solver.set(kind);
@@ -230,35 +483,64 @@ pub fn App() -> impl IntoView {
                 >
                     {SolverKind::ALL
                         .iter()
-                        .map(|kind| view! { <option value=kind.name()>{solver_label(*kind)}</option> })
+                        .map(|kind| {
+                            view! {
+                                <option value=kind.name() selected=kind.name() == initial.solver>
+                                    {solver_label(*kind)}
+                                </option>
+                            }
+                        })
                         .collect_view()}
                 </select>
             </label>
-            <label>
-                "Time limit, s "
+            <NumberField
+                id="time-limit"
+                label="Time limit, s"
+                tip="Wall-clock time the solver may run; it stops earlier when it proves optimality"
+                min="0.1"
+                value=time_limit
+            />
+            <label title="Seed of the solver's random choices: the same seed repeats a run">
+                "Seed "
                 <input
-                    id="time-limit"
+                    id="seed"
                     type="number"
-                    min="0.1"
+                    min="0"
                     step="1"
-                    prop:value=move || time_limit.get().to_string()
+                    prop:value=move || seed.get().to_string()
                     on:change=move |ev| {
-                        if let Ok(v) = event_target_value(&ev).parse::<f64>() {
-                            if v > 0.0 {
-                                time_limit.set(v);
-                            }
+                        if let Ok(v) = event_target_value(&ev).parse::<u64>() {
+                            seed.set(v);
                         }
                     }
                 />
             </label>
-            <crate::theme::ThemePicker />
-            <button id="start" on:click=start disabled=move || running() || document.get().is_none()>
+            <NumberField
+                id="step"
+                label="Pierce step, mm"
+                tip="Discrete solvers: spacing of candidate pierce points along each contour (smaller = finer, slower)"
+                min="0.1"
+                value=step_mm
+            />
+            <button id="start" on:click=move |_| launch(None) disabled=move || running() || document.get().is_none()>
                 "Start"
             </button>
             <button id="stop" on:click=stop disabled=move || !running()>
                 "Stop"
             </button>
-        </header>
+            <button
+                id="continue"
+                title="Run again from the best result so far (another seed, pruned by its cost)"
+                disabled=move || !can_continue()
+                on:click=move |_| launch(progress.get_untracked())
+            >
+                "Continue"
+            </button>
+            <label class="share" title="A link that opens this sample with these solver settings">
+                "Link "
+                <input id="share-link" type="text" readonly prop:value=share_link />
+            </label>
+        </section>
         <main class="workspace">
             <section
                 class="view"
@@ -272,7 +554,33 @@ pub fn App() -> impl IntoView {
                 }
             >
                 {move || open_error.get().map(|e| view! { <p class="error" role="alert">{e}</p> })}
-                <NestView document=document progress=progress />
+                // A local file cannot be reopened without the user: say which one it was.
+                {move || {
+                    last_file
+                        .get()
+                        .filter(|f| file_name.with(|shown| shown.as_ref() != Some(f)))
+                        .map(|f| {
+                            view! {
+                                <p id="last-file" class="note">
+                                    "Last time " <strong>{f}</strong>
+                                    " was open: choose it again with Open files… (the sample is shown meanwhile)"
+                                </p>
+                            }
+                        })
+                }}
+                <NestView
+                    nest=shown_nest
+                    route=shown_route
+                    certified=certified
+                    hidden_layers=hidden_layers
+                    candidates_step=Signal::derive(move || {
+                        matches!(solver.get(), SolverKind::Heuristic | SolverKind::Exact)
+                            .then(|| step_mm.get())
+                    })
+                    kept=kept
+                    animation=animation
+                />
+                <AnimationControls animation=animation />
             </section>
             <aside class="stats" aria-label="Job status">
                 <dl>
@@ -294,11 +602,88 @@ pub fn App() -> impl IntoView {
                     </dd>
                     <dt>"Elapsed"</dt>
                     <dd id="elapsed">{move || progress.get().map(|p| format!("{:.2} s", p.elapsed_s)).unwrap_or_default()}</dd>
+                    <dt>"Certified"</dt>
+                    <dd id="certified-count">
+                        {move || certified.with(|c| {
+                            if c.is_empty() {
+                                "—".to_string()
+                            } else {
+                                format!("{} of {}", c.iter().filter(|x| **x).count(), c.len())
+                            }
+                        })}
+                    </dd>
                 </dl>
                 <StatsPanel nest=shown_nest route=shown_route machine=machine />
                 <BoundsChart samples=samples log_time=log_time />
+                <LayerPanel hidden=hidden_layers />
+                <ComparePanel kept=kept keep=keep can_keep=Signal::derive(move || shown_route.with(Option::is_some)) />
             </aside>
         </main>
+    }
+}
+
+/// A labelled positive number input with a tooltip.
+#[component]
+fn NumberField(
+    id: &'static str,
+    label: &'static str,
+    tip: &'static str,
+    min: &'static str,
+    value: RwSignal<f64>,
+) -> impl IntoView {
+    view! {
+        <label title=tip>
+            {label} " "
+            <input
+                id=id
+                type="number"
+                min=min
+                step="any"
+                prop:value=move || value.get().to_string()
+                on:change=move |ev| {
+                    if let Ok(v) = event_target_value(&ev).parse::<f64>() {
+                        if v > 0.0 && v.is_finite() {
+                            value.set(v);
+                        }
+                    }
+                }
+            />
+        </label>
+    }
+}
+
+/// A checkbox per drawing layer.
+#[component]
+fn LayerPanel(hidden: RwSignal<Vec<Layer>>) -> impl IntoView {
+    view! {
+        <fieldset class="layers">
+            <legend>"Layers"</legend>
+            {Layer::ALL
+                .into_iter()
+                .map(|layer| {
+                    view! {
+                        <label>
+                            <input
+                                type="checkbox"
+                                id=format!("layer-{}", layer.name())
+                                prop:checked=move || hidden.with(|h| !h.contains(&layer))
+                                on:change=move |ev| {
+                                    let show = event_target_checked(&ev);
+                                    hidden.update(|h| {
+                                        h.retain(|l| *l != layer);
+                                        if !show {
+                                            h.push(layer);
+                                        }
+                                    });
+                                }
+                            />
+                            " "
+                            {layer.label()}
+                        </label>
+                    }
+                })
+                .collect_view()}
+        </fieldset>
     }
 }
 
@@ -315,6 +700,24 @@ fn format_bound(value: Option<f64>) -> String {
     value
         .map(|v| format!("{v:.1}"))
         .unwrap_or_else(|| "—".into())
+}
+
+/// Asks for full screen; a refusal (no user gesture, a browser without it) is awaited and
+/// ignored, so it never surfaces as an unhandled rejection: large fonts still apply.
+fn request_fullscreen(element: &web_sys::Element) {
+    let Ok(method) = js_sys::Reflect::get(element, &"requestFullscreen".into()) else {
+        return;
+    };
+    let Some(method) = method.dyn_ref::<js_sys::Function>() else {
+        return;
+    };
+    if let Ok(answer) = method.call0(element) {
+        if let Ok(promise) = answer.dyn_into::<js_sys::Promise>() {
+            leptos::task::spawn_local(async move {
+                let _ = wasm_bindgen_futures::JsFuture::from(promise).await;
+            });
+        }
+    }
 }
 
 async fn read_file(file: &web_sys::File) -> Result<Vec<u8>, String> {
@@ -335,18 +738,17 @@ async fn fetch_bytes(url: &str) -> Result<Vec<u8>, String> {
     response.binary().await.map_err(|e| e.to_string())
 }
 
-/// The drawing: sheet, parts, idle moves and pierce points, y axis up.
+/// The drawing: sheet, parts and the route's layers, y axis up.
 #[component]
 fn NestView(
-    document: RwSignal<Option<Document>>,
-    progress: RwSignal<Option<Progress>>,
+    nest: Signal<Option<Nest>>,
+    route: Signal<Option<Route>>,
+    certified: Memo<Vec<bool>>,
+    hidden_layers: RwSignal<Vec<Layer>>,
+    candidates_step: Signal<Option<f64>>,
+    kept: RwSignal<Vec<Kept>>,
+    animation: Animation,
 ) -> impl IntoView {
-    let nest = Memo::new(move |_| {
-        document.with(|d| match d.as_ref().map(|d| &d.problem) {
-            Some(Problem::Nest { nest, .. }) => Some(nest.clone()),
-            _ => None,
-        })
-    });
     let fit = Signal::derive(move || {
         nest.with(|n| n.as_ref().and_then(nest_bounds))
             .map(|[x0, y0, x1, y1]| {
@@ -360,18 +762,55 @@ fn NestView(
                 ]
             })
     });
+    // Size of the drawing: fixed-size marks (arrows, dots, numbers) scale with it.
+    let extent = Memo::new(move |_| fit.get().map_or(100.0, |f| f[2].max(f[3])));
     let pan_zoom = PanZoom::new(fit);
-    // A new drawing starts fitted.
+    // A new drawing starts fitted, with the animation rewound.
     Effect::new(move |_| {
         nest.track();
         pan_zoom.reset();
+        animation.playing.set(false);
+        animation.time.set(None);
     });
     let view_box = move || {
         pan_zoom
             .current()
             .map(|[x, y, w, h]| format!("{x} {y} {w} {h}"))
     };
-    let parts = move || nest.with(|n| n.as_ref().map(part_paths).unwrap_or_default());
+    let view_width =
+        Signal::derive(move || pan_zoom.current().map_or(100.0, |[_, _, w, h]| w.max(h)));
+    let classes = move || {
+        hidden_layers.with(|hidden| {
+            let mut c = String::from("nest");
+            for layer in hidden {
+                c.push_str(" hide-");
+                c.push_str(layer.name());
+            }
+            c
+        })
+    };
+    let parts = move || {
+        nest.with(|n| {
+            n.as_ref().map(|n| {
+                n.parts
+                    .iter()
+                    .enumerate()
+                    .map(|(i, part)| {
+                        let mut d = String::new();
+                        part.contours.iter().for_each(|c| contour_path(c, &mut d));
+                        let title = format!(
+                            "part {} “{}”, {} contour{}",
+                            i + 1,
+                            part.name,
+                            part.contours.len(),
+                            if part.contours.len() == 1 { "" } else { "s" }
+                        );
+                        view! { <path class="part" d=d><title>{title}</title></path> }
+                    })
+                    .collect_view()
+            })
+        })
+    };
     let sheet = move || {
         nest.with(|n| {
             n.as_ref().and_then(|n| n.sheet.as_ref()).map(|sheet| {
@@ -381,11 +820,133 @@ fn NestView(
             })
         })
     };
-    let route = move || progress.with(|p| p.as_ref().and_then(|p| p.route.clone()));
+    let arrows = move || {
+        let size = extent.get() / 60.0;
+        nest.with(|n| n.as_ref().map(|n| direction_arrows(n, size)))
+    };
+    let candidates = move || {
+        let step = candidates_step.get()?;
+        nest.with(|n| n.as_ref().map(|n| candidate_dots(n, step)))
+    };
+    let cuts = move || {
+        animation
+            .timeline
+            .with(|t| t.as_ref().map(|t| cut_path(&t.toolpath)))
+    };
+    // Certified and uncertified contours of the route (CCP's certificates).
+    let certificates = move || {
+        let flags = certified.get();
+        if flags.is_empty() {
+            return None;
+        }
+        let route = route.get()?;
+        nest.with(|n| {
+            let n = n.as_ref()?;
+            let (mut yes, mut no) = (String::new(), String::new());
+            for (step, ok) in route.steps.iter().zip(flags.iter()) {
+                if let Some(c) = n.contour(step.contour) {
+                    contour_path(c, if *ok { &mut yes } else { &mut no });
+                }
+            }
+            Some((yes, no))
+        })
+    };
+    let pierces = move || {
+        let route = route.get()?;
+        let r = extent.get() / 250.0;
+        nest.with(|n| {
+            let n = n.as_ref()?;
+            let total = route.steps.len();
+            Some(
+                route
+                    .steps
+                    .iter()
+                    .enumerate()
+                    .map(|(k, s)| {
+                        let part = n.parts.get(s.contour.part);
+                        let title = format!(
+                            "cut {} of {total}: part {} “{}”, contour {}{} — pierce at ({:.2}, {:.2})",
+                            k + 1,
+                            s.contour.part + 1,
+                            part.map_or("", |p| p.name.as_str()),
+                            s.contour.contour,
+                            if s.contour.contour == 0 { " (outer)" } else { "" },
+                            s.pierce_point.x,
+                            s.pierce_point.y
+                        );
+                        view! {
+                            <circle class="pierce" cx=s.pierce_point.x cy=s.pierce_point.y r=r>
+                                <title>{title}</title>
+                            </circle>
+                        }
+                    })
+                    .collect_view(),
+            )
+        })
+    };
+    let ends = move || {
+        let route = route.get()?;
+        let r = extent.get() / 100.0;
+        let marker = move |p: Point, class: &'static str, name: &'static str| {
+            view! {
+                <rect class=class x=p.x - r y=p.y - r width=2.0 * r height=2.0 * r>
+                    <title>{format!("{name} ({:.2}, {:.2})", p.x, p.y)}</title>
+                </rect>
+            }
+        };
+        Some(view! {
+            {marker(route.start, "start-marker", "start")}
+            {route.finish.map(|f| marker(f, "finish-marker", "finish"))}
+        })
+    };
+    // Order numbers live outside the flipped group (text must not be mirrored): (x, −y).
+    let order_labels = move || {
+        let route = route.get()?;
+        Some(
+            route
+                .steps
+                .iter()
+                .enumerate()
+                .map(|(k, s)| {
+                    view! {
+                        <text x=s.pierce_point.x y=-s.pierce_point.y dx="0.4em" dy="-0.3em">
+                            {(k + 1).to_string()}
+                        </text>
+                    }
+                })
+                .collect_view(),
+        )
+    };
+    let compared = move || {
+        kept.with(|k| {
+            k.iter()
+                .filter(|e| e.overlay)
+                .take(2)
+                .zip(["compare-a", "compare-b"])
+                .map(|(e, class)| {
+                    view! {
+                        <path class=format!("compare {class}") d=idle_path(&e.route)>
+                            <title>{format!("kept result #{}: {}", e.id, e.label)}</title>
+                        </path>
+                    }
+                })
+                .collect_view()
+        })
+    };
+    let hatch = move || {
+        let s = extent.get() / 120.0;
+        view! {
+            <pattern id="hatch" patternUnits="userSpaceOnUse" width=s height=s patternTransform="rotate(45)">
+                <rect class="hatch-bg" width=s height=s />
+                <line class="hatch-line" x1="0" y1="0" x2="0" y2=s />
+            </pattern>
+        }
+    };
     view! {
         <svg
             id="nest-view"
-            class="nest"
+            xmlns="http://www.w3.org/2000/svg"
+            class=classes
             viewBox=view_box
             preserveAspectRatio="xMidYMid meet"
             tabindex="0"
@@ -398,46 +959,33 @@ fn NestView(
             on:pointercancel=move |ev| pan_zoom.on_pointer_up(ev)
             on:keydown=move |ev| pan_zoom.on_key(ev)
         >
+            <defs>{hatch}</defs>
             <g transform="scale(1,-1)">
                 <path class="sheet" d=sheet />
+                <g class="parts">{parts}</g>
+                <path class="arrows" d=arrows />
+                <path class="candidates" d=candidates />
                 {move || {
-                    parts()
-                        .into_iter()
-                        .map(|(name, d)| view! { <path class="part" d=d><title>{name}</title></path> })
-                        .collect_view()
-                }}
-                {move || {
-                    route()
-                        .map(|route| {
-                            let pierces = route
-                                .steps
-                                .iter()
-                                .map(|s| pierce_marker(s.pierce_point))
-                                .collect_view();
+                    certificates()
+                        .map(|(yes, no)| {
                             view! {
-                                <g class="route">
-                                    <path class="idle" d=idle_path(&route) />
-                                    {pierces}
+                                <g class="certificates">
+                                    <path class="certified" d=yes />
+                                    <path class="uncertified" d=no />
                                 </g>
                             }
                         })
                 }}
+                <g class="route">
+                    <path class="cut" d=cuts />
+                    <path class="idle" d=move || route.with(|r| r.as_ref().map(idle_path)) />
+                    <g class="pierces">{pierces}</g>
+                    <g class="ends">{ends}</g>
+                </g>
+                <g class="compared">{compared}</g>
+                <AnimationOverlay animation=animation scale=view_width />
             </g>
+            <g class="order" font-size=move || view_width.get() / 70.0>{order_labels}</g>
         </svg>
     }
-}
-
-fn pierce_marker(p: Point) -> impl IntoView {
-    view! { <circle class="pierce" cx=p.x cy=p.y r="1" /> }
-}
-
-fn part_paths(nest: &Nest) -> Vec<(String, String)> {
-    nest.parts
-        .iter()
-        .map(|part| {
-            let mut d = String::new();
-            part.contours.iter().for_each(|c| contour_path(c, &mut d));
-            (part.name.clone(), d)
-        })
-        .collect()
 }

@@ -1,9 +1,14 @@
-//! cutroute's browser application: open a nest, solve it in the worker, watch the route improve.
+//! cutroute's browser application: open a nest, solve it in the worker, watch the route improve,
+//! review it (layers, animation, certificates), compare and export it.
 
+mod animation;
 mod app;
 mod chart;
+mod compare;
 mod drawing;
+mod export;
 mod pan_zoom;
+mod settings;
 mod stats;
 mod theme;
 mod worker_client;

@@ -1,0 +1,435 @@
+//! The export menu: files built in the page and handed to the browser as downloads (Blob +
+//! object URL). Nest and result formats come from `cutroute-formats`' writers, so our own readers
+//! parse them back; the SVG is the current view as drawn.
+//!
+//! The standalone HTML page comes from `cutroute-formats`' `route_html`, G-code from the
+//! `cutroute-gcode` post-processor with the options chosen in the menu (and a preview of the
+//! first lines).
+
+use cutroute_formats::{
+    route_html, write_dbs, write_geometry_json, write_result_json, HtmlOptions,
+    ResultExportOptions, RmResult,
+};
+use cutroute_gcode::{route_gcode, ArcOutput, DistanceMode, GcodeOptions};
+use cutroute_geometry::{MachineParameters, Nest, Route};
+use leptos::prelude::*;
+use wasm_bindgen::JsCast;
+
+/// Styles inlined into an exported SVG so it looks like the view without the page's CSS.
+const SVG_STYLE: &str = ".sheet{fill:#e9e6df;stroke:#6b6b70}.part{fill:#c9d6e8;fill-rule:evenodd;stroke:#2b4a73}\
+.idle{fill:none;stroke:#d55e00;stroke-dasharray:6 4}.cut{fill:none;stroke:#0072b2}\
+.arrows{fill:none;stroke:#2b4a73}.pierce{fill:#009e73}.candidates{fill:none;stroke:#888;stroke-linecap:round;stroke-width:3px}\
+path,circle{vector-effect:non-scaling-stroke}.done,.tool-head{display:none}";
+
+/// Builds a download from the file stem, the nest and the route (if any).
+type Exporter<'a> = &'a dyn Fn(&str, &Nest, Option<&Route>) -> Result<Download, String>;
+
+/// One file to download.
+pub struct Download {
+    /// Suggested file name.
+    pub name: String,
+    /// MIME type.
+    pub mime: &'static str,
+    /// Content.
+    pub bytes: Vec<u8>,
+}
+
+/// The base of exported file names: the opened file's name without its extensions.
+pub fn stem(file_name: &str) -> String {
+    let base = file_name.rsplit(['/', '\\']).next().unwrap_or(file_name);
+    let stem = base.split('.').next().unwrap_or(base);
+    if stem.is_empty() {
+        "cutroute".into()
+    } else {
+        stem.into()
+    }
+}
+
+/// The route in RouteManager's result format.
+pub fn result_json(
+    stem: &str,
+    nest: &Nest,
+    route: &Route,
+    machine: &MachineParameters,
+) -> Result<Download, String> {
+    let options = ResultExportOptions {
+        idle_speed: machine.idle_speed,
+        ..ResultExportOptions::default()
+    };
+    let result = RmResult::from_route(nest, route, &options).map_err(|e| e.to_string())?;
+    let text = write_result_json(&result).map_err(|e| e.to_string())?;
+    Ok(Download {
+        name: format!("{stem}.rm-result.json"),
+        mime: "application/json",
+        bytes: text.into_bytes(),
+    })
+}
+
+/// The nest as geometry JSON.
+pub fn geometry_json(stem: &str, nest: &Nest) -> Result<Download, String> {
+    let text = write_geometry_json(nest).map_err(|e| e.to_string())?;
+    Ok(Download {
+        name: format!("{stem}.dbs.json"),
+        mime: "application/json",
+        bytes: text.into_bytes(),
+    })
+}
+
+/// The nest as binary DBS.
+pub fn dbs(stem: &str, nest: &Nest) -> Result<Download, String> {
+    let bytes = write_dbs(nest).map_err(|e| e.to_string())?;
+    Ok(Download {
+        name: format!("{stem}.dbs"),
+        mime: "application/octet-stream",
+        bytes,
+    })
+}
+
+/// A page that shows and animates the route with no server.
+pub fn standalone_html(
+    stem: &str,
+    nest: &Nest,
+    route: &Route,
+    machine: &MachineParameters,
+) -> Result<Download, String> {
+    let options = HtmlOptions {
+        title: stem.to_string(),
+        machine: *machine,
+        ..HtmlOptions::default()
+    };
+    let text = route_html(nest, route, &options).map_err(|e| e.to_string())?;
+    Ok(Download {
+        name: format!("{stem}.html"),
+        mime: "text/html",
+        bytes: text.into_bytes(),
+    })
+}
+
+/// What the G-code panel lets the user choose.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GcodeChoice {
+    /// `G91` instead of `G90`.
+    pub incremental: bool,
+    /// "ij", "r" or "lines".
+    pub arcs: String,
+    /// Torch on line.
+    pub torch_on: String,
+    /// Torch off line.
+    pub torch_off: String,
+    /// Pierce dwell, s.
+    pub dwell_s: f64,
+}
+
+impl GcodeChoice {
+    /// The post-processor's options for this choice under `machine`'s feed.
+    pub fn options(&self, machine: &MachineParameters) -> GcodeOptions {
+        GcodeOptions {
+            distance_mode: if self.incremental {
+                DistanceMode::Incremental
+            } else {
+                DistanceMode::Absolute
+            },
+            arcs: match self.arcs.as_str() {
+                "r" => ArcOutput::Radius,
+                "lines" => ArcOutput::Lines { tolerance_mm: 0.01 },
+                _ => ArcOutput::CentreOffsets,
+            },
+            torch_on: self.torch_on.clone(),
+            torch_off: self.torch_off.clone(),
+            pierce_dwell_s: self.dwell_s,
+            ..GcodeOptions::for_machine(machine)
+        }
+    }
+}
+
+/// The route as a G-code program.
+pub fn gcode(
+    stem: &str,
+    nest: &Nest,
+    route: &Route,
+    options: &GcodeOptions,
+) -> Result<Download, String> {
+    let text = route_gcode(nest, route, options).map_err(|e| e.to_string())?;
+    Ok(Download {
+        name: format!("{stem}.nc"),
+        mime: "text/plain",
+        bytes: text.into_bytes(),
+    })
+}
+
+/// The SVG element with id `svg_id` as a standalone document, view box as currently shown.
+pub fn current_view_svg(stem: &str, svg_id: &str) -> Result<Download, String> {
+    let element = web_sys::window()
+        .and_then(|w| w.document())
+        .and_then(|d| d.get_element_by_id(svg_id))
+        .ok_or("the drawing is not on the page")?;
+    let markup = element.outer_html();
+    // Insert the style right after the opening tag.
+    let open_end = markup.find('>').ok_or("the drawing has no markup")? + 1;
+    let mut text = String::from("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
+    text.push_str(&markup[..open_end]);
+    text.push_str("<style>");
+    text.push_str(SVG_STYLE);
+    text.push_str("</style>");
+    text.push_str(&markup[open_end..]);
+    Ok(Download {
+        name: format!("{stem}.svg"),
+        mime: "image/svg+xml",
+        bytes: text.into_bytes(),
+    })
+}
+
+/// Hands a file to the browser's download machinery.
+pub fn save(download: &Download) -> Result<(), String> {
+    let js = |e: wasm_bindgen::JsValue| format!("{e:?}");
+    let parts = js_sys::Array::new();
+    parts.push(&js_sys::Uint8Array::from(download.bytes.as_slice()));
+    let options = web_sys::BlobPropertyBag::new();
+    options.set_type(download.mime);
+    let blob =
+        web_sys::Blob::new_with_u8_array_sequence_and_options(&parts, &options).map_err(js)?;
+    let url = web_sys::Url::create_object_url_with_blob(&blob).map_err(js)?;
+    let document = web_sys::window()
+        .and_then(|w| w.document())
+        .ok_or("no document")?;
+    let anchor: web_sys::HtmlAnchorElement = document
+        .create_element("a")
+        .map_err(js)?
+        .dyn_into()
+        .map_err(|_| "not an anchor".to_string())?;
+    anchor.set_href(&url);
+    anchor.set_download(&download.name);
+    anchor.click();
+    // The click has started the download; the URL can go once the browser has read it.
+    set_timeout(
+        move || {
+            let _ = web_sys::Url::revoke_object_url(&url);
+        },
+        std::time::Duration::from_secs(30),
+    );
+    Ok(())
+}
+
+/// The export menu for the nest and route shown.
+#[component]
+pub fn ExportMenu(
+    file_name: Signal<Option<String>>,
+    nest: Signal<Option<Nest>>,
+    route: Signal<Option<Route>>,
+    machine: RwSignal<MachineParameters>,
+) -> impl IntoView {
+    let message = RwSignal::new(None::<String>);
+    let run = move |make: Exporter| {
+        let Some(nest) = nest.get_untracked() else {
+            return;
+        };
+        let stem = stem(&file_name.get_untracked().unwrap_or_default());
+        let route = route.get_untracked();
+        let outcome = make(&stem, &nest, route.as_ref()).and_then(|d| {
+            save(&d)?;
+            Ok(d.name)
+        });
+        message.set(Some(match outcome {
+            Ok(name) => format!("saved {name}"),
+            Err(e) => format!("export failed: {e}"),
+        }));
+    };
+    let no_nest = move || nest.with(Option::is_none);
+    let no_route = move || route.with(Option::is_none);
+    let choice = RwSignal::new(GcodeChoice {
+        incremental: false,
+        arcs: "ij".into(),
+        torch_on: "M03".into(),
+        torch_off: "M05".into(),
+        dwell_s: machine.get_untracked().pierce_time,
+    });
+    let preview = RwSignal::new(String::new());
+    let make_gcode = move || -> Result<Download, String> {
+        let nest = nest.get_untracked().ok_or("no nest")?;
+        let route = route.get_untracked().ok_or("no route yet")?;
+        let options = machine.with_untracked(|m| choice.with_untracked(|c| c.options(m)));
+        gcode(
+            &stem(&file_name.get_untracked().unwrap_or_default()),
+            &nest,
+            &route,
+            &options,
+        )
+    };
+    let show_preview = move || match make_gcode() {
+        Ok(d) => preview.set(
+            String::from_utf8_lossy(&d.bytes)
+                .lines()
+                .take(PREVIEW_LINES)
+                .collect::<Vec<_>>()
+                .join("\n"),
+        ),
+        Err(e) => preview.set(format!("no G-code: {e}")),
+    };
+    view! {
+        <details class="export">
+            <summary>"Export"</summary>
+            <div class="export-buttons" role="group" aria-label="Export">
+                <button
+                    id="export-result"
+                    title="The route in RouteManager's result format (rm-result.json)"
+                    disabled=no_route
+                    on:click=move |_| {
+                        run(&|stem, nest, route| {
+                            let route = route.ok_or("no route yet")?;
+                            machine.with_untracked(|m| result_json(stem, nest, route, m))
+                        })
+                    }
+                >
+                    "Result JSON"
+                </button>
+                <button
+                    id="export-geometry"
+                    title="The nest as geometry JSON (dbs.json)"
+                    disabled=no_nest
+                    on:click=move |_| run(&|stem, nest, _| geometry_json(stem, nest))
+                >
+                    "Geometry JSON"
+                </button>
+                <button
+                    id="export-dbs"
+                    title="The nest as binary DBS"
+                    disabled=no_nest
+                    on:click=move |_| run(&|stem, nest, _| dbs(stem, nest))
+                >
+                    "DBS"
+                </button>
+                <button
+                    id="export-svg"
+                    title="The drawing as shown (current zoom and layers)"
+                    disabled=no_nest
+                    on:click=move |_| run(&|stem, _, _| current_view_svg(stem, "nest-view"))
+                >
+                    "SVG of the view"
+                </button>
+                <button
+                    id="export-html"
+                    title="A single HTML file that shows and animates the route, no server needed"
+                    disabled=no_route
+                    on:click=move |_| {
+                        run(&|stem, nest, route| {
+                            let route = route.ok_or("no route yet")?;
+                            machine.with_untracked(|m| standalone_html(stem, nest, route, m))
+                        })
+                    }
+                >
+                    "Standalone HTML"
+                </button>
+            </div>
+            <fieldset class="gcode">
+                <legend>"G-code"</legend>
+                <label title="G90: positions; G91: increments from the previous point">
+                    "Coordinates "
+                    <select
+                        id="gcode-distance"
+                        on:change=move |ev| {
+                            let incremental = event_target_value(&ev) == "incremental";
+                            choice.update(|c| c.incremental = incremental);
+                        }
+                    >
+                        <option value="absolute">"absolute (G90)"</option>
+                        <option value="incremental">"incremental (G91)"</option>
+                    </select>
+                </label>
+                <label title="How arcs are written">
+                    "Arcs "
+                    <select
+                        id="gcode-arcs"
+                        on:change=move |ev| {
+                            let arcs = event_target_value(&ev);
+                            choice.update(|c| c.arcs = arcs);
+                        }
+                    >
+                        <option value="ij">"G02/G03 with I, J"</option>
+                        <option value="r">"G02/G03 with R"</option>
+                        <option value="lines">"G01 chords only"</option>
+                    </select>
+                </label>
+                <label title="Line that switches the torch on">
+                    "Torch on "
+                    <input
+                        id="gcode-torch-on"
+                        type="text"
+                        size="8"
+                        prop:value=move || choice.with(|c| c.torch_on.clone())
+                        on:change=move |ev| {
+                            let v = event_target_value(&ev);
+                            choice.update(|c| c.torch_on = v);
+                        }
+                    />
+                </label>
+                <label title="Line that switches the torch off">
+                    "Torch off "
+                    <input
+                        id="gcode-torch-off"
+                        type="text"
+                        size="8"
+                        prop:value=move || choice.with(|c| c.torch_off.clone())
+                        on:change=move |ev| {
+                            let v = event_target_value(&ev);
+                            choice.update(|c| c.torch_off = v);
+                        }
+                    />
+                </label>
+                <label title="Dwell after the torch is switched on (G04), seconds">
+                    "Pierce dwell, s "
+                    <input
+                        id="gcode-dwell"
+                        type="number"
+                        min="0"
+                        step="any"
+                        prop:value=move || choice.with(|c| c.dwell_s.to_string())
+                        on:change=move |ev| {
+                            if let Ok(v) = event_target_value(&ev).parse::<f64>() {
+                                if v >= 0.0 && v.is_finite() {
+                                    choice.update(|c| c.dwell_s = v);
+                                }
+                            }
+                        }
+                    />
+                </label>
+                <button id="gcode-preview-button" disabled=no_route on:click=move |_| show_preview()>
+                    "Preview"
+                </button>
+                <button
+                    id="export-gcode"
+                    disabled=no_route
+                    on:click=move |_| {
+                        show_preview();
+                        let outcome = make_gcode().and_then(|d| {
+                            save(&d)?;
+                            Ok(d.name)
+                        });
+                        message.set(Some(match outcome {
+                            Ok(name) => format!("saved {name}"),
+                            Err(e) => format!("export failed: {e}"),
+                        }));
+                    }
+                >
+                    "G-code"
+                </button>
+                <pre id="gcode-preview" aria-label="First lines of the G-code">{move || preview.get()}</pre>
+            </fieldset>
+            <p id="export-status" class="muted" aria-live="polite">{move || message.get()}</p>
+        </details>
+    }
+}
+
+/// Lines of G-code shown in the preview.
+const PREVIEW_LINES: usize = 12;
+
+#[cfg(test)]
+mod tests {
+    use super::stem;
+
+    #[test]
+    fn stems_drop_folders_and_every_extension() {
+        assert_eq!(stem("E1X_6_01.dbs.json"), "E1X_6_01");
+        assert_eq!(stem("C:\\nests\\seven.dbs"), "seven");
+        assert_eq!(stem(""), "cutroute");
+    }
+}

@@ -1,0 +1,234 @@
+//! What survives a reload (local storage) and what a link can set (`?sample=…&solver=…&time=…`):
+//! the chosen sample or file name, solver settings and drawing layers. The theme keeps its own
+//! key (see `theme`).
+
+use serde::{Deserialize, Serialize};
+
+/// Local-storage key of [`Settings`].
+const STORAGE_KEY: &str = "cutroute.settings";
+
+/// The drawing layers, each toggled by a checkbox.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum Layer {
+    /// Hatched fill of the parts.
+    Hatch,
+    /// Chevrons along each contour showing its cutting direction.
+    Arrows,
+    /// Candidate pierce points of the discrete solvers.
+    Candidates,
+    /// The chosen pierce points.
+    Pierces,
+    /// Tool-on moves.
+    Cuts,
+    /// Tool-off moves.
+    Idle,
+    /// The position of each contour in the cutting order.
+    Order,
+    /// Start and finish markers.
+    Ends,
+    /// CCP's per-contour optimality certificates.
+    Certificates,
+}
+
+impl Layer {
+    /// Every layer, in the order the panel lists them.
+    pub const ALL: [Layer; 9] = [
+        Layer::Hatch,
+        Layer::Arrows,
+        Layer::Candidates,
+        Layer::Pierces,
+        Layer::Cuts,
+        Layer::Idle,
+        Layer::Order,
+        Layer::Ends,
+        Layer::Certificates,
+    ];
+
+    /// Stable short name (element ids, CSS classes).
+    pub fn name(self) -> &'static str {
+        match self {
+            Layer::Hatch => "hatch",
+            Layer::Arrows => "arrows",
+            Layer::Candidates => "candidates",
+            Layer::Pierces => "pierces",
+            Layer::Cuts => "cuts",
+            Layer::Idle => "idle",
+            Layer::Order => "order",
+            Layer::Ends => "ends",
+            Layer::Certificates => "certificates",
+        }
+    }
+
+    /// What the layer panel shows.
+    pub fn label(self) -> &'static str {
+        match self {
+            Layer::Hatch => "Hatched parts",
+            Layer::Arrows => "Contour direction",
+            Layer::Candidates => "Candidate pierce points",
+            Layer::Pierces => "Pierce points",
+            Layer::Cuts => "Cut moves",
+            Layer::Idle => "Idle moves",
+            Layer::Order => "Cutting order",
+            Layer::Ends => "Start and finish",
+            Layer::Certificates => "Optimality certificates",
+        }
+    }
+}
+
+/// Everything remembered between visits.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Settings {
+    /// The bundled sample shown last (file name under `assets/samples/`).
+    pub sample: String,
+    /// Name of the last local file opened (it cannot be reopened without the user).
+    pub last_file: Option<String>,
+    /// Solver short name (`SolverKind::name`).
+    pub solver: String,
+    /// Time limit, s.
+    pub time_limit_s: f64,
+    /// Random seed.
+    pub seed: u64,
+    /// Spacing of candidate pierce points of the discrete solvers, mm.
+    pub step_mm: f64,
+    /// Layers switched off (everything else is shown).
+    pub hidden_layers: Vec<Layer>,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        let params = cutroute_protocol::SolverParams::default();
+        Self {
+            sample: crate::app::SAMPLES[0].0.to_string(),
+            last_file: None,
+            solver: cutroute_protocol::SolverKind::NearestNeighbour
+                .name()
+                .to_string(),
+            time_limit_s: params.time_limit_s,
+            seed: params.seed,
+            step_mm: params.discretisation_step_mm,
+            hidden_layers: Vec::new(),
+        }
+    }
+}
+
+impl Settings {
+    /// Applies the query of a link: `sample`, `solver`, `time`, `seed`, `step`; unknown or
+    /// malformed values are ignored.
+    pub fn with_query(mut self, query: &str) -> Self {
+        for pair in query.trim_start_matches('?').split('&') {
+            let (key, value) = pair.split_once('=').unwrap_or((pair, ""));
+            let value = js_decode(value);
+            match key {
+                "sample" if crate::app::SAMPLES.iter().any(|(f, _)| *f == value) => {
+                    self.sample = value;
+                    self.last_file = None;
+                }
+                "solver" if cutroute_protocol::SolverKind::from_name(&value).is_some() => {
+                    self.solver = value
+                }
+                "time" => {
+                    if let Some(v) = positive(&value) {
+                        self.time_limit_s = v;
+                    }
+                }
+                "step" => {
+                    if let Some(v) = positive(&value) {
+                        self.step_mm = v;
+                    }
+                }
+                "seed" => {
+                    if let Ok(v) = value.parse() {
+                        self.seed = v;
+                    }
+                }
+                _ => {}
+            }
+        }
+        self
+    }
+
+    /// The query of a link that reopens this sample with these solver settings.
+    pub fn query(&self) -> String {
+        format!(
+            "?sample={}&solver={}&time={}&seed={}&step={}",
+            self.sample, self.solver, self.time_limit_s, self.seed, self.step_mm
+        )
+    }
+
+    /// The remembered settings (defaults when nothing or something unreadable is stored).
+    pub fn load() -> Self {
+        storage()
+            .and_then(|s| s.get_item(STORAGE_KEY).ok().flatten())
+            .and_then(|text| serde_json::from_str(&text).ok())
+            .unwrap_or_default()
+    }
+
+    /// Remember these settings.
+    pub fn save(&self) {
+        if let (Some(storage), Ok(text)) = (storage(), serde_json::to_string(self)) {
+            let _ = storage.set_item(STORAGE_KEY, &text);
+        }
+    }
+}
+
+fn positive(value: &str) -> Option<f64> {
+    value
+        .parse::<f64>()
+        .ok()
+        .filter(|v| *v > 0.0 && v.is_finite())
+}
+
+/// Percent-decoding of a query value (sample names are plain ASCII; this keeps `%2E` and `+`
+/// working when a link was escaped by some other tool).
+fn js_decode(value: &str) -> String {
+    #[cfg(target_arch = "wasm32")]
+    {
+        js_sys::decode_uri_component(&value.replace('+', " "))
+            .ok()
+            .and_then(|s| s.as_string())
+            .unwrap_or_else(|| value.to_string())
+    }
+    #[cfg(not(target_arch = "wasm32"))]
+    {
+        value.to_string()
+    }
+}
+
+fn storage() -> Option<web_sys::Storage> {
+    web_sys::window()?.local_storage().ok()?
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_link_sets_sample_and_solver_and_ignores_nonsense() {
+        let s =
+            Settings::default().with_query("?sample=test1.dbs.json&solver=ccp&time=3&step=-1&x=y");
+        assert_eq!(s.sample, "test1.dbs.json");
+        assert_eq!(s.solver, "ccp");
+        assert_eq!(s.time_limit_s, 3.0);
+        assert_eq!(
+            s.step_mm,
+            Settings::default().step_mm,
+            "negative step ignored"
+        );
+        let unknown = Settings::default().with_query("sample=../../etc/passwd&solver=magic");
+        assert_eq!(unknown, Settings::default());
+    }
+
+    #[test]
+    fn the_link_round_trips() {
+        let s = Settings {
+            sample: "seven.dbs".into(),
+            solver: "exact".into(),
+            time_limit_s: 7.5,
+            seed: 9,
+            step_mm: 20.0,
+            ..Settings::default()
+        };
+        assert_eq!(Settings::default().with_query(&s.query()), s);
+    }
+}

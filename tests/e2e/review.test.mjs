@@ -1,0 +1,386 @@
+// Issue 7, review features: drawing layers, animation, certificates, presentation mode, exports,
+// state across reloads and links, Continue, comparison, keyboard use and layout.
+import { test, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import fs from 'node:fs';
+import os from 'node:os';
+import path from 'node:path';
+import { watchErrors, screenshotDir, projectRoot, useApp } from './harness.mjs';
+
+const app = useApp(before, after);
+
+async function fileShown(page, name) {
+  await page.waitForFunction((n) => document.querySelector('#file-name')?.textContent.includes(n),
+    name, { timeout: 20000 });
+}
+
+async function solve(page, solver, seconds = 2) {
+  await page.selectOption('#solver', solver);
+  await page.fill('#time-limit', String(seconds));
+  await page.dispatchEvent('#time-limit', 'change');
+  await page.click('#start');
+  await page.waitForFunction(() => document.querySelector('#job-status')?.textContent === 'finished',
+    null, { timeout: 60000 });
+}
+
+/** A fresh page with empty storage, the default sample open. */
+async function freshPage(viewport = { width: 1280, height: 800 }, query = '') {
+  const context = await app.browser.newContext({ viewport, acceptDownloads: true });
+  const page = await context.newPage();
+  const errors = watchErrors(page);
+  await page.goto(app.baseUrl + query);
+  return { page, errors, context };
+}
+
+const subpaths = (d) => (d?.match(/M/g) ?? []).length;
+
+test('drawing layers: arrows, cuts, order, ends, candidates, hover text; each can be hidden', async () => {
+  const { page, errors, context } = await freshPage();
+  await fileShown(page, 'E1X_6_01');
+  assert.equal(subpaths(await page.locator('#nest-view path.arrows').getAttribute('d')), 16, 'one arrow per contour');
+  await solve(page, 'nearest');
+  assert.equal(subpaths(await page.locator('#nest-view .route path.cut').getAttribute('d')), 16, 'one cut subpath per contour');
+  assert.equal(await page.locator('#nest-view .order text').count(), 16);
+  assert.equal(await page.locator('#nest-view .order text').first().textContent(), '1');
+  assert.equal(await page.locator('#nest-view .ends rect.start-marker').count(), 1);
+  const hover = await page.locator('#nest-view circle.pierce title').first().textContent();
+  assert.match(hover, /^cut 1 of 16: part \d+ .*contour \d+.*pierce at \(-?[\d.]+, -?[\d.]+\)$/);
+  assert.match(await page.locator('#nest-view path.part title').first().textContent(), /^part 1 /);
+  // Candidate pierce points appear for the discrete solvers only.
+  assert.equal(await page.locator('#nest-view path.candidates').getAttribute('d') ?? '', '');
+  await page.selectOption('#solver', 'heuristic');
+  assert.ok(subpaths(await page.locator('#nest-view path.candidates').getAttribute('d')) > 16, 'candidate dots');
+  // Hatched parts use the pattern; switching the layer off falls back to a plain fill.
+  const fill = () => page.evaluate(() => getComputedStyle(document.querySelector('#nest-view path.part')).fill);
+  assert.match(await fill(), /url\(.*#hatch/);
+  await page.uncheck('#layer-hatch');
+  assert.doesNotMatch(await fill(), /url/);
+  // Every other layer hides its own elements.
+  for (const [layer, selector] of [['idle', 'path.idle'], ['cuts', 'path.cut'], ['arrows', 'path.arrows'],
+    ['pierces', 'g.pierces'], ['order', 'g.order'], ['ends', 'g.ends'], ['candidates', 'path.candidates']]) {
+    const display = () => page.evaluate((s) => getComputedStyle(document.querySelector(`#nest-view ${s}`)).display, selector);
+    assert.notEqual(await display(), 'none', `${layer} shown`);
+    await page.uncheck(`#layer-${layer}`);
+    assert.equal(await display(), 'none', `${layer} hidden`);
+    await page.check(`#layer-${layer}`);
+  }
+  await page.screenshot({ path: path.join(screenshotDir, 'layers.png') });
+  assert.deepEqual(errors, []);
+  await context.close();
+});
+
+test('animation: play reaches the end on the machine clock; steps and scrub move the head', async () => {
+  const { page, errors, context } = await freshPage();
+  await fileShown(page, 'E1X_6_01');
+  await solve(page, 'nearest');
+  const clock = page.locator('#anim-clock');
+  const total = Number(await clock.getAttribute('data-total'));
+  assert.ok(total > 0, `machine time of the route: ${total}`);
+  // Steps land on contour starts, in order.
+  await page.click('#anim-next');
+  const first = Number(await clock.getAttribute('data-time'));
+  await page.click('#anim-next');
+  const second = Number(await clock.getAttribute('data-time'));
+  assert.ok(first > 0 && second > first, `contour starts ${first} < ${second}`);
+  assert.match(await page.locator('#anim-contour').textContent(), /^contour 2 of 16$/);
+  await page.click('#anim-prev');
+  assert.equal(Number(await clock.getAttribute('data-time')), first);
+  // Scrub to the middle: the head moves there and the travelled path is revealed up to it.
+  await page.locator('#anim-scrub').fill(String(total / 2));
+  await page.waitForFunction((t) => Math.abs(Number(document.querySelector('#tool-head').dataset.machineTime) - t) < 1e-2, total / 2);
+  const dash = Number((await page.locator('#anim-done').getAttribute('stroke-dasharray')).split(' ')[0]);
+  const length = Number(await page.locator('#anim-done').getAttribute('pathLength'));
+  assert.ok(dash > 0 && dash < length, `half-way reveals part of the path: ${dash} of ${length}`);
+  // Play at ×100 from the middle to the end.
+  await page.selectOption('#anim-speed', '100');
+  await page.click('#anim-play');
+  await page.screenshot({ path: path.join(screenshotDir, 'animation.png') });
+  await page.waitForFunction(() => {
+    const c = document.querySelector('#anim-clock');
+    return c.dataset.time === c.dataset.total;
+  }, null, { timeout: 30000 });
+  assert.equal(await page.locator('#anim-play').getAttribute('aria-label'), 'Play', 'stopped at the end');
+  assert.equal(Number(await page.locator('#tool-head').getAttribute('data-machine-time')), total);
+  const [shownNow, shownTotal] = (await clock.textContent()).split(' / ');
+  assert.equal(shownNow, shownTotal, 'the clock reads the total');
+  const endDash = Number((await page.locator('#anim-done').getAttribute('stroke-dasharray')).split(' ')[0]);
+  assert.ok(Math.abs(endDash - length) < 1e-6 * length + 1e-6, 'whole route travelled');
+  assert.deepEqual(errors, []);
+  await context.close();
+});
+
+test('CCP certificates on the drawing; presentation mode by button and F key', async () => {
+  const { page, errors, context } = await freshPage();
+  await fileShown(page, 'E1X_6_01');
+  await solve(page, 'ccp', 2);
+  const [certified, of] = (await page.locator('#certified-count').textContent()).split(' of ').map(Number);
+  assert.equal(of, 16, 'one certificate per contour');
+  const yes = subpaths(await page.locator('#nest-view .certificates path.certified').getAttribute('d'));
+  const no = subpaths(await page.locator('#nest-view .certificates path.uncertified').getAttribute('d'));
+  assert.equal(yes, certified, 'certified contours marked');
+  assert.equal(yes + no, 16, 'the others highlighted');
+  await page.screenshot({ path: path.join(screenshotDir, 'certificates.png') });
+
+  const fontSize = () => page.evaluate(() => parseFloat(getComputedStyle(document.body).fontSize));
+  const normal = await fontSize();
+  await page.click('#present');
+  assert.equal(await page.getAttribute('#present', 'aria-pressed'), 'true');
+  assert.ok(await fontSize() > normal * 1.2, 'large fonts');
+  await page.screenshot({ path: path.join(screenshotDir, 'presentation.png') });
+  await page.locator('#nest-view').focus();
+  await page.keyboard.press('f');
+  assert.equal(await page.evaluate(() => document.documentElement.hasAttribute('data-presentation')), false, 'F leaves');
+  await page.keyboard.press('F');
+  assert.equal(await page.evaluate(() => document.documentElement.hasAttribute('data-presentation')), true, 'F enters');
+  // Typing an F into a field does not toggle it.
+  await page.locator('#share-link').focus();
+  await page.keyboard.press('f');
+  assert.equal(await page.evaluate(() => document.documentElement.hasAttribute('data-presentation')), true);
+  assert.deepEqual(errors, []);
+  await context.close();
+});
+
+test('every export downloads a file that our readers open again', async () => {
+  const { page, errors, context } = await freshPage();
+  await fileShown(page, 'E1X_6_01');
+  await solve(page, 'nearest');
+  const upper = await page.locator('#upper-bound').textContent();
+  const dir = fs.mkdtempSync(path.join(os.tmpdir(), 'cutroute-export-'));
+  await page.click('.export summary');
+  const download = async (button) => {
+    const [file] = await Promise.all([page.waitForEvent('download'), page.click(button)]);
+    const target = path.join(dir, file.suggestedFilename());
+    await file.saveAs(target);
+    assert.ok(fs.statSync(target).size > 0, `${button} wrote ${target}`);
+    return target;
+  };
+  const svg = fs.readFileSync(await download('#export-svg'), 'utf8');
+  assert.match(svg, /^<\?xml[^>]*>\n<svg[^>]*xmlns="http:\/\/www.w3.org\/2000\/svg"/);
+  assert.equal((svg.match(/class="part"/g) ?? []).length, 8, 'the view\'s 8 parts');
+  assert.match(svg, /<style>/);
+
+  const files = {
+    result: await download('#export-result'),
+    geometry: await download('#export-geometry'),
+    dbs: await download('#export-dbs'),
+  };
+  // Read back through the app's own Open path (the readers run in the worker).
+  for (const [kind, format] of [['geometry', 'geometry JSON'], ['dbs', 'DBS binary'], ['result', 'result JSON']]) {
+    await page.setInputFiles('#file-input', files[kind]);
+    await fileShown(page, `${path.basename(files[kind])} (${format})`);
+    assert.equal(await page.locator('#nest-view path.part').count(), 8, `${kind}: 8 parts back`);
+  }
+  // The result file carries the route: same pierces, same idle length.
+  assert.equal(await page.locator('#nest-view .route circle.pierce').count(), 16);
+  assert.equal(Number((await page.locator('#idle-length').textContent()).replace(' mm', '')), Number(upper));
+  assert.deepEqual(errors, []);
+  await context.close();
+});
+
+test('settings and layers survive a reload; a link opens a sample with solver settings', async () => {
+  const { page, errors, context } = await freshPage();
+  await fileShown(page, 'E1X_6_01');
+  await page.selectOption('#sample', 'test1.dbs.json');
+  await fileShown(page, 'test1');
+  await page.selectOption('#solver', 'exact');
+  for (const [id, value] of [['#time-limit', '7'], ['#seed', '3'], ['#step', '20']]) {
+    await page.fill(id, value);
+    await page.dispatchEvent(id, 'change');
+  }
+  await page.uncheck('#layer-arrows');
+  const link = await page.inputValue('#share-link');
+  assert.match(link, /\?sample=test1\.dbs\.json&solver=exact&time=7&seed=3&step=20$/);
+  await page.reload();
+  await fileShown(page, 'test1');
+  assert.equal(await page.inputValue('#sample'), 'test1.dbs.json');
+  assert.equal(await page.inputValue('#solver'), 'exact');
+  assert.equal(await page.inputValue('#time-limit'), '7');
+  assert.equal(await page.inputValue('#seed'), '3');
+  assert.equal(await page.inputValue('#step'), '20');
+  assert.equal(await page.isChecked('#layer-arrows'), false);
+  assert.match(await page.getAttribute('#nest-view', 'class'), /hide-arrows/);
+  assert.equal(await page.locator('#last-file').count(), 0, 'a sample was open: nothing to remind');
+  // A local file is remembered by name (browsers cannot reopen it alone).
+  const local = path.resolve(projectRoot, '..', 'shared', 'data', 'nests', 'dbs', 'nested.dbs');
+  assert.ok(fs.existsSync(local), `missing test file ${local}`);
+  await page.setInputFiles('#file-input', local);
+  await fileShown(page, 'nested.dbs (DBS binary)');
+  await page.reload();
+  await fileShown(page, 'test1');
+  assert.match(await page.locator('#last-file').textContent(), /Last time nested\.dbs was open/);
+  await page.selectOption('#sample', 'E1X_6_01.dbs.json');
+  await fileShown(page, 'E1X_6_01');
+  assert.equal(await page.locator('#last-file').count(), 0, 'choosing a sample forgets the file');
+  await context.close();
+
+  // A link in a fresh browser profile.
+  const fresh = await freshPage({ width: 1280, height: 800 }, '?sample=nested.dbs&solver=ccp&time=4');
+  await fileShown(fresh.page, 'nested.dbs');
+  assert.equal(await fresh.page.inputValue('#solver'), 'ccp');
+  assert.equal(await fresh.page.inputValue('#time-limit'), '4');
+  assert.deepEqual([...errors, ...fresh.errors], []);
+  await fresh.context.close();
+});
+
+test('Continue restarts from the best result; kept results are compared and overlaid', async () => {
+  const { page, errors, context } = await freshPage();
+  await fileShown(page, 'E1X_6_01');
+  assert.equal(await page.isDisabled('#continue'), true, 'nothing to continue yet');
+  await solve(page, 'nearest');
+  await page.click('#keep-result');
+  await solve(page, 'heuristic', 1);
+  const first = Number(await page.locator('#upper-bound').textContent());
+  const elapsed = parseFloat(await page.locator('#elapsed').textContent());
+  await page.click('#continue');
+  await page.waitForFunction(() => document.querySelector('#job-status')?.textContent === 'finished',
+    null, { timeout: 30000 });
+  const second = Number(await page.locator('#upper-bound').textContent());
+  assert.ok(second <= first, `continued result ${second} is no worse than ${first}`);
+  assert.ok(parseFloat(await page.locator('#elapsed').textContent()) > elapsed, 'time adds up');
+  await page.click('#keep-result');
+  const rows = page.locator('#compare-table tbody tr');
+  assert.equal(await rows.count(), 2);
+  assert.equal(await rows.nth(1).locator('td').nth(1).textContent(), 'Discrete heuristic (ALNS)');
+  const idles = (await page.locator('#compare-table .kept-idle').allTextContents()).map(Number);
+  assert.ok(idles.every((v) => v > 0), `idle lengths ${idles}`);
+  assert.equal(idles[1], second, 'the kept figure is the result shown');
+  const excess = await page.locator('#compare-table tbody tr td:nth-child(4)').allTextContents();
+  assert.ok(excess.includes('+0.0 %'), `the best result is 0 % over the best: ${excess}`);
+  await page.locator('.kept-overlay').nth(0).check();
+  await page.locator('.kept-overlay').nth(1).check();
+  assert.equal(await page.locator('#nest-view path.compare-a').count(), 1);
+  assert.equal(await page.locator('#nest-view path.compare-b').count(), 1);
+  await page.screenshot({ path: path.join(screenshotDir, 'compare.png') });
+  assert.deepEqual(errors, []);
+  await context.close();
+});
+
+for (const [width, height] of [[1024, 768], [1920, 1080]]) {
+  test(`keyboard only and layout at ${width}×${height}`, async () => {
+    const { page, errors, context } = await freshPage({ width, height });
+    await fileShown(page, 'E1X_6_01');
+    // No horizontal scroll.
+    const scroll = await page.evaluate(() => [document.documentElement.scrollWidth, document.documentElement.clientWidth]);
+    assert.ok(scroll[0] <= scroll[1], `no horizontal scroll: ${scroll}`);
+    // Every control has a label (label element, aria-label, title or text).
+    const unlabelled = await page.evaluate(() => [...document.querySelectorAll('input, select, button, textarea')]
+      .filter((e) => !(e.labels?.length || e.getAttribute('aria-label') || e.title || e.textContent.trim()))
+      .map((e) => e.outerHTML.slice(0, 80)));
+    assert.deepEqual(unlabelled, []);
+    // Enter on a focused button starts the job (the default solver is the baseline).
+    await page.locator('#start').focus();
+    await page.keyboard.press('Enter');
+    await page.waitForFunction(() => document.querySelector('#job-status')?.textContent === 'finished', null, { timeout: 20000 });
+    // Tab walks the controls in reading order and focus is visible.
+    await page.locator('#sample').focus();
+    const seen = ['sample'];
+    for (let i = 0; i < 40; i++) {
+      await page.keyboard.press('Tab');
+      const info = await page.evaluate(() => {
+        const e = document.activeElement;
+        return { id: e.id, outline: getComputedStyle(e).outlineStyle };
+      });
+      if (info.id) seen.push(info.id);
+      if (['start', 'nest-view', 'anim-play'].includes(info.id)) assert.notEqual(info.outline, 'none', `${info.id} shows focus`);
+    }
+    for (const id of ['theme', 'solver', 'time-limit', 'start', 'nest-view', 'anim-play', 'anim-speed']) {
+      assert.ok(seen.includes(id), `Tab reaches #${id}: ${seen.join(' ')}`);
+    }
+    assert.ok(seen.indexOf('solver') < seen.indexOf('start') && seen.indexOf('start') < seen.indexOf('nest-view')
+      && seen.indexOf('nest-view') < seen.indexOf('anim-play'), `reading order: ${seen.join(' ')}`);
+    // Space plays and pauses the animation.
+    await page.locator('#anim-play').focus();
+    await page.keyboard.press('Space');
+    await page.waitForFunction(() => Number(document.querySelector('#anim-clock').dataset.time) > 0);
+    assert.equal(await page.locator('#anim-play').getAttribute('aria-label'), 'Pause');
+    await page.keyboard.press('Space');
+    await page.waitForFunction(() => document.querySelector('#anim-play').getAttribute('aria-label') === 'Play');
+    const shot = path.join(screenshotDir, `layout-${width}x${height}.png`);
+    await page.screenshot({ path: shot });
+    assert.ok(fs.statSync(shot).size > 10000, 'screenshot is not blank');
+    const after = await page.evaluate(() => [document.documentElement.scrollWidth, document.documentElement.clientWidth]);
+    assert.ok(after[0] <= after[1], `no horizontal scroll with a route: ${after}`);
+    assert.deepEqual(errors, []);
+    await context.close();
+  });
+}
+
+test('several files at once: a task JSON is combined with its result file', async () => {
+  const { page, errors, context } = await freshPage();
+  await fileShown(page, 'E1X_6_01');
+  const nests = path.resolve(projectRoot, '..', 'shared', 'data', 'nests');
+  const task = path.join(nests, 'task-json', 'E1X_6_01.task.json');
+  const result = path.join(nests, 'result-json', 'E1X_6_01.result.json');
+  for (const f of [task, result]) assert.ok(fs.existsSync(f), `missing test file ${f}`);
+  // The task's speeds replace edited ones.
+  await page.click('.machine summary');
+  await page.fill('#idle-speed', '123');
+  await page.dispatchEvent('#idle-speed', 'change');
+  await page.setInputFiles('#file-input', [task, result]);
+  await fileShown(page, 'E1X_6_01.result.json (result JSON) + E1X_6_01.task.json (task JSON)');
+  assert.equal(await page.inputValue('#idle-speed'), '500');
+  assert.equal(await page.locator('#nest-view path.part').count(), 8);
+  assert.ok(await page.locator('#nest-view .route circle.pierce').count() > 0, 'the result\'s route is drawn');
+  // The combined problem can be solved.
+  await solve(page, 'nearest');
+  assert.equal(await page.locator('#nest-view .route circle.pierce').count(), 16);
+  // A task alone has no geometry: a plain error, and the app stays usable.
+  await page.setInputFiles('#file-input', task);
+  await page.locator('.error[role=alert]').waitFor({ timeout: 10000 });
+  assert.match(await page.locator('.error[role=alert]').textContent(), /E1X_6_01\.task\.json/);
+  assert.deepEqual(errors, []);
+  await context.close();
+});
+
+test('standalone HTML and G-code exports; G-code options and preview', async () => {
+  const { page, errors, context } = await freshPage();
+  await fileShown(page, 'E1X_6_01');
+  await solve(page, 'nearest');
+  const dir = fs.mkdtempSync(path.join(os.tmpdir(), 'cutroute-export-'));
+  await page.click('.export summary');
+  const download = async (button) => {
+    const [file] = await Promise.all([page.waitForEvent('download'), page.click(button)]);
+    const target = path.join(dir, file.suggestedFilename());
+    await file.saveAs(target);
+    return target;
+  };
+  // The HTML page needs nothing but itself: no external script, style or image.
+  const htmlFile = await download('#export-html');
+  const html = fs.readFileSync(htmlFile, 'utf8');
+  assert.match(html, /^<!DOCTYPE html>/i);
+  assert.doesNotMatch(html, /(src|href)\s*=\s*["']?(https?:|\/\/)/i, 'standalone');
+  const viewer = await context.newPage();
+  const viewerErrors = watchErrors(viewer);
+  await viewer.goto(`file://${htmlFile}`);
+  assert.ok(await viewer.locator('svg path').count() > 0, 'the page draws the nest');
+  assert.match(await viewer.title(), /E1X_6_01/);
+  assert.deepEqual(viewerErrors, []);
+  await viewer.close();
+
+  // Preview: the first lines of the program, absolute by default.
+  await page.click('#gcode-preview-button');
+  const preview = await page.locator('#gcode-preview').textContent();
+  const lines = preview.split('\n');
+  assert.ok(lines.length > 3 && lines.length <= 12, `${lines.length} preview lines`);
+  assert.ok(lines.includes('G90'), preview);
+  // Options reach the post-processor: incremental, R arcs, custom torch codes and dwell.
+  await page.selectOption('#gcode-distance', 'incremental');
+  await page.selectOption('#gcode-arcs', 'r');
+  for (const [id, value] of [['#gcode-torch-on', 'M07'], ['#gcode-torch-off', 'M08'], ['#gcode-dwell', '2']]) {
+    await page.fill(id, value);
+    await page.dispatchEvent(id, 'change');
+  }
+  const gcode = fs.readFileSync(await download('#export-gcode'), 'utf8');
+  const program = gcode.split('\n').map((l) => l.trim());
+  assert.ok(program.includes('G91'), 'incremental');
+  assert.ok(!program.includes('G90'), 'not absolute');
+  assert.equal(program.filter((l) => l === 'M07').length, 16, 'torch on once per pierce');
+  assert.equal(program.filter((l) => l === 'M08').length, 16, 'torch off after every contour');
+  assert.equal(program.filter((l) => l === 'G04 P2.000').length, 16, 'pierce dwell');
+  assert.ok(program.some((l) => /^G0[23] .*R[\d.]+/.test(l)), 'arcs with R');
+  assert.ok(!program.some((l) => /^G0[23] .* I/.test(l)), 'no I/J arcs');
+  assert.match(await page.locator('#gcode-preview').textContent(), /G91/, 'preview follows the options');
+  assert.match(await page.locator('#export-status').textContent(), /saved E1X_6_01\.nc/);
+  assert.deepEqual(errors, []);
+  await context.close();
+});
