@@ -29,7 +29,10 @@ pub(crate) struct Problem {
     pub node_cluster: Vec<usize>,
     /// Transitively closed precedence, `words` u64 per row: bit `b` of row `a` = a before b.
     before: Vec<u64>,
-    words: usize,
+    /// The transpose of `before`: bit `a` of row `b` = a before b.
+    after: Vec<u64>,
+    /// u64 words per bit row (`⌈m / 64⌉`).
+    pub words: usize,
     /// Clusters that must come before each cluster (closure, depot excluded).
     pub preds: Vec<Vec<usize>>,
     /// Clusters that must come after each cluster (closure, depot excluded).
@@ -145,6 +148,7 @@ impl Problem {
                 }
             }
         }
+        let mut after = vec![0u64; m * words];
         let mut preds = vec![Vec::new(); m];
         let mut succs = vec![Vec::new(); m];
         let mut has_precedence = false;
@@ -156,6 +160,7 @@ impl Problem {
                     }
                     preds[b].push(a);
                     succs[a].push(b);
+                    after[b * words + a / 64] |= 1 << (a % 64);
                     has_precedence = true;
                 }
             }
@@ -169,6 +174,7 @@ impl Problem {
             clusters: instance.clusters.clone(),
             node_cluster: instance.node_cluster.clone(),
             before,
+            after,
             words,
             preds,
             succs,
@@ -194,6 +200,18 @@ impl Problem {
     #[inline(always)]
     pub(crate) fn precedes(&self, a: usize, b: usize) -> bool {
         self.before[a * self.words + b / 64] >> (b % 64) & 1 == 1
+    }
+
+    /// The clusters that must come after cluster `a`, as a bit row of `words` words.
+    #[inline(always)]
+    pub(crate) fn successor_bits(&self, a: usize) -> &[u64] {
+        &self.before[a * self.words..(a + 1) * self.words]
+    }
+
+    /// The clusters that must come before cluster `b`, as a bit row of `words` words.
+    #[inline(always)]
+    pub(crate) fn predecessor_bits(&self, b: usize) -> &[u64] {
+        &self.after[b * self.words..(b + 1) * self.words]
     }
 
     /// Whether clusters `a` and `b` are ordered by the precedence relation either way.

@@ -372,3 +372,71 @@ fn handles_instances_with_one_or_two_clusters() {
         assert_eq!(result.progress.stop_reason, Some(StopReason::Exhausted));
     }
 }
+
+#[test]
+fn a_time_limit_only_decides_where_the_iteration_sequence_stops() {
+    // The annealing schedule runs on iteration counts, so a run cut by its time limit after
+    // I iterations holds the same tour as a run limited to I iterations.
+    let instance = load("pcgtsplib", "ft53.1");
+    let timed = solve(
+        &instance,
+        AlnsOptions {
+            seed: 4,
+            time_limit: Some(Duration::from_millis(200)),
+            ..AlnsOptions::default()
+        },
+        &mut |_| {},
+    )
+    .unwrap();
+    assert_eq!(timed.progress.stop_reason, Some(StopReason::TimeLimit));
+    let iterations = timed.progress.iterations;
+    assert!(iterations > 100, "only {iterations} iterations in 200 ms");
+    let counted = solve(
+        &instance,
+        AlnsOptions {
+            seed: 4,
+            time_limit: None,
+            max_iterations: Some(iterations),
+            ..AlnsOptions::default()
+        },
+        &mut |_| {},
+    )
+    .unwrap();
+    assert_eq!(counted.tour, timed.tour);
+    assert_eq!(counted.cost, timed.cost);
+    checked(&instance, timed.tour.as_ref().unwrap(), timed.cost.unwrap());
+}
+
+#[test]
+fn plain_gtsp_with_symmetric_and_asymmetric_costs_is_feasible_and_deterministic() {
+    for symmetric in [true, false] {
+        // 40 clusters, no precedence, 10 % forbidden arcs.
+        let instance = random_instance(if symmetric { 101 } else { 102 }, 40, symmetric, 0, 10);
+        assert!(instance.precedence.is_empty());
+        let options = AlnsOptions {
+            seed: 9,
+            time_limit: None,
+            max_iterations: Some(1500),
+            ..AlnsOptions::default()
+        };
+        let first = solve(&instance, options.clone(), &mut |_| {}).unwrap();
+        let second = solve(&instance, options, &mut |_| {}).unwrap();
+        assert_eq!(first.tour, second.tour, "symmetric = {symmetric}");
+        let tour = first.tour.expect("a feasible tour");
+        let cost = checked(&instance, &tour, first.cost.unwrap());
+        // A different seed gives a feasible tour too, not necessarily the same.
+        let other = solve(
+            &instance,
+            AlnsOptions {
+                seed: 10,
+                time_limit: None,
+                max_iterations: Some(1500),
+                ..AlnsOptions::default()
+            },
+            &mut |_| {},
+        )
+        .unwrap();
+        let other_cost = checked(&instance, other.tour.as_ref().unwrap(), other.cost.unwrap());
+        assert!(cost.is_finite() && other_cost.is_finite());
+    }
+}

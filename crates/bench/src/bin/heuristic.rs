@@ -2,21 +2,34 @@
 //! `../shared/data/pcgtsp`, next to PCGLNS and the known optima of `reference.csv`.
 //!
 //! ```text
-//! cargo run --release -p cutroute-bench --bin heuristic -- [--seeds 5] [--limits 1,5,30|pcglns]
-//!     [--filter NAME[,NAME…]] [--no-target] [--scale F]
+//! cargo run --release -p cutroute-bench --bin heuristic -- [--seeds 5] [--limits 1,5,30]
+//!     [--filter NAME[,NAME…]] [--no-target] [--cap-unknown S] [--wall]
+//! cargo run --release -p cutroute-bench --bin heuristic -- --iterations N [--seeds K] [--filter …]
 //! ```
 //!
-//! `--limits` takes seconds; `pcglns` means "each instance's own `pcglns_time_s`" (the main
-//! target: beat PCGLNS in the time it took). Each tour is checked by `cutroute_pcgtsp::check_tour`.
-//! Runs stop early at the known optimum (a proven optimum cannot be beaten) unless `--no-target`.
-//! `--scale F` multiplies every limit. Limits and times are CPU seconds of the solver's thread
-//! (from `/proc/thread-self/stat`, 10 ms resolution) so that a loaded shared machine does not
-//! distort the comparison; `--wall` uses wall-clock time instead.
+//! One run per instance and seed, to the largest limit; the result at every smaller limit is
+//! the best tour at that time of the same run (the search's trajectory depends only on the seed
+//! and the iteration count, so this is what a run with the smaller limit returns). The run also
+//! takes a snapshot at `min(pcglns_time_s, largest limit)`: the main target is a median cost ≤
+//! PCGLNS's in no more time than PCGLNS took. Runs stop early at the known optimum (a proven
+//! optimum cannot be beaten; later limits then show that tour) unless `--no-target`.
+//! `--cap-unknown S` ends the runs on instances without a known optimum at
+//! `max(S, min(pcglns_time_s, largest limit))` to save CPU time (their larger-limit columns
+//! then show "–"). Limits and times are CPU seconds of the solver's thread (from
+//! `/proc/thread-self/stat`, 10 ms resolution) so that a loaded shared machine does not distort
+//! the comparison; `--wall` uses wall-clock time instead. Each tour is checked by
+//! `cutroute_pcgtsp::check_tour`.
+//!
+//! `--iterations N` measures throughput instead: N iterations per seed (no target), printing
+//! iterations per CPU second and the final cost (equal costs before and after a speed-up show
+//! that it left the search unchanged).
 
+use std::io::Write;
 use std::path::PathBuf;
 use std::time::Duration;
 
-use cutroute_alns::{AlnsOptions, AlnsSolver, SolverStatus};
+use cutroute_alns::{AlnsOptions, AlnsSolver};
+use cutroute_bench::{run_heuristic_with_snapshots, HeuristicSnapshot};
 use cutroute_pcgtsp::{check_tour, Instance};
 
 /// One row of `reference.csv`.
@@ -74,19 +87,14 @@ fn read_reference() -> Vec<Reference> {
         .collect()
 }
 
-#[derive(Clone, Copy)]
-enum Limit {
-    Seconds(f64),
-    Pcglns,
-}
-
 struct Args {
     seeds: u64,
-    limits: Vec<Limit>,
+    limits: Vec<f64>,
     filter: Vec<String>,
     target: bool,
-    scale: f64,
+    cap_unknown: Option<f64>,
     wall: bool,
+    iterations: Option<u64>,
 }
 
 /// A clock that measures either the thread's CPU time or wall-clock time.
@@ -117,15 +125,12 @@ impl Clock {
 fn parse_args() -> Args {
     let mut args = Args {
         seeds: 5,
-        limits: vec![
-            Limit::Seconds(1.0),
-            Limit::Seconds(5.0),
-            Limit::Seconds(30.0),
-        ],
+        limits: vec![1.0, 5.0, 30.0],
         filter: Vec::new(),
         target: true,
-        scale: 1.0,
+        cap_unknown: None,
         wall: false,
+        iterations: None,
     };
     let mut it = std::env::args().skip(1);
     while let Some(arg) = it.next() {
@@ -135,23 +140,23 @@ fn parse_args() -> Args {
             "--limits" => {
                 args.limits = value()
                     .split(',')
-                    .map(|s| match s.trim() {
-                        "pcglns" => Limit::Pcglns,
-                        x => Limit::Seconds(x.parse().expect("--limits 1,5,30 or pcglns")),
-                    })
-                    .collect()
+                    .map(|s| s.trim().parse().expect("--limits 1,5,30"))
+                    .collect();
+                args.limits.sort_by(f64::total_cmp);
             }
             "--filter" => args.filter = value().split(',').map(str::to_owned).collect(),
             "--no-target" => args.target = false,
-            "--scale" => args.scale = value().parse().expect("--scale F"),
+            "--cap-unknown" => args.cap_unknown = Some(value().parse().expect("--cap-unknown S")),
             "--wall" => args.wall = true,
+            "--iterations" => args.iterations = Some(value().parse().expect("--iterations N")),
             other => panic!("unknown argument {other}"),
         }
     }
     args
 }
 
-fn median(values: &mut [f64]) -> f64 {
+fn median(values: &[f64]) -> f64 {
+    let mut values = values.to_vec();
     values.sort_by(f64::total_cmp);
     let n = values.len();
     if n % 2 == 1 {
@@ -161,131 +166,385 @@ fn median(values: &mut [f64]) -> f64 {
     }
 }
 
+fn load(r: &Reference) -> Instance {
+    let path = data_dir()
+        .join(&r.set)
+        .join(format!("{}.pcglns", r.instance));
+    let text = std::fs::read_to_string(&path)
+        .unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
+    Instance::parse(&text).expect("instance parses")
+}
+
+/// Checks a tour with the independent checker and that it costs what the solver said.
+fn check(instance: &Instance, tour: &[usize], cost: f64) {
+    let checked = check_tour(instance, tour)
+        .unwrap_or_else(|e| panic!("{}: infeasible tour: {e}", instance.name));
+    assert!(
+        (checked - cost).abs() <= 1e-6 * (1.0 + cost.abs()),
+        "{}: solver says {cost}, checker {checked}",
+        instance.name
+    );
+}
+
+/// `--iterations N`: iterations per CPU second and final cost for a fixed iteration count.
+fn throughput(args: &Args, selected: &[&Reference], iterations: u64) {
+    println!("| instance | m | seeds × iterations | CPU s | iterations / CPU s | final costs |");
+    println!("|---|---|---|---|---|---|");
+    let mut total_iterations = 0.0;
+    let mut total_seconds = 0.0;
+    for r in selected {
+        let instance = load(r);
+        let clock = Clock::start(args.wall);
+        let mut costs = Vec::new();
+        for seed in 1..=args.seeds {
+            let options = AlnsOptions {
+                seed,
+                time_limit: None,
+                max_iterations: Some(iterations),
+                ..AlnsOptions::default()
+            };
+            let result = cutroute_alns::solve(&instance, options, &mut |_| {}).expect("solves");
+            let tour = result.tour.expect("a feasible tour");
+            check(&instance, &tour, result.cost.unwrap());
+            costs.push(result.cost.unwrap().to_string());
+        }
+        let seconds = clock.seconds();
+        let done = (iterations * args.seeds) as f64;
+        total_iterations += done;
+        total_seconds += seconds;
+        println!(
+            "| {} | {} | {} × {iterations} | {seconds:.2} | {:.0} | {} |",
+            r.instance,
+            r.clusters,
+            args.seeds,
+            done / seconds,
+            costs.join(" ")
+        );
+    }
+    println!(
+        "\nAll: {total_iterations} iterations in {total_seconds:.2} CPU s ({:.0} / s).",
+        total_iterations / total_seconds
+    );
+}
+
+fn cell(values: Option<(f64, f64)>) -> String {
+    values.map_or("–".to_owned(), |(best, med)| format!("{best} / {med}"))
+}
+
+/// One seed's run, kept alive so that a capped run can be continued.
+struct SeedRun {
+    solver: AlnsSolver,
+    /// Snapshots at every limit reached so far.
+    snapshots: Vec<HeuristicSnapshot>,
+    time_to_reach: Option<f64>,
+    time_to_optimum: Option<f64>,
+    seconds: f64,
+    finished_early: bool,
+}
+
+/// All seeds of one instance.
+struct InstanceRuns<'a> {
+    reference: &'a Reference,
+    instance: Instance,
+    /// `min(pcglns_time_s, largest limit)`: where the main target is checked.
+    target_time: f64,
+    /// How far the first pass ran.
+    run_to: f64,
+    seeds: Vec<SeedRun>,
+}
+
+/// Advances every seed of `runs` to `limits` (clock readings continue from where each seed
+/// stopped), checking every snapshot's tour with the independent checker.
+fn advance(runs: &mut InstanceRuns, limits: &[f64], wall: bool) {
+    let pcglns_cost = runs.reference.pcglns_cost + 1e-6;
+    let optimum = runs
+        .reference
+        .known_optimum
+        .map_or(f64::NEG_INFINITY, |o| o + 1e-6);
+    for seed in &mut runs.seeds {
+        let offset = seed.seconds;
+        let clock = Clock::start(wall);
+        let mut to_optimum = seed.time_to_optimum;
+        let run = run_heuristic_with_snapshots(
+            &mut seed.solver,
+            limits,
+            pcglns_cost,
+            Duration::from_millis(2),
+            &mut |progress| {
+                let now = offset + clock.seconds();
+                if to_optimum.is_none() && progress.best_cost.is_some_and(|c| c <= optimum) {
+                    to_optimum = Some(now);
+                }
+                now
+            },
+        );
+        for snapshot in &run.snapshots {
+            check(&runs.instance, &snapshot.tour, snapshot.cost);
+        }
+        seed.time_to_reach = seed.time_to_reach.or(run.time_to_reach);
+        seed.time_to_optimum = to_optimum;
+        seed.seconds = seed.seconds.max(run.seconds);
+        seed.finished_early |= run.finished_early;
+        seed.snapshots.extend(run.snapshots);
+    }
+}
+
+/// Costs of all seeds at `limit`, if every seed has a snapshot there (or stopped before it:
+/// a run stopped at the optimum keeps its tour).
+fn costs_at(runs: &InstanceRuns, limit: f64) -> Option<Vec<f64>> {
+    runs.seeds
+        .iter()
+        .map(|seed| {
+            seed.snapshots
+                .iter()
+                .find(|s| s.limit == limit)
+                .or_else(|| {
+                    seed.finished_early
+                        .then(|| {
+                            seed.snapshots
+                                .iter()
+                                .max_by(|a, b| a.limit.total_cmp(&b.limit))
+                        })
+                        .flatten()
+                })
+                .map(|s| s.cost)
+        })
+        .collect()
+}
+
+fn summary(costs: &[f64]) -> (f64, f64) {
+    let best = costs.iter().cloned().fold(f64::INFINITY, f64::min);
+    (best, median(costs))
+}
+
+fn fmt_time(t: f64) -> String {
+    if t.is_finite() {
+        format!("{t:.2}")
+    } else {
+        "–".to_owned()
+    }
+}
+
+fn print_header(args: &Args) {
+    let limit_headers: Vec<String> = args
+        .limits
+        .iter()
+        .map(|l| format!("{l} s best / median"))
+        .collect();
+    println!(
+        "| instance | n | m | PCGLNS cost | PCGLNS s | known opt | {} | at PCGLNS s: median | ≤ PCGLNS (seeds) | median s to PCGLNS cost | at opt (seeds) | median s to opt | run s (max) | median iterations |",
+        limit_headers.join(" | ")
+    );
+    println!(
+        "|---|---|---|---|---|---|{}---|---|---|---|---|---|---|---|",
+        "---|".repeat(args.limits.len())
+    );
+}
+
+/// Totals for the summary lines.
+#[derive(Default)]
+struct Tally {
+    instances: usize,
+    median_fails: Vec<String>,
+    optimum_instances: usize,
+    optimum_reached: usize,
+    optimum_missed: Vec<String>,
+}
+
+fn print_row(args: &Args, runs: &InstanceRuns, tally: &mut Tally) {
+    let r = runs.reference;
+    let limit_cells: Vec<String> = args
+        .limits
+        .iter()
+        .map(|&l| costs_at(runs, l).map(|c| summary(&c)))
+        .map(cell)
+        .collect();
+    let target_costs = costs_at(runs, runs.target_time).expect("target snapshot");
+    let target_median = median(&target_costs);
+    let beat = target_costs
+        .iter()
+        .filter(|&&c| c <= r.pcglns_cost + 1e-6)
+        .count();
+    tally.instances += 1;
+    if target_median > r.pcglns_cost + 1e-6 {
+        tally.median_fails.push(format!(
+            "{} (median {target_median} > {} at {} s)",
+            r.instance, r.pcglns_cost, runs.target_time
+        ));
+    }
+    let reach: Vec<f64> = runs
+        .seeds
+        .iter()
+        .map(|s| s.time_to_reach.unwrap_or(f64::INFINITY))
+        .collect();
+    let to_optimum: Vec<f64> = runs
+        .seeds
+        .iter()
+        .map(|s| s.time_to_optimum.unwrap_or(f64::INFINITY))
+        .collect();
+    let at_optimum = to_optimum.iter().filter(|t| t.is_finite()).count();
+    if let Some(optimum) = r.known_optimum {
+        tally.optimum_instances += 1;
+        if at_optimum > 0 {
+            tally.optimum_reached += 1;
+        } else {
+            let best = runs
+                .seeds
+                .iter()
+                .flat_map(|s| s.snapshots.iter().map(|x| x.cost))
+                .fold(f64::INFINITY, f64::min);
+            tally
+                .optimum_missed
+                .push(format!("{} (best {best}, optimum {optimum})", r.instance));
+        }
+    }
+    let iterations: Vec<f64> = runs
+        .seeds
+        .iter()
+        .map(|s| s.snapshots.iter().map(|x| x.iterations).max().unwrap_or(0) as f64)
+        .collect();
+    let run_seconds = runs.seeds.iter().map(|s| s.seconds).fold(0.0, f64::max);
+    let with_optimum = |text: String| {
+        if r.known_optimum.is_some() {
+            text
+        } else {
+            "–".to_owned()
+        }
+    };
+    println!(
+        "| {} | {} | {} | {} | {} | {} | {} | {} | {beat}/{} | {} | {} | {} | {run_seconds:.1} | {} |",
+        r.instance,
+        r.nodes,
+        r.clusters,
+        r.pcglns_cost,
+        r.pcglns_time_s,
+        r.known_optimum.map_or("–".to_owned(), |o| o.to_string()),
+        limit_cells.join(" | "),
+        target_median,
+        args.seeds,
+        fmt_time(median(&reach)),
+        with_optimum(format!("{at_optimum}/{}", args.seeds)),
+        with_optimum(fmt_time(median(&to_optimum))),
+        median(&iterations),
+    );
+    std::io::stdout().flush().ok();
+}
+
+fn print_tally(tally: &Tally, largest: f64) {
+    println!(
+        "\nMedian ≤ PCGLNS cost at min(pcglns_time_s, {largest} s): {}/{} instances{}.",
+        tally.instances - tally.median_fails.len(),
+        tally.instances,
+        if tally.median_fails.is_empty() {
+            String::new()
+        } else {
+            format!("; not on {}", tally.median_fails.join(", "))
+        }
+    );
+    println!(
+        "Known optimum reached (≥ 1 seed) within the run: {}/{}{}.",
+        tally.optimum_reached,
+        tally.optimum_instances,
+        if tally.optimum_missed.is_empty() {
+            String::new()
+        } else {
+            format!("; not on {}", tally.optimum_missed.join(", "))
+        }
+    );
+}
+
 fn main() {
     let args = parse_args();
     let references = read_reference();
     let selected: Vec<&Reference> = references
         .iter()
-        .filter(|r| args.filter.is_empty() || args.filter.iter().any(|f| r.instance.contains(f)))
+        .filter(|r| args.filter.is_empty() || args.filter.contains(&r.instance))
         .collect();
-    for &limit in &args.limits {
-        let title = match limit {
-            Limit::Seconds(s) => format!("{s} s"),
-            Limit::Pcglns => "pcglns_time_s".to_owned(),
+    if let Some(iterations) = args.iterations {
+        throughput(&args, &selected, iterations);
+        return;
+    }
+    let largest = *args.limits.last().expect("at least one limit");
+    let clock_name = if args.wall {
+        "wall clock"
+    } else {
+        "CPU time of the solver thread"
+    };
+    println!(
+        "\n### ALNS, limits {:?} s ({clock_name}), {} seeds{}; `at PCGLNS s` = at min(pcglns_time_s, {largest} s)\n",
+        args.limits,
+        args.seeds,
+        args.cap_unknown.map_or(String::new(), |c| format!(
+            "; first pass: instances without a known optimum to max({c} s, min(pcglns_time_s, {largest} s))"
+        )),
+    );
+    print_header(&args);
+    let mut all = Vec::new();
+    let mut tally = Tally::default();
+    for r in &selected {
+        let instance = load(r);
+        let target_time = r.pcglns_time_s.min(largest);
+        let run_to = match (args.cap_unknown, r.known_optimum) {
+            (Some(cap), None) => cap.max(target_time).min(largest),
+            _ => largest,
         };
-        println!(
-            "\n### ALNS, time limit {title} × {} ({}), {} seeds\n",
-            args.scale,
-            if args.wall {
-                "wall clock"
-            } else {
-                "CPU time of the solver thread"
-            },
-            args.seeds
-        );
-        println!("| instance | n | m | PCGLNS cost | PCGLNS s | known opt | ALNS best | ALNS median | ≤ PCGLNS (seeds) | median s to PCGLNS cost | median s to final best | at opt (seeds) | median iterations |");
-        println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|");
-        let mut median_ok = 0;
-        let mut optimum_instances = 0;
-        let mut optimum_reached = 0;
-        for r in &selected {
-            let path = data_dir()
-                .join(&r.set)
-                .join(format!("{}.pcglns", r.instance));
-            let text = std::fs::read_to_string(&path)
-                .unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
-            let instance = Instance::parse(&text).expect("instance parses");
-            let seconds = match limit {
-                Limit::Seconds(s) => s,
-                Limit::Pcglns => r.pcglns_time_s,
-            } * args.scale;
-            let mut costs = Vec::new();
-            let mut times_to_pcglns = Vec::new();
-            let mut iterations = Vec::new();
-            let mut times_to_best = Vec::new();
-            let mut at_optimum = 0;
-            for seed in 1..=args.seeds {
+        let mut limits: Vec<f64> = args
+            .limits
+            .iter()
+            .copied()
+            .filter(|&l| l <= run_to)
+            .collect();
+        limits.push(target_time);
+        limits.push(run_to);
+        let seeds = (1..=args.seeds)
+            .map(|seed| {
                 let options = AlnsOptions {
                     seed,
                     time_limit: None,
                     target_cost: if args.target { r.known_optimum } else { None },
                     ..AlnsOptions::default()
                 };
-                let mut reached: Option<f64> = None;
-                let mut last_improvement = 0.0;
-                let mut solver =
-                    AlnsSolver::new(&instance, options).expect("solver accepts the instance");
-                let clock = Clock::start(args.wall);
-                loop {
-                    let status = solver.step_with(Duration::from_millis(10), &mut |progress| {
-                        last_improvement = clock.seconds();
-                        if reached.is_none()
-                            && progress
-                                .best_cost
-                                .is_some_and(|c| c <= r.pcglns_cost + 1e-6)
-                        {
-                            reached = Some(clock.seconds());
-                        }
-                    });
-                    if status == SolverStatus::Finished || clock.seconds() >= seconds {
-                        break;
-                    }
+                SeedRun {
+                    solver: AlnsSolver::new(&instance, options)
+                        .expect("solver accepts the instance"),
+                    snapshots: Vec::new(),
+                    time_to_reach: None,
+                    time_to_optimum: None,
+                    seconds: 0.0,
+                    finished_early: false,
                 }
-                let result = solver.best().map(|(t, c)| (t.to_vec(), c));
-                let (tour, cost) = result.expect("a feasible tour");
-                let checked = check_tour(&instance, &tour).expect("tour passes the checker");
-                assert!((checked - cost).abs() <= 1e-6 * (1.0 + cost.abs()));
-                costs.push(cost);
-                times_to_pcglns.push(reached.unwrap_or(f64::INFINITY));
-                iterations.push(solver.progress().iterations as f64);
-                times_to_best.push(last_improvement);
-                if r.known_optimum.is_some_and(|o| cost <= o + 1e-6) {
-                    at_optimum += 1;
-                }
-            }
-            let best = costs.iter().cloned().fold(f64::INFINITY, f64::min);
-            let med = median(&mut costs.clone());
-            let beat = costs.iter().filter(|&&c| c <= r.pcglns_cost + 1e-6).count();
-            let med_time = median(&mut times_to_pcglns);
-            if med <= r.pcglns_cost + 1e-6 {
-                median_ok += 1;
-            }
-            if r.known_optimum.is_some() {
-                optimum_instances += 1;
-                if at_optimum > 0 {
-                    optimum_reached += 1;
-                }
-            }
-            println!(
-                "| {} | {} | {} | {} | {} | {} | {} | {} | {}/{} | {} | {:.2} | {} | {} |",
-                r.instance,
-                r.nodes,
-                r.clusters,
-                r.pcglns_cost,
-                r.pcglns_time_s,
-                r.known_optimum.map_or("–".to_owned(), |o| o.to_string()),
-                best,
-                med,
-                beat,
-                args.seeds,
-                if med_time.is_finite() {
-                    format!("{med_time:.2}")
-                } else {
-                    "–".to_owned()
-                },
-                median(&mut times_to_best),
-                if r.known_optimum.is_some() {
-                    format!("{at_optimum}/{}", args.seeds)
-                } else {
-                    "–".to_owned()
-                },
-                median(&mut iterations),
-            );
+            })
+            .collect();
+        let mut runs = InstanceRuns {
+            reference: r,
+            instance,
+            target_time,
+            run_to,
+            seeds,
+        };
+        advance(&mut runs, &limits, args.wall);
+        print_row(&args, &runs, &mut tally);
+        if run_to < largest {
+            all.push(runs);
         }
-        println!(
-            "\nMedian ≤ PCGLNS cost on {median_ok}/{} instances; known optimum reached (≥ 1 seed) on \
-             {optimum_reached}/{optimum_instances}.",
-            selected.len()
-        );
     }
+    print_tally(&tally, largest);
+    if all.is_empty() {
+        return;
+    }
+    // Second pass: continue the capped runs to the largest limit (same solvers, clocks go on).
+    println!("\n### Second pass: capped runs continued to {largest} s\n");
+    print_header(&args);
+    let mut tally = Tally::default();
+    for runs in &mut all {
+        let limits: Vec<f64> = args
+            .limits
+            .iter()
+            .copied()
+            .filter(|&l| l > runs.run_to)
+            .collect();
+        advance(runs, &limits, args.wall);
+        print_row(&args, runs, &mut tally);
+    }
+    print_tally(&tally, largest);
 }
