@@ -185,6 +185,7 @@ impl DiscreteInstance {
                 steps.push(CutStep {
                     contour,
                     pierce_point: point,
+                    entry: Default::default(),
                 });
             }
         }

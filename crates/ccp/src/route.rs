@@ -112,6 +112,7 @@ pub(crate) fn assemble_route(s: &Search, order: &[u32], pts: &[V]) -> Route {
             steps.push(CutStep {
                 contour: prob.refs[c],
                 pierce_point: poly[t].into(),
+                entry: Default::default(),
             });
         }
         if t < moves {
@@ -121,6 +122,7 @@ pub(crate) fn assemble_route(s: &Search, order: &[u32], pts: &[V]) -> Route {
                 steps.push(CutStep {
                     contour: prob.refs[c],
                     pierce_point: x.into(),
+                    entry: Default::default(),
                 });
             }
         }
@@ -139,6 +141,7 @@ pub(crate) fn assemble_route(s: &Search, order: &[u32], pts: &[V]) -> Route {
         steps.push(CutStep {
             contour: prob.refs[c],
             pierce_point: x.into(),
+            entry: Default::default(),
         });
         cur = x;
     }

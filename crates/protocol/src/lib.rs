@@ -280,6 +280,7 @@ mod tests {
                         contour: 0,
                     },
                     pierce_point: Point::new(0.0, 0.0),
+                    entry: Default::default(),
                 }],
                 finish: None,
             }),
