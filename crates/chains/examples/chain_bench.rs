@@ -7,27 +7,42 @@ use std::time::{Duration, Instant};
 
 use cutroute_chains::{chain_route, ChainOptions, TABLE1_MATERIALS};
 use cutroute_geometry::{MachineParameters, Nest, Point};
+use cutroute_protocol::Problem;
 
-const NESTS: [&str; 10] = [
-    "dbs-json/E1X_6_01.dbs.json",
-    "dbs-json/test0.dbs.json",
-    "dbs-json/test1.dbs.json",
-    "dbs/nested.dbs",
-    "dbs/seven.dbs",
-    "dbs/test0.json.dbs",
-    "dbs/rounded3x4.dbs",
-    "tflex/Nest01.tfnesting",
-    "tflex/Nest02.tfnesting",
-    "tflex/Nest03.tfnesting",
-];
+/// Every nest file of the shared data: DBS, geometry JSON and T-FLEX projects.
+fn nest_files() -> Vec<String> {
+    let root = format!("{}/../../../shared/data/nests", env!("CARGO_MANIFEST_DIR"));
+    let mut files = Vec::new();
+    for dir in ["dbs-json", "dbs", "tflex"] {
+        let entries = std::fs::read_dir(format!("{root}/{dir}"))
+            .unwrap_or_else(|e| panic!("missing data folder {root}/{dir}: {e}"));
+        let mut names: Vec<String> = entries
+            .map(|e| {
+                e.expect("readable folder")
+                    .file_name()
+                    .to_string_lossy()
+                    .into_owned()
+            })
+            .collect();
+        names.sort();
+        files.extend(names.into_iter().map(|n| format!("{root}/{dir}/{n}")));
+    }
+    files
+}
 
-fn read_nest(path: &str) -> Nest {
-    let full = format!(
-        "{}/../../../shared/data/nests/{path}",
-        env!("CARGO_MANIFEST_DIR")
-    );
-    let bytes = std::fs::read(&full).unwrap_or_else(|e| panic!("missing file {full}: {e}"));
-    cutroute_formats::read_nest(&bytes).unwrap_or_else(|e| panic!("cannot read {full}: {e}"))
+/// The nest, start and finish of a file as the app and CLI open it (orientation normalised).
+fn read_nest(path: &str) -> (Nest, Point, Option<Point>) {
+    let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("missing file {path}: {e}"));
+    let document = cutroute_engine::open_document(path, &bytes)
+        .unwrap_or_else(|e| panic!("cannot read {path}: {e}"));
+    match document.problem {
+        Problem::Nest {
+            nest,
+            start,
+            finish,
+        } => (nest, start, finish),
+        Problem::PcgtspText { .. } => panic!("{path} is not a nest"),
+    }
 }
 
 fn main() {
@@ -43,24 +58,30 @@ fn main() {
         value("--filter").map(|v| v.split(',').map(str::to_string).collect());
     println!("| nest | contours | material | condValue mm | pierces CCP → chain | saved | links mm | idle mm CCP → chain | cut mm CCP → chain | time s CCP → chain | cost CCP → chain | cost change | chain s |");
     println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|");
-    for path in NESTS {
+    for path in nest_files() {
+        let path = path.as_str();
         if filter
             .as_ref()
             .is_some_and(|f| !f.iter().any(|x| path.contains(x.as_str())))
         {
             continue;
         }
-        let nest = read_nest(path);
+        let (nest, start, finish) = read_nest(path);
+        // Single contours have nothing to chain.
+        if nest.contour_count() < 2 {
+            continue;
+        }
         let ccp = cutroute_ccp::solve(
             &nest,
             cutroute_ccp::CcpOptions {
-                start: Point::new(0.0, 0.0),
+                start,
+                finish,
                 time_limit: Duration::from_secs_f64(ccp_seconds),
                 ..cutroute_ccp::CcpOptions::default()
             },
             &mut |_| {},
         )
-        .expect("CCP solves every real nest");
+        .unwrap_or_else(|e| panic!("{path}: CCP failed: {e}"));
         for material in TABLE1_MATERIALS {
             let machine = material.priced(&MachineParameters::default());
             let options = ChainOptions {
@@ -89,7 +110,7 @@ fn main() {
                 r.pierces_before,
                 r.pierces_after,
                 r.pierces_before - r.pierces_after,
-                r.link_length,
+                r.link_length + 0.0, // no "-0.0"
                 r.idle_before,
                 r.idle_after,
                 cut_before,

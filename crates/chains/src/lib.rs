@@ -22,8 +22,9 @@
 //!    (visibility graph over the obstacles' corners and arc tangent points), keeping a link only
 //!    when it pays and cutting the chain otherwise,
 //! 5. moves the chain to where its last member stood (every member's inner contours are cut
-//!    earlier there, and the parent still after), and keeps the change only if the route's
-//!    cost drops.
+//!    earlier there, and the parent still after) or, if cheaper, to the place in the window
+//!    between the members' inner contours and their parent where the chain is the smallest
+//!    idle detour, and keeps the change only if the route's cost drops.
 //!
 //! The printed pseudo-code's defects (`../shared/spec/chain-cutting-and-ccp-paper.md` §A.6.3)
 //! are avoided by construction: the route is rebuilt from scratch for each group (no growing
@@ -246,6 +247,7 @@ pub fn chain_route(
     let mut current_cost = current.cost(nest, m);
     let context = Context {
         nest,
+        forest: &forest,
         machine: m,
         options,
         threshold: profitable_link_length(m),
@@ -406,6 +408,7 @@ fn nest_scale(nest: &Nest) -> f64 {
 /// What every group needs.
 struct Context<'a> {
     nest: &'a Nest,
+    forest: &'a ContainmentForest,
     machine: &'a MachineParameters,
     options: &'a ChainOptions,
     /// [`profitable_link_length`], mm.
@@ -442,16 +445,72 @@ impl Context<'_> {
             .iter()
             .rposition(|s| is_member(s.contour))
             .unwrap_or(0);
-        let insert_at = current.steps[..last]
-            .iter()
-            .filter(|s| !is_member(s.contour))
-            .count();
         let rest: Vec<CutStep> = current
             .steps
             .iter()
             .filter(|s| !is_member(s.contour))
             .cloned()
             .collect();
+        // The paper puts the chain where its last member stood ...
+        let paper_at = current.steps[..last]
+            .iter()
+            .filter(|s| !is_member(s.contour))
+            .count();
+        // ... but any place after every member's inner contours and before their parent is
+        // feasible: also try the one where the chain's box is the smallest idle detour.
+        let after_inner = rest
+            .iter()
+            .rposition(|s| self.forest.ancestors(s.contour).any(is_member))
+            .map_or(0, |i| i + 1);
+        let parent = self.forest.parent(group[0]);
+        let before_parent = parent
+            .and_then(|p| rest.iter().position(|s| s.contour == p))
+            .unwrap_or(rest.len());
+        let area = group
+            .iter()
+            .filter_map(|&r| self.nest.contour(r))
+            .fold(BoundingBox::EMPTY, |b, c| b.union(c.bounding_box()));
+        let detour = |k: usize| {
+            let a = if k > 0 {
+                rest[k - 1].pierce_point
+            } else {
+                current.start
+            };
+            match rest.get(k).map(|s| s.pierce_point).or(current.finish) {
+                Some(b) => {
+                    point_box_distance(a, &area) + point_box_distance(b, &area) - a.distance(b)
+                }
+                None => point_box_distance(a, &area),
+            }
+        };
+        let nearest_at = (after_inner..=before_parent.max(after_inner))
+            .min_by(|&a, &b| detour(a).total_cmp(&detour(b)))
+            .unwrap_or(paper_at);
+        let mut best: Option<(f64, Route)> = None;
+        for k in [paper_at, nearest_at] {
+            if best.is_some() && k == paper_at {
+                continue;
+            }
+            let route = self.chain_at(current, group, &rest, k, region);
+            let cost = route.cost(self.nest, self.machine);
+            if best.as_ref().is_none_or(|(c, _)| cost < *c) {
+                best = Some((cost, route));
+            }
+        }
+        best.map_or_else(|| current.clone(), |(_, r)| r)
+    }
+
+    /// `current` with `group` cut as one chain, inserted into `rest` (the other steps) at
+    /// `insert_at`.
+    fn chain_at(
+        &self,
+        current: &Route,
+        group: &[ContourRef],
+        rest: &[CutStep],
+        insert_at: usize,
+        region: &Region,
+    ) -> Route {
+        let rest = rest.to_vec();
         let before = if insert_at > 0 {
             rest[insert_at - 1].pierce_point
         } else {
