@@ -3,11 +3,11 @@
 //!
 //! `cargo run --release -p cutroute-chains --example chain_bench -- [--ccp-seconds S] [--filter A,B]`
 
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 use cutroute_chains::{chain_route, ChainOptions, TABLE1_MATERIALS};
 use cutroute_geometry::{MachineParameters, Nest, Point};
-use cutroute_protocol::Problem;
+use cutroute_protocol::{JobRequest, Problem, SolverKind, SolverParams};
 
 /// Every nest file of the shared data: DBS, geometry JSON and T-FLEX projects.
 fn nest_files() -> Vec<String> {
@@ -71,17 +71,26 @@ fn main() {
         if nest.contour_count() < 2 {
             continue;
         }
-        let ccp = cutroute_ccp::solve(
-            &nest,
-            cutroute_ccp::CcpOptions {
+        // CCP through the engine's 40 ms slices, as the app and CLI run it (one large budget
+        // overruns on Nest02, see the CCP section).
+        let request = JobRequest {
+            job_id: 1,
+            problem: Problem::Nest {
+                nest: nest.clone(),
                 start,
                 finish,
-                time_limit: Duration::from_secs_f64(ccp_seconds),
-                ..cutroute_ccp::CcpOptions::default()
             },
-            &mut |_| {},
-        )
-        .unwrap_or_else(|e| panic!("{path}: CCP failed: {e}"));
+            solver: SolverKind::Ccp,
+            params: SolverParams {
+                time_limit_s: ccp_seconds,
+                ..SolverParams::default()
+            },
+        };
+        let mut job = cutroute_engine::start_job(&request)
+            .unwrap_or_else(|e| panic!("{path}: CCP refused: {e}"));
+        let ccp_route = cutroute_engine::run_to_end(job.as_mut(), &mut |_| {})
+            .route
+            .unwrap_or_else(|| panic!("{path}: CCP found no route"));
         for material in TABLE1_MATERIALS {
             let machine = material.priced(&MachineParameters::default());
             let options = ChainOptions {
@@ -89,7 +98,7 @@ fn main() {
                 ..ChainOptions::default()
             };
             let started = Instant::now();
-            let chained = chain_route(&nest, &ccp.route, &options).expect("valid CCP route");
+            let chained = chain_route(&nest, &ccp_route, &options).expect("valid CCP route");
             let seconds = started.elapsed().as_secs_f64();
             let scale = {
                 let b = nest.bounding_box();
@@ -99,7 +108,7 @@ fn main() {
                 panic!("{path}: chained route invalid: {e}");
             }
             let r = &chained.report;
-            let cut_before = ccp.route.cut_length(&nest);
+            let cut_before = ccp_route.cut_length(&nest);
             let cut_after = chained.route.cut_length(&nest);
             println!(
                 "| {} | {} | {} | {:.0} | {} → {} | {} | {:.1} | {:.0} → {:.0} | {:.0} → {:.0} | {:.0} → {:.0} | {:.2} → {:.2} | {:+.2} % | {:.2} |",

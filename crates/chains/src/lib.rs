@@ -622,8 +622,33 @@ impl Context<'_> {
                 let mut candidates: Vec<Point> = chain[k].spans().map(|s| s.start).collect();
                 candidates.sort_by(|a, b| straight_cost(*a).total_cmp(&straight_cost(*b)));
                 candidates.truncate(REFINEMENT_CANDIDATES);
+                // Links are never shorter than straight: a candidate whose straight-line cost
+                // is no better than the best true cost so far cannot win.
+                let at_least = |a: Point, b: Point, end_price: Option<f64>| {
+                    let d = a.distance(b);
+                    match end_price {
+                        Some(price) => price * d,
+                        None => (on * d).min(pierce + off * d),
+                    }
+                };
+                let lower_bound = |x: Point| {
+                    let entering = if k == 0 {
+                        at_least(before, x, Some(off))
+                    } else {
+                        at_least(points[k - 1], x, None)
+                    };
+                    let leaving = if k + 1 < n {
+                        at_least(x, points[k + 1], None)
+                    } else {
+                        after.map_or(0.0, |a| at_least(x, a, Some(off)))
+                    };
+                    entering + leaving
+                };
                 let mut best = (entering(points[k]) + leaving(points[k]), points[k]);
                 for x in candidates {
+                    if lower_bound(x) >= best.0 {
+                        continue;
+                    }
                     let c = entering(x) + leaving(x);
                     if c < best.0 - 1e-12 {
                         best = (c, x);

@@ -63,8 +63,8 @@ impl<'a> Region<'a> {
     }
 
     /// `p` lies in the open region (inside the enclosing hole, outside every sibling).
-    fn contains(&self, p: Point) -> bool {
-        self.obstacles.iter().all(|o| {
+    fn contains(local: &[&Obstacle], p: Point) -> bool {
+        local.iter().all(|o| {
             let inside = o.bbox.contains_point(p) && o.contour.contains(p);
             inside == o.encloses_region
         })
@@ -72,10 +72,10 @@ impl<'a> Region<'a> {
 
     /// The straight piece `a → b` stays in the region: it crosses no contour except at the
     /// link's own end points `ends`, and its middle lies in the region.
-    fn sees(&self, a: Point, b: Point, ends: [Point; 2]) -> bool {
+    fn sees(&self, local: &[&Obstacle], a: Point, b: Point, ends: [Point; 2]) -> bool {
         let reach = BoundingBox::from_corners(a, b).expanded(self.end_tolerance);
         let at_an_end = |x: Point| ends.iter().any(|e| e.distance(x) <= self.end_tolerance);
-        for o in &self.obstacles {
+        for o in local {
             if !o.bbox.intersects(&reach) {
                 continue;
             }
@@ -91,17 +91,17 @@ impl<'a> Region<'a> {
                 }
             }
         }
-        self.contains(a.midpoint(b))
+        Self::contains(local, a.midpoint(b))
     }
 
     /// Corner points a shortest link may bend at, within the ellipse `|x−p| + |x−q| ≤ reach`:
     /// every vertex of every obstacle pushed `clearance` into the region, and points round every
     /// arc (at most 30° apart) far enough out that the chords between them clear the arc.
-    fn corners(&self, p: Point, q: Point, reach: f64) -> Vec<Point> {
+    fn corners(&self, local: &[&Obstacle], p: Point, q: Point, reach: f64) -> Vec<Point> {
         let ellipse = BoundingBox::from_corners(p, q).expanded(reach / 2.0);
         let mut corners = Vec::new();
         let in_ellipse = |x: Point| x.distance(p) + x.distance(q) <= reach;
-        for o in &self.obstacles {
+        for o in local {
             if !o.bbox.intersects(&ellipse) {
                 continue;
             }
@@ -128,7 +128,7 @@ impl<'a> Region<'a> {
                     };
                     for side in [1.0, -1.0] {
                         let x = v + normal * (side * self.clearance);
-                        if in_ellipse(x) && self.contains(x) {
+                        if in_ellipse(x) && Self::contains(local, x) {
                             corners.push(x);
                             break;
                         }
@@ -153,7 +153,7 @@ impl<'a> Region<'a> {
                         centre + out * ((radius + self.clearance) / half.cos()),
                         centre + out * (radius - self.clearance).max(0.0),
                     ] {
-                        if in_ellipse(x) && self.contains(x) {
+                        if in_ellipse(x) && Self::contains(local, x) {
                             corners.push(x);
                         }
                     }
@@ -177,11 +177,19 @@ impl<'a> Region<'a> {
         if direct > reach {
             return None;
         }
-        if self.sees(p, q, ends) {
+        // Every point of a path no longer than `reach` lies in this box: only obstacles
+        // meeting it matter (a sibling outside it cannot contain such a point either).
+        let area = BoundingBox::from_corners(p, q).expanded(reach / 2.0 + self.end_tolerance);
+        let local: Vec<&Obstacle> = self
+            .obstacles
+            .iter()
+            .filter(|o| o.bbox.intersects(&area))
+            .collect();
+        if self.sees(&local, p, q, ends) {
             return Some((Vec::new(), direct));
         }
         let mut nodes = vec![p, q];
-        nodes.extend(self.corners(p, q, reach));
+        nodes.extend(self.corners(&local, p, q, reach));
         // A* over the visibility graph, edges tested lazily when a node is settled.
         let n = nodes.len();
         let mut best = vec![f64::INFINITY; n];
@@ -220,7 +228,7 @@ impl<'a> Region<'a> {
                 if length >= best[next] || estimate > reach {
                     continue;
                 }
-                if !self.sees(nodes[node], nodes[next], ends) {
+                if !self.sees(&local, nodes[node], nodes[next], ends) {
                     continue;
                 }
                 best[next] = length;
