@@ -1,7 +1,8 @@
 //! Chain cutting vs plain CCP on every real nest: pierces, lengths, time and cost per material
 //! of Verkhoturov–Tarasenko's Table 1. Prints a Markdown table for BENCHMARKS.md.
 //!
-//! `cargo run --release -p cutroute-chains --example chain_bench -- [--ccp-seconds S] [--filter A,B]`
+//! `cargo run --release -p cutroute-chains --example chain_bench -- [--ccp-seconds S] [--filter A,B]
+//! [--base ccp|nearest]`
 
 use std::time::Instant;
 
@@ -54,6 +55,13 @@ fn main() {
             .cloned()
     };
     let ccp_seconds: f64 = value("--ccp-seconds").map_or(5.0, |v| v.parse().expect("seconds"));
+    // The route to chain: CCP-Relax (default) or the nearest-neighbour baseline (for nests on
+    // which CCP overruns its time limit).
+    let base = match value("--base").as_deref() {
+        None | Some("ccp") => SolverKind::Ccp,
+        Some("nearest") => SolverKind::NearestNeighbour,
+        Some(other) => panic!("--base {other}: ccp or nearest"),
+    };
     let filter: Option<Vec<String>> =
         value("--filter").map(|v| v.split(',').map(str::to_string).collect());
     println!("| nest | contours | material | condValue mm | pierces CCP → chain | saved | links mm | idle mm CCP → chain | cut mm CCP → chain | time s CCP → chain | cost CCP → chain | cost change | chain s |");
@@ -80,7 +88,7 @@ fn main() {
                 start,
                 finish,
             },
-            solver: SolverKind::Ccp,
+            solver: base,
             params: SolverParams {
                 time_limit_s: ccp_seconds,
                 ..SolverParams::default()

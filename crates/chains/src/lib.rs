@@ -257,13 +257,9 @@ pub fn chain_route(
         if siblings.len() < 2 {
             continue;
         }
-        let region = Region::new(
-            nest,
-            parent,
-            &siblings,
-            options.clearance_mm,
-            tolerance * 10.0,
-        );
+        // Far stricter than the checker's tolerance, so every link the region accepts passes
+        // `Route::validate` (a crossing near but not at a link's end is a crossing).
+        let region = Region::new(nest, parent, &siblings, options.clearance_mm, 1e-9 * scale);
         for group in close_groups(nest, &siblings, context.threshold) {
             if group.len() < 2 {
                 continue;

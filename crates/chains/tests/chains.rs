@@ -279,3 +279,50 @@ fn ccp_routes_of_real_nests_chain_validly_and_never_cost_more() {
         }
     }
 }
+
+#[test]
+fn tflex_nests_with_touching_parts_chain_validly() {
+    // 406 parts, many touching: links start at points where neighbours touch, the case that
+    // once let a link through a neighbour within the region's old end tolerance.
+    for file in ["Nest02.tfnesting", "Nest03.tfnesting"] {
+        let full = format!(
+            "{}/../../../shared/data/nests/tflex/{file}",
+            env!("CARGO_MANIFEST_DIR")
+        );
+        let bytes =
+            std::fs::read(&full).unwrap_or_else(|e| panic!("missing test file {full}: {e}"));
+        let document = cutroute_engine::open_document(&full, &bytes).unwrap();
+        let cutroute_protocol::Problem::Nest {
+            nest,
+            start,
+            finish,
+        } = &document.problem
+        else {
+            panic!("{file} is a nest")
+        };
+        let request = cutroute_protocol::JobRequest {
+            job_id: 1,
+            problem: document.problem.clone(),
+            solver: cutroute_protocol::SolverKind::NearestNeighbour,
+            params: cutroute_protocol::SolverParams::default(),
+        };
+        let mut job = cutroute_engine::start_job(&request).unwrap();
+        let route = cutroute_engine::run_to_end(job.as_mut(), &mut |_| {})
+            .route
+            .unwrap();
+        assert_eq!((route.start, route.finish), (*start, *finish));
+        for material in TABLE1_MATERIALS {
+            let options = ChainOptions {
+                machine: material.priced(&MachineParameters::default()),
+                ..ChainOptions::default()
+            };
+            let chained = chain_route(nest, &route, &options).unwrap();
+            chained
+                .route
+                .validate(nest, 1e-6 * 8000.0)
+                .unwrap_or_else(|e| panic!("{file}, {}: {e}", material.name));
+            assert!(chained.report.pierces_after < chained.report.pierces_before);
+            assert!(chained.report.cost_after < chained.report.cost_before);
+        }
+    }
+}
