@@ -405,10 +405,7 @@ mod tests {
                 },
             ],
         };
-        let step = |part, x| CutStep {
-            contour: ContourRef { part, contour: 0 },
-            pierce_point: Point::new(x, 0.0),
-        };
+        let step = |part, x| CutStep::pierced(ContourRef { part, contour: 0 }, Point::new(x, 0.0));
         let route = Route {
             start: Point::new(0.0, -10.0),
             steps: vec![step(0, 0.0), step(1, 20.0)],

@@ -311,6 +311,8 @@ pub fn App() -> impl IntoView {
             seed: seed.get_untracked().wrapping_add(run),
             discretisation_step_mm: step_mm.get_untracked(),
             initial_upper_bound: from.as_ref().and_then(|p| p.upper_bound),
+            // The stats panel's speeds and prices: chain cutting decides by this cost model.
+            machine: machine.get_untracked(),
         };
         if from.is_none() {
             progress.set(None);
@@ -406,7 +408,7 @@ pub fn App() -> impl IntoView {
             return;
         };
         let label = progress
-            .with_untracked(|p| p.as_ref().map(|_| solver_label(solver.get_untracked())))
+            .with_untracked(|p| p.as_ref().map(|_| solver.get_untracked().label()))
             .unwrap_or("from the file");
         let entry = machine.with_untracked(|m| Kept::new(&nest, route, m, label));
         kept.update(|k| {
@@ -486,7 +488,7 @@ pub fn App() -> impl IntoView {
                         .map(|kind| {
                             view! {
                                 <option value=kind.name() selected=kind.name() == initial.solver>
-                                    {solver_label(*kind)}
+                                    {kind.label()}
                                 </option>
                             }
                         })
@@ -684,15 +686,6 @@ fn LayerPanel(hidden: RwSignal<Vec<Layer>>) -> impl IntoView {
                 })
                 .collect_view()}
         </fieldset>
-    }
-}
-
-fn solver_label(kind: SolverKind) -> &'static str {
-    match kind {
-        SolverKind::NearestNeighbour => "Nearest neighbour (baseline)",
-        SolverKind::Ccp => "Continuous CCP-Relax",
-        SolverKind::Heuristic => "Discrete heuristic (ALNS)",
-        SolverKind::Exact => "Discrete exact with lower bound",
     }
 }
 

@@ -198,13 +198,13 @@ mod tests {
         };
         let route = Route {
             start: Point::new(-10.0, 0.0),
-            steps: vec![CutStep {
-                contour: ContourRef {
+            steps: vec![CutStep::pierced(
+                ContourRef {
                     part: 0,
                     contour: 0,
                 },
-                pierce_point: Point::new(0.0, 0.0),
-            }],
+                Point::new(0.0, 0.0),
+            )],
             finish: Some(Point::new(-10.0, 0.0)),
         };
         (nest, route)

@@ -168,6 +168,7 @@ pub(crate) fn assemble_route(s: &Search, order: &[u32], pts: &[V]) -> Route {
             steps.push(CutStep {
                 contour: prob.refs[c],
                 pierce_point: poly[t].into(),
+                entry: Default::default(),
             });
         }
         if t < moves {
@@ -177,6 +178,7 @@ pub(crate) fn assemble_route(s: &Search, order: &[u32], pts: &[V]) -> Route {
                 steps.push(CutStep {
                     contour: prob.refs[c],
                     pierce_point: x.into(),
+                    entry: Default::default(),
                 });
             }
         }
@@ -195,6 +197,7 @@ pub(crate) fn assemble_route(s: &Search, order: &[u32], pts: &[V]) -> Route {
         steps.push(CutStep {
             contour: prob.refs[c],
             pierce_point: x.into(),
+            entry: Default::default(),
         });
         cur = x;
     }

@@ -7,9 +7,13 @@
 //!                  [--incremental] [--arcs ij|r|lines] [--decimals N] [--line-numbers]
 //!                  [--feed MM_PER_MIN] [--dwell S] [--torch-on CODE] [--torch-off CODE]
 //! cutroute generate --contours N [--seed S] --out FILE   # synthetic nest as geometry JSON
-//! cutroute solve FILE --solver nearest|ccp|heuristic|exact|discrete [--time-limit S] [--seed N]
-//!                     [--ub N] [--step MM] [--json]
+//! cutroute solve FILE --solver nearest|ccp|heuristic|exact|discrete|chain [--time-limit S]
+//!                     [--seed N] [--ub N] [--step MM] [--cost C_off,C_on,C_pt]
+//!                     [--speeds V_off,V_on,t_pt] [--task TASK.json] [--json]
 //! ```
+//! The time and cost model (`--speeds`, `--cost`) defaults to the task file's speeds and pierce
+//! time when `--task` is given, else to `MachineParameters::default()`; prices are per metre of
+//! idle travel and of cut and per pierce, speeds in mm/s, the pierce time in s.
 //! Errors go to stderr with the reader's location, and the exit code is 1.
 
 use std::path::{Path, PathBuf};
@@ -17,7 +21,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use cutroute_engine::{open_document, run_to_end, start_job};
-use cutroute_geometry::{Nest, Route};
+use cutroute_geometry::{Entry, MachineParameters, Nest, Route};
 use cutroute_protocol::{Document, JobRequest, Problem, Progress, SolverKind, SolverParams};
 use serde_json::{json, Value};
 
@@ -84,7 +88,8 @@ enum Command {
     Solve {
         /// A nest file or a PCGTSP instance.
         file: PathBuf,
-        /// nearest, ccp, heuristic, exact, or discrete (= heuristic on a discretised nest).
+        /// nearest, ccp, heuristic, exact, discrete (= heuristic on a discretised nest), or
+        /// chain (ccp, then chain cutting).
         #[arg(long, default_value = "ccp")]
         solver: String,
         /// Wall-clock limit in seconds.
@@ -99,6 +104,15 @@ enum Command {
         /// Spacing of candidate pierce points for the discrete solvers on nests, mm.
         #[arg(long, default_value_t = 50.0)]
         step: f64,
+        /// Prices: idle travel per metre, cut per metre, one pierce (C_off,C_on,C_pt).
+        #[arg(long, value_name = "C_off,C_on,C_pt")]
+        cost: Option<String>,
+        /// Idle speed and cutting speed (mm/s) and pierce time (s): V_off,V_on,t_pt.
+        #[arg(long, value_name = "V_off,V_on,t_pt")]
+        speeds: Option<String>,
+        /// A RouteManager task JSON whose speeds and pierce time are the defaults.
+        #[arg(long)]
+        task: Option<PathBuf>,
         /// Print one JSON object instead of text.
         #[arg(long)]
         json: bool,
@@ -124,6 +138,7 @@ fn main() -> ExitCode {
                 seed,
                 discretisation_step_mm: step,
                 initial_upper_bound: None,
+                machine: Default::default(),
             };
             convert(
                 &input,
@@ -146,16 +161,22 @@ fn main() -> ExitCode {
             seed,
             ub,
             step,
+            cost,
+            speeds,
+            task,
             json,
-        } => {
-            let params = SolverParams {
-                time_limit_s: time_limit,
-                seed,
-                discretisation_step_mm: step,
-                initial_upper_bound: ub,
-            };
-            solve(&file, &solver, params, json)
-        }
+        } => machine_parameters(cost.as_deref(), speeds.as_deref(), task.as_deref()).and_then(
+            |machine| {
+                let params = SolverParams {
+                    time_limit_s: time_limit,
+                    seed,
+                    discretisation_step_mm: step,
+                    initial_upper_bound: ub,
+                    machine,
+                };
+                solve(&file, &solver, params, json)
+            },
+        ),
     };
     match outcome {
         Ok(()) => ExitCode::SUCCESS,
@@ -164,6 +185,59 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// Three comma-separated finite non-negative numbers.
+fn triple(flag: &str, text: &str) -> Result<[f64; 3], String> {
+    let values: Vec<f64> = text
+        .split(',')
+        .map(|v| v.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|e| format!("--{flag} {text:?}: {e}"))?;
+    let [a, b, c] = values[..] else {
+        return Err(format!(
+            "--{flag} {text:?}: expected three comma-separated numbers"
+        ));
+    };
+    if [a, b, c].iter().any(|v| !(v.is_finite() && *v >= 0.0)) {
+        return Err(format!(
+            "--{flag} {text:?}: values must be finite and non-negative"
+        ));
+    }
+    Ok([a, b, c])
+}
+
+/// The time and cost model: defaults, then the task file's speeds, then the flags.
+fn machine_parameters(
+    cost: Option<&str>,
+    speeds: Option<&str>,
+    task: Option<&Path>,
+) -> Result<MachineParameters, String> {
+    let mut machine = MachineParameters::default();
+    if let Some(path) = task {
+        let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let task = cutroute_formats::read_task_json(&bytes)
+            .map_err(|e| format!("{}: {e}", path.display()))?;
+        machine.idle_speed = task.task_data.tool_idling_speed;
+        machine.cut_speed = task.task_data.tool_cut_speed;
+        machine.pierce_time = task.task_data.piercing_duration;
+    }
+    if let Some(text) = speeds {
+        let [idle, cut, pierce] = triple("speeds", text)?;
+        if !(idle > 0.0 && cut > 0.0) {
+            return Err(format!("--speeds {text:?}: speeds must be positive"));
+        }
+        machine.idle_speed = idle;
+        machine.cut_speed = cut;
+        machine.pierce_time = pierce;
+    }
+    if let Some(text) = cost {
+        let [idle, cut, pierce] = triple("cost", text)?;
+        machine.idle_price_per_metre = idle;
+        machine.cut_price_per_metre = cut;
+        machine.pierce_price = pierce;
+    }
+    Ok(machine)
 }
 
 fn open(path: &Path) -> Result<Document, String> {
@@ -385,7 +459,7 @@ fn solved_route(
     let solver = match solver_name {
         "discrete" => SolverKind::Heuristic,
         name => SolverKind::from_name(name).ok_or_else(|| {
-            format!("unknown solver {name:?} (nearest, ccp, heuristic, discrete)")
+            format!("unknown solver {name:?} (nearest, ccp, heuristic, discrete, chain)")
         })?,
     };
     let request = JobRequest {
@@ -417,9 +491,11 @@ fn solve(
     let solver = match solver_name {
         "discrete" => SolverKind::Heuristic,
         name => SolverKind::from_name(name).ok_or_else(|| {
-            format!("unknown solver {name:?} (nearest, ccp, heuristic, exact, discrete)")
+            let known: Vec<&str> = SolverKind::ALL.iter().map(|k| k.name()).collect();
+            format!("unknown solver {name:?} ({}, discrete)", known.join(", "))
         })?,
     };
+    let machine = params.machine;
     let request = JobRequest {
         job_id: 1,
         problem: document.problem.clone(),
@@ -442,7 +518,7 @@ fn solve(
     });
     let report = match &document.problem {
         Problem::PcgtspText { .. } => tour_report(solver_name, &result),
-        Problem::Nest { nest, .. } => route_report(solver_name, nest, &result)?,
+        Problem::Nest { nest, .. } => route_report(solver_name, nest, &machine, &result)?,
     };
     if as_json {
         println!("{report}");
@@ -476,25 +552,48 @@ fn tour_report(solver: &str, result: &Progress) -> Value {
     })
 }
 
-/// The nest report: lengths recomputed from the route itself, not taken from the solver.
-fn route_report(solver: &str, nest: &Nest, result: &Progress) -> Result<Value, String> {
+/// The nest report: lengths recomputed from the route itself, not taken from the solver; time
+/// and cost under `machine`. Cut length includes the tool-on links of chains (also reported
+/// alone as `link_length`); a linked step lists its link's corners under `link`.
+fn route_report(
+    solver: &str,
+    nest: &Nest,
+    machine: &MachineParameters,
+    result: &Progress,
+) -> Result<Value, String> {
     let route: &Route = result.route.as_ref().ok_or("the solver found no route")?;
     route
         .validate(nest, 1e-6 * nest_scale(nest))
         .map_err(|e| format!("invalid route: {e}"))?;
-    let machine = cutroute_geometry::MachineParameters::default();
     let idle_length = route.idle_length();
     let cut_length = route.cut_length(nest);
+    let pierces = route.pierce_count();
     Ok(json!({
         "solver": solver,
         "idle_length": idle_length,
         "cut_length": cut_length,
-        "pierces": route.pierce_count(),
-        "time_s": machine.time(cut_length, idle_length, route.pierce_count()),
-        "route": route.steps.iter().map(|s| json!({
-            "contour": [s.contour.part, s.contour.contour],
-            "pierce": [s.pierce_point.x, s.pierce_point.y],
-        })).collect::<Vec<_>>(),
+        "link_length": route.link_length(),
+        "pierces": pierces,
+        "time_s": machine.time(cut_length, idle_length, pierces),
+        "cost": machine.cost(cut_length, idle_length, pierces),
+        "machine": {
+            "idle_speed": machine.idle_speed,
+            "cut_speed": machine.cut_speed,
+            "pierce_time": machine.pierce_time,
+            "idle_price_per_metre": machine.idle_price_per_metre,
+            "cut_price_per_metre": machine.cut_price_per_metre,
+            "pierce_price": machine.pierce_price,
+        },
+        "route": route.steps.iter().map(|s| {
+            let mut step = json!({
+                "contour": [s.contour.part, s.contour.contour],
+                "pierce": [s.pierce_point.x, s.pierce_point.y],
+            });
+            if let Entry::Link(corners) = &s.entry {
+                step["link"] = json!(corners.iter().map(|c| [c.x, c.y]).collect::<Vec<_>>());
+            }
+            step
+        }).collect::<Vec<_>>(),
         "certified_contours": result.certified.iter().filter(|c| **c).count(),
         "ub": result.upper_bound,
         "lb": result.lower_bound,

@@ -2,7 +2,8 @@
 
 use cutroute_alns::{AlnsOptions, AlnsSolver};
 use cutroute_ccp::{CcpOptions, CcpSolver, DiscreteInstance};
-use cutroute_geometry::Route;
+use cutroute_chains::{chain_route, ChainOptions, Chained};
+use cutroute_geometry::{MachineParameters, Nest, Route};
 use cutroute_pcgtsp::{ExactOptions, ExactSolver, Instance};
 use cutroute_protocol::{JobId, Progress};
 use web_time::{Duration, Instant};
@@ -233,12 +234,87 @@ pub fn ccp_options(
     finish: Option<cutroute_geometry::Point>,
     time_limit: Duration,
     seed: u64,
+    machine: MachineParameters,
 ) -> CcpOptions {
     CcpOptions {
         start,
         finish,
         time_limit,
         seed,
+        machine,
         ..CcpOptions::default()
+    }
+}
+
+/// CCP-Relax, then chain cutting of its route (`cutroute-chains`): the CCP phase streams its
+/// progress as a CCP job does; the chaining runs in the step after CCP ends.
+pub struct ChainJob {
+    ccp: CcpJob,
+    nest: Nest,
+    options: ChainOptions,
+    chained: Option<Chained>,
+    failure: Option<String>,
+    started: Instant,
+}
+
+impl ChainJob {
+    /// Wrap a prepared CCP solver; `machine` prices the links.
+    pub fn new(job_id: JobId, solver: CcpSolver, nest: Nest, machine: MachineParameters) -> Self {
+        Self {
+            ccp: CcpJob::new(job_id, solver),
+            nest,
+            options: ChainOptions {
+                machine,
+                ..ChainOptions::default()
+            },
+            chained: None,
+            failure: None,
+            started: Instant::now(),
+        }
+    }
+}
+
+impl Job for ChainJob {
+    fn step(&mut self, budget: Duration) -> JobStatus {
+        if self.chained.is_some() || self.failure.is_some() {
+            return JobStatus::Done;
+        }
+        if self.ccp.step(budget) == JobStatus::Running {
+            return JobStatus::Running;
+        }
+        let Some(route) = self.ccp.progress().route else {
+            self.failure = Some("CCP found no route to chain".into());
+            return JobStatus::Done;
+        };
+        match chain_route(&self.nest, &route, &self.options) {
+            Ok(chained) => self.chained = Some(chained),
+            Err(e) => self.failure = Some(e.to_string()),
+        }
+        JobStatus::Done
+    }
+
+    fn progress(&self) -> Progress {
+        let mut progress = self.ccp.progress();
+        if let Some(chained) = &self.chained {
+            let r = &chained.report;
+            progress.elapsed_s = self.started.elapsed().as_secs_f64();
+            progress.upper_bound = Some(chained.route.idle_length());
+            progress.phase = format!(
+                "chained: {} of {} pierces saved, {} chains, cost {:.2} → {:.2}",
+                r.pierces_before - r.pierces_after,
+                r.pierces_before,
+                r.chains,
+                r.cost_before,
+                r.cost_after
+            );
+            progress.route = Some(chained.route.clone());
+            // CCP's certificates are about its own pierce points, which chaining moved.
+            progress.certified = Vec::new();
+        } else if let Some(failure) = &self.failure {
+            progress.phase = format!("chain cutting failed: {failure}; CCP route kept");
+        } else if !progress.phase.is_empty() {
+            progress.phase = format!("ccp: {}", progress.phase);
+        }
+        progress
     }
 }

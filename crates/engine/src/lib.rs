@@ -38,7 +38,7 @@ mod open;
 use cutroute_protocol::{JobRequest, Problem, Progress, SolverKind};
 use web_time::Duration;
 
-pub use jobs::{CcpJob, DiscreteJob, DiscreteMode};
+pub use jobs::{CcpJob, ChainJob, DiscreteJob, DiscreteMode};
 pub use nearest::NearestNeighbourJob;
 pub use open::{format_name, open_document, OpenError};
 
@@ -133,12 +133,21 @@ pub fn start_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
                 start,
                 finish,
             },
-            SolverKind::Ccp,
+            SolverKind::Ccp | SolverKind::Chain,
         ) => {
-            let options = jobs::ccp_options(*start, *finish, time_limit, params.seed);
-            let solver =
+            let options =
+                jobs::ccp_options(*start, *finish, time_limit, params.seed, params.machine);
+            let ccp =
                 cutroute_ccp::CcpSolver::new(nest, options).map_err(|e| refused(e.to_string()))?;
-            Ok(Box::new(CcpJob::new(request.job_id, solver)))
+            if solver == SolverKind::Chain {
+                return Ok(Box::new(ChainJob::new(
+                    request.job_id,
+                    ccp,
+                    nest.clone(),
+                    params.machine,
+                )));
+            }
+            Ok(Box::new(CcpJob::new(request.job_id, ccp)))
         }
         (
             Problem::Nest {

@@ -82,6 +82,7 @@ impl NearestNeighbourJob {
             steps.push(CutStep {
                 contour: contour_ref,
                 pierce_point,
+                entry: Default::default(),
             });
         }
         if let Some(finish) = self.finish {

@@ -74,6 +74,33 @@ fn every_nest_solver_returns_a_valid_route() {
 }
 
 #[test]
+fn the_chain_solver_saves_pierces_and_cost_over_its_ccp_route() {
+    for file in ["nests/dbs-json/E1X_6_01.dbs.json", "nests/dbs/nested.dbs"] {
+        let (problem, chained) = run(file, SolverKind::Chain, 1.0);
+        check_route(&problem, &chained);
+        let Problem::Nest { nest, .. } = &problem else {
+            panic!("a nest")
+        };
+        let route = chained.route.as_ref().unwrap();
+        assert!(
+            route.pierce_count() < nest.contour_count(),
+            "{file}: no pierce saved"
+        );
+        assert!(route.link_length() > 0.0);
+        assert!(chained.phase.starts_with("chained:"), "{}", chained.phase);
+        let machine = SolverParams::default().machine;
+        let (_, ccp) = run(file, SolverKind::Ccp, 1.0);
+        let ccp_cost = ccp.route.as_ref().unwrap().cost(nest, &machine);
+        // The CCP phases of the two runs may differ (timed), but chaining saves far more.
+        assert!(
+            route.cost(nest, &machine) < ccp_cost,
+            "{file}: chain {} vs ccp {ccp_cost}",
+            route.cost(nest, &machine)
+        );
+    }
+}
+
+#[test]
 fn discrete_solvers_on_a_nest_return_valid_routes() {
     for solver in [SolverKind::Heuristic, SolverKind::Exact] {
         let (problem, result) = run("nests/dbs-json/E1X_6_01.dbs.json", solver, 2.0);

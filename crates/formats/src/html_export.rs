@@ -347,7 +347,7 @@ fn route_paths(out: &mut String, toolpath: &Toolpath) {
                 );
             }
             ToolMove::Pierce { .. } => {}
-            ToolMove::Cut { step, span } => {
+            ToolMove::Cut { step, span, .. } => {
                 if cut_step != Some(step) {
                     flush(out, &mut cut, cut_step);
                     cut_step = Some(step);
@@ -497,9 +497,8 @@ mod tests {
                 contours: vec![square, hole],
             }],
         };
-        let step = |contour: usize, x: f64, y: f64| CutStep {
-            contour: ContourRef { part: 0, contour },
-            pierce_point: Point::new(x, y),
+        let step = |contour: usize, x: f64, y: f64| {
+            CutStep::pierced(ContourRef { part: 0, contour }, Point::new(x, y))
         };
         let route = Route {
             start: Point::new(-10.0, -10.0),

@@ -437,6 +437,7 @@ impl RmResult {
                     steps.push(CutStep {
                         contour,
                         pierce_point: m.from,
+                        entry: Default::default(),
                     });
                 }
             }

@@ -28,7 +28,7 @@
 //!     moves: vec![
 //!         ToolMove::Idle { from: Point::new(0.0, 0.0), to: at },
 //!         ToolMove::Pierce { at, step: 0 },
-//!         ToolMove::Cut { step: 0, span: Span::new(at, Point::new(-10.0, 0.0), 1.0) },
+//!         ToolMove::Cut { step: 0, span: Span::new(at, Point::new(-10.0, 0.0), 1.0), link: false },
 //!     ],
 //! };
 //! let options = GcodeOptions { pierce_dwell_s: 0.5, ..GcodeOptions::default() };

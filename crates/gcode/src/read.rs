@@ -176,9 +176,12 @@ impl Program {
                     from: span.start,
                     to: span.end,
                 }),
+                // A feed move cannot tell a contour's cut from a chain's tool-on link: both
+                // count as cut length, which is all a read-back check needs.
                 Motion::Feed { span, .. } => moves.push(ToolMove::Cut {
                     step: step.saturating_sub(1),
                     span,
+                    link: false,
                 }),
                 Motion::TorchOn { at, .. } => {
                     moves.push(ToolMove::Pierce { at, step });

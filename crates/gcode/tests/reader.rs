@@ -36,6 +36,7 @@ fn quarter(bulge_sign: f64) -> Toolpath {
             ToolMove::Cut {
                 step: 0,
                 span: Span::new(a, z, bulge),
+                link: false,
             },
         ],
     }
@@ -213,6 +214,7 @@ fn writer_options_show_in_the_program() {
             ToolMove::Cut {
                 step: 0,
                 span: Span::new(a, Point::new(0.0, -10.0), (3.0 * PI / 8.0).tan()),
+                link: false,
             },
         ],
     };
@@ -337,6 +339,7 @@ fn random_path(points: &[(f64, f64)], bulges: &[f64]) -> Toolpath {
         moves.push(ToolMove::Cut {
             step: 0,
             span: Span::new(a, z, *b),
+            link: false,
         });
     }
     Toolpath { start, moves }

@@ -15,7 +15,8 @@
 //! - [`Nest`] and [`ContainmentForest`]: which contour lies inside which, hence the cutting
 //!   precedence "inner before outer".
 //! - [`Route`]: idle and cut length, time and cost under [`MachineParameters`], and an
-//!   independent validity check; [`Toolpath`] and [`ToolClock`]: the head's moves (idle, pierce,
+//!   independent validity check; a step may be entered by a tool-on link ([`Entry::Link`],
+//!   chain cutting) instead of idle move + pierce, checked to cross no contour; [`Toolpath`] and [`ToolClock`]: the head's moves (idle, pierce,
 //!   cut span by span) on the machine's time axis, for animation, G-code and exports.
 //! - [`generate_nest`]: deterministic synthetic nests of up to tens of thousands of contours.
 //!
@@ -52,8 +53,8 @@
 //! let route = Route {
 //!     start: Point::new(0.0, -10.0),
 //!     steps: vec![
-//!         CutStep { contour: inner, pierce_point: Point::new(7.0, 5.0) },
-//!         CutStep { contour: outer, pierce_point: Point::new(10.0, 5.0) },
+//!         CutStep::pierced(inner, Point::new(7.0, 5.0)),
+//!         CutStep::pierced(outer, Point::new(10.0, 5.0)),
 //!     ],
 //!     finish: None,
 //! };
@@ -82,7 +83,10 @@ pub use contour::{
 };
 pub use forest::ContainmentForest;
 pub use generator::{generate_nest, SplitMix64};
-pub use route::{ContourRef, CutStep, MachineParameters, Route, RouteError};
+pub use route::{
+    in_scrap_region, is_scrap_region, ContourRef, CutStep, Entry, MachineParameters, Route,
+    RouteError,
+};
 pub use span::{tan_half_arg, Span, SpanIntersection, SpanProjection};
 pub use toolpath::{ToolClock, ToolMove, ToolState, Toolpath};
 pub use transform::Transform;

@@ -14,16 +14,51 @@ pub struct ContourRef {
     pub contour: usize,
 }
 
-/// One cut of a route: pierce a contour at a point on it and cut it all the way round.
+/// How the tool reaches the contour of a step.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub enum Entry {
+    /// Idle move from where the previous step ended (or the start), then a pierce.
+    #[default]
+    Pierce,
+    /// Chain cutting: the torch stays on and cuts a *link* from the previous step's exit point
+    /// (its pierce point, since contours are closed) to this step's pierce point, through these
+    /// intermediate corners (empty for a straight link). No idle move and no pierce: the link
+    /// is cut length. Valid only between siblings of one scrap region (see [`Route::problems`]).
+    Link(Vec<Point>),
+}
+
+/// One cut of a route: reach a contour at a point on it (idle + pierce, or a tool-on link) and
+/// cut it all the way round.
 ///
 /// The cut follows the contour's own direction (outer clockwise, holes counter-clockwise) from
-/// `pierce_point` back to `pierce_point`; the idle move to the next step starts there.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+/// `pierce_point` back to `pierce_point`; the move to the next step starts there.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct CutStep {
     /// The contour that is cut.
     pub contour: ContourRef,
-    /// Where the torch pierces; lies on the contour.
+    /// Where the cut of the contour starts and ends (where the torch pierces, unless the step
+    /// is entered by a link); lies on the contour.
     pub pierce_point: Point,
+    /// How the tool gets there; routes written before chain cutting have no such field and
+    /// read as [`Entry::Pierce`].
+    #[serde(default)]
+    pub entry: Entry,
+}
+
+impl CutStep {
+    /// A step entered the usual way: idle move, then a pierce at `pierce_point`.
+    pub fn pierced(contour: ContourRef, pierce_point: Point) -> CutStep {
+        CutStep {
+            contour,
+            pierce_point,
+            entry: Entry::Pierce,
+        }
+    }
+
+    /// Whether the torch pierces at this step (it does unless the step is entered by a link).
+    pub fn is_pierced(&self) -> bool {
+        matches!(self.entry, Entry::Pierce)
+    }
 }
 
 /// A complete route: idle from `start` to the first pierce point, cut, idle to the next, …, and
@@ -137,35 +172,117 @@ pub enum RouteError {
         /// Step at which that is cut.
         outer_step: usize,
     },
+    /// The first step is entered by a link, but there is no previous cut to link from.
+    #[error("step 0 is entered by a tool-on link, but no contour was cut before it")]
+    LinkWithoutPrevious,
+    /// A link joins two contours that are not siblings in one scrap region (the sheet or a
+    /// hole): it would cut through a part.
+    #[error(
+        "step {step} links {from:?} to {to:?}, which do not lie side by side in one scrap region"
+    )]
+    LinkNotBetweenSiblings {
+        /// Index of the linked step.
+        step: usize,
+        /// The contour the link leaves.
+        from: ContourRef,
+        /// The contour the link enters.
+        to: ContourRef,
+    },
+    /// A link crosses a contour (a part or scrap boundary) away from its two end points.
+    #[error("the link into step {step} crosses contour {contour:?} at ({x}, {y})")]
+    LinkCrossesContour {
+        /// Index of the linked step.
+        step: usize,
+        /// The contour crossed.
+        contour: ContourRef,
+        /// Where, x.
+        x: f64,
+        /// Where, y.
+        y: f64,
+    },
+    /// A piece of a link lies outside the scrap region of the contours it joins (inside a
+    /// part, or outside the hole they sit in).
+    #[error("the link into step {step} leaves its scrap region near ({x}, {y})")]
+    LinkLeavesScrap {
+        /// Index of the linked step.
+        step: usize,
+        /// A point of the link outside the region, x.
+        x: f64,
+        /// Its y.
+        y: f64,
+    },
 }
 
 impl Route {
-    /// The points the tool head idles through: start, every pierce point, finish (if any).
+    /// The points the head passes between contours: start, every step's pierce point (where
+    /// its cut starts), finish (if any). Consecutive points are joined by idle moves except
+    /// where a step is entered by a link (see [`Route::idle_moves`]).
     pub fn idle_points(&self) -> impl Iterator<Item = Point> + '_ {
         std::iter::once(self.start)
             .chain(self.steps.iter().map(|s| s.pierce_point))
             .chain(self.finish)
     }
 
-    /// Total length of the straight idle moves start → pierce → … → pierce → finish, mm.
+    /// The straight idle moves `(from, to)`: to every pierced step from where the head stands
+    /// (the start, or the previous step's pierce point, where its cut ends), and to the finish.
+    pub fn idle_moves(&self) -> Vec<(Point, Point)> {
+        let mut moves = Vec::with_capacity(self.steps.len() + 1);
+        let mut at = self.start;
+        for s in &self.steps {
+            if s.is_pierced() {
+                moves.push((at, s.pierce_point));
+            }
+            at = s.pierce_point;
+        }
+        if let Some(finish) = self.finish {
+            moves.push((at, finish));
+        }
+        moves
+    }
+
+    /// Total length of the straight idle moves, mm.
     pub fn idle_length(&self) -> f64 {
-        let points: Vec<Point> = self.idle_points().collect();
-        points.windows(2).map(|w| w[0].distance(w[1])).sum()
+        self.idle_moves().iter().map(|(a, b)| a.distance(*b)).sum()
     }
 
-    /// Number of pierces (one per step).
+    /// The whole polyline of the link into step `step`: the previous step's pierce point, the
+    /// link's corners, this step's pierce point. `None` when the step is pierced, does not
+    /// exist, or is the first step.
+    pub fn link_path(&self, step: usize) -> Option<Vec<Point>> {
+        let s = self.steps.get(step)?;
+        let Entry::Link(corners) = &s.entry else {
+            return None;
+        };
+        let previous = self.steps.get(step.checked_sub(1)?)?;
+        let mut path = Vec::with_capacity(corners.len() + 2);
+        path.push(previous.pierce_point);
+        path.extend_from_slice(corners);
+        path.push(s.pierce_point);
+        Some(path)
+    }
+
+    /// Total length of the tool-on links between chained contours, mm.
+    pub fn link_length(&self) -> f64 {
+        (0..self.steps.len())
+            .filter_map(|i| self.link_path(i))
+            .map(|p| p.windows(2).map(|w| w[0].distance(w[1])).sum::<f64>())
+            .sum()
+    }
+
+    /// Number of pierces: one per step not entered by a link.
     pub fn pierce_count(&self) -> usize {
-        self.steps.len()
+        self.steps.iter().filter(|s| s.is_pierced()).count()
     }
 
-    /// Total cut length: the perimeters of the contours cut, mm. Unknown contours count 0
-    /// (see [`Route::validate`]).
+    /// Total cut length: the perimeters of the contours cut plus the tool-on links, mm.
+    /// Unknown contours count 0 (see [`Route::validate`]).
     pub fn cut_length(&self, nest: &Nest) -> f64 {
         self.steps
             .iter()
             .filter_map(|s| nest.contour(s.contour))
             .map(|c| c.perimeter())
-            .sum()
+            .sum::<f64>()
+            + self.link_length()
     }
 
     /// Machining time of the route, seconds (formula 1.2).
@@ -187,8 +304,10 @@ impl Route {
     }
 
     /// Every way the route fails the nest (empty when valid): each contour cut exactly once,
-    /// each pierce point within `tolerance` mm of its contour, and inner contours cut before
-    /// every contour containing them.
+    /// each pierce point within `tolerance` mm of its contour, inner contours cut before
+    /// every contour containing them, and every tool-on link joining two siblings of one scrap
+    /// region (children of the sheet or of one hole) without crossing any contour or leaving
+    /// that region.
     pub fn problems(
         &self,
         nest: &Nest,
@@ -250,6 +369,11 @@ impl Route {
                 }
             }
         }
+        for step in 0..self.steps.len() {
+            if let Entry::Link(_) = self.steps[step].entry {
+                check_link(self, step, nest, forest, tolerance, &mut problems);
+            }
+        }
         problems
     }
 
@@ -260,6 +384,107 @@ impl Route {
         match self.problems(nest, &forest, tolerance).into_iter().next() {
             Some(e) => Err(e),
             None => Ok(()),
+        }
+    }
+}
+
+/// Whether the children of `parent` lie in scrap: children of the sheet (`None`) and of holes
+/// (odd depth: a part's outer contour has even depth, its holes odd). Children of a part's
+/// outer contour are its holes, which lie in material.
+pub fn is_scrap_region(forest: &ContainmentForest, parent: Option<ContourRef>) -> bool {
+    match parent {
+        None => true,
+        Some(p) => forest.depth(p).is_some_and(|d| d % 2 == 1),
+    }
+}
+
+/// Whether `p` lies in the scrap region of `parent` (see [`is_scrap_region`]): inside the
+/// parent (or anywhere for the sheet) and outside every child of the parent.
+pub fn in_scrap_region(
+    nest: &Nest,
+    forest: &ContainmentForest,
+    parent: Option<ContourRef>,
+    p: Point,
+) -> bool {
+    let inside_parent = match parent {
+        None => true,
+        Some(r) => nest.contour(r).is_some_and(|c| c.contains(p)),
+    };
+    let children: &[ContourRef] = match parent {
+        None => forest.roots(),
+        Some(r) => forest.children(r),
+    };
+    inside_parent
+        && !children
+            .iter()
+            .any(|&c| nest.contour(c).is_some_and(|c| c.contains(p)))
+}
+
+/// The checks of one link (see [`Route::problems`]). Independent of how links are built: it
+/// tests the polyline against every contour of the nest.
+fn check_link(
+    route: &Route,
+    step: usize,
+    nest: &Nest,
+    forest: &ContainmentForest,
+    tolerance: f64,
+    problems: &mut Vec<RouteError>,
+) {
+    let Some(path) = route.link_path(step) else {
+        problems.push(RouteError::LinkWithoutPrevious);
+        return;
+    };
+    let (from, to) = (route.steps[step - 1].contour, route.steps[step].contour);
+    let (Some(_), Some(_)) = (forest.index_of(from), forest.index_of(to)) else {
+        return; // reported as an unknown contour
+    };
+    let parent = forest.parent(to);
+    if forest.parent(from) != parent || from == to || !is_scrap_region(forest, parent) {
+        problems.push(RouteError::LinkNotBetweenSiblings { step, from, to });
+        return;
+    }
+    let (first, last) = (path[0], path[path.len() - 1]);
+    let at_an_end = |x: Point| x.distance(first) <= tolerance || x.distance(last) <= tolerance;
+    for w in path.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        if !(a.is_finite() && b.is_finite()) {
+            problems.push(RouteError::LinkLeavesScrap {
+                step,
+                x: b.x,
+                y: b.y,
+            });
+            return;
+        }
+        let reach = crate::BoundingBox::from_corners(a, b).expanded(tolerance);
+        for r in nest.contour_refs() {
+            let Some(c) = nest.contour(r) else { continue };
+            if !c.bounding_box().intersects(&reach) {
+                continue;
+            }
+            if let Some(x) = c
+                .segment_crossings(a, b)
+                .into_iter()
+                .find(|x| !at_an_end(x.point))
+            {
+                problems.push(RouteError::LinkCrossesContour {
+                    step,
+                    contour: r,
+                    x: x.point.x,
+                    y: x.point.y,
+                });
+                return;
+            }
+        }
+        // No crossing inside the piece, so one interior point tells on which side of every
+        // contour the whole piece lies.
+        let probe = a.midpoint(b);
+        if a.distance(b) > tolerance && !in_scrap_region(nest, forest, parent, probe) {
+            problems.push(RouteError::LinkLeavesScrap {
+                step,
+                x: probe.x,
+                y: probe.y,
+            });
+            return;
         }
     }
 }

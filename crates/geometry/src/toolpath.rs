@@ -2,8 +2,8 @@
 //! and the exporters consume.
 //!
 //! A [`Route`] says *which* contour is cut where; a [`Toolpath`] spells out *how* the head moves:
-//! straight idle moves, pierces, and every span of every contour from the pierce point round to
-//! the pierce point again. [`ToolClock`] puts the moves on the machine's time axis (idle and cut
+//! straight idle moves, pierces, tool-on links between chained contours, and every span of
+//! every contour from the pierce point round to the pierce point again. [`ToolClock`] puts the moves on the machine's time axis (idle and cut
 //! speeds, pierce time) so a viewer can ask where the head is at any moment.
 
 use crate::{MachineParameters, Nest, Point, Route, RouteError, Span};
@@ -25,12 +25,16 @@ pub enum ToolMove {
         /// Index of the route step this pierce starts.
         step: usize,
     },
-    /// Tool on: one span (segment or arc) of the contour of a route step, in cutting direction.
+    /// Tool on: one span (segment or arc) of the contour of a route step, in cutting direction,
+    /// or one straight piece of the tool-on link that enters the step (chain cutting).
     Cut {
         /// Index of the route step.
         step: usize,
-        /// The piece of the contour.
+        /// The piece of the contour or link.
         span: Span,
+        /// A piece of the link between two chained contours rather than of a contour: cut like
+        /// any other move (the torch is on), drawn apart by viewers.
+        link: bool,
     },
 }
 
@@ -87,7 +91,8 @@ impl ToolMove {
 }
 
 /// Every move of a route in order: idle to the first pierce point, pierce, cut the contour span by
-/// span back to the pierce point, idle to the next, …, idle to the finish point.
+/// span back to the pierce point, idle to the next (or cut the link to it, for a step entered by
+/// a link: no idle move and no pierce), …, idle to the finish point.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Toolpath {
     /// Where the head starts.
@@ -115,16 +120,31 @@ impl Toolpath {
                     step,
                     contour: cut.contour,
                 })?;
-            if at != cut.pierce_point {
-                moves.push(ToolMove::Idle {
-                    from: at,
-                    to: cut.pierce_point,
-                });
+            match route.link_path(step) {
+                Some(link) => {
+                    for w in link.windows(2) {
+                        if w[0].distance(w[1]) > MIN_PIECE_LENGTH {
+                            moves.push(ToolMove::Cut {
+                                step,
+                                span: Span::line(w[0], w[1]),
+                                link: true,
+                            });
+                        }
+                    }
+                }
+                None => {
+                    if at != cut.pierce_point {
+                        moves.push(ToolMove::Idle {
+                            from: at,
+                            to: cut.pierce_point,
+                        });
+                    }
+                    moves.push(ToolMove::Pierce {
+                        at: cut.pierce_point,
+                        step,
+                    });
+                }
             }
-            moves.push(ToolMove::Pierce {
-                at: cut.pierce_point,
-                step,
-            });
             at = cut.pierce_point;
             let Some(entry) = contour.nearest_point(cut.pierce_point) else {
                 continue;
@@ -133,7 +153,11 @@ impl Toolpath {
             let (i, t) = (entry.position.span, entry.position.t);
             let mut push = |span: Span| {
                 if span.length() > MIN_PIECE_LENGTH {
-                    moves.push(ToolMove::Cut { step, span });
+                    moves.push(ToolMove::Cut {
+                        step,
+                        span,
+                        link: false,
+                    });
                 }
             };
             // Open the contour at the entry: the rest of span i, the spans after it round the
@@ -167,7 +191,17 @@ impl Toolpath {
             .sum()
     }
 
-    /// Total length cut with the tool on, mm.
+    /// Total length of the tool-on links between chained contours, mm (part of
+    /// [`Toolpath::cut_length`]).
+    pub fn link_length(&self) -> f64 {
+        self.moves
+            .iter()
+            .filter(|m| matches!(m, ToolMove::Cut { link: true, .. }))
+            .map(ToolMove::length)
+            .sum()
+    }
+
+    /// Total length cut with the tool on (contours and links), mm.
     pub fn cut_length(&self) -> f64 {
         self.moves
             .iter()
@@ -271,7 +305,7 @@ impl ToolClock {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{Contour, ContourRef, CutStep, Part, Vertex};
+    use crate::{Contour, ContourRef, CutStep, Entry, Part, Vertex};
 
     fn plate() -> (Nest, Route) {
         let square = Contour::new(vec![
@@ -291,20 +325,20 @@ mod tests {
         let route = Route {
             start: Point::new(0.0, -10.0),
             steps: vec![
-                CutStep {
-                    contour: ContourRef {
+                CutStep::pierced(
+                    ContourRef {
                         part: 0,
                         contour: 1,
                     },
-                    pierce_point: Point::new(7.0, 5.0),
-                },
-                CutStep {
-                    contour: ContourRef {
+                    Point::new(7.0, 5.0),
+                ),
+                CutStep::pierced(
+                    ContourRef {
                         part: 0,
                         contour: 0,
                     },
-                    pierce_point: Point::new(10.0, 5.0),
-                },
+                    Point::new(10.0, 5.0),
+                ),
             ],
             finish: Some(Point::new(0.0, -10.0)),
         };
@@ -378,5 +412,84 @@ mod tests {
             Toolpath::new(&route, &nest),
             Err(RouteError::UnknownContour { step: 0, .. })
         ));
+    }
+
+    #[test]
+    fn a_linked_step_is_cut_from_the_previous_exit_without_idle_or_pierce() {
+        let square = |x: f64| {
+            Contour::new(vec![
+                Vertex::line(x, 0.0),
+                Vertex::line(x, 10.0),
+                Vertex::line(x + 10.0, 10.0),
+                Vertex::line(x + 10.0, 0.0),
+            ])
+        };
+        let nest = Nest {
+            sheet: None,
+            parts: vec![
+                Part {
+                    name: "a".into(),
+                    contours: vec![square(0.0)],
+                },
+                Part {
+                    name: "b".into(),
+                    contours: vec![square(12.0)],
+                },
+            ],
+        };
+        let a = ContourRef {
+            part: 0,
+            contour: 0,
+        };
+        let b = ContourRef {
+            part: 1,
+            contour: 0,
+        };
+        let route = Route {
+            start: Point::new(0.0, -10.0),
+            steps: vec![
+                CutStep::pierced(a, Point::new(10.0, 5.0)),
+                CutStep {
+                    contour: b,
+                    pierce_point: Point::new(12.0, 5.0),
+                    entry: Entry::Link(vec![Point::new(11.0, 5.0)]),
+                },
+            ],
+            finish: None,
+        };
+        route.validate(&nest, 1e-9).unwrap();
+        let path = Toolpath::new(&route, &nest).unwrap();
+        assert_eq!(path.pierce_count(), 1);
+        assert_eq!(route.pierce_count(), 1);
+        assert!((path.link_length() - 2.0).abs() < 1e-12);
+        assert!((path.cut_length() - 82.0).abs() < 1e-9);
+        assert!((route.cut_length(&nest) - 82.0).abs() < 1e-9);
+        assert!((path.idle_length() - route.idle_length()).abs() < 1e-12);
+        let links = path
+            .moves
+            .iter()
+            .filter(|m| {
+                matches!(
+                    m,
+                    ToolMove::Cut {
+                        link: true,
+                        step: 1,
+                        ..
+                    }
+                )
+            })
+            .count();
+        assert_eq!(links, 2, "one piece per corner-to-corner stretch");
+        let machine = MachineParameters::default();
+        let clock = ToolClock::new(&path, &machine);
+        assert!((clock.total() - route.time(&nest, &machine)).abs() < 1e-9);
+        let mut at = path.start;
+        for m in &path.moves {
+            assert!(
+                m.point_at(0.0).distance(at) < 1e-9,
+                "{m:?} starts away from {at:?}"
+            );
+            at = m.end();
+        }
     }
 }

@@ -23,7 +23,7 @@
 //! ```
 #![deny(missing_docs)]
 
-use cutroute_geometry::{Nest, Point, Route};
+use cutroute_geometry::{MachineParameters, Nest, Point, Route};
 use serde::{Deserialize, Serialize};
 
 /// Identifies one job for the lifetime of a worker; chosen by the sender, echoed in every answer.
@@ -128,15 +128,19 @@ pub enum SolverKind {
     Heuristic,
     /// Discretised pierce points, exact dynamic programming with lower bounds.
     Exact,
+    /// CCP-Relax, then chain cutting: neighbouring contours of one scrap region cut from one
+    /// pierce, joined by tool-on links that pay under the machine's prices.
+    Chain,
 }
 
 impl SolverKind {
     /// Every solver, in the order the UI lists them.
-    pub const ALL: [SolverKind; 4] = [
+    pub const ALL: [SolverKind; 5] = [
         SolverKind::NearestNeighbour,
         SolverKind::Ccp,
         SolverKind::Heuristic,
         SolverKind::Exact,
+        SolverKind::Chain,
     ];
 
     /// The short name used on the command line and in links.
@@ -146,6 +150,18 @@ impl SolverKind {
             SolverKind::Ccp => "ccp",
             SolverKind::Heuristic => "heuristic",
             SolverKind::Exact => "exact",
+            SolverKind::Chain => "chain",
+        }
+    }
+
+    /// What the UI shows for the solver.
+    pub fn label(self) -> &'static str {
+        match self {
+            SolverKind::NearestNeighbour => "Nearest neighbour (baseline)",
+            SolverKind::Ccp => "Continuous CCP-Relax",
+            SolverKind::Heuristic => "Discrete heuristic (ALNS)",
+            SolverKind::Exact => "Discrete exact with lower bound",
+            SolverKind::Chain => "Chain cutting (CCP-Relax + chains)",
         }
     }
 
@@ -166,6 +182,10 @@ pub struct SolverParams {
     pub discretisation_step_mm: f64,
     /// An upper bound known in advance (the exact solver prunes with it).
     pub initial_upper_bound: Option<f64>,
+    /// Speeds, pierce time and prices of the time and cost model (chain cutting links
+    /// contours when the link costs less than the pierce it saves).
+    #[serde(default)]
+    pub machine: MachineParameters,
 }
 
 impl Default for SolverParams {
@@ -175,6 +195,7 @@ impl Default for SolverParams {
             seed: 1,
             discretisation_step_mm: 50.0,
             initial_upper_bound: None,
+            machine: MachineParameters::default(),
         }
     }
 }
@@ -280,6 +301,7 @@ mod tests {
                         contour: 0,
                     },
                     pierce_point: Point::new(0.0, 0.0),
+                    entry: Default::default(),
                 }],
                 finish: None,
             }),

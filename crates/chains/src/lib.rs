@@ -1,0 +1,733 @@
+//! Chain cutting (Verkhoturov–Tarasenko): post-optimise a cutting route so that sibling
+//! contours lying in one scrap region are cut from a single pierce, joined by tool-on links.
+//!
+//! A pierce costs as much as tens of metres of idle travel; a short tool-on link between two
+//! neighbouring contours costs less than the pierce it saves. A link from contour A to contour
+//! B pays when `C_on·n < C_pt + C_off·d` (n the link's length, d the straight idle distance it
+//! replaces); for a straight link this is the paper's `n < C_pt / (C_on − C_off)`
+//! ([`profitable_link_length`]).
+//!
+//! What [`chain_route`] does, per scrap region (the sheet, or a hole of a part: never the holes
+//! of one part, which lie in material):
+//! 1. groups the region's contours whose straight distance is below the threshold (connected
+//!    components of the "close" graph; the paper's *SelectProfitable*),
+//! 2. orders each group by an open-path TSP from the point the tool comes from to the point it
+//!    goes to next (exact Held–Karp up to [`ChainOptions::exact_order_limit`] members, 2-opt and
+//!    Or-opt beyond), weighing links at `C_on` and the idle moves at its ends at `C_off`,
+//! 3. places the pierce points to minimise that weighted length (the paper's midpoint rule as a
+//!    start, then coordinate descent, each point the exact minimiser on its contour's spans),
+//!    then refines them against the true link costs (a chain leaves a contour where it entered
+//!    it, so the contour itself is often the obstacle: corners are tried),
+//! 4. routes every link on the shortest path inside the region that crosses no contour
+//!    (visibility graph over the obstacles' corners and arc tangent points), keeping a link only
+//!    when it pays and cutting the chain otherwise,
+//! 5. moves the chain to where its last member stood (every member's inner contours are cut
+//!    earlier there, and the parent still after) or, if cheaper, to the place in the window
+//!    between the members' inner contours and their parent where the chain is the smallest
+//!    idle detour, and keeps the change only if the route's cost drops.
+//!
+//! The printed pseudo-code's defects (`../shared/spec/chain-cutting-and-ccp-paper.md` §A.6.3)
+//! are avoided by construction: the route is rebuilt from scratch for each group (no growing
+//! `resultPath`), groups are processed once each instead of by a moving index, the link test
+//! uses the obstacle-avoiding length between consecutive chain members only, the tool comes from
+//! the last non-member before the chain, and only children of the sheet or of a hole are chained.
+//!
+//! ```
+//! use cutroute_chains::{chain_route, ChainOptions};
+//! use cutroute_geometry::{Contour, ContourRef, CutStep, Nest, Part, Point, Route, Vertex};
+//! // Three 10 mm squares 5 mm apart on the sheet, each pierced on its own.
+//! let square = |x: f64| Contour::new(vec![
+//!     Vertex::line(x, 0.0), Vertex::line(x, 10.0), Vertex::line(x + 10.0, 10.0), Vertex::line(x + 10.0, 0.0),
+//! ]);
+//! let nest = Nest { sheet: None, parts: (0..3).map(|i| Part {
+//!     name: format!("p{i}"), contours: vec![square(15.0 * i as f64)] }).collect() };
+//! let route = Route {
+//!     start: Point::new(-10.0, 5.0),
+//!     steps: (0..3).map(|i| CutStep::pierced(
+//!         ContourRef { part: i, contour: 0 }, Point::new(15.0 * i as f64, 5.0))).collect(),
+//!     finish: None,
+//! };
+//! let chained = chain_route(&nest, &route, &ChainOptions::default()).unwrap();
+//! assert_eq!(chained.route.pierce_count(), 1);
+//! // 5 mm from the first square to a corner of the middle one, then over its top to the
+//! // third: about 5 + 15 mm (the middle square is left where it was entered).
+//! assert!((chained.route.link_length() - 20.0).abs() < 0.5);
+//! chained.route.validate(&nest, 1e-6).unwrap();
+//! assert!(chained.report.cost_after < chained.report.cost_before);
+//! ```
+#![deny(missing_docs)]
+
+mod order;
+mod region;
+
+use cutroute_geometry::{
+    is_scrap_region, BoundingBox, ContainmentForest, Contour, ContourRef, CutStep, Entry,
+    MachineParameters, Nest, Point, Route, RouteError,
+};
+use thiserror::Error;
+
+use region::Region;
+
+/// Settings of [`chain_route`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct ChainOptions {
+    /// Prices (and speeds, for the reported time) of the cost model; links pay by these.
+    pub machine: MachineParameters,
+    /// Chains of up to this many contours are ordered exactly (Held–Karp, at most 16).
+    pub exact_order_limit: usize,
+    /// How far (mm) link corners keep from the contours they bend round.
+    pub clearance_mm: f64,
+    /// Rounds of pierce-point coordinate descent per chain (straight-line lengths).
+    pub descent_rounds: usize,
+    /// Rounds of refinement against true (obstacle-avoiding) link lengths, trying contour
+    /// corners as pierce points; 0 skips it.
+    pub refinement_rounds: usize,
+}
+
+/// Corners of a contour tried per refinement round (those nearest its chain neighbours).
+const REFINEMENT_CANDIDATES: usize = 12;
+
+impl Default for ChainOptions {
+    fn default() -> Self {
+        ChainOptions {
+            machine: MachineParameters::default(),
+            exact_order_limit: 10,
+            clearance_mm: 0.05,
+            descent_rounds: 4,
+            refinement_rounds: 2,
+        }
+    }
+}
+
+/// Why a route cannot be chained.
+#[derive(Clone, Debug, PartialEq, Error)]
+pub enum ChainError {
+    /// The route given is not a valid route of the nest.
+    #[error("the route to chain is invalid: {0}")]
+    InvalidRoute(RouteError),
+    /// A price is negative or not a number.
+    #[error("prices must be finite and non-negative (idle {idle}, cut {cut}, pierce {pierce})")]
+    InvalidPrices {
+        /// Price per metre of idle travel.
+        idle: f64,
+        /// Price per metre of cut.
+        cut: f64,
+        /// Price per pierce.
+        pierce: f64,
+    },
+}
+
+/// What chaining changed.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ChainReport {
+    /// Pierces of the route given.
+    pub pierces_before: usize,
+    /// Pierces of the chained route.
+    pub pierces_after: usize,
+    /// Chains of two or more contours in the result.
+    pub chains: usize,
+    /// Total length of the tool-on links, mm.
+    pub link_length: f64,
+    /// Idle length before and after, mm.
+    pub idle_before: f64,
+    /// Idle length after, mm.
+    pub idle_after: f64,
+    /// Cost of the route given (formula 1.3, perimeters included).
+    pub cost_before: f64,
+    /// Cost of the chained route.
+    pub cost_after: f64,
+    /// Machine time of the route given, s.
+    pub time_before: f64,
+    /// Machine time of the chained route, s.
+    pub time_after: f64,
+}
+
+/// The chained route and what changed.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Chained {
+    /// The route: chains are runs of steps entered by [`Entry::Link`].
+    pub route: Route,
+    /// Pierces saved, cost and time before and after.
+    pub report: ChainReport,
+}
+
+/// The paper's condValue in mm: a straight tool-on link shorter than this costs less than the
+/// pierce plus idle move it replaces, `C_pt / (C_on − C_off)` with prices per metre. Infinite
+/// when cutting is no dearer than idling.
+pub fn profitable_link_length(machine: &MachineParameters) -> f64 {
+    let extra = machine.cut_price_per_metre - machine.idle_price_per_metre;
+    if extra > 0.0 {
+        1000.0 * machine.pierce_price / extra
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// One material of the paper's Table 1 (waterjet prices): name and prices per metre / pierce.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Material {
+    /// Name and thickness.
+    pub name: &'static str,
+    /// Idle travel, per metre (C_off).
+    pub idle_price_per_metre: f64,
+    /// Cut, per metre (C_on).
+    pub cut_price_per_metre: f64,
+    /// Pierce (C_pt).
+    pub pierce_price: f64,
+}
+
+impl Material {
+    /// `machine` with this material's prices.
+    pub fn priced(&self, machine: &MachineParameters) -> MachineParameters {
+        MachineParameters {
+            idle_price_per_metre: self.idle_price_per_metre,
+            cut_price_per_metre: self.cut_price_per_metre,
+            pierce_price: self.pierce_price,
+            ..*machine
+        }
+    }
+}
+
+/// The three materials of Table 1 of Verkhoturov–Tarasenko.
+pub const TABLE1_MATERIALS: [Material; 3] = [
+    Material {
+        name: "granite 30 mm",
+        idle_price_per_metre: 0.1,
+        cut_price_per_metre: 30.0,
+        pierce_price: 5.0,
+    },
+    Material {
+        name: "steel 20 mm",
+        idle_price_per_metre: 0.1,
+        cut_price_per_metre: 35.0,
+        pierce_price: 7.0,
+    },
+    Material {
+        name: "marble 30 mm",
+        idle_price_per_metre: 0.1,
+        cut_price_per_metre: 20.0,
+        pierce_price: 5.0,
+    },
+];
+
+/// Chain the contours of `route` (any valid route of `nest`; links it already has are
+/// dropped and rebuilt). The result is valid whenever the input is, and never costs more.
+pub fn chain_route(
+    nest: &Nest,
+    route: &Route,
+    options: &ChainOptions,
+) -> Result<Chained, ChainError> {
+    let m = &options.machine;
+    let prices = [
+        m.idle_price_per_metre,
+        m.cut_price_per_metre,
+        m.pierce_price,
+    ];
+    if prices.iter().any(|p| !(p.is_finite() && *p >= 0.0)) {
+        return Err(ChainError::InvalidPrices {
+            idle: prices[0],
+            cut: prices[1],
+            pierce: prices[2],
+        });
+    }
+    let forest = nest.containment_forest();
+    let scale = nest_scale(nest);
+    let tolerance = 1e-6 * scale;
+    if let Some(e) = route.problems(nest, &forest, tolerance).into_iter().next() {
+        return Err(ChainError::InvalidRoute(e));
+    }
+    let mut current = Route {
+        steps: route
+            .steps
+            .iter()
+            .map(|s| CutStep::pierced(s.contour, s.pierce_point))
+            .collect(),
+        ..route.clone()
+    };
+    let mut current_cost = current.cost(nest, m);
+    let context = Context {
+        nest,
+        forest: &forest,
+        machine: m,
+        options,
+        threshold: profitable_link_length(m),
+        scale,
+    };
+    for (parent, siblings) in scrap_regions(nest, &forest) {
+        if siblings.len() < 2 {
+            continue;
+        }
+        // Far stricter than the checker's tolerance, so every link the region accepts passes
+        // `Route::validate` (a crossing near but not at a link's end is a crossing).
+        let region = Region::new(nest, parent, &siblings, options.clearance_mm, 1e-9 * scale);
+        for group in close_groups(nest, &siblings, context.threshold) {
+            if group.len() < 2 {
+                continue;
+            }
+            let candidate = context.chain_group(&current, &group, &region);
+            let cost = candidate.cost(nest, m);
+            if cost < current_cost - 1e-12 * current_cost.abs().max(1.0) {
+                current = candidate;
+                current_cost = cost;
+            }
+        }
+    }
+    let chains = current
+        .steps
+        .windows(2)
+        .filter(|w| w[0].is_pierced() && !w[1].is_pierced())
+        .count();
+    let report = ChainReport {
+        pierces_before: route.pierce_count(),
+        pierces_after: current.pierce_count(),
+        chains,
+        link_length: current.link_length(),
+        idle_before: route.idle_length(),
+        idle_after: current.idle_length(),
+        cost_before: route.cost(nest, m),
+        cost_after: current_cost,
+        time_before: route.time(nest, m),
+        time_after: current.time(nest, m),
+    };
+    Ok(Chained {
+        route: current,
+        report,
+    })
+}
+
+/// The scrap regions with their contours: the sheet with the top-level contours, and every
+/// hole with the parts placed in it.
+fn scrap_regions(
+    nest: &Nest,
+    forest: &ContainmentForest,
+) -> Vec<(Option<ContourRef>, Vec<ContourRef>)> {
+    let mut regions = vec![(None, forest.roots().to_vec())];
+    for r in nest.contour_refs() {
+        if is_scrap_region(forest, Some(r)) && !forest.children(r).is_empty() {
+            regions.push((Some(r), forest.children(r).to_vec()));
+        }
+    }
+    regions
+}
+
+/// Connected components of the graph joining contours closer than `threshold` (straight
+/// distance: a link is never shorter, so farther pairs can never pay).
+fn close_groups(nest: &Nest, members: &[ContourRef], threshold: f64) -> Vec<Vec<ContourRef>> {
+    let boxes: Vec<BoundingBox> = members
+        .iter()
+        .map(|&r| {
+            nest.contour(r)
+                .map_or(BoundingBox::EMPTY, |c| c.bounding_box())
+        })
+        .collect();
+    let mut parent: Vec<usize> = (0..members.len()).collect();
+    fn find(parent: &mut [usize], mut i: usize) -> usize {
+        while parent[i] != i {
+            parent[i] = parent[parent[i]];
+            i = parent[i];
+        }
+        i
+    }
+    // Sweep by left edge so only boxes overlapping in x (within the threshold) are compared.
+    let mut by_left: Vec<usize> = (0..members.len())
+        .filter(|&i| !boxes[i].is_empty())
+        .collect();
+    by_left.sort_by(|&a, &b| boxes[a].min.x.total_cmp(&boxes[b].min.x));
+    for (k, &i) in by_left.iter().enumerate() {
+        for &j in &by_left[k + 1..] {
+            if boxes[j].min.x - boxes[i].max.x >= threshold {
+                break;
+            }
+            if box_distance(&boxes[i], &boxes[j]) >= threshold
+                || find(&mut parent, i) == find(&mut parent, j)
+            {
+                continue;
+            }
+            let (Some(a), Some(b)) = (nest.contour(members[i]), nest.contour(members[j])) else {
+                continue;
+            };
+            if contour_distance(a, b) < threshold {
+                let (ri, rj) = (find(&mut parent, i), find(&mut parent, j));
+                parent[ri] = rj;
+            }
+        }
+    }
+    let mut groups: std::collections::BTreeMap<usize, Vec<ContourRef>> = Default::default();
+    for (i, &member) in members.iter().enumerate() {
+        let root = find(&mut parent, i);
+        groups.entry(root).or_default().push(member);
+    }
+    groups.into_values().collect()
+}
+
+fn box_distance(a: &BoundingBox, b: &BoundingBox) -> f64 {
+    let dx = (a.min.x - b.max.x).max(b.min.x - a.max.x).max(0.0);
+    let dy = (a.min.y - b.max.y).max(b.min.y - a.max.y).max(0.0);
+    dx.hypot(dy)
+}
+
+/// Distance between two disjoint contours: from every vertex and span middle of each to the
+/// other. Exact for straight spans (two segments are nearest at an end point of one of them),
+/// within the arcs' sagitta between samples otherwise. Spans whose box is farther than the best
+/// distance so far are skipped.
+fn contour_distance(a: &Contour, b: &Contour) -> f64 {
+    let boxed = |c: &Contour| -> Vec<(cutroute_geometry::Span, BoundingBox)> {
+        c.spans().map(|s| (s, s.bounding_box())).collect()
+    };
+    let (spans_a, spans_b) = (boxed(a), boxed(b));
+    let mut best = f64::INFINITY;
+    for (from, to) in [(&spans_a, &spans_b), (&spans_b, &spans_a)] {
+        for (s, _) in from.iter() {
+            for p in [s.start, s.point_at(0.5)] {
+                for (t, bbox) in to.iter() {
+                    if point_box_distance(p, bbox) < best {
+                        best = best.min(t.distance_to(p));
+                    }
+                }
+            }
+        }
+    }
+    best
+}
+
+fn point_box_distance(p: Point, b: &BoundingBox) -> f64 {
+    let dx = (b.min.x - p.x).max(p.x - b.max.x).max(0.0);
+    let dy = (b.min.y - p.y).max(p.y - b.max.y).max(0.0);
+    dx.hypot(dy)
+}
+
+fn nest_scale(nest: &Nest) -> f64 {
+    let b = nest.bounding_box();
+    ((b.max.x - b.min.x).abs() + (b.max.y - b.min.y).abs()).max(1.0)
+}
+
+/// What every group needs.
+struct Context<'a> {
+    nest: &'a Nest,
+    forest: &'a ContainmentForest,
+    machine: &'a MachineParameters,
+    options: &'a ChainOptions,
+    /// [`profitable_link_length`], mm.
+    threshold: f64,
+    scale: f64,
+}
+
+impl Context<'_> {
+    /// Price of a mm of cut and of idle travel.
+    fn per_mm(&self) -> (f64, f64) {
+        (
+            self.machine.cut_price_per_metre * 1e-3,
+            self.machine.idle_price_per_metre * 1e-3,
+        )
+    }
+
+    /// Longest link (mm) that pays instead of a pierce plus an idle move of `straight` mm.
+    fn link_reach(&self, straight: f64) -> f64 {
+        let (on, off) = self.per_mm();
+        let reach = if on > 0.0 {
+            (self.machine.pierce_price + off * straight) / on
+        } else {
+            f64::INFINITY
+        };
+        // Beyond the nest's size a detour is never the shortest way round anything.
+        reach.min(straight + 2.0 * self.scale)
+    }
+
+    /// `current` with `group` cut as one chain where its last member stood.
+    fn chain_group(&self, current: &Route, group: &[ContourRef], region: &Region) -> Route {
+        let is_member = |c: ContourRef| group.contains(&c);
+        let last = current
+            .steps
+            .iter()
+            .rposition(|s| is_member(s.contour))
+            .unwrap_or(0);
+        let rest: Vec<CutStep> = current
+            .steps
+            .iter()
+            .filter(|s| !is_member(s.contour))
+            .cloned()
+            .collect();
+        // The paper puts the chain where its last member stood ...
+        let paper_at = current.steps[..last]
+            .iter()
+            .filter(|s| !is_member(s.contour))
+            .count();
+        // ... but any place after every member's inner contours and before their parent is
+        // feasible: also try the one where the chain's box is the smallest idle detour.
+        let after_inner = rest
+            .iter()
+            .rposition(|s| self.forest.ancestors(s.contour).any(is_member))
+            .map_or(0, |i| i + 1);
+        let parent = self.forest.parent(group[0]);
+        let before_parent = parent
+            .and_then(|p| rest.iter().position(|s| s.contour == p))
+            .unwrap_or(rest.len());
+        let area = group
+            .iter()
+            .filter_map(|&r| self.nest.contour(r))
+            .fold(BoundingBox::EMPTY, |b, c| b.union(c.bounding_box()));
+        let detour = |k: usize| {
+            let a = if k > 0 {
+                rest[k - 1].pierce_point
+            } else {
+                current.start
+            };
+            match rest.get(k).map(|s| s.pierce_point).or(current.finish) {
+                Some(b) => {
+                    point_box_distance(a, &area) + point_box_distance(b, &area) - a.distance(b)
+                }
+                None => point_box_distance(a, &area),
+            }
+        };
+        let nearest_at = (after_inner..=before_parent.max(after_inner))
+            .min_by(|&a, &b| detour(a).total_cmp(&detour(b)))
+            .unwrap_or(paper_at);
+        let mut best: Option<(f64, Route)> = None;
+        for k in [paper_at, nearest_at] {
+            if best.is_some() && k == paper_at {
+                continue;
+            }
+            let route = self.chain_at(current, group, &rest, k, region);
+            let cost = route.cost(self.nest, self.machine);
+            if best.as_ref().is_none_or(|(c, _)| cost < *c) {
+                best = Some((cost, route));
+            }
+        }
+        best.map_or_else(|| current.clone(), |(_, r)| r)
+    }
+
+    /// `current` with `group` cut as one chain, inserted into `rest` (the other steps) at
+    /// `insert_at`.
+    fn chain_at(
+        &self,
+        current: &Route,
+        group: &[ContourRef],
+        rest: &[CutStep],
+        insert_at: usize,
+        region: &Region,
+    ) -> Route {
+        let rest = rest.to_vec();
+        let before = if insert_at > 0 {
+            rest[insert_at - 1].pierce_point
+        } else {
+            current.start
+        };
+        let after = rest
+            .get(insert_at)
+            .map(|s| s.pierce_point)
+            .or(current.finish);
+        let contours: Vec<&Contour> = group
+            .iter()
+            .map(|&r| self.nest.contour(r).expect("validated route"))
+            .collect();
+
+        // Order: open-path TSP over contour-to-contour distances.
+        let (on, off) = self.per_mm();
+        let pierce = self.machine.pierce_price;
+        let n = group.len();
+        let enter: Vec<f64> = contours
+            .iter()
+            .map(|c| off * c.distance_to(before))
+            .collect();
+        let leave: Vec<f64> = contours
+            .iter()
+            .map(|c| after.map_or(0.0, |a| off * c.distance_to(a)))
+            .collect();
+        let boxes: Vec<BoundingBox> = contours.iter().map(|c| c.bounding_box()).collect();
+        let mut between = vec![vec![0.0; n]; n];
+        for i in 0..n {
+            for j in i + 1..n {
+                let near = box_distance(&boxes[i], &boxes[j]);
+                let d = if near < self.threshold {
+                    contour_distance(contours[i], contours[j])
+                } else {
+                    near.max(boxes[i].centre().distance(boxes[j].centre()) * 0.5)
+                };
+                let w = (on * d).min(pierce + off * d);
+                between[i][j] = w;
+                between[j][i] = w;
+            }
+        }
+        let order =
+            order::open_path_order(&enter, &leave, &between, self.options.exact_order_limit);
+        let chain: Vec<&Contour> = order.iter().map(|&i| contours[i]).collect();
+
+        // Pierce points: the paper's rule (nearest to the middle of before–after) as a start,
+        // then coordinate descent on the weighted link + end-idle length.
+        let middle = match after {
+            Some(a) => before.midpoint(a),
+            None => before,
+        };
+        let mut points: Vec<Point> = chain
+            .iter()
+            .map(|c| c.nearest_point(middle).map_or(middle, |p| p.point))
+            .collect();
+        for _ in 0..self.options.descent_rounds {
+            for k in 0..n {
+                let mut terms = Vec::with_capacity(2);
+                terms.push(if k == 0 {
+                    (before, off)
+                } else {
+                    (points[k - 1], on)
+                });
+                if k + 1 < n {
+                    terms.push((points[k + 1], on));
+                } else if let Some(a) = after {
+                    terms.push((a, off));
+                }
+                points[k] = best_point(chain[k], &terms);
+            }
+        }
+
+        // The straight-line model misses that a contour blocks the way out of itself (a chain
+        // leaves a contour where it entered it): refine against true link costs, trying the
+        // contour's corners, where the way round starts shortest.
+        let transition = |a: Point, b: Point| -> f64 {
+            let straight = a.distance(b);
+            let idle = pierce + off * straight;
+            match region.shortest_link(a, b, self.link_reach(straight)) {
+                Some((_, length)) => (on * length).min(idle),
+                None => idle,
+            }
+        };
+        for _ in 0..self.options.refinement_rounds {
+            for k in 0..n {
+                let entering = |x: Point| {
+                    if k == 0 {
+                        off * before.distance(x)
+                    } else {
+                        transition(points[k - 1], x)
+                    }
+                };
+                let leaving = |x: Point| {
+                    if k + 1 < n {
+                        transition(x, points[k + 1])
+                    } else {
+                        after.map_or(0.0, |a| off * x.distance(a))
+                    }
+                };
+                let straight_cost = |x: Point| {
+                    let prev = if k == 0 { before } else { points[k - 1] };
+                    x.distance(prev)
+                        + (if k + 1 < n {
+                            x.distance(points[k + 1])
+                        } else {
+                            0.0
+                        })
+                };
+                let mut candidates: Vec<Point> = chain[k].spans().map(|s| s.start).collect();
+                candidates.sort_by(|a, b| straight_cost(*a).total_cmp(&straight_cost(*b)));
+                candidates.truncate(REFINEMENT_CANDIDATES);
+                // Links are never shorter than straight: a candidate whose straight-line cost
+                // is no better than the best true cost so far cannot win.
+                let at_least = |a: Point, b: Point, end_price: Option<f64>| {
+                    let d = a.distance(b);
+                    match end_price {
+                        Some(price) => price * d,
+                        None => (on * d).min(pierce + off * d),
+                    }
+                };
+                let lower_bound = |x: Point| {
+                    let entering = if k == 0 {
+                        at_least(before, x, Some(off))
+                    } else {
+                        at_least(points[k - 1], x, None)
+                    };
+                    let leaving = if k + 1 < n {
+                        at_least(x, points[k + 1], None)
+                    } else {
+                        after.map_or(0.0, |a| at_least(x, a, Some(off)))
+                    };
+                    entering + leaving
+                };
+                let mut best = (entering(points[k]) + leaving(points[k]), points[k]);
+                for x in candidates {
+                    if lower_bound(x) >= best.0 {
+                        continue;
+                    }
+                    let c = entering(x) + leaving(x);
+                    if c < best.0 - 1e-12 {
+                        best = (c, x);
+                    }
+                }
+                points[k] = best.1;
+            }
+        }
+
+        // Links that pay, on obstacle-avoiding paths; elsewhere the chain is cut.
+        let mut steps = Vec::with_capacity(n);
+        for k in 0..n {
+            let contour = group[order[k]];
+            let entry = if k == 0 {
+                Entry::Pierce
+            } else {
+                let straight = points[k - 1].distance(points[k]);
+                let reach = self.link_reach(straight);
+                match region.shortest_link(points[k - 1], points[k], reach) {
+                    Some((corners, length)) if on * length < pierce + off * straight - 1e-12 => {
+                        Entry::Link(corners)
+                    }
+                    _ => Entry::Pierce,
+                }
+            };
+            steps.push(CutStep {
+                contour,
+                pierce_point: points[k],
+                entry,
+            });
+        }
+        let mut new_steps = rest;
+        new_steps.splice(insert_at..insert_at, steps);
+        Route {
+            steps: new_steps,
+            ..current.clone()
+        }
+    }
+}
+
+/// The point of `contour` minimising `Σ w·|x − a|` over `terms`: every span is sampled, the
+/// best span and its neighbours are searched by golden section (exact on straight spans, where
+/// the sum is convex), and the nearest points to each `a` are candidates too.
+fn best_point(contour: &Contour, terms: &[(Point, f64)]) -> Point {
+    let f = |x: Point| terms.iter().map(|(a, w)| w * x.distance(*a)).sum::<f64>();
+    let spans: Vec<_> = contour.spans().collect();
+    if spans.is_empty() {
+        return terms.first().map_or(Point::default(), |t| t.0);
+    }
+    let mut best = (f64::INFINITY, spans[0].start, 0usize);
+    let consider = |x: Point, span: usize, best: &mut (f64, Point, usize)| {
+        let v = f(x);
+        if v < best.0 {
+            *best = (v, x, span);
+        }
+    };
+    for (i, s) in spans.iter().enumerate() {
+        for t in [0.0, 0.25, 0.5, 0.75] {
+            consider(s.point_at(t), i, &mut best);
+        }
+    }
+    for (a, _) in terms {
+        if let Some(p) = contour.nearest_point(*a) {
+            consider(p.point, p.position.span, &mut best);
+        }
+    }
+    let n = spans.len();
+    let around = best.2;
+    for i in [around, (around + 1) % n, (around + n - 1) % n] {
+        let s = spans[i];
+        let (mut lo, mut hi) = (0.0f64, 1.0f64);
+        let g = |t: f64| f(s.point_at(t));
+        let ratio = (5f64.sqrt() - 1.0) / 2.0;
+        for _ in 0..60 {
+            let m1 = hi - ratio * (hi - lo);
+            let m2 = lo + ratio * (hi - lo);
+            if g(m1) < g(m2) {
+                hi = m2;
+            } else {
+                lo = m1;
+            }
+        }
+        consider(s.point_at(0.5 * (lo + hi)), i, &mut best);
+    }
+    best.1
+}
