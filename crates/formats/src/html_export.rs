@@ -414,34 +414,10 @@ fn samples_json(toolpath: &Toolpath, clock: &ToolClock) -> String {
 }
 
 fn extent(nest: &Nest, toolpath: &Toolpath) -> (Point, Point) {
-    let mut lo = Point::new(f64::INFINITY, f64::INFINITY);
-    let mut hi = Point::new(f64::NEG_INFINITY, f64::NEG_INFINITY);
-    let mut add = |p: Point| {
-        if p.is_finite() {
-            lo = Point::new(lo.x.min(p.x), lo.y.min(p.y));
-            hi = Point::new(hi.x.max(p.x), hi.y.max(p.y));
-        }
-    };
-    for contour in nest
-        .sheet
-        .iter()
-        .chain(&nest.parts)
-        .flat_map(|p| &p.contours)
-    {
-        let b = contour.bounding_box();
-        if !b.is_empty() {
-            add(b.min);
-            add(b.max);
-        }
-    }
-    add(toolpath.start);
-    for m in &toolpath.moves {
-        add(m.end());
-    }
-    if !lo.x.is_finite() {
-        return (Point::new(0.0, 0.0), Point::new(1.0, 1.0));
-    }
-    (lo, hi)
+    crate::svg_export::drawing_extent(
+        nest,
+        std::iter::once(toolpath.start).chain(toolpath.moves.iter().map(ToolMove::end)),
+    )
 }
 
 /// A coordinate with at most three decimals; non-finite values (never in a valid nest) as 0 so

@@ -48,7 +48,10 @@ impl Default for SvgOptions {
 
 /// Renders a nest, and the tool moves when given, as a standalone SVG document.
 pub fn nest_svg(nest: &Nest, moves: Option<&[ToolMove]>, options: &SvgOptions) -> String {
-    let (min, max) = extent(nest, moves.unwrap_or(&[]));
+    let (min, max) = drawing_extent(
+        nest,
+        moves.unwrap_or(&[]).iter().flat_map(|m| [m.from, m.to]),
+    );
     let side = (max.x - min.x).max(max.y - min.y).max(1e-9);
     let margin = side * options.margin;
     let mut doc = Document::new().set("class", "cutroute-nest").set(
@@ -181,8 +184,12 @@ fn route_group(moves: &[ToolMove], marker: f64) -> Group {
     group
 }
 
-/// Bounding box of everything drawn (arc zeniths included).
-fn extent(nest: &Nest, moves: &[ToolMove]) -> (Point, Point) {
+/// Bounding box of everything drawn: the nest's contours (arc zeniths included) and `points`
+/// (the route's); a unit box when nothing finite is drawn.
+pub(crate) fn drawing_extent(
+    nest: &Nest,
+    points: impl IntoIterator<Item = Point>,
+) -> (Point, Point) {
     let mut lo = Point::new(f64::INFINITY, f64::INFINITY);
     let mut hi = Point::new(f64::NEG_INFINITY, f64::NEG_INFINITY);
     let mut add = |p: Point| {
@@ -203,10 +210,7 @@ fn extent(nest: &Nest, moves: &[ToolMove]) -> (Point, Point) {
             add(b.max);
         }
     }
-    for m in moves {
-        add(m.from);
-        add(m.to);
-    }
+    points.into_iter().for_each(add);
     if !lo.x.is_finite() {
         return (Point::default(), Point::new(1.0, 1.0));
     }
