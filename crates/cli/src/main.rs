@@ -456,12 +456,7 @@ fn solved_route(
     solver_name: &str,
     params: SolverParams,
 ) -> Result<Route, String> {
-    let solver = match solver_name {
-        "discrete" => SolverKind::Heuristic,
-        name => SolverKind::from_name(name).ok_or_else(|| {
-            format!("unknown solver {name:?} (nearest, ccp, heuristic, discrete, chain)")
-        })?,
-    };
+    let solver = solver_kind(solver_name)?;
     let request = JobRequest {
         job_id: 1,
         problem: document.problem.clone(),
@@ -472,6 +467,17 @@ fn solved_route(
     run_to_end(job.as_mut(), &mut |_| {})
         .route
         .ok_or_else(|| format!("the {solver_name} solver found no route"))
+}
+
+/// The solver a CLI name selects; "discrete" is the heuristic on a discretised nest.
+fn solver_kind(name: &str) -> Result<SolverKind, String> {
+    match name {
+        "discrete" => Ok(SolverKind::Heuristic),
+        name => SolverKind::from_name(name).ok_or_else(|| {
+            let known: Vec<&str> = SolverKind::ALL.iter().map(|k| k.name()).collect();
+            format!("unknown solver {name:?} ({}, discrete)", known.join(", "))
+        }),
+    }
 }
 
 /// Writes `generate_nest(contours, seed)` as geometry JSON.
@@ -488,13 +494,7 @@ fn solve(
     as_json: bool,
 ) -> Result<(), String> {
     let document = open(path)?;
-    let solver = match solver_name {
-        "discrete" => SolverKind::Heuristic,
-        name => SolverKind::from_name(name).ok_or_else(|| {
-            let known: Vec<&str> = SolverKind::ALL.iter().map(|k| k.name()).collect();
-            format!("unknown solver {name:?} ({}, discrete)", known.join(", "))
-        })?,
-    };
+    let solver = solver_kind(solver_name)?;
     let machine = params.machine;
     let request = JobRequest {
         job_id: 1,
