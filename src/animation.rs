@@ -336,10 +336,13 @@ pub fn AnimationOverlay(animation: Animation, scale: Signal<f64>) -> impl IntoVi
         let t = time.get()?;
         timeline.with(|tl| tl.as_ref().map(|tl| tl.travelled_at(t)))
     };
-    let head = move || {
+    // One memo for the head: a frame then only updates the circle's attributes (the element
+    // stays; re-creating it every frame would be DOM work for nothing).
+    let head = Memo::new(move |_| {
         let t = time.get().unwrap_or(0.0);
         timeline.with(|tl| tl.as_ref().map(|tl| (tl.state_at(t), t)))
-    };
+    });
+    let head_shown = Memo::new(move |_| head.with(Option::is_some));
     view! {
         {move || {
             timeline
@@ -361,19 +364,27 @@ pub fn AnimationOverlay(animation: Animation, scale: Signal<f64>) -> impl IntoVi
                 })
         }}
         {move || {
-            head()
-                .map(|(state, t)| {
-                    view! {
-                        <circle
-                            id="tool-head"
-                            class=if state.tool_on { "tool-head on" } else { "tool-head" }
-                            cx=state.position.x
-                            cy=state.position.y
-                            r=move || scale.get() / 120.0
-                            data-machine-time=format!("{t:.3}")
-                        />
-                    }
-                })
+            head_shown.get().then(|| {
+                let state = move || head.get().map(|(state, _)| state);
+                view! {
+                    <circle
+                        id="tool-head"
+                        class=move || {
+                            if state().is_some_and(|s| s.tool_on) {
+                                "tool-head on"
+                            } else {
+                                "tool-head"
+                            }
+                        }
+                        cx=move || state().map_or(0.0, |s| s.position.x)
+                        cy=move || state().map_or(0.0, |s| s.position.y)
+                        r=move || scale.get() / 120.0
+                        data-machine-time=move || {
+                            format!("{:.3}", head.get().map_or(0.0, |(_, t)| t))
+                        }
+                    />
+                }
+            })
         }}
     }
 }

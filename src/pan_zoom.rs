@@ -4,8 +4,19 @@
 //! The state is the SVG `viewBox` in the drawing's outer coordinates; `None` means "fit the
 //! sheet". Screen → drawing conversion uses the element's screen transformation matrix, so the
 //! point under the cursor stays put while zooming.
+//!
+//! Gestures are cheap: changing the `viewBox` makes the browser lay out, paint and raster every
+//! path again (tens of milliseconds per frame at 5,000 contours), so while a wheel, drag or
+//! pinch gesture is under way only the *live* view changes, shown by a CSS transform of the
+//! `<svg>` element — its own composited layer (`will-change: transform` in the style sheet), so
+//! the compositor moves and scales the picture already rastered. (A transform on a `<g>` inside
+//! would not do: Chromium lays out and paints SVG content again for that.) The `viewBox` — the
+//! *committed* view, which also sizes strokes, marks and labels — follows when the gesture
+//! ends: on the last pointer up, or [`WHEEL_SETTLE_MS`] after the last wheel event. Keys commit
+//! at once.
 
 use std::collections::HashMap;
+use std::time::Duration;
 
 use leptos::prelude::*;
 use wasm_bindgen::JsCast;
@@ -18,6 +29,8 @@ pub type ViewBox = [f64; 4];
 const KEY_ZOOM: f64 = 1.25;
 /// Fraction of the view one arrow key pans.
 const KEY_PAN: f64 = 0.1;
+/// A wheel gesture ends when no wheel event came for this long; the view box is then committed.
+pub const WHEEL_SETTLE_MS: u64 = 150;
 
 /// Scale `view` by `factor` (> 1 zooms out) keeping the drawing point `(ux, uy)` fixed.
 pub fn zoom_about(view: ViewBox, factor: f64, ux: f64, uy: f64) -> ViewBox {
@@ -31,28 +44,80 @@ pub fn zoom_about(view: ViewBox, factor: f64, ux: f64, uy: f64) -> ViewBox {
     ]
 }
 
-/// The drawing point under a screen point, through the element's screen matrix.
-fn to_drawing(svg: &SvgGraphicsElement, client_x: f64, client_y: f64) -> Option<(f64, f64, f64)> {
-    let m = svg.get_screen_ctm()?;
-    let (a, e, d, f) = (
-        f64::from(m.a()),
-        f64::from(m.e()),
-        f64::from(m.d()),
-        f64::from(m.f()),
-    );
-    if a == 0.0 || d == 0.0 {
-        return None;
+/// The CSS transform of the `<svg>` element (origin at its centre) that makes the picture drawn
+/// for the `committed` view box look as the `live` one would: `(tx, ty, k)` for
+/// `translate(tx px, ty px) scale(k)`. `a` is the committed view's screen pixels per drawing
+/// unit. Both boxes have the same aspect ratio (zooms scale both sides alike, pans keep them)
+/// and `preserveAspectRatio="xMidYMid meet"` puts each box's centre at the element's centre `O`,
+/// so a drawing point `p` shown at `O + a (p − c₀)` must move to `O + a k (p − c)` (`c₀`, `c` the
+/// boxes' centres, `k = committed width / live width`): that is `t = a k (c₀ − c)`.
+pub fn gesture_transform(a: f64, committed: ViewBox, live: ViewBox) -> (f64, f64, f64) {
+    let k = committed[2] / live[2];
+    let centre = |v: ViewBox| (v[0] + v[2] / 2.0, v[1] + v[3] / 2.0);
+    let (c0, c) = (centre(committed), centre(live));
+    (a * k * (c0.0 - c.0), a * k * (c0.1 - c.1), k)
+}
+
+/// Screen ↔ drawing mapping of a live view box, from the screen matrix of the committed one.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct LiveMapping {
+    /// Screen pixels per drawing unit in the live view.
+    scale: f64,
+    /// Screen point of the committed view's centre (also the live view's centre).
+    screen_centre: (f64, f64),
+    /// Drawing point at the centre of the live view.
+    live_centre: (f64, f64),
+}
+
+impl LiveMapping {
+    /// The mapping, given the committed view's screen matrix `screen = a · user + (e, f)`.
+    fn new(a: f64, e: f64, f: f64, committed: ViewBox, live: ViewBox) -> Self {
+        Self {
+            scale: a * committed[2] / live[2],
+            screen_centre: (
+                a * (committed[0] + committed[2] / 2.0) + e,
+                a * (committed[1] + committed[3] / 2.0) + f,
+            ),
+            live_centre: (live[0] + live[2] / 2.0, live[1] + live[3] / 2.0),
+        }
     }
-    Some(((client_x - e) / a, (client_y - f) / d, a))
+
+    /// The drawing point under a screen point.
+    fn drawing_at(self, client_x: f64, client_y: f64) -> (f64, f64) {
+        (
+            self.live_centre.0 + (client_x - self.screen_centre.0) / self.scale,
+            self.live_centre.1 + (client_y - self.screen_centre.1) / self.scale,
+        )
+    }
+}
+
+/// A gesture under way: the element it moves, the committed view's screen matrix taken when
+/// it began (the element's own CSS transform must not enter it), and the live view.
+struct Gesture {
+    svg: SvgGraphicsElement,
+    /// `screen = a · user + (e, f)` for the committed view box.
+    ctm: (f64, f64, f64),
+    committed: ViewBox,
+    live: ViewBox,
+}
+
+impl Gesture {
+    fn mapping(&self) -> LiveMapping {
+        let (a, e, f) = self.ctm;
+        LiveMapping::new(a, e, f, self.committed, self.live)
+    }
 }
 
 /// Handlers that drive `view` (the current view box, `None` = fit) given the fitted box.
 #[derive(Clone, Copy)]
 pub struct PanZoom {
-    /// The view box shown, `None` = fit the whole drawing.
+    /// The committed view box (the SVG `viewBox`), `None` = fit the whole drawing.
     pub view: RwSignal<Option<ViewBox>>,
     /// The fitted view box, used when `view` is `None`.
     pub fit: Signal<Option<ViewBox>>,
+    gesture: StoredValue<Option<Gesture>, LocalStorage>,
+    /// Commits the view when the wheel has been quiet for [`WHEEL_SETTLE_MS`].
+    wheel_timer: StoredValue<Option<TimeoutHandle>>,
     pointers: StoredValue<HashMap<i32, (f64, f64)>, LocalStorage>,
 }
 
@@ -62,42 +127,112 @@ impl PanZoom {
         Self {
             view: RwSignal::new(None),
             fit,
+            gesture: StoredValue::new_local(None),
+            wheel_timer: StoredValue::new(None),
             pointers: StoredValue::new_local(HashMap::new()),
         }
     }
 
-    /// The view box to render.
+    /// The committed view box to render.
     pub fn current(&self) -> Option<ViewBox> {
         self.view.get().or_else(|| self.fit.get())
     }
 
-    fn current_untracked(&self) -> Option<ViewBox> {
+    fn committed_untracked(&self) -> Option<ViewBox> {
         self.view
             .get_untracked()
             .or_else(|| self.fit.get_untracked())
     }
 
-    /// Back to "fit the sheet".
+    /// Back to "fit the sheet" (ends any gesture without committing it).
     pub fn reset(&self) {
+        self.end_gesture();
         self.view.set(None);
+    }
+
+    /// The live view and its screen mapping, starting a gesture on `ev`'s `<svg>` if none is
+    /// under way.
+    fn gesture_view<E: AsRef<web_sys::Event>>(&self, ev: &E) -> Option<(ViewBox, LiveMapping)> {
+        let running = self
+            .gesture
+            .with_value(|g| g.as_ref().map(|g| (g.live, g.mapping())));
+        if running.is_some() {
+            return running;
+        }
+        let committed = self.committed_untracked()?;
+        let svg = target_svg(ev)?;
+        let m = svg.get_screen_ctm()?;
+        let (a, e, f) = (f64::from(m.a()), f64::from(m.e()), f64::from(m.f()));
+        if a == 0.0 || !a.is_finite() || committed[2] == 0.0 {
+            return None;
+        }
+        // Hit-testing thousands of paths on every move is wasted work mid-gesture.
+        let _ = svg.set_attribute("data-gesture", "");
+        let gesture = Gesture {
+            svg,
+            ctm: (a, e, f),
+            committed,
+            live: committed,
+        };
+        let result = (gesture.live, gesture.mapping());
+        self.gesture.set_value(Some(gesture));
+        Some(result)
+    }
+
+    /// Shows `live` during a gesture: a transform of the `<svg>`, no `viewBox` change.
+    fn show_live(&self, live: ViewBox) {
+        self.gesture.update_value(|g| {
+            if let Some(g) = g {
+                g.live = live;
+                let (tx, ty, k) = gesture_transform(g.ctm.0, g.committed, live);
+                let _ = g.svg.set_attribute(
+                    "style",
+                    &format!("transform:translate({tx}px,{ty}px) scale({k})"),
+                );
+            }
+        });
+    }
+
+    /// Ends the gesture under way, if any, undoing its transform; returns its live view.
+    fn end_gesture(&self) -> Option<ViewBox> {
+        if let Some(timer) = self.wheel_timer.try_update_value(Option::take).flatten() {
+            timer.clear();
+        }
+        let gesture = self.gesture.try_update_value(Option::take).flatten()?;
+        let _ = gesture.svg.remove_attribute("style");
+        let _ = gesture.svg.remove_attribute("data-gesture");
+        Some(gesture.live)
+    }
+
+    /// Ends the gesture under way, making its view box the `viewBox`.
+    pub fn commit(&self) {
+        if let Some(live) = self.end_gesture() {
+            self.view.set(Some(live));
+        }
     }
 
     /// Wheel: zoom around the cursor.
     pub fn on_wheel(&self, ev: WheelEvent) {
         ev.prevent_default();
-        let Some(view) = self.current_untracked() else {
+        let Some((live, mapping)) = self.gesture_view(&ev) else {
             return;
         };
-        let Some(svg) = target_svg(&ev) else { return };
-        let Some((ux, uy, _)) =
-            to_drawing(&svg, f64::from(ev.client_x()), f64::from(ev.client_y()))
-        else {
-            return;
-        };
+        let (ux, uy) = mapping.drawing_at(f64::from(ev.client_x()), f64::from(ev.client_y()));
         // deltaMode 1 = lines: scale them to pixels so mice and touchpads feel alike.
         let delta = ev.delta_y() * if ev.delta_mode() == 1 { 16.0 } else { 1.0 };
-        self.view
-            .set(Some(zoom_about(view, (delta * 0.0015).exp(), ux, uy)));
+        self.show_live(zoom_about(live, (delta * 0.0015).exp(), ux, uy));
+        let this = *self;
+        let timer = set_timeout_with_handle(
+            move || this.commit(),
+            Duration::from_millis(WHEEL_SETTLE_MS),
+        )
+        .ok();
+        if let Some(old) = self
+            .wheel_timer
+            .try_update_value(|t| std::mem::replace(t, timer))
+        {
+            old.iter().for_each(TimeoutHandle::clear);
+        }
     }
 
     /// Pointer down: start a drag (or a pinch with the second finger).
@@ -123,11 +258,7 @@ impl PanZoom {
         let Some(before) = self.pointers.with_value(|p| p.get(&id).copied()) else {
             return;
         };
-        let Some(view) = self.current_untracked() else {
-            return;
-        };
-        let Some(svg) = target_svg(&ev) else { return };
-        let Some((_, _, scale)) = to_drawing(&svg, now.0, now.1) else {
+        let Some((view, mapping)) = self.gesture_view(&ev) else {
             return;
         };
         let others: Vec<(f64, f64)> = self.pointers.with_value(|p| {
@@ -145,16 +276,14 @@ impl PanZoom {
                 view
             } else {
                 let mid = ((now.0 + other.0) / 2.0, (now.1 + other.1) / 2.0);
-                match to_drawing(&svg, mid.0, mid.1) {
-                    Some((ux, uy, _)) => zoom_about(view, d_before / d_now, ux, uy),
-                    None => view,
-                }
+                let (ux, uy) = mapping.drawing_at(mid.0, mid.1);
+                zoom_about(view, d_before / d_now, ux, uy)
             }
         } else {
             let [x, y, w, h] = view;
             [
-                x - (now.0 - before.0) / scale,
-                y - (now.1 - before.1) / scale,
+                x - (now.0 - before.0) / mapping.scale,
+                y - (now.1 - before.1) / mapping.scale,
                 w,
                 h,
             ]
@@ -162,19 +291,29 @@ impl PanZoom {
         self.pointers.update_value(|p| {
             p.insert(id, now);
         });
-        self.view.set(Some(next));
+        self.show_live(next);
     }
 
-    /// Pointer up or cancelled: that pointer no longer drags.
+    /// Pointer up or cancelled: that pointer no longer drags; the last one commits the view.
     pub fn on_pointer_up(&self, ev: PointerEvent) {
-        self.pointers.update_value(|p| {
-            p.remove(&ev.pointer_id());
-        });
+        let none_left = self
+            .pointers
+            .try_update_value(|p| {
+                p.remove(&ev.pointer_id());
+                p.is_empty()
+            })
+            .unwrap_or(true);
+        if none_left {
+            self.commit();
+        }
     }
 
     /// Keyboard: `+`/`=` zoom in, `-` zoom out, arrows pan, `0` fits the sheet.
     pub fn on_key(&self, ev: KeyboardEvent) {
-        let Some(view) = self.current_untracked() else {
+        // A key press is a whole gesture: it ends any other one (keeping where it got to) and
+        // commits at once.
+        self.commit();
+        let Some(view) = self.committed_untracked() else {
             return;
         };
         let [x, y, w, h] = view;
@@ -209,7 +348,7 @@ fn target_svg<E: AsRef<web_sys::Event>>(ev: &E) -> Option<SvgGraphicsElement> {
 
 #[cfg(test)]
 mod tests {
-    use super::zoom_about;
+    use super::{gesture_transform, zoom_about, LiveMapping};
 
     #[test]
     fn zoom_keeps_the_anchor_point_fixed() {
@@ -219,5 +358,63 @@ mod tests {
         // The anchor sits at the same relative place in both boxes.
         let rel = |v: [f64; 4]| ((20.0 - v[0]) / v[2], (10.0 - v[1]) / v[3]);
         assert_eq!(rel(view), rel(zoomed));
+    }
+
+    /// Screen point of drawing point `p` when `view` is the viewBox of an 800 × 500 px viewport
+    /// at (40, 60), `xMidYMid meet` (what the browser does).
+    fn screen(view: [f64; 4], p: (f64, f64)) -> (f64, f64) {
+        let (vw, vh) = (800.0, 500.0);
+        let a = (vw / view[2]).min(vh / view[3]);
+        let e = 40.0 + (vw - a * view[2]) / 2.0 - a * view[0];
+        let f = 60.0 + (vh - a * view[3]) / 2.0 - a * view[1];
+        (a * p.0 + e, a * p.1 + f)
+    }
+
+    fn close(a: (f64, f64), b: (f64, f64)) -> bool {
+        (a.0 - b.0).abs() < 1e-6 && (a.1 - b.1).abs() < 1e-6
+    }
+
+    #[test]
+    fn the_gesture_transform_shows_the_live_view() {
+        // Committed box taller than the viewport's aspect, so "meet" letterboxes it.
+        let committed = [-20.0, -310.0, 400.0, 300.0];
+        let a = screen(committed, (1.0, 0.0)).0 - screen(committed, (0.0, 0.0)).0;
+        // The element's centre, the CSS transform origin.
+        let origin = (40.0 + 400.0, 60.0 + 250.0);
+        let lives = [
+            zoom_about(committed, 0.37, 55.0, -120.0),
+            zoom_about(committed, 2.5, 300.0, -20.0),
+            [committed[0] + 33.0, committed[1] - 71.0, 400.0, 300.0],
+        ];
+        for live in lives {
+            let (tx, ty, k) = gesture_transform(a, committed, live);
+            for p in [(0.0, 0.0), (123.0, -45.0), (-300.0, 80.0)] {
+                let (sx, sy) = screen(committed, p);
+                let moved = (
+                    origin.0 + tx + k * (sx - origin.0),
+                    origin.1 + ty + k * (sy - origin.1),
+                );
+                assert!(close(moved, screen(live, p)), "{live:?} {p:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn the_live_mapping_inverts_the_live_view_and_zoom_stays_under_the_cursor() {
+        let committed = [-20.0, -310.0, 400.0, 300.0];
+        // The committed view's screen matrix, as getScreenCTM reports it.
+        let (e, f) = screen(committed, (0.0, 0.0));
+        let a = screen(committed, (1.0, 0.0)).0 - e;
+        let mut live = committed;
+        let cursor = (500.0, 200.0);
+        for step in 0..20 {
+            let mapping = LiveMapping::new(a, e, f, committed, live);
+            let (ux, uy) = mapping.drawing_at(cursor.0, cursor.1);
+            assert!(close(screen(live, (ux, uy)), cursor), "step {step}");
+            let factor = if step < 10 { 0.8 } else { 1.3 };
+            live = zoom_about(live, factor, ux, uy);
+            // The drawing point under the cursor is the same after the zoom.
+            assert!(close(screen(live, (ux, uy)), cursor), "step {step}");
+        }
     }
 }
