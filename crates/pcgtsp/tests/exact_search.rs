@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::references;
+use common::{brute_force, references};
 use cutroute_pcgtsp::{check_tour, solve, ExactOptions, ExactSolver, Instance, SolverStatus};
 use std::time::Duration;
 
@@ -68,56 +68,13 @@ fn random_instance(seed: u64, m: usize) -> Instance {
     }
 }
 
-/// The optimum by enumerating every cluster order and node choice (`None` if infeasible).
-fn brute_force(instance: &Instance) -> Option<f64> {
-    fn extend(
-        instance: &Instance,
-        tour: &mut Vec<usize>,
-        visited: &mut Vec<bool>,
-        best: &mut Option<f64>,
-    ) {
-        let m = instance.clusters.len();
-        if tour.len() == m {
-            if let Ok(cost) = check_tour(instance, tour) {
-                if best.is_none_or(|b| cost < b) {
-                    *best = Some(cost);
-                }
-            }
-            return;
-        }
-        for c in 0..m {
-            let ready = instance
-                .precedence
-                .iter()
-                .all(|&(a, b)| b != c || visited[a]);
-            if visited[c] || !ready {
-                continue;
-            }
-            visited[c] = true;
-            for &x in &instance.clusters[c] {
-                tour.push(x);
-                extend(instance, tour, visited, best);
-                tour.pop();
-            }
-            visited[c] = false;
-        }
-    }
-    let mut best = None;
-    let mut visited = vec![false; instance.clusters.len()];
-    visited[instance.depot] = true;
-    for &start in &instance.clusters[instance.depot] {
-        extend(instance, &mut vec![start], &mut visited, &mut best);
-    }
-    best
-}
-
 #[test]
 fn proven_optimum_equals_brute_force_on_random_instances() {
     let mut feasible = 0;
     for seed in 0..120u64 {
         let m = 3 + (seed % 6) as usize;
         let instance = random_instance(seed, m);
-        let expected = brute_force(&instance);
+        let expected = brute_force(&instance).map(|(cost, _)| cost);
         for heuristic in [true, false] {
             let options = ExactOptions {
                 heuristic,

@@ -130,3 +130,51 @@ pub fn reference(name: &str) -> Reference {
         .find(|r| r.instance == name)
         .unwrap_or_else(|| panic!("{name} not in reference.csv"))
 }
+
+/// Brute force over cluster orders and node choices: the optimum and an optimal tour.
+pub fn brute_force(instance: &Instance) -> Option<(f64, Vec<usize>)> {
+    fn extend(
+        instance: &Instance,
+        tour: &mut Vec<usize>,
+        visited: &mut Vec<bool>,
+        cost: f64,
+        best: &mut Option<(f64, Vec<usize>)>,
+    ) {
+        let m = instance.clusters.len();
+        let last = *tour.last().expect("tour starts at the depot");
+        if tour.len() == m {
+            let total = cost + instance.arc_cost(last, tour[0]);
+            if total.is_finite() && best.as_ref().is_none_or(|(b, _)| total < *b) {
+                *best = Some((total, tour.clone()));
+            }
+            return;
+        }
+        for c in 0..m {
+            let ready = !visited[c]
+                && instance
+                    .precedence
+                    .iter()
+                    .all(|&(a, b)| b != c || visited[a]);
+            if !ready {
+                continue;
+            }
+            visited[c] = true;
+            for &x in &instance.clusters[c] {
+                let arc = instance.arc_cost(last, x);
+                if arc.is_finite() {
+                    tour.push(x);
+                    extend(instance, tour, visited, cost + arc, best);
+                    tour.pop();
+                }
+            }
+            visited[c] = false;
+        }
+    }
+    let mut best = None;
+    for &start in &instance.clusters[instance.depot] {
+        let mut visited = vec![false; instance.clusters.len()];
+        visited[instance.depot] = true;
+        extend(instance, &mut vec![start], &mut visited, 0.0, &mut best);
+    }
+    best
+}
