@@ -1,35 +1,9 @@
 //! The command-line tool as users call it, on the real files.
 
+mod common;
+
+use common::{cutroute, data, json};
 use std::path::PathBuf;
-use std::process::Command;
-
-use serde_json::Value;
-
-fn data(relative: &str) -> PathBuf {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/data")
-        .join(relative);
-    assert!(path.exists(), "missing test file {}", path.display());
-    path
-}
-
-fn cutroute(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_cutroute"))
-        .args(args)
-        .output()
-        .expect("runs");
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into(),
-        String::from_utf8_lossy(&out.stderr).into(),
-    )
-}
-
-fn json(args: &[&str]) -> Value {
-    let (ok, stdout, stderr) = cutroute(args);
-    assert!(ok, "cutroute {args:?} failed: {stderr}");
-    serde_json::from_str(&stdout).unwrap_or_else(|e| panic!("not JSON ({e}): {stdout}"))
-}
 
 #[test]
 fn inspect_reports_the_stored_facts_of_nests() {

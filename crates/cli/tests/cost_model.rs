@@ -1,35 +1,14 @@
 //! `cutroute solve` prices and times every solver's route by the cost model given on the
 //! command line (or a task file's speeds), and the chain solver saves pierces.
 
-use std::path::PathBuf;
-use std::process::Command;
+mod common;
 
+use common::{cutroute, json};
 use serde_json::Value;
 
+/// A file under `shared/data/` as a command-line argument.
 fn data(relative: &str) -> String {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/data")
-        .join(relative);
-    assert!(path.exists(), "missing test file {}", path.display());
-    path.to_string_lossy().into_owned()
-}
-
-fn run(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_cutroute"))
-        .args(args)
-        .output()
-        .expect("runs");
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into(),
-        String::from_utf8_lossy(&out.stderr).into(),
-    )
-}
-
-fn json(args: &[&str]) -> Value {
-    let (ok, stdout, stderr) = run(args);
-    assert!(ok, "cutroute {args:?} failed: {stderr}");
-    serde_json::from_str(&stdout).unwrap_or_else(|e| panic!("not JSON ({e}): {stdout}"))
+    common::data(relative).to_string_lossy().into_owned()
 }
 
 fn number(v: &Value, key: &str) -> f64 {
@@ -165,7 +144,7 @@ fn malformed_model_flags_are_refused() {
         ["--speeds", "0,10,1"],
         ["--cost", "1,-2,3"],
     ] {
-        let (ok, _, stderr) = run(&["solve", &nest, "--solver", "nearest", args[0], args[1]]);
+        let (ok, _, stderr) = cutroute(&["solve", &nest, "--solver", "nearest", args[0], args[1]]);
         assert!(!ok, "{args:?} accepted");
         assert!(stderr.contains(args[0]), "{args:?}: {stderr}");
     }
