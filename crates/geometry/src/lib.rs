@@ -18,6 +18,8 @@
 //!   independent validity check; a step may be entered by a tool-on link ([`Entry::Link`],
 //!   chain cutting) instead of idle move + pierce, checked to cross no contour; [`Toolpath`] and [`ToolClock`]: the head's moves (idle, pierce,
 //!   cut span by span) on the machine's time axis, for animation, G-code and exports.
+//! - [`PathRoute`]: segment cutting (SCCP/GSCCP): tool-on paths of arbitrary spans, each from
+//!   one pierce, with lengths, time, cost and an independent coverage/scrap/precedence check.
 //! - [`generate_nest`]: deterministic synthetic nests of up to tens of thousands of contours.
 //!
 //! Sign conventions: [`Contour::signed_area`] is positive for counter-clockwise contours (the
@@ -70,6 +72,7 @@ mod bbox;
 mod contour;
 mod forest;
 mod generator;
+mod path_route;
 mod point;
 mod route;
 mod span;
@@ -83,6 +86,7 @@ pub use contour::{
 };
 pub use forest::ContainmentForest;
 pub use generator::{generate_nest, SplitMix64};
+pub use path_route::{PathRoute, PathRouteError, ToolOnPath};
 pub use route::{
     in_scrap_region, is_scrap_region, ContourRef, CutStep, Entry, MachineParameters, Route,
     RouteError,

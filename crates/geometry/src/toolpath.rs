@@ -6,7 +6,7 @@
 //! every contour from the pierce point round to the pierce point again. [`ToolClock`] puts the moves on the machine's time axis (idle and cut
 //! speeds, pierce time) so a viewer can ask where the head is at any moment.
 
-use crate::{MachineParameters, Nest, Point, Route, RouteError, Span};
+use crate::{MachineParameters, Nest, PathRoute, Point, Route, RouteError, Span};
 
 /// One move of the machine.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -180,6 +180,49 @@ impl Toolpath {
             start: route.start,
             moves,
         })
+    }
+
+    /// The toolpath of a segment-cutting route: per path an idle move (when the head is not
+    /// there already), a pierce, and the path's spans as cuts; the path's index is the move's
+    /// step. Pieces through scrap are cuts like the rest (`link: false`: telling them apart
+    /// needs the nest, see [`PathRoute::problems`]).
+    pub fn from_path_route(route: &PathRoute) -> Toolpath {
+        let mut moves = Vec::new();
+        let mut at = route.start;
+        for (step, path) in route.paths.iter().enumerate() {
+            if at != path.pierce {
+                moves.push(ToolMove::Idle {
+                    from: at,
+                    to: path.pierce,
+                });
+            }
+            moves.push(ToolMove::Pierce {
+                at: path.pierce,
+                step,
+            });
+            for &span in &path.spans {
+                if span.length() > MIN_PIECE_LENGTH {
+                    moves.push(ToolMove::Cut {
+                        step,
+                        span,
+                        link: false,
+                    });
+                }
+            }
+            at = path.end();
+        }
+        if let Some(finish) = route.finish {
+            if at != finish {
+                moves.push(ToolMove::Idle {
+                    from: at,
+                    to: finish,
+                });
+            }
+        }
+        Toolpath {
+            start: route.start,
+            moves,
+        }
     }
 
     /// Total length of the idle moves, mm.

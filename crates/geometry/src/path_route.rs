@@ -1,0 +1,1033 @@
+//! Routes made of tool-on paths (segment cutting, SCCP/GSCCP): each path is pierced once and then
+//! cuts an arbitrary chain of spans end to end — a whole contour, part of one, several
+//! contours joined along their common edges, or pieces through scrap between them.
+//!
+//! A [`Route`] can only say "cut this whole contour from this pierce point"; a [`PathRoute`]
+//! says exactly where the torch goes. [`PathRoute::problems`] checks one against a nest without
+//! trusting whoever built it: paths are contiguous, every contour's boundary is covered exactly
+//! once by measure (a span on a common edge covers both contours), tool-on pieces off every
+//! contour stay in scrap and cross no contour, and a contour's boundary is completed only after
+//! the boundaries of all contours inside it.
+
+use rstar::{RTree, RTreeObject, AABB};
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+use crate::{
+    BoundingBox, ContainmentForest, ContourRef, MachineParameters, Nest, Point, Route, RouteError,
+    Span,
+};
+
+/// One pierce's worth of cutting: the torch pierces at `pierce` and cuts `spans` in order.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct ToolOnPath {
+    /// Where the torch pierces; the first span starts here.
+    pub pierce: Point,
+    /// The spans in cutting direction, each starting where the previous one ends.
+    pub spans: Vec<Span>,
+}
+
+impl ToolOnPath {
+    /// Where the torch switches off: the end of the last span (the pierce point if empty).
+    pub fn end(&self) -> Point {
+        self.spans.last().map_or(self.pierce, |s| s.end)
+    }
+
+    /// Tool-on length of the path, mm.
+    pub fn length(&self) -> f64 {
+        self.spans.iter().map(|s| s.length()).sum()
+    }
+}
+
+/// A route of tool-on paths: idle from `start` to the first pierce, cut the path, idle to the
+/// next pierce, …, and finally idle to `finish` if the machine must return somewhere.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct PathRoute {
+    /// Where the head starts.
+    pub start: Point,
+    /// The tool-on paths in order.
+    pub paths: Vec<ToolOnPath>,
+    /// Where the head ends, if the route is closed by a final idle move.
+    pub finish: Option<Point>,
+}
+
+/// One way a [`PathRoute`] fails to cut a nest.
+#[derive(Clone, Debug, PartialEq, Error)]
+pub enum PathRouteError {
+    /// A path pierces but cuts nothing.
+    #[error("path {path} pierces at ({x}, {y}) but cuts nothing")]
+    EmptyPath {
+        /// Index of the path.
+        path: usize,
+        /// Pierce point, x.
+        x: f64,
+        /// Pierce point, y.
+        y: f64,
+    },
+    /// A span has a non-finite coordinate or bulge.
+    #[error("span {span} of path {path} has a non-finite coordinate or bulge")]
+    NonFinite {
+        /// Index of the path.
+        path: usize,
+        /// Index of the span in the path.
+        span: usize,
+    },
+    /// A span does not start where the previous one (or the pierce, for the first) ends.
+    #[error("span {span} of path {path} starts {distance} mm away from where the torch is, at ({x}, {y})")]
+    NotContiguous {
+        /// Index of the path.
+        path: usize,
+        /// Index of the span in the path.
+        span: usize,
+        /// How far the span's start is from the torch.
+        distance: f64,
+        /// Where the torch is, x.
+        x: f64,
+        /// Where the torch is, y.
+        y: f64,
+    },
+    /// Part of a contour's boundary is never cut.
+    #[error("{length} mm of contour {contour:?} from ({x}, {y}) are never cut")]
+    Gap {
+        /// The contour.
+        contour: ContourRef,
+        /// Where the uncut piece starts, x.
+        x: f64,
+        /// Its y.
+        y: f64,
+        /// Its length along the contour, mm.
+        length: f64,
+    },
+    /// Part of a contour's boundary is cut more than once.
+    #[error("{length} mm of contour {contour:?} from ({x}, {y}) are cut more than once")]
+    Overlap {
+        /// The contour.
+        contour: ContourRef,
+        /// Where the doubly cut piece starts, x.
+        x: f64,
+        /// Its y.
+        y: f64,
+        /// Its length along the contour, mm.
+        length: f64,
+    },
+    /// A tool-on piece off every contour crosses a contour: it cuts into a part or across a
+    /// scrap boundary.
+    #[error("span {span} of path {path} crosses contour {contour:?} at ({x}, {y}) away from every contour it follows")]
+    CrossesContour {
+        /// Index of the path.
+        path: usize,
+        /// Index of the span in the path.
+        span: usize,
+        /// The contour crossed.
+        contour: ContourRef,
+        /// Where, x.
+        x: f64,
+        /// Where, y.
+        y: f64,
+    },
+    /// A tool-on piece off every contour runs through material (inside a part).
+    #[error("span {span} of path {path} cuts through material near ({x}, {y})")]
+    ThroughMaterial {
+        /// Index of the path.
+        path: usize,
+        /// Index of the span in the path.
+        span: usize,
+        /// A point of the piece inside a part, x.
+        x: f64,
+        /// Its y.
+        y: f64,
+    },
+    /// A contour's boundary is completed before that of a contour inside it: the outer piece
+    /// would drop (or move) before the inner one is cut out.
+    #[error("contour {outer:?} is completed (path {outer_path}) before contour {inner:?} inside it (path {inner_path})")]
+    PrecedenceViolated {
+        /// The contained contour.
+        inner: ContourRef,
+        /// Path that completes it.
+        inner_path: usize,
+        /// The containing contour.
+        outer: ContourRef,
+        /// Path that completes it.
+        outer_path: usize,
+    },
+}
+
+/// R-tree entry: the box of one span of a contour.
+struct SpanEntry {
+    envelope: AABB<[f64; 2]>,
+    contour: usize,
+    span: usize,
+}
+
+impl RTreeObject for SpanEntry {
+    type Envelope = AABB<[f64; 2]>;
+    fn envelope(&self) -> Self::Envelope {
+        self.envelope
+    }
+}
+
+fn aabb(b: &BoundingBox) -> AABB<[f64; 2]> {
+    AABB::from_corners([b.min.x, b.min.y], [b.max.x, b.max.y])
+}
+
+/// Where a route span lies on a contour span: `[a, b]` on the contour span, `[ra, rb]` (sorted)
+/// on the route span.
+struct Overlap {
+    a: f64,
+    b: f64,
+    ra: f64,
+    rb: f64,
+}
+
+/// Sub-intervals of `on` that lie on `other` within `tolerance`: the candidates are the ends of
+/// `on` and the projections of `other`'s ends; a piece between candidates lies on `other` when
+/// three interior points do (two distinct circles or lines share at most two points).
+fn pieces_on(on: &Span, other: &Span, tolerance: f64) -> Vec<(f64, f64)> {
+    let mut cuts = vec![0.0, 1.0];
+    for p in [other.start, other.end] {
+        let q = on.nearest_point(p);
+        if q.distance <= tolerance {
+            cuts.push(q.t);
+        }
+    }
+    cuts.sort_by(f64::total_cmp);
+    let length = on.length();
+    let mut pieces: Vec<(f64, f64)> = Vec::new();
+    for w in cuts.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        if !((b - a) * length > tolerance) {
+            continue;
+        }
+        let lies = [0.25, 0.5, 0.75]
+            .iter()
+            .all(|f| other.distance_to(on.point_at(a + (b - a) * f)) <= tolerance);
+        if lies {
+            match pieces.last_mut() {
+                Some(last) if last.1 >= a => last.1 = b,
+                _ => pieces.push((a, b)),
+            }
+        }
+    }
+    pieces
+}
+
+fn overlaps(contour_span: &Span, route_span: &Span, tolerance: f64) -> Vec<Overlap> {
+    pieces_on(contour_span, route_span, tolerance)
+        .into_iter()
+        .map(|(a, b)| {
+            let ta = route_span.parameter_of(contour_span.point_at(a));
+            let tb = route_span.parameter_of(contour_span.point_at(b));
+            Overlap {
+                a,
+                b,
+                ra: ta.min(tb),
+                rb: ta.max(tb),
+            }
+        })
+        .collect()
+}
+
+/// When a piece of contour is cut: path, span within the path, and parameter on that span.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Moment {
+    path: usize,
+    span: usize,
+    t: f64,
+}
+
+impl Moment {
+    fn is_after(&self, other: &Moment) -> bool {
+        (self.path, self.span) > (other.path, other.span)
+            || ((self.path, self.span) == (other.path, other.span) && self.t > other.t + 1e-9)
+    }
+}
+
+impl PathRoute {
+    /// The route of the same cuts as `route`: each step's contour opened at its pierce point
+    /// and cut round in its own direction; a step entered by a tool-on link continues the
+    /// previous path with the link's straight pieces instead of starting a new one.
+    ///
+    /// Fails when a step names a contour the nest does not have.
+    pub fn from_route(route: &Route, nest: &Nest) -> Result<PathRoute, RouteError> {
+        let mut paths: Vec<ToolOnPath> = Vec::new();
+        for (step, cut) in route.steps.iter().enumerate() {
+            let contour = nest
+                .contour(cut.contour)
+                .ok_or(RouteError::UnknownContour {
+                    step,
+                    contour: cut.contour,
+                })?;
+            let linked = match (route.link_path(step), paths.last_mut()) {
+                (Some(link), Some(path)) => {
+                    for w in link.windows(2) {
+                        if w[0] != w[1] {
+                            path.spans.push(Span::line(w[0], w[1]));
+                        }
+                    }
+                    true
+                }
+                _ => false,
+            };
+            if !linked {
+                paths.push(ToolOnPath {
+                    pierce: cut.pierce_point,
+                    spans: Vec::new(),
+                });
+            }
+            let path = paths.last_mut().expect("a path was just ensured");
+            let Some(entry) = contour.nearest_point(cut.pierce_point) else {
+                continue;
+            };
+            let spans: Vec<Span> = contour.spans().collect();
+            let (i, t) = (entry.position.span, entry.position.t);
+            // The contour opened at the entry, which is the pierce point itself for a valid
+            // route; pieces of zero length at a vertex are dropped.
+            let mut opened = vec![spans[i].sub_span(t, 1.0)];
+            opened.extend((1..spans.len()).map(|k| spans[(i + k) % spans.len()]));
+            opened.push(spans[i].sub_span(0.0, t));
+            let mut at = path.end();
+            for mut s in opened {
+                if s.length() <= 1e-12 {
+                    continue;
+                }
+                s.start = at; // exact contiguity: the split point is computed twice
+                at = s.end;
+                path.spans.push(s);
+            }
+        }
+        Ok(PathRoute {
+            start: route.start,
+            paths,
+            finish: route.finish,
+        })
+    }
+
+    /// The straight idle moves `(from, to)`: start → first pierce, each path's end → next
+    /// pierce, last end → finish.
+    pub fn idle_moves(&self) -> Vec<(Point, Point)> {
+        let mut moves = Vec::with_capacity(self.paths.len() + 1);
+        let mut at = self.start;
+        for p in &self.paths {
+            moves.push((at, p.pierce));
+            at = p.end();
+        }
+        if let Some(finish) = self.finish {
+            moves.push((at, finish));
+        }
+        moves
+    }
+
+    /// Total idle length, mm.
+    pub fn idle_length(&self) -> f64 {
+        self.idle_moves().iter().map(|(a, b)| a.distance(*b)).sum()
+    }
+
+    /// Total tool-on length (contours and pieces through scrap alike), mm.
+    pub fn cut_length(&self) -> f64 {
+        self.paths.iter().map(|p| p.length()).sum()
+    }
+
+    /// Number of pierces: one per path.
+    pub fn pierce_count(&self) -> usize {
+        self.paths.len()
+    }
+
+    /// Machining time, seconds (formula 1.2).
+    pub fn time(&self, machine: &MachineParameters) -> f64 {
+        machine.time(self.cut_length(), self.idle_length(), self.pierce_count())
+    }
+
+    /// Cost (formula 1.3).
+    pub fn cost(&self, machine: &MachineParameters) -> f64 {
+        machine.cost(self.cut_length(), self.idle_length(), self.pierce_count())
+    }
+
+    /// Every way the route fails to cut `nest` (empty when it is valid), with `tolerance` mm
+    /// for points to coincide and for pieces to count:
+    /// - every path cuts something, its spans finite and end to end from the pierce point;
+    /// - every contour's boundary covered exactly once by measure: gaps and overlaps longer
+    ///   than `tolerance` are reported with the contour and where they start;
+    /// - every tool-on piece that lies on no contour crosses no contour and lies in scrap (an
+    ///   even number of part contours around it: outside every part, or in a hole);
+    /// - when a contour's boundary is completed, every contour inside it is already complete.
+    pub fn problems(&self, nest: &Nest, tolerance: f64) -> Vec<PathRouteError> {
+        let mut problems = Vec::new();
+        let refs: Vec<ContourRef> = nest.contour_refs().collect();
+        let contours: Vec<Vec<Span>> = refs
+            .iter()
+            .map(|&r| nest.contour(r).map_or(Vec::new(), |c| c.spans().collect()))
+            .collect();
+        let mut entries = Vec::new();
+        for (c, spans) in contours.iter().enumerate() {
+            for (s, span) in spans.iter().enumerate() {
+                entries.push(SpanEntry {
+                    envelope: aabb(&span.bounding_box().expanded(tolerance)),
+                    contour: c,
+                    span: s,
+                });
+            }
+        }
+        let span_tree = RTree::bulk_load(entries);
+        // Per contour and span: covered intervals on the contour span with their moment.
+        let mut covered: Vec<Vec<Vec<(f64, f64, Moment)>>> = contours
+            .iter()
+            .map(|spans| vec![Vec::new(); spans.len()])
+            .collect();
+
+        for (p, path) in self.paths.iter().enumerate() {
+            if path.spans.is_empty() {
+                problems.push(PathRouteError::EmptyPath {
+                    path: p,
+                    x: path.pierce.x,
+                    y: path.pierce.y,
+                });
+                continue;
+            }
+            let mut at = path.pierce;
+            for (s, span) in path.spans.iter().enumerate() {
+                if !(span.start.is_finite() && span.end.is_finite() && span.bulge.is_finite()) {
+                    problems.push(PathRouteError::NonFinite { path: p, span: s });
+                    at = span.end;
+                    continue;
+                }
+                let distance = at.distance(span.start);
+                if !(distance <= tolerance) {
+                    problems.push(PathRouteError::NotContiguous {
+                        path: p,
+                        span: s,
+                        distance,
+                        x: at.x,
+                        y: at.y,
+                    });
+                }
+                at = span.end;
+                let reach = aabb(&span.bounding_box().expanded(tolerance));
+                let mut on_route: Vec<(f64, f64)> = Vec::new();
+                for e in span_tree.locate_in_envelope_intersecting(&reach) {
+                    let contour_span = &contours[e.contour][e.span];
+                    for o in overlaps(contour_span, span, tolerance) {
+                        covered[e.contour][e.span].push((
+                            o.a,
+                            o.b,
+                            Moment {
+                                path: p,
+                                span: s,
+                                t: o.rb,
+                            },
+                        ));
+                        on_route.push((o.ra, o.rb));
+                    }
+                }
+                self.check_off_contour(
+                    nest,
+                    &refs,
+                    &span_tree,
+                    &contours,
+                    p,
+                    s,
+                    span,
+                    on_route,
+                    tolerance,
+                    &mut problems,
+                );
+            }
+        }
+
+        let mut completed: Vec<Option<Moment>> = vec![None; refs.len()];
+        for (c, spans) in contours.iter().enumerate() {
+            let lengths: Vec<f64> = spans.iter().map(|s| s.length()).collect();
+            let mut intervals: Vec<(f64, f64, Moment, Point)> = Vec::new();
+            let mut offset = 0.0;
+            for (s, pieces) in covered[c].iter().enumerate() {
+                for &(a, b, m) in pieces {
+                    intervals.push((
+                        offset + a * lengths[s],
+                        offset + b * lengths[s],
+                        m,
+                        spans[s].point_at(a),
+                    ));
+                }
+                offset += lengths[s];
+            }
+            let perimeter = offset;
+            intervals.sort_by(|x, y| x.0.total_cmp(&y.0));
+            let point_at_length = |l: f64| {
+                nest.contour(refs[c])
+                    .and_then(|k| k.point_at_length(l))
+                    .unwrap_or_default()
+            };
+            let mut reach = 0.0;
+            let mut last: Option<Moment> = None;
+            for &(a, b, m, pa) in &intervals {
+                if a - reach > tolerance {
+                    let p = point_at_length(reach);
+                    problems.push(PathRouteError::Gap {
+                        contour: refs[c],
+                        x: p.x,
+                        y: p.y,
+                        length: a - reach,
+                    });
+                } else if reach - a > tolerance {
+                    problems.push(PathRouteError::Overlap {
+                        contour: refs[c],
+                        x: pa.x,
+                        y: pa.y,
+                        length: reach.min(b) - a,
+                    });
+                }
+                reach = reach.max(b);
+                if last.is_none_or(|l| m.is_after(&l)) {
+                    last = Some(m);
+                }
+            }
+            if perimeter - reach > tolerance {
+                let p = point_at_length(reach);
+                problems.push(PathRouteError::Gap {
+                    contour: refs[c],
+                    x: p.x,
+                    y: p.y,
+                    length: perimeter - reach,
+                });
+            }
+            completed[c] = last;
+        }
+
+        let forest = ContainmentForest::new(nest);
+        for (inner, outer) in forest.all_precedence_pairs() {
+            let (Some(i), Some(o)) = (forest.index_of(inner), forest.index_of(outer)) else {
+                continue;
+            };
+            if let (Some(mi), Some(mo)) = (completed[i], completed[o]) {
+                if mi.is_after(&mo) {
+                    problems.push(PathRouteError::PrecedenceViolated {
+                        inner,
+                        inner_path: mi.path,
+                        outer,
+                        outer_path: mo.path,
+                    });
+                }
+            }
+        }
+        problems
+    }
+
+    /// The pieces of `span` outside `on_route` (the parts lying on contours) must cross no
+    /// contour and lie in scrap.
+    #[allow(clippy::too_many_arguments)]
+    fn check_off_contour(
+        &self,
+        nest: &Nest,
+        refs: &[ContourRef],
+        span_tree: &RTree<SpanEntry>,
+        contours: &[Vec<Span>],
+        path: usize,
+        s: usize,
+        span: &Span,
+        mut on_route: Vec<(f64, f64)>,
+        tolerance: f64,
+        problems: &mut Vec<PathRouteError>,
+    ) {
+        on_route.sort_by(|x, y| x.0.total_cmp(&y.0));
+        let mut free = Vec::new();
+        let mut reach = 0.0;
+        for (a, b) in on_route {
+            if a > reach {
+                free.push((reach, a));
+            }
+            reach = f64::max(reach, b);
+        }
+        if reach < 1.0 {
+            free.push((reach, 1.0));
+        }
+        let length = span.length();
+        for (a, b) in free {
+            if !((b - a) * length > tolerance) {
+                continue;
+            }
+            let piece = span.sub_span(a, b);
+            let (first, last) = (piece.start, piece.end);
+            let reach = aabb(&piece.bounding_box().expanded(tolerance));
+            for e in span_tree.locate_in_envelope_intersecting(&reach) {
+                let crossing = contours[e.contour][e.span]
+                    .intersections(&piece)
+                    .into_iter()
+                    .find(|x| {
+                        x.point.distance(first) > tolerance && x.point.distance(last) > tolerance
+                    });
+                if let Some(x) = crossing {
+                    problems.push(PathRouteError::CrossesContour {
+                        path,
+                        span: s,
+                        contour: refs[e.contour],
+                        x: x.point.x,
+                        y: x.point.y,
+                    });
+                    return;
+                }
+            }
+            // No crossing inside the piece: one interior point tells on which side of every
+            // contour the whole piece lies.
+            let probe = piece.point_at(0.5);
+            let around = refs
+                .iter()
+                .filter(|&&r| nest.contour(r).is_some_and(|c| c.contains(probe)))
+                .count();
+            if around % 2 == 1 {
+                problems.push(PathRouteError::ThroughMaterial {
+                    path,
+                    span: s,
+                    x: probe.x,
+                    y: probe.y,
+                });
+                return;
+            }
+        }
+    }
+
+    /// Checks the route against the nest (see [`PathRoute::problems`]) and reports the first
+    /// failure.
+    pub fn validate(&self, nest: &Nest, tolerance: f64) -> Result<(), PathRouteError> {
+        match self.problems(nest, tolerance).into_iter().next() {
+            Some(e) => Err(e),
+            None => Ok(()),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{Contour, CutStep, Entry, Part, Toolpath, Vertex};
+    use proptest::prelude::*;
+
+    const TOL: f64 = 1e-7;
+
+    /// Clockwise rectangle (outer contours run clockwise).
+    fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> Contour {
+        Contour::new(vec![
+            Vertex::line(x0, y0),
+            Vertex::line(x0, y1),
+            Vertex::line(x1, y1),
+            Vertex::line(x1, y0),
+        ])
+    }
+
+    fn part(contours: Vec<Contour>) -> Part {
+        Part {
+            name: String::new(),
+            contours,
+        }
+    }
+
+    fn p(x: f64, y: f64) -> Point {
+        Point::new(x, y)
+    }
+
+    fn polyline(points: &[(f64, f64)]) -> ToolOnPath {
+        ToolOnPath {
+            pierce: p(points[0].0, points[0].1),
+            spans: points
+                .windows(2)
+                .map(|w| Span::line(p(w[0].0, w[0].1), p(w[1].0, w[1].1)))
+                .collect(),
+        }
+    }
+
+    /// Two 10 × 10 squares sharing the edge x = 10.
+    fn pair() -> Nest {
+        Nest {
+            sheet: None,
+            parts: vec![
+                part(vec![rect(0.0, 0.0, 10.0, 10.0)]),
+                part(vec![rect(10.0, 0.0, 20.0, 10.0)]),
+            ],
+        }
+    }
+
+    /// A 100 × 100 plate with a 60 × 60 hole holding a 20 × 20 part.
+    fn nested() -> Nest {
+        Nest {
+            sheet: None,
+            parts: vec![
+                part(vec![
+                    rect(0.0, 0.0, 100.0, 100.0),
+                    rect(20.0, 20.0, 80.0, 80.0).reversed(),
+                ]),
+                part(vec![rect(40.0, 40.0, 60.0, 60.0)]),
+            ],
+        }
+    }
+
+    #[test]
+    fn a_route_converts_to_a_valid_path_route_with_the_same_numbers() {
+        let nest = nested();
+        let (plate, hole, inner) = (
+            ContourRef {
+                part: 0,
+                contour: 0,
+            },
+            ContourRef {
+                part: 0,
+                contour: 1,
+            },
+            ContourRef {
+                part: 1,
+                contour: 0,
+            },
+        );
+        let route = Route {
+            start: p(-10.0, -10.0),
+            steps: vec![
+                CutStep::pierced(inner, p(45.0, 40.0)),
+                CutStep::pierced(hole, p(20.0, 33.0)),
+                CutStep::pierced(plate, p(0.0, 0.0)),
+            ],
+            finish: Some(p(-10.0, -10.0)),
+        };
+        route.validate(&nest, TOL).unwrap();
+        let paths = PathRoute::from_route(&route, &nest).unwrap();
+        assert_eq!(paths.problems(&nest, TOL), vec![]);
+        assert_eq!(paths.pierce_count(), 3);
+        assert!((paths.cut_length() - route.cut_length(&nest)).abs() < 1e-9);
+        assert!((paths.idle_length() - route.idle_length()).abs() < 1e-9);
+        let machine = MachineParameters::default();
+        assert!((paths.time(&machine) - route.time(&nest, &machine)).abs() < 1e-9);
+        assert!((paths.cost(&machine) - route.cost(&nest, &machine)).abs() < 1e-12);
+        let toolpath = Toolpath::from_path_route(&paths);
+        assert!((toolpath.cut_length() - paths.cut_length()).abs() < 1e-9);
+        assert!((toolpath.idle_length() - paths.idle_length()).abs() < 1e-9);
+        assert_eq!(toolpath.pierce_count(), 3);
+        let text = serde_json::to_string(&paths).unwrap();
+        assert_eq!(serde_json::from_str::<PathRoute>(&text).unwrap(), paths);
+    }
+
+    #[test]
+    fn precedence_is_checked_when_a_boundary_completes() {
+        let nest = nested();
+        let route = Route {
+            start: p(0.0, 0.0),
+            steps: vec![
+                CutStep::pierced(
+                    ContourRef {
+                        part: 1,
+                        contour: 0,
+                    },
+                    p(40.0, 40.0),
+                ),
+                CutStep::pierced(
+                    ContourRef {
+                        part: 0,
+                        contour: 0,
+                    },
+                    p(0.0, 0.0),
+                ),
+                CutStep::pierced(
+                    ContourRef {
+                        part: 0,
+                        contour: 1,
+                    },
+                    p(20.0, 20.0),
+                ),
+            ],
+            finish: None,
+        };
+        let paths = PathRoute::from_route(&route, &nest).unwrap();
+        let problems = paths.problems(&nest, TOL);
+        assert_eq!(
+            problems,
+            vec![PathRouteError::PrecedenceViolated {
+                inner: ContourRef {
+                    part: 0,
+                    contour: 1
+                },
+                inner_path: 2,
+                outer: ContourRef {
+                    part: 0,
+                    contour: 0
+                },
+                outer_path: 1,
+            }]
+        );
+        // Starting the plate before the hole is fine as long as it is completed after it:
+        // cut three sides of the plate, then the hole, then the last side in a new path.
+        let mut good = PathRoute {
+            start: p(0.0, 0.0),
+            paths: vec![polyline(&[
+                (40.0, 40.0),
+                (40.0, 60.0),
+                (60.0, 60.0),
+                (60.0, 40.0),
+                (40.0, 40.0),
+            ])],
+            finish: None,
+        };
+        good.paths.push(polyline(&[
+            (0.0, 0.0),
+            (0.0, 100.0),
+            (100.0, 100.0),
+            (100.0, 0.0),
+        ]));
+        good.paths.push(polyline(&[
+            (20.0, 20.0),
+            (80.0, 20.0),
+            (80.0, 80.0),
+            (20.0, 80.0),
+            (20.0, 20.0),
+        ]));
+        good.paths.push(polyline(&[(100.0, 0.0), (0.0, 0.0)]));
+        assert_eq!(good.problems(&nest, TOL), vec![]);
+        assert_eq!(good.pierce_count(), 4);
+    }
+
+    #[test]
+    fn a_common_edge_is_cut_once_and_cutting_it_twice_is_an_overlap() {
+        let nest = pair();
+        // One path: the outline of both squares, then the common edge.
+        let once = PathRoute {
+            start: p(0.0, 0.0),
+            paths: vec![polyline(&[
+                (10.0, 0.0),
+                (0.0, 0.0),
+                (0.0, 10.0),
+                (20.0, 10.0),
+                (20.0, 0.0),
+                (10.0, 0.0),
+                (10.0, 10.0),
+            ])],
+            finish: None,
+        };
+        assert_eq!(once.problems(&nest, TOL), vec![]);
+        assert!((once.cut_length() - 70.0).abs() < 1e-12);
+        // Each square cut whole: the common edge twice.
+        let route = Route {
+            start: p(0.0, 0.0),
+            steps: vec![
+                CutStep::pierced(
+                    ContourRef {
+                        part: 0,
+                        contour: 0,
+                    },
+                    p(0.0, 0.0),
+                ),
+                CutStep::pierced(
+                    ContourRef {
+                        part: 1,
+                        contour: 0,
+                    },
+                    p(10.0, 0.0),
+                ),
+            ],
+            finish: None,
+        };
+        let twice = PathRoute::from_route(&route, &nest).unwrap();
+        let problems = twice.problems(&nest, TOL);
+        assert_eq!(problems.len(), 2, "{problems:?}"); // the edge is doubled on both contours
+        for e in &problems {
+            let PathRouteError::Overlap { length, x, .. } = e else {
+                panic!("expected an overlap, got {e}");
+            };
+            assert!((length - 10.0).abs() < 1e-9 && (x - 10.0).abs() < 1e-9);
+        }
+    }
+
+    #[test]
+    fn gaps_breaks_and_empty_paths_are_reported() {
+        let nest = pair();
+        let route = PathRoute {
+            start: p(0.0, 0.0),
+            paths: vec![
+                polyline(&[
+                    (10.0, 0.0),
+                    (0.0, 0.0),
+                    (0.0, 10.0),
+                    (20.0, 10.0),
+                    (20.0, 0.0),
+                ]),
+                ToolOnPath {
+                    pierce: p(10.0, 0.0),
+                    // starts 1 mm off the pierce point
+                    spans: vec![
+                        Span::line(p(11.0, 0.0), p(10.0, 0.0)),
+                        Span::line(p(10.0, 0.0), p(10.0, 10.0)),
+                    ],
+                },
+                ToolOnPath {
+                    pierce: p(5.0, 5.0),
+                    spans: vec![],
+                },
+            ],
+            finish: None,
+        };
+        let problems = route.problems(&nest, TOL);
+        assert!(problems.contains(&PathRouteError::EmptyPath {
+            path: 2,
+            x: 5.0,
+            y: 5.0
+        }));
+        assert!(problems.iter().any(|e| matches!(e, PathRouteError::NotContiguous { path: 1, span: 0, distance, .. } if (distance - 1.0).abs() < 1e-12)));
+        // 9 mm of the bottom of the right square are never cut.
+        assert!(problems.iter().any(|e| matches!(e, PathRouteError::Gap { contour: ContourRef { part: 1, contour: 0 }, length, .. } if (length - 9.0).abs() < 1e-9)));
+    }
+
+    #[test]
+    fn tool_on_pieces_must_stay_in_scrap() {
+        let nest = pair();
+        let whole = |c: usize, pierce: Point| {
+            PathRoute::from_route(
+                &Route {
+                    start: p(0.0, 0.0),
+                    steps: vec![CutStep::pierced(
+                        ContourRef {
+                            part: c,
+                            contour: 0,
+                        },
+                        pierce,
+                    )],
+                    finish: None,
+                },
+                &nest,
+            )
+            .unwrap()
+            .paths
+            .remove(0)
+        };
+        // Left square, then a piece through the sheet around to the right square: fine.
+        let mut through_scrap = whole(0, p(0.0, 0.0));
+        through_scrap
+            .spans
+            .push(Span::line(p(0.0, 0.0), p(0.0, -5.0)));
+        through_scrap
+            .spans
+            .push(Span::line(p(0.0, -5.0), p(20.0, -5.0)));
+        through_scrap
+            .spans
+            .push(Span::line(p(20.0, -5.0), p(20.0, 0.0)));
+        let right: Vec<Span> = vec![
+            Span::line(p(20.0, 0.0), p(20.0, 10.0)),
+            Span::line(p(20.0, 10.0), p(10.0, 10.0)),
+            Span::line(p(10.0, 0.0), p(20.0, 0.0)),
+        ];
+        through_scrap.spans.extend(right.iter().take(2));
+        let mut route = PathRoute {
+            start: p(0.0, 0.0),
+            paths: vec![through_scrap, polyline(&[(10.0, 0.0), (20.0, 0.0)])],
+            finish: None,
+        };
+        assert_eq!(route.problems(&nest, TOL), vec![]);
+        // A piece through the left square.
+        route.paths[1] = polyline(&[(5.0, 0.0), (5.0, 5.0), (10.0, 5.0)]);
+        let problems = route.problems(&nest, TOL);
+        assert!(
+            problems
+                .iter()
+                .any(|e| matches!(e, PathRouteError::ThroughMaterial { path: 1, .. })),
+            "{problems:?}"
+        );
+        // A piece across the right square's boundary.
+        route.paths[1] = polyline(&[(10.0, 0.0), (20.0, 0.0), (25.0, 5.0), (15.0, 5.0)]);
+        let problems = route.problems(&nest, TOL);
+        assert!(
+            problems.iter().any(|e| matches!(
+                e,
+                PathRouteError::CrossesContour {
+                    path: 1,
+                    span: 2,
+                    ..
+                }
+            )),
+            "{problems:?}"
+        );
+        // Chain-cutting links become tool-on pieces of the previous path.
+        let linked = Route {
+            start: p(0.0, 0.0),
+            steps: vec![
+                CutStep::pierced(
+                    ContourRef {
+                        part: 0,
+                        contour: 0,
+                    },
+                    p(0.0, 0.0),
+                ),
+                CutStep {
+                    contour: ContourRef {
+                        part: 1,
+                        contour: 0,
+                    },
+                    pierce_point: p(20.0, 0.0),
+                    entry: Entry::Link(vec![p(0.0, -5.0), p(20.0, -5.0)]),
+                },
+            ],
+            finish: None,
+        };
+        let paths = PathRoute::from_route(&linked, &nest).unwrap();
+        assert_eq!(paths.pierce_count(), 1);
+        assert!((paths.cut_length() - linked.cut_length(&nest)).abs() < 1e-9);
+        // Both squares whole: the common edge is cut twice, and nothing else is wrong.
+        let problems = paths.problems(&nest, TOL);
+        assert!(
+            problems
+                .iter()
+                .all(|e| matches!(e, PathRouteError::Overlap { .. })),
+            "{problems:?}"
+        );
+    }
+
+    #[test]
+    fn arcs_are_covered_by_measure() {
+        // A round part cut in two halves from two pierces, the second half in reverse.
+        let nest = Nest {
+            sheet: None,
+            parts: vec![part(vec![Contour::circle(p(0.0, 0.0), 5.0, true)])],
+        };
+        let c = nest.parts[0].contours[0].clone();
+        let spans: Vec<Span> = c.spans().collect();
+        assert_eq!(spans.len(), 2);
+        let (first, second) = spans[0].split_at(0.3);
+        let route = PathRoute {
+            start: p(0.0, 0.0),
+            paths: vec![
+                ToolOnPath {
+                    pierce: spans[0].start,
+                    spans: vec![first],
+                },
+                ToolOnPath {
+                    pierce: spans[1].end,
+                    spans: vec![spans[1].reversed(), second.reversed()],
+                },
+            ],
+            finish: None,
+        };
+        assert_eq!(route.problems(&nest, TOL), vec![]);
+        assert!((route.cut_length() - c.perimeter()).abs() < 1e-9);
+        // Dropping the first path leaves 30 % of a semicircle uncut.
+        let mut short = route.clone();
+        short.paths.remove(0);
+        let problems = short.problems(&nest, TOL);
+        assert!(
+            matches!(problems[..], [PathRouteError::Gap { length, .. }] if (length - first.length()).abs() < 1e-6),
+            "{problems:?}"
+        );
+    }
+
+    proptest! {
+        /// Squares in a row cut whole in any order from any pierce points: valid, and the
+        /// numbers agree with the route's.
+        #[test]
+        fn whole_contour_routes_stay_valid(order in Just((0..6usize).collect::<Vec<_>>()).prop_shuffle(), fractions in prop::collection::vec(0.0..1.0f64, 6)) {
+            let nest = Nest {
+                sheet: None,
+                parts: (0..6).map(|i| part(vec![rect(i as f64 * 15.0, 0.0, i as f64 * 15.0 + 10.0, 7.0)])).collect(),
+            };
+            let steps = order.iter().map(|&i| {
+                let r = ContourRef { part: i, contour: 0 };
+                let c = nest.contour(r).unwrap();
+                CutStep::pierced(r, c.point_at_length(fractions[i] * c.perimeter()).unwrap())
+            }).collect();
+            let route = Route { start: p(-5.0, -5.0), steps, finish: None };
+            let paths = PathRoute::from_route(&route, &nest).unwrap();
+            prop_assert_eq!(paths.problems(&nest, TOL), vec![]);
+            prop_assert!((paths.cut_length() - route.cut_length(&nest)).abs() < 1e-9);
+            prop_assert!((paths.idle_length() - route.idle_length()).abs() < 1e-9);
+        }
+    }
+}
