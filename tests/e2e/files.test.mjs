@@ -97,6 +97,18 @@ test('a PCGTSP instance with its PCGLNS result: the tour is checked; a bad tour 
   assert.match(await alert(page).textContent(), /^bad\.pcglns\.result\.txt: the tour is not feasible for E1X_6_01\.pcgtsp: arc \d+ -> \d+ is forbidden/);
   assert.match(await page.textContent('#file-name'), /E1X_6_01\.pcglns\.result\.txt/, 'the checked tour stays open');
 
+  // Drag and drop works the same as the picker: the instance and its result dropped together.
+  const dropped = await page.evaluateHandle(([a, b]) => {
+    const transfer = new DataTransfer();
+    transfer.items.add(new File([a.text], a.name));
+    transfer.items.add(new File([b.text], b.name));
+    return transfer;
+  }, [instance, result].map((f) => ({ name: path.basename(f), text: fs.readFileSync(f, 'utf8') })));
+  await page.setInputFiles('#file-input', instance);
+  await fileShown(page, 'E1X_6_01.pcgtsp (PCGTSP instance)');
+  await page.dispatchEvent('section.view', 'drop', { dataTransfer: dropped });
+  await fileShown(page, 'E1X_6_01.pcgtsp + E1X_6_01.pcglns.result.txt (PCGTSP instance + PCGLNS result)');
+
   // A result alone says what it needs.
   await page.setInputFiles('#file-input', result);
   await page.waitForFunction(() => /holds only a tour/.test(document.querySelector('.error[role=alert]')?.textContent));

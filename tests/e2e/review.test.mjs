@@ -154,10 +154,22 @@ test('every export downloads a file that our readers open again', async () => {
     assert.ok(fs.statSync(target).size > 0, `${button} wrote ${target}`);
     return target;
   };
-  const svg = fs.readFileSync(await download('#export-svg'), 'utf8');
+  const svgFile = await download('#export-svg');
+  const svg = fs.readFileSync(svgFile, 'utf8');
   assert.match(svg, /^<\?xml[^>]*>\n<svg[^>]*xmlns="http:\/\/www.w3.org\/2000\/svg"/);
   assert.equal((svg.match(/class="part"/g) ?? []).length, 8, 'the view\'s 8 parts');
   assert.match(svg, /<style>/);
+  // The browser's XML parser reads it back (a parse error would show as <parsererror>) with
+  // the drawing and the route the app showed.
+  const svgViewer = await context.newPage();
+  await svgViewer.goto(`file://${svgFile}`);
+  const parsed = await svgViewer.evaluate(() => ({
+    root: document.documentElement.localName,
+    errors: document.getElementsByTagName('parsererror').length,
+    parts: document.querySelectorAll('.part').length,
+  }));
+  assert.deepEqual(parsed, { root: 'svg', errors: 0, parts: 8 });
+  await svgViewer.close();
 
   const files = {
     result: await download('#export-result'),
