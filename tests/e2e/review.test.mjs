@@ -267,13 +267,17 @@ test('Continue restarts from the best result; kept results are compared and over
   await context.close();
 });
 
-for (const [width, height] of [[1024, 768], [1920, 1080]]) {
+for (const [width, height] of [[1024, 768], [1920, 1080], [3840, 2160]]) {
   test(`keyboard only and layout at ${width}×${height}`, async () => {
     const { page, errors, context } = await freshPage({ width, height });
     await fileShown(page, 'E1X_6_01');
     // No horizontal scroll.
     const scroll = await page.evaluate(() => [document.documentElement.scrollWidth, document.documentElement.clientWidth]);
     assert.ok(scroll[0] <= scroll[1], `no horizontal scroll: ${scroll}`);
+    // The drawing takes the room the screen gives it (a projector's too).
+    const drawing = await page.locator('#nest-view').boundingBox();
+    assert.ok(drawing.width >= width * 0.5 && drawing.height >= height * 0.4,
+      `drawing ${drawing.width}×${drawing.height} on ${width}×${height}`);
     // Every control has a label (label element, aria-label, title or text).
     const unlabelled = await page.evaluate(() => [...document.querySelectorAll('input, select, button, textarea')]
       .filter((e) => !(e.labels?.length || e.getAttribute('aria-label') || e.title || e.textContent.trim()))
