@@ -89,6 +89,23 @@ test('the theme switch restyles the page and survives a reload', async () => {
   await fileShown(page, 'E1X_6_01');
   assert.equal(await page.evaluate(() => document.documentElement.dataset.theme), 'dark', 'remembered');
   assert.equal(await page.locator('#theme').inputValue(), 'dark');
+  // Every theme offered applies and tells cut and idle moves apart (by colour, or by dashes
+  // where print is black only).
+  const themes = await page.locator('#theme option').evaluateAll((options) => options.map((o) => o.value));
+  assert.ok(themes.length >= 4, `themes: ${themes}`);
+  await page.selectOption('#solver', 'nearest');
+  await page.click('#start');
+  await page.waitForFunction(() => document.querySelector('#job-status')?.textContent === 'finished');
+  for (const theme of themes) {
+    await page.selectOption('#theme', theme);
+    assert.equal(await page.evaluate(() => document.documentElement.dataset.theme), theme);
+    const [cut, idle] = await page.evaluate(() => ['path.cut', 'path.idle'].map((s) => {
+      const style = getComputedStyle(document.querySelector(`#nest-view .route ${s}`));
+      return `${style.stroke} dashes ${style.strokeDasharray}`;
+    }));
+    assert.notEqual(cut, idle, `${theme}: cut ${cut} vs idle ${idle}`);
+    await screenshot(page, `theme-${theme}.png`);
+  }
 });
 
 test('the exact solver reports both bounds and the chart draws them', async () => {
