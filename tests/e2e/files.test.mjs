@@ -232,3 +232,19 @@ test('the chain solver runs and its G-code (links included) reads back as the sa
   assert.deepEqual(errors, []);
   await context.close();
 });
+
+test('every bundled sample of the gallery opens and solves', async () => {
+  const { page, errors, context } = await freshPage();
+  const samples = await page.locator('#sample option').evaluateAll((options) => options.map((o) => o.value));
+  assert.ok(samples.length >= 4, `samples: ${samples}`);
+  for (const sample of samples) {
+    await page.selectOption('#sample', sample);
+    await fileShown(page, sample);
+    assert.ok(await page.locator('#nest-view path.part').count() > 0, `${sample} draws parts`);
+    await solve(page, 'nearest');
+    const contours = await page.evaluate(() => (document.querySelector('#nest-view path.arrows')?.getAttribute('d')?.match(/M/g) ?? []).length);
+    assert.equal(Number(await page.textContent('#pierces')), contours, `${sample}: one pierce per contour`);
+  }
+  assert.deepEqual(errors, []);
+  await context.close();
+});
