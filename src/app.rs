@@ -144,8 +144,9 @@ pub fn App() -> impl IntoView {
         None => update,
     };
 
-    let bridge: StoredValue<WorkerBridge<SolverWorker>, LocalStorage> =
-        StoredValue::new_local(spawn(move |message| match message {
+    // Kept so a worker stuck in a long step can be replaced (see `stop`).
+    let on_message: StoredValue<std::rc::Rc<dyn Fn(FromWorker)>, LocalStorage> =
+        StoredValue::new_local(std::rc::Rc::new(move |message: FromWorker| match message {
             FromWorker::Opened {
                 document: mut opened,
                 ..
@@ -200,6 +201,12 @@ pub fn App() -> impl IntoView {
                 }
             }
         }));
+    let spawn_worker = move || {
+        let on_message = on_message.get_value();
+        spawn(move |message| on_message(message))
+    };
+    let bridge: StoredValue<WorkerBridge<SolverWorker>, LocalStorage> =
+        StoredValue::new_local(spawn_worker());
 
     let shown_nest = Memo::new(move |_| {
         document.with(|d| match d.as_ref().map(|d| &d.problem) {
@@ -360,6 +367,19 @@ pub fn App() -> impl IntoView {
     let stop = move |_| {
         if let JobState::Running(job_id) = job_state.get_untracked() {
             bridge.with_value(|b| b.send(WorkerRequest::Protocol(ToWorker::Cancel { job_id })));
+            // The worker answers between solver steps; a step that runs long (a big chain
+            // group, a bound build) would hold Stop up. After 200 ms the job is dropped with
+            // the best result already received and a fresh worker takes over (the old one is
+            // told to close, and its late messages name a job that is no longer running).
+            set_timeout(
+                move || {
+                    if job_state.get_untracked() == JobState::Running(job_id) {
+                        bridge.set_value(spawn_worker());
+                        job_state.set(JobState::Cancelled);
+                    }
+                },
+                std::time::Duration::from_millis(200),
+            );
         }
     };
     let running = move || matches!(job_state.get(), JobState::Running(_));

@@ -217,82 +217,152 @@ pub fn chain_route(
     route: &Route,
     options: &ChainOptions,
 ) -> Result<Chained, ChainError> {
-    let m = &options.machine;
-    let prices = [
-        m.idle_price_per_metre,
-        m.cut_price_per_metre,
-        m.pierce_price,
-    ];
-    if prices.iter().any(|p| !(p.is_finite() && *p >= 0.0)) {
-        return Err(ChainError::InvalidPrices {
-            idle: prices[0],
-            cut: prices[1],
-            pierce: prices[2],
-        });
-    }
-    let forest = nest.containment_forest();
-    let scale = nest_scale(nest);
-    let tolerance = 1e-6 * scale;
-    if let Some(e) = route.problems(nest, &forest, tolerance).into_iter().next() {
-        return Err(ChainError::InvalidRoute(e));
-    }
-    let mut current = Route {
-        steps: route
-            .steps
-            .iter()
-            .map(|s| CutStep::pierced(s.contour, s.pierce_point))
-            .collect(),
-        ..route.clone()
-    };
-    let mut current_cost = current.cost(nest, m);
-    let context = Context {
-        nest,
-        forest: &forest,
-        machine: m,
-        options,
-        threshold: profitable_link_length(m),
-        scale,
-    };
-    for (parent, siblings) in scrap_regions(nest, &forest) {
-        if siblings.len() < 2 {
-            continue;
+    let mut chaining = Chaining::new(nest, route, options)?;
+    while !chaining.step(nest, options, &|| false) {}
+    Ok(chaining.finish(nest, options))
+}
+
+/// [`chain_route`] in resumable slices, so a caller that must stay responsive (the app's
+/// worker answers Stop between slices) can interleave: [`Chaining::new`], then
+/// [`Chaining::step`] until it returns `true`, then [`Chaining::finish`]. The unit of work is
+/// one group of close contours; pass the same `nest` and `options` to every call.
+pub struct Chaining {
+    original: Route,
+    current: Route,
+    current_cost: f64,
+    forest: ContainmentForest,
+    scale: f64,
+    regions: Vec<(Option<ContourRef>, Vec<ContourRef>)>,
+    /// The region being worked on and its groups still to try (reversed: next is last).
+    region: usize,
+    groups: Option<Vec<Vec<ContourRef>>>,
+}
+
+impl Chaining {
+    /// Checks the prices and the route (as [`chain_route`] does) and plans the work.
+    pub fn new(nest: &Nest, route: &Route, options: &ChainOptions) -> Result<Self, ChainError> {
+        let m = &options.machine;
+        let prices = [
+            m.idle_price_per_metre,
+            m.cut_price_per_metre,
+            m.pierce_price,
+        ];
+        if prices.iter().any(|p| !(p.is_finite() && *p >= 0.0)) {
+            return Err(ChainError::InvalidPrices {
+                idle: prices[0],
+                cut: prices[1],
+                pierce: prices[2],
+            });
         }
-        // Far stricter than the checker's tolerance, so every link the region accepts passes
-        // `Route::validate` (a crossing near but not at a link's end is a crossing).
-        let region = Region::new(nest, parent, &siblings, options.clearance_mm, 1e-9 * scale);
-        for group in close_groups(nest, &siblings, context.threshold) {
-            if group.len() < 2 {
+        let forest = nest.containment_forest();
+        let scale = nest_scale(nest);
+        let tolerance = 1e-6 * scale;
+        if let Some(e) = route.problems(nest, &forest, tolerance).into_iter().next() {
+            return Err(ChainError::InvalidRoute(e));
+        }
+        let current = Route {
+            steps: route
+                .steps
+                .iter()
+                .map(|s| CutStep::pierced(s.contour, s.pierce_point))
+                .collect(),
+            ..route.clone()
+        };
+        let current_cost = current.cost(nest, m);
+        let regions = scrap_regions(nest, &forest);
+        Ok(Chaining {
+            original: route.clone(),
+            current,
+            current_cost,
+            forest,
+            scale,
+            regions,
+            region: 0,
+            groups: None,
+        })
+    }
+
+    /// Tries groups of close contours until all are done (`true`) or `stop()` says so after a
+    /// group (`false`: call again).
+    pub fn step(&mut self, nest: &Nest, options: &ChainOptions, stop: &dyn Fn() -> bool) -> bool {
+        let m = &options.machine;
+        let context = Context {
+            nest,
+            forest: &self.forest,
+            machine: m,
+            options,
+            threshold: profitable_link_length(m),
+            scale: self.scale,
+        };
+        while self.region < self.regions.len() {
+            let (parent, siblings) = &self.regions[self.region];
+            if siblings.len() < 2 {
+                self.region += 1;
                 continue;
             }
-            let candidate = context.chain_group(&current, &group, &region);
+            let groups = self.groups.get_or_insert_with(|| {
+                let mut groups: Vec<_> = close_groups(nest, siblings, context.threshold)
+                    .into_iter()
+                    .filter(|g| g.len() >= 2)
+                    .collect();
+                groups.reverse();
+                groups
+            });
+            let Some(group) = groups.pop() else {
+                self.groups = None;
+                self.region += 1;
+                continue;
+            };
+            // Far stricter than the checker's tolerance, so every link the region accepts
+            // passes `Route::validate` (a crossing near but not at a link's end is a crossing).
+            // Rebuilt per group: cheap (boxes of the siblings), and it borrows the nest.
+            let region = Region::new(
+                nest,
+                *parent,
+                siblings,
+                options.clearance_mm,
+                1e-9 * self.scale,
+            );
+            let candidate = context.chain_group(&self.current, &group, &region);
             let cost = candidate.cost(nest, m);
-            if cost < current_cost - 1e-12 * current_cost.abs().max(1.0) {
-                current = candidate;
-                current_cost = cost;
+            if cost < self.current_cost - 1e-12 * self.current_cost.abs().max(1.0) {
+                self.current = candidate;
+                self.current_cost = cost;
+            }
+            if stop() {
+                return self.region >= self.regions.len();
             }
         }
+        true
     }
-    let chains = current
-        .steps
-        .windows(2)
-        .filter(|w| w[0].is_pierced() && !w[1].is_pierced())
-        .count();
-    let report = ChainReport {
-        pierces_before: route.pierce_count(),
-        pierces_after: current.pierce_count(),
-        chains,
-        link_length: current.link_length(),
-        idle_before: route.idle_length(),
-        idle_after: current.idle_length(),
-        cost_before: route.cost(nest, m),
-        cost_after: current_cost,
-        time_before: route.time(nest, m),
-        time_after: current.time(nest, m),
-    };
-    Ok(Chained {
-        route: current,
-        report,
-    })
+
+    /// The chained route and its report (all groups tried or not: the route is valid after
+    /// every group).
+    pub fn finish(self, nest: &Nest, options: &ChainOptions) -> Chained {
+        let m = &options.machine;
+        let (route, current) = (self.original, self.current);
+        let chains = current
+            .steps
+            .windows(2)
+            .filter(|w| w[0].is_pierced() && !w[1].is_pierced())
+            .count();
+        let report = ChainReport {
+            pierces_before: route.pierce_count(),
+            pierces_after: current.pierce_count(),
+            chains,
+            link_length: current.link_length(),
+            idle_before: route.idle_length(),
+            idle_after: current.idle_length(),
+            cost_before: route.cost(nest, m),
+            cost_after: self.current_cost,
+            time_before: route.time(nest, m),
+            time_after: current.time(nest, m),
+        };
+        Chained {
+            route: current,
+            report,
+        }
+    }
 }
 
 /// The scrap regions with their contours: the sheet with the top-level contours, and every

@@ -351,3 +351,27 @@ fn tflex_nests_with_touching_parts_chain_validly() {
         }
     }
 }
+
+#[test]
+fn chaining_in_slices_of_one_group_gives_the_same_route() {
+    for path in ["dbs/nested.dbs", "dbs/seven.dbs", "dbs-json/test1.dbs.json"] {
+        let nest = read_nest(path);
+        let route = plain_route(&nest, Point::new(0.0, 0.0));
+        let options = ChainOptions {
+            machine: TABLE1_MATERIALS[1].priced(&MachineParameters::default()),
+            ..ChainOptions::default()
+        };
+        let whole = chain_route(&nest, &route, &options).unwrap();
+        let mut chaining = cutroute_chains::Chaining::new(&nest, &route, &options).unwrap();
+        let mut slices = 1;
+        // Stop after every group: each call does exactly one group of close contours.
+        while !chaining.step(&nest, &options, &|| true) {
+            slices += 1;
+        }
+        let sliced = chaining.finish(&nest, &options);
+        assert_eq!(sliced.route, whole.route, "{path}");
+        assert_eq!(sliced.report, whole.report, "{path}");
+        assert!(slices > 1, "{path}: one slice only");
+        check(&nest, &sliced.route);
+    }
+}

@@ -2,7 +2,7 @@
 
 use cutroute_alns::{AlnsOptions, AlnsSolver};
 use cutroute_ccp::{CcpOptions, CcpSolver, DiscreteInstance};
-use cutroute_chains::{chain_route, ChainOptions, Chained};
+use cutroute_chains::{ChainOptions, Chained, Chaining};
 use cutroute_geometry::{MachineParameters, Nest, Route};
 use cutroute_pcgtsp::{ExactOptions, ExactSolver, Instance};
 use cutroute_protocol::{JobId, Progress};
@@ -252,6 +252,8 @@ pub struct ChainJob {
     ccp: CcpJob,
     nest: Nest,
     options: ChainOptions,
+    /// Chain cutting under way, in slices of close-contour groups (Stop stays responsive).
+    chaining: Option<Chaining>,
     chained: Option<Chained>,
     failure: Option<String>,
     started: Instant,
@@ -267,6 +269,7 @@ impl ChainJob {
                 machine,
                 ..ChainOptions::default()
             },
+            chaining: None,
             chained: None,
             failure: None,
             started: Instant::now(),
@@ -279,17 +282,29 @@ impl Job for ChainJob {
         if self.chained.is_some() || self.failure.is_some() {
             return JobStatus::Done;
         }
-        if self.ccp.step(budget) == JobStatus::Running {
+        let deadline = Instant::now() + budget;
+        if self.chaining.is_none() {
+            if self.ccp.step(budget) == JobStatus::Running {
+                return JobStatus::Running;
+            }
+            let Some(route) = self.ccp.progress().route else {
+                self.failure = Some("CCP found no route to chain".into());
+                return JobStatus::Done;
+            };
+            match Chaining::new(&self.nest, &route, &self.options) {
+                Ok(chaining) => self.chaining = Some(chaining),
+                Err(e) => {
+                    self.failure = Some(e.to_string());
+                    return JobStatus::Done;
+                }
+            }
+        }
+        let chaining = self.chaining.as_mut().expect("set above");
+        if !chaining.step(&self.nest, &self.options, &|| Instant::now() >= deadline) {
             return JobStatus::Running;
         }
-        let Some(route) = self.ccp.progress().route else {
-            self.failure = Some("CCP found no route to chain".into());
-            return JobStatus::Done;
-        };
-        match chain_route(&self.nest, &route, &self.options) {
-            Ok(chained) => self.chained = Some(chained),
-            Err(e) => self.failure = Some(e.to_string()),
-        }
+        let chaining = self.chaining.take().expect("set above");
+        self.chained = Some(chaining.finish(&self.nest, &self.options));
         JobStatus::Done
     }
 
@@ -312,6 +327,8 @@ impl Job for ChainJob {
             progress.certified = Vec::new();
         } else if let Some(failure) = &self.failure {
             progress.phase = format!("chain cutting failed: {failure}; CCP route kept");
+        } else if self.chaining.is_some() {
+            progress.phase = "chain cutting: joining close contours".into();
         } else if !progress.phase.is_empty() {
             progress.phase = format!("ccp: {}", progress.phase);
         }

@@ -192,3 +192,29 @@ fn bad_files_give_located_errors() {
         .to_string();
     assert!(unknown.contains("unknown format"), "{unknown}");
 }
+
+#[test]
+fn the_chain_job_chains_in_short_slices_and_reports_the_phase() {
+    let (name, bytes) = data("nests/dbs/seven.dbs");
+    let document = open_document(&name, &bytes).expect("opens");
+    let request = JobRequest {
+        job_id: 3,
+        problem: document.problem.clone(),
+        solver: SolverKind::Chain,
+        params: SolverParams {
+            time_limit_s: 0.5,
+            ..SolverParams::default()
+        },
+    };
+    let mut job = start_job(&request).expect("starts");
+    let mut chaining_slices = 0;
+    while job.step(Duration::from_millis(1)) == JobStatus::Running {
+        if job.progress().phase.starts_with("chain cutting:") {
+            chaining_slices += 1;
+        }
+    }
+    assert!(chaining_slices >= 1, "chaining ran in one blocking step");
+    let result = job.progress();
+    assert!(result.phase.starts_with("chained:"), "{}", result.phase);
+    check_route(&document.problem, &result);
+}
