@@ -1,24 +1,10 @@
 //! Nest geometry to plane graph on hand-made plans whose graph is known.
 
+mod common;
+
+use common::{part, rect};
 use cutroute_aoe::{aoe_chain, check_chain, AoeOptions, PlanGraph, PlanOptions};
 use cutroute_geometry::{Contour, Nest, Part, Point, Vertex};
-
-fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> Contour {
-    // Clockwise, as outer contours run.
-    Contour::new(vec![
-        Vertex::line(x0, y0),
-        Vertex::line(x0, y1),
-        Vertex::line(x1, y1),
-        Vertex::line(x1, y0),
-    ])
-}
-
-fn part(contours: Vec<Contour>) -> Part {
-    Part {
-        name: String::new(),
-        contours,
-    }
-}
 
 fn nest(parts: Vec<Part>) -> Nest {
     Nest { sheet: None, parts }

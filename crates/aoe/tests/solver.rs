@@ -3,35 +3,9 @@
 
 mod common;
 
-use common::{load_nest, REAL_NESTS};
+use common::{hole, load_nest, part, rect, REAL_NESTS};
 use cutroute_aoe::{solve_nest, AoeSolveOptions, PlanGraph, PlanOptions};
-use cutroute_geometry::{Contour, Nest, Part, Point, Vertex};
-
-/// A clockwise rectangle (outer contours run clockwise, holes counter-clockwise).
-fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> Contour {
-    Contour::new(vec![
-        Vertex::line(x0, y0),
-        Vertex::line(x0, y1),
-        Vertex::line(x1, y1),
-        Vertex::line(x1, y0),
-    ])
-}
-
-fn hole(x0: f64, y0: f64, x1: f64, y1: f64) -> Contour {
-    Contour::new(vec![
-        Vertex::line(x0, y0),
-        Vertex::line(x1, y0),
-        Vertex::line(x1, y1),
-        Vertex::line(x0, y1),
-    ])
-}
-
-fn part(contours: Vec<Contour>) -> Part {
-    Part {
-        name: String::new(),
-        contours,
-    }
-}
+use cutroute_geometry::{Nest, Point};
 
 /// `n × m` rectangles of `w × h` sharing their edges.
 fn grid(n: usize, m: usize, w: f64, h: f64) -> Nest {

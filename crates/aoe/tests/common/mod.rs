@@ -2,8 +2,36 @@
 #![allow(dead_code)]
 
 use cutroute_aoe::{edge_list, Embedding};
-use cutroute_geometry::Nest;
+use cutroute_geometry::{Contour, Nest, Part, Vertex};
 use std::path::PathBuf;
+
+/// An axis-parallel rectangle, clockwise as outer contours run.
+pub fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> Contour {
+    Contour::new(vec![
+        Vertex::line(x0, y0),
+        Vertex::line(x0, y1),
+        Vertex::line(x1, y1),
+        Vertex::line(x1, y0),
+    ])
+}
+
+/// An axis-parallel rectangle, counter-clockwise as holes run.
+pub fn hole(x0: f64, y0: f64, x1: f64, y1: f64) -> Contour {
+    Contour::new(vec![
+        Vertex::line(x0, y0),
+        Vertex::line(x1, y0),
+        Vertex::line(x1, y1),
+        Vertex::line(x0, y1),
+    ])
+}
+
+/// A nameless part.
+pub fn part(contours: Vec<Contour>) -> Part {
+    Part {
+        name: String::new(),
+        contours,
+    }
+}
 
 /// A nest of `shared/data/nests` by its path there; panics loudly when the file is missing.
 pub fn load_nest(relative: &str) -> Nest {
