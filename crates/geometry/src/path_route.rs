@@ -215,8 +215,10 @@ fn overlaps(contour_span: &Span, route_span: &Span, tolerance: f64) -> Vec<Overl
     pieces_on(contour_span, route_span, tolerance)
         .into_iter()
         .map(|(a, b)| {
-            let ta = route_span.parameter_of(contour_span.point_at(a));
-            let tb = route_span.parameter_of(contour_span.point_at(b));
+            // Not `Span::parameter_of`: for arcs of |φ| ≥ 1 it can wrap a point at the start
+            // round to 2π/φ; the nearest point compares with the ends.
+            let ta = route_span.nearest_point(contour_span.point_at(a)).t;
+            let tb = route_span.nearest_point(contour_span.point_at(b)).t;
             Overlap {
                 a,
                 b,
