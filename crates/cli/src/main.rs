@@ -663,6 +663,7 @@ fn solve_segments(
             start: *start,
             finish: *finish,
             time_limit: std::time::Duration::from_secs_f64(params.time_limit_s),
+            seed: params.seed,
             ..SccpOptions::default()
         },
         kinds,

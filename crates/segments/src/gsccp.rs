@@ -25,8 +25,9 @@ pub enum Objective {
 /// Settings of [`solve_gsccp`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct GsccpOptions {
-    /// Start, finish, time limit (for everything: the CCP run that seeds the orders and every
-    /// ensemble) and search settings.
+    /// Start, finish, time limit (for everything: the CCP run that seeds the orders, then the
+    /// ensembles in turn, sharing what is left 1 : 3 : 2 for standard, chains and junctions)
+    /// and search settings.
     pub sccp: SccpOptions,
     /// The ensembles to build and solve.
     pub kinds: Vec<EnsembleKind>,
@@ -142,9 +143,16 @@ pub fn solve_gsccp(
     let machine = &options.machine;
     let mut reports = Vec::new();
     let mut best: Option<(f64, EnsembleKind, PathRoute)> = None;
+    // Standard cutting starts from CCP-Relax's own local optimum: it needs the least time.
+    let weight = |kind: EnsembleKind| match kind {
+        EnsembleKind::Standard => 1.0,
+        EnsembleKind::Chains => 3.0,
+        EnsembleKind::Junctions => 2.0,
+    };
     for (k, &kind) in options.kinds.iter().enumerate() {
         let left = limit.saturating_sub(started.elapsed());
-        let share = left.div_f64((options.kinds.len() - k) as f64);
+        let remaining: f64 = options.kinds[k..].iter().map(|&x| weight(x)).sum();
+        let share = left.mul_f64(weight(kind) / remaining);
         let mut report = EnsembleReport {
             kind,
             segments: 0,

@@ -7,14 +7,18 @@
 //! segment to its cheaper direction, until a sweep gains less than δ. The order is improved by
 //! block re-insertion (Or-opt, blocks of 1 to `max_block` segments, at the places next to the k
 //! nearest segments, single open segments in both directions, single closed ones with their
-//! point relaxed at the new place), always respecting the ensemble's precedence; sweeps and
-//! moves alternate until neither gains, the time is up or the cancel flag is raised.
+//! point relaxed at the new place) and block reversal (2-opt: open segments in the block
+//! change direction, so only the two joints change length), always respecting the ensemble's
+//! precedence; sweeps and moves alternate to a local optimum. Then VNS: random block moves in
+//! a window shake the best order, descent follows, and the result is kept only if shorter,
+//! until `max_non_improving_shakes` shakes in a row fail, the time is up or the cancel flag is
+//! raised.
 
 use std::collections::{BinaryHeap, HashMap};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
-use cutroute_geometry::{ContourRef, PathRoute, Point, Route, Span, ToolOnPath};
+use cutroute_geometry::{ContourRef, PathRoute, Point, Route, Span, SplitMix64, ToolOnPath};
 use web_time::Instant;
 
 use crate::segment::{Ensemble, Segment};
@@ -37,6 +41,14 @@ pub struct SccpOptions {
     pub delta: f64,
     /// Most relaxation sweeps in a row.
     pub max_relaxation_sweeps: usize,
+    /// Longest block reversed at once (2-opt; open segments in it change direction).
+    pub max_reversal: usize,
+    /// The search stops after this many shakes in a row that did not improve the best route.
+    pub max_non_improving_shakes: usize,
+    /// Most random block moves in one shake.
+    pub max_shake_strength: usize,
+    /// Seed of the shakes.
+    pub seed: u64,
 }
 
 impl Default for SccpOptions {
@@ -49,6 +61,10 @@ impl Default for SccpOptions {
             max_block: 3,
             delta: 1e-6,
             max_relaxation_sweeps: 1000,
+            max_reversal: 50,
+            max_non_improving_shakes: 100,
+            max_shake_strength: 4,
+            seed: 1,
         }
     }
 }
@@ -64,9 +80,11 @@ pub struct SccpSolution {
     pub idle_length: f64,
     /// Idle length of the first order after its first relaxation, mm.
     pub initial_idle_length: f64,
-    /// Whether the search stopped at the time limit or the cancel flag rather than at a local
-    /// optimum.
+    /// Whether the search stopped at the time limit or the cancel flag rather than after
+    /// `max_non_improving_shakes` fruitless shakes.
     pub interrupted: bool,
+    /// Shakes tried.
+    pub shakes: usize,
 }
 
 /// Where the tool enters and leaves a segment.
@@ -443,6 +461,121 @@ impl Search<'_> {
         true
     }
 
+    /// One pass of block reversal (2-opt): the block from position `i` to a position `j`
+    /// where the segment before `i` has a near neighbour is cut backwards, open segments
+    /// flipped; only the two joints change. Returns whether some reversal gained.
+    fn two_opt_pass(&mut self) -> bool {
+        let mut improved = false;
+        let n = self.order.len();
+        for i in 0..n {
+            if self.stopped() {
+                break;
+            }
+            let p = self.before_point(i);
+            let first = self.order[i];
+            let anchors: Vec<usize> = match i.checked_sub(1) {
+                Some(k) => self.neighbours[self.order[k]].clone(),
+                None => self.neighbours[first].clone(),
+            };
+            let mut best: Option<(f64, usize)> = None;
+            for c in anchors {
+                let j = self.pos[c];
+                if j <= i || j - i + 1 > self.options.max_reversal {
+                    continue;
+                }
+                let last = self.order[j];
+                let next = self.after_point(j);
+                let old = p.distance(self.entry(first))
+                    + next.map_or(0.0, |q| self.exit(last).distance(q));
+                let new = p.distance(self.exit(last))
+                    + next.map_or(0.0, |q| self.entry(first).distance(q));
+                let delta = new - old;
+                if delta < -1e-9 && best.is_none_or(|b| delta < b.0) && self.can_reverse(i, j) {
+                    best = Some((delta, j));
+                }
+            }
+            if let Some((_, j)) = best {
+                self.reverse(i, j);
+                improved = true;
+            }
+        }
+        improved
+    }
+
+    /// No precedence pair inside positions `[i, j]`.
+    fn can_reverse(&self, i: usize, j: usize) -> bool {
+        self.order[i..=j]
+            .iter()
+            .all(|&b| self.after[b].iter().all(|&x| self.pos[x] > j))
+    }
+
+    fn reverse(&mut self, i: usize, j: usize) {
+        self.order[i..=j].reverse();
+        for k in i..=j {
+            let s = self.order[k];
+            self.pos[s] = k;
+            if let Place::Open { reversed } = self.place[s] {
+                self.place[s] = Place::Open {
+                    reversed: !reversed,
+                };
+            }
+        }
+    }
+
+    /// Descends to a local optimum of relaxation, block moves and reversals.
+    fn descend(&mut self) {
+        loop {
+            if self.stopped() {
+                return;
+            }
+            let moved = self.or_opt_pass();
+            let reversed = self.two_opt_pass();
+            let relaxed = self.relax_full();
+            if !moved && !reversed && relaxed < self.options.delta {
+                return;
+            }
+        }
+    }
+
+    /// Random block moves to valid places within a window of the order.
+    fn shake(&mut self, rng: &mut SplitMix64) {
+        let n = self.order.len();
+        if n < 3 {
+            return;
+        }
+        let strength = 1 + rng.below(self.options.max_shake_strength.max(1) as u64) as usize;
+        for _ in 0..strength {
+            let len = 1 + rng.below(self.options.max_block.clamp(1, n - 1) as u64) as usize;
+            let i = rng.below((n - len + 1) as u64) as usize;
+            let window = 10usize;
+            let lo = i.saturating_sub(window);
+            let hi = (i + len + window).min(n - 1);
+            let target = lo + rng.below((hi - lo + 1) as u64) as usize;
+            let j = if target == 0 && rng.below(2) == 0 {
+                None
+            } else {
+                Some(target)
+            };
+            if j == i.checked_sub(1) || j.is_some_and(|j| j >= i && j < i + len) {
+                continue;
+            }
+            if self.can_move(i, len, j) {
+                let block: Vec<usize> = self.order.drain(i..i + len).collect();
+                let at = match j {
+                    None => 0,
+                    Some(j) if j >= i + len => j + 1 - len,
+                    Some(j) => j + 1,
+                };
+                for (k, s) in block.into_iter().enumerate() {
+                    self.order.insert(at + k, s);
+                }
+                for (k, &s) in self.order.iter().enumerate() {
+                    self.pos[s] = k;
+                }
+            }
+        }
+    }
+
     fn route(&self) -> PathRoute {
         let paths = self
             .order
@@ -505,8 +638,9 @@ fn hints(route: &Route) -> HashMap<ContourRef, (usize, Point)> {
 /// Solves one SCCP. The first order follows `hint` (a route of the nest, e.g. CCP-Relax's:
 /// segments sorted by the earliest step that cuts one of their contours, as far as precedence
 /// allows; a closed segment that is one whole contour starts at that step's pierce point);
-/// without a hint, greedy nearest neighbour. Then relaxation and block moves alternate until
-/// neither gains, `options.time_limit` passes or `cancel` is raised.
+/// without a hint, greedy nearest neighbour. Then descent and VNS (see the module notes) until
+/// the shakes stop paying, `options.time_limit` passes or `cancel` is raised; the route is the
+/// best order found with its relaxed points.
 pub fn solve_sccp(
     ensemble: &Ensemble,
     hint: Option<&Route>,
@@ -724,23 +858,39 @@ pub fn solve_sccp(
     };
     search.relax_full();
     let initial_idle_length = search.idle_length();
-    let mut interrupted = false;
-    loop {
-        if search.stopped() {
-            interrupted = true;
-            break;
-        }
-        let moved = search.or_opt_pass();
-        let relaxed = search.relax_full();
-        if !moved && relaxed < options.delta {
-            break;
+    search.descend();
+    // VNS: shake the best order, descend again, keep the result only if shorter.
+    let mut best = (
+        search.idle_length(),
+        search.order.clone(),
+        search.place.clone(),
+    );
+    let mut rng = SplitMix64::new(options.seed);
+    let (mut shakes, mut fruitless) = (0, 0);
+    while fruitless < options.max_non_improving_shakes && !search.stopped() {
+        search.shake(&mut rng);
+        search.descend();
+        shakes += 1;
+        let length = search.idle_length();
+        if length < best.0 - options.delta {
+            best = (length, search.order.clone(), search.place.clone());
+            fruitless = 0;
+        } else {
+            fruitless += 1;
+            search.order.clone_from(&best.1);
+            search.place.clone_from(&best.2);
+            for (k, &s) in search.order.iter().enumerate() {
+                search.pos[s] = k;
+            }
         }
     }
+    let interrupted = fruitless < options.max_non_improving_shakes;
     Ok(SccpSolution {
         route: search.route(),
         idle_length: search.idle_length(),
         order: search.order,
         initial_idle_length,
         interrupted,
+        shakes,
     })
 }
