@@ -1011,6 +1011,41 @@ mod tests {
         );
     }
 
+    /// A ring (plate with a round hole) opened anywhere: the pieces of the semicircles that
+    /// start mid-arc sweep more than a radian, where mapping a point at an arc's start back to
+    /// its parameter once wrapped round to 2π/φ and made covered arc look uncovered.
+    #[test]
+    fn contours_of_arcs_opened_anywhere_are_covered() {
+        let nest = Nest {
+            sheet: None,
+            parts: vec![part(vec![
+                Contour::circle(p(0.0, 0.0), 63.0, true),
+                Contour::circle(p(5.0, 0.0), 20.0, false),
+            ])],
+        };
+        for k in 1..100 {
+            let f = k as f64 / 100.0;
+            let steps = [(1, f), (0, 1.0 - f)]
+                .iter()
+                .map(|&(c, f)| {
+                    let r = ContourRef {
+                        part: 0,
+                        contour: c,
+                    };
+                    let contour = nest.contour(r).unwrap();
+                    CutStep::pierced(r, contour.point_at_length(f * contour.perimeter()).unwrap())
+                })
+                .collect();
+            let route = Route {
+                start: p(0.0, -100.0),
+                steps,
+                finish: None,
+            };
+            let paths = PathRoute::from_route(&route, &nest).unwrap();
+            assert_eq!(paths.problems(&nest, 1e-7), vec![], "f = {f}");
+        }
+    }
+
     proptest! {
         /// Squares in a row cut whole in any order from any pierce points: valid, and the
         /// numbers agree with the route's.
