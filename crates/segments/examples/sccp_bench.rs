@@ -1,16 +1,19 @@
 //! Segment cutting vs plain CCP on every real nest and on synthetic grids of touching
-//! rectangles: per ensemble (standard, chains, junctions) the pierces, lengths, time and cost
-//! of its route, and the one GSCCP keeps. Prints a Markdown table for BENCHMARKS.md.
+//! rectangles. Prints a Markdown table for BENCHMARKS.md: per nest CCP-Relax's route, the
+//! SCCP route (the multi-contour chain ensemble, what `--solver sccp` returns) and the route
+//! GSCCP keeps (`--solver gsccp`); with `--full`, every ensemble's row.
 //!
 //! `cargo run --release -p cutroute-segments --example sccp_bench -- [--seconds S]
-//! [--filter A,B] [--objective time|cost]`
+//! [--filter A,B] [--objective time|cost] [--full]`
 
 use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
 
 use cutroute_geometry::{Nest, Point};
 use cutroute_protocol::Problem;
-use cutroute_segments::{rectangle_grid, solve_gsccp, GsccpOptions, Objective, SccpOptions};
+use cutroute_segments::{
+    rectangle_grid, solve_gsccp, EnsembleKind, GsccpOptions, Objective, SccpOptions,
+};
 
 /// Every nest file of the shared data: DBS, geometry JSON and T-FLEX projects.
 fn nest_files() -> Vec<String> {
@@ -81,8 +84,14 @@ fn main() {
         ));
     }
     println!("GSCCP time limit {seconds} s per nest (half for the CCP-Relax run that seeds every order), objective {objective:?}, default machine parameters.\n");
-    println!("| nest | contours | ensemble | segments | pierces | cut mm | recut mm | idle mm | time s | cost | |");
-    println!("|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---|");
+    let full = args.iter().any(|a| a == "--full");
+    if full {
+        println!("| nest | contours | ensemble | segments | pierces | cut mm | recut mm | idle mm | time s | cost | |");
+        println!("|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---|");
+    } else {
+        println!("| nest | contours | CCP pierces / cut / idle mm | CCP time s / cost | SCCP pierces / cut / idle mm | SCCP time s / cost | GSCCP best | GSCCP pierces / cut / idle mm | GSCCP time s / cost | Δ time | Δ cost | wall s |");
+        println!("|---|---:|---|---|---|---|---|---|---|---:|---:|---:|");
+    }
     for (name, nest, start, finish) in cases {
         if let Some(f) = &filter {
             if !f.iter().any(|x| name.contains(x.as_str())) {
@@ -113,6 +122,48 @@ fn main() {
         let wall = clock.elapsed().as_secs_f64();
         let m = &options.machine;
         let ccp = &result.ccp_route;
+        if !full {
+            let chains = result
+                .reports
+                .iter()
+                .find(|r| r.kind == EnsembleKind::Chains)
+                .expect("every kind is reported");
+            let best = result
+                .reports
+                .iter()
+                .find(|r| r.kind == result.best)
+                .expect("the best is reported");
+            let sccp = match &chains.failure {
+                Some(f) => (format!("failed: {f}"), String::new()),
+                None => (
+                    format!(
+                        "{} / {:.0} / {:.0}",
+                        chains.pierces, chains.cut_length, chains.idle_length
+                    ),
+                    format!("{:.1} / {:.3}", chains.time_s, chains.cost),
+                ),
+            };
+            println!(
+                "| {name} | {} | {} / {:.0} / {:.0} | {:.1} / {:.3} | {} | {} | {} | {} / {:.0} / {:.0} | {:.1} / {:.3} | {:+.1} % | {:+.1} % | {wall:.1} |",
+                nest.contour_count(),
+                ccp.pierce_count(),
+                ccp.cut_length(),
+                ccp.idle_length(),
+                ccp.time(m),
+                ccp.cost(m),
+                sccp.0,
+                sccp.1,
+                best.kind.name(),
+                best.pierces,
+                best.cut_length,
+                best.idle_length,
+                best.time_s,
+                best.cost,
+                100.0 * (best.time_s / ccp.time(m) - 1.0),
+                100.0 * (best.cost / ccp.cost(m) - 1.0),
+            );
+            continue;
+        }
         println!(
             "| {name} | {} | ccp | {} | {} | {:.1} | | {:.1} | {:.1} | {:.3} | |",
             nest.contour_count(),
