@@ -677,13 +677,14 @@ fn solve_segments(
         .map_err(|e| e.to_string())?;
     let route = &result.route;
     let tolerance = 1e-6 * nest_scale(nest);
-    let mut recut_length = 0.0;
-    for problem in route.problems(nest, tolerance) {
-        match problem {
-            cutroute_geometry::PathRouteError::Overlap { length, .. } => recut_length += length,
-            other => return Err(format!("invalid route: {other}")),
-        }
+    let problems = route.problems(nest, tolerance);
+    if let Some(other) = problems
+        .iter()
+        .find(|p| !matches!(p, cutroute_geometry::PathRouteError::Overlap { .. }))
+    {
+        return Err(format!("invalid route: {other}"));
     }
+    let recut_length = cutroute_segments::recut_length(&problems, tolerance);
     let machine = &params.machine;
     let (idle_length, cut_length, pierces) = (
         route.idle_length(),
@@ -694,8 +695,7 @@ fn solve_segments(
         "solver": solver_name,
         "idle_length": idle_length,
         "cut_length": cut_length,
-        // Both contours of a common edge report a doubled piece.
-        "recut_length": 0.5 * recut_length,
+        "recut_length": recut_length,
         "pierces": pierces,
         "time_s": machine.time(cut_length, idle_length, pierces),
         "cost": machine.cost(cut_length, idle_length, pierces),

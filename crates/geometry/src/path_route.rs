@@ -98,15 +98,20 @@ pub enum PathRouteError {
         /// Its length along the contour, mm.
         length: f64,
     },
-    /// Part of a contour's boundary is cut more than once.
-    #[error("{length} mm of contour {contour:?} from ({x}, {y}) are cut more than once")]
+    /// Part of a contour's boundary is cut more than once. A common edge cut twice is reported
+    /// on both its contours, with the ends swapped when they run opposite ways.
+    #[error("{length} mm of contour {contour:?} from ({x}, {y}) to ({to_x}, {to_y}) are cut more than once")]
     Overlap {
         /// The contour.
         contour: ContourRef,
-        /// Where the doubly cut piece starts, x.
+        /// Where the doubly cut piece starts (in the contour's direction), x.
         x: f64,
         /// Its y.
         y: f64,
+        /// Where it ends, x.
+        to_x: f64,
+        /// Its y.
+        to_y: f64,
         /// Its length along the contour, mm.
         length: f64,
     },
@@ -470,10 +475,13 @@ impl PathRoute {
                         length: a - reach,
                     });
                 } else if reach - a > tolerance {
+                    let to = point_at_length(reach.min(b));
                     problems.push(PathRouteError::Overlap {
                         contour: refs[c],
                         x: pa.x,
                         y: pa.y,
+                        to_x: to.x,
+                        to_y: to.y,
                         length: reach.min(b) - a,
                     });
                 }

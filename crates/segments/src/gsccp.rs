@@ -185,15 +185,8 @@ pub fn solve_gsccp(
                 // Cutting a piece of contour twice wastes time but harms nothing: such
                 // routes compete with their true cost. Anything else disqualifies.
                 let mut problems = route.problems(nest, tolerance);
-                problems.retain(|p| match p {
-                    PathRouteError::Overlap { length, .. } => {
-                        report.recut_length += length;
-                        false
-                    }
-                    _ => true,
-                });
-                // Both contours of a common edge report it.
-                report.recut_length *= 0.5;
+                report.recut_length = recut_length(&problems, tolerance);
+                problems.retain(|p| !matches!(p, PathRouteError::Overlap { .. }));
                 match problems.first() {
                     Some(problem) => {
                         report.failure = Some(format!("the route fails the check: {problem}"))
@@ -231,6 +224,37 @@ pub fn solve_gsccp(
         reports,
         ccp_route,
     })
+}
+
+/// Length cut more than once among `problems` (their [`PathRouteError::Overlap`]s), each
+/// piece once: a common edge cut twice is reported on both its contours (same ends, perhaps
+/// swapped, within `tolerance`) and counted once.
+pub fn recut_length(problems: &[PathRouteError], tolerance: f64) -> f64 {
+    let mut seen: Vec<(f64, f64, f64, f64)> = Vec::new();
+    let mut total = 0.0;
+    for p in problems {
+        let PathRouteError::Overlap {
+            x,
+            y,
+            to_x,
+            to_y,
+            length,
+            ..
+        } = *p
+        else {
+            continue;
+        };
+        let near = |a: f64, b: f64, c: f64, d: f64| (a - c).hypot(b - d) <= tolerance;
+        let repeated = seen.iter().any(|&(sx, sy, tx, ty)| {
+            (near(x, y, sx, sy) && near(to_x, to_y, tx, ty))
+                || (near(x, y, tx, ty) && near(to_x, to_y, sx, sy))
+        });
+        if !repeated {
+            seen.push((x, y, to_x, to_y));
+            total += length;
+        }
+    }
+    total
 }
 
 fn run_ccp(nest: &Nest, options: CcpOptions, cancel: &AtomicBool) -> Result<Route, SegmentError> {

@@ -51,7 +51,7 @@ mod gsccp;
 mod segment;
 mod solver;
 
-pub use gsccp::{solve_gsccp, EnsembleReport, GsccpOptions, GsccpResult, Objective};
+pub use gsccp::{recut_length, solve_gsccp, EnsembleReport, GsccpOptions, GsccpResult, Objective};
 pub use segment::{Ensemble, EnsembleKind, Segment};
 pub use solver::{solve_sccp, SccpOptions, SccpSolution};
 

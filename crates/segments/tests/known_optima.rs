@@ -54,10 +54,17 @@ fn a_row_of_touching_rectangles_cuts_each_common_edge_once_from_k_minus_one_pier
         assert_eq!(route.pierce_count(), k);
         assert!((route.cut_length() - k as f64 * 2.0 * (w + h)).abs() < 1e-9);
         // Each doubled edge is reported on both its contours.
-        let doubled = overlap_length(&route.problems(&nest, TOL));
+        let problems = route.problems(&nest, TOL);
+        let doubled = overlap_length(&problems);
         assert!(
             (doubled - 2.0 * (k - 1) as f64 * h).abs() < 1e-6,
             "k = {k}: {doubled}"
+        );
+        // Counted once per piece, that is the k − 1 common edges.
+        let recut = cutroute_segments::recut_length(&problems, TOL);
+        assert!(
+            (recut - (k - 1) as f64 * h).abs() < 1e-6,
+            "k = {k}: {recut}"
         );
         // Junctions: every plan edge one segment, still every common edge once.
         let junctions = Ensemble::build(&nest, EnsembleKind::Junctions, 1e-6).unwrap();
