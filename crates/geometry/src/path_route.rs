@@ -1055,6 +1055,41 @@ mod tests {
     }
 
     proptest! {
+        /// Damage to a valid route never goes unnoticed: a span left out leaves a gap (or
+        /// breaks its path), a span cut again from a new pierce is an overlap.
+        #[test]
+        fn dropped_or_repeated_spans_are_found(path in 0..6usize, pick in 0.0..1.0f64, fraction in 0.0..1.0f64) {
+            let nest = Nest {
+                sheet: None,
+                parts: (0..6).map(|i| part(vec![Contour::circle(p(i as f64 * 30.0, 0.0), 10.0, true), rect(i as f64 * 30.0 - 5.0, -5.0, i as f64 * 30.0 + 5.0, 3.0).reversed()])).collect(),
+            };
+            let steps = (0..6).flat_map(|i| {
+                let hole = ContourRef { part: i, contour: 1 };
+                let outer = ContourRef { part: i, contour: 0 };
+                [hole, outer].map(|r| {
+                    let c = nest.contour(r).unwrap();
+                    CutStep::pierced(r, c.point_at_length(fraction * c.perimeter()).unwrap())
+                })
+            }).collect();
+            let route = PathRoute::from_route(&Route { start: p(0.0, -50.0), steps, finish: None }, &nest).unwrap();
+            prop_assert_eq!(route.problems(&nest, TOL), vec![]);
+            let spans = &route.paths[path].spans;
+            let k = ((pick * spans.len() as f64) as usize).min(spans.len() - 1);
+            let victim = spans[k];
+            prop_assume!(victim.length() > 1e-3);
+            let mut dropped = route.clone();
+            dropped.paths[path].spans.remove(k);
+            let problems = dropped.problems(&nest, TOL);
+            prop_assert!(problems.iter().any(|e| matches!(e, PathRouteError::Gap { length, .. } if (length - victim.length()).abs() < 1e-6)), "{:?}", problems);
+            let mut repeated = route.clone();
+            // First, so that no contour's completion moves.
+            repeated.paths.insert(0, ToolOnPath { pierce: victim.start, spans: vec![victim] });
+            let problems = repeated.problems(&nest, TOL);
+            prop_assert!(problems.iter().all(|e| matches!(e, PathRouteError::Overlap { .. })), "{:?}", problems);
+            let doubled: f64 = problems.iter().map(|e| match e { PathRouteError::Overlap { length, .. } => *length, _ => 0.0 }).sum();
+            prop_assert!((doubled - victim.length()).abs() < 1e-6, "{}", doubled);
+        }
+
         /// Squares in a row cut whole in any order from any pierce points: valid, and the
         /// numbers agree with the route's.
         #[test]
