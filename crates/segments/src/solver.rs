@@ -110,6 +110,7 @@ fn golden(span: &Span, a: Point, b: Point, mut lo: f64, mut hi: f64) -> (f64, f6
         a.distance(m) + m.distance(b)
     };
     const R: f64 = 0.618_033_988_749_894_8;
+    let (first, last) = (lo, hi);
     let mut x1 = hi - R * (hi - lo);
     let mut x2 = lo + R * (hi - lo);
     let (mut f1, mut f2) = (f(x1), f(x2));
@@ -133,12 +134,11 @@ fn golden(span: &Span, a: Point, b: Point, mut lo: f64, mut hi: f64) -> (f64, f6
     }
     let t = 0.5 * (lo + hi);
     let mut best = (t, f(t));
-    for t in [0.0f64, 1.0] {
-        if (lo..=hi).contains(&t) || t == lo || t == hi {
-            let v = f(t);
-            if v < best.1 {
-                best = (t, v);
-            }
+    // The search never evaluates the bracket's own ends, where a monotone f is least.
+    for t in [first, last] {
+        let v = f(t);
+        if v < best.1 {
+            best = (t, v);
         }
     }
     best
@@ -893,4 +893,65 @@ pub fn solve_sccp(
         interrupted,
         shakes,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use cutroute_geometry::{Contour, ContourRef, SplitMix64, Vertex};
+
+    /// The relaxation's minimiser over a closed segment is never beaten by dense sampling.
+    #[test]
+    fn best_point_matches_dense_sampling() {
+        let mut rng = SplitMix64::new(7);
+        // A rounded slot: lines and semicircles; and a circle of two arcs.
+        let shapes = [
+            Contour::new(vec![
+                Vertex::line(0.0, 0.0),
+                Vertex::arc(40.0, 0.0, 1.0),
+                Vertex::line(40.0, 20.0),
+                Vertex::arc(0.0, 20.0, 1.0),
+            ]),
+            Contour::circle(Point::new(5.0, -3.0), 12.0, true),
+        ];
+        for shape in shapes {
+            let spans: Vec<Span> = shape.spans().collect();
+            let segment = Segment::new(
+                spans.clone(),
+                vec![ContourRef {
+                    part: 0,
+                    contour: 0,
+                }],
+                1e-9,
+            );
+            assert!(segment.closed);
+            let boxes: Vec<(Point, Point)> = spans
+                .iter()
+                .map(|s| {
+                    let b = s.bounding_box();
+                    (b.min, b.max)
+                })
+                .collect();
+            for _ in 0..200 {
+                let a = Point::new(rng.range(-60.0, 100.0), rng.range(-60.0, 80.0));
+                let b = Point::new(rng.range(-60.0, 100.0), rng.range(-60.0, 80.0));
+                let (_, _, m, value) =
+                    best_point(&segment, &boxes, a, Some(b), f64::INFINITY).unwrap();
+                assert!((a.distance(m) + m.distance(b) - value).abs() < 1e-9);
+                assert!(shape.distance_to(m) < 1e-9);
+                let sampled = (0..20_000)
+                    .map(|k| {
+                        shape
+                            .point_at_length(k as f64 / 20_000.0 * shape.perimeter())
+                            .unwrap()
+                    })
+                    .map(|q| a.distance(q) + q.distance(b))
+                    .fold(f64::INFINITY, f64::min);
+                assert!(
+                    value <= sampled + 1e-9,
+                    "{value} > {sampled} for {a:?}, {b:?}"
+                );
+            }
+        }
+    }
 }
