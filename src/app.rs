@@ -19,7 +19,7 @@ use crate::export::ExportMenu;
 use crate::pan_zoom::PanZoom;
 use crate::settings::{Layer, Settings};
 use crate::stats::StatsPanel;
-use crate::worker_client::{spawn, SolverWorker};
+use crate::worker_client::{spawn, SolverWorker, WorkerRequest};
 
 /// Bundled sample nests (files under `assets/samples/`), the first is opened on start.
 pub const SAMPLES: [(&str, &str); 4] = [
@@ -235,11 +235,11 @@ pub fn App() -> impl IntoView {
             let url = format!("./assets/samples/{file_name}");
             match fetch_bytes(&url).await {
                 Ok(bytes) => bridge.with_value(|b| {
-                    b.send(ToWorker::Open {
+                    b.send(WorkerRequest::Protocol(ToWorker::Open {
                         request_id,
                         file_name,
                         bytes,
-                    })
+                    }))
                 }),
                 Err(message) => open_error.set(Some(format!("{url}: {message}"))),
             }
@@ -263,17 +263,46 @@ pub fn App() -> impl IntoView {
             let is_task = |bytes: &[u8]| {
                 cutroute_formats::detect(bytes) == cutroute_formats::Format::TaskJson
             };
+            // The task's speeds become the machine's (its start and finish go with the nest).
+            let take_speeds = |task: &cutroute_formats::RmTask| {
+                let data = &task.task_data;
+                machine.update(|m| {
+                    m.idle_speed = data.tool_idling_speed;
+                    m.cut_speed = data.tool_cut_speed;
+                    m.pierce_time = data.piercing_duration;
+                });
+            };
+            // A PCGTSP instance or a PCGLNS result with other files: the worker combines the
+            // whole batch (the tour is checked there and drawn on the nest when a task places
+            // its nodes).
+            let is_pcgtsp = |bytes: &[u8]| {
+                cutroute_formats::detect(bytes) == cutroute_formats::Format::Pcglns
+                    || is_pcglns_result(bytes)
+            };
+            if batch.len() > 1 && batch.iter().any(|(_, b)| is_pcgtsp(b.as_slice())) {
+                for (_, bytes) in batch.iter().filter(|(_, b)| is_task(b.as_slice())) {
+                    if let Ok(task) = cutroute_formats::read_task_json(bytes) {
+                        take_speeds(&task);
+                    }
+                }
+                let names: Vec<String> = batch.iter().map(|(n, _)| n.clone()).collect();
+                last_file.set(Some(names.join(" + ")));
+                let request_id = take_id();
+                bridge.with_value(|b| {
+                    b.send(WorkerRequest::OpenTogether {
+                        request_id,
+                        files: batch,
+                    })
+                });
+                return;
+            }
             let has_geometry = batch.iter().any(|(_, b)| !is_task(b.as_slice()));
             for (file_name, bytes) in batch {
                 if has_geometry && is_task(bytes.as_slice()) {
                     match cutroute_formats::read_task_json(&bytes) {
                         Ok(task) => {
+                            take_speeds(&task);
                             let data = &task.task_data;
-                            machine.update(|m| {
-                                m.idle_speed = data.tool_idling_speed;
-                                m.cut_speed = data.tool_cut_speed;
-                                m.pierce_time = data.piercing_duration;
-                            });
                             pending_task.set_value(Some((file_name, data.start(), data.finish())));
                         }
                         Err(e) => open_error.set(Some(format!("{file_name}: {e}"))),
@@ -283,11 +312,11 @@ pub fn App() -> impl IntoView {
                 last_file.set(Some(file_name.clone()));
                 let request_id = take_id();
                 bridge.with_value(|b| {
-                    b.send(ToWorker::Open {
+                    b.send(WorkerRequest::Protocol(ToWorker::Open {
                         request_id,
                         file_name,
                         bytes,
-                    })
+                    }))
                 });
             }
         });
@@ -326,11 +355,11 @@ pub fn App() -> impl IntoView {
             solver: solver.get_untracked(),
             params,
         };
-        bridge.with_value(|b| b.send(ToWorker::Start(request)));
+        bridge.with_value(|b| b.send(WorkerRequest::Protocol(ToWorker::Start(request))));
     };
     let stop = move |_| {
         if let JobState::Running(job_id) = job_state.get_untracked() {
-            bridge.with_value(|b| b.send(ToWorker::Cancel { job_id }));
+            bridge.with_value(|b| b.send(WorkerRequest::Protocol(ToWorker::Cancel { job_id })));
         }
     };
     let running = move || matches!(job_state.get(), JobState::Running(_));
@@ -556,6 +585,17 @@ pub fn App() -> impl IntoView {
                 }
             >
                 {move || open_error.get().map(|e| view! { <p class="error" role="alert">{e}</p> })}
+                // What the reader left out or approximated, and what was checked on opening.
+                {move || {
+                    let notes = document.with(|d| d.as_ref().map(|d| d.warnings.clone()).unwrap_or_default());
+                    (!notes.is_empty()).then(|| {
+                        view! {
+                            <ul id="open-notes" class="note" aria-label="Notes on the open file">
+                                {notes.into_iter().map(|n| view! { <li>{n}</li> }).collect_view()}
+                            </ul>
+                        }
+                    })
+                }}
                 // A local file cannot be reopened without the user: say which one it was.
                 {move || {
                     last_file
@@ -622,6 +662,12 @@ pub fn App() -> impl IntoView {
             </aside>
         </main>
     }
+}
+
+/// Whether the bytes are a PCGLNS run summary (the same test as the worker's).
+fn is_pcglns_result(bytes: &[u8]) -> bool {
+    cutroute_formats::detect(bytes) == cutroute_formats::Format::Unknown
+        && std::str::from_utf8(bytes).is_ok_and(|t| t.contains("Tour Ordering"))
 }
 
 /// A labelled positive number input with a tooltip.

@@ -86,9 +86,14 @@ pub fn StatsPanel(
     view! {
         <dl class="route-stats">
             <dt>"Idle length"</dt>
-            <dd id="idle-length">{cell(|f| format!("{:.1} mm", f.0))}</dd>
+            // The shown figures are rounded; `data-mm` keeps 0.001 mm for checks by tools.
+            <dd id="idle-length" data-mm=cell(|f| format!("{:.3}", f.0))>
+                {cell(|f| format!("{:.1} mm", f.0))}
+            </dd>
             <dt>"Cut length"</dt>
-            <dd id="cut-length">{cell(|f| format!("{:.1} mm", f.1))}</dd>
+            <dd id="cut-length" data-mm=cell(|f| format!("{:.3}", f.1))>
+                {cell(|f| format!("{:.1} mm", f.1))}
+            </dd>
             <dt>"Pierces"</dt>
             <dd id="pierces">{cell(|f| f.2.to_string())}</dd>
             <dt>"Machine time"</dt>

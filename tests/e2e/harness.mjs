@@ -75,3 +75,34 @@ export function useApp(before, after) {
   });
   return app;
 }
+
+/**
+ * Saves a screenshot of the page under `target/e2e/` and fails unless it shows something: the
+ * PNG is decoded in the browser and must have several colours, none covering almost all of it.
+ */
+export async function screenshot(page, name) {
+  const file = path.join(screenshotDir, name);
+  const png = await page.screenshot({ path: file });
+  const seen = await page.evaluate(async (b64) => {
+    const img = new Image();
+    img.src = `data:image/png;base64,${b64}`;
+    await img.decode();
+    const canvas = new OffscreenCanvas(img.width, img.height);
+    const g = canvas.getContext('2d');
+    g.drawImage(img, 0, 0);
+    const data = g.getImageData(0, 0, img.width, img.height).data;
+    const counts = new Map();
+    let samples = 0;
+    // Every 7th pixel: enough to see the drawing, cheap at 1920×1080.
+    for (let i = 0; i < data.length; i += 4 * 7) {
+      const key = (data[i] << 16) | (data[i + 1] << 8) | data[i + 2];
+      counts.set(key, (counts.get(key) ?? 0) + 1);
+      samples++;
+    }
+    return { colours: counts.size, largestShare: Math.max(...counts.values()) / samples };
+  }, png.toString('base64'));
+  if (seen.colours < 8 || seen.largestShare > 0.97) {
+    throw new Error(`screenshot ${file} looks blank: ${JSON.stringify(seen)}`);
+  }
+  return file;
+}

@@ -5,7 +5,7 @@ import assert from 'node:assert/strict';
 import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
-import { watchErrors, screenshotDir, projectRoot, useApp } from './harness.mjs';
+import { watchErrors, projectRoot, useApp, screenshot } from './harness.mjs';
 
 const app = useApp(before, after);
 
@@ -64,7 +64,7 @@ test('drawing layers: arrows, cuts, order, ends, candidates, hover text; each ca
     assert.equal(await display(), 'none', `${layer} hidden`);
     await page.check(`#layer-${layer}`);
   }
-  await page.screenshot({ path: path.join(screenshotDir, 'layers.png') });
+  await screenshot(page, 'layers.png');
   assert.deepEqual(errors, []);
   await context.close();
 });
@@ -94,7 +94,7 @@ test('animation: play reaches the end on the machine clock; steps and scrub move
   // Play at ×100 from the middle to the end.
   await page.selectOption('#anim-speed', '100');
   await page.click('#anim-play');
-  await page.screenshot({ path: path.join(screenshotDir, 'animation.png') });
+  await screenshot(page, 'animation.png');
   await page.waitForFunction(() => {
     const c = document.querySelector('#anim-clock');
     return c.dataset.time === c.dataset.total;
@@ -119,14 +119,14 @@ test('CCP certificates on the drawing; presentation mode by button and F key', a
   const no = subpaths(await page.locator('#nest-view .certificates path.uncertified').getAttribute('d'));
   assert.equal(yes, certified, 'certified contours marked');
   assert.equal(yes + no, 16, 'the others highlighted');
-  await page.screenshot({ path: path.join(screenshotDir, 'certificates.png') });
+  await screenshot(page, 'certificates.png');
 
   const fontSize = () => page.evaluate(() => parseFloat(getComputedStyle(document.body).fontSize));
   const normal = await fontSize();
   await page.click('#present');
   assert.equal(await page.getAttribute('#present', 'aria-pressed'), 'true');
   assert.ok(await fontSize() > normal * 1.2, 'large fonts');
-  await page.screenshot({ path: path.join(screenshotDir, 'presentation.png') });
+  await screenshot(page, 'presentation.png');
   await page.locator('#nest-view').focus();
   await page.keyboard.press('f');
   assert.equal(await page.evaluate(() => document.documentElement.hasAttribute('data-presentation')), false, 'F leaves');
@@ -154,10 +154,22 @@ test('every export downloads a file that our readers open again', async () => {
     assert.ok(fs.statSync(target).size > 0, `${button} wrote ${target}`);
     return target;
   };
-  const svg = fs.readFileSync(await download('#export-svg'), 'utf8');
+  const svgFile = await download('#export-svg');
+  const svg = fs.readFileSync(svgFile, 'utf8');
   assert.match(svg, /^<\?xml[^>]*>\n<svg[^>]*xmlns="http:\/\/www.w3.org\/2000\/svg"/);
   assert.equal((svg.match(/class="part"/g) ?? []).length, 8, 'the view\'s 8 parts');
   assert.match(svg, /<style>/);
+  // The browser's XML parser reads it back (a parse error would show as <parsererror>) with
+  // the drawing and the route the app showed.
+  const svgViewer = await context.newPage();
+  await svgViewer.goto(`file://${svgFile}`);
+  const parsed = await svgViewer.evaluate(() => ({
+    root: document.documentElement.localName,
+    errors: document.getElementsByTagName('parsererror').length,
+    parts: document.querySelectorAll('.part').length,
+  }));
+  assert.deepEqual(parsed, { root: 'svg', errors: 0, parts: 8 });
+  await svgViewer.close();
 
   const files = {
     result: await download('#export-result'),
@@ -250,18 +262,22 @@ test('Continue restarts from the best result; kept results are compared and over
   await page.locator('.kept-overlay').nth(1).check();
   assert.equal(await page.locator('#nest-view path.compare-a').count(), 1);
   assert.equal(await page.locator('#nest-view path.compare-b').count(), 1);
-  await page.screenshot({ path: path.join(screenshotDir, 'compare.png') });
+  await screenshot(page, 'compare.png');
   assert.deepEqual(errors, []);
   await context.close();
 });
 
-for (const [width, height] of [[1024, 768], [1920, 1080]]) {
+for (const [width, height] of [[1024, 768], [1920, 1080], [3840, 2160]]) {
   test(`keyboard only and layout at ${width}×${height}`, async () => {
     const { page, errors, context } = await freshPage({ width, height });
     await fileShown(page, 'E1X_6_01');
     // No horizontal scroll.
     const scroll = await page.evaluate(() => [document.documentElement.scrollWidth, document.documentElement.clientWidth]);
     assert.ok(scroll[0] <= scroll[1], `no horizontal scroll: ${scroll}`);
+    // The drawing takes the room the screen gives it (a projector's too).
+    const drawing = await page.locator('#nest-view').boundingBox();
+    assert.ok(drawing.width >= width * 0.5 && drawing.height >= height * 0.4,
+      `drawing ${drawing.width}×${drawing.height} on ${width}×${height}`);
     // Every control has a label (label element, aria-label, title or text).
     const unlabelled = await page.evaluate(() => [...document.querySelectorAll('input, select, button, textarea')]
       .filter((e) => !(e.labels?.length || e.getAttribute('aria-label') || e.title || e.textContent.trim()))
@@ -295,9 +311,7 @@ for (const [width, height] of [[1024, 768], [1920, 1080]]) {
     assert.equal(await page.locator('#anim-play').getAttribute('aria-label'), 'Pause');
     await page.keyboard.press('Space');
     await page.waitForFunction(() => document.querySelector('#anim-play').getAttribute('aria-label') === 'Play');
-    const shot = path.join(screenshotDir, `layout-${width}x${height}.png`);
-    await page.screenshot({ path: shot });
-    assert.ok(fs.statSync(shot).size > 10000, 'screenshot is not blank');
+    await screenshot(page, `layout-${width}x${height}.png`);
     const after = await page.evaluate(() => [document.documentElement.scrollWidth, document.documentElement.clientWidth]);
     assert.ok(after[0] <= after[1], `no horizontal scroll with a route: ${after}`);
     assert.deepEqual(errors, []);

@@ -2,9 +2,7 @@
 // sample, runs a solver job in the Web Worker, draws the route, and cancels a running job.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import fs from 'node:fs';
-import path from 'node:path';
-import { watchErrors, screenshotDir, useApp } from './harness.mjs';
+import { watchErrors, useApp, screenshot } from './harness.mjs';
 
 const app = useApp(before, after);
 
@@ -38,7 +36,7 @@ test('opens the default sample, solves in the worker, draws the route, cancels',
   await page.fill('#cut-speed', '50');
   await page.dispatchEvent('#cut-speed', 'change');
   assert.notEqual(await page.locator('#machine-time').textContent(), timeBefore, 'faster cutting, shorter time');
-  await page.screenshot({ path: path.join(screenshotDir, 'shell-route.png') });
+  await screenshot(page, 'shell-route.png');
 
   // Second job: a long one, cancelled while it runs; the answer must come promptly.
   await page.selectOption('#solver', 'ccp');
@@ -53,8 +51,6 @@ test('opens the default sample, solves in the worker, draws the route, cancels',
     null, { timeout: 5000 });
   const cancelMs = Date.now() - cancelAt;
   assert.ok(cancelMs < 1000, `cancel answered in ${cancelMs} ms`);
-  await page.screenshot({ path: path.join(screenshotDir, 'shell-cancelled.png') });
-  const shot = fs.statSync(path.join(screenshotDir, 'shell-route.png'));
-  assert.ok(shot.size > 10000, 'screenshot is not blank');
+  await screenshot(page, 'shell-cancelled.png');
   assert.deepEqual(errors, [], 'no errors in the page');
 });

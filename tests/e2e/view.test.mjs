@@ -4,7 +4,7 @@ import assert from 'node:assert/strict';
 import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
-import { watchErrors, screenshotDir, projectRoot, useApp } from './harness.mjs';
+import { watchErrors, projectRoot, useApp, screenshot } from './harness.mjs';
 
 const shared = path.resolve(projectRoot, '..', 'shared', 'data', 'nests');
 const app = useApp(before, after);
@@ -41,7 +41,7 @@ test('opens DBS, DXF and T-FLEX files from the picker; a broken file shows a loc
   await page.click('#start');
   await page.waitForFunction(() => document.querySelector('#job-status')?.textContent === 'finished',
     null, { timeout: 20000 });
-  await page.screenshot({ path: path.join(screenshotDir, 'open-error.png') });
+  await screenshot(page, 'open-error.png');
   assert.deepEqual(errors, []);
 });
 
@@ -84,11 +84,28 @@ test('the theme switch restyles the page and survives a reload', async () => {
   assert.equal(await page.evaluate(() => document.documentElement.dataset.theme), 'dark');
   const dark = await background();
   assert.notEqual(dark, light, 'dark theme changes the background');
-  await page.screenshot({ path: path.join(screenshotDir, 'theme-dark.png') });
+  await screenshot(page, 'theme-dark.png');
   await page.reload();
   await fileShown(page, 'E1X_6_01');
   assert.equal(await page.evaluate(() => document.documentElement.dataset.theme), 'dark', 'remembered');
   assert.equal(await page.locator('#theme').inputValue(), 'dark');
+  // Every theme offered applies and tells cut and idle moves apart (by colour, or by dashes
+  // where print is black only).
+  const themes = await page.locator('#theme option').evaluateAll((options) => options.map((o) => o.value));
+  assert.ok(themes.length >= 4, `themes: ${themes}`);
+  await page.selectOption('#solver', 'nearest');
+  await page.click('#start');
+  await page.waitForFunction(() => document.querySelector('#job-status')?.textContent === 'finished');
+  for (const theme of themes) {
+    await page.selectOption('#theme', theme);
+    assert.equal(await page.evaluate(() => document.documentElement.dataset.theme), theme);
+    const [cut, idle] = await page.evaluate(() => ['path.cut', 'path.idle'].map((s) => {
+      const style = getComputedStyle(document.querySelector(`#nest-view .route ${s}`));
+      return `${style.stroke} dashes ${style.strokeDasharray}`;
+    }));
+    assert.notEqual(cut, idle, `${theme}: cut ${cut} vs idle ${idle}`);
+    await screenshot(page, `theme-${theme}.png`);
+  }
 });
 
 test('the exact solver reports both bounds and the chart draws them', async () => {
@@ -108,6 +125,6 @@ test('the exact solver reports both bounds and the chart draws them', async () =
   assert.ok((await page.locator('.chart-ub').getAttribute('d')).startsWith('M'), 'upper bound drawn');
   assert.ok((await page.locator('.chart-lb').getAttribute('d')).startsWith('M'), 'lower bound drawn');
   assert.equal(await page.locator('#nest-view .route circle.pierce').count(), 16);
-  await page.screenshot({ path: path.join(screenshotDir, 'exact-bounds.png') });
+  await screenshot(page, 'exact-bounds.png');
   assert.deepEqual(errors, []);
 });

@@ -21,6 +21,8 @@
 //! - [`oe_route`]: beyond 4-regular graphs (T-junctions, any degree): non-crossing chains
 //!   joined by idle moves, ordered so the whole route is OE, with few pierces;
 //!   [`PlanGraph::route`] runs it on every component of a nest, inner components first;
+//! - [`solve_nest`]: the solver behind `--solver aoe`: a nest in, a [`cutroute_geometry::PathRoute`]
+//!   out (components ordered inner-first with short idle moves), checked by both checkers;
 //! - [`random`]: seeded random plane 4-regular graphs (medial graphs of random plane multigraphs).
 //!
 //! ```
@@ -46,6 +48,7 @@ mod graph;
 mod plan;
 pub mod random;
 mod route;
+mod solve;
 
 pub use chain::{
     aoe_chain, split_cut_points, AoeChain, AoeError, AoeOptions, SplitRule, Transitions,
@@ -55,3 +58,4 @@ pub use embedding::{CutPoint, Embedding, EmbeddingError};
 pub use graph::{Dart, DualGraph, Faces, GraphError, PlaneGraph};
 pub use plan::{CutChain, DirectedEdge, PlanComponent, PlanError, PlanGraph, PlanOptions};
 pub use route::{oe_route, pierce_lower_bound, OeRoute};
+pub use solve::{solve_nest, AoeSolution, AoeSolveError, AoeSolveOptions};

@@ -238,33 +238,42 @@ impl PlanGraph {
     /// by [`crate::oe_route`]; chains carry their geometry.
     pub fn route(&self) -> Result<Vec<CutChain>, EmbeddingError> {
         let components = self.components()?;
-        let enclosed: Vec<f64> = components
-            .iter()
-            .map(|c| {
-                let faces = c.embedding.faces();
-                let origin = self.points[c.vertices[0]];
-                let mut area = 0.0;
-                for d in 0..c.embedding.graph().dart_count() {
-                    if faces.left(d) == c.embedding.outer_face() {
-                        for span in self.dart_spans(2 * c.edges[d / 2] + d % 2) {
-                            area -= span.area_term(origin);
-                        }
-                    }
-                }
-                area
-            })
-            .collect();
+        let enclosed: Vec<f64> = components.iter().map(|c| self.enclosed_area(c)).collect();
         let mut order: Vec<usize> = (0..components.len()).collect();
         order.sort_by(|&a, &b| enclosed[a].total_cmp(&enclosed[b]));
-        let mut chains = Vec::new();
-        for i in order {
-            let component = &components[i];
-            for darts in crate::route::oe_route(&component.embedding).chains {
+        Ok(order
+            .into_iter()
+            .flat_map(|i| self.component_chains(&components[i]))
+            .collect())
+    }
+
+    /// Area enclosed by a component's outer boundary (the region it cuts free when done).
+    pub fn enclosed_area(&self, component: &PlanComponent) -> f64 {
+        let faces = component.embedding.faces();
+        let origin = self.points[component.vertices[0]];
+        let mut area = 0.0;
+        for d in 0..component.embedding.graph().dart_count() {
+            if faces.left(d) == component.embedding.outer_face() {
+                for span in self.dart_spans(2 * component.edges[d / 2] + d % 2) {
+                    area -= span.area_term(origin);
+                }
+            }
+        }
+        area
+    }
+
+    /// The OE-route of one component ([`crate::oe_route`]) as chains of plan edges with
+    /// their geometry.
+    pub fn component_chains(&self, component: &PlanComponent) -> Vec<CutChain> {
+        crate::route::oe_route(&component.embedding)
+            .chains
+            .into_iter()
+            .map(|darts| {
                 let plan_darts: Vec<Dart> = darts
                     .iter()
                     .map(|&d| 2 * component.edges[d / 2] + d % 2)
                     .collect();
-                chains.push(CutChain {
+                CutChain {
                     edges: plan_darts
                         .iter()
                         .map(|&d| DirectedEdge {
@@ -276,10 +285,9 @@ impl PlanGraph {
                         .iter()
                         .flat_map(|&d| self.dart_spans(d))
                         .collect(),
-                });
-            }
-        }
-        Ok(chains)
+                }
+            })
+            .collect()
     }
 
     /// Checks a route over the whole plan (for example [`PlanGraph::route`]): every edge cut

@@ -2,38 +2,15 @@
 //! edges account for every contour's perimeter exactly once per contour they belong to.
 
 use cutroute_aoe::{PlanGraph, PlanOptions};
-use cutroute_geometry::Nest;
-use std::path::PathBuf;
+mod common;
 
-fn load(relative: &str) -> Nest {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/data/nests")
-        .join(relative);
-    let bytes = std::fs::read(&path)
-        .unwrap_or_else(|e| panic!("required test data {} is missing: {e}", path.display()));
-    if relative.ends_with(".tfnesting") {
-        cutroute_cad::tflex::read_tfnesting(&bytes)
-            .unwrap()
-            .remove(0)
-    } else {
-        cutroute_formats::read_nest(&bytes).unwrap()
-    }
-}
+use common::{load_nest as load, REAL_NESTS};
 
 #[test]
 fn real_nests_give_plane_graphs_that_account_for_every_contour() {
     let options = PlanOptions::default();
     let mut total_common = 0;
-    for name in [
-        "dbs/nested.dbs",
-        "dbs/seven.dbs",
-        "dbs/test0.json.dbs",
-        "dbs-json/E1X_6_01.dbs.json",
-        "dbs-json/test1.dbs.json",
-        "tflex/Nest01.tfnesting",
-        "tflex/Nest02.tfnesting",
-        "tflex/Nest03.tfnesting",
-    ] {
+    for name in REAL_NESTS {
         let nest = load(name);
         let plan = PlanGraph::from_nest(&nest, &options).unwrap_or_else(|e| panic!("{name}: {e}"));
         let components = plan.components().unwrap_or_else(|e| panic!("{name}: {e}"));

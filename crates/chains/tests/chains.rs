@@ -245,6 +245,7 @@ fn read_nest(path: &str) -> Nest {
 
 #[test]
 fn ccp_routes_of_real_nests_chain_validly_and_never_cost_more() {
+    let mut links_seen = 0;
     for path in [
         "dbs-json/E1X_6_01.dbs.json",
         "dbs/nested.dbs",
@@ -272,12 +273,36 @@ fn ccp_routes_of_real_nests_chain_validly_and_never_cost_more() {
                 .route
                 .validate(&nest, scale)
                 .unwrap_or_else(|e| panic!("{path}, {}: {e}", material.name));
+            // The result format keeps the links: same steps, same entries, still valid.
+            let exported = cutroute_formats::RmResult::from_route(
+                &nest,
+                &chained.route,
+                &cutroute_formats::ResultExportOptions::default(),
+            )
+            .unwrap();
+            let back = exported.route();
+            links_seen += back.steps.iter().filter(|s| !s.is_pierced()).count();
+            assert_eq!(back.steps.len(), chained.route.steps.len(), "{path}");
+            for (ours, read) in chained.route.steps.iter().zip(&back.steps) {
+                assert_eq!(ours.contour, read.contour, "{path}");
+                assert!(
+                    ours.pierce_point.distance(read.pierce_point) < 1e-6,
+                    "{path}"
+                );
+                assert_eq!(ours.is_pierced(), read.is_pierced(), "{path}");
+            }
+            back.validate(&nest, scale)
+                .unwrap_or_else(|e| panic!("{path}, read back: {e}"));
             let r = &chained.report;
             assert!(r.cost_after <= r.cost_before, "{path}: {r:?}");
             assert_eq!(r.pierces_before, nest.contour_count());
             assert!(r.pierces_after <= r.pierces_before);
         }
     }
+    assert!(
+        links_seen > 0,
+        "no real nest was chained: the round trip saw no link"
+    );
 }
 
 #[test]

@@ -7,7 +7,7 @@
 //!                  [--incremental] [--arcs ij|r|lines] [--decimals N] [--line-numbers]
 //!                  [--feed MM_PER_MIN] [--dwell S] [--torch-on CODE] [--torch-off CODE]
 //! cutroute generate --contours N [--seed S] --out FILE   # synthetic nest as geometry JSON
-//! cutroute solve FILE --solver nearest|ccp|heuristic|exact|discrete|chain|sccp|gsccp
+//! cutroute solve FILE --solver nearest|ccp|heuristic|exact|discrete|chain|aoe|sccp|gsccp
 //!                     [--time-limit S] [--seed N] [--ub N] [--step MM] [--cost C_off,C_on,C_pt]
 //!                     [--speeds V_off,V_on,t_pt] [--task TASK.json] [--objective time|cost]
 //!                     [--json]
@@ -94,8 +94,9 @@ enum Command {
         /// A nest file or a PCGTSP instance.
         file: PathBuf,
         /// nearest, ccp, heuristic, exact, discrete (= heuristic on a discretised nest),
-        /// chain (ccp, then chain cutting), sccp (segment cutting along the plan's common
-        /// edges) or gsccp (the best of several segment ensembles).
+        /// chain (ccp, then chain cutting), aoe (common edges cut once along AOE-chains),
+        /// sccp (segment cutting along the plan's common edges) or gsccp (the best of several
+        /// segment ensembles).
         #[arg(long, default_value = "ccp")]
         solver: String,
         /// Wall-clock limit in seconds.
@@ -507,6 +508,9 @@ fn solve(
     as_json: bool,
 ) -> Result<(), String> {
     let document = open(path)?;
+    if solver_name == "aoe" {
+        return solve_aoe(&document, &params.machine, as_json);
+    }
     let solver = solver_kind(solver_name)?;
     let machine = params.machine;
     let request = JobRequest {
@@ -543,6 +547,80 @@ fn solve(
         }
     }
     Ok(())
+}
+
+/// `--solver aoe`: common edges cut once along AOE-chains (`cutroute_aoe::solve_nest`), the
+/// same report keys as the other nest solvers, the route as tool-on paths of spans.
+fn solve_aoe(
+    document: &Document,
+    machine: &MachineParameters,
+    as_json: bool,
+) -> Result<(), String> {
+    let Problem::Nest {
+        nest,
+        start,
+        finish,
+    } = &document.problem
+    else {
+        return Err("the aoe solver routes nests, not PCGTSP instances".into());
+    };
+    let started = std::time::Instant::now();
+    let scale = nest_scale(nest);
+    let options = cutroute_aoe::AoeSolveOptions {
+        plan: cutroute_aoe::PlanOptions {
+            tolerance: 1e-6 * scale,
+            ..cutroute_aoe::PlanOptions::default()
+        },
+        start: *start,
+        finish: *finish,
+    };
+    let solution = cutroute_aoe::solve_nest(nest, &options).map_err(|e| e.to_string())?;
+    let route = &solution.route;
+    // Checked again here, as every route the CLI prints.
+    route
+        .validate(nest, 1e-5 * scale)
+        .map_err(|e| format!("invalid route: {e}"))?;
+    let (idle_length, cut_length, pierces) = (
+        route.idle_length(),
+        route.cut_length(),
+        route.pierce_count(),
+    );
+    let report = json!({
+        "solver": "aoe",
+        "idle_length": idle_length,
+        "cut_length": cut_length,
+        "pierces": pierces,
+        "time_s": machine.time(cut_length, idle_length, pierces),
+        "cost": machine.cost(cut_length, idle_length, pierces),
+        "machine": machine_json(machine),
+        "pierce_lower_bound": solution.pierce_lower_bound,
+        "components": solution.components,
+        "route": route,
+        "ub": idle_length,
+        "lb": null,
+        "elapsed_s": started.elapsed().as_secs_f64(),
+    });
+    if as_json {
+        println!("{report}");
+    } else {
+        for (key, value) in report.as_object().into_iter().flatten() {
+            if key != "route" {
+                println!("{key:>18}: {value}");
+            }
+        }
+    }
+    Ok(())
+}
+
+fn machine_json(machine: &MachineParameters) -> Value {
+    json!({
+        "idle_speed": machine.idle_speed,
+        "cut_speed": machine.cut_speed,
+        "pierce_time": machine.pierce_time,
+        "idle_price_per_metre": machine.idle_price_per_metre,
+        "cut_price_per_metre": machine.cut_price_per_metre,
+        "pierce_price": machine.pierce_price,
+    })
 }
 
 fn fmt(value: Option<f64>) -> String {
@@ -589,14 +667,7 @@ fn route_report(
         "pierces": pierces,
         "time_s": machine.time(cut_length, idle_length, pierces),
         "cost": machine.cost(cut_length, idle_length, pierces),
-        "machine": {
-            "idle_speed": machine.idle_speed,
-            "cut_speed": machine.cut_speed,
-            "pierce_time": machine.pierce_time,
-            "idle_price_per_metre": machine.idle_price_per_metre,
-            "cut_price_per_metre": machine.cut_price_per_metre,
-            "pierce_price": machine.pierce_price,
-        },
+        "machine": machine_json(machine),
         "route": route.steps.iter().map(|s| {
             let mut step = json!({
                 "contour": [s.contour.part, s.contour.contour],
@@ -700,14 +771,7 @@ fn solve_segments(
         "time_s": machine.time(cut_length, idle_length, pierces),
         "cost": machine.cost(cut_length, idle_length, pierces),
         "objective": match objective { Objective::Time => "time", Objective::Cost => "cost" },
-        "machine": {
-            "idle_speed": machine.idle_speed,
-            "cut_speed": machine.cut_speed,
-            "pierce_time": machine.pierce_time,
-            "idle_price_per_metre": machine.idle_price_per_metre,
-            "cut_price_per_metre": machine.cut_price_per_metre,
-            "pierce_price": machine.pierce_price,
-        },
+        "machine": machine_json(machine),
         "ensemble": result.best.name(),
         "ensembles": result.reports.iter().map(|r| json!({
             "kind": r.kind.name(),

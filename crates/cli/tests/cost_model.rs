@@ -41,7 +41,15 @@ fn assert_model(v: &Value, speeds: [f64; 3], prices: [f64; 3], what: &str) {
 #[test]
 fn every_solver_reports_time_and_cost_under_the_given_model() {
     let nest = data("nests/dbs-json/E1X_6_01.dbs.json");
-    for solver in ["nearest", "ccp", "heuristic", "exact", "discrete", "chain"] {
+    for solver in [
+        "nearest",
+        "ccp",
+        "heuristic",
+        "exact",
+        "discrete",
+        "chain",
+        "aoe",
+    ] {
         let v = json(&[
             "solve",
             &nest,
@@ -133,6 +141,38 @@ fn chain_cutting_saves_pierces_and_cost_over_ccp() {
         .filter(|s| s.get("link").is_some())
         .count();
     assert_eq!(linked as f64, 87.0 - number(&chain, "pierces"));
+}
+
+#[test]
+fn aoe_cuts_common_edges_once_with_fewer_pierces_than_ccp() {
+    // Nest01: five parts sharing four edges; the OE-route needs 4 pierces (8 odd vertices).
+    let nest = data("nests/tflex/Nest01.tfnesting");
+    let run = |solver: &str| {
+        json(&[
+            "solve",
+            &nest,
+            "--solver",
+            solver,
+            "--time-limit",
+            "1",
+            "--cost",
+            "0.1,35,7",
+            "--json",
+        ])
+    };
+    let (aoe, ccp) = (run("aoe"), run("ccp"));
+    assert_eq!(number(&ccp, "pierces"), 5.0);
+    assert_eq!(number(&aoe, "pierces"), 4.0);
+    assert_eq!(number(&aoe, "pierce_lower_bound"), 4.0);
+    // The four common edges (590 mm in all) are cut once instead of twice.
+    let saved = number(&ccp, "cut_length") - number(&aoe, "cut_length");
+    assert!((saved - 590.0).abs() < 1.0, "saved {saved} mm");
+    assert!(number(&aoe, "cost") < number(&ccp, "cost"));
+    let paths = aoe["route"]["paths"].as_array().expect("route.paths");
+    assert_eq!(paths.len(), 4);
+    assert!(paths
+        .iter()
+        .all(|p| p["spans"].as_array().is_some_and(|s| !s.is_empty())));
 }
 
 #[test]

@@ -7,8 +7,11 @@
 //! `partid` / `pathid`; they are accepted. Our own routes are exported in this format
 //! ([`RmResult::from_route`]) so existing tools can read them, and results are turned into
 //! things the UI can draw ([`RmResult::tool_moves`], [`RmResult::nest`]).
+//!
+//! Chain cutting's tool-on links (see [`cutroute_geometry::Entry::Link`]) are written as `cut`
+//! moves without a `part.id` (the torch is on, no contour is being cut) and read back as links.
 
-use cutroute_geometry::{ContourRef, CutStep, Nest, Part, Point, Route};
+use cutroute_geometry::{ContourRef, CutStep, Entry, Nest, Part, Point, Route};
 use serde::{Deserialize, Serialize};
 
 use crate::contour_check::{self, DEFAULT_CLOSURE_TOLERANCE};
@@ -221,21 +224,35 @@ fn stored_degrees(contour: &cutroute_geometry::Contour) -> Vec<[f64; 3]> {
         .collect()
 }
 
-/// The moves of a route over a nest: idle to each pierce point, the full contour from there
-/// (split where the pierce point falls inside a span), and idle to the finish.
+/// The moves of a route over a nest: idle to each pierce point (or the tool-on link of a chained
+/// step, as `Cut` moves without a contour), the full contour from there (split where the pierce
+/// point falls inside a span), and idle to the finish.
 pub fn route_moves(nest: &Nest, route: &Route) -> Result<Vec<ToolMove>, RouteError> {
     let mut moves = Vec::new();
     let mut at = route.start;
     for (step, cut) in route.steps.iter().enumerate() {
         let vertices = cut_vertices(nest, step, cut)?;
         let pierce = vertices[0].point;
-        moves.push(ToolMove {
-            kind: MoveKind::Air,
-            from: at,
-            to: pierce,
-            bulge: 0.0,
-            contour: None,
-        });
+        match &cut.entry {
+            Entry::Pierce => moves.push(ToolMove {
+                kind: MoveKind::Air,
+                from: at,
+                to: pierce,
+                bulge: 0.0,
+                contour: None,
+            }),
+            Entry::Link(corners) => {
+                for (from, to) in link_pieces(at, corners, pierce) {
+                    moves.push(ToolMove {
+                        kind: MoveKind::Cut,
+                        from,
+                        to,
+                        bulge: 0.0,
+                        contour: None,
+                    });
+                }
+            }
+        }
         for w in vertices.windows(2) {
             moves.push(ToolMove {
                 kind: MoveKind::Cut,
@@ -257,6 +274,15 @@ pub fn route_moves(nest: &Nest, route: &Route) -> Result<Vec<ToolMove>, RouteErr
         });
     }
     Ok(moves)
+}
+
+/// The straight pieces of a tool-on link from `from` through `corners` to `to`.
+fn link_pieces(from: Point, corners: &[Point], to: Point) -> Vec<(Point, Point)> {
+    let points: Vec<Point> = std::iter::once(from)
+        .chain(corners.iter().copied())
+        .chain(std::iter::once(to))
+        .collect();
+    points.windows(2).map(|w| (w[0], w[1])).collect()
 }
 
 fn cut_vertices(
@@ -321,7 +347,14 @@ impl RmResult {
         let mut at = route.start;
         for (step, cut) in route.steps.iter().enumerate() {
             let vertices = cut_vertices(nest, step, cut)?;
-            idle += geom::dist(at, vertices[0].point);
+            match &cut.entry {
+                Entry::Pierce => idle += geom::dist(at, vertices[0].point),
+                Entry::Link(corners) => {
+                    for (from, to) in link_pieces(at, corners, vertices[0].point) {
+                        cut_len += geom::dist(from, to);
+                    }
+                }
+            }
             for w in vertices.windows(2) {
                 cut_len += geom::span(w[0].point, w[1].point, w[0].bulge).length();
                 push(
@@ -332,7 +365,16 @@ impl RmResult {
                 );
             }
             at = vertices[0].point;
-            push(MoveKind::Air, at, 0.0, None);
+            // The vertex's mode is that of the move leaving it: the next step's link, or idle.
+            match route.steps.get(step + 1).map(|next| &next.entry) {
+                Some(Entry::Link(corners)) => {
+                    push(MoveKind::Cut, at, 0.0, None);
+                    for &corner in corners {
+                        push(MoveKind::Cut, corner, 0.0, None);
+                    }
+                }
+                _ => push(MoveKind::Air, at, 0.0, None),
+            }
         }
         if let Some(finish) = route.finish {
             idle += geom::dist(at, finish);
@@ -426,22 +468,41 @@ impl RmResult {
 
     /// The route the tool path describes: the start, one step per cut contour (pierce point =
     /// where cutting of the contour begins, after any lead-in) and the final point as finish.
+    /// A contour reached from the previous one by `cut` moves without a contour (torch on, no
+    /// idle move, no lead) is a chained step: its entry is a link through those moves' corners.
     pub fn route(&self) -> Route {
         let moves = self.tool_moves();
         let start = moves.first().map(|m| m.from).unwrap_or_default();
         let mut steps: Vec<CutStep> = Vec::new();
-        let mut previous: Option<MoveKind> = None;
+        // The contour being cut, and the ends of the link moves since it (torch still on).
+        let mut current: Option<ContourRef> = None;
+        let mut link_ends: Option<Vec<Point>> = None;
         for m in &moves {
-            if m.kind == MoveKind::Cut && previous != Some(MoveKind::Cut) {
-                if let Some(contour) = m.contour {
+            match (m.kind, m.contour) {
+                (MoveKind::Cut, Some(contour)) if current != Some(contour) => {
+                    let entry = match (current, link_ends.take()) {
+                        (Some(_), Some(mut ends)) => {
+                            ends.pop(); // the last end is this step's pierce point
+                            Entry::Link(ends)
+                        }
+                        _ => Entry::Pierce,
+                    };
                     steps.push(CutStep {
                         contour,
                         pierce_point: m.from,
-                        entry: Default::default(),
+                        entry,
                     });
+                    current = Some(contour);
+                }
+                (MoveKind::Cut, Some(_)) => {}
+                (MoveKind::Cut, None) if current.is_some() => {
+                    link_ends.get_or_insert_with(Vec::new).push(m.to);
+                }
+                _ => {
+                    current = None;
+                    link_ends = None;
                 }
             }
-            previous = Some(m.kind);
         }
         let finish = match moves.last() {
             Some(m) if m.kind == MoveKind::Air => Some(m.to),

@@ -4,7 +4,8 @@
 //! everything inside `<g transform="scale(1,-1)">` so CAD's y-up coordinates display upright,
 //! arcs as `A` commands split at their zenith when they reach 180° (so the large-arc flag is
 //! always 0). Styling is by CSS class, so the app's themes restyle it: `sheet`, `part`, `idle`,
-//! `cut`, `lead` (lead-in/out), `pierce`, `start`, `finish`.
+//! `cut`, `link` (chain cutting's tool-on links between contours), `lead` (lead-in/out),
+//! `pierce`, `start`, `finish`.
 
 use cutroute_geometry::{Contour, Nest, Part, Point};
 use svg::node::element::path::Data;
@@ -22,6 +23,7 @@ path.part{fill:#cdff00;fill-opacity:.6;stroke:black}\
 path.cut{fill:none;stroke:#d00;stroke-width:2px}\
 path.lead{fill:none;stroke:#f80;stroke-width:2px}\
 path.idle{fill:none;stroke:#06c;stroke-dasharray:4 3}\
+path.link{fill:none;stroke:#d55e00;stroke-width:2px;stroke-dasharray:1 2}\
 circle.pierce{fill:#0f0;stroke:navy;vector-effect:non-scaling-stroke}\
 circle.start,circle.finish{fill:#fc0;stroke:black;vector-effect:non-scaling-stroke}";
 
@@ -140,24 +142,25 @@ fn arc(data: Data, a: Point, z: Point, b: f64) -> Data {
 fn route_group(moves: &[ToolMove], marker: f64) -> Group {
     let mut group = Group::new().set("class", "route");
     let mut i = 0;
-    // Consecutive moves of one kind form one path, so a contour cut is a single element.
+    // Consecutive moves of one class form one path, so a contour cut is a single element.
+    let class_of = |m: &ToolMove| match (m.kind, m.contour) {
+        (MoveKind::Air, _) => "idle",
+        (MoveKind::Cut, Some(_)) => "cut",
+        (MoveKind::Cut, None) => "link",
+        (MoveKind::CutIn | MoveKind::CutOut, _) => "lead",
+    };
     while i < moves.len() {
-        let kind = moves[i].kind;
+        let class = class_of(&moves[i]);
         let mut data = Data::new().move_to((moves[i].from.x, moves[i].from.y));
         let mut j = i;
         while j < moves.len()
-            && moves[j].kind == kind
+            && class_of(&moves[j]) == class
             && (j == i || moves[j].from == moves[j - 1].to)
         {
             let m = &moves[j];
             data = span_data(data, m.from, m.to, m.bulge);
             j += 1;
         }
-        let class = match kind {
-            MoveKind::Air => "idle",
-            MoveKind::Cut => "cut",
-            MoveKind::CutIn | MoveKind::CutOut => "lead",
-        };
         group = group.add(Path::new().set("class", class).set("d", data));
         i = j;
     }

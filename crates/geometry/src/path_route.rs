@@ -182,6 +182,8 @@ struct Overlap {
     b: f64,
     ra: f64,
     rb: f64,
+    /// The route span runs along the contour span ([`same_carrier`]) rather than touching it.
+    along: bool,
 }
 
 /// Sub-intervals of `on` that lie on `other` within `tolerance`: the candidates are the ends of
@@ -216,12 +218,34 @@ fn pieces_on(on: &Span, other: &Span, tolerance: f64) -> Vec<(f64, f64)> {
     pieces
 }
 
+/// Whether two spans run along each other: both straight (a span whose sagitta is within
+/// `tolerance` counts as straight), or both arcs of one circle. Distance alone cannot tell: a
+/// line tangent to an arc of radius R stays within `tolerance` of it for √(2·R·tol) either side
+/// of the touching point, far longer than `tolerance`. Such contact still covers the contour
+/// (an arc bulging a rounding error across a line is cut by the line), but two cuts of one
+/// piece are reported as an overlap only when both run along it: a tangent touch between two
+/// edges that must both be cut is not a second cut of either.
+fn same_carrier(a: &Span, b: &Span, tolerance: f64) -> bool {
+    let straight = |s: &Span| s.is_line() || 0.5 * s.chord_length() * s.bulge.abs() <= tolerance;
+    match (straight(a), straight(b)) {
+        (true, true) => true,
+        (false, false) => match (a.centre(), b.centre()) {
+            (Some(ca), Some(cb)) => {
+                ca.distance(cb) <= tolerance && (a.radius() - b.radius()).abs() <= tolerance
+            }
+            _ => false,
+        },
+        _ => false,
+    }
+}
+
 fn overlaps(contour_span: &Span, route_span: &Span, tolerance: f64) -> Vec<Overlap> {
+    let along = same_carrier(contour_span, route_span, tolerance);
     pieces_on(contour_span, route_span, tolerance)
         .into_iter()
         .map(|(a, b)| {
-            // Not `Span::parameter_of`: for arcs of |φ| ≥ 1 it can wrap a point at the start
-            // round to 2π/φ; the nearest point compares with the ends.
+            // The nearest point's parameter (clamped, compared with the span's ends), not
+            // `Span::parameter_of`: that one once wrapped a point at an arc's start to 2π/φ.
             let ta = route_span.nearest_point(contour_span.point_at(a)).t;
             let tb = route_span.nearest_point(contour_span.point_at(b)).t;
             Overlap {
@@ -229,10 +253,15 @@ fn overlaps(contour_span: &Span, route_span: &Span, tolerance: f64) -> Vec<Overl
                 b,
                 ra: ta.min(tb),
                 rb: ta.max(tb),
+                along,
             }
         })
         .collect()
 }
+
+/// A piece `(a, b)` of a contour span cut at a moment, and whether the cut ran along it
+/// ([`same_carrier`]) rather than touching it.
+type Coverage = (f64, f64, Moment, bool);
 
 /// When a piece of contour is cut: path, span within the path, and parameter on that span.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -376,7 +405,7 @@ impl PathRoute {
         }
         let span_tree = RTree::bulk_load(entries);
         // Per contour and span: covered intervals on the contour span with their moment.
-        let mut covered: Vec<Vec<Vec<(f64, f64, Moment)>>> = contours
+        let mut covered: Vec<Vec<Vec<Coverage>>> = contours
             .iter()
             .map(|spans| vec![Vec::new(); spans.len()])
             .collect();
@@ -421,6 +450,7 @@ impl PathRoute {
                                 span: s,
                                 t: o.rb,
                             },
+                            o.along,
                         ));
                         on_route.push((o.ra, o.rb));
                     }
@@ -443,15 +473,16 @@ impl PathRoute {
         let mut completed: Vec<Option<Moment>> = vec![None; refs.len()];
         for (c, spans) in contours.iter().enumerate() {
             let lengths: Vec<f64> = spans.iter().map(|s| s.length()).collect();
-            let mut intervals: Vec<(f64, f64, Moment, Point)> = Vec::new();
+            let mut intervals: Vec<(f64, f64, Moment, Point, bool)> = Vec::new();
             let mut offset = 0.0;
             for (s, pieces) in covered[c].iter().enumerate() {
-                for &(a, b, m) in pieces {
+                for &(a, b, m, along) in pieces {
                     intervals.push((
                         offset + a * lengths[s],
                         offset + b * lengths[s],
                         m,
                         spans[s].point_at(a),
+                        along,
                     ));
                 }
                 offset += lengths[s];
@@ -463,9 +494,9 @@ impl PathRoute {
                     .and_then(|k| k.point_at_length(l))
                     .unwrap_or_default()
             };
-            let mut reach = 0.0;
+            let (mut reach, mut along_reach) = (0.0, 0.0);
             let mut last: Option<Moment> = None;
-            for &(a, b, m, pa) in &intervals {
+            for &(a, b, m, pa, along) in &intervals {
                 if a - reach > tolerance {
                     let p = point_at_length(reach);
                     problems.push(PathRouteError::Gap {
@@ -474,18 +505,22 @@ impl PathRoute {
                         y: p.y,
                         length: a - reach,
                     });
-                } else if reach - a > tolerance {
-                    let to = point_at_length(reach.min(b));
-                    problems.push(PathRouteError::Overlap {
-                        contour: refs[c],
-                        x: pa.x,
-                        y: pa.y,
-                        to_x: to.x,
-                        to_y: to.y,
-                        length: reach.min(b) - a,
-                    });
                 }
-                reach = reach.max(b);
+                if along {
+                    if along_reach - a > tolerance {
+                        let to = point_at_length(f64::min(along_reach, b));
+                        problems.push(PathRouteError::Overlap {
+                            contour: refs[c],
+                            x: pa.x,
+                            y: pa.y,
+                            to_x: to.x,
+                            to_y: to.y,
+                            length: f64::min(along_reach, b) - a,
+                        });
+                    }
+                    along_reach = f64::max(along_reach, b);
+                }
+                reach = f64::max(reach, b);
                 if last.is_none_or(|l| m.is_after(&l)) {
                     last = Some(m);
                 }

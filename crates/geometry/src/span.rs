@@ -424,14 +424,11 @@ impl Span {
             // distance), which rounding of P's coordinates erases.
             let (u, w) = (self.start - c, p - c);
             let angle = u.cross(w).atan2(u.dot(w));
-            let angle = if phi > 0.0 && angle < 0.0 {
-                angle + std::f64::consts::TAU
-            } else if phi < 0.0 && angle > 0.0 {
-                angle - std::f64::consts::TAU
-            } else {
-                angle
-            };
-            return angle / phi;
+            // Take the turn of that angle nearest the arc's middle (φ/2), so a point a rounding
+            // error before A (or past Z) maps just outside [0, 1], not a full turn away.
+            let from_middle = angle - 0.5 * phi;
+            let from_middle = from_middle.sin().atan2(from_middle.cos());
+            return (0.5 * phi + from_middle) / phi;
         }
         // Tangent–chord angle: the chord A→P makes half of its arc's angle with the start tangent.
         let psi = tangent.cross(v).atan2(tangent.dot(v));

@@ -218,7 +218,31 @@ fn points_just_past_the_start_of_a_wide_arc_keep_their_parameter() {
     assert!(close(t, delta / PI, 1e-12), "t = {t}");
     let n = s.nearest_point(q);
     assert!(n.distance < 1e-9, "distance {}", n.distance);
-    // Points of the circle outside the arc still map outside [0, 1].
+    // Points of the circle outside the arc still map outside [0, 1], on their own side: a
+    // point δ before A just below 0 (not a full turn away, past Z).
     let before = p(1100.0002 + 100.0 * delta.sin(), 1300.0);
-    assert!(s.parameter_of(before) > 1.0);
+    let t = s.parameter_of(before);
+    assert!(t < 0.0 && t > -1e-6, "t = {t}");
+}
+
+#[test]
+fn every_point_of_an_arc_maps_to_its_own_parameter_even_at_the_ends() {
+    // Nest02: an arc of 144° traversed clockwise (common edge of a hole and a round part); its
+    // start once mapped to t = 2.5 because the angle from A came out as +1e-16 instead of 0.
+    let s = Span::new(
+        p(2219.9999928000047, 109.9999903999997),
+        p(2249.99998, 200.0),
+        -0.7207593416156713,
+    );
+    assert!(s.parameter_of(s.start).abs() < 1e-12);
+    assert!((s.parameter_of(s.end) - 1.0).abs() < 1e-12);
+    for k in 0..=64 {
+        let t = k as f64 / 64.0;
+        for sp in [s, s.reversed(), Span::new(s.start, s.end, 1.0 / s.bulge)] {
+            assert!(
+                (sp.parameter_of(sp.point_at(t)) - t).abs() < 1e-9,
+                "{sp:?} at {t}"
+            );
+        }
+    }
 }

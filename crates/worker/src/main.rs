@@ -3,15 +3,40 @@
 //!
 //! Between two slices the worker awaits a zero-delay timer, which hands control back to the
 //! browser's event loop: that is how a Cancel message reaches a job that is still running.
+//!
+//! Files are opened here too ([`open_files`]): what the engine reads, G-code programs, and
+//! several files combined into one document.
+
+// Natively only the tests use the opening code (the worker itself is wasm only).
+#![cfg_attr(not(target_arch = "wasm32"), allow(dead_code))]
+
+mod open_files;
+mod request;
 
 #[cfg(target_arch = "wasm32")]
 mod web {
     use std::collections::HashMap;
 
-    use cutroute_engine::{open_document, start_job, Job, JobStatus, DEFAULT_SLICE};
-    use cutroute_protocol::{FromWorker, JobId, ToWorker};
+    use cutroute_engine::{start_job, Job, JobStatus, DEFAULT_SLICE};
+    use cutroute_protocol::{Document, FromWorker, JobId, ToWorker};
     use gloo_worker::{HandlerId, Worker, WorkerScope};
     use web_time::{Duration, Instant};
+
+    use crate::open_files::{open_file, open_together, OpenFilesError};
+    use crate::request::WorkerRequest;
+
+    fn opened(request_id: u64, result: Result<Document, OpenFilesError>) -> FromWorker {
+        match result {
+            Ok(document) => FromWorker::Opened {
+                request_id,
+                document,
+            },
+            Err(error) => FromWorker::OpenFailed {
+                request_id,
+                message: error.to_string(),
+            },
+        }
+    }
 
     /// Progress is sent at most this often while a job improves (the page redraws on each one).
     const PROGRESS_INTERVAL: Duration = Duration::from_millis(150);
@@ -44,7 +69,7 @@ mod web {
 
     impl Worker for SolverWorker {
         type Message = Tick;
-        type Input = ToWorker;
+        type Input = WorkerRequest;
         type Output = FromWorker;
 
         fn create(_scope: &WorkerScope<Self>) -> Self {
@@ -86,6 +111,13 @@ mod web {
         }
 
         fn received(&mut self, scope: &WorkerScope<Self>, msg: Self::Input, requester: HandlerId) {
+            let msg = match msg {
+                WorkerRequest::Protocol(msg) => msg,
+                WorkerRequest::OpenTogether { request_id, files } => {
+                    scope.respond(requester, opened(request_id, open_together(&files)));
+                    return;
+                }
+            };
             match msg {
                 ToWorker::Start(request) => match start_job(&request) {
                     Ok(job) => {
@@ -116,17 +148,7 @@ mod web {
                     file_name,
                     bytes,
                 } => {
-                    let answer = match open_document(&file_name, &bytes) {
-                        Ok(document) => FromWorker::Opened {
-                            request_id,
-                            document,
-                        },
-                        Err(error) => FromWorker::OpenFailed {
-                            request_id,
-                            message: error.to_string(),
-                        },
-                    };
-                    scope.respond(requester, answer);
+                    scope.respond(requester, opened(request_id, open_file(&file_name, &bytes)));
                 }
                 ToWorker::Cancel { job_id } => {
                     if let Some(running) = self.jobs.remove(&job_id) {

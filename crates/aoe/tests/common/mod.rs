@@ -2,6 +2,36 @@
 #![allow(dead_code)]
 
 use cutroute_aoe::{edge_list, Embedding};
+use cutroute_geometry::Nest;
+use std::path::PathBuf;
+
+/// A nest of `shared/data/nests` by its path there; panics loudly when the file is missing.
+pub fn load_nest(relative: &str) -> Nest {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/data/nests")
+        .join(relative);
+    let bytes = std::fs::read(&path)
+        .unwrap_or_else(|e| panic!("required test data {} is missing: {e}", path.display()));
+    if relative.ends_with(".tfnesting") {
+        cutroute_cad::tflex::read_tfnesting(&bytes)
+            .unwrap()
+            .remove(0)
+    } else {
+        cutroute_formats::read_nest(&bytes).unwrap()
+    }
+}
+
+/// Every real nest the plan-graph tests use.
+pub const REAL_NESTS: [&str; 8] = [
+    "dbs/nested.dbs",
+    "dbs/seven.dbs",
+    "dbs/test0.json.dbs",
+    "dbs-json/E1X_6_01.dbs.json",
+    "dbs-json/test1.dbs.json",
+    "tflex/Nest01.tfnesting",
+    "tflex/Nest02.tfnesting",
+    "tflex/Nest03.tfnesting",
+];
 
 /// Fig. 4 of the paper, rebuilt by the digest (§6.1): the square antiprism.
 pub const FIG4_ANTIPRISM: &str = "16

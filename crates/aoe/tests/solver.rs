@@ -1,0 +1,170 @@
+//! `solve_nest`: checked routes with the fewest pierces on hand-made plans with known optima and
+//! on every real nest; idle travel never worse than the plain inner-first order.
+
+mod common;
+
+use common::{load_nest, REAL_NESTS};
+use cutroute_aoe::{solve_nest, AoeSolveOptions, PlanGraph, PlanOptions};
+use cutroute_geometry::{Contour, Nest, Part, Point, Vertex};
+
+/// A clockwise rectangle (outer contours run clockwise, holes counter-clockwise).
+fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> Contour {
+    Contour::new(vec![
+        Vertex::line(x0, y0),
+        Vertex::line(x0, y1),
+        Vertex::line(x1, y1),
+        Vertex::line(x1, y0),
+    ])
+}
+
+fn hole(x0: f64, y0: f64, x1: f64, y1: f64) -> Contour {
+    Contour::new(vec![
+        Vertex::line(x0, y0),
+        Vertex::line(x1, y0),
+        Vertex::line(x1, y1),
+        Vertex::line(x0, y1),
+    ])
+}
+
+fn part(contours: Vec<Contour>) -> Part {
+    Part {
+        name: String::new(),
+        contours,
+    }
+}
+
+/// `n × m` rectangles of `w × h` sharing their edges.
+fn grid(n: usize, m: usize, w: f64, h: f64) -> Nest {
+    let mut parts = Vec::new();
+    for i in 0..n {
+        for j in 0..m {
+            let (x, y) = (w * i as f64, h * j as f64);
+            parts.push(part(vec![rect(x, y, x + w, y + h)]));
+        }
+    }
+    Nest { sheet: None, parts }
+}
+
+fn check(nest: &Nest, options: &AoeSolveOptions) -> cutroute_aoe::AoeSolution {
+    let solution = solve_nest(nest, options).unwrap_or_else(|e| panic!("{e}"));
+    // Both checkers again, independently of the solver's own final check.
+    solution
+        .route
+        .validate(nest, 1e-6)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let plan = PlanGraph::from_nest(nest, &options.plan).unwrap();
+    plan.check_route(&solution.chains).unwrap();
+    assert_eq!(solution.route.paths.len(), solution.chains.len());
+    assert!(solution.route.idle_length() <= solution.unordered_idle_length + 1e-9);
+    solution
+}
+
+#[test]
+fn grids_cut_every_common_edge_once_with_the_fewest_pierces() {
+    for (n, m) in [(1, 1), (1, 5), (2, 2), (3, 3), (4, 7), (10, 10)] {
+        let (w, h) = (100.0, 50.0);
+        let solution = check(&grid(n, m, w, h), &AoeSolveOptions::default());
+        // Every grid line once: m + 1 horizontal lines of n·w, n + 1 vertical ones of m·h.
+        let lines = (m + 1) as f64 * n as f64 * w + (n + 1) as f64 * m as f64 * h;
+        assert!(
+            (solution.route.cut_length() - lines).abs() < 1e-6,
+            "{n}×{m}: {} vs {lines}",
+            solution.route.cut_length()
+        );
+        // Odd vertices: the T-junctions on the boundary, 2(n − 1) + 2(m − 1); one trail per pair.
+        let odd = 2 * (n - 1) + 2 * (m - 1);
+        assert_eq!(solution.pierce_lower_bound, (odd / 2).max(1), "{n}×{m}");
+        assert_eq!(solution.route.pierce_count(), (odd / 2).max(1), "{n}×{m}");
+    }
+}
+
+#[test]
+fn a_part_in_a_hole_in_a_part_is_cut_inside_out() {
+    // A plate with a hole, a smaller plate with a hole inside that hole, a square in the
+    // smallest hole: three levels, six closed curves, no common edges.
+    let nest = Nest {
+        sheet: None,
+        parts: vec![
+            part(vec![
+                rect(0.0, 0.0, 100.0, 100.0),
+                hole(10.0, 10.0, 90.0, 90.0),
+            ]),
+            part(vec![
+                rect(20.0, 20.0, 80.0, 80.0),
+                hole(30.0, 30.0, 70.0, 70.0),
+            ]),
+            part(vec![rect(40.0, 40.0, 60.0, 60.0)]),
+        ],
+    };
+    // Start far outside: the nearest curve is the outermost, which must still come last.
+    let options = AoeSolveOptions {
+        start: Point::new(-500.0, -500.0),
+        ..AoeSolveOptions::default()
+    };
+    let solution = check(&nest, &options);
+    assert_eq!(solution.route.pierce_count(), 5);
+    let first = solution.route.paths[0].pierce;
+    assert!(first.x >= 40.0 && first.x <= 60.0 && first.y >= 40.0 && first.y <= 60.0);
+    let last = solution.route.paths[4].pierce;
+    assert!(
+        last.x == 0.0 || last.x == 100.0 || last.y == 0.0 || last.y == 100.0,
+        "{last:?}"
+    );
+}
+
+#[test]
+fn ordering_beats_the_inner_first_area_order_on_scattered_parts() {
+    // Squares on a diagonal, smaller the farther from the start: the area order (smallest
+    // first) goes out to the far end and back.
+    let parts = (0..8)
+        .map(|k| {
+            let x = 100.0 * k as f64;
+            let side = 45.0 - 5.0 * k as f64;
+            part(vec![rect(x, x, x + side, x + side)])
+        })
+        .collect();
+    let nest = Nest { sheet: None, parts };
+    let solution = check(&nest, &AoeSolveOptions::default());
+    assert!(
+        solution.route.idle_length() < 0.6 * solution.unordered_idle_length,
+        "{} vs {}",
+        solution.route.idle_length(),
+        solution.unordered_idle_length
+    );
+}
+
+#[test]
+fn every_real_nest_gets_a_checked_route_at_the_pierce_lower_bound() {
+    for name in REAL_NESTS {
+        let nest = load_nest(name);
+        let scale = {
+            let b = nest.bounding_box();
+            (b.max.x - b.min.x).abs() + (b.max.y - b.min.y).abs()
+        };
+        let options = AoeSolveOptions {
+            plan: PlanOptions {
+                tolerance: 1e-6 * scale.max(1.0),
+                ..PlanOptions::default()
+            },
+            ..AoeSolveOptions::default()
+        };
+        let solution = solve_nest(&nest, &options).unwrap_or_else(|e| panic!("{name}: {e}"));
+        solution
+            .route
+            .validate(&nest, 1e-5 * scale.max(1.0))
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(
+            solution.route.pierce_count(),
+            solution.pierce_lower_bound,
+            "{name}"
+        );
+        assert!(
+            solution.route.pierce_count() <= nest.contour_count(),
+            "{name}"
+        );
+        assert!(
+            solution.route.idle_length() <= solution.unordered_idle_length + 1e-9,
+            "{name}"
+        );
+    }
+}

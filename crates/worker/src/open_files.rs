@@ -1,0 +1,922 @@
+//! Opening what `cutroute-engine` does not open alone: a G-code program (shown as the nest its
+//! cuts trace, with the program's own route), and several files opened together — a nest with
+//! its task JSON and a PCGLNS result, or a PCGTSP instance with a PCGLNS result. Tours are
+//! checked by the independent checker (`cutroute_pcgtsp::check_tour`) and routes by
+//! `Route::validate` before anything is shown.
+//!
+//! Plain code (no web APIs): the worker calls it, and it is tested natively.
+
+use cutroute_engine::{format_name, open_document, OpenError};
+use cutroute_formats::{detect, read_task_json, Format, RmTask};
+use cutroute_gcode::{read_gcode, Motion, ReadOptions};
+use cutroute_geometry::{
+    Contour, ContourRef, CutStep, Entry, Nest, Part, Point, Route, RouteError, Span, Vertex,
+};
+use cutroute_pcgtsp::{check_tour, Instance, PcglnsResult};
+use cutroute_protocol::{Document, Problem};
+
+/// Pierce points of a task and the end points of G-code moves count as "the same point" within
+/// this distance, mm (files round coordinates to a few decimals).
+pub const POINT_TOLERANCE_MM: f64 = 0.01;
+
+/// Why files could not be opened; every message names the file.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum OpenFilesError {
+    /// The engine's reader refused a file.
+    #[error(transparent)]
+    Engine(#[from] OpenError),
+    /// Nothing the engine or this module recognises.
+    #[error(
+        "{0}: unknown format (expected DBS, geometry/task/result JSON, DXF, T-FLEX, a PCGLNS/PCGTSPLIB \
+         instance or result, or G-code)"
+    )]
+    UnknownFormat(String),
+    /// A G-code program that does not read.
+    #[error("{file_name} (G-code): {message}")]
+    Gcode {
+        /// The file's name.
+        file_name: String,
+        /// The reader's error with its line and column.
+        message: String,
+    },
+    /// A G-code program that never cuts a closed contour.
+    #[error("{0} (G-code): the program cuts no closed contour")]
+    GcodeCutsNothing(String),
+    /// A PCGLNS result opened with nothing to check its tour against.
+    #[error(
+        "{0}: a PCGLNS result holds only a tour; open it together with its instance \
+         (.pcglns/.pcgtsp), or with its nest and task JSON"
+    )]
+    TourAlone(String),
+    /// Two files of one kind in a batch.
+    #[error("{first} and {second} are both {kind}: open one {kind} at a time")]
+    TwoOfAKind {
+        /// The kind, in words.
+        kind: &'static str,
+        /// The first file.
+        first: String,
+        /// The second file.
+        second: String,
+    },
+    /// A file of a batch that is none of the kinds a batch combines.
+    #[error("{0}: cannot be combined with the other files (expected a nest, a task JSON, a PCGTSP instance or a PCGLNS result)")]
+    NotCombinable(String),
+    /// The tour fails the independent checker.
+    #[error("{file_name}: the tour is not feasible for {against}: {reason} (nodes and clusters counted from 0)")]
+    InfeasibleTour {
+        /// The result file.
+        file_name: String,
+        /// What it was checked against (the instance's or the task's file name).
+        against: String,
+        /// The checker's finding.
+        reason: String,
+    },
+    /// The checked cost of the tour differs from what the result file reports.
+    #[error("{file_name}: the file reports cost {reported} but the tour costs {checked:.3} on {against}")]
+    CostMismatch {
+        /// The result file.
+        file_name: String,
+        /// What it was checked against.
+        against: String,
+        /// The cost in the file.
+        reported: f64,
+        /// The cost recomputed by the checker.
+        checked: f64,
+    },
+    /// An instance whose nodes are not the task's pierce points plus the start.
+    #[error("{instance} has {nodes} nodes but {task} has {points} pierce points plus the start: they do not belong together")]
+    InstanceNotOfTask {
+        /// The instance file.
+        instance: String,
+        /// Its node count.
+        nodes: usize,
+        /// The task file.
+        task: String,
+        /// The task's pierce points.
+        points: usize,
+    },
+    /// A task contour that lies on no contour of the nest.
+    #[error("{task}: contour {index} (pierce point ({x:.3}, {y:.3})) is on no contour of {nest}: they do not belong together")]
+    TaskNotOnNest {
+        /// The task file.
+        task: String,
+        /// The task contour's 1-based `Index`.
+        index: i64,
+        /// Its first pierce point.
+        x: f64,
+        /// Its first pierce point.
+        y: f64,
+        /// The nest file.
+        nest: String,
+    },
+    /// The tour, as a cutting route, fails the route checker.
+    #[error("{file_name}: as a cutting route of {nest} the tour is not valid: {reason}")]
+    InvalidRoute {
+        /// The result file.
+        file_name: String,
+        /// The nest file.
+        nest: String,
+        /// The route checker's finding.
+        reason: String,
+    },
+    /// A task or a tour with no nest to draw it on, and no instance either.
+    #[error("{0}: a cutting task holds no geometry; open it together with its nest (geometry JSON or DBS)")]
+    TaskWithoutNest(String),
+}
+
+/// Whether the text is a PCGLNS run summary (`*.pcglns.result.txt`).
+pub fn is_pcglns_result(bytes: &[u8]) -> bool {
+    detect(bytes) == Format::Unknown
+        && std::str::from_utf8(bytes).is_ok_and(|t| t.contains("Tour Ordering"))
+}
+
+/// Opens one file: what the engine reads, else a G-code program, else a PCGLNS result (which
+/// needs company, so it is an error alone).
+pub fn open_file(file_name: &str, bytes: &[u8]) -> Result<Document, OpenFilesError> {
+    match open_document(file_name, bytes) {
+        Err(OpenError::UnknownFormat(name)) => {
+            if is_pcglns_result(bytes) {
+                return Err(OpenFilesError::TourAlone(name));
+            }
+            match std::str::from_utf8(bytes) {
+                Ok(text) if looks_like_gcode(text) => open_gcode(file_name, text),
+                _ => Err(OpenFilesError::UnknownFormat(name)),
+            }
+        }
+        other => Ok(other?),
+    }
+}
+
+/// A cheap look at the first words: G-code programs start with `%`, a comment, a line number
+/// or a G/M/T word.
+fn looks_like_gcode(text: &str) -> bool {
+    text.lines()
+        .map(str::trim)
+        .find(|l| !l.is_empty())
+        .and_then(|l| l.chars().next())
+        .is_some_and(|c| {
+            matches!(
+                c.to_ascii_uppercase(),
+                '%' | '(' | ';' | 'N' | 'G' | 'M' | 'T' | 'O'
+            )
+        })
+}
+
+/// A G-code program as the nest its cuts trace and the route it takes: every closed tool-on
+/// loop is a contour (loops inside loops become holes of their part), every torch-on a pierce,
+/// a tool-on path from one loop to the next in the same torch-on run a chain link. The cut
+/// direction is the program's own. Tool-on paths that close no loop are left out with a
+/// warning.
+pub fn open_gcode(file_name: &str, text: &str) -> Result<Document, OpenFilesError> {
+    let program = read_gcode(text, &ReadOptions::default()).map_err(|e| OpenFilesError::Gcode {
+        file_name: file_name.to_string(),
+        message: e.to_string(),
+    })?;
+    let mut warnings = Vec::new();
+    // (loop, entry) in cutting order.
+    let mut loops: Vec<(Contour, Entry)> = Vec::new();
+    let mut run: Option<RunState> = None;
+    let finish_run = |run: Option<RunState>, warnings: &mut Vec<String>| {
+        if let Some(r) = run {
+            if !r.pending.is_empty() {
+                warnings.push(format!(
+                    "line {}: a tool-on path of {:.3} mm closes no contour and is not drawn",
+                    r.pending_line,
+                    r.pending.iter().map(Span::length).sum::<f64>()
+                ));
+            }
+        }
+    };
+    for motion in &program.motions {
+        match *motion {
+            Motion::TorchOn { .. } => {
+                finish_run(run.take(), &mut warnings);
+                run = Some(RunState::default());
+            }
+            Motion::TorchOff { .. } => finish_run(run.take(), &mut warnings),
+            Motion::Feed {
+                span,
+                tool_on: true,
+                line,
+                ..
+            } => {
+                let Some(r) = run.as_mut() else { continue };
+                if r.pending.is_empty() {
+                    r.pending_line = line;
+                }
+                r.pending.push(span);
+                // Does this span close a loop that began at one of the pending spans?
+                let closes = r
+                    .pending
+                    .iter()
+                    .position(|s| s.start.distance(span.end) <= POINT_TOLERANCE_MM);
+                if let Some(j) = closes {
+                    let lead: Vec<Span> = r.pending.drain(..j).collect();
+                    let vertices: Vec<Vertex> = r
+                        .pending
+                        .drain(..)
+                        .map(|s| Vertex {
+                            point: s.start,
+                            bulge: s.bulge,
+                        })
+                        .collect();
+                    let entry = if r.loops_cut == 0 {
+                        if !lead.is_empty() {
+                            warnings.push(format!(
+                                "line {}: a lead-in of {:.3} mm before the contour is not drawn",
+                                r.pending_line,
+                                lead.iter().map(Span::length).sum::<f64>()
+                            ));
+                        }
+                        Entry::Pierce
+                    } else {
+                        // The link's corners: where its pieces meet.
+                        Entry::Link(lead.iter().skip(1).map(|s| s.start).collect())
+                    };
+                    r.loops_cut += 1;
+                    loops.push((Contour::new(vertices), entry));
+                }
+            }
+            Motion::Feed { .. } | Motion::Rapid { .. } | Motion::Dwell { .. } => {}
+        }
+    }
+    finish_run(run.take(), &mut warnings);
+    if loops.is_empty() {
+        return Err(OpenFilesError::GcodeCutsNothing(file_name.to_string()));
+    }
+    let (nest, refs) = nest_of_loops(loops.iter().map(|(c, _)| c.clone()).collect());
+    let steps: Vec<CutStep> = loops
+        .into_iter()
+        .zip(refs)
+        .map(|((contour, entry), r)| CutStep {
+            contour: r,
+            pierce_point: contour.vertices[0].point,
+            entry,
+        })
+        .collect();
+    let last_exit = steps.last().map(|s| s.pierce_point);
+    let finish = (last_exit.is_some_and(|p| p.distance(program.end) > POINT_TOLERANCE_MM))
+        .then_some(program.end);
+    let route = Route {
+        start: program.start,
+        steps,
+        finish,
+    };
+    Ok(Document {
+        file_name: file_name.to_string(),
+        format: "G-code".to_string(),
+        problem: Problem::Nest {
+            nest,
+            start: program.start,
+            finish,
+        },
+        route: Some(route),
+        warnings,
+    })
+}
+
+#[derive(Default)]
+struct RunState {
+    /// Tool-on spans since the last closed loop.
+    pending: Vec<Span>,
+    /// Line of the first pending span.
+    pending_line: usize,
+    /// Loops closed in this run so far.
+    loops_cut: usize,
+}
+
+/// Groups loops into parts by containment (a loop at odd depth is a hole of its parent);
+/// returns the nest and where each loop went.
+fn nest_of_loops(loops: Vec<Contour>) -> (Nest, Vec<ContourRef>) {
+    let flat = Nest {
+        sheet: None,
+        parts: loops
+            .iter()
+            .map(|c| Part {
+                name: String::new(),
+                contours: vec![c.clone()],
+            })
+            .collect(),
+    };
+    let forest = flat.containment_forest();
+    let at = |i: usize| ContourRef {
+        part: i,
+        contour: 0,
+    };
+    let depth = |i: usize| forest.depth(at(i)).unwrap_or(0);
+    let mut part_of_loop = vec![usize::MAX; loops.len()];
+    let mut refs = vec![at(0); loops.len()];
+    let mut parts: Vec<Part> = Vec::new();
+    for i in (0..loops.len()).filter(|&i| depth(i) % 2 == 0) {
+        part_of_loop[i] = parts.len();
+        refs[i] = ContourRef {
+            part: parts.len(),
+            contour: 0,
+        };
+        parts.push(Part {
+            name: format!("cut {}", i + 1),
+            contours: vec![loops[i].clone()],
+        });
+    }
+    for i in (0..loops.len()).filter(|&i| depth(i) % 2 == 1) {
+        let parent = forest.parent(at(i)).map(|p| p.part).unwrap_or(i);
+        let part = part_of_loop[parent];
+        refs[i] = ContourRef {
+            part,
+            contour: parts[part].contours.len(),
+        };
+        parts[part].contours.push(loops[i].clone());
+    }
+    (Nest { sheet: None, parts }, refs)
+}
+
+/// One file of a batch, as recognised from its content.
+enum Piece {
+    Nest(Document),
+    Task(RmTask),
+    Instance(Instance, String),
+    Tour(PcglnsResult),
+}
+
+/// Opens several files as one document: a nest (any nest format) with its task JSON (start,
+/// finish) and optionally a PCGLNS result whose tour becomes the shown route; or a PCGTSP
+/// instance with a PCGLNS result (the tour is checked and reported; with a nest and task too,
+/// it is also drawn). One file alone opens as [`open_file`] does.
+pub fn open_together(files: &[(String, Vec<u8>)]) -> Result<Document, OpenFilesError> {
+    if let [(name, bytes)] = files {
+        return open_file(name, bytes);
+    }
+    let mut nest: Option<(String, Document)> = None;
+    let mut task: Option<(String, RmTask)> = None;
+    let mut instance: Option<(String, Instance, String)> = None;
+    let mut tour: Option<(String, PcglnsResult)> = None;
+    let mut labels = Vec::new();
+    for (name, bytes) in files {
+        let format = detect(bytes);
+        let unreadable = |message: String| OpenError::Unreadable {
+            file_name: name.clone(),
+            format: format_name(format),
+            message,
+        };
+        let piece = match format {
+            Format::TaskJson => {
+                Piece::Task(read_task_json(bytes).map_err(|e| unreadable(e.to_string()))?)
+            }
+            Format::Pcglns => {
+                let text = std::str::from_utf8(bytes).map_err(|e| unreadable(e.to_string()))?;
+                let parsed = Instance::parse(text).map_err(|e| unreadable(e.to_string()))?;
+                Piece::Instance(parsed, text.to_string())
+            }
+            Format::Unknown if is_pcglns_result(bytes) => {
+                let text = std::str::from_utf8(bytes).unwrap_or_default();
+                Piece::Tour(
+                    PcglnsResult::parse(text).map_err(|e| OpenError::Unreadable {
+                        file_name: name.clone(),
+                        format: "PCGLNS result",
+                        message: e.to_string(),
+                    })?,
+                )
+            }
+            _ => match open_file(name, bytes)? {
+                d if matches!(d.problem, Problem::Nest { .. }) => Piece::Nest(d),
+                _ => return Err(OpenFilesError::NotCombinable(name.clone())),
+            },
+        };
+        let kind = match &piece {
+            Piece::Nest(d) => d.format.clone(),
+            Piece::Task(_) => "task JSON".to_string(),
+            Piece::Instance(..) => "PCGTSP instance".to_string(),
+            Piece::Tour(_) => "PCGLNS result".to_string(),
+        };
+        labels.push((name.clone(), kind));
+        let two = |kind: &'static str, first: &str| OpenFilesError::TwoOfAKind {
+            kind,
+            first: first.to_string(),
+            second: name.clone(),
+        };
+        match piece {
+            Piece::Nest(d) => match &nest {
+                Some((first, _)) => return Err(two("nests", first)),
+                None => nest = Some((name.clone(), d)),
+            },
+            Piece::Task(t) => match &task {
+                Some((first, _)) => return Err(two("task files", first)),
+                None => task = Some((name.clone(), t)),
+            },
+            Piece::Instance(i, text) => match &instance {
+                Some((first, ..)) => return Err(two("PCGTSP instances", first)),
+                None => instance = Some((name.clone(), i, text)),
+            },
+            Piece::Tour(r) => match &tour {
+                Some((first, _)) => return Err(two("PCGLNS results", first)),
+                None => tour = Some((name.clone(), r)),
+            },
+        }
+    }
+    let file_name = labels
+        .iter()
+        .map(|(n, _)| n.as_str())
+        .collect::<Vec<_>>()
+        .join(" + ");
+    let format = labels
+        .iter()
+        .map(|(_, k)| k.as_str())
+        .collect::<Vec<_>>()
+        .join(" + ");
+    let mut notes = Vec::new();
+    // The tour first: checked against the instance when there is one, else against the
+    // instance the task defines (rounded idle lengths between pierce points, as PCGLNS needs).
+    let checked_tour = match (&tour, &instance, &task) {
+        (Some((tour_name, result)), Some((instance_name, inst, _)), _) => {
+            if let Some((task_name, t)) = &task {
+                let points = t.pierce_point_count();
+                if inst.node_count != points + 1 {
+                    return Err(OpenFilesError::InstanceNotOfTask {
+                        instance: instance_name.clone(),
+                        nodes: inst.node_count,
+                        task: task_name.clone(),
+                        points,
+                    });
+                }
+            }
+            let cost = checked(tour_name, instance_name, inst, result)?;
+            notes.push(tour_note(tour_name, instance_name, result, cost));
+            Some(result.tour.clone())
+        }
+        (Some((tour_name, result)), None, Some((task_name, t))) => {
+            let inst = task_instance(t);
+            let cost = checked(tour_name, task_name, &inst, result)?;
+            notes.push(tour_note(tour_name, task_name, result, cost));
+            Some(result.tour.clone())
+        }
+        (Some((tour_name, _)), None, None) => {
+            return Err(OpenFilesError::TourAlone(tour_name.clone()))
+        }
+        (None, ..) => None,
+    };
+    let Some((nest_name, mut document)) = nest else {
+        if let Some((_, _, text)) = instance {
+            return Ok(Document {
+                file_name,
+                format,
+                problem: Problem::PcgtspText { text },
+                route: None,
+                warnings: notes,
+            });
+        }
+        let (task_name, _) = task.expect("a batch of two or more files has a piece");
+        return Err(OpenFilesError::TaskWithoutNest(task_name));
+    };
+    if let Some((task_name, t)) = &task {
+        if let Problem::Nest { start, finish, .. } = &mut document.problem {
+            *start = t.task_data.start();
+            *finish = t.task_data.finish();
+        }
+        if let (Some(tour_nodes), Some((tour_name, _))) = (&checked_tour, &tour) {
+            let Problem::Nest {
+                nest,
+                start,
+                finish,
+            } = &document.problem
+            else {
+                unreachable!("matched above")
+            };
+            let (route, listed) =
+                tour_route(t, task_name, nest, &nest_name, *start, *finish, tour_nodes)?;
+            // Contours the task leaves out (files repeat a hole as a part of its own) are not
+            // cut; everything else is checked.
+            let forest = nest.containment_forest();
+            let mut left_out = Vec::new();
+            for problem in route.problems(nest, &forest, POINT_TOLERANCE_MM) {
+                match problem {
+                    RouteError::NotCut { contour } if !listed.contains(&contour) => {
+                        left_out.push(contour)
+                    }
+                    other => {
+                        return Err(OpenFilesError::InvalidRoute {
+                            file_name: tour_name.clone(),
+                            nest: nest_name.clone(),
+                            reason: other.to_string(),
+                        })
+                    }
+                }
+            }
+            notes.push(format!(
+                "{tour_name}: drawn as a cutting route of {nest_name} (route checked: every contour of the task once, on its contour, inner before outer)"
+            ));
+            if !left_out.is_empty() {
+                let names: Vec<String> = left_out
+                    .iter()
+                    .map(|r| format!("part {} contour {}", r.part + 1, r.contour))
+                    .collect();
+                notes.push(format!(
+                    "{task_name} does not list {} of {nest_name}: not cut",
+                    names.join(", ")
+                ));
+            }
+            document.route = Some(route);
+        }
+    } else if let Some((tour_name, _)) = &tour {
+        notes.push(format!(
+            "{tour_name}: not drawn: open the nest's task JSON too to place its nodes on the contours"
+        ));
+    }
+    document.file_name = file_name;
+    document.format = format;
+    document.warnings.extend(notes);
+    Ok(document)
+}
+
+/// The independent check of a result's tour, and of the cost it reports.
+fn checked(
+    tour_name: &str,
+    against: &str,
+    instance: &Instance,
+    result: &PcglnsResult,
+) -> Result<f64, OpenFilesError> {
+    let cost = check_tour(instance, &result.tour).map_err(|e| OpenFilesError::InfeasibleTour {
+        file_name: tour_name.to_string(),
+        against: against.to_string(),
+        reason: e.to_string(),
+    })?;
+    // PCGLNS works on integers: a tour over real weights may differ by rounding, half a unit
+    // per arc at most.
+    let slack = 0.5 * result.tour.len() as f64 + 1e-6;
+    if (cost - result.cost).abs() > slack {
+        return Err(OpenFilesError::CostMismatch {
+            file_name: tour_name.to_string(),
+            against: against.to_string(),
+            reported: result.cost,
+            checked: cost,
+        });
+    }
+    Ok(cost)
+}
+
+fn tour_note(tour_name: &str, against: &str, result: &PcglnsResult, cost: f64) -> String {
+    let nodes: Vec<String> = result.tour.iter().map(|n| (n + 1).to_string()).collect();
+    format!(
+        "{tour_name}: tour checked against {against}: feasible, cost {cost:.3} (the file reports {}); nodes {}",
+        result.cost,
+        nodes.join(" ")
+    )
+}
+
+/// The PCGTSP instance a task defines: node 0 is the start (the depot cluster), node `1 + g`
+/// the pierce point with 0-based global index `g`; one cluster per task contour; a contour
+/// nested in another is cut before it; arcs cost the idle length rounded to whole millimetres
+/// (as the instances built from these tasks for PCGLNS do), closing back to the finish.
+pub fn task_instance(task: &RmTask) -> Instance {
+    let flat = task.flat_contours();
+    let point_count = task.pierce_point_count();
+    let node_count = point_count + 1;
+    let mut position = vec![task.task_data.start(); node_count];
+    let mut node_cluster = vec![0; node_count];
+    let mut clusters = vec![vec![0]];
+    for (i, c) in flat.iter().enumerate() {
+        let mut nodes = Vec::new();
+        for p in &c.contour.points {
+            let node = 1 + usize::try_from(p.zero_based_global_index).unwrap_or(usize::MAX);
+            if node < node_count {
+                position[node] = p.point();
+                node_cluster[node] = i + 1;
+                nodes.push(node);
+            }
+        }
+        clusters.push(nodes);
+    }
+    let mut precedence = Vec::new();
+    for (i, c) in flat.iter().enumerate() {
+        let mut ancestor = c.parent;
+        while let Some(a) = ancestor {
+            precedence.push((i + 1, a + 1));
+            ancestor = flat[a].parent;
+        }
+    }
+    let finish = task.task_data.finish();
+    let mut cost = vec![0.0; node_count * node_count];
+    for from in 0..node_count {
+        for to in 0..node_count {
+            let target = if to == 0 { finish } else { Some(position[to]) };
+            cost[from * node_count + to] = match target {
+                Some(t) if from != to => position[from].distance(t).round(),
+                _ => 0.0,
+            };
+        }
+    }
+    Instance {
+        name: "task".to_string(),
+        node_count,
+        cost,
+        clusters,
+        node_cluster,
+        precedence,
+        depot: 0,
+    }
+}
+
+/// The tour's nodes placed on the nest: each task contour is matched to the nest contour its
+/// pierce points lie on, and each node after the start becomes a pierce there.
+fn tour_route(
+    task: &RmTask,
+    task_name: &str,
+    nest: &Nest,
+    nest_name: &str,
+    start: Point,
+    finish: Option<Point>,
+    tour: &[usize],
+) -> Result<(Route, Vec<ContourRef>), OpenFilesError> {
+    let refs: Vec<ContourRef> = nest.contour_refs().collect();
+    // Global index → (pierce point on the nest, nest contour).
+    let mut placed: Vec<Option<(Point, ContourRef)>> = vec![None; task.pierce_point_count()];
+    let mut listed = Vec::new();
+    for c in task.flat_contours() {
+        let points: Vec<Point> = c.contour.points.iter().map(on_contour_point).collect();
+        let best = refs
+            .iter()
+            .filter_map(|&r| {
+                let contour = nest.contour(r)?;
+                let worst = points
+                    .iter()
+                    .map(|p| contour.distance_to(*p))
+                    .fold(0.0_f64, f64::max);
+                Some((worst, r))
+            })
+            .min_by(|a, b| a.0.total_cmp(&b.0));
+        let Some((_, r)) = best.filter(|(d, _)| *d <= POINT_TOLERANCE_MM) else {
+            let first = points.first().copied().unwrap_or(Point::new(0.0, 0.0));
+            return Err(OpenFilesError::TaskNotOnNest {
+                task: task_name.to_string(),
+                index: c.contour.index,
+                x: first.x,
+                y: first.y,
+                nest: nest_name.to_string(),
+            });
+        };
+        listed.push(r);
+        let contour = nest.contour(r).expect("found above");
+        for (p, point) in c.contour.points.iter().zip(&points) {
+            let on = contour.nearest_point(*point).map_or(*point, |n| n.point);
+            if let Some(slot) = usize::try_from(p.zero_based_global_index)
+                .ok()
+                .and_then(|g| placed.get_mut(g))
+            {
+                *slot = Some((on, r));
+            }
+        }
+    }
+    let steps = tour
+        .iter()
+        .filter(|&&node| node != 0)
+        .filter_map(|&node| placed.get(node - 1).copied().flatten())
+        .map(|(point, r)| CutStep::pierced(r, point))
+        .collect();
+    Ok((
+        Route {
+            start,
+            steps,
+            finish,
+        },
+        listed,
+    ))
+}
+
+/// Where a task's pierce point meets its contour: the circuit point when the task cuts a lead-in
+/// to it, else the pierce point itself.
+fn on_contour_point(p: &cutroute_formats::PiercePoint) -> Point {
+    match (
+        p.use_circuit_and_finish_cut_point,
+        p.circuit_point_x,
+        p.circuit_point_y,
+    ) {
+        (true, Some(x), Some(y)) => Point::new(x, y),
+        _ => p.point(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::PathBuf;
+
+    /// A file under `shared/data/nests/`; panics naming the file when it is missing.
+    fn nests_file(relative: &str) -> (String, Vec<u8>) {
+        let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+            .join("../../../shared/data/nests")
+            .join(relative);
+        let bytes = std::fs::read(&path).unwrap_or_else(|e| {
+            panic!(
+                "reference file {} is missing or unreadable ({e}); the tests need ../shared/data beside the repository",
+                path.display()
+            )
+        });
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        (name, bytes)
+    }
+
+    fn route_of(document: &Document) -> &Route {
+        document.route.as_ref().expect("a route")
+    }
+
+    #[test]
+    fn instance_and_result_check_the_tour() {
+        let files = [
+            nests_file("pcgtsp/E1X_6_01.pcgtsp"),
+            nests_file("pcgtsp/E1X_6_01.pcglns.result.txt"),
+        ];
+        let document = open_together(&files).unwrap();
+        assert!(matches!(document.problem, Problem::PcgtspText { .. }));
+        assert_eq!(document.format, "PCGTSP instance + PCGLNS result");
+        assert!(
+            document.warnings[0].contains("feasible"),
+            "{:?}",
+            document.warnings
+        );
+        assert!(
+            document.warnings[0].contains("reports 1514"),
+            "{:?}",
+            document.warnings
+        );
+    }
+
+    #[test]
+    fn an_infeasible_tour_is_refused_in_plain_words() {
+        let (name, bytes) = nests_file("pcgtsp/E1X_6_01.pcglns.result.txt");
+        // Cut the outer contour 2 (nodes 25..28 are its hole, cluster 3) before its hole.
+        let text = String::from_utf8(bytes).unwrap().replace(
+            "[1, 161, 138, 80, 67, 27, 14,",
+            "[1, 161, 138, 80, 67, 14, 27,",
+        );
+        assert!(
+            text.contains("[1, 161, 138, 80, 67, 14, 27,"),
+            "the edit applies"
+        );
+        let files = [
+            nests_file("pcgtsp/E1X_6_01.pcgtsp"),
+            (name, text.into_bytes()),
+        ];
+        let error = open_together(&files).unwrap_err();
+        assert!(
+            matches!(error, OpenFilesError::InfeasibleTour { .. }),
+            "{error}"
+        );
+        // Arcs that break the order are forbidden in the matrix: that is what the checker meets.
+        assert!(error.to_string().contains("is forbidden"), "{error}");
+    }
+
+    #[test]
+    fn a_tour_alone_asks_for_its_instance() {
+        let (name, bytes) = nests_file("pcgtsp/test1.pcglns.result.txt");
+        let error = open_file(&name, &bytes).unwrap_err();
+        assert_eq!(error, OpenFilesError::TourAlone(name));
+    }
+
+    #[test]
+    fn nest_task_instance_and_result_become_a_checked_route() {
+        let files = [
+            nests_file("dbs-json/E1X_6_01.dbs.json"),
+            nests_file("task-json/E1X_6_01.task.json"),
+            nests_file("pcgtsp/E1X_6_01.pcgtsp"),
+            nests_file("pcgtsp/E1X_6_01.pcglns.result.txt"),
+        ];
+        let document = open_together(&files).unwrap();
+        let Problem::Nest { nest, .. } = &document.problem else {
+            panic!("a nest")
+        };
+        let route = route_of(&document);
+        assert_eq!(route.steps.len(), 16);
+        route.validate(nest, POINT_TOLERANCE_MM).unwrap();
+        // The instance's weights are the exact idle lengths: the route's idle length is the
+        // tour's cost (1514 rounded in the file).
+        // The instance's weights are the exact idle lengths between pierce points (PCGLNS
+        // rounds them: it reports 1514), so the drawn route's idle length is the tour's cost.
+        let (_, instance) = nests_file("pcgtsp/E1X_6_01.pcgtsp");
+        let instance = Instance::parse(std::str::from_utf8(&instance).unwrap()).unwrap();
+        let tour = [
+            1, 161, 138, 80, 67, 27, 14, 92, 90, 181, 177, 112, 108, 47, 41, 133, 124,
+        ];
+        let tour: Vec<usize> = tour.iter().map(|n| n - 1).collect();
+        let cost = check_tour(&instance, &tour).unwrap();
+        assert!(
+            (route.idle_length() - cost).abs() < 1e-6,
+            "{} vs {cost}",
+            route.idle_length()
+        );
+        assert!(document.warnings[0].contains(&format!("feasible, cost {cost:.3}")));
+        assert!(
+            (cost - 1514.0).abs() < 0.5 * 17.0,
+            "rounding explains the file's cost"
+        );
+    }
+
+    #[test]
+    fn test1_nest_task_and_result_become_a_checked_route() {
+        let files = [
+            nests_file("dbs-json/test1.dbs.json"),
+            nests_file("task-json/test1.task.json"),
+            nests_file("pcgtsp/test1.pcglns.result.txt"),
+        ];
+        let document = open_together(&files).unwrap();
+        let Problem::Nest { nest, .. } = &document.problem else {
+            panic!("a nest")
+        };
+        let route = route_of(&document);
+        assert_eq!(route.steps.len(), 23);
+        // Parts 16 and 18 coincide with the holes they fill (a common edge): the task lists each
+        // such edge once, so those two contours are all the route checker finds uncut.
+        let problems = route.problems(nest, &nest.containment_forest(), POINT_TOLERANCE_MM);
+        assert_eq!(problems.len(), 2, "{problems:?}");
+        assert!(
+            problems
+                .iter()
+                .all(|p| matches!(p, RouteError::NotCut { .. })),
+            "{problems:?}"
+        );
+        assert!(
+            document.warnings[0].contains("feasible, cost 4662.000"),
+            "{:?}",
+            document.warnings
+        );
+        // The task repeats two holes as parts of their own only once: those are not cut.
+        assert!(
+            document.warnings[2].contains("does not list part 16 contour 0, part 18 contour 0 of"),
+            "{:?}",
+            document.warnings
+        );
+        assert_eq!(document.warnings.len(), 3, "{:?}", document.warnings);
+    }
+
+    #[test]
+    fn the_e1x_task_instance_agrees_with_the_shipped_instance() {
+        let (_, task) = nests_file("task-json/E1X_6_01.task.json");
+        let (_, shipped) = nests_file("pcgtsp/E1X_6_01.pcgtsp");
+        let built = task_instance(&read_task_json(&task).unwrap());
+        let shipped = Instance::parse(std::str::from_utf8(&shipped).unwrap()).unwrap();
+        assert_eq!(built.node_count, shipped.node_count);
+        assert_eq!(built.clusters, shipped.clusters);
+        for from in 0..built.node_count {
+            for to in 0..built.node_count {
+                let (a, b) = (built.arc_cost(from, to), shipped.arc_cost(from, to));
+                if from != to && built.node_cluster[from] != built.node_cluster[to] && b.is_finite()
+                {
+                    assert!((a - b).abs() <= 0.5 + 1e-9, "arc {from}->{to}: {a} vs {b}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn gcode_reads_back_as_the_route_it_was_written_from() {
+        let (name, bytes) = nests_file("dbs-json/E1X_6_01.dbs.json");
+        let Problem::Nest { nest, start, .. } = open_document(&name, &bytes).unwrap().problem
+        else {
+            panic!("a nest")
+        };
+        let request = cutroute_protocol::JobRequest {
+            job_id: 1,
+            problem: Problem::Nest {
+                nest: nest.clone(),
+                start,
+                finish: None,
+            },
+            solver: cutroute_protocol::SolverKind::NearestNeighbour,
+            params: Default::default(),
+        };
+        let mut job = cutroute_engine::start_job(&request).unwrap();
+        let route = cutroute_engine::run_to_end(job.as_mut(), &mut |_| {})
+            .route
+            .unwrap();
+        let program =
+            cutroute_gcode::route_gcode(&nest, &route, &cutroute_gcode::GcodeOptions::default())
+                .unwrap();
+        let document = open_file("E1X_6_01.nc", program.as_bytes()).unwrap();
+        assert_eq!(document.format, "G-code");
+        let Problem::Nest { nest: read, .. } = &document.problem else {
+            panic!("a nest")
+        };
+        let back = route_of(&document);
+        assert_eq!(read.parts.len(), 8, "parts by containment");
+        assert_eq!(back.pierce_count(), route.pierce_count());
+        assert!((back.idle_length() - route.idle_length()).abs() < 0.01);
+        assert!((back.cut_length(read) - route.cut_length(&nest)).abs() < 0.01);
+        back.validate(read, POINT_TOLERANCE_MM).unwrap();
+        assert!(document.warnings.is_empty(), "{:?}", document.warnings);
+    }
+
+    #[test]
+    fn unknown_files_list_what_is_understood() {
+        let error = open_file("notes.txt", b"just some words").unwrap_err();
+        assert_eq!(error, OpenFilesError::UnknownFormat("notes.txt".into()));
+        assert!(error.to_string().contains("G-code"), "{error}");
+    }
+
+    #[test]
+    fn broken_gcode_names_its_line() {
+        let error = open_file("bad.nc", b"G90\nG01 X10 Y\n").unwrap_err();
+        assert!(
+            error.to_string().starts_with("bad.nc (G-code): "),
+            "{error}"
+        );
+        assert!(error.to_string().contains("line 2"), "{error}");
+    }
+}
