@@ -7,13 +7,18 @@
 //!                  [--incremental] [--arcs ij|r|lines] [--decimals N] [--line-numbers]
 //!                  [--feed MM_PER_MIN] [--dwell S] [--torch-on CODE] [--torch-off CODE]
 //! cutroute generate --contours N [--seed S] --out FILE   # synthetic nest as geometry JSON
-//! cutroute solve FILE --solver nearest|ccp|heuristic|exact|discrete|chain|aoe [--time-limit S]
-//!                     [--seed N] [--ub N] [--step MM] [--cost C_off,C_on,C_pt]
-//!                     [--speeds V_off,V_on,t_pt] [--task TASK.json] [--json]
+//! cutroute solve FILE --solver nearest|ccp|heuristic|exact|discrete|chain|aoe|sccp|gsccp
+//!                     [--time-limit S] [--seed N] [--ub N] [--step MM] [--cost C_off,C_on,C_pt]
+//!                     [--speeds V_off,V_on,t_pt] [--task TASK.json] [--objective time|cost]
+//!                     [--json]
 //! ```
 //! The time and cost model (`--speeds`, `--cost`) defaults to the task file's speeds and pierce
 //! time when `--task` is given, else to `MachineParameters::default()`; prices are per metre of
 //! idle travel and of cut and per pierce, speeds in mm/s, the pierce time in s.
+//! `sccp` cuts the multi-contour chains of the nest's plan graph (common edges once) as base
+//! segments; `gsccp` also tries standard cutting and contours split at junctions and keeps
+//! the best by `--objective` (`cutroute-segments`); both report the route as tool-on paths
+//! (`PathRoute` JSON) and each ensemble's numbers.
 //! Errors go to stderr with the reader's location, and the exit code is 1.
 
 use std::path::{Path, PathBuf};
@@ -89,7 +94,9 @@ enum Command {
         /// A nest file or a PCGTSP instance.
         file: PathBuf,
         /// nearest, ccp, heuristic, exact, discrete (= heuristic on a discretised nest),
-        /// chain (ccp, then chain cutting) or aoe (common edges cut once along AOE-chains).
+        /// chain (ccp, then chain cutting), aoe (common edges cut once along AOE-chains),
+        /// sccp (segment cutting along the plan's common edges) or gsccp (the best of several
+        /// segment ensembles).
         #[arg(long, default_value = "ccp")]
         solver: String,
         /// Wall-clock limit in seconds.
@@ -113,6 +120,9 @@ enum Command {
         /// A RouteManager task JSON whose speeds and pierce time are the defaults.
         #[arg(long)]
         task: Option<PathBuf>,
+        /// What gsccp minimises when it picks an ensemble: time or cost.
+        #[arg(long, default_value = "time")]
+        objective: String,
         /// Print one JSON object instead of text.
         #[arg(long)]
         json: bool,
@@ -164,6 +174,7 @@ fn main() -> ExitCode {
             cost,
             speeds,
             task,
+            objective,
             json,
         } => machine_parameters(cost.as_deref(), speeds.as_deref(), task.as_deref()).and_then(
             |machine| {
@@ -174,7 +185,10 @@ fn main() -> ExitCode {
                     initial_upper_bound: ub,
                     machine,
                 };
-                solve(&file, &solver, params, json)
+                match solver.as_str() {
+                    "sccp" | "gsccp" => solve_segments(&file, &solver, &params, &objective, json),
+                    _ => solve(&file, &solver, params, json),
+                }
             },
         ),
     };
@@ -674,4 +688,129 @@ fn route_report(
 fn nest_scale(nest: &Nest) -> f64 {
     let b = nest.bounding_box();
     ((b.max.x - b.min.x).abs() + (b.max.y - b.min.y).abs()).max(1.0)
+}
+
+/// `--solver sccp|gsccp`: segment cutting (`cutroute-segments`). sccp solves the multi-contour
+/// chain ensemble alone, gsccp every ensemble, keeping the best by `objective`. The report's
+/// numbers are recomputed from the route, which must pass `PathRoute::problems` but for
+/// contour cut twice (standard cutting of common edges, reported as `recut_length`).
+fn solve_segments(
+    path: &Path,
+    solver_name: &str,
+    params: &SolverParams,
+    objective: &str,
+    as_json: bool,
+) -> Result<(), String> {
+    use cutroute_segments::{EnsembleKind, GsccpOptions, Objective, SccpOptions};
+    let document = open(path)?;
+    let Problem::Nest {
+        nest,
+        start,
+        finish,
+    } = &document.problem
+    else {
+        return Err(format!(
+            "the {solver_name} solver routes nests, not PCGTSP instances"
+        ));
+    };
+    let objective = match objective {
+        "time" => Objective::Time,
+        "cost" => Objective::Cost,
+        other => return Err(format!("--objective {other:?}: expected time or cost")),
+    };
+    if !(params.time_limit_s.is_finite() && params.time_limit_s > 0.0) {
+        return Err(format!(
+            "--time-limit {}: must be a positive number of seconds",
+            params.time_limit_s
+        ));
+    }
+    let kinds = if solver_name == "sccp" {
+        vec![EnsembleKind::Chains]
+    } else {
+        EnsembleKind::ALL.to_vec()
+    };
+    let options = GsccpOptions {
+        sccp: SccpOptions {
+            start: *start,
+            finish: *finish,
+            time_limit: std::time::Duration::from_secs_f64(params.time_limit_s),
+            seed: params.seed,
+            ..SccpOptions::default()
+        },
+        kinds,
+        machine: params.machine,
+        objective,
+        seed: params.seed,
+        ..GsccpOptions::default()
+    };
+    let started = std::time::Instant::now();
+    let result = cutroute_segments::solve_gsccp(nest, &options, &Default::default())
+        .map_err(|e| e.to_string())?;
+    let route = &result.route;
+    let tolerance = 1e-6 * nest_scale(nest);
+    let problems = route.problems(nest, tolerance);
+    if let Some(other) = problems
+        .iter()
+        .find(|p| !matches!(p, cutroute_geometry::PathRouteError::Overlap { .. }))
+    {
+        return Err(format!("invalid route: {other}"));
+    }
+    let recut_length = cutroute_segments::recut_length(&problems, tolerance);
+    let machine = &params.machine;
+    let (idle_length, cut_length, pierces) = (
+        route.idle_length(),
+        route.cut_length(),
+        route.pierce_count(),
+    );
+    let report = json!({
+        "solver": solver_name,
+        "idle_length": idle_length,
+        "cut_length": cut_length,
+        "recut_length": recut_length,
+        "pierces": pierces,
+        "time_s": machine.time(cut_length, idle_length, pierces),
+        "cost": machine.cost(cut_length, idle_length, pierces),
+        "objective": match objective { Objective::Time => "time", Objective::Cost => "cost" },
+        "machine": machine_json(machine),
+        "ensemble": result.best.name(),
+        "ensembles": result.reports.iter().map(|r| json!({
+            "kind": r.kind.name(),
+            "segments": r.segments,
+            "pierces": r.pierces,
+            "idle_length": finite(r.idle_length),
+            "cut_length": finite(r.cut_length),
+            "recut_length": r.recut_length,
+            "time_s": finite(r.time_s),
+            "cost": finite(r.cost),
+            "failure": r.failure,
+        })).collect::<Vec<_>>(),
+        "ccp": {
+            "idle_length": result.ccp_route.idle_length(),
+            "cut_length": result.ccp_route.cut_length(),
+            "pierces": result.ccp_route.pierce_count(),
+            "time_s": result.ccp_route.time(machine),
+            "cost": result.ccp_route.cost(machine),
+        },
+        "route": serde_json::to_value(route).map_err(|e| e.to_string())?,
+        "elapsed_s": started.elapsed().as_secs_f64(),
+    });
+    if as_json {
+        println!("{report}");
+    } else {
+        for (key, value) in report.as_object().into_iter().flatten() {
+            if key != "route" {
+                println!("{key:>18}: {value}");
+            }
+        }
+    }
+    Ok(())
+}
+
+/// A number for JSON: `null` when not finite (an ensemble that gave no route).
+fn finite(value: f64) -> Value {
+    if value.is_finite() {
+        json!(value)
+    } else {
+        Value::Null
+    }
 }

@@ -98,15 +98,20 @@ pub enum PathRouteError {
         /// Its length along the contour, mm.
         length: f64,
     },
-    /// Part of a contour's boundary is cut more than once.
-    #[error("{length} mm of contour {contour:?} from ({x}, {y}) are cut more than once")]
+    /// Part of a contour's boundary is cut more than once. A common edge cut twice is reported
+    /// on both its contours, with the ends swapped when they run opposite ways.
+    #[error("{length} mm of contour {contour:?} from ({x}, {y}) to ({to_x}, {to_y}) are cut more than once")]
     Overlap {
         /// The contour.
         contour: ContourRef,
-        /// Where the doubly cut piece starts, x.
+        /// Where the doubly cut piece starts (in the contour's direction), x.
         x: f64,
         /// Its y.
         y: f64,
+        /// Where it ends, x.
+        to_x: f64,
+        /// Its y.
+        to_y: f64,
         /// Its length along the contour, mm.
         length: f64,
     },
@@ -239,8 +244,10 @@ fn overlaps(contour_span: &Span, route_span: &Span, tolerance: f64) -> Vec<Overl
     pieces_on(contour_span, route_span, tolerance)
         .into_iter()
         .map(|(a, b)| {
-            let ta = route_span.parameter_of(contour_span.point_at(a));
-            let tb = route_span.parameter_of(contour_span.point_at(b));
+            // The nearest point's parameter (clamped, compared with the span's ends), not
+            // `Span::parameter_of`: that one once wrapped a point at an arc's start to 2π/φ.
+            let ta = route_span.nearest_point(contour_span.point_at(a)).t;
+            let tb = route_span.nearest_point(contour_span.point_at(b)).t;
             Overlap {
                 a,
                 b,
@@ -501,10 +508,13 @@ impl PathRoute {
                 }
                 if along {
                     if along_reach - a > tolerance {
+                        let to = point_at_length(f64::min(along_reach, b));
                         problems.push(PathRouteError::Overlap {
                             contour: refs[c],
                             x: pa.x,
                             y: pa.y,
+                            to_x: to.x,
+                            to_y: to.y,
                             length: f64::min(along_reach, b) - a,
                         });
                     }
@@ -1044,7 +1054,77 @@ mod tests {
         );
     }
 
+    /// A ring (plate with a round hole) opened anywhere: the pieces of the semicircles that
+    /// start mid-arc sweep more than a radian, where mapping a point at an arc's start back to
+    /// its parameter once wrapped round to 2π/φ and made covered arc look uncovered.
+    #[test]
+    fn contours_of_arcs_opened_anywhere_are_covered() {
+        let nest = Nest {
+            sheet: None,
+            parts: vec![part(vec![
+                Contour::circle(p(0.0, 0.0), 63.0, true),
+                Contour::circle(p(5.0, 0.0), 20.0, false),
+            ])],
+        };
+        for k in 1..100 {
+            let f = k as f64 / 100.0;
+            let steps = [(1, f), (0, 1.0 - f)]
+                .iter()
+                .map(|&(c, f)| {
+                    let r = ContourRef {
+                        part: 0,
+                        contour: c,
+                    };
+                    let contour = nest.contour(r).unwrap();
+                    CutStep::pierced(r, contour.point_at_length(f * contour.perimeter()).unwrap())
+                })
+                .collect();
+            let route = Route {
+                start: p(0.0, -100.0),
+                steps,
+                finish: None,
+            };
+            let paths = PathRoute::from_route(&route, &nest).unwrap();
+            assert_eq!(paths.problems(&nest, 1e-7), vec![], "f = {f}");
+        }
+    }
+
     proptest! {
+        /// Damage to a valid route never goes unnoticed: a span left out leaves a gap (or
+        /// breaks its path), a span cut again from a new pierce is an overlap.
+        #[test]
+        fn dropped_or_repeated_spans_are_found(path in 0..6usize, pick in 0.0..1.0f64, fraction in 0.0..1.0f64) {
+            let nest = Nest {
+                sheet: None,
+                parts: (0..6).map(|i| part(vec![Contour::circle(p(i as f64 * 30.0, 0.0), 10.0, true), rect(i as f64 * 30.0 - 5.0, -5.0, i as f64 * 30.0 + 5.0, 3.0).reversed()])).collect(),
+            };
+            let steps = (0..6).flat_map(|i| {
+                let hole = ContourRef { part: i, contour: 1 };
+                let outer = ContourRef { part: i, contour: 0 };
+                [hole, outer].map(|r| {
+                    let c = nest.contour(r).unwrap();
+                    CutStep::pierced(r, c.point_at_length(fraction * c.perimeter()).unwrap())
+                })
+            }).collect();
+            let route = PathRoute::from_route(&Route { start: p(0.0, -50.0), steps, finish: None }, &nest).unwrap();
+            prop_assert_eq!(route.problems(&nest, TOL), vec![]);
+            let spans = &route.paths[path].spans;
+            let k = ((pick * spans.len() as f64) as usize).min(spans.len() - 1);
+            let victim = spans[k];
+            prop_assume!(victim.length() > 1e-3);
+            let mut dropped = route.clone();
+            dropped.paths[path].spans.remove(k);
+            let problems = dropped.problems(&nest, TOL);
+            prop_assert!(problems.iter().any(|e| matches!(e, PathRouteError::Gap { length, .. } if (length - victim.length()).abs() < 1e-6)), "{:?}", problems);
+            let mut repeated = route.clone();
+            // First, so that no contour's completion moves.
+            repeated.paths.insert(0, ToolOnPath { pierce: victim.start, spans: vec![victim] });
+            let problems = repeated.problems(&nest, TOL);
+            prop_assert!(problems.iter().all(|e| matches!(e, PathRouteError::Overlap { .. })), "{:?}", problems);
+            let doubled: f64 = problems.iter().map(|e| match e { PathRouteError::Overlap { length, .. } => *length, _ => 0.0 }).sum();
+            prop_assert!((doubled - victim.length()).abs() < 1e-6, "{}", doubled);
+        }
+
         /// Squares in a row cut whole in any order from any pierce points: valid, and the
         /// numbers agree with the route's.
         #[test]

@@ -1,0 +1,957 @@
+//! The SCCP solver: CCP-Relax generalised to a fixed set of base segments.
+//!
+//! A closed segment is entered and left at one point that may lie anywhere on it (the CCP
+//! rule); an open segment is entered at one end and left at the other, the direction being a
+//! binary choice. For a fixed order, relaxation sweeps move every closed segment's point to
+//! the exact minimiser of `|X(i−1) M| + |M E(i+1)|` over the segment and flip every open
+//! segment to its cheaper direction, until a sweep gains less than δ. The order is improved by
+//! block re-insertion (Or-opt, blocks of 1 to `max_block` segments, at the places next to the k
+//! nearest segments, single open segments in both directions, single closed ones with their
+//! point relaxed at the new place) and block reversal (2-opt: open segments in the block
+//! change direction, so only the two joints change length), always respecting the ensemble's
+//! precedence; sweeps and moves alternate to a local optimum. Then VNS: random block moves in
+//! a window shake the best order, descent follows, and the result is kept only if shorter,
+//! until `max_non_improving_shakes` shakes in a row fail, the time is up or the cancel flag is
+//! raised.
+
+use std::collections::{BinaryHeap, HashMap};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Duration;
+
+use cutroute_geometry::{ContourRef, PathRoute, Point, Route, Span, SplitMix64, ToolOnPath};
+use web_time::Instant;
+
+use crate::segment::{Ensemble, Segment};
+use crate::SegmentError;
+
+/// Settings of [`solve_sccp`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct SccpOptions {
+    /// Where the head starts.
+    pub start: Point,
+    /// Where it must end, if anywhere.
+    pub finish: Option<Point>,
+    /// Wall-clock limit of the search.
+    pub time_limit: Duration,
+    /// Re-insertion places tried next to this many nearest segments.
+    pub neighbours: usize,
+    /// Longest block of consecutive segments moved at once.
+    pub max_block: usize,
+    /// A relaxation sweep gaining less than this (mm) ends the relaxation.
+    pub delta: f64,
+    /// Most relaxation sweeps in a row.
+    pub max_relaxation_sweeps: usize,
+    /// Longest block reversed at once (2-opt; open segments in it change direction).
+    pub max_reversal: usize,
+    /// The search stops after this many shakes in a row that did not improve the best route.
+    pub max_non_improving_shakes: usize,
+    /// Most random block moves in one shake.
+    pub max_shake_strength: usize,
+    /// Seed of the shakes.
+    pub seed: u64,
+}
+
+impl Default for SccpOptions {
+    fn default() -> Self {
+        SccpOptions {
+            start: Point::new(0.0, 0.0),
+            finish: None,
+            time_limit: Duration::from_secs(10),
+            neighbours: 8,
+            max_block: 3,
+            delta: 1e-6,
+            max_relaxation_sweeps: 1000,
+            max_reversal: 50,
+            max_non_improving_shakes: 100,
+            max_shake_strength: 4,
+            seed: 1,
+        }
+    }
+}
+
+/// A solved SCCP.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SccpSolution {
+    /// The route: one tool-on path per segment, in cutting order.
+    pub route: PathRoute,
+    /// The segments in cutting order.
+    pub order: Vec<usize>,
+    /// Idle length of the route, mm.
+    pub idle_length: f64,
+    /// Idle length of the first order after its first relaxation, mm.
+    pub initial_idle_length: f64,
+    /// Whether the search stopped at the time limit or the cancel flag rather than after
+    /// `max_non_improving_shakes` fruitless shakes.
+    pub interrupted: bool,
+    /// Shakes tried.
+    pub shakes: usize,
+}
+
+/// Where the tool enters and leaves a segment.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Place {
+    /// Closed segment: in and out at `point`, on span `span` at parameter `t`.
+    Closed { span: usize, t: f64, point: Point },
+    /// Open segment: in at its first point (or its last, reversed).
+    Open { reversed: bool },
+}
+
+/// Distance from `p` to a box given by its corners.
+fn box_distance(p: Point, min: Point, max: Point) -> f64 {
+    let dx = (min.x - p.x).max(p.x - max.x).max(0.0);
+    let dy = (min.y - p.y).max(p.y - max.y).max(0.0);
+    dx.hypot(dy)
+}
+
+/// Minimum of `|a − s(t)| + |s(t) − b|` over `t ∈ [lo, hi]` where it is unimodal.
+fn golden(span: &Span, a: Point, b: Point, mut lo: f64, mut hi: f64) -> (f64, f64) {
+    let f = |t: f64| {
+        let m = span.point_at(t);
+        a.distance(m) + m.distance(b)
+    };
+    const R: f64 = 0.618_033_988_749_894_8;
+    let (first, last) = (lo, hi);
+    let mut x1 = hi - R * (hi - lo);
+    let mut x2 = lo + R * (hi - lo);
+    let (mut f1, mut f2) = (f(x1), f(x2));
+    for _ in 0..60 {
+        if hi - lo < 1e-12 {
+            break;
+        }
+        if f1 <= f2 {
+            hi = x2;
+            x2 = x1;
+            f2 = f1;
+            x1 = hi - R * (hi - lo);
+            f1 = f(x1);
+        } else {
+            lo = x1;
+            x1 = x2;
+            f1 = f2;
+            x2 = lo + R * (hi - lo);
+            f2 = f(x2);
+        }
+    }
+    let t = 0.5 * (lo + hi);
+    let mut best = (t, f(t));
+    // The search never evaluates the bracket's own ends, where a monotone f is least.
+    for t in [first, last] {
+        let v = f(t);
+        if v < best.1 {
+            best = (t, v);
+        }
+    }
+    best
+}
+
+/// The point of a closed segment minimising `|a M| + |M b|` (or `|a M|` without `b`), starting
+/// from the value `current` to prune spans: `(span, t, point, value)`, or `None` if no span
+/// beats `current`.
+fn best_point(
+    segment: &Segment,
+    boxes: &[(Point, Point)],
+    a: Point,
+    b: Option<Point>,
+    current: f64,
+) -> Option<(usize, f64, Point, f64)> {
+    let mut best: Option<(usize, f64, Point, f64)> = None;
+    let mut bound = current;
+    for (i, span) in segment.spans.iter().enumerate() {
+        let (min, max) = boxes[i];
+        let lower = box_distance(a, min, max) + b.map_or(0.0, |b| box_distance(b, min, max));
+        // Not `lower >= …`: a NaN bound must skip the span too.
+        if lower.partial_cmp(&(bound - 1e-12)) != Some(std::cmp::Ordering::Less) {
+            continue;
+        }
+        let (t, value) = match b {
+            None => {
+                let q = span.nearest_point(a);
+                (q.t, q.distance)
+            }
+            Some(b) => {
+                if let Some(x) = span.intersect_segment(a, b).first() {
+                    (x.t_self, a.distance(x.point) + x.point.distance(b))
+                } else if span.is_line() {
+                    golden(span, a, b, 0.0, 1.0)
+                } else {
+                    // An arc: sample, then refine around the best sample.
+                    let n = 8 + (span.sweep().abs() / (std::f64::consts::PI / 8.0)).ceil() as usize;
+                    let f = |t: f64| {
+                        let m = span.point_at(t);
+                        a.distance(m) + m.distance(b)
+                    };
+                    let k = (0..=n)
+                        .min_by(|&x, &y| f(x as f64 / n as f64).total_cmp(&f(y as f64 / n as f64)))
+                        .unwrap_or(0);
+                    let lo = k.saturating_sub(1) as f64 / n as f64;
+                    let hi = ((k + 1).min(n)) as f64 / n as f64;
+                    golden(span, a, b, lo, hi)
+                }
+            }
+        };
+        if value < bound {
+            bound = value;
+            best = Some((i, t, span.point_at(t), value));
+        }
+    }
+    best
+}
+
+struct Search<'a> {
+    segments: &'a [Segment],
+    boxes: Vec<Vec<(Point, Point)>>,
+    whole_box: Vec<(Point, Point)>,
+    before: Vec<Vec<usize>>,
+    after: Vec<Vec<usize>>,
+    neighbours: Vec<Vec<usize>>,
+    order: Vec<usize>,
+    pos: Vec<usize>,
+    place: Vec<Place>,
+    options: &'a SccpOptions,
+    deadline: Instant,
+    cancel: &'a AtomicBool,
+}
+
+impl Search<'_> {
+    fn stopped(&self) -> bool {
+        self.cancel.load(Ordering::Relaxed) || Instant::now() >= self.deadline
+    }
+
+    fn entry(&self, s: usize) -> Point {
+        match self.place[s] {
+            Place::Closed { point, .. } => point,
+            Place::Open { reversed: false } => self.segments[s].first_point(),
+            Place::Open { reversed: true } => self.segments[s].last_point(),
+        }
+    }
+
+    fn exit(&self, s: usize) -> Point {
+        match self.place[s] {
+            Place::Closed { point, .. } => point,
+            Place::Open { reversed: false } => self.segments[s].last_point(),
+            Place::Open { reversed: true } => self.segments[s].first_point(),
+        }
+    }
+
+    /// Where the head is before position `i` (the start for 0).
+    fn before_point(&self, i: usize) -> Point {
+        if i == 0 {
+            self.options.start
+        } else {
+            self.exit(self.order[i - 1])
+        }
+    }
+
+    /// Where the head goes after position `i` (the finish, or nowhere, after the last).
+    fn after_point(&self, i: usize) -> Option<Point> {
+        match self.order.get(i + 1) {
+            Some(&s) => Some(self.entry(s)),
+            None => self.options.finish,
+        }
+    }
+
+    fn idle_length(&self) -> f64 {
+        let mut at = self.options.start;
+        let mut total = 0.0;
+        for &s in &self.order {
+            total += at.distance(self.entry(s));
+            at = self.exit(s);
+        }
+        if let Some(f) = self.options.finish {
+            total += at.distance(f);
+        }
+        total
+    }
+
+    /// Relaxes the place of the segment at position `i` for its current neighbours; returns
+    /// the gain.
+    fn relax_at(&mut self, i: usize) -> f64 {
+        let s = self.order[i];
+        let a = self.before_point(i);
+        let b = self.after_point(i);
+        let cost = |e: Point, x: Point| a.distance(e) + b.map_or(0.0, |b| x.distance(b));
+        let old = cost(self.entry(s), self.exit(s));
+        match self.place[s] {
+            Place::Closed { .. } => {
+                if let Some((span, t, point, value)) =
+                    best_point(&self.segments[s], &self.boxes[s], a, b, old)
+                {
+                    if value < old {
+                        self.place[s] = Place::Closed { span, t, point };
+                        return old - value;
+                    }
+                }
+                0.0
+            }
+            Place::Open { reversed } => {
+                let flipped = Place::Open {
+                    reversed: !reversed,
+                };
+                let previous = self.place[s];
+                self.place[s] = flipped;
+                let new = cost(self.entry(s), self.exit(s));
+                if new < old {
+                    old - new
+                } else {
+                    self.place[s] = previous;
+                    0.0
+                }
+            }
+        }
+    }
+
+    fn relax_full(&mut self) -> f64 {
+        let mut total = 0.0;
+        for _ in 0..self.options.max_relaxation_sweeps {
+            let mut gain = 0.0;
+            for i in 0..self.order.len() {
+                gain += self.relax_at(i);
+            }
+            total += gain;
+            if gain < self.options.delta || self.stopped() {
+                break;
+            }
+        }
+        total
+    }
+
+    /// Can the block at positions `[i, i + len)` move to just after position `j` (before
+    /// position 0 for `j = usize::MAX`)?
+    fn can_move(&self, i: usize, len: usize, j: Option<usize>) -> bool {
+        let block = &self.order[i..i + len];
+        match j {
+            Some(j) if j >= i + len => block
+                .iter()
+                .all(|&b| self.after[b].iter().all(|&x| self.pos[x] > j)),
+            _ => {
+                let limit = j.map_or(0, |j| j + 1);
+                block
+                    .iter()
+                    .all(|&b| self.before[b].iter().all(|&x| self.pos[x] < limit))
+            }
+        }
+    }
+
+    /// One pass of block re-insertion; returns whether some move gained.
+    fn or_opt_pass(&mut self) -> bool {
+        let mut improved = false;
+        let mut i = 0;
+        while i < self.order.len() {
+            if self.stopped() {
+                break;
+            }
+            let mut moved = false;
+            for len in 1..=self.options.max_block.min(self.order.len() - i) {
+                if self.try_move_block(i, len) {
+                    moved = true;
+                    improved = true;
+                    break;
+                }
+            }
+            if !moved {
+                i += 1;
+            }
+        }
+        improved
+    }
+
+    fn try_move_block(&mut self, i: usize, len: usize) -> bool {
+        let n = self.order.len();
+        let first = self.order[i];
+        let last = self.order[i + len - 1];
+        let p = self.before_point(i);
+        let next = self.after_point(i + len - 1);
+        let (e0, x0) = (self.entry(first), self.exit(last));
+        let removal = p.distance(e0) + next.map_or(0.0, |q| x0.distance(q))
+            - next.map_or(0.0, |q| p.distance(q));
+        if removal <= 1e-9 {
+            return false;
+        }
+        // Places: just after position j (None = before everything).
+        let mut places: Vec<Option<usize>> = Vec::new();
+        for &c in self.neighbours[first]
+            .iter()
+            .chain(self.neighbours[last].iter())
+        {
+            let k = self.pos[c];
+            if k >= i && k < i + len {
+                continue;
+            }
+            places.push(Some(k));
+            places.push(k.checked_sub(1));
+        }
+        places.push(Some(n - 1));
+        places.push(None);
+        places.sort_unstable();
+        places.dedup();
+        let single = len == 1;
+        let mut best: Option<(f64, Option<usize>, Place)> = None;
+        for j in places {
+            // Same place as now.
+            if j == i.checked_sub(1) || j.is_some_and(|j| j >= i && j < i + len) {
+                continue;
+            }
+            let u = match j {
+                None => self.options.start,
+                Some(j) => self.exit(self.order[j]),
+            };
+            let v_index = j.map_or(0, |j| j + 1);
+            // `v_index == i` is the block's own place, skipped above.
+            let v = if v_index < n {
+                Some(self.entry(self.order[v_index]))
+            } else {
+                self.options.finish
+            };
+            let base = v.map_or(0.0, |v| u.distance(v));
+            let add = |e: Point, x: Point| u.distance(e) + v.map_or(0.0, |v| x.distance(v)) - base;
+            let mut candidate = (add(e0, x0), self.place[first]);
+            if single {
+                match self.place[first] {
+                    Place::Open { reversed } => {
+                        let (e, x) = (x0, e0);
+                        let flipped = add(e, x);
+                        if flipped < candidate.0 {
+                            candidate = (
+                                flipped,
+                                Place::Open {
+                                    reversed: !reversed,
+                                },
+                            );
+                        }
+                    }
+                    Place::Closed { .. } => {
+                        let (min, max) = self.whole_box[first];
+                        let lower = box_distance(u, min, max)
+                            + v.map_or(0.0, |v| box_distance(v, min, max))
+                            - base;
+                        if candidate.0 >= removal && lower < removal {
+                            let current = candidate.0 + base;
+                            if let Some((span, t, point, value)) =
+                                best_point(&self.segments[first], &self.boxes[first], u, v, current)
+                            {
+                                candidate = (value - base, Place::Closed { span, t, point });
+                            }
+                        }
+                    }
+                }
+            }
+            let delta = candidate.0 - removal;
+            if delta < -1e-9 && best.is_none_or(|b| delta < b.0) && self.can_move(i, len, j) {
+                best = Some((delta, j, candidate.1));
+            }
+        }
+        let Some((_, j, place)) = best else {
+            return false;
+        };
+        if single {
+            self.place[first] = place;
+        }
+        let block: Vec<usize> = self.order.drain(i..i + len).collect();
+        let at = match j {
+            None => 0,
+            Some(j) if j >= i + len => j + 1 - len,
+            Some(j) => j + 1,
+        };
+        for (k, s) in block.into_iter().enumerate() {
+            self.order.insert(at + k, s);
+        }
+        for (k, &s) in self.order.iter().enumerate() {
+            self.pos[s] = k;
+        }
+        true
+    }
+
+    /// One pass of block reversal (2-opt): the block from position `i` to a position `j`
+    /// where the segment before `i` has a near neighbour is cut backwards, open segments
+    /// flipped; only the two joints change. Returns whether some reversal gained.
+    fn two_opt_pass(&mut self) -> bool {
+        let mut improved = false;
+        let n = self.order.len();
+        for i in 0..n {
+            if self.stopped() {
+                break;
+            }
+            let p = self.before_point(i);
+            let first = self.order[i];
+            let anchors: Vec<usize> = match i.checked_sub(1) {
+                Some(k) => self.neighbours[self.order[k]].clone(),
+                None => self.neighbours[first].clone(),
+            };
+            let mut best: Option<(f64, usize)> = None;
+            for c in anchors {
+                let j = self.pos[c];
+                if j <= i || j - i + 1 > self.options.max_reversal {
+                    continue;
+                }
+                let last = self.order[j];
+                let next = self.after_point(j);
+                let old = p.distance(self.entry(first))
+                    + next.map_or(0.0, |q| self.exit(last).distance(q));
+                let new = p.distance(self.exit(last))
+                    + next.map_or(0.0, |q| self.entry(first).distance(q));
+                let delta = new - old;
+                if delta < -1e-9 && best.is_none_or(|b| delta < b.0) && self.can_reverse(i, j) {
+                    best = Some((delta, j));
+                }
+            }
+            if let Some((_, j)) = best {
+                self.reverse(i, j);
+                improved = true;
+            }
+        }
+        improved
+    }
+
+    /// No precedence pair inside positions `[i, j]`.
+    fn can_reverse(&self, i: usize, j: usize) -> bool {
+        self.order[i..=j]
+            .iter()
+            .all(|&b| self.after[b].iter().all(|&x| self.pos[x] > j))
+    }
+
+    fn reverse(&mut self, i: usize, j: usize) {
+        self.order[i..=j].reverse();
+        for k in i..=j {
+            let s = self.order[k];
+            self.pos[s] = k;
+            if let Place::Open { reversed } = self.place[s] {
+                self.place[s] = Place::Open {
+                    reversed: !reversed,
+                };
+            }
+        }
+    }
+
+    /// Descends to a local optimum of relaxation, block moves and reversals.
+    fn descend(&mut self) {
+        loop {
+            if self.stopped() {
+                return;
+            }
+            let moved = self.or_opt_pass();
+            let reversed = self.two_opt_pass();
+            let relaxed = self.relax_full();
+            if !moved && !reversed && relaxed < self.options.delta {
+                return;
+            }
+        }
+    }
+
+    /// Random block moves to valid places within a window of the order.
+    fn shake(&mut self, rng: &mut SplitMix64) {
+        let n = self.order.len();
+        if n < 3 {
+            return;
+        }
+        let strength = 1 + rng.below(self.options.max_shake_strength.max(1) as u64) as usize;
+        for _ in 0..strength {
+            let len = 1 + rng.below(self.options.max_block.clamp(1, n - 1) as u64) as usize;
+            let i = rng.below((n - len + 1) as u64) as usize;
+            let window = 10usize;
+            let lo = i.saturating_sub(window);
+            let hi = (i + len + window).min(n - 1);
+            let target = lo + rng.below((hi - lo + 1) as u64) as usize;
+            let j = if target == 0 && rng.below(2) == 0 {
+                None
+            } else {
+                Some(target)
+            };
+            if j == i.checked_sub(1) || j.is_some_and(|j| j >= i && j < i + len) {
+                continue;
+            }
+            if self.can_move(i, len, j) {
+                let block: Vec<usize> = self.order.drain(i..i + len).collect();
+                let at = match j {
+                    None => 0,
+                    Some(j) if j >= i + len => j + 1 - len,
+                    Some(j) => j + 1,
+                };
+                for (k, s) in block.into_iter().enumerate() {
+                    self.order.insert(at + k, s);
+                }
+                for (k, &s) in self.order.iter().enumerate() {
+                    self.pos[s] = k;
+                }
+            }
+        }
+    }
+
+    fn route(&self) -> PathRoute {
+        let paths = self
+            .order
+            .iter()
+            .map(|&s| {
+                let segment = &self.segments[s];
+                let spans = match self.place[s] {
+                    Place::Closed { span, t, point } => opened(&segment.spans, span, t, point),
+                    Place::Open { reversed: false } => segment.spans.clone(),
+                    Place::Open { reversed: true } => {
+                        segment.spans.iter().rev().map(Span::reversed).collect()
+                    }
+                };
+                ToolOnPath {
+                    pierce: self.entry(s),
+                    spans,
+                }
+            })
+            .collect();
+        PathRoute {
+            start: self.options.start,
+            paths,
+            finish: self.options.finish,
+        }
+    }
+}
+
+/// A closed chain of spans opened at `point` (on span `i` at `t`): the rest of span `i`, the
+/// spans after it round the cycle, the part of span `i` before the point.
+fn opened(spans: &[Span], i: usize, t: f64, point: Point) -> Vec<Span> {
+    let mut out = Vec::with_capacity(spans.len() + 1);
+    let mut at = point;
+    let mut push = |mut s: Span| {
+        if s.length() > 1e-12 {
+            s.start = at;
+            at = s.end;
+            out.push(s);
+        }
+    };
+    push(spans[i].sub_span(t, 1.0));
+    for k in 1..spans.len() {
+        push(spans[(i + k) % spans.len()]);
+    }
+    let mut tail = spans[i].sub_span(0.0, t);
+    tail.end = point;
+    push(tail);
+    out
+}
+
+/// What a CCP route says about each contour: its position in the route and pierce point.
+fn hints(route: &Route) -> HashMap<ContourRef, (usize, Point)> {
+    route
+        .steps
+        .iter()
+        .enumerate()
+        .map(|(i, s)| (s.contour, (i, s.pierce_point)))
+        .collect()
+}
+
+/// Solves one SCCP. The first order follows `hint` (a route of the nest, e.g. CCP-Relax's:
+/// segments sorted by the earliest step that cuts one of their contours, as far as precedence
+/// allows; a closed segment that is one whole contour starts at that step's pierce point);
+/// without a hint, greedy nearest neighbour. Then descent and VNS (see the module notes) until
+/// the shakes stop paying, `options.time_limit` passes or `cancel` is raised; the route is the
+/// best order found with its relaxed points.
+pub fn solve_sccp(
+    ensemble: &Ensemble,
+    hint: Option<&Route>,
+    options: &SccpOptions,
+    cancel: &AtomicBool,
+) -> Result<SccpSolution, SegmentError> {
+    let segments = &ensemble.segments;
+    let n = segments.len();
+    if let Some(i) = segments.iter().position(|s| s.spans.is_empty()) {
+        return Err(SegmentError::EmptySegment { segment: i });
+    }
+    let started = Instant::now();
+    let mut before = vec![Vec::new(); n];
+    let mut after = vec![Vec::new(); n];
+    for &(a, b) in &ensemble.precedence {
+        if a >= n || b >= n {
+            return Err(SegmentError::UnknownSegment {
+                segment: a.max(b),
+                count: n,
+            });
+        }
+        after[a].push(b);
+        before[b].push(a);
+    }
+    let boxes: Vec<Vec<(Point, Point)>> = segments
+        .iter()
+        .map(|s| {
+            s.spans
+                .iter()
+                .map(|sp| {
+                    let b = sp.bounding_box();
+                    (b.min, b.max)
+                })
+                .collect()
+        })
+        .collect();
+    let whole_box: Vec<(Point, Point)> = boxes
+        .iter()
+        .map(|bs| {
+            bs.iter().fold(
+                (
+                    Point::new(f64::INFINITY, f64::INFINITY),
+                    Point::new(f64::NEG_INFINITY, f64::NEG_INFINITY),
+                ),
+                |(lo, hi), (a, b)| {
+                    (
+                        Point::new(lo.x.min(a.x), lo.y.min(a.y)),
+                        Point::new(hi.x.max(b.x), hi.y.max(b.y)),
+                    )
+                },
+            )
+        })
+        .collect();
+    // Representative points for neighbour lists: the ends of open segments, the box centre
+    // of closed ones.
+    let reps: Vec<Vec<Point>> = segments
+        .iter()
+        .zip(&whole_box)
+        .map(|(s, &(lo, hi))| {
+            if s.closed {
+                vec![lo.midpoint(hi)]
+            } else {
+                vec![s.first_point(), s.last_point()]
+            }
+        })
+        .collect();
+    let k = options.neighbours.min(n.saturating_sub(1));
+    let neighbours: Vec<Vec<usize>> = (0..n)
+        .map(|a| {
+            let mut d: Vec<(f64, usize)> = (0..n)
+                .filter(|&b| b != a)
+                .map(|b| {
+                    let dist = reps[a]
+                        .iter()
+                        .flat_map(|p| reps[b].iter().map(move |q| p.distance(*q)))
+                        .fold(f64::INFINITY, f64::min);
+                    (dist, b)
+                })
+                .collect();
+            if d.len() > k {
+                d.select_nth_unstable_by(k, |x, y| x.0.total_cmp(&y.0));
+                d.truncate(k);
+            }
+            d.into_iter().map(|(_, b)| b).collect()
+        })
+        .collect();
+
+    // First order: by hint rank within precedence (Kahn's algorithm with a priority queue),
+    // or greedy nearest neighbour.
+    let hint_map = hint.map(hints);
+    let mut place: Vec<Place> = segments
+        .iter()
+        .map(|s| {
+            if s.closed {
+                Place::Closed {
+                    span: 0,
+                    t: 0.0,
+                    point: s.first_point(),
+                }
+            } else {
+                Place::Open { reversed: false }
+            }
+        })
+        .collect();
+    let mut indegree: Vec<usize> = before.iter().map(Vec::len).collect();
+    let mut order = Vec::with_capacity(n);
+    if let Some(map) = &hint_map {
+        let key: Vec<usize> = segments
+            .iter()
+            .map(|s| {
+                s.contours
+                    .iter()
+                    .filter_map(|c| map.get(c).map(|h| h.0))
+                    .min()
+                    .unwrap_or(usize::MAX)
+            })
+            .collect();
+        for (s, segment) in segments.iter().enumerate() {
+            if let ([c], true) = (&segment.contours[..], segment.closed) {
+                if let Some(&(_, pierce)) = map.get(c) {
+                    let best = segment
+                        .spans
+                        .iter()
+                        .enumerate()
+                        .map(|(i, sp)| (i, sp.nearest_point(pierce)))
+                        .min_by(|x, y| x.1.distance.total_cmp(&y.1.distance));
+                    if let Some((span, q)) = best {
+                        place[s] = Place::Closed {
+                            span,
+                            t: q.t,
+                            point: q.point,
+                        };
+                    }
+                }
+            }
+        }
+        let mut ready: BinaryHeap<std::cmp::Reverse<(usize, usize)>> = (0..n)
+            .filter(|&s| indegree[s] == 0)
+            .map(|s| std::cmp::Reverse((key[s], s)))
+            .collect();
+        while let Some(std::cmp::Reverse((_, s))) = ready.pop() {
+            order.push(s);
+            for &t in &after[s] {
+                indegree[t] -= 1;
+                if indegree[t] == 0 {
+                    ready.push(std::cmp::Reverse((key[t], t)));
+                }
+            }
+        }
+    } else {
+        let mut ready: Vec<usize> = (0..n).filter(|&s| indegree[s] == 0).collect();
+        let mut at = options.start;
+        while !ready.is_empty() {
+            let (r, _) = ready
+                .iter()
+                .enumerate()
+                .map(|(r, &s)| {
+                    let d = if segments[s].closed {
+                        segments[s]
+                            .spans
+                            .iter()
+                            .map(|sp| sp.start.distance(at))
+                            .fold(f64::INFINITY, f64::min)
+                    } else {
+                        at.distance(segments[s].first_point())
+                            .min(at.distance(segments[s].last_point()))
+                    };
+                    (r, d)
+                })
+                .min_by(|x, y| x.1.total_cmp(&y.1))
+                .expect("ready is not empty");
+            let s = ready.swap_remove(r);
+            if !segments[s].closed {
+                let reversed =
+                    at.distance(segments[s].last_point()) < at.distance(segments[s].first_point());
+                place[s] = Place::Open { reversed };
+            }
+            order.push(s);
+            at = match place[s] {
+                Place::Open { reversed: false } => segments[s].last_point(),
+                Place::Open { reversed: true } => segments[s].first_point(),
+                Place::Closed { point, .. } => point,
+            };
+            for &t in &after[s] {
+                indegree[t] -= 1;
+                if indegree[t] == 0 {
+                    ready.push(t);
+                }
+            }
+        }
+    }
+    if order.len() != n {
+        return Err(SegmentError::CyclicPrecedence {
+            kind: ensemble.kind,
+            segment: (0..n).find(|&s| indegree[s] > 0).unwrap_or(0),
+        });
+    }
+    let mut pos = vec![0; n];
+    for (k, &s) in order.iter().enumerate() {
+        pos[s] = k;
+    }
+    let mut search = Search {
+        segments,
+        boxes,
+        whole_box,
+        before,
+        after,
+        neighbours,
+        order,
+        pos,
+        place,
+        options,
+        deadline: started + options.time_limit,
+        cancel,
+    };
+    search.relax_full();
+    let initial_idle_length = search.idle_length();
+    search.descend();
+    // VNS: shake the best order, descend again, keep the result only if shorter.
+    let mut best = (
+        search.idle_length(),
+        search.order.clone(),
+        search.place.clone(),
+    );
+    let mut rng = SplitMix64::new(options.seed);
+    let (mut shakes, mut fruitless) = (0, 0);
+    while fruitless < options.max_non_improving_shakes && !search.stopped() {
+        search.shake(&mut rng);
+        search.descend();
+        shakes += 1;
+        let length = search.idle_length();
+        if length < best.0 - options.delta {
+            best = (length, search.order.clone(), search.place.clone());
+            fruitless = 0;
+        } else {
+            fruitless += 1;
+            search.order.clone_from(&best.1);
+            search.place.clone_from(&best.2);
+            for (k, &s) in search.order.iter().enumerate() {
+                search.pos[s] = k;
+            }
+        }
+    }
+    let interrupted = fruitless < options.max_non_improving_shakes;
+    Ok(SccpSolution {
+        route: search.route(),
+        idle_length: search.idle_length(),
+        order: search.order,
+        initial_idle_length,
+        interrupted,
+        shakes,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use cutroute_geometry::{Contour, ContourRef, SplitMix64, Vertex};
+
+    /// The relaxation's minimiser over a closed segment is never beaten by dense sampling.
+    #[test]
+    fn best_point_matches_dense_sampling() {
+        let mut rng = SplitMix64::new(7);
+        // A rounded slot: lines and semicircles; and a circle of two arcs.
+        let shapes = [
+            Contour::new(vec![
+                Vertex::line(0.0, 0.0),
+                Vertex::arc(40.0, 0.0, 1.0),
+                Vertex::line(40.0, 20.0),
+                Vertex::arc(0.0, 20.0, 1.0),
+            ]),
+            Contour::circle(Point::new(5.0, -3.0), 12.0, true),
+        ];
+        for shape in shapes {
+            let spans: Vec<Span> = shape.spans().collect();
+            let segment = Segment::new(
+                spans.clone(),
+                vec![ContourRef {
+                    part: 0,
+                    contour: 0,
+                }],
+                1e-9,
+            );
+            assert!(segment.closed);
+            let boxes: Vec<(Point, Point)> = spans
+                .iter()
+                .map(|s| {
+                    let b = s.bounding_box();
+                    (b.min, b.max)
+                })
+                .collect();
+            for _ in 0..200 {
+                let a = Point::new(rng.range(-60.0, 100.0), rng.range(-60.0, 80.0));
+                let b = Point::new(rng.range(-60.0, 100.0), rng.range(-60.0, 80.0));
+                let (_, _, m, value) =
+                    best_point(&segment, &boxes, a, Some(b), f64::INFINITY).unwrap();
+                assert!((a.distance(m) + m.distance(b) - value).abs() < 1e-9);
+                assert!(shape.distance_to(m) < 1e-9);
+                let sampled = (0..20_000)
+                    .map(|k| {
+                        shape
+                            .point_at_length(k as f64 / 20_000.0 * shape.perimeter())
+                            .unwrap()
+                    })
+                    .map(|q| a.distance(q) + q.distance(b))
+                    .fold(f64::INFINITY, f64::min);
+                assert!(
+                    value <= sampled + 1e-9,
+                    "{value} > {sampled} for {a:?}, {b:?}"
+                );
+            }
+        }
+    }
+}
