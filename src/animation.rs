@@ -1,23 +1,38 @@
 //! The animation of the tool along the route, on the machine's time axis.
 //!
 //! State is the machine time shown; every frame (requestAnimationFrame) advances it by the real
-//! time elapsed times the speed factor, and the drawing asks [`ToolClock::state_at`] where the
-//! head is. The already-travelled route is one path revealed by a dash whose length is the
-//! distance travelled, so a frame changes a handful of attributes whatever the nest's size.
+//! time elapsed times the speed factor, and the drawing asks [`Timeline::frame_at`] where the
+//! head is. The route is cut once into chunks of a few dozen moves, each small on the drawing
+//! ([`crate::drawing::travel_chunks`]). The part travelled is drawn by two paths: the whole
+//! route revealed by a dash up to the last chunk fully travelled (`#anim-done`, changed only
+//! when the head leaves a chunk), and the chunk under the head revealed up to the head
+//! (`#anim-current`). The head moves by a transform. A frame thus changes a handful of
+//! attributes of two small elements, whatever the nest's size, in an overlay `<svg>` of its
+//! own (see [`AnimationOverlay`]).
 //!
-//! Contract with the app benchmark (keep): play button `#anim-play` (aria-label "Play" /
-//! "Pause"), slider `#anim-scrub`, speed select `#anim-speed`, the head `<circle id="tool-head">`
-//! with `data-machine-time` (seconds, updated each frame), and the clock `#anim-clock`.
+//! Contract with the tests and the app benchmark (keep): play button `#anim-play` (aria-label
+//! "Play" / "Pause"), slider `#anim-scrub`, speed select `#anim-speed`, the head
+//! `<circle id="tool-head">` with `data-machine-time` (seconds, updated each frame), the clock
+//! `#anim-clock`, and `#anim-done` whose `pathLength` is the route's length and whose
+//! `stroke-dasharray` starts with the length of the chunks fully travelled.
 
-use cutroute_geometry::{MachineParameters, Nest, Route, ToolClock, ToolMove, ToolState, Toolpath};
+use cutroute_geometry::{
+    BoundingBox, MachineParameters, Nest, Route, ToolClock, ToolMove, ToolState, Toolpath,
+};
 use leptos::prelude::*;
 
-use crate::drawing::travel_path;
+use crate::drawing::{travel_chunks, ChunkLimits, Travel};
 
 /// Speed factors offered: machine seconds per real second.
 pub const SPEEDS: [u32; 7] = [1, 2, 5, 10, 20, 50, 100];
 /// The speed selected at first.
 const DEFAULT_SPEED: u32 = 10;
+
+/// Chunks of the travelled route are at most this fraction of the route's extent wide or high:
+/// it bounds the area a frame repaints.
+const CHUNK_SIDE_FRACTION: f64 = 1.0 / 12.0;
+/// Most moves in one chunk.
+const CHUNK_MOVES: usize = 128;
 
 /// A route laid out in time and space, ready to animate.
 #[derive(Clone, Debug, PartialEq)]
@@ -26,12 +41,25 @@ pub struct Timeline {
     pub toolpath: Toolpath,
     /// When each move starts.
     pub clock: ToolClock,
-    /// The whole toolpath as one continuous SVG subpath.
-    pub travel: String,
-    /// Distance along `travel` at which each move starts (one more entry for the end).
-    pub travel_starts: Vec<f64>,
+    /// The toolpath as path data in chunks, with the distance at which each move starts.
+    pub travel: Travel,
     /// Indices of the pierce moves: where each contour begins.
     pub pierces: Vec<usize>,
+    /// Machine time at which each pierce starts (non-decreasing).
+    pierce_times: Vec<f64>,
+}
+
+/// What one animation frame shows.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Frame {
+    /// Machine time, s.
+    pub time: f64,
+    /// The head.
+    pub state: ToolState,
+    /// Index of the chunk under the head (`None` for an empty route).
+    pub chunk: Option<usize>,
+    /// Distance travelled within that chunk.
+    pub chunk_travelled: f64,
 }
 
 impl Timeline {
@@ -40,20 +68,28 @@ impl Timeline {
     pub fn new(nest: &Nest, route: &Route, machine: &MachineParameters) -> Option<Timeline> {
         let toolpath = Toolpath::new(route, nest).ok()?;
         let clock = ToolClock::new(&toolpath, machine);
-        let (travel, travel_starts) = travel_path(&toolpath);
-        let pierces = toolpath
+        let extent = toolpath_extent(&toolpath);
+        let travel = travel_chunks(
+            &toolpath,
+            ChunkLimits {
+                max_moves: CHUNK_MOVES,
+                max_side: extent * CHUNK_SIDE_FRACTION,
+            },
+        );
+        let pierces: Vec<usize> = toolpath
             .moves
             .iter()
             .enumerate()
             .filter(|(_, m)| matches!(m, ToolMove::Pierce { .. }))
             .map(|(i, _)| i)
             .collect();
+        let pierce_times = pierces.iter().filter_map(|&i| clock.start_of(i)).collect();
         Some(Timeline {
             toolpath,
             clock,
             travel,
-            travel_starts,
             pierces,
+            pierce_times,
         })
     }
 
@@ -67,49 +103,77 @@ impl Timeline {
         self.clock.state_at(&self.toolpath, t)
     }
 
-    /// Distance travelled along `travel` at machine time `t`.
+    /// Distance travelled along the route at machine time `t` (the tests' measure of progress;
+    /// the drawing uses [`Timeline::frame_at`]).
+    #[cfg(test)]
     pub fn travelled_at(&self, t: f64) -> f64 {
-        let state = self.state_at(t);
+        self.travelled(&self.state_at(t))
+    }
+
+    fn travelled(&self, state: &ToolState) -> f64 {
         match state.move_index {
             None => 0.0,
             Some(i) => {
-                let (a, b) = (self.travel_starts[i], self.travel_starts[i + 1]);
+                let starts = &self.travel.move_starts;
+                let (a, b) = (starts[i], starts[i + 1]);
                 a + (b - a) * state.fraction
             }
         }
     }
 
-    /// Length of `travel`.
+    /// Everything a frame at machine time `t` draws.
+    pub fn frame_at(&self, t: f64) -> Frame {
+        let state = self.state_at(t);
+        let chunk = state.move_index.and_then(|i| self.travel.chunk_of_move(i));
+        let chunk_travelled = chunk.map_or(0.0, |k| {
+            let c = &self.travel.chunks[k];
+            (self.travelled(&state) - c.start).clamp(0.0, c.length)
+        });
+        Frame {
+            time: t,
+            state,
+            chunk,
+            chunk_travelled,
+        }
+    }
+
+    /// Length of the route, idle and cut moves.
+    #[cfg(test)]
     pub fn travel_length(&self) -> f64 {
-        self.travel_starts.last().copied().unwrap_or(0.0)
+        self.travel.length()
     }
 
     /// Start time of the first contour beginning after `t` (the end when there is none).
     pub fn next_contour(&self, t: f64) -> f64 {
-        self.pierces
-            .iter()
-            .filter_map(|&i| self.clock.start_of(i))
-            .find(|&s| s > t + 1e-9)
+        let after = self.pierce_times.partition_point(|&s| s <= t + 1e-9);
+        self.pierce_times
+            .get(after)
+            .copied()
             .unwrap_or_else(|| self.total())
     }
 
     /// Start time of the last contour beginning before `t` (0 when there is none).
     pub fn previous_contour(&self, t: f64) -> f64 {
-        self.pierces
-            .iter()
-            .filter_map(|&i| self.clock.start_of(i))
-            .rfind(|&s| s < t - 1e-9)
-            .unwrap_or(0.0)
+        let before = self.pierce_times.partition_point(|&s| s < t - 1e-9);
+        before.checked_sub(1).map_or(0.0, |k| self.pierce_times[k])
     }
 
     /// Number of contours begun by machine time `t` (pierce included).
     pub fn contours_begun(&self, t: f64) -> usize {
-        self.pierces
-            .iter()
-            .filter_map(|&i| self.clock.start_of(i))
-            .filter(|&s| s <= t)
-            .count()
+        self.pierce_times.partition_point(|&s| s <= t)
     }
+}
+
+/// Largest side of the box of everything the toolpath draws (0 for an empty toolpath).
+fn toolpath_extent(toolpath: &Toolpath) -> f64 {
+    let mut bounds = BoundingBox::from_corners(toolpath.start, toolpath.start);
+    for m in &toolpath.moves {
+        bounds = match m {
+            ToolMove::Cut { span, .. } => bounds.union(span.bounding_box()),
+            other => bounds.including(other.end()),
+        };
+    }
+    bounds.width().max(bounds.height())
 }
 
 /// The animation's state, shared by the controls and the drawing.
@@ -327,65 +391,153 @@ pub fn AnimationControls(animation: Animation) -> impl IntoView {
     }
 }
 
-/// The travelled route and the tool head, drawn inside the view's y-up group. `scale` is the
-/// current view's width in drawing units (sizes follow the zoom).
+/// The travelled route and the tool head, in an `<svg>` of their own stacked on the view (same
+/// `view_box`, y up). `scale` is the current view's width in drawing units (sizes follow the
+/// zoom).
+///
+/// The paths are created once per route; per frame only the dash of `#anim-current` and the
+/// head's transform change; `#anim-done`'s dash and `#anim-current`'s path data change when the
+/// head leaves a chunk. Nothing here re-renders the route as the time advances. Being a separate element (its own paint layer
+/// and compositing layer, `style/base.css`), a frame repaints and rasters only this overlay:
+/// inside the view's SVG the same change made Chromium repaint thousands of labels and pierce
+/// marks and re-raster the route's single big paths under the head, ~50–130 ms a frame at
+/// 5,000 contours. Pan/zoom gestures move it with the view (`data-follows-gesture`,
+/// `src/pan_zoom.rs`).
 #[component]
-pub fn AnimationOverlay(animation: Animation, scale: Signal<f64>) -> impl IntoView {
+pub fn AnimationOverlay(
+    animation: Animation,
+    scale: Signal<f64>,
+    view_box: Signal<Option<String>>,
+) -> impl IntoView {
     let Animation { timeline, time, .. } = animation;
-    let travelled = move || {
-        let t = time.get()?;
-        timeline.with(|tl| tl.as_ref().map(|tl| tl.travelled_at(t)))
-    };
-    // One memo for the head: a frame then only updates the circle's attributes (the element
-    // stays; re-creating it every frame would be DOM work for nothing).
-    let head = Memo::new(move |_| {
+    // One frame's state, computed once and read by every attribute below; the head is shown at
+    // the route's start before the animation is first used.
+    let frame = Memo::new(move |_| {
         let t = time.get().unwrap_or(0.0);
-        timeline.with(|tl| tl.as_ref().map(|tl| (tl.state_at(t), t)))
+        timeline.with(|tl| tl.as_ref().map(|tl| tl.frame_at(t)))
     });
-    let head_shown = Memo::new(move |_| head.with(Option::is_some));
+    let revealed = Memo::new(move |_| time.get().is_some());
+    // The chunk under the head while the travelled route is shown, and the length of the
+    // chunks fully travelled: both change a few times a second at most.
+    let current = Memo::new(move |_| {
+        if revealed.get() {
+            frame.with(|f| f.and_then(|f| f.chunk))
+        } else {
+            None
+        }
+    });
+    let finished = Memo::new(move |_| {
+        let (k, travelled) = frame.with(|f| f.and_then(|f| Some((f.chunk?, f.chunk_travelled))))?;
+        timeline.with(|tl| {
+            let chunk = tl.as_ref()?.travel.chunks.get(k)?;
+            Some(if travelled >= chunk.length {
+                chunk.start + chunk.length
+            } else {
+                chunk.start
+            })
+        })
+    });
+    let route_length = Memo::new(move |_| {
+        timeline.with(|tl| {
+            tl.as_ref()
+                .map(|tl| tl.travel.length())
+                .filter(|&l| l > 0.0)
+        })
+    });
+    let route_d = move || timeline.with(|tl| tl.as_ref().map(|tl| tl.travel.d.clone()));
+    // The chunk under the head, unless already drawn whole by `#anim-done`. A chunk of a lone
+    // pierce has no length: not drawn (a zero pathLength is invalid).
+    let partial = Memo::new(move |_| {
+        let k = current.get()?;
+        let done = finished.get()?;
+        timeline.with(|tl| {
+            let chunk = tl.as_ref()?.travel.chunks.get(k)?;
+            (chunk.length > 0.0 && done <= chunk.start).then_some(k)
+        })
+    });
+    let partial_length = Memo::new(move |_| {
+        let k = partial.get()?;
+        timeline.with(|tl| tl.as_ref()?.travel.chunks.get(k).map(|c| c.length))
+    });
+    let partial_d = move || {
+        let k = partial.get()?;
+        timeline.with(|tl| tl.as_ref()?.travel.chunks.get(k).map(|c| c.d.clone()))
+    };
+    let head_state = move || frame.get().map(|f| f.state);
+    let head_shown = Memo::new(move |_| frame.with(Option::is_some));
     view! {
-        {move || {
-            timeline
-                .with(|tl| tl.as_ref().map(|tl| (tl.travel.clone(), tl.travel_length())))
-                .map(|(d, length)| {
-                    view! {
-                        <path
-                            id="anim-done"
-                            class="done"
-                            d=d
-                            pathLength=length
-                            stroke-width=move || scale.get() / 250.0
-                            stroke-dasharray=move || {
-                                format!("{} {}", travelled().unwrap_or(0.0), length * 2.0 + 1.0)
-                            }
-                            visibility=move || if time.get().is_some() { "visible" } else { "hidden" }
-                        />
+        <svg
+            id="anim-overlay"
+            class="nest-overlay"
+            xmlns="http://www.w3.org/2000/svg"
+            viewBox=move || view_box.get()
+            preserveAspectRatio="xMidYMid meet"
+            aria-hidden="true"
+            data-follows-gesture=""
+            data-chunks=move || timeline.with(|tl| tl.as_ref().map(|tl| tl.travel.chunks.len()))
+        >
+        <g transform="scale(1,-1)">
+        <g class="travelled" stroke-width=move || scale.get() / 250.0>
+            // The chunks fully travelled: the whole route revealed by a dash that changes only
+            // when the head leaves a chunk.
+            <path
+                id="anim-done"
+                class="done"
+                d=route_d
+                pathLength=move || route_length.get()
+                stroke-dasharray=move || {
+                    let length = route_length.get()?;
+                    Some(format!("{} {}", finished.get()?, length * 2.0 + 1.0))
+                }
+                // (Hidden before the first chunk is done: a dash of length 0 shows as a dot.)
+                visibility=move || {
+                    if current.get().is_some() && finished.get().is_some_and(|d| d > 0.0) {
+                        "visible"
+                    } else {
+                        "hidden"
                     }
-                })
-        }}
+                }
+            />
+            // The travelled part of the chunk under the head: the only path a frame changes.
+            <path
+                id="anim-current"
+                class="done"
+                d=partial_d
+                pathLength=move || partial_length.get()
+                stroke-dasharray=move || {
+                    let length = partial_length.get()?;
+                    let travelled = frame.get()?.chunk_travelled;
+                    Some(format!("{travelled} {}", length * 2.0 + 1.0))
+                }
+                visibility=move || if partial.get().is_some() { "visible" } else { "hidden" }
+            />
+        </g>
         {move || {
             head_shown.get().then(|| {
-                let state = move || head.get().map(|(state, _)| state);
                 view! {
                     <circle
                         id="tool-head"
                         class=move || {
-                            if state().is_some_and(|s| s.tool_on) {
+                            if head_state().is_some_and(|s| s.tool_on) {
                                 "tool-head on"
                             } else {
                                 "tool-head"
                             }
                         }
-                        cx=move || state().map_or(0.0, |s| s.position.x)
-                        cy=move || state().map_or(0.0, |s| s.position.y)
                         r=move || scale.get() / 120.0
+                        transform=move || {
+                            head_state()
+                                .map(|s| format!("translate({} {})", s.position.x, s.position.y))
+                        }
                         data-machine-time=move || {
-                            format!("{:.3}", head.get().map_or(0.0, |(_, t)| t))
+                            format!("{:.3}", frame.get().map_or(0.0, |f| f.time))
                         }
                     />
                 }
             })
         }}
+        </g>
+        </svg>
     }
 }
 
@@ -446,6 +598,35 @@ mod tests {
             assert!(d >= last);
             last = d;
         }
+    }
+
+    #[test]
+    fn a_frame_is_the_finished_chunks_plus_the_part_of_the_current_one() {
+        let (nest, route) = two_squares();
+        let tl = Timeline::new(&nest, &route, &MachineParameters::default()).unwrap();
+        // The route spans 30 mm: chunks are at most 2.5 mm wide, so nearly every move is one.
+        assert!(
+            tl.travel.chunks.len() > 4,
+            "{} chunks",
+            tl.travel.chunks.len()
+        );
+        let mut last_chunk = 0;
+        for k in 0..=200 {
+            let t = tl.total() * f64::from(k) / 200.0;
+            let frame = tl.frame_at(t);
+            let chunk = frame.chunk.unwrap();
+            assert!(chunk >= last_chunk, "the head never goes back");
+            last_chunk = chunk;
+            let c = &tl.travel.chunks[chunk];
+            assert!((0.0..=c.length).contains(&frame.chunk_travelled));
+            let finished: f64 = tl.travel.chunks[..chunk].iter().map(|c| c.length).sum();
+            assert!((finished + frame.chunk_travelled - tl.travelled_at(t)).abs() < 1e-9);
+            assert_eq!(frame.state, tl.state_at(t));
+        }
+        let end = tl.frame_at(tl.total());
+        assert_eq!(end.chunk, Some(tl.travel.chunks.len() - 1));
+        let last = tl.travel.chunks.last().unwrap();
+        assert!((end.chunk_travelled - last.length).abs() < 1e-9);
     }
 
     #[test]

@@ -1002,6 +1002,7 @@ fn NestView(
         }
     };
     view! {
+        <div class="canvas">
         <svg
             id="nest-view"
             xmlns="http://www.w3.org/2000/svg"
@@ -1042,9 +1043,12 @@ fn NestView(
                     <g class="ends">{ends}</g>
                 </g>
                 <g class="compared">{compared}</g>
-                <AnimationOverlay animation=animation scale=view_width />
             </g>
             <g class="order" font-size=move || view_width.get() / 70.0>{order_labels}</g>
         </svg>
+        // A second SVG stacked on the view: its own layer, so an animation frame repaints and
+        // rasters the tool head only, not the nest (src/animation.rs).
+        <AnimationOverlay animation=animation scale=view_width view_box=Signal::derive(view_box) />
+        </div>
     }
 }

@@ -2,7 +2,7 @@
 
 use std::fmt::Write;
 
-use cutroute_geometry::{Contour, Nest, Point, Route, Span, ToolMove, Toolpath};
+use cutroute_geometry::{BoundingBox, Contour, Nest, Point, Route, Span, ToolMove, Toolpath};
 
 /// Axis-aligned box `[min_x, min_y, max_x, max_y]` of everything worth showing.
 pub fn nest_bounds(nest: &Nest) -> Option<[f64; 4]> {
@@ -94,27 +94,138 @@ pub fn cut_path(toolpath: &Toolpath) -> String {
     out
 }
 
-/// The whole toolpath as one continuous subpath (idle and cut moves in machine order), with the
-/// distance along it at which each move starts (one more entry for the end). The animation
-/// reveals it with a dash of that length: a single attribute per frame, whatever the nest size.
-pub fn travel_path(toolpath: &Toolpath) -> (String, Vec<f64>) {
-    let mut out = String::new();
-    let _ = write!(out, "M{:.3} {:.3}", toolpath.start.x, toolpath.start.y);
-    let mut starts = Vec::with_capacity(toolpath.moves.len() + 1);
+/// Consecutive moves of a toolpath drawn as one path element: the animation shows the
+/// travelled route piece by piece, so a frame redraws one small path instead of the whole
+/// route (a dash on one path of every move made Chromium lay out, paint and raster the entire
+/// view each frame).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TravelChunk {
+    /// Path data: one continuous subpath (a dash over it must not restart).
+    pub d: String,
+    /// The moves drawn, as indices into the toolpath's moves.
+    pub moves: std::ops::Range<usize>,
+    /// Distance along the whole route at which the chunk starts.
+    pub start: f64,
+    /// Length of the chunk's path.
+    pub length: f64,
+}
+
+/// How the travelled route is cut into chunks.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ChunkLimits {
+    /// Most moves in one chunk (a pierce counts as a move).
+    pub max_moves: usize,
+    /// Largest width or height of a chunk's bounding box, in drawing units: the area a frame
+    /// repaints is the box of the chunk under the head. A single move larger than this is a
+    /// chunk of its own.
+    pub max_side: f64,
+}
+
+impl Default for ChunkLimits {
+    fn default() -> Self {
+        Self {
+            max_moves: 64,
+            max_side: f64::INFINITY,
+        }
+    }
+}
+
+/// The whole toolpath (idle and cut moves in machine order) as path data, whole and in chunks,
+/// with the distance along it at which each move starts.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Travel {
+    /// The whole route as one continuous subpath (a dash over it must not restart).
+    pub d: String,
+    /// The chunks in machine order; together they hold every move once.
+    pub chunks: Vec<TravelChunk>,
+    /// `move_starts[i]` = distance along the route at which move `i` starts; one more entry
+    /// for the end.
+    pub move_starts: Vec<f64>,
+}
+
+impl Travel {
+    /// Length of the whole route, idle and cut moves.
+    pub fn length(&self) -> f64 {
+        self.move_starts.last().copied().unwrap_or(0.0)
+    }
+
+    /// Index of the chunk that draws move `index` (the last chunk past the end).
+    pub fn chunk_of_move(&self, index: usize) -> Option<usize> {
+        if self.chunks.is_empty() {
+            return None;
+        }
+        let after = self.chunks.partition_point(|c| c.moves.end <= index);
+        Some(after.min(self.chunks.len() - 1))
+    }
+}
+
+/// Bounding box of what a move draws.
+fn move_box(m: &ToolMove) -> BoundingBox {
+    match m {
+        ToolMove::Idle { from, to } => BoundingBox::from_corners(*from, *to),
+        ToolMove::Pierce { at, .. } => BoundingBox::from_corners(*at, *at),
+        ToolMove::Cut { span, .. } => span.bounding_box(),
+    }
+}
+
+/// The toolpath as chunks within `limits`.
+pub fn travel_chunks(toolpath: &Toolpath, limits: ChunkLimits) -> Travel {
+    let max_moves = limits.max_moves.max(1);
+    let mut chunks = Vec::new();
+    let mut move_starts = Vec::with_capacity(toolpath.moves.len() + 1);
     let mut walked = 0.0;
-    for m in &toolpath.moves {
-        starts.push(walked);
+    let mut pen = toolpath.start;
+    let mut current: Option<(TravelChunk, BoundingBox)> = None;
+    let mut whole = String::new();
+    let _ = write!(whole, "M{:.3} {:.3}", pen.x, pen.y);
+    for (i, m) in toolpath.moves.iter().enumerate() {
+        move_starts.push(walked);
+        let bounds = move_box(m);
+        if let Some((chunk, chunk_box)) = current.take() {
+            let grown = chunk_box.union(bounds);
+            // Moves of no length (a pierce after a long idle move) stay with what follows.
+            let too_big = chunk.length > 0.0
+                && (grown.width() > limits.max_side || grown.height() > limits.max_side);
+            if chunk.moves.len() >= max_moves || too_big {
+                chunks.push(chunk);
+            } else {
+                current = Some((chunk, grown));
+            }
+        }
+        let (chunk, _) = current.get_or_insert_with(|| {
+            let mut d = String::new();
+            let _ = write!(d, "M{:.3} {:.3}", pen.x, pen.y);
+            (
+                TravelChunk {
+                    d,
+                    moves: i..i,
+                    start: walked,
+                    length: 0.0,
+                },
+                bounds,
+            )
+        });
+        let drawn = chunk.d.len();
         match m {
             ToolMove::Idle { to, .. } => {
-                let _ = write!(out, "L{:.3} {:.3}", to.x, to.y);
+                let _ = write!(chunk.d, "L{:.3} {:.3}", to.x, to.y);
             }
             ToolMove::Pierce { .. } => {}
-            ToolMove::Cut { span, .. } => push_span(span, &mut out),
+            ToolMove::Cut { span, .. } => push_span(span, &mut chunk.d),
         }
+        whole.push_str(&chunk.d[drawn..]);
+        chunk.moves.end = i + 1;
+        chunk.length += m.length();
         walked += m.length();
+        pen = m.end();
     }
-    starts.push(walked);
-    (out, starts)
+    chunks.extend(current.map(|(chunk, _)| chunk));
+    move_starts.push(walked);
+    Travel {
+        d: whole,
+        chunks,
+        move_starts,
+    }
 }
 
 /// Chevrons showing each contour's cutting direction, `size` drawing units long, placed a
@@ -210,20 +321,116 @@ mod tests {
         (nest, route)
     }
 
-    #[test]
-    fn travel_path_measures_every_move() {
-        let (nest, route) = square_nest();
-        let toolpath = Toolpath::new(&route, &nest).unwrap();
-        let (d, starts) = travel_path(&toolpath);
-        assert!(d.starts_with("M-10.000 0.000"));
+    /// Checks that `travel` draws every move of `toolpath` once, in order, each chunk one
+    /// continuous subpath starting where the previous one ended.
+    fn check_chunks(toolpath: &Toolpath, travel: &Travel) {
+        assert_eq!(travel.move_starts.len(), toolpath.moves.len() + 1);
+        let mut next_move = 0;
+        let mut pen = toolpath.start;
+        let mut walked = 0.0;
+        for chunk in &travel.chunks {
+            assert_eq!(chunk.moves.start, next_move, "chunks are contiguous");
+            assert!(chunk.moves.end > chunk.moves.start, "no empty chunk");
+            assert_eq!(
+                chunk.d.matches('M').count(),
+                1,
+                "one subpath: the dash must not restart"
+            );
+            assert!(chunk.d.starts_with(&format!("M{:.3} {:.3}", pen.x, pen.y)));
+            assert!((chunk.start - travel.move_starts[chunk.moves.start]).abs() < 1e-9);
+            assert!((chunk.start - walked).abs() < 1e-9);
+            let length: f64 = toolpath.moves[chunk.moves.clone()]
+                .iter()
+                .map(ToolMove::length)
+                .sum();
+            assert!((chunk.length - length).abs() < 1e-9);
+            walked += length;
+            next_move = chunk.moves.end;
+            pen = toolpath.moves[chunk.moves.end - 1].end();
+        }
+        assert_eq!(next_move, toolpath.moves.len(), "every move drawn");
+        // The whole route is the chunks joined, each one's `M` dropped but the first.
+        let joined: String = travel
+            .chunks
+            .iter()
+            .enumerate()
+            .map(|(k, c)| {
+                if k == 0 {
+                    c.d.clone()
+                } else {
+                    c.d[c.d.find(['L', 'A']).unwrap_or(c.d.len())..].to_string()
+                }
+            })
+            .collect();
+        assert_eq!(travel.d, joined);
         assert_eq!(
-            d.matches('M').count(),
+            travel.d.matches('M').count(),
             1,
             "one subpath: the dash must not restart"
         );
-        assert_eq!(starts.len(), toolpath.moves.len() + 1);
+        assert!((travel.length() - walked).abs() < 1e-9);
+    }
+
+    #[test]
+    fn travel_chunks_draw_every_move_once() {
+        let (nest, route) = square_nest();
+        let toolpath = Toolpath::new(&route, &nest).unwrap();
+        // Idle in, pierce, four sides, idle back.
+        assert_eq!(toolpath.moves.len(), 7);
+        let whole = travel_chunks(&toolpath, ChunkLimits::default());
+        check_chunks(&toolpath, &whole);
+        assert_eq!(whole.chunks.len(), 1);
+        assert!(whole.chunks[0].d.starts_with("M-10.000 0.000"));
         // 10 idle in, 40 around the square, 10 idle back.
-        assert!((starts.last().unwrap() - 60.0).abs() < 1e-9);
+        assert!((whole.length() - 60.0).abs() < 1e-9);
+        for max_moves in 1..=7 {
+            let limits = ChunkLimits {
+                max_moves,
+                ..ChunkLimits::default()
+            };
+            let travel = travel_chunks(&toolpath, limits);
+            check_chunks(&toolpath, &travel);
+            assert_eq!(travel.chunks.len(), 7usize.div_ceil(max_moves));
+            assert!(travel.chunks.iter().all(|c| c.moves.len() <= max_moves));
+        }
+        assert_eq!(
+            travel_chunks(&Toolpath::default(), ChunkLimits::default()).chunks,
+            vec![]
+        );
+    }
+
+    #[test]
+    fn travel_chunks_stay_small_on_the_drawing() {
+        let (nest, route) = square_nest();
+        let toolpath = Toolpath::new(&route, &nest).unwrap();
+        let limits = ChunkLimits {
+            max_moves: 100,
+            max_side: 12.0,
+        };
+        let travel = travel_chunks(&toolpath, limits);
+        check_chunks(&toolpath, &travel);
+        // The idle move in with the pierce (the first side would widen the box to 20 mm),
+        // the four sides (10 × 10 mm), the idle move out.
+        for chunk in &travel.chunks {
+            let bounds = toolpath.moves[chunk.moves.clone()]
+                .iter()
+                .map(move_box)
+                .fold(BoundingBox::EMPTY, BoundingBox::union);
+            assert!(
+                chunk.moves.len() == 1 || bounds.width().max(bounds.height()) <= 12.0,
+                "chunk {:?} spans {bounds:?}",
+                chunk.moves
+            );
+        }
+        let moves: Vec<_> = travel.chunks.iter().map(|c| c.moves.clone()).collect();
+        assert_eq!(moves, vec![0..2, 2..6, 6..7]);
+        // Look-up from a move to its chunk.
+        for (k, chunk) in travel.chunks.iter().enumerate() {
+            for i in chunk.moves.clone() {
+                assert_eq!(travel.chunk_of_move(i), Some(k));
+            }
+        }
+        assert_eq!(travel.chunk_of_move(99), Some(travel.chunks.len() - 1));
     }
 
     #[test]

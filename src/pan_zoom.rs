@@ -13,7 +13,8 @@
 //! would not do: Chromium lays out and paints SVG content again for that.) The `viewBox` — the
 //! *committed* view, which also sizes strokes, marks and labels — follows when the gesture
 //! ends: on the last pointer up, or [`WHEEL_SETTLE_MS`] after the last wheel event. Keys commit
-//! at once.
+//! at once. Elements stacked on the view with the same box (the animation's overlay, marked
+//! `data-follows-gesture`) get the same transform.
 
 use std::collections::HashMap;
 use std::time::Duration;
@@ -95,6 +96,9 @@ impl LiveMapping {
 /// it began (the element's own CSS transform must not enter it), and the live view.
 struct Gesture {
     svg: SvgGraphicsElement,
+    /// Siblings drawn over the view that must move with it (`data-follows-gesture`: the
+    /// animation's overlay).
+    followers: Vec<web_sys::Element>,
     /// `screen = a · user + (e, f)` for the committed view box.
     ctm: (f64, f64, f64),
     committed: ViewBox,
@@ -168,8 +172,13 @@ impl PanZoom {
         }
         // Hit-testing thousands of paths on every move is wasted work mid-gesture.
         let _ = svg.set_attribute("data-gesture", "");
+        let followers =
+            std::iter::successors(svg.next_element_sibling(), |e| e.next_element_sibling())
+                .filter(|e| e.has_attribute("data-follows-gesture"))
+                .collect();
         let gesture = Gesture {
             svg,
+            followers,
             ctm: (a, e, f),
             committed,
             live: committed,
@@ -185,10 +194,11 @@ impl PanZoom {
             if let Some(g) = g {
                 g.live = live;
                 let (tx, ty, k) = gesture_transform(g.ctm.0, g.committed, live);
-                let _ = g.svg.set_attribute(
-                    "style",
-                    &format!("transform:translate({tx}px,{ty}px) scale({k})"),
-                );
+                let style = format!("transform:translate({tx}px,{ty}px) scale({k})");
+                let _ = g.svg.set_attribute("style", &style);
+                for follower in &g.followers {
+                    let _ = follower.set_attribute("style", &style);
+                }
             }
         });
     }
@@ -200,6 +210,9 @@ impl PanZoom {
         }
         let gesture = self.gesture.try_update_value(Option::take).flatten()?;
         let _ = gesture.svg.remove_attribute("style");
+        for follower in &gesture.followers {
+            let _ = follower.remove_attribute("style");
+        }
         let _ = gesture.svg.remove_attribute("data-gesture");
         Some(gesture.live)
     }
