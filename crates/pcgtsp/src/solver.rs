@@ -5,6 +5,7 @@ use crate::check::check_tour;
 use crate::dp::{Dp, DpStatus, Incumbent};
 use crate::heuristic;
 use crate::instance::Instance;
+use crate::lagrange::{self, NodePenalties, PenaltyOptions};
 use crate::lattice::Lattice;
 use crate::order::OrderError;
 use crate::prepare::{LatticeLimits, Preparation};
@@ -39,6 +40,10 @@ pub struct ExactOptions {
     /// pierce groups per cluster the bound keeps (more = tighter and slower). 0 = automatic:
     /// 40 million steps per second of the time limit, clamped to 0.3–4 billion.
     pub lattice_work: usize,
+    /// Subgradient iterations of the node penalties (a Lagrangian strengthening of the
+    /// assignment bounds, see `lagrange.rs`; the arborescence bound gets 4× as many); 0
+    /// disables both. Used only when the lattice bound is not built.
+    pub penalty_iterations: usize,
 }
 
 impl ExactOptions {
@@ -55,6 +60,13 @@ impl ExactOptions {
     fn effective_subset_work(&self) -> f64 {
         let seconds = self.time_limit.map_or(f64::INFINITY, |t| t.as_secs_f64());
         (seconds * 4e7).clamp(2e7, 4e8)
+    }
+
+    /// Work budget (elementary steps) of the node penalties' subgradient optimisation:
+    /// 2·10⁷ steps per second of the time limit, at most 10⁹ (about a second).
+    fn effective_penalty_work(&self) -> f64 {
+        let seconds = self.time_limit.map_or(f64::INFINITY, |t| t.as_secs_f64());
+        (seconds * 2e7).clamp(1e7, 1e9)
     }
 
     /// The lattice work budget after resolving the automatic setting.
@@ -78,6 +90,7 @@ impl Default for ExactOptions {
             gap_tolerance: 0.0,
             lattice_max_ideals: 8_000_000,
             lattice_work: 0,
+            penalty_iterations: 400,
         }
     }
 }
@@ -193,6 +206,15 @@ impl Engine {
         }
     }
 
+    fn set_penalties(&mut self, model: &Model, penalties: Rc<NodePenalties>) {
+        match self {
+            Engine::W1(dp) => dp.set_penalties(model, penalties),
+            Engine::W2(dp) => dp.set_penalties(model, penalties),
+            Engine::W4(dp) => dp.set_penalties(model, penalties),
+            Engine::Unsupported => {}
+        }
+    }
+
     fn run(&mut self, model: &Model, incumbent: &mut Incumbent, work: u64) -> DpStatus {
         match self {
             Engine::W1(dp) => dp.run(model, incumbent, work),
@@ -260,6 +282,8 @@ struct Run {
     preparation: Option<Preparation>,
     /// The subset DP bound, once built.
     subset: Option<Rc<SubsetBound>>,
+    /// Node penalties for the per-state assignment bounds (when the run has no lattice).
+    penalties: Option<Rc<NodePenalties>>,
     root_bound: f64,
     engine: Option<Engine>,
     finished_bound: Option<f64>,
@@ -270,6 +294,7 @@ impl Run {
     /// Builds the bounds until `deadline`; sets `lattice` once they are complete.
     fn build_lattice(
         &mut self,
+        instance: &Instance,
         options: &ExactOptions,
         tour: Option<&[usize]>,
         upper_bound: f64,
@@ -296,6 +321,10 @@ impl Run {
         };
         self.subset = preparation.subset.clone();
         self.preparation = None;
+        if store.root_bound().is_none() {
+            // Without the lattice the DP bounds its states by assignments: strengthen them.
+            self.build_penalties(instance, options, upper_bound);
+        }
         if let Some(root) = store.root_bound() {
             self.root_bound = self.root_bound.max(self.model.round_bound(root));
         }
@@ -317,6 +346,57 @@ impl Run {
         self.lattice = Some(store);
     }
 
+    /// The Lagrangian bounds (`lagrange.rs`): node penalties for the per-state assignment
+    /// bounds, and the Held–Karp style arborescence bound at the root.
+    fn build_penalties(&mut self, instance: &Instance, options: &ExactOptions, upper_bound: f64) {
+        if options.penalty_iterations == 0 || self.model.m > 256 {
+            return;
+        }
+        let began = Instant::now();
+        let work = options.effective_penalty_work();
+        let penalties = lagrange::optimise(
+            instance,
+            &self.model,
+            upper_bound,
+            PenaltyOptions {
+                iterations: options.penalty_iterations,
+                work,
+            },
+        )
+        .map(Rc::new);
+        if let Some(p) = &penalties {
+            self.root_bound = self.root_bound.max(self.model.round_bound(p.root_bound));
+            debug_log(|| {
+                format!(
+                    "node penalties in {:?}: root L1 {} -> {} ({} iterations)",
+                    began.elapsed(),
+                    p.plain_l1,
+                    p.root_bound,
+                    p.iterations
+                )
+            });
+        }
+        self.penalties = penalties;
+        let began = Instant::now();
+        let arborescence = lagrange::arborescence_bound(
+            &self.model,
+            upper_bound,
+            PenaltyOptions {
+                iterations: 4 * options.penalty_iterations,
+                work: 4.0 * work,
+            },
+        );
+        if let Some((bound, iterations)) = arborescence {
+            self.root_bound = self.root_bound.max(self.model.round_bound(bound));
+            debug_log(|| {
+                format!(
+                    "arborescence bound in {:?}: {bound} ({iterations} iterations)",
+                    began.elapsed()
+                )
+            });
+        }
+    }
+
     /// A new DP engine with every bound this run has.
     fn engine(&mut self, beam: Option<usize>, memory: usize, use_l2: bool) -> Engine {
         let store = self
@@ -326,6 +406,9 @@ impl Run {
         let mut engine = Engine::new(&self.model, beam, memory, use_l2, store);
         if let Some(subset) = &self.subset {
             engine.set_subset_bound(&self.model, subset.clone());
+        }
+        if let Some(penalties) = &self.penalties {
+            engine.set_penalties(&self.model, penalties.clone());
         }
         engine
     }
@@ -374,6 +457,7 @@ impl ExactSolver {
                 lattice: None,
                 preparation: None,
                 subset: None,
+                penalties: None,
                 root_bound,
                 engine: None,
                 finished_bound: None,
@@ -558,6 +642,7 @@ impl ExactSolver {
                             debug_log(|| format!("greedy: UB {}", self.incumbent.upper_bound));
                         }
                         self.runs[0].build_lattice(
+                            &self.instance,
                             &self.options,
                             self.incumbent.tour.as_deref(),
                             self.incumbent.upper_bound,
@@ -636,6 +721,7 @@ impl ExactSolver {
                     let run = &mut self.runs[self.current_run];
                     if run.lattice.is_none() {
                         run.build_lattice(
+                            &self.instance,
                             &self.options,
                             self.incumbent.tour.as_deref(),
                             self.incumbent.upper_bound,
@@ -678,6 +764,16 @@ impl ExactSolver {
                         return self.stop(began);
                     }
                     if layer_changed {
+                        debug_log(|| {
+                            format!(
+                                "layer {} at {:?}: {} live states, LB {}, UB {}",
+                                p.layer,
+                                self.elapsed + began.elapsed(),
+                                p.live_states,
+                                p.lower_bound,
+                                p.upper_bound
+                            )
+                        });
                         // Let the caller report progress after every layer.
                         self.elapsed += began.elapsed();
                         return SolverStatus::Running;

@@ -54,6 +54,18 @@ fn root_bounds_never_exceed_known_optima() {
             assert!(dp <= opt, "{}: cluster DP {dp} > {opt}", r.instance);
         }
         assert!(
+            b.node_penalty <= opt,
+            "{}: node-penalty bound {} > {opt}",
+            r.instance,
+            b.node_penalty
+        );
+        let arborescence = b.arborescence.expect("every instance has ≥ 3 clusters");
+        assert!(
+            arborescence <= opt,
+            "{}: arborescence bound {arborescence} > {opt}",
+            r.instance
+        );
+        assert!(
             b.best() > 0.0 || opt == 0.0 || r.instance.starts_with("br17"),
             "{}: trivial bound",
             r.instance
