@@ -44,13 +44,24 @@ pub struct ExactOptions {
     /// assignment bounds, see `lagrange.rs`; the arborescence bound gets 4× as many); 0
     /// disables both. Used only when the lattice bound is not built.
     pub penalty_iterations: usize,
+    /// Seconds the automatic work budgets (lattice, subset and penalty bounds) are sized for;
+    /// `None` = `time_limit`. Set it when the run is stopped by another clock (e.g. CPU time)
+    /// and `time_limit` is only a backstop.
+    pub budget_seconds: Option<f64>,
 }
 
 impl ExactOptions {
+    /// The seconds the automatic budgets scale with (`budget_seconds`, else `time_limit`).
+    fn budget_seconds_or(&self, unlimited: f64) -> f64 {
+        self.budget_seconds
+            .or(self.time_limit.map(|t| t.as_secs_f64()))
+            .unwrap_or(unlimited)
+    }
+
     /// The lattice size cap after scaling with the time limit: a failed build (too many
     /// ideals) costs about a second per million ideals, so short runs try smaller lattices.
     fn effective_lattice_max_ideals(&self) -> usize {
-        let seconds = self.time_limit.map_or(f64::INFINITY, |t| t.as_secs_f64());
+        let seconds = self.budget_seconds_or(f64::INFINITY);
         self.lattice_max_ideals
             .min((seconds * 60_000.0).max(100_000.0) as usize)
     }
@@ -58,14 +69,14 @@ impl ExactOptions {
     /// Work budget (elementary steps) of the subset DP bound's backward pass.
     /// 4·10⁸ steps (a fraction of a second), less under short time limits.
     fn effective_subset_work(&self) -> f64 {
-        let seconds = self.time_limit.map_or(f64::INFINITY, |t| t.as_secs_f64());
+        let seconds = self.budget_seconds_or(f64::INFINITY);
         (seconds * 4e7).clamp(2e7, 4e8)
     }
 
     /// Work budget (elementary steps) of the node penalties' subgradient optimisation:
     /// 2·10⁷ steps per second of the time limit, at most 10⁹ (about a second).
     fn effective_penalty_work(&self) -> f64 {
-        let seconds = self.time_limit.map_or(f64::INFINITY, |t| t.as_secs_f64());
+        let seconds = self.budget_seconds_or(f64::INFINITY);
         (seconds * 2e7).clamp(1e7, 1e9)
     }
 
@@ -74,7 +85,7 @@ impl ExactOptions {
         if self.lattice_work > 0 {
             return self.lattice_work;
         }
-        let seconds = self.time_limit.map_or(100.0, |t| t.as_secs_f64());
+        let seconds = self.budget_seconds_or(100.0);
         (seconds * 40e6).clamp(3e8, 4e9) as usize
     }
 }
@@ -91,6 +102,7 @@ impl Default for ExactOptions {
             lattice_max_ideals: 8_000_000,
             lattice_work: 0,
             penalty_iterations: 400,
+            budget_seconds: None,
         }
     }
 }
