@@ -460,10 +460,12 @@ pub fn root_bounds(instance: &Instance, max_ideals: usize) -> Result<RootBounds,
             iterations: 400,
             work: 1e9,
         };
-        let penalised =
-            optimise(instance, &model, INF, penalty_options).map_or(INF, |p| p.root_bound);
-        result.node_penalty = result.node_penalty.min(penalised);
-        let arborescence = arborescence_bound(&model, INF, penalty_options).map(|(b, _)| b);
+        let penalised = optimise(instance, &model, INF, penalty_options);
+        result.node_penalty = result
+            .node_penalty
+            .min(penalised.as_ref().map_or(INF, |p| p.root_bound));
+        let lambda = penalised.as_ref().map(|p| p.lambda.as_slice());
+        let arborescence = arborescence_bound(&model, INF, lambda, penalty_options).map(|(b, _)| b);
         result.arborescence = match (result.arborescence, arborescence) {
             (Some(a), Some(b)) => Some(a.min(b)),
             _ => None,

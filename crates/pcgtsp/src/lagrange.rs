@@ -328,11 +328,13 @@ pub(crate) fn min_arborescence(k: usize, root: usize, w: &[f64]) -> Option<(f64,
 /// depot (the path) plus one arc back into the depot, with out-degree 1 at every cluster.
 /// Relaxing the out-degrees with cluster multipliers `μ` (and node consistency with `λ`, as
 /// above) and optimising both by subgradient ascent bounds the tour cost from below.
+/// `initial_lambda` (node penalties, e.g. those of [`optimise`]) is the starting point.
 /// Returns the best bound and the iterations done (`INF` when no tour exists), or `None` with
 /// fewer than 3 clusters.
 pub(crate) fn arborescence_bound(
     model: &Model,
     upper_bound: f64,
+    initial_lambda: Option<&[f64]>,
     options: PenaltyOptions,
 ) -> Option<(f64, usize)> {
     let (n, m) = (model.n, model.m);
@@ -340,7 +342,8 @@ pub(crate) fn arborescence_bound(
     if m < 3 {
         return None;
     }
-    let mut lambda = vec![0.0; n];
+    // Any start is valid; the node penalties of the assignment bound are a good one.
+    let mut lambda = initial_lambda.map_or_else(|| vec![0.0; n], <[f64]>::to_vec);
     let mut mu = vec![0.0; m];
     let mut into = vec![(INF, u32::MAX); n * m];
     let mut base = vec![INF; m * m];

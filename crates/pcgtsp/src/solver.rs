@@ -393,6 +393,7 @@ impl Run {
         let arborescence = lagrange::arborescence_bound(
             &self.model,
             upper_bound,
+            self.penalties.as_ref().map(|p| p.lambda.as_slice()),
             PenaltyOptions {
                 iterations: 4 * options.penalty_iterations,
                 work: 4.0 * work,
