@@ -275,3 +275,16 @@ fn p43_4_optimum_is_66848_not_the_published_bound_66846() {
     // Consistent with the published lower bound.
     assert!(result.progress.lower_bound >= r.known_optimum.unwrap());
 }
+
+#[test]
+fn lagrangian_bounds_lift_the_assignment_bound_on_ft70_2() {
+    // ft70.2 (> 6 M ideals, no lattice): L1 = 30994; the node penalties and the arborescence
+    // bound lift it to ~31460 and ~32070 (best published bound 31787, best tour 33374).
+    let r = reference("ft70.2");
+    let instance = r.load();
+    let b = root_bounds(&instance, 0).unwrap();
+    assert!(b.node_penalty >= b.l1 + 300.0, "node penalties: {b:?}");
+    let arborescence = b.arborescence.expect("70 clusters");
+    assert!(arborescence >= 31900.0, "arborescence: {b:?}");
+    assert!(arborescence <= 33374.0, "above a known tour: {b:?}");
+}
