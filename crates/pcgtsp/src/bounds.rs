@@ -405,24 +405,38 @@ pub struct RootBounds {
     /// The pierce-consistent cluster DP over the ideal lattice (`None` when the order has
     /// more ideals than allowed, or more than 256 clusters).
     pub cluster_dp: Option<f64>,
+    /// `max(L1, L2)` on costs with node penalties (Lagrangian multipliers of "a tour leaves
+    /// every node it enters") chosen by subgradient ascent on L1.
+    pub node_penalty: f64,
+    /// The Held–Karp style bound: a spanning arborescence of the clusters rooted at the depot
+    /// plus an arc back, with out-degrees and node consistency relaxed by subgradient ascent
+    /// (`None` with fewer than 3 clusters).
+    pub arborescence: Option<f64>,
 }
 
 impl RootBounds {
     /// The best of the bounds.
     pub fn best(&self) -> f64 {
-        self.l1.max(self.l2).max(self.cluster_dp.unwrap_or(-INF))
+        self.l1
+            .max(self.l2)
+            .max(self.cluster_dp.unwrap_or(-INF))
+            .max(self.node_penalty)
+            .max(self.arborescence.unwrap_or(-INF))
     }
 }
 
 /// Computes the root bounds (minimum over the start nodes of the depot cluster). The cluster DP
 /// is built only when the precedence order has at most `max_ideals` order ideals.
 pub fn root_bounds(instance: &Instance, max_ideals: usize) -> Result<RootBounds, OrderError> {
+    use crate::lagrange::{arborescence_bound, optimise, PenaltyOptions};
     use crate::lattice::Lattice;
     const LATTICE_WORK: usize = 300_000_000;
     let mut result = RootBounds {
         l1: INF,
         l2: INF,
         cluster_dp: Some(INF),
+        node_penalty: INF,
+        arborescence: Some(INF),
     };
     let mut bounder = ResidualBounder::default();
     for &start in &instance.clusters[instance.depot] {
@@ -442,6 +456,20 @@ pub fn root_bounds(instance: &Instance, max_ideals: usize) -> Result<RootBounds,
                     .map(|l| l.root_bound),
                 _ => None,
             };
+        let penalty_options = PenaltyOptions {
+            iterations: 400,
+            work: 1e9,
+        };
+        let penalised = optimise(instance, &model, INF, penalty_options);
+        result.node_penalty = result
+            .node_penalty
+            .min(penalised.as_ref().map_or(INF, |p| p.root_bound));
+        let lambda = penalised.as_ref().map(|p| p.lambda.as_slice());
+        let arborescence = arborescence_bound(&model, INF, lambda, penalty_options).map(|(b, _)| b);
+        result.arborescence = match (result.arborescence, arborescence) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            _ => None,
+        };
         result.cluster_dp = match (result.cluster_dp, dp) {
             (Some(a), Some(b)) => Some(a.min(b)),
             _ => None,

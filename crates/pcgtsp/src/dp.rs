@@ -11,6 +11,7 @@
 //! parent index of every state, for reconstruction.
 
 use crate::bounds::{Model, ResidualBounder};
+use crate::lagrange::NodePenalties;
 use crate::lattice::Lattice;
 use crate::subset::{SubsetBound, SubsetQuery};
 use std::rc::Rc;
@@ -174,6 +175,8 @@ pub(crate) struct Dp<const W: usize> {
     /// The subset DP bound (exact node-level completion over tracked clusters), if built.
     subset: Option<Rc<SubsetBound>>,
     subset_query: SubsetQuery,
+    /// Node penalties: when set, the assignment bounds are computed on the penalised costs.
+    penalties: Option<Rc<NodePenalties>>,
 }
 
 impl<const W: usize> Dp<W> {
@@ -237,7 +240,16 @@ impl<const W: usize> Dp<W> {
             next_values: Vec::new(),
             subset: None,
             subset_query: SubsetQuery::default(),
+            penalties: None,
         }
+    }
+
+    /// Computes the per-state assignment bounds on penalised costs from now on.
+    pub fn set_penalties(&mut self, model: &Model, penalties: Rc<NodePenalties>) {
+        self.layer_bound = self
+            .layer_bound
+            .max(model.round_bound(penalties.root_bound));
+        self.penalties = Some(penalties);
     }
 
     /// Adds the subset DP bound: every state created from now on is bounded by it too.
@@ -389,6 +401,20 @@ impl<const W: usize> Dp<W> {
             cheap = true;
             group_bound = 0.0;
             self.bounder.l2 = -INF;
+        } else if let Some(penalties) = &self.penalties {
+            // Bounds in penalised costs: a completion from `x` costs its penalised cost plus
+            // `λ_x − λ_start`.
+            group_bound =
+                self.bounder
+                    .compute(&penalties.model, &|c| ideal.contains(c), v, self.use_l2);
+            let shifted_min = nodes
+                .iter()
+                .zip(&self.costs)
+                .map(|(&x, &g)| g + penalties.shift(x))
+                .fold(INF, f64::min);
+            if Self::prunable(model, shifted_min + group_bound, upper_bound) {
+                return work + (model.m * model.m) as u64;
+            }
         } else {
             group_bound = self
                 .bounder
@@ -418,6 +444,13 @@ impl<const W: usize> Dp<W> {
                 g
             } else if let (true, Some(lattice)) = (use_lattice, &self.lattice) {
                 g + lattice.node_completion(model, &self.next_values, x)
+            } else if let Some(penalties) = &self.penalties {
+                g + self
+                    .bounder
+                    .node_bound(&penalties.model, x)
+                    .max(l2)
+                    .max(group_bound)
+                    + penalties.shift(x)
             } else {
                 g + self.bounder.node_bound(model, x).max(l2).max(group_bound)
             };

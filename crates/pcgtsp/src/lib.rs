@@ -14,6 +14,10 @@
 //!   node-level backward DP over a subset of the clusters, with penalised walks through the
 //!   others) that bounds every search state's completion, and the restricted bound: an exact
 //!   solve of a subset of the clusters under restricted shortest-path costs ([`restricted_bound`]);
+//!   and two Lagrangian bounds for orders too large for the lattice: node penalties (relaxing
+//!   "a tour leaves every node it enters") that strengthen the per-state assignment bounds, and
+//!   a Held–Karp style spanning-arborescence bound on the cluster graph with out-degrees
+//!   relaxed, both optimised by subgradient ascent ([`RootBounds`]);
 //! - the exact solver: a DP over order ideals with node-level states, per-state bounding
 //!   against the incumbent, a memory cap and an anytime, resumable API ([`ExactSolver`],
 //!   [`solve`]); and the breadth-first branch-and-bound variant ([`solve_bnb`]).
@@ -45,6 +49,7 @@ mod check;
 mod dp;
 mod heuristic;
 mod instance;
+mod lagrange;
 mod lattice;
 mod order;
 mod parse;

@@ -5,6 +5,7 @@ use crate::check::check_tour;
 use crate::dp::{Dp, DpStatus, Incumbent};
 use crate::heuristic;
 use crate::instance::Instance;
+use crate::lagrange::{self, NodePenalties, PenaltyOptions};
 use crate::lattice::Lattice;
 use crate::order::OrderError;
 use crate::prepare::{LatticeLimits, Preparation};
@@ -39,13 +40,28 @@ pub struct ExactOptions {
     /// pierce groups per cluster the bound keeps (more = tighter and slower). 0 = automatic:
     /// 40 million steps per second of the time limit, clamped to 0.3–4 billion.
     pub lattice_work: usize,
+    /// Subgradient iterations of the node penalties (a Lagrangian strengthening of the
+    /// assignment bounds, see `lagrange.rs`; the arborescence bound gets 4× as many); 0
+    /// disables both. Used only when the lattice bound is not built.
+    pub penalty_iterations: usize,
+    /// Seconds the automatic work budgets (lattice, subset and penalty bounds) are sized for;
+    /// `None` = `time_limit`. Set it when the run is stopped by another clock (e.g. CPU time)
+    /// and `time_limit` is only a backstop.
+    pub budget_seconds: Option<f64>,
 }
 
 impl ExactOptions {
+    /// The seconds the automatic budgets scale with (`budget_seconds`, else `time_limit`).
+    fn budget_seconds_or(&self, unlimited: f64) -> f64 {
+        self.budget_seconds
+            .or(self.time_limit.map(|t| t.as_secs_f64()))
+            .unwrap_or(unlimited)
+    }
+
     /// The lattice size cap after scaling with the time limit: a failed build (too many
     /// ideals) costs about a second per million ideals, so short runs try smaller lattices.
     fn effective_lattice_max_ideals(&self) -> usize {
-        let seconds = self.time_limit.map_or(f64::INFINITY, |t| t.as_secs_f64());
+        let seconds = self.budget_seconds_or(f64::INFINITY);
         self.lattice_max_ideals
             .min((seconds * 60_000.0).max(100_000.0) as usize)
     }
@@ -53,8 +69,15 @@ impl ExactOptions {
     /// Work budget (elementary steps) of the subset DP bound's backward pass.
     /// 4·10⁸ steps (a fraction of a second), less under short time limits.
     fn effective_subset_work(&self) -> f64 {
-        let seconds = self.time_limit.map_or(f64::INFINITY, |t| t.as_secs_f64());
+        let seconds = self.budget_seconds_or(f64::INFINITY);
         (seconds * 4e7).clamp(2e7, 4e8)
+    }
+
+    /// Work budget (elementary steps) of the node penalties' subgradient optimisation:
+    /// 2·10⁷ steps per second of the time limit, at most 10⁹ (about a second).
+    fn effective_penalty_work(&self) -> f64 {
+        let seconds = self.budget_seconds_or(f64::INFINITY);
+        (seconds * 2e7).clamp(1e7, 1e9)
     }
 
     /// The lattice work budget after resolving the automatic setting.
@@ -62,7 +85,7 @@ impl ExactOptions {
         if self.lattice_work > 0 {
             return self.lattice_work;
         }
-        let seconds = self.time_limit.map_or(100.0, |t| t.as_secs_f64());
+        let seconds = self.budget_seconds_or(100.0);
         (seconds * 40e6).clamp(3e8, 4e9) as usize
     }
 }
@@ -78,6 +101,8 @@ impl Default for ExactOptions {
             gap_tolerance: 0.0,
             lattice_max_ideals: 8_000_000,
             lattice_work: 0,
+            penalty_iterations: 400,
+            budget_seconds: None,
         }
     }
 }
@@ -193,6 +218,15 @@ impl Engine {
         }
     }
 
+    fn set_penalties(&mut self, model: &Model, penalties: Rc<NodePenalties>) {
+        match self {
+            Engine::W1(dp) => dp.set_penalties(model, penalties),
+            Engine::W2(dp) => dp.set_penalties(model, penalties),
+            Engine::W4(dp) => dp.set_penalties(model, penalties),
+            Engine::Unsupported => {}
+        }
+    }
+
     fn run(&mut self, model: &Model, incumbent: &mut Incumbent, work: u64) -> DpStatus {
         match self {
             Engine::W1(dp) => dp.run(model, incumbent, work),
@@ -260,6 +294,8 @@ struct Run {
     preparation: Option<Preparation>,
     /// The subset DP bound, once built.
     subset: Option<Rc<SubsetBound>>,
+    /// Node penalties for the per-state assignment bounds (when the run has no lattice).
+    penalties: Option<Rc<NodePenalties>>,
     root_bound: f64,
     engine: Option<Engine>,
     finished_bound: Option<f64>,
@@ -270,6 +306,7 @@ impl Run {
     /// Builds the bounds until `deadline`; sets `lattice` once they are complete.
     fn build_lattice(
         &mut self,
+        instance: &Instance,
         options: &ExactOptions,
         tour: Option<&[usize]>,
         upper_bound: f64,
@@ -296,6 +333,10 @@ impl Run {
         };
         self.subset = preparation.subset.clone();
         self.preparation = None;
+        if store.root_bound().is_none() {
+            // Without the lattice the DP bounds its states by assignments: strengthen them.
+            self.build_penalties(instance, options, upper_bound);
+        }
         if let Some(root) = store.root_bound() {
             self.root_bound = self.root_bound.max(self.model.round_bound(root));
         }
@@ -317,6 +358,58 @@ impl Run {
         self.lattice = Some(store);
     }
 
+    /// The Lagrangian bounds (`lagrange.rs`): node penalties for the per-state assignment
+    /// bounds, and the Held–Karp style arborescence bound at the root.
+    fn build_penalties(&mut self, instance: &Instance, options: &ExactOptions, upper_bound: f64) {
+        if options.penalty_iterations == 0 || self.model.m > 256 {
+            return;
+        }
+        let began = Instant::now();
+        let work = options.effective_penalty_work();
+        let penalties = lagrange::optimise(
+            instance,
+            &self.model,
+            upper_bound,
+            PenaltyOptions {
+                iterations: options.penalty_iterations,
+                work,
+            },
+        )
+        .map(Rc::new);
+        if let Some(p) = &penalties {
+            self.root_bound = self.root_bound.max(self.model.round_bound(p.root_bound));
+            debug_log(|| {
+                format!(
+                    "node penalties in {:?}: root L1 {} -> {} ({} iterations)",
+                    began.elapsed(),
+                    p.plain_l1,
+                    p.root_bound,
+                    p.iterations
+                )
+            });
+        }
+        self.penalties = penalties;
+        let began = Instant::now();
+        let arborescence = lagrange::arborescence_bound(
+            &self.model,
+            upper_bound,
+            self.penalties.as_ref().map(|p| p.lambda.as_slice()),
+            PenaltyOptions {
+                iterations: 4 * options.penalty_iterations,
+                work: 4.0 * work,
+            },
+        );
+        if let Some((bound, iterations)) = arborescence {
+            self.root_bound = self.root_bound.max(self.model.round_bound(bound));
+            debug_log(|| {
+                format!(
+                    "arborescence bound in {:?}: {bound} ({iterations} iterations)",
+                    began.elapsed()
+                )
+            });
+        }
+    }
+
     /// A new DP engine with every bound this run has.
     fn engine(&mut self, beam: Option<usize>, memory: usize, use_l2: bool) -> Engine {
         let store = self
@@ -326,6 +419,9 @@ impl Run {
         let mut engine = Engine::new(&self.model, beam, memory, use_l2, store);
         if let Some(subset) = &self.subset {
             engine.set_subset_bound(&self.model, subset.clone());
+        }
+        if let Some(penalties) = &self.penalties {
+            engine.set_penalties(&self.model, penalties.clone());
         }
         engine
     }
@@ -374,6 +470,7 @@ impl ExactSolver {
                 lattice: None,
                 preparation: None,
                 subset: None,
+                penalties: None,
                 root_bound,
                 engine: None,
                 finished_bound: None,
@@ -558,6 +655,7 @@ impl ExactSolver {
                             debug_log(|| format!("greedy: UB {}", self.incumbent.upper_bound));
                         }
                         self.runs[0].build_lattice(
+                            &self.instance,
                             &self.options,
                             self.incumbent.tour.as_deref(),
                             self.incumbent.upper_bound,
@@ -636,6 +734,7 @@ impl ExactSolver {
                     let run = &mut self.runs[self.current_run];
                     if run.lattice.is_none() {
                         run.build_lattice(
+                            &self.instance,
                             &self.options,
                             self.incumbent.tour.as_deref(),
                             self.incumbent.upper_bound,
@@ -678,6 +777,16 @@ impl ExactSolver {
                         return self.stop(began);
                     }
                     if layer_changed {
+                        debug_log(|| {
+                            format!(
+                                "layer {} at {:?}: {} live states, LB {}, UB {}",
+                                p.layer,
+                                self.elapsed + began.elapsed(),
+                                p.live_states,
+                                p.lower_bound,
+                                p.upper_bound
+                            )
+                        });
                         // Let the caller report progress after every layer.
                         self.elapsed += began.elapsed();
                         return SolverStatus::Running;

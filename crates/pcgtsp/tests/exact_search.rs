@@ -4,7 +4,9 @@
 mod common;
 
 use common::{brute_force, references};
-use cutroute_pcgtsp::{check_tour, solve, ExactOptions, ExactSolver, Instance, SolverStatus};
+use cutroute_pcgtsp::{
+    check_tour, root_bounds, solve, ExactOptions, ExactSolver, Instance, SolverStatus,
+};
 use std::time::Duration;
 
 /// A small deterministic generator (the test must not depend on an RNG crate's stream).
@@ -148,4 +150,63 @@ fn bounds_are_built_in_slices_and_the_build_can_be_cancelled() {
         SolverStatus::Stopped
     );
     assert!(cancelled.progress().lower_bound <= 3258.0);
+}
+
+#[test]
+fn lagrangian_root_bounds_never_exceed_brute_force_optima() {
+    let mut compared = 0;
+    for seed in 0..200u64 {
+        let m = 3 + (seed % 6) as usize;
+        let instance = random_instance(seed + 1000, m);
+        let Some((opt, _)) = brute_force(&instance) else {
+            continue;
+        };
+        let b = root_bounds(&instance, 0).expect("valid instance");
+        assert!(
+            b.node_penalty <= opt + 1e-6,
+            "seed {seed}: node-penalty bound {} > optimum {opt}",
+            b.node_penalty
+        );
+        let arborescence = b.arborescence.expect("at least 3 clusters");
+        assert!(
+            arborescence <= opt + 1e-6,
+            "seed {seed}: arborescence bound {arborescence} > optimum {opt}"
+        );
+        compared += 1;
+    }
+    assert!(compared > 120, "only {compared} feasible random instances");
+}
+
+#[test]
+fn search_with_penalised_assignment_bounds_matches_brute_force() {
+    // Without the lattice the DP bounds states by assignments on penalised costs and starts
+    // from the arborescence bound: both must keep the optimum.
+    let mut proven = 0;
+    for seed in 0..80u64 {
+        let m = 4 + (seed % 5) as usize;
+        let instance = random_instance(seed + 5000, m);
+        let expected = brute_force(&instance).map(|(cost, _)| cost);
+        let options = ExactOptions {
+            lattice_max_ideals: 0,
+            heuristic: seed % 2 == 0,
+            time_limit: Some(Duration::from_secs(30)),
+            ..ExactOptions::default()
+        };
+        let result = solve(&instance, options, &mut |p| {
+            if let Some(opt) = expected {
+                assert!(
+                    p.lower_bound <= opt + 1e-9,
+                    "seed {seed}: LB above the optimum"
+                );
+            }
+        })
+        .expect("valid instance");
+        if let Some(opt) = expected {
+            assert!(result.proven_optimal(), "seed {seed}: not proven");
+            assert!(result.root_bound <= opt + 1e-9, "seed {seed}: root bound");
+            assert_eq!(result.progress.upper_bound, opt, "seed {seed}");
+            proven += 1;
+        }
+    }
+    assert!(proven > 50, "only {proven} feasible random instances");
 }

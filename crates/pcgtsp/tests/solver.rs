@@ -54,6 +54,18 @@ fn root_bounds_never_exceed_known_optima() {
             assert!(dp <= opt, "{}: cluster DP {dp} > {opt}", r.instance);
         }
         assert!(
+            b.node_penalty <= opt,
+            "{}: node-penalty bound {} > {opt}",
+            r.instance,
+            b.node_penalty
+        );
+        let arborescence = b.arborescence.expect("every instance has ≥ 3 clusters");
+        assert!(
+            arborescence <= opt,
+            "{}: arborescence bound {arborescence} > {opt}",
+            r.instance
+        );
+        assert!(
             b.best() > 0.0 || opt == 0.0 || r.instance.starts_with("br17"),
             "{}: trivial bound",
             r.instance
@@ -262,4 +274,17 @@ fn p43_4_optimum_is_66848_not_the_published_bound_66846() {
     assert_eq!(result.progress.upper_bound, common::P43_4_OPTIMUM);
     // Consistent with the published lower bound.
     assert!(result.progress.lower_bound >= r.known_optimum.unwrap());
+}
+
+#[test]
+fn lagrangian_bounds_lift_the_assignment_bound_on_ft70_2() {
+    // ft70.2 (> 6 M ideals, no lattice): L1 = 30994; the node penalties and the arborescence
+    // bound lift it to ~31460 and ~32070 (best published bound 31787, best tour 33374).
+    let r = reference("ft70.2");
+    let instance = r.load();
+    let b = root_bounds(&instance, 0).unwrap();
+    assert!(b.node_penalty >= b.l1 + 300.0, "node penalties: {b:?}");
+    let arborescence = b.arborescence.expect("70 clusters");
+    assert!(arborescence >= 31900.0, "arborescence: {b:?}");
+    assert!(arborescence <= 33374.0, "above a known tour: {b:?}");
 }
