@@ -160,6 +160,11 @@ pub struct AlnsParameters {
     pub score_better: f64,
     /// Score for an accepted worse tour.
     pub score_accepted: f64,
+    /// How many of the best distinct epoch results are kept as restart points.
+    pub elite_size: usize,
+    /// Fraction of the non-depot clusters removed (and re-inserted at random) by the kick that
+    /// starts an epoch after an epoch that did not improve the best tour.
+    pub kick_fraction: f64,
 }
 
 impl Default for AlnsParameters {
@@ -183,6 +188,8 @@ impl Default for AlnsParameters {
             score_new_best: 33.0,
             score_better: 9.0,
             score_accepted: 13.0,
+            elite_size: 6,
+            kick_fraction: 0.3,
         }
     }
 }
