@@ -384,9 +384,11 @@ fn a_time_limit_only_decides_where_the_iteration_sequence_stops() {
     // I iterations holds the same tour as a run limited to I iterations. Short epochs put
     // many restarts (kicked ones after stagnant epochs included) inside the run.
     let instance = load("pcgtsplib", "ft53.1");
-    let mut parameters = AlnsParameters::default();
-    parameters.epoch_iterations = 40;
-    parameters.epoch_growth = 1.1;
+    let parameters = AlnsParameters {
+        epoch_iterations: 40,
+        epoch_growth: 1.1,
+        ..AlnsParameters::default()
+    };
     // Wall-clock limits: a heavily loaded machine may starve the first one, so lengthen it.
     let mut timed = None;
     for millis in [200, 1000, 5000] {
@@ -460,9 +462,11 @@ fn plain_gtsp_with_symmetric_and_asymmetric_costs_is_feasible_and_deterministic(
         assert!(cost.is_finite() && other_cost.is_finite());
         // Short epochs: many restarts, kicked ones after stagnant epochs among them; still
         // feasible and deterministic.
-        let mut parameters = AlnsParameters::default();
-        parameters.epoch_iterations = 30;
-        parameters.epoch_growth = 1.0;
+        let parameters = AlnsParameters {
+            epoch_iterations: 30,
+            epoch_growth: 1.0,
+            ..AlnsParameters::default()
+        };
         let short = AlnsOptions {
             seed: 9,
             time_limit: None,
