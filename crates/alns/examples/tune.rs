@@ -1,7 +1,8 @@
 //! Parameter exploration on one instance file (not a benchmark; see `cutroute-bench`).
 //!
 //! `cargo run --release -p cutroute-alns --example tune -- FILE SECONDS SEEDS [key=value …]`
-//! with keys `start`, `end`, `epoch`, `growth`, `noise`, `frac`, `gate`, `maxrem`.
+//! with keys `start`, `end`, `epoch`, `growth`, `noise`, `frac`, `gate`, `maxrem`,
+//! `block`, `bgate`, `cycle`, `elite`, `kick`, `target`.
 
 use std::time::Duration;
 
@@ -33,6 +34,8 @@ fn main() {
             "block" => p.block_reverse_length = v.parse().unwrap(),
             "bgate" => p.block_reverse_gate = v.parse().unwrap(),
             "cycle" => p.temperature_cycle = v.split(',').map(|x| x.parse().unwrap()).collect(),
+            "elite" => p.elite_size = v.parse().unwrap(),
+            "kick" => p.kick_fraction = v.parse().unwrap(),
             "target" => options.target_cost = Some(v.parse().unwrap()),
             _ => panic!("unknown key {k}"),
         }

@@ -7,7 +7,10 @@
 //! positions (cheapest, nearest, farthest, random; with or without noise), pick the optimal nodes
 //! for the new cluster order by a shortest-cycle DP over the layered graph, polish with
 //! precedence-respecting 2-opt, or-opt and cluster re-insertion, and accept by simulated
-//! annealing with periodic restarts from the best tour. Operator weights adapt to their success.
+//! annealing in epochs. An epoch that improved the best tour is followed by one that starts from
+//! it; after a stagnant epoch the next starts from a kicked copy (large random destroy, random
+//! re-insertion, local search) of a random elite tour, so that the search leaves a basin it
+//! keeps returning to. Operator weights adapt to their success.
 //!
 //! It is deterministic for a given seed (its own PRNG, no threads, time only decides when to
 //! stop), runs on wasm32 (`web_time`), and is resumable: [`AlnsSolver::step`] does a slice of
@@ -137,7 +140,8 @@ pub struct AlnsParameters {
     pub temperature_cycle: Vec<f64>,
     /// Temperature at the end of an epoch, as a fraction of the best cost.
     pub end_temperature: f64,
-    /// Iterations of the first annealing epoch; each epoch ends with a restart from the best.
+    /// Iterations of the first annealing epoch; each epoch ends with a restart (from the best
+    /// tour, or from a kicked elite tour after an epoch that did not improve it).
     pub epoch_iterations: u64,
     /// Factor by which each epoch is longer than the previous one.
     pub epoch_growth: f64,
@@ -160,6 +164,11 @@ pub struct AlnsParameters {
     pub score_better: f64,
     /// Score for an accepted worse tour.
     pub score_accepted: f64,
+    /// How many of the best distinct epoch results are kept as restart points.
+    pub elite_size: usize,
+    /// Fraction of the non-depot clusters removed (and re-inserted at random) by the kick that
+    /// starts an epoch after an epoch that did not improve the best tour.
+    pub kick_fraction: f64,
 }
 
 impl Default for AlnsParameters {
@@ -183,6 +192,8 @@ impl Default for AlnsParameters {
             score_new_best: 33.0,
             score_better: 9.0,
             score_accepted: 13.0,
+            elite_size: 6,
+            kick_fraction: 0.3,
         }
     }
 }
@@ -252,7 +263,7 @@ pub struct AlnsProgress {
     pub iterations: u64,
     /// Times the best tour improved.
     pub improvements: u64,
-    /// Restarts from the best tour (annealing epochs completed).
+    /// Restarts (annealing epochs completed).
     pub restarts: u64,
     /// Set once the search has stopped.
     pub stop_reason: Option<StopReason>,
