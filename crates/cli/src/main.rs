@@ -537,15 +537,7 @@ fn solve(
         Problem::PcgtspText { .. } => tour_report(solver_name, &result),
         Problem::Nest { nest, .. } => route_report(solver_name, nest, &machine, &result)?,
     };
-    if as_json {
-        println!("{report}");
-    } else {
-        for (key, value) in report.as_object().into_iter().flatten() {
-            if key != "route" && key != "tour" {
-                println!("{key:>18}: {value}");
-            }
-        }
-    }
+    print_report(&report, as_json);
     Ok(())
 }
 
@@ -600,16 +592,21 @@ fn solve_aoe(
         "lb": null,
         "elapsed_s": started.elapsed().as_secs_f64(),
     });
+    print_report(&report, as_json);
+    Ok(())
+}
+
+/// A solve report: one JSON object, or its keys one per line without the route or tour.
+fn print_report(report: &Value, as_json: bool) {
     if as_json {
         println!("{report}");
     } else {
         for (key, value) in report.as_object().into_iter().flatten() {
-            if key != "route" {
+            if key != "route" && key != "tour" {
                 println!("{key:>18}: {value}");
             }
         }
     }
-    Ok(())
 }
 
 fn machine_json(machine: &MachineParameters) -> Value {
@@ -794,15 +791,7 @@ fn solve_segments(
         "route": serde_json::to_value(route).map_err(|e| e.to_string())?,
         "elapsed_s": started.elapsed().as_secs_f64(),
     });
-    if as_json {
-        println!("{report}");
-    } else {
-        for (key, value) in report.as_object().into_iter().flatten() {
-            if key != "route" {
-                println!("{key:>18}: {value}");
-            }
-        }
-    }
+    print_report(&report, as_json);
     Ok(())
 }
 
