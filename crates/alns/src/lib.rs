@@ -311,3 +311,16 @@ pub fn solve_until(
         progress: solver.progress(),
     })
 }
+
+/// A reference instance of `shared/data/pcgtsp/<set>/<name>.pcglns` for the unit tests; panics
+/// loudly when the file is missing.
+#[cfg(test)]
+pub(crate) fn reference_instance(set: &str, name: &str) -> cutroute_pcgtsp::Instance {
+    let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/data/pcgtsp")
+        .join(set)
+        .join(format!("{name}.pcglns"));
+    let text = std::fs::read_to_string(&path)
+        .unwrap_or_else(|e| panic!("missing reference instance {}: {e}", path.display()));
+    cutroute_pcgtsp::Instance::parse(&text).unwrap()
+}

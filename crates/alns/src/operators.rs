@@ -473,16 +473,9 @@ fn arg_best(items: &[usize], key: impl Fn(usize) -> f64) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use cutroute_pcgtsp::Instance;
 
     fn problem(set: &str, name: &str) -> Problem {
-        let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-            .join("../../../shared/data/pcgtsp")
-            .join(set)
-            .join(format!("{name}.pcglns"));
-        let text = std::fs::read_to_string(&path)
-            .unwrap_or_else(|e| panic!("missing reference instance {}: {e}", path.display()));
-        Problem::new(&Instance::parse(&text).unwrap()).unwrap()
+        Problem::new(&crate::reference_instance(set, name)).unwrap()
     }
 
     /// Many destroy–repair cycles with every operator. `repair` asserts (under `cfg(test)`)

@@ -448,13 +448,7 @@ mod tests {
     use cutroute_pcgtsp::check_tour;
 
     fn instance(set: &str, name: &str) -> Instance {
-        let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-            .join("../../../shared/data/pcgtsp")
-            .join(set)
-            .join(format!("{name}.pcglns"));
-        let text = std::fs::read_to_string(&path)
-            .unwrap_or_else(|e| panic!("missing reference instance {}: {e}", path.display()));
-        Instance::parse(&text).unwrap()
+        crate::reference_instance(set, name)
     }
 
     /// After a stagnant epoch the next one starts from a kicked elite tour: feasible (checked

@@ -668,6 +668,11 @@ mod tests {
         Point::new(x, y)
     }
 
+    /// The step that pierces contour `contour` of part `part` at `at`.
+    fn step(part: usize, contour: usize, at: Point) -> CutStep {
+        CutStep::pierced(ContourRef { part, contour }, at)
+    }
+
     fn polyline(points: &[(f64, f64)]) -> ToolOnPath {
         ToolOnPath {
             pierce: p(points[0].0, points[0].1),
@@ -752,27 +757,9 @@ mod tests {
         let route = Route {
             start: p(0.0, 0.0),
             steps: vec![
-                CutStep::pierced(
-                    ContourRef {
-                        part: 1,
-                        contour: 0,
-                    },
-                    p(40.0, 40.0),
-                ),
-                CutStep::pierced(
-                    ContourRef {
-                        part: 0,
-                        contour: 0,
-                    },
-                    p(0.0, 0.0),
-                ),
-                CutStep::pierced(
-                    ContourRef {
-                        part: 0,
-                        contour: 1,
-                    },
-                    p(20.0, 20.0),
-                ),
+                step(1, 0, p(40.0, 40.0)),
+                step(0, 0, p(0.0, 0.0)),
+                step(0, 1, p(20.0, 20.0)),
             ],
             finish: None,
         };
@@ -846,22 +833,7 @@ mod tests {
         // Each square cut whole: the common edge twice.
         let route = Route {
             start: p(0.0, 0.0),
-            steps: vec![
-                CutStep::pierced(
-                    ContourRef {
-                        part: 0,
-                        contour: 0,
-                    },
-                    p(0.0, 0.0),
-                ),
-                CutStep::pierced(
-                    ContourRef {
-                        part: 1,
-                        contour: 0,
-                    },
-                    p(10.0, 0.0),
-                ),
-            ],
+            steps: vec![step(0, 0, p(0.0, 0.0)), step(1, 0, p(10.0, 0.0))],
             finish: None,
         };
         let twice = PathRoute::from_route(&route, &nest).unwrap();
@@ -986,13 +958,7 @@ mod tests {
         let linked = Route {
             start: p(0.0, 0.0),
             steps: vec![
-                CutStep::pierced(
-                    ContourRef {
-                        part: 0,
-                        contour: 0,
-                    },
-                    p(0.0, 0.0),
-                ),
+                step(0, 0, p(0.0, 0.0)),
                 CutStep {
                     contour: ContourRef {
                         part: 1,
