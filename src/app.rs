@@ -349,6 +349,7 @@ pub fn App() -> impl IntoView {
             initial_upper_bound: from.as_ref().and_then(|p| p.upper_bound),
             // The stats panel's speeds and prices: chain cutting decides by this cost model.
             machine: machine.get_untracked(),
+            objective: Default::default(),
         };
         if from.is_none() {
             progress.set(None);

@@ -149,6 +149,7 @@ fn main() -> ExitCode {
                 discretisation_step_mm: step,
                 initial_upper_bound: None,
                 machine: Default::default(),
+                objective: Default::default(),
             };
             convert(
                 &input,
@@ -184,6 +185,7 @@ fn main() -> ExitCode {
                     discretisation_step_mm: step,
                     initial_upper_bound: ub,
                     machine,
+                    objective: Default::default(),
                 };
                 match solver.as_str() {
                     "sccp" | "gsccp" => solve_segments(&file, &solver, &params, &objective, json),

@@ -68,6 +68,7 @@ impl Job for CcpJob {
             proven_optimal: false,
             states: None,
             certified,
+            path_route: None,
         }
     }
 }
@@ -224,6 +225,7 @@ impl Job for DiscreteJob {
             proven_optimal,
             states: self.exact.as_ref().map(|e| e.states_created()),
             certified: Vec::new(),
+            path_route: None,
         }
     }
 }

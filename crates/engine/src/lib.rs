@@ -149,13 +149,19 @@ pub fn start_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
             }
             Ok(Box::new(CcpJob::new(request.job_id, ccp)))
         }
+        (Problem::Nest { .. }, SolverKind::Sccp | SolverKind::Gsccp | SolverKind::Aoe) => {
+            Err(EngineError::UnsupportedProblem {
+                solver: solver.name(),
+                problem: "a nest in the job engine yet (use the CLI)",
+            })
+        }
         (
             Problem::Nest {
                 nest,
                 start,
                 finish,
             },
-            _,
+            SolverKind::Heuristic | SolverKind::Exact,
         ) => {
             let options = cutroute_ccp::DiscretisationOptions {
                 start: *start,

@@ -125,6 +125,7 @@ impl Job for NearestNeighbourJob {
             proven_optimal: false,
             states: None,
             certified: Vec::new(),
+            path_route: None,
         }
     }
 }

@@ -88,8 +88,8 @@ pub use forest::ContainmentForest;
 pub use generator::{generate_nest, SplitMix64};
 pub use path_route::{PathRoute, PathRouteError, ToolOnPath};
 pub use route::{
-    in_scrap_region, is_scrap_region, ContourRef, CutStep, Entry, MachineParameters, Route,
-    RouteError,
+    in_scrap_region, is_scrap_region, ContourRef, CutStep, Entry, MachineParameters, Objective,
+    Route, RouteError,
 };
 pub use span::{tan_half_arg, Span, SpanIntersection, SpanProjection};
 pub use toolpath::{ToolClock, ToolMove, ToolState, Toolpath};

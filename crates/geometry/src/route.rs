@@ -121,6 +121,40 @@ impl MachineParameters {
     }
 }
 
+/// What a solver minimises, or what routes are compared by, under the machine's model.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum Objective {
+    /// Machining time (formula 1.2).
+    #[default]
+    Time,
+    /// Cost (formula 1.3).
+    Cost,
+}
+
+impl Objective {
+    /// The objective's value for a route of these lengths (mm) and pierces.
+    pub fn value(
+        self,
+        machine: &MachineParameters,
+        cut_length: f64,
+        idle_length: f64,
+        pierces: usize,
+    ) -> f64 {
+        match self {
+            Objective::Time => machine.time(cut_length, idle_length, pierces),
+            Objective::Cost => machine.cost(cut_length, idle_length, pierces),
+        }
+    }
+
+    /// The short name used on the command line: `time` or `cost`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Objective::Time => "time",
+            Objective::Cost => "cost",
+        }
+    }
+}
+
 /// One way a route fails to be a valid continuous cutting route of a nest.
 #[derive(Clone, Debug, PartialEq, Error)]
 pub enum RouteError {

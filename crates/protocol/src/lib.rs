@@ -23,7 +23,7 @@
 //! ```
 #![deny(missing_docs)]
 
-use cutroute_geometry::{MachineParameters, Nest, Point, Route};
+use cutroute_geometry::{MachineParameters, Nest, Objective, PathRoute, Point, Route};
 use serde::{Deserialize, Serialize};
 
 /// Identifies one job for the lifetime of a worker; chosen by the sender, echoed in every answer.
@@ -131,17 +131,35 @@ pub enum SolverKind {
     /// CCP-Relax, then chain cutting: neighbouring contours of one scrap region cut from one
     /// pierce, joined by tool-on links that pay under the machine's prices.
     Chain,
+    /// Segment cutting (SCCP): the multi-contour chains of the nest's plan graph (parts
+    /// sharing edges cut along them once) as base segments; reports a [`Progress::path_route`].
+    Sccp,
+    /// Generalised segment cutting (GSCCP): standard, chain and junction-split ensembles, the
+    /// best by the chosen [`Objective`]; reports a [`Progress::path_route`].
+    Gsccp,
+    /// Common-edge routes along AOE-chains of the nest's plane graph (each edge cut once, no
+    /// self-crossing, nothing enclosed before it is cut); reports a [`Progress::path_route`].
+    Aoe,
 }
 
 impl SolverKind {
     /// Every solver, in the order the UI lists them.
-    pub const ALL: [SolverKind; 5] = [
+    pub const ALL: [SolverKind; 8] = [
         SolverKind::NearestNeighbour,
         SolverKind::Ccp,
         SolverKind::Heuristic,
         SolverKind::Exact,
         SolverKind::Chain,
+        SolverKind::Sccp,
+        SolverKind::Gsccp,
+        SolverKind::Aoe,
     ];
+
+    /// Whether the solver's result is a [`PathRoute`] (tool-on paths that may cut parts of
+    /// several contours) rather than a [`Route`] of whole contours.
+    pub fn gives_path_route(self) -> bool {
+        matches!(self, SolverKind::Sccp | SolverKind::Gsccp | SolverKind::Aoe)
+    }
 
     /// The short name used on the command line and in links.
     pub fn name(self) -> &'static str {
@@ -151,6 +169,9 @@ impl SolverKind {
             SolverKind::Heuristic => "heuristic",
             SolverKind::Exact => "exact",
             SolverKind::Chain => "chain",
+            SolverKind::Sccp => "sccp",
+            SolverKind::Gsccp => "gsccp",
+            SolverKind::Aoe => "aoe",
         }
     }
 
@@ -162,6 +183,9 @@ impl SolverKind {
             SolverKind::Heuristic => "Discrete heuristic (ALNS)",
             SolverKind::Exact => "Discrete exact with lower bound",
             SolverKind::Chain => "Chain cutting (CCP-Relax + chains)",
+            SolverKind::Sccp => "Segment cutting (SCCP, common edges once)",
+            SolverKind::Gsccp => "Generalised segment cutting (GSCCP)",
+            SolverKind::Aoe => "Common-edge AOE-chains",
         }
     }
 
@@ -186,6 +210,10 @@ pub struct SolverParams {
     /// contours when the link costs less than the pierce it saves).
     #[serde(default)]
     pub machine: MachineParameters,
+    /// What the solvers that choose between routes (GSCCP's ensembles) minimise, and what the
+    /// UI compares routes by.
+    #[serde(default)]
+    pub objective: Objective,
 }
 
 impl Default for SolverParams {
@@ -196,6 +224,7 @@ impl Default for SolverParams {
             discretisation_step_mm: 50.0,
             initial_upper_bound: None,
             machine: MachineParameters::default(),
+            objective: Objective::default(),
         }
     }
 }
@@ -237,6 +266,11 @@ pub struct Progress {
     /// Per step of `route`: whether its pierce point is certified optimal for the order
     /// (CCP's Condition 1); empty when the solver does not certify.
     pub certified: Vec<bool>,
+    /// The best route so far as tool-on paths, for solvers whose routes cut parts of several
+    /// contours in one path (sccp, gsccp, aoe; see [`SolverKind::gives_path_route`]); `route`
+    /// is then `None`.
+    #[serde(default)]
+    pub path_route: Option<PathRoute>,
 }
 
 impl Progress {
@@ -309,6 +343,18 @@ mod tests {
             proven_optimal: false,
             states: Some(12),
             certified: vec![true],
+            path_route: Some(cutroute_geometry::PathRoute {
+                start: Point::default(),
+                paths: vec![cutroute_geometry::ToolOnPath {
+                    pierce: Point::new(0.0, 0.0),
+                    spans: vec![cutroute_geometry::Span {
+                        start: Point::new(0.0, 0.0),
+                        end: Point::new(10.0, 0.0),
+                        bulge: 0.5,
+                    }],
+                }],
+                finish: Some(Point::new(1.0, 1.0)),
+            }),
         });
         let bytes = bincode::serialize(&progress).unwrap();
         assert_eq!(

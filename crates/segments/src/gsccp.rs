@@ -4,23 +4,13 @@ use std::sync::atomic::AtomicBool;
 use std::time::Duration;
 
 use cutroute_ccp::{CcpOptions, CcpSolver, SolverStatus};
-use cutroute_geometry::{MachineParameters, Nest, PathRoute, PathRouteError, Route};
+use cutroute_geometry::{MachineParameters, Nest, Objective, PathRoute, PathRouteError, Route};
 use serde::{Deserialize, Serialize};
 use web_time::Instant;
 
 use crate::segment::{Ensemble, EnsembleKind};
 use crate::solver::{solve_sccp, SccpOptions};
 use crate::SegmentError;
-
-/// What GSCCP minimises when it picks an ensemble's route.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-pub enum Objective {
-    /// Machining time (formula 1.2).
-    #[default]
-    Time,
-    /// Cost (formula 1.3).
-    Cost,
-}
 
 /// Settings of [`solve_gsccp`].
 #[derive(Clone, Debug, PartialEq)]

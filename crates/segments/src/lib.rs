@@ -51,7 +51,8 @@ mod gsccp;
 mod segment;
 mod solver;
 
-pub use gsccp::{recut_length, solve_gsccp, EnsembleReport, GsccpOptions, GsccpResult, Objective};
+pub use cutroute_geometry::Objective;
+pub use gsccp::{recut_length, solve_gsccp, EnsembleReport, GsccpOptions, GsccpResult};
 pub use segment::{Ensemble, EnsembleKind, Segment};
 pub use solver::{solve_sccp, SccpOptions, SccpSolution};
 
