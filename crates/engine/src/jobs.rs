@@ -69,6 +69,7 @@ impl Job for CcpJob {
             states: None,
             certified,
             path_route: None,
+            alternatives: Vec::new(),
         }
     }
 }
@@ -226,6 +227,7 @@ impl Job for DiscreteJob {
             states: self.exact.as_ref().map(|e| e.states_created()),
             certified: Vec::new(),
             path_route: None,
+            alternatives: Vec::new(),
         }
     }
 }

@@ -126,6 +126,7 @@ impl Job for NearestNeighbourJob {
             states: None,
             certified: Vec::new(),
             path_route: None,
+            alternatives: Vec::new(),
         }
     }
 }

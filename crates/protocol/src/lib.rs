@@ -271,6 +271,31 @@ pub struct Progress {
     /// is then `None`.
     #[serde(default)]
     pub path_route: Option<PathRoute>,
+    /// The candidates the solver weighed (GSCCP: each ensemble and the CCP route that seeded
+    /// them), with their numbers under the machine's model; empty for other solvers.
+    #[serde(default)]
+    pub alternatives: Vec<RouteSummary>,
+}
+
+/// One candidate route a solver weighed, in numbers (lengths in mm, time in s).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct RouteSummary {
+    /// What the candidate is, e.g. "chains" or "standard".
+    pub name: String,
+    /// Pierces of its route.
+    pub pierces: usize,
+    /// Idle length.
+    pub idle_length: f64,
+    /// Cut length (common edges cut twice counted twice).
+    pub cut_length: f64,
+    /// Machining time.
+    pub time_s: f64,
+    /// Cost.
+    pub cost: f64,
+    /// Whether this is the route the solver returned.
+    pub chosen: bool,
+    /// Why the candidate gave no route, if it did not.
+    pub failure: Option<String>,
 }
 
 impl Progress {
@@ -355,6 +380,16 @@ mod tests {
                 }],
                 finish: Some(Point::new(1.0, 1.0)),
             }),
+            alternatives: vec![RouteSummary {
+                name: "chains".into(),
+                pierces: 1,
+                idle_length: 2.0,
+                cut_length: 10.0,
+                time_s: 3.0,
+                cost: 4.0,
+                chosen: true,
+                failure: None,
+            }],
         });
         let bytes = bincode::serialize(&progress).unwrap();
         assert_eq!(
