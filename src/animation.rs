@@ -1,5 +1,9 @@
 //! The animation of the tool along the route, on the machine's time axis.
 //!
+//! What is animated is a [`Toolpath`]: the head's moves, whether they come from a route of
+//! whole contours (`Toolpath::new`) or from a route of tool-on paths (segment cutting, AOE:
+//! [`crate::drawing::path_route_toolpath`]); the clock is the toolpath's machine time.
+//!
 //! State is the machine time shown; every frame (requestAnimationFrame) advances it by the real
 //! time elapsed times the speed factor, and the drawing asks [`Timeline::frame_at`] where the
 //! head is. The route is cut once into chunks of a few dozen moves, each small on the drawing
@@ -16,9 +20,7 @@
 //! `#anim-clock`, and `#anim-done` whose `pathLength` is the route's length and whose
 //! `stroke-dasharray` starts with the length of the chunks fully travelled.
 
-use cutroute_geometry::{
-    BoundingBox, MachineParameters, Nest, Route, ToolClock, ToolMove, ToolState, Toolpath,
-};
+use cutroute_geometry::{BoundingBox, MachineParameters, ToolClock, ToolMove, ToolState, Toolpath};
 use leptos::prelude::*;
 
 use crate::drawing::{travel_chunks, ChunkLimits, Travel};
@@ -43,7 +45,7 @@ pub struct Timeline {
     pub clock: ToolClock,
     /// The toolpath as path data in chunks, with the distance at which each move starts.
     pub travel: Travel,
-    /// Indices of the pierce moves: where each contour begins.
+    /// Indices of the pierce moves: where each contour (each tool-on path) begins.
     pub pierces: Vec<usize>,
     /// Machine time at which each pierce starts (non-decreasing).
     pierce_times: Vec<f64>,
@@ -63,10 +65,8 @@ pub struct Frame {
 }
 
 impl Timeline {
-    /// The timeline of `route` over `nest` under `machine`; `None` if the route names contours
-    /// the nest lacks.
-    pub fn new(nest: &Nest, route: &Route, machine: &MachineParameters) -> Option<Timeline> {
-        let toolpath = Toolpath::new(route, nest).ok()?;
+    /// The timeline of `toolpath` under `machine`.
+    pub fn new(toolpath: Toolpath, machine: &MachineParameters) -> Timeline {
         let clock = ToolClock::new(&toolpath, machine);
         let extent = toolpath_extent(&toolpath);
         let travel = travel_chunks(
@@ -84,13 +84,13 @@ impl Timeline {
             .map(|(i, _)| i)
             .collect();
         let pierce_times = pierces.iter().filter_map(|&i| clock.start_of(i)).collect();
-        Some(Timeline {
+        Timeline {
             toolpath,
             clock,
             travel,
             pierces,
             pierce_times,
-        })
+        }
     }
 
     /// Machine time of the whole route, s.
@@ -188,20 +188,22 @@ pub struct Animation {
     pub playing: RwSignal<bool>,
     /// Machine seconds per real second.
     pub speed: RwSignal<u32>,
+    /// What one pierce starts, for the step buttons and the counter: "contour" for routes of
+    /// whole contours, "path" for routes of tool-on paths.
+    pub piece: Signal<&'static str>,
 }
 
 impl Animation {
-    /// State for the route shown.
+    /// State for the toolpath shown.
     pub fn new(
-        nest: Signal<Option<Nest>>,
-        route: Signal<Option<Route>>,
+        toolpath: Signal<Option<Toolpath>>,
         machine: RwSignal<MachineParameters>,
+        piece: Signal<&'static str>,
     ) -> Self {
         let timeline = Memo::new(move |_| {
-            nest.with(|nest| {
-                route.with(|route| {
-                    machine.with(|m| Timeline::new(nest.as_ref()?, route.as_ref()?, m))
-                })
+            toolpath.with(|toolpath| {
+                let toolpath = toolpath.as_ref()?.clone();
+                machine.with(|m| Some(Timeline::new(toolpath, m)))
             })
         });
         Self {
@@ -209,6 +211,7 @@ impl Animation {
             time: RwSignal::new(None),
             playing: RwSignal::new(false),
             speed: RwSignal::new(DEFAULT_SPEED),
+            piece,
         }
     }
 
@@ -281,6 +284,7 @@ pub fn AnimationControls(animation: Animation) -> impl IntoView {
         time,
         playing,
         speed,
+        piece,
     } = animation;
     let total = move || timeline.with(|t| t.as_ref().map_or(0.0, Timeline::total));
     let shown = move || time.get().unwrap_or(0.0);
@@ -303,16 +307,22 @@ pub fn AnimationControls(animation: Animation) -> impl IntoView {
     let contour_text = move || {
         let t = time.get()?;
         timeline.with(|tl| {
-            tl.as_ref()
-                .map(|tl| format!("contour {} of {}", tl.contours_begun(t), tl.pierces.len()))
+            tl.as_ref().map(|tl| {
+                format!(
+                    "{} {} of {}",
+                    piece.get(),
+                    tl.contours_begun(t),
+                    tl.pierces.len()
+                )
+            })
         })
     };
     view! {
         <div class="animation" role="group" aria-label="Animation of the route">
             <button
                 id="anim-prev"
-                title="Previous contour"
-                aria-label="Previous contour"
+                title=move || format!("Previous {}", piece.get())
+                aria-label=move || format!("Previous {}", piece.get())
                 disabled=absent
                 on:click=move |_| step(false)
             >
@@ -329,8 +339,8 @@ pub fn AnimationControls(animation: Animation) -> impl IntoView {
             </button>
             <button
                 id="anim-next"
-                title="Next contour"
-                aria-label="Next contour"
+                title=move || format!("Next {}", piece.get())
+                aria-label=move || format!("Next {}", piece.get())
                 disabled=absent
                 on:click=move |_| step(true)
             >
@@ -544,7 +554,7 @@ pub fn AnimationOverlay(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use cutroute_geometry::{Contour, ContourRef, CutStep, Part, Point, Vertex};
+    use cutroute_geometry::{Contour, ContourRef, CutStep, Nest, Part, Point, Route, Vertex};
 
     fn two_squares() -> (Nest, Route) {
         let square = |x: f64| {
@@ -580,7 +590,10 @@ mod tests {
     #[test]
     fn contour_steps_land_on_pierces_and_the_travel_grows() {
         let (nest, route) = two_squares();
-        let tl = Timeline::new(&nest, &route, &MachineParameters::default()).unwrap();
+        let tl = Timeline::new(
+            Toolpath::new(&route, &nest).unwrap(),
+            &MachineParameters::default(),
+        );
         assert_eq!(tl.pierces.len(), 2);
         let first = tl.next_contour(0.0);
         let second = tl.next_contour(first);
@@ -603,7 +616,10 @@ mod tests {
     #[test]
     fn a_frame_is_the_finished_chunks_plus_the_part_of_the_current_one() {
         let (nest, route) = two_squares();
-        let tl = Timeline::new(&nest, &route, &MachineParameters::default()).unwrap();
+        let tl = Timeline::new(
+            Toolpath::new(&route, &nest).unwrap(),
+            &MachineParameters::default(),
+        );
         // The route spans 30 mm: chunks are at most 2.5 mm wide, so nearly every move is one.
         assert!(
             tl.travel.chunks.len() > 4,
@@ -633,5 +649,37 @@ mod tests {
     fn the_clock_reads_minutes_seconds_tenths() {
         assert_eq!(format_clock(0.0), "0:00.0");
         assert_eq!(format_clock(75.34), "1:15.3");
+    }
+
+    #[test]
+    fn a_path_route_plays_to_its_machine_time() {
+        use cutroute_geometry::{PathRoute, Span, ToolOnPath};
+        let p = Point::new;
+        let route = PathRoute {
+            start: p(0.0, -10.0),
+            paths: vec![
+                ToolOnPath {
+                    pierce: p(0.0, 0.0),
+                    spans: vec![Span::line(p(0.0, 0.0), p(10.0, 0.0))],
+                },
+                ToolOnPath {
+                    pierce: p(20.0, 0.0),
+                    spans: vec![
+                        Span::line(p(20.0, 0.0), p(20.0, 10.0)),
+                        Span::line(p(20.0, 10.0), p(30.0, 10.0)),
+                    ],
+                },
+            ],
+            finish: None,
+        };
+        let machine = MachineParameters::default();
+        let tl = Timeline::new(Toolpath::from_path_route(&route), &machine);
+        assert!((tl.total() - route.time(&machine)).abs() < 1e-9);
+        assert_eq!(tl.pierces.len(), 2);
+        assert_eq!(tl.contours_begun(tl.total()), 2);
+        // Idle 10 + cut 10 + idle 10 + cut 20.
+        assert!((tl.travel_length() - 50.0).abs() < 1e-9);
+        let end = tl.state_at(tl.total());
+        assert_eq!(end.position, p(30.0, 10.0));
     }
 }

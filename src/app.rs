@@ -1,7 +1,7 @@
 //! The application shell: sample picker, solver panel, live bounds, the route drawing with its
 //! layers, the animation, exports, and the comparison of kept results.
 
-use cutroute_geometry::{MachineParameters, Nest, Point, Route};
+use cutroute_geometry::{MachineParameters, Nest, Objective, PathRoute, Point, Route, Toolpath};
 use cutroute_protocol::{
     Document, FromWorker, JobId, JobRequest, Problem, Progress, SolverKind, SolverParams, ToWorker,
 };
@@ -13,12 +13,13 @@ use crate::animation::{Animation, AnimationControls, AnimationOverlay};
 use crate::chart::{BoundSample, BoundsChart};
 use crate::compare::{ComparePanel, Kept};
 use crate::drawing::{
-    candidate_dots, contour_path, cut_path, direction_arrows, idle_path, nest_bounds,
+    candidate_dots, contour_path, cut_path, cut_paths_by_step, direction_arrows, idle_path,
+    link_path, nest_bounds, path_route_idle_path, path_route_toolpath, toolpath_bounds,
 };
 use crate::export::ExportMenu;
 use crate::pan_zoom::PanZoom;
-use crate::settings::{Layer, Settings};
-use crate::stats::StatsPanel;
+use crate::settings::{objective_from_name, Layer, Settings};
+use crate::stats::{AlternativesTable, StatsPanel};
 use crate::worker_client::{spawn, SolverWorker, WorkerRequest};
 
 /// Bundled sample nests (files under `assets/samples/`), the first is opened on start.
@@ -113,6 +114,10 @@ pub fn App() -> impl IntoView {
     let runs = StoredValue::new(0_u64);
     let kept = RwSignal::new(Vec::<Kept>::new());
     let machine = RwSignal::new(MachineParameters::default());
+    let objective = RwSignal::new(objective_from_name(&initial.objective).unwrap_or_default());
+    // The tool-on paths a G-code file holds when they are not whole contours (see
+    // `reopened_paths`).
+    let file_paths = RwSignal::new(None::<PathRoute>);
     let presentation = RwSignal::new(false);
 
     // Everything remembered is saved whenever it changes.
@@ -125,6 +130,7 @@ pub fn App() -> impl IntoView {
             seed: seed.get(),
             step_mm: step_mm.get(),
             hidden_layers: hidden_layers.get(),
+            objective: objective.get().name().to_string(),
         }
         .save();
     });
@@ -160,6 +166,7 @@ pub fn App() -> impl IntoView {
                     opened.format = format!("{}) + {task_name} (task JSON", opened.format);
                 }
                 open_error.set(None);
+                file_paths.set(None);
                 progress.set(None);
                 samples.set(Vec::new());
                 continued_from.set_value(None);
@@ -215,17 +222,67 @@ pub fn App() -> impl IntoView {
         })
     });
     let shown_nest = Signal::from(shown_nest);
-    // The solver's best route, or else the route the file holds (result files).
+    // The solver's best route of tool-on paths (segment cutting, AOE), or else the tool-on
+    // paths of a G-code file that cuts open paths.
+    let shown_paths =
+        Memo::new(
+            move |_| match progress.with(|p| p.as_ref().map(|p| p.path_route.clone())) {
+                Some(paths) => paths,
+                None => file_paths.get(),
+            },
+        );
+    let shown_paths = Signal::from(shown_paths);
+    // The solver's best route, or else the route the file holds (result files); none while
+    // tool-on paths are shown.
     let shown_route = Memo::new(move |_| {
+        if shown_paths.with(Option::is_some) {
+            return None;
+        }
         progress
             .with(|p| p.as_ref().and_then(|p| p.route.clone()))
             .or_else(|| document.with(|d| d.as_ref().and_then(|d| d.route.clone())))
     });
     let shown_route = Signal::from(shown_route);
+    // The head's moves of what is shown: drawn, animated and exported.
+    let shown_toolpath = Memo::new(move |_| {
+        shown_nest.with(|nest: &Option<Nest>| {
+            let nest = nest.as_ref()?;
+            match shown_route.get() {
+                Some(route) => Toolpath::new(&route, nest).ok(),
+                None => shown_paths.with(|p| p.as_ref().map(|p| path_route_toolpath(p, nest))),
+            }
+        })
+    });
+    let shown_toolpath = Signal::from(shown_toolpath);
+    let alternatives = Signal::derive(move || {
+        progress.with(|p| {
+            p.as_ref()
+                .map(|p| p.alternatives.clone())
+                .unwrap_or_default()
+        })
+    });
+    // What the bounds measure: the objective for the solvers that minimise it, else idle mm.
+    let bound_unit = Signal::derive(move || {
+        if solver.get().gives_path_route() {
+            objective_unit(objective.get())
+        } else {
+            "mm idle"
+        }
+    });
     let certified = Memo::new(move |_| {
         progress.with(|p| p.as_ref().map(|p| p.certified.clone()).unwrap_or_default())
     });
-    let animation = Animation::new(shown_nest, shown_route, machine);
+    let animation = Animation::new(
+        shown_toolpath,
+        machine,
+        Signal::derive(move || {
+            if shown_paths.with(Option::is_some) {
+                "path"
+            } else {
+                "contour"
+            }
+        }),
+    );
     let file_name =
         Signal::derive(move || document.with(|d| d.as_ref().map(|d| d.file_name.clone())));
 
@@ -349,7 +406,7 @@ pub fn App() -> impl IntoView {
             initial_upper_bound: from.as_ref().and_then(|p| p.upper_bound),
             // The stats panel's speeds and prices: chain cutting decides by this cost model.
             machine: machine.get_untracked(),
-            objective: Default::default(),
+            objective: objective.get_untracked(),
         };
         if from.is_none() {
             progress.set(None);
@@ -441,6 +498,7 @@ pub fn App() -> impl IntoView {
             time_limit_s: time_limit.get(),
             seed: seed.get(),
             step_mm: step_mm.get(),
+            objective: objective.get().name().to_string(),
             ..Settings::default()
         };
         let base = web_sys::window()
@@ -453,14 +511,19 @@ pub fn App() -> impl IntoView {
     };
 
     let keep = move |_| {
-        let (Some(nest), Some(route)) = (shown_nest.get_untracked(), shown_route.get_untracked())
-        else {
-            return;
-        };
         let label = progress
             .with_untracked(|p| p.as_ref().map(|_| solver.get_untracked().label()))
             .unwrap_or("from the file");
-        let entry = machine.with_untracked(|m| Kept::new(&nest, route, m, label));
+        let entry = if let Some(paths) = shown_paths.get_untracked() {
+            machine.with_untracked(|m| Kept::of_paths(&paths, m, label))
+        } else {
+            let (Some(nest), Some(route)) =
+                (shown_nest.get_untracked(), shown_route.get_untracked())
+            else {
+                return;
+            };
+            machine.with_untracked(|m| Kept::new(&nest, &route, m, label))
+        };
         kept.update(|k| {
             let id = k.iter().map(|e| e.id).max().unwrap_or(0) + 1;
             k.push(Kept { id, ..entry });
@@ -518,7 +581,14 @@ pub fn App() -> impl IntoView {
             >
                 "Present"
             </button>
-            <ExportMenu file_name=file_name nest=shown_nest route=shown_route machine=machine />
+            <ExportMenu
+                file_name=file_name
+                nest=shown_nest
+                route=shown_route
+                paths=shown_paths
+                toolpath=shown_toolpath
+                machine=machine
+            />
         </header>
         <section class="solver-panel" aria-label="Solver">
             <label title="Which algorithm routes the tool">
@@ -543,6 +613,22 @@ pub fn App() -> impl IntoView {
                             }
                         })
                         .collect_view()}
+                </select>
+            </label>
+            <label title="What routes are compared by, and what GSCCP picks its ensemble by (machine parameters in the stats panel)">
+                "Objective "
+                <select
+                    id="objective"
+                    aria-label="Objective"
+                    prop:value=move || objective.get().name()
+                    on:change=move |ev| {
+                        if let Some(o) = objective_from_name(&event_target_value(&ev)) {
+                            objective.set(o);
+                        }
+                    }
+                >
+                    <option value="time" selected=initial.objective == "time">"machine time"</option>
+                    <option value="cost" selected=initial.objective == "cost">"cost"</option>
                 </select>
             </label>
             <NumberField
@@ -592,6 +678,7 @@ pub fn App() -> impl IntoView {
                 "Link "
                 <input id="share-link" type="text" readonly prop:value=share_link />
             </label>
+            <p id="solver-uses" class="note">{move || solver_uses(solver.get())}</p>
         </section>
         <main class="workspace">
             <section
@@ -634,6 +721,7 @@ pub fn App() -> impl IntoView {
                 <NestView
                     nest=shown_nest
                     route=shown_route
+                    paths=shown_paths
                     certified=certified
                     hidden_layers=hidden_layers
                     candidates_step=Signal::derive(move || {
@@ -656,7 +744,7 @@ pub fn App() -> impl IntoView {
                     <dt>"Phase"</dt>
                     <dd id="phase">{move || progress.get().map(|p| p.phase).unwrap_or_default()}</dd>
                     <dt>"Upper bound"</dt>
-                    <dd id="upper-bound">{move || format_bound(progress.get().and_then(|p| p.upper_bound))}</dd>
+                    <dd id="upper-bound" data-unit=move || bound_unit.get()>{move || format_bound(progress.get().and_then(|p| p.upper_bound))}</dd>
                     <dt>"Lower bound"</dt>
                     <dd id="lower-bound">{move || format_bound(progress.get().and_then(|p| p.lower_bound))}</dd>
                     <dt>"Gap"</dt>
@@ -676,14 +764,23 @@ pub fn App() -> impl IntoView {
                         })}
                     </dd>
                 </dl>
-                <StatsPanel nest=shown_nest route=shown_route machine=machine />
-                <BoundsChart samples=samples log_time=log_time />
+                <StatsPanel nest=shown_nest route=shown_route paths=shown_paths machine=machine />
+                <AlternativesTable alternatives=alternatives />
+                <BoundsChart samples=samples log_time=log_time unit=bound_unit />
                 <LayerPanel hidden=hidden_layers />
-                <ComparePanel kept=kept keep=keep can_keep=Signal::derive(move || shown_route.with(Option::is_some)) />
+                <ComparePanel
+                    kept=kept
+                    keep=keep
+                    can_keep=Signal::derive(move || shown_route.with(Option::is_some) || shown_paths.with(Option::is_some))
+                    objective=Signal::from(objective)
+                />
             </aside>
         </main>
     }
 }
+
+/// Hues the tool-on paths of a path route take in turn (`.hue-0` … `.hue-5` in `style/`).
+const PATH_HUES: usize = 6;
 
 /// Whether the bytes are a PCGLNS run summary (the same test as the worker's).
 fn is_pcglns_result(bytes: &[u8]) -> bool {
@@ -756,6 +853,28 @@ fn LayerPanel(hidden: RwSignal<Vec<Layer>>) -> impl IntoView {
     }
 }
 
+/// The unit of an objective's values, as the chart and bounds show it.
+fn objective_unit(objective: Objective) -> &'static str {
+    match objective {
+        Objective::Time => "s (machine time)",
+        Objective::Cost => "cost",
+    }
+}
+
+/// Which of the panel's parameters a solver uses, in words.
+fn solver_uses(kind: SolverKind) -> &'static str {
+    match kind {
+        SolverKind::NearestNeighbour => "Uses: the nest only (greedy, one pass); bound = idle length, mm.",
+        SolverKind::Ccp => "Uses: time limit, seed; bound = idle length, mm.",
+        SolverKind::Heuristic => "Uses: time limit, seed, pierce step; bound = idle length, mm.",
+        SolverKind::Exact => "Uses: time limit, seed, pierce step; bounds = idle length, mm.",
+        SolverKind::Chain => "Uses: time limit, seed, machine prices (a link replaces a pierce when it costs less); bound = idle length, mm.",
+        SolverKind::Sccp => "Uses: time limit, seed, objective, machine speeds and prices; bound = the objective's value.",
+        SolverKind::Gsccp => "Uses: time limit, seed, objective (picks the best ensemble), machine speeds and prices; bound = the objective's value.",
+        SolverKind::Aoe => "Uses: objective, machine speeds and prices (common edges cut once); bound = the objective's value.",
+    }
+}
+
 fn format_bound(value: Option<f64>) -> String {
     value
         .map(|v| format!("{v:.1}"))
@@ -803,14 +922,22 @@ async fn fetch_bytes(url: &str) -> Result<Vec<u8>, String> {
 fn NestView(
     nest: Signal<Option<Nest>>,
     route: Signal<Option<Route>>,
+    paths: Signal<Option<PathRoute>>,
     certified: Memo<Vec<bool>>,
     hidden_layers: RwSignal<Vec<Layer>>,
     candidates_step: Signal<Option<f64>>,
     kept: RwSignal<Vec<Kept>>,
     animation: Animation,
 ) -> impl IntoView {
+    // The nest's box; for a nest with nothing to draw (a G-code program of open paths), the
+    // box of the head's moves.
     let fit = Signal::derive(move || {
         nest.with(|n| n.as_ref().and_then(nest_bounds))
+            .or_else(|| {
+                animation
+                    .timeline
+                    .with(|t| t.as_ref().and_then(|t| toolpath_bounds(&t.toolpath)))
+            })
             .map(|[x0, y0, x1, y1]| {
                 let margin = ((x1 - x0).max(y1 - y0) * 0.03).max(1.0);
                 // The group below flips y, so the box spans [-y1, -y0] vertically.
@@ -888,10 +1015,52 @@ fn NestView(
         let step = candidates_step.get()?;
         nest.with(|n| n.as_ref().map(|n| candidate_dots(n, step)))
     };
+    // A route of whole contours: its cuts in one path. Tool-on paths: one element each,
+    // coloured in turn (six hues, distinct in every theme), so where one path ends and the
+    // next begins shows.
     let cuts = move || {
+        if paths.with(Option::is_some) {
+            return None;
+        }
         animation
             .timeline
             .with(|t| t.as_ref().map(|t| cut_path(&t.toolpath)))
+    };
+    let tool_on_paths = move || {
+        if paths.with(Option::is_none) {
+            return None;
+        }
+        animation.timeline.with(|t| {
+            let t = t.as_ref()?;
+            let pieces = cut_paths_by_step(&t.toolpath);
+            let total = pieces.len();
+            Some(
+                pieces
+                    .into_iter()
+                    .enumerate()
+                    .map(|(k, d)| {
+                        let title = format!("tool-on path {} of {total}", k + 1);
+                        view! {
+                            <path class=format!("cut tool-on-path hue-{}", k % PATH_HUES) data-path=k + 1 d=d>
+                                <title>{title}</title>
+                            </path>
+                        }
+                    })
+                    .collect_view(),
+            )
+        })
+    };
+    // Tool-on moves off the contours: chain links, and a path's pieces through scrap.
+    let links = move || {
+        animation
+            .timeline
+            .with(|t| t.as_ref().map(|t| link_path(&t.toolpath)))
+            .filter(|d| !d.is_empty())
+    };
+    let idle = move || {
+        route
+            .with(|r| r.as_ref().map(idle_path))
+            .or_else(|| paths.with(|p| p.as_ref().map(path_route_idle_path)))
     };
     // Certified and uncertified contours of the route (CCP's certificates).
     let certificates = move || {
@@ -910,6 +1079,33 @@ fn NestView(
             }
             Some((yes, no))
         })
+    };
+    let path_pierces = move || {
+        let paths = paths.get()?;
+        let r = extent.get() / 250.0;
+        let total = paths.paths.len();
+        Some(
+            paths
+                .paths
+                .iter()
+                .enumerate()
+                .map(|(k, p)| {
+                    let title = format!(
+                        "path {} of {total}: pierce at ({:.2}, {:.2}), {:.1} mm tool-on, {} spans",
+                        k + 1,
+                        p.pierce.x,
+                        p.pierce.y,
+                        p.length(),
+                        p.spans.len()
+                    );
+                    view! {
+                        <circle class="pierce" cx=p.pierce.x cy=p.pierce.y r=r>
+                            <title>{title}</title>
+                        </circle>
+                    }
+                })
+                .collect_view(),
+        )
     };
     let pierces = move || {
         let route = route.get()?;
@@ -945,7 +1141,9 @@ fn NestView(
         })
     };
     let ends = move || {
-        let route = route.get()?;
+        let (start, finish) = route
+            .with(|r| r.as_ref().map(|r| (r.start, r.finish)))
+            .or_else(|| paths.with(|p| p.as_ref().map(|p| (p.start, p.finish))))?;
         let r = extent.get() / 100.0;
         let marker = move |p: Point, class: &'static str, name: &'static str| {
             view! {
@@ -955,21 +1153,31 @@ fn NestView(
             }
         };
         Some(view! {
-            {marker(route.start, "start-marker", "start")}
-            {route.finish.map(|f| marker(f, "finish-marker", "finish"))}
+            {marker(start, "start-marker", "start")}
+            {finish.map(|f| marker(f, "finish-marker", "finish"))}
         })
     };
     // Order numbers live outside the flipped group (text must not be mirrored): (x, −y).
+    // Numbered by step (contour) or by tool-on path.
     let order_labels = move || {
-        let route = route.get()?;
+        let points: Vec<Point> = route
+            .with(|r| {
+                r.as_ref()
+                    .map(|r| r.steps.iter().map(|s| s.pierce_point).collect())
+            })
+            .or_else(|| {
+                paths.with(|p| {
+                    p.as_ref()
+                        .map(|p| p.paths.iter().map(|p| p.pierce).collect())
+                })
+            })?;
         Some(
-            route
-                .steps
-                .iter()
+            points
+                .into_iter()
                 .enumerate()
-                .map(|(k, s)| {
+                .map(|(k, p)| {
                     view! {
-                        <text x=s.pierce_point.x y=-s.pierce_point.y dx="0.4em" dy="-0.3em">
+                        <text x=p.x y=-p.y dx="0.4em" dy="-0.3em">
                             {(k + 1).to_string()}
                         </text>
                     }
@@ -985,7 +1193,7 @@ fn NestView(
                 .zip(["compare-a", "compare-b"])
                 .map(|(e, class)| {
                     view! {
-                        <path class=format!("compare {class}") d=idle_path(&e.route)>
+                        <path class=format!("compare {class}") d=e.idle_d.clone()>
                             <title>{format!("kept result #{}: {}", e.id, e.label)}</title>
                         </path>
                     }
@@ -1039,8 +1247,10 @@ fn NestView(
                 }}
                 <g class="route">
                     <path class="cut" d=cuts />
-                    <path class="idle" d=move || route.with(|r| r.as_ref().map(idle_path)) />
-                    <g class="pierces">{pierces}</g>
+                    <g class="tool-on-paths">{tool_on_paths}</g>
+                    <path class="link" d=links />
+                    <path class="idle" d=idle />
+                    <g class="pierces">{pierces}{path_pierces}</g>
                     <g class="ends">{ends}</g>
                 </g>
                 <g class="compared">{compared}</g>

@@ -45,9 +45,15 @@ fn step_path(
     d
 }
 
-/// The chart of `samples`; `log_time` spaces the time axis logarithmically.
+/// The chart of `samples`; `log_time` spaces the time axis logarithmically; `unit` names what the
+/// bounds measure (the y axis): idle length in mm for most solvers, the objective's seconds or
+/// cost for the solvers that minimise time or cost.
 #[component]
-pub fn BoundsChart(samples: RwSignal<Vec<BoundSample>>, log_time: RwSignal<bool>) -> impl IntoView {
+pub fn BoundsChart(
+    samples: RwSignal<Vec<BoundSample>>,
+    log_time: RwSignal<bool>,
+    unit: Signal<&'static str>,
+) -> impl IntoView {
     let paths = move || {
         samples.with(|samples| {
             let values: Vec<f64> = samples
@@ -74,7 +80,7 @@ pub fn BoundsChart(samples: RwSignal<Vec<BoundSample>>, log_time: RwSignal<bool>
                 PAD + f * (WIDTH - 2.0 * PAD)
             };
             let vy = move |v: f64| HEIGHT - PAD - (v - lo) / span * (HEIGHT - 2.0 * PAD);
-            let label = format!("{lo:.1} – {hi:.1} over {t_max:.2} s");
+            let label = format!("{lo:.1} – {hi:.1} {} over {t_max:.2} s", unit.get());
             (
                 step_path(samples, |s| s.upper_bound, tx, vy),
                 step_path(samples, |s| s.lower_bound, tx, vy),
@@ -88,6 +94,7 @@ pub fn BoundsChart(samples: RwSignal<Vec<BoundSample>>, log_time: RwSignal<bool>
                 <rect class="chart-frame" x="0" y="0" width=WIDTH height=HEIGHT />
                 <path class="chart-ub" d=move || paths().0 />
                 <path class="chart-lb" d=move || paths().1 />
+                <text id="chart-y-label" class="chart-axis" x=PAD y=PAD + 10.0>{move || unit.get()}</text>
             </svg>
             <figcaption>
                 <span class="legend-ub">"upper bound"</span>

@@ -1,8 +1,13 @@
 //! Results kept for comparison: several routes of the same nest side by side (numbers) and up to
-//! two of them overlaid on the drawing.
+//! two of them overlaid on the drawing. Routes of whole contours and routes of tool-on paths
+//! (segment cutting, AOE) are compared alike, by the objective the user chooses (machine time
+//! or cost).
 
-use cutroute_geometry::{MachineParameters, Nest, Route};
+use cutroute_geometry::{MachineParameters, Nest, Objective, PathRoute, Route};
 use leptos::prelude::*;
+
+use crate::drawing::{idle_path, path_route_idle_path};
+use crate::stats::{path_route_figures, route_figures, Figures};
 
 /// A kept result.
 #[derive(Clone, Debug, PartialEq)]
@@ -19,32 +24,57 @@ pub struct Kept {
     pub pierces: usize,
     /// Machine time, s.
     pub time_s: f64,
-    /// The route.
-    pub route: Route,
+    /// Cost.
+    pub cost: f64,
+    /// Path data of the route's idle moves (what an overlay draws).
+    pub idle_d: String,
     /// Drawn over the current route.
     pub overlay: bool,
 }
 
 impl Kept {
-    /// The figures of `route` under `machine`.
-    pub fn new(
-        nest: &Nest,
-        route: Route,
-        machine: &MachineParameters,
+    fn from_figures(
+        (idle_length, cut_length, pierces, time_s, cost): Figures,
+        idle_d: String,
         label: &'static str,
     ) -> Kept {
-        let idle_length = route.idle_length();
-        let cut_length = route.cut_length(nest);
-        let pierces = route.pierce_count();
         Kept {
             id: 0,
             label,
             idle_length,
             cut_length,
             pierces,
-            time_s: machine.time(cut_length, idle_length, pierces),
-            route,
+            time_s,
+            cost,
+            idle_d,
             overlay: false,
+        }
+    }
+
+    /// The figures of `route` under `machine`.
+    pub fn new(
+        nest: &Nest,
+        route: &Route,
+        machine: &MachineParameters,
+        label: &'static str,
+    ) -> Kept {
+        Kept::from_figures(route_figures(nest, route, machine), idle_path(route), label)
+    }
+
+    /// The figures of a route of tool-on paths under `machine`.
+    pub fn of_paths(route: &PathRoute, machine: &MachineParameters, label: &'static str) -> Kept {
+        Kept::from_figures(
+            path_route_figures(route, machine),
+            path_route_idle_path(route),
+            label,
+        )
+    }
+
+    /// The value of the objective the results are compared by.
+    pub fn value(&self, objective: Objective) -> f64 {
+        match objective {
+            Objective::Time => self.time_s,
+            Objective::Cost => self.cost,
         }
     }
 }
@@ -55,11 +85,13 @@ pub fn ComparePanel(
     kept: RwSignal<Vec<Kept>>,
     keep: impl Fn(web_sys::MouseEvent) + 'static,
     can_keep: Signal<bool>,
+    objective: Signal<Objective>,
 ) -> impl IntoView {
     let best = move || {
+        let objective = objective.get();
         kept.with(|k| {
             k.iter()
-                .map(|e| e.idle_length)
+                .map(|e| e.value(objective))
                 .fold(f64::INFINITY, f64::min)
         })
     };
@@ -87,8 +119,10 @@ pub fn ComparePanel(
                         <th scope="col">"#"</th>
                         <th scope="col">"Solver"</th>
                         <th scope="col">"Idle, mm"</th>
-                        <th scope="col">"vs best"</th>
+                        <th scope="col" id="compare-by">{move || format!("vs best ({})", objective.get().name())}</th>
                         <th scope="col">"Time, s"</th>
+                        <th scope="col">"Cost"</th>
+                        <th scope="col">"Pierces"</th>
                         <th scope="col">"Overlay"</th>
                     </tr>
                 </thead>
@@ -98,10 +132,15 @@ pub fn ComparePanel(
                         key=|e| (e.id, e.overlay)
                         children=move |e: Kept| {
                             let id = e.id;
+                            let (time_s, cost) = (e.time_s, e.cost);
+                            let value = move || match objective.get() {
+                                Objective::Time => time_s,
+                                Objective::Cost => cost,
+                            };
                             let excess = move || {
                                 let b = best();
                                 if b > 0.0 {
-                                    format!("+{:.1} %", (e.idle_length / b - 1.0) * 100.0)
+                                    format!("+{:.1} %", (value() / b - 1.0) * 100.0)
                                 } else {
                                     "—".into()
                                 }
@@ -113,6 +152,8 @@ pub fn ComparePanel(
                                     <td class="kept-idle">{format!("{:.1}", e.idle_length)}</td>
                                     <td>{excess}</td>
                                     <td>{format!("{:.1}", e.time_s)}</td>
+                                    <td class="kept-cost">{format!("{:.2}", e.cost)}</td>
+                                    <td class="kept-pierces">{e.pierces}</td>
                                     <td>
                                         <input
                                             type="checkbox"

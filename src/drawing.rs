@@ -2,7 +2,9 @@
 
 use std::fmt::Write;
 
-use cutroute_geometry::{BoundingBox, Contour, Nest, Point, Route, Span, ToolMove, Toolpath};
+use cutroute_geometry::{
+    BoundingBox, Contour, Nest, PathRoute, Point, Route, Span, ToolMove, Toolpath,
+};
 
 /// Axis-aligned box `[min_x, min_y, max_x, max_y]` of everything worth showing.
 pub fn nest_bounds(nest: &Nest) -> Option<[f64; 4]> {
@@ -78,12 +80,31 @@ pub fn idle_path(route: &Route) -> String {
     out
 }
 
-/// Path data of the cut (tool-on) moves of a toolpath, one subpath per contour.
-pub fn cut_path(toolpath: &Toolpath) -> String {
+/// Path data of the idle moves of a path route: start → first pierce, each path's end → the
+/// next pierce, last end → finish.
+pub fn path_route_idle_path(route: &PathRoute) -> String {
+    let mut out = String::new();
+    let mut pen: Option<Point> = None;
+    for (from, to) in route.idle_moves() {
+        if pen != Some(from) {
+            let _ = write!(out, "M{:.3} {:.3}", from.x, from.y);
+        }
+        let _ = write!(out, "L{:.3} {:.3}", to.x, to.y);
+        pen = Some(to);
+    }
+    out
+}
+
+/// Path data of the cut (tool-on) moves of a toolpath that `keep` accepts, a new subpath
+/// wherever the pen would jump.
+fn cuts_where(toolpath: &Toolpath, keep: impl Fn(usize, bool) -> bool) -> String {
     let mut out = String::new();
     let mut pen: Option<Point> = None;
     for m in &toolpath.moves {
-        if let ToolMove::Cut { span, .. } = m {
+        if let ToolMove::Cut { span, step, link } = m {
+            if !keep(*step, *link) {
+                continue;
+            }
             if pen != Some(span.start) {
                 let _ = write!(out, "M{:.3} {:.3}", span.start.x, span.start.y);
             }
@@ -92,6 +113,151 @@ pub fn cut_path(toolpath: &Toolpath) -> String {
         }
     }
     out
+}
+
+/// Path data of the cut moves along contours (links left out), one subpath per contour.
+pub fn cut_path(toolpath: &Toolpath) -> String {
+    cuts_where(toolpath, |_, link| !link)
+}
+
+/// Path data of the tool-on links (chain links, a path's pieces through scrap).
+pub fn link_path(toolpath: &Toolpath) -> String {
+    cuts_where(toolpath, |_, link| link)
+}
+
+/// Path data of the cut moves along contours, one string per step of the toolpath (per
+/// tool-on path of a path route), so each can be drawn apart. Steps without such moves give
+/// an empty string.
+pub fn cut_paths_by_step(toolpath: &Toolpath) -> Vec<String> {
+    let steps = toolpath
+        .moves
+        .iter()
+        .filter_map(ToolMove::step)
+        .max()
+        .map_or(0, |s| s + 1);
+    let mut out = vec![String::new(); steps];
+    let mut pen: Option<(usize, Point)> = None;
+    for m in &toolpath.moves {
+        if let ToolMove::Cut {
+            span,
+            step,
+            link: false,
+        } = m
+        {
+            let d = &mut out[*step];
+            if pen != Some((*step, span.start)) {
+                let _ = write!(d, "M{:.3} {:.3}", span.start.x, span.start.y);
+            }
+            push_span(span, d);
+            pen = Some((*step, span.end));
+        }
+    }
+    out
+}
+
+/// Distance (mm) within which a tool-on span counts as following a contour. Spans of a path
+/// route on a contour are pieces of that contour's spans (off by rounding only); a piece
+/// through scrap crosses no contour, so its midpoint is well away from all of them.
+pub const ON_CONTOUR_TOLERANCE_MM: f64 = 1e-3;
+
+/// The contours' spans of a nest bucketed on a uniform grid, to ask quickly whether a point
+/// lies on some contour.
+struct ContourGrid {
+    spans: Vec<Span>,
+    min: Point,
+    cell: f64,
+    columns: usize,
+    rows: usize,
+    cells: Vec<Vec<u32>>,
+}
+
+/// Most cells along one side of the grid.
+const MAX_GRID_SIDE: usize = 512;
+
+impl ContourGrid {
+    fn new(nest: &Nest, tolerance: f64) -> Option<ContourGrid> {
+        let spans: Vec<Span> = nest
+            .sheet
+            .iter()
+            .chain(nest.parts.iter())
+            .flat_map(|p| p.contours.iter())
+            .flat_map(|c| c.spans())
+            .collect();
+        let boxes: Vec<BoundingBox> = spans
+            .iter()
+            .map(|s| s.bounding_box().expanded(tolerance))
+            .collect();
+        let all = boxes.iter().copied().reduce(BoundingBox::union)?;
+        let side = all.width().max(all.height()).max(tolerance);
+        let per_side = ((spans.len() as f64).sqrt().ceil() as usize).clamp(1, MAX_GRID_SIDE);
+        let cell = side / per_side as f64;
+        let columns = (all.width() / cell).floor() as usize + 1;
+        let rows = (all.height() / cell).floor() as usize + 1;
+        let mut grid = ContourGrid {
+            spans,
+            min: all.min,
+            cell,
+            columns,
+            rows,
+            cells: vec![Vec::new(); columns * rows],
+        };
+        for (i, b) in boxes.iter().enumerate() {
+            let (c0, r0) = grid.cell_of(b.min);
+            let (c1, r1) = grid.cell_of(b.max);
+            for r in r0..=r1 {
+                for c in c0..=c1 {
+                    grid.cells[r * columns + c].push(i as u32);
+                }
+            }
+        }
+        Some(grid)
+    }
+
+    fn cell_of(&self, p: Point) -> (usize, usize) {
+        let index = |v: f64, n: usize| {
+            if v.is_finite() && v > 0.0 {
+                ((v / self.cell) as usize).min(n - 1)
+            } else {
+                0
+            }
+        };
+        (
+            index(p.x - self.min.x, self.columns),
+            index(p.y - self.min.y, self.rows),
+        )
+    }
+
+    fn on_contour(&self, p: Point, tolerance: f64) -> bool {
+        let (c, r) = self.cell_of(p);
+        self.cells[r * self.columns + c]
+            .iter()
+            .any(|&i| self.spans[i as usize].distance_to(p) <= tolerance)
+    }
+}
+
+/// The toolpath of a path route over `nest`, with the tool-on pieces that follow no contour
+/// (links between parts through scrap) marked as links, as chain cutting's links are, so the
+/// drawing, the animation and the exports show them apart.
+pub fn path_route_toolpath(route: &PathRoute, nest: &Nest) -> Toolpath {
+    let mut toolpath = Toolpath::from_path_route(route);
+    let Some(grid) = ContourGrid::new(nest, ON_CONTOUR_TOLERANCE_MM) else {
+        return toolpath;
+    };
+    for m in &mut toolpath.moves {
+        if let ToolMove::Cut { span, link, .. } = m {
+            *link = !grid.on_contour(span.point_at(0.5), ON_CONTOUR_TOLERANCE_MM);
+        }
+    }
+    toolpath
+}
+
+/// Box `[min_x, min_y, max_x, max_y]` of everything a toolpath draws (`None` if empty).
+pub fn toolpath_bounds(toolpath: &Toolpath) -> Option<[f64; 4]> {
+    let mut bounds = BoundingBox::from_corners(toolpath.start, toolpath.start);
+    for m in &toolpath.moves {
+        bounds = bounds.union(move_box(m));
+    }
+    (!toolpath.moves.is_empty()).then_some([bounds.min.x, bounds.min.y, bounds.max.x, bounds.max.y])
 }
 
 /// Consecutive moves of a toolpath drawn as one path element: the animation shows the
@@ -291,7 +457,7 @@ pub fn candidate_dots(nest: &Nest, step: f64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use cutroute_geometry::{ContourRef, CutStep, Part, Vertex};
+    use cutroute_geometry::{ContourRef, CutStep, Part, ToolOnPath, Vertex};
 
     fn square_nest() -> (Nest, Route) {
         let square = Contour::new(vec![
@@ -450,5 +616,130 @@ mod tests {
         // A quarter of the way round a counter-clockwise square (from (0,0) along +x) is the
         // corner (10, 0): the tip points along the first edge's direction at that place.
         assert!(arrows.contains("L11.000 0.000") || arrows.contains("L10.000 1.000"));
+    }
+
+    /// Parts A = [0,10]², B = [10,20]×[0,10] sharing the edge x = 10, C = [30,40]×[0,10] apart;
+    /// a path route cutting A∪B's outline, then the common edge, a link through scrap over to C
+    /// and C's outline.
+    fn common_edge_route() -> (Nest, PathRoute) {
+        let square = |x0: f64, x1: f64| {
+            Contour::new(vec![
+                Vertex::line(x0, 0.0),
+                Vertex::line(x0, 10.0),
+                Vertex::line(x1, 10.0),
+                Vertex::line(x1, 0.0),
+            ])
+        };
+        let part = |name: &str, contour| Part {
+            name: name.into(),
+            contours: vec![contour],
+        };
+        let nest = Nest {
+            sheet: None,
+            parts: vec![
+                part("a", square(0.0, 10.0)),
+                part("b", square(10.0, 20.0)),
+                part("c", square(30.0, 40.0)),
+            ],
+        };
+        let p = Point::new;
+        let walk = |points: &[Point]| -> Vec<Span> {
+            points.windows(2).map(|w| Span::line(w[0], w[1])).collect()
+        };
+        let outline = ToolOnPath {
+            pierce: p(0.0, 0.0),
+            spans: walk(&[
+                p(0.0, 0.0),
+                p(0.0, 10.0),
+                p(10.0, 10.0),
+                p(20.0, 10.0),
+                p(20.0, 0.0),
+                p(10.0, 0.0),
+                p(0.0, 0.0),
+            ]),
+        };
+        let edge_then_c = ToolOnPath {
+            pierce: p(10.0, 0.0),
+            spans: walk(&[
+                p(10.0, 0.0),
+                p(10.0, 10.0),
+                // Link: up into scrap, across, down onto C's top edge.
+                p(10.0, 20.0),
+                p(35.0, 20.0),
+                p(35.0, 10.0),
+                // C's outline from there.
+                p(30.0, 10.0),
+                p(30.0, 0.0),
+                p(40.0, 0.0),
+                p(40.0, 10.0),
+                p(35.0, 10.0),
+            ]),
+        };
+        let route = PathRoute {
+            start: p(0.0, -10.0),
+            paths: vec![outline, edge_then_c],
+            finish: Some(p(0.0, -10.0)),
+        };
+        (nest, route)
+    }
+
+    #[test]
+    fn path_route_pieces_through_scrap_become_links() {
+        let (nest, route) = common_edge_route();
+        // The hand-made route is valid for the independent checker.
+        assert_eq!(route.problems(&nest, 1e-6), vec![]);
+        let toolpath = path_route_toolpath(&route, &nest);
+        let links: Vec<Span> = toolpath
+            .moves
+            .iter()
+            .filter_map(|m| match m {
+                ToolMove::Cut {
+                    span, link: true, ..
+                } => Some(*span),
+                _ => None,
+            })
+            .collect();
+        assert_eq!(links.len(), 3, "{links:?}");
+        assert!((toolpath.link_length() - 45.0).abs() < 1e-9);
+        // Links still count as cut length; nothing else changes.
+        assert!((toolpath.cut_length() - route.cut_length()).abs() < 1e-9);
+        assert!((toolpath.idle_length() - route.idle_length()).abs() < 1e-9);
+        assert_eq!(toolpath.pierce_count(), 2);
+        // Drawn apart: the links in their own path, each tool-on path in its own.
+        assert_eq!(link_path(&toolpath).matches('M').count(), 1);
+        assert_eq!(link_path(&toolpath).matches('L').count(), 3);
+        let by_step = cut_paths_by_step(&toolpath);
+        assert_eq!(by_step.len(), 2);
+        assert_eq!(by_step[0].matches('L').count(), 6);
+        // Path 2: the common edge, then (after the link) C's outline: two subpaths.
+        assert_eq!(by_step[1].matches('M').count(), 2);
+        assert_eq!(by_step[1].matches('L').count(), 1 + 5);
+        assert!(
+            !cut_path(&toolpath).contains("L10.000 20.000"),
+            "links are not cuts"
+        );
+    }
+
+    #[test]
+    fn path_route_idle_moves_join_the_paths() {
+        let (_, route) = common_edge_route();
+        let d = path_route_idle_path(&route);
+        // start → pierce 1 (0,0) = end of path 1 → pierce 2 (10,0) in one stroke; then end of
+        // path 2 (35,10) → finish.
+        assert_eq!(d.matches('M').count(), 2, "{d}");
+        assert!(d.contains("L0.000 0.000L10.000 0.000M"), "{d}");
+        assert!(d.starts_with("M0.000 -10.000L0.000 0.000"), "{d}");
+        assert!(d.ends_with("M35.000 10.000L0.000 -10.000"), "{d}");
+    }
+
+    #[test]
+    fn a_nest_with_nothing_to_draw_is_fitted_to_the_toolpath() {
+        let (_, route) = common_edge_route();
+        let toolpath = Toolpath::from_path_route(&route);
+        assert_eq!(toolpath_bounds(&toolpath), Some([0.0, -10.0, 40.0, 20.0]));
+        // With no contours there is nothing to follow: no move is called a link.
+        let bare = path_route_toolpath(&route, &Nest::default());
+        assert_eq!(bare.link_length(), 0.0);
+        assert_eq!(toolpath_bounds(&Toolpath::default()), None);
     }
 }

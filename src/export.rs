@@ -5,13 +5,19 @@
 //! The standalone HTML page comes from `cutroute-formats`' `route_html`, G-code from the
 //! `cutroute-gcode` post-processor with the options chosen in the menu (and a preview of the
 //! first lines).
+//!
+//! A route of tool-on paths (segment cutting, AOE) exports as G-code (`path_route_gcode`), as
+//! the standalone page (`toolpath_html` of its toolpath, links marked) and as the SVG of the
+//! view. RouteManager's result format has one entry per whole contour cut from one pierce, so
+//! it cannot say "cut this common edge once, then this piece of that contour": that export is
+//! disabled for such routes, with the reason shown next to it.
 
 use cutroute_formats::{
-    route_html, write_dbs, write_geometry_json, write_result_json, HtmlOptions,
+    route_html, toolpath_html, write_dbs, write_geometry_json, write_result_json, HtmlOptions,
     ResultExportOptions, RmResult,
 };
-use cutroute_gcode::{route_gcode, ArcOutput, DistanceMode, GcodeOptions};
-use cutroute_geometry::{MachineParameters, Nest, Route};
+use cutroute_gcode::{path_route_gcode, route_gcode, ArcOutput, DistanceMode, GcodeOptions};
+use cutroute_geometry::{MachineParameters, Nest, PathRoute, Route, Toolpath};
 use leptos::prelude::*;
 use wasm_bindgen::JsCast;
 
@@ -105,6 +111,44 @@ pub fn standalone_html(
     })
 }
 
+/// A page that shows and animates a route of tool-on paths: `toolpath` is its toolpath with the
+/// pieces through scrap marked as links.
+pub fn standalone_html_of_paths(
+    stem: &str,
+    nest: &Nest,
+    paths: &PathRoute,
+    toolpath: &Toolpath,
+    machine: &MachineParameters,
+) -> Download {
+    let options = HtmlOptions {
+        title: stem.to_string(),
+        machine: *machine,
+        ..HtmlOptions::default()
+    };
+    let total = paths.paths.len();
+    let labels: Vec<String> = paths
+        .paths
+        .iter()
+        .enumerate()
+        .map(|(k, p)| {
+            format!(
+                "Path {} of {total}: {} spans, {:.1} mm tool-on",
+                k + 1,
+                p.spans.len(),
+                p.length()
+            )
+        })
+        .collect();
+    Download {
+        name: format!("{stem}.html"),
+        mime: "text/html",
+        bytes: toolpath_html(nest, toolpath, &labels, &options).into_bytes(),
+    }
+}
+
+/// Why the result JSON export is off for routes of tool-on paths.
+pub const RESULT_JSON_CANNOT_HOLD_PATHS: &str = "Result JSON is off for this route: RouteManager's format cuts each contour whole from one pierce and cannot hold tool-on paths that cut common edges once or parts of contours. Use G-code or the standalone HTML page.";
+
 /// What the G-code panel lets the user choose.
 #[derive(Clone, Debug, PartialEq)]
 pub struct GcodeChoice {
@@ -142,14 +186,20 @@ impl GcodeChoice {
     }
 }
 
-/// The route as a G-code program.
+/// The route (of whole contours, or of tool-on paths when `paths` is given) as a G-code program.
 pub fn gcode(
     stem: &str,
     nest: &Nest,
-    route: &Route,
+    route: Option<&Route>,
+    paths: Option<&PathRoute>,
     options: &GcodeOptions,
 ) -> Result<Download, String> {
-    let text = route_gcode(nest, route, options).map_err(|e| e.to_string())?;
+    let text = match (paths, route) {
+        (Some(paths), _) => path_route_gcode(paths, options),
+        (None, Some(route)) => route_gcode(nest, route, options),
+        (None, None) => return Err("no route yet".into()),
+    }
+    .map_err(|e| e.to_string())?;
     Ok(Download {
         name: format!("{stem}.nc"),
         mime: "text/plain",
@@ -216,6 +266,8 @@ pub fn ExportMenu(
     file_name: Signal<Option<String>>,
     nest: Signal<Option<Nest>>,
     route: Signal<Option<Route>>,
+    paths: Signal<Option<PathRoute>>,
+    toolpath: Signal<Option<Toolpath>>,
     machine: RwSignal<MachineParameters>,
 ) -> impl IntoView {
     let message = RwSignal::new(None::<String>);
@@ -235,7 +287,8 @@ pub fn ExportMenu(
         }));
     };
     let no_nest = move || nest.with(Option::is_none);
-    let no_route = move || route.with(Option::is_none);
+    let no_route = move || route.with(Option::is_none) && paths.with(Option::is_none);
+    let is_paths = move || paths.with(Option::is_some);
     let choice = RwSignal::new(GcodeChoice {
         incremental: false,
         arcs: "ij".into(),
@@ -246,12 +299,14 @@ pub fn ExportMenu(
     let preview = RwSignal::new(String::new());
     let make_gcode = move || -> Result<Download, String> {
         let nest = nest.get_untracked().ok_or("no nest")?;
-        let route = route.get_untracked().ok_or("no route yet")?;
+        let route = route.get_untracked();
+        let paths = paths.get_untracked();
         let options = machine.with_untracked(|m| choice.with_untracked(|c| c.options(m)));
         gcode(
             &stem(&file_name.get_untracked().unwrap_or_default()),
             &nest,
-            &route,
+            route.as_ref(),
+            paths.as_ref(),
             &options,
         )
     };
@@ -271,8 +326,14 @@ pub fn ExportMenu(
             <div class="export-buttons" role="group" aria-label="Export">
                 <button
                     id="export-result"
-                    title="The route in RouteManager's result format (rm-result.json)"
-                    disabled=no_route
+                    title=move || {
+                        if is_paths() {
+                            RESULT_JSON_CANNOT_HOLD_PATHS
+                        } else {
+                            "The route in RouteManager's result format (rm-result.json)"
+                        }
+                    }
+                    disabled=move || route.with(Option::is_none)
                     on:click=move |_| {
                         run(&|stem, nest, route| {
                             let route = route.ok_or("no route yet")?;
@@ -312,6 +373,9 @@ pub fn ExportMenu(
                     disabled=no_route
                     on:click=move |_| {
                         run(&|stem, nest, route| {
+                            if let (Some(p), Some(t)) = (paths.get_untracked(), toolpath.get_untracked()) {
+                                return Ok(machine.with_untracked(|m| standalone_html_of_paths(stem, nest, &p, &t, m)));
+                            }
                             let route = route.ok_or("no route yet")?;
                             machine.with_untracked(|m| standalone_html(stem, nest, route, m))
                         })
@@ -320,6 +384,10 @@ pub fn ExportMenu(
                     "Standalone HTML"
                 </button>
             </div>
+            {move || {
+                is_paths()
+                    .then(|| view! { <p id="export-result-note" class="note">{RESULT_JSON_CANNOT_HOLD_PATHS}</p> })
+            }}
             <fieldset class="gcode">
                 <legend>"G-code"</legend>
                 <label title="G90: positions; G91: increments from the previous point">

@@ -1,7 +1,8 @@
 //! What survives a reload (local storage) and what a link can set (`?sample=…&solver=…&time=…`):
-//! the chosen sample or file name, solver settings and drawing layers. The theme keeps its own
+//! the chosen sample or file name, solver settings (objective included) and drawing layers. The theme keeps its own
 //! key (see `theme`).
 
+use cutroute_geometry::Objective;
 use serde::{Deserialize, Serialize};
 
 /// Local-storage key of [`Settings`].
@@ -93,6 +94,9 @@ pub struct Settings {
     pub step_mm: f64,
     /// Layers switched off (everything else is shown).
     pub hidden_layers: Vec<Layer>,
+    /// What routes are compared by and what the solvers that weigh routes minimise:
+    /// `Objective::name`, "time" or "cost".
+    pub objective: String,
 }
 
 impl Default for Settings {
@@ -108,12 +112,13 @@ impl Default for Settings {
             seed: params.seed,
             step_mm: params.discretisation_step_mm,
             hidden_layers: Vec::new(),
+            objective: params.objective.name().to_string(),
         }
     }
 }
 
 impl Settings {
-    /// Applies the query of a link: `sample`, `solver`, `time`, `seed`, `step`; unknown or
+    /// Applies the query of a link: `sample`, `solver`, `time`, `seed`, `step`, `objective`; unknown or
     /// malformed values are ignored.
     pub fn with_query(mut self, query: &str) -> Self {
         for pair in query.trim_start_matches('?').split('&') {
@@ -137,6 +142,7 @@ impl Settings {
                         self.step_mm = v;
                     }
                 }
+                "objective" if objective_from_name(&value).is_some() => self.objective = value,
                 "seed" => {
                     if let Ok(v) = value.parse() {
                         self.seed = v;
@@ -151,8 +157,8 @@ impl Settings {
     /// The query of a link that reopens this sample with these solver settings.
     pub fn query(&self) -> String {
         format!(
-            "?sample={}&solver={}&time={}&seed={}&step={}",
-            self.sample, self.solver, self.time_limit_s, self.seed, self.step_mm
+            "?sample={}&solver={}&time={}&seed={}&step={}&objective={}",
+            self.sample, self.solver, self.time_limit_s, self.seed, self.step_mm, self.objective
         )
     }
 
@@ -170,6 +176,13 @@ impl Settings {
             let _ = storage.set_item(STORAGE_KEY, &text);
         }
     }
+}
+
+/// The objective with the given short name (`Objective::name`).
+pub fn objective_from_name(name: &str) -> Option<Objective> {
+    [Objective::Time, Objective::Cost]
+        .into_iter()
+        .find(|o| o.name() == name)
 }
 
 fn positive(value: &str) -> Option<f64> {
@@ -227,8 +240,13 @@ mod tests {
             time_limit_s: 7.5,
             seed: 9,
             step_mm: 20.0,
+            objective: "cost".into(),
             ..Settings::default()
         };
         assert_eq!(Settings::default().with_query(&s.query()), s);
+        assert_eq!(Settings::default().objective, "time");
+        let nonsense = Settings::default().with_query("?objective=speed");
+        assert_eq!(nonsense.objective, "time", "unknown objectives are ignored");
+        assert_eq!(objective_from_name("cost"), Some(Objective::Cost));
     }
 }

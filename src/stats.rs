@@ -1,7 +1,9 @@
-//! The statistics panel: lengths, pierces, machine time and cost of the shown route, from
-//! editable machine parameters.
+//! The statistics panel: lengths, pierces, machine time and cost of the shown route (of whole
+//! contours or of tool-on paths), from editable machine parameters; and the table of the
+//! candidates a solver weighed (GSCCP's ensembles).
 
-use cutroute_geometry::{MachineParameters, Nest, Route};
+use cutroute_geometry::{MachineParameters, Nest, PathRoute, Route};
+use cutroute_protocol::RouteSummary;
 use leptos::prelude::*;
 
 /// One editable machine parameter: (id, label, unit, getter, setter).
@@ -58,29 +60,52 @@ const FIELDS: [Field; 6] = [
     ),
 ];
 
-/// Route statistics under `machine`.
+/// The numbers of a route under a machine: (idle mm, cut mm, pierces, time s, cost).
+pub type Figures = (f64, f64, usize, f64, f64);
+
+/// The figures of a route of whole contours over `nest`.
+pub fn route_figures(nest: &Nest, route: &Route, m: &MachineParameters) -> Figures {
+    let idle = route.idle_length();
+    let cut = route.cut_length(nest);
+    let pierces = route.pierce_count();
+    (
+        idle,
+        cut,
+        pierces,
+        m.time(cut, idle, pierces),
+        m.cost(cut, idle, pierces),
+    )
+}
+
+/// The figures of a route of tool-on paths (links through scrap count as cut length).
+pub fn path_route_figures(route: &PathRoute, m: &MachineParameters) -> Figures {
+    (
+        route.idle_length(),
+        route.cut_length(),
+        route.pierce_count(),
+        route.time(m),
+        route.cost(m),
+    )
+}
+
+/// Route statistics under `machine`: of `paths` when there is one, else of `route`.
 #[component]
 pub fn StatsPanel(
     nest: Signal<Option<Nest>>,
     route: Signal<Option<Route>>,
+    paths: Signal<Option<PathRoute>>,
     machine: RwSignal<MachineParameters>,
 ) -> impl IntoView {
     let figures = move || {
+        let m = machine.get();
+        if let Some(paths) = paths.get() {
+            return Some(path_route_figures(&paths, &m));
+        }
         let route = route.get()?;
         let nest = nest.get()?;
-        let m = machine.get();
-        let idle = route.idle_length();
-        let cut = route.cut_length(&nest);
-        let pierces = route.pierce_count();
-        Some((
-            idle,
-            cut,
-            pierces,
-            m.time(cut, idle, pierces),
-            m.cost(cut, idle, pierces),
-        ))
+        Some(route_figures(&nest, &route, &m))
     };
-    let cell = move |pick: fn((f64, f64, usize, f64, f64)) -> String| {
+    let cell = move |pick: fn(Figures) -> String| {
         move || figures().map(pick).unwrap_or_else(|| "—".into())
     };
     view! {
@@ -97,9 +122,10 @@ pub fn StatsPanel(
             <dt>"Pierces"</dt>
             <dd id="pierces">{cell(|f| f.2.to_string())}</dd>
             <dt>"Machine time"</dt>
-            <dd id="machine-time">{cell(|f| format_duration(f.3))}</dd>
+            // `data-s` / `data-value` keep the unrounded figures for checks by tools.
+            <dd id="machine-time" data-s=cell(|f| format!("{:.3}", f.3))>{cell(|f| format_duration(f.3))}</dd>
             <dt>"Cost"</dt>
-            <dd id="route-cost">{cell(|f| format!("{:.2}", f.4))}</dd>
+            <dd id="route-cost" data-value=cell(|f| format!("{:.3}", f.4))>{cell(|f| format!("{:.2}", f.4))}</dd>
         </dl>
         <details class="machine">
             <summary>"Machine parameters"</summary>
@@ -129,6 +155,61 @@ pub fn StatsPanel(
                 })
                 .collect_view()}
         </details>
+    }
+}
+
+/// The candidates a solver weighed (GSCCP: each segment ensemble and the CCP route that seeded
+/// them), the one it returned marked; nothing when the solver weighed none.
+#[component]
+pub fn AlternativesTable(alternatives: Signal<Vec<RouteSummary>>) -> impl IntoView {
+    move || {
+        let rows = alternatives.get();
+        (!rows.is_empty()).then(|| {
+            view! {
+                <table id="alternatives" aria-label="Candidates the solver weighed">
+                    <caption>"Candidates weighed"</caption>
+                    <thead>
+                        <tr>
+                            <th scope="col">"Candidate"</th>
+                            <th scope="col">"Pierces"</th>
+                            <th scope="col">"Idle, mm"</th>
+                            <th scope="col">"Cut, mm"</th>
+                            <th scope="col">"Time, s"</th>
+                            <th scope="col">"Cost"</th>
+                        </tr>
+                    </thead>
+                    <tbody>
+                        {rows
+                            .into_iter()
+                            .map(|r| {
+                                let class = if r.chosen { "alternative chosen" } else { "alternative" };
+                                let name = if r.chosen { format!("✓ {} (chosen)", r.name) } else { r.name.clone() };
+                                match r.failure {
+                                    Some(why) => view! {
+                                        <tr class=class data-name=r.name.clone() data-chosen=r.chosen.to_string()>
+                                            <td>{name}</td>
+                                            <td colspan="5" class="failure">{format!("no route: {why}")}</td>
+                                        </tr>
+                                    }
+                                    .into_any(),
+                                    None => view! {
+                                        <tr class=class data-name=r.name.clone() data-chosen=r.chosen.to_string()>
+                                            <td>{name}</td>
+                                            <td class="alt-pierces">{r.pierces}</td>
+                                            <td class="alt-idle">{format!("{:.1}", r.idle_length)}</td>
+                                            <td class="alt-cut">{format!("{:.1}", r.cut_length)}</td>
+                                            <td class="alt-time" data-s=format!("{:.3}", r.time_s)>{format!("{:.1}", r.time_s)}</td>
+                                            <td class="alt-cost" data-value=format!("{:.3}", r.cost)>{format!("{:.2}", r.cost)}</td>
+                                        </tr>
+                                    }
+                                    .into_any(),
+                                }
+                            })
+                            .collect_view()}
+                    </tbody>
+                </table>
+            }
+        })
     }
 }
 

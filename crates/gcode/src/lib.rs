@@ -2,7 +2,7 @@
 //! cutting machine (laser, plasma, water jet), and a reader that turns such a program back into
 //! the tool's motion.
 //!
-//! The writer ([`write_gcode`], [`route_gcode`]) is configured by a plain [`GcodeOptions`]:
+//! The writer ([`write_gcode`], [`route_gcode`], [`path_route_gcode`] for routes of tool-on paths) is configured by a plain [`GcodeOptions`]:
 //! absolute (`G90`) or incremental (`G91`) coordinates in millimetres (`G21`), the number of
 //! decimals, optional `N` line numbers, arcs as `G02`/`G03` with `I`/`J` centre offsets, with `R`
 //! (arcs split into pieces of at most 150°), or flattened into `G01` chords, rapid `G00` idle moves, the cutting feed
@@ -50,4 +50,6 @@ mod write;
 use cutroute_geometry::Toolpath;
 
 pub use read::{read_gcode, GcodeReadError, Motion, Program, ReadOptions};
-pub use write::{route_gcode, write_gcode, ArcOutput, DistanceMode, GcodeError, GcodeOptions};
+pub use write::{
+    path_route_gcode, route_gcode, write_gcode, ArcOutput, DistanceMode, GcodeError, GcodeOptions,
+};

@@ -4,7 +4,7 @@ use std::f64::consts::PI;
 use std::fmt::Write as _;
 
 use cutroute_geometry::{
-    MachineParameters, Nest, Point, Route, RouteError, Span, ToolMove, Toolpath,
+    MachineParameters, Nest, PathRoute, Point, Route, RouteError, Span, ToolMove, Toolpath,
 };
 use thiserror::Error;
 
@@ -201,6 +201,23 @@ pub fn route_gcode(
         Some(format!(
             "part {} ({}) contour {}",
             contour.part, part.name, contour.contour
+        ))
+    };
+    write_labelled(&toolpath, &label, options)
+}
+
+/// Writes a route of tool-on paths (segment cutting, AOE-chains), with a comment numbering
+/// each path before its pierce (when [`GcodeOptions::comments`] is on).
+pub fn path_route_gcode(route: &PathRoute, options: &GcodeOptions) -> Result<String, GcodeError> {
+    let toolpath = Toolpath::from_path_route(route);
+    let total = route.paths.len();
+    let label = |step: usize| {
+        let path = route.paths.get(step)?;
+        Some(format!(
+            "path {} of {total}: {} spans, {:.3} mm tool-on",
+            step + 1,
+            path.spans.len(),
+            path.length()
         ))
     };
     write_labelled(&toolpath, &label, options)
