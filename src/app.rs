@@ -118,6 +118,9 @@ pub fn App() -> impl IntoView {
     // The tool-on paths a G-code file holds when they are not whole contours (see
     // `reopened_paths`).
     let file_paths = RwSignal::new(None::<PathRoute>);
+    // A G-code file being opened: (request id, its program's tool-on paths), compared with
+    // what the worker makes of it (see `program_paths_note`).
+    let pending_program = StoredValue::new(None::<(u64, PathRoute)>);
     let presentation = RwSignal::new(false);
 
     // Everything remembered is saved whenever it changes.
@@ -155,8 +158,20 @@ pub fn App() -> impl IntoView {
         StoredValue::new_local(std::rc::Rc::new(move |message: FromWorker| match message {
             FromWorker::Opened {
                 document: mut opened,
-                ..
+                request_id,
             } => {
+                let program = pending_program
+                    .get_value()
+                    .filter(|(id, _)| *id == request_id)
+                    .map(|(_, paths)| paths);
+                pending_program.set_value(None);
+                // A program that cuts open paths: the worker's nest holds only the loops they
+                // close, so the program's own tool-on paths are shown.
+                let program = program.and_then(|paths| {
+                    let note = program_paths_note(&opened, &paths)?;
+                    opened.warnings.push(note);
+                    Some(paths)
+                });
                 if let Some((task_name, task_start, task_finish)) = pending_task.get_value() {
                     pending_task.set_value(None);
                     if let Problem::Nest { start, finish, .. } = &mut opened.problem {
@@ -176,10 +191,46 @@ pub fn App() -> impl IntoView {
                     kept.set(Vec::new());
                 }
                 document.set(Some(opened));
+                file_paths.set(program);
             }
-            FromWorker::OpenFailed { message, .. } => {
+            FromWorker::OpenFailed {
+                message,
+                request_id,
+            } => {
                 pending_task.set_value(None);
-                open_error.set(Some(message));
+                let program = pending_program
+                    .get_value()
+                    .filter(|(id, _)| *id == request_id);
+                pending_program.set_value(None);
+                match program {
+                    // No closed contour to make a nest of: the program's paths alone.
+                    Some((_, paths)) if !paths.paths.is_empty() => {
+                        open_error.set(None);
+                        progress.set(None);
+                        samples.set(Vec::new());
+                        continued_from.set_value(None);
+                        kept.set(Vec::new());
+                        document.set(Some(Document {
+                            file_name: last_file.get_untracked().unwrap_or_default(),
+                            format: "G-code".into(),
+                            problem: Problem::Nest {
+                                nest: Nest::default(),
+                                start: paths.start,
+                                finish: paths.finish,
+                            },
+                            route: None,
+                            warnings: vec![
+                                message,
+                                format!(
+                                    "shown as the program's {} tool-on paths (open paths: segment or common-edge cutting); there is no nest to solve",
+                                    paths.paths.len()
+                                ),
+                            ],
+                        }));
+                        file_paths.set(Some(paths));
+                    }
+                    _ => open_error.set(Some(message)),
+                }
             }
             FromWorker::Progress(update) => {
                 if job_state.get_untracked() == JobState::Running(update.job_id) {
@@ -375,6 +426,7 @@ pub fn App() -> impl IntoView {
                 }
                 last_file.set(Some(file_name.clone()));
                 let request_id = take_id();
+                pending_program.set_value(gcode_paths(&bytes).map(|p| (request_id, p)));
                 bridge.with_value(|b| {
                     b.send(WorkerRequest::Protocol(ToWorker::Open {
                         request_id,
@@ -782,6 +834,49 @@ pub fn App() -> impl IntoView {
 /// Hues the tool-on paths of a path route take in turn (`.hue-0` … `.hue-5` in `style/`).
 const PATH_HUES: usize = 6;
 
+/// The tool-on paths of a G-code program (read as the worker reads it, from the origin), or
+/// `None` when the bytes are some other format or not a program that pierces.
+fn gcode_paths(bytes: &[u8]) -> Option<PathRoute> {
+    if cutroute_formats::detect(bytes) != cutroute_formats::Format::Unknown {
+        return None;
+    }
+    let text = std::str::from_utf8(bytes).ok()?;
+    let program = cutroute_gcode::read_gcode(text, &cutroute_gcode::ReadOptions::default()).ok()?;
+    let paths = program.path_route();
+    (!paths.paths.is_empty()).then_some(paths)
+}
+
+/// Differences of tool-on length (mm) between the worker's loops and a program's own paths
+/// that are rounding, not a lost path.
+const PROGRAM_LENGTH_NOISE_MM: f64 = 0.05;
+
+/// When the worker's reading of a G-code program (closed loops as contours, the rest left
+/// out) loses tool-on length or pierces that the program's own paths have, a note saying the
+/// paths are shown instead; `None` when the worker's route is the whole program.
+fn program_paths_note(opened: &Document, paths: &PathRoute) -> Option<String> {
+    let Problem::Nest { nest, .. } = &opened.problem else {
+        return None;
+    };
+    let (cut, pierces) = opened
+        .route
+        .as_ref()
+        .and_then(|r| Toolpath::new(r, nest).ok())
+        .map_or((0.0, 0), |t| (t.cut_length(), t.pierce_count()));
+    // Loops the worker closes within its point tolerance may differ from the program's spans by
+    // rounding; what it leaves out is at least a whole span or path.
+    let lost = paths.cut_length() - cut;
+    let noise = PROGRAM_LENGTH_NOISE_MM.max(1e-6 * cut);
+    (lost > noise || pierces != paths.pierce_count()).then(|| {
+        format!(
+            "the program cuts open tool-on paths (segment or common-edge cutting): shown as its {} paths ({:.1} mm tool-on); as contours it would keep {:.1} mm in {} pierces",
+            paths.paths.len(),
+            paths.cut_length(),
+            cut,
+            pierces
+        )
+    })
+}
+
 /// Whether the bytes are a PCGLNS run summary (the same test as the worker's).
 fn is_pcglns_result(bytes: &[u8]) -> bool {
     cutroute_formats::detect(bytes) == cutroute_formats::Format::Unknown
@@ -931,24 +1026,35 @@ fn NestView(
 ) -> impl IntoView {
     // The nest's box; for a nest with nothing to draw (a G-code program of open paths), the
     // box of the head's moves.
-    let fit = Signal::derive(move || {
-        nest.with(|n| n.as_ref().and_then(nest_bounds))
-            .or_else(|| {
-                animation
-                    .timeline
-                    .with(|t| t.as_ref().and_then(|t| toolpath_bounds(&t.toolpath)))
-            })
-            .map(|[x0, y0, x1, y1]| {
-                let margin = ((x1 - x0).max(y1 - y0) * 0.03).max(1.0);
-                // The group below flips y, so the box spans [-y1, -y0] vertically.
-                [
-                    x0 - margin,
-                    -y1 - margin,
-                    x1 - x0 + 2.0 * margin,
-                    y1 - y0 + 2.0 * margin,
-                ]
-            })
+    let fit = Memo::new(move |_| {
+        let nest_box = nest.with(|n| n.as_ref().and_then(nest_bounds));
+        // Tool-on paths may leave the nest's box (a program's paths over the loops they
+        // close): the view takes in their moves too.
+        let paths_box = if paths.with(Option::is_some) || nest_box.is_none() {
+            animation
+                .timeline
+                .with(|t| t.as_ref().and_then(|t| toolpath_bounds(&t.toolpath)))
+        } else {
+            None
+        };
+        match (nest_box, paths_box) {
+            (Some([a, b, c, d]), Some([e, f, g, h])) => {
+                Some([a.min(e), b.min(f), c.max(g), d.max(h)])
+            }
+            (n, p) => n.or(p),
+        }
+        .map(|[x0, y0, x1, y1]| {
+            let margin = ((x1 - x0).max(y1 - y0) * 0.03).max(1.0);
+            // The group below flips y, so the box spans [-y1, -y0] vertically.
+            [
+                x0 - margin,
+                -y1 - margin,
+                x1 - x0 + 2.0 * margin,
+                y1 - y0 + 2.0 * margin,
+            ]
+        })
     });
+    let fit: Signal<Option<[f64; 4]>> = Signal::from(fit);
     // Size of the drawing: fixed-size marks (arrows, dots, numbers) scale with it.
     let extent = Memo::new(move |_| fit.get().map_or(100.0, |f| f[2].max(f[3])));
     let pan_zoom = PanZoom::new(fit);

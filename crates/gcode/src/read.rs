@@ -12,7 +12,7 @@
 
 use std::f64::consts::{PI, TAU};
 
-use cutroute_geometry::{Point, Span, ToolMove, Toolpath};
+use cutroute_geometry::{PathRoute, Point, Span, ToolMove, ToolOnPath, Toolpath};
 use thiserror::Error;
 
 /// Settings of [`read_gcode`].
@@ -193,6 +193,43 @@ impl Program {
         Toolpath {
             start: self.start,
             moves,
+        }
+    }
+}
+
+impl Program {
+    /// The program as a route of tool-on paths (what segment cutting and AOE-chains write): each
+    /// torch-on starts a path at the head's position, and the torch-on feed moves until the next
+    /// torch-on are its spans, whether they close contours or not. The route finishes where the
+    /// program ends when the head moves on after the last cut. Idle travel between paths is
+    /// taken as the straight move a [`PathRoute`] implies, so a program whose idle motion bends
+    /// (several rapids between two pierces) reads back with less idle length than
+    /// [`Program::idle_length`].
+    pub fn path_route(&self) -> PathRoute {
+        let mut paths: Vec<ToolOnPath> = Vec::new();
+        for m in &self.motions {
+            match *m {
+                Motion::TorchOn { at, .. } => paths.push(ToolOnPath {
+                    pierce: at,
+                    spans: Vec::new(),
+                }),
+                Motion::Feed {
+                    span,
+                    tool_on: true,
+                    ..
+                } => {
+                    if let Some(path) = paths.last_mut() {
+                        path.spans.push(span);
+                    }
+                }
+                _ => {}
+            }
+        }
+        let last_exit = paths.last().map_or(self.start, ToolOnPath::end);
+        PathRoute {
+            start: self.start,
+            paths,
+            finish: (last_exit != self.end).then_some(self.end),
         }
     }
 }

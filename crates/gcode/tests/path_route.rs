@@ -68,6 +68,17 @@ fn path_routes_read_back_with_the_same_pierces_and_lengths() {
     // The half-disc's arc survives as an arc: the cut length counts its half circumference.
     let expected_cut = 40.0 + 20.0 + 5.0 * std::f64::consts::PI + 10.0 + 25.0;
     assert!((route.cut_length() - expected_cut).abs() < 1e-9);
+    // Read back as tool-on paths: the very route written (to the program's rounding).
+    let paths = program.path_route();
+    assert_eq!(paths.paths.len(), 2);
+    assert_eq!(paths.start, route.start);
+    assert_eq!(paths.finish, route.finish);
+    for (a, b) in paths.paths.iter().zip(&route.paths) {
+        assert_eq!(a.spans.len(), b.spans.len());
+        assert!(a.pierce.distance(b.pierce) < 1e-3);
+        assert!((a.length() - b.length()).abs() < 1e-3);
+    }
+    assert!((paths.idle_length() - route.idle_length()).abs() < 1e-3);
     let back = program.toolpath();
     let written = Toolpath::from_path_route(&route);
     assert_eq!(back.pierce_count(), written.pierce_count());
