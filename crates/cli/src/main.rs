@@ -771,7 +771,7 @@ fn solve_segments(
         "cost": machine.cost(cut_length, idle_length, pierces),
         "objective": match objective { Objective::Time => "time", Objective::Cost => "cost" },
         "machine": machine_json(machine),
-        "ensemble": result.best.name(),
+        "ensemble": result.best.map_or("ccp", |kind| kind.name()),
         "ensembles": result.reports.iter().map(|r| json!({
             "kind": r.kind.name(),
             "segments": r.segments,

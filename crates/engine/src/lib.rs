@@ -34,6 +34,7 @@
 mod jobs;
 mod nearest;
 mod open;
+mod path_jobs;
 
 use cutroute_protocol::{JobRequest, Problem, Progress, SolverKind};
 use web_time::Duration;
@@ -41,6 +42,7 @@ use web_time::Duration;
 pub use jobs::{CcpJob, ChainJob, DiscreteJob, DiscreteMode};
 pub use nearest::NearestNeighbourJob;
 pub use open::{format_name, open_document, OpenError};
+pub use path_jobs::{AoeJob, PlanBound, SegmentJob};
 
 /// How long one [`Job::step`] may run before it returns, so cancel requests are seen quickly.
 pub const DEFAULT_SLICE: Duration = Duration::from_millis(40);
@@ -149,12 +151,10 @@ pub fn start_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
             }
             Ok(Box::new(CcpJob::new(request.job_id, ccp)))
         }
-        (Problem::Nest { .. }, SolverKind::Sccp | SolverKind::Gsccp | SolverKind::Aoe) => {
-            Err(EngineError::UnsupportedProblem {
-                solver: solver.name(),
-                problem: "a nest in the job engine yet (use the CLI)",
-            })
+        (Problem::Nest { .. }, SolverKind::Sccp | SolverKind::Gsccp) => {
+            Ok(Box::new(SegmentJob::from_request(request)?))
         }
+        (Problem::Nest { .. }, SolverKind::Aoe) => Ok(Box::new(AoeJob::from_request(request)?)),
         (
             Problem::Nest {
                 nest,

@@ -249,9 +249,14 @@ pub struct Progress {
     pub job_id: JobId,
     /// Seconds since the job started.
     pub elapsed_s: f64,
-    /// The cost of the best solution so far (idle length in mm for nests), if any.
+    /// The cost of the best solution so far, if any: idle length in mm for nest solvers whose
+    /// result is a `route`; for the solvers that give a `path_route` (sccp, gsccp, aoe; see
+    /// [`SolverKind::gives_path_route`]) the value of [`SolverParams::objective`] for it under
+    /// [`SolverParams::machine`]: machining time in seconds, or cost.
     pub upper_bound: Option<f64>,
-    /// A proven lower bound on the optimal cost, if the solver computes one.
+    /// A proven lower bound on the optimal cost, in the unit of `upper_bound`, if the solver
+    /// computes one (sccp, gsccp, aoe: the plan's length cut, the pierces every route needs and
+    /// the idle travel to and from the parts, under the same objective).
     pub lower_bound: Option<f64>,
     /// What the solver is doing, in a few words.
     pub phase: String,

@@ -96,11 +96,9 @@ fn main() {
                 .iter()
                 .find(|r| r.kind == EnsembleKind::Chains)
                 .expect("every kind is reported");
-            let best = result
-                .reports
-                .iter()
-                .find(|r| r.kind == result.best)
-                .expect("the best is reported");
+            // The route GSCCP keeps: the best ensemble's, or CCP-Relax's when none beat it.
+            let best = &result.route;
+            let best_name = result.best.map_or("ccp", |kind| kind.name());
             let sccp = match &chains.failure {
                 Some(f) => (format!("failed: {f}"), String::new()),
                 None => (
@@ -121,14 +119,14 @@ fn main() {
                 ccp.cost(m),
                 sccp.0,
                 sccp.1,
-                best.kind.name(),
-                best.pierces,
-                best.cut_length,
-                best.idle_length,
-                best.time_s,
-                best.cost,
-                100.0 * (best.time_s / ccp.time(m) - 1.0),
-                100.0 * (best.cost / ccp.cost(m) - 1.0),
+                best_name,
+                best.pierce_count(),
+                best.cut_length(),
+                best.idle_length(),
+                best.time(m),
+                best.cost(m),
+                100.0 * (best.time(m) / ccp.time(m) - 1.0),
+                100.0 * (best.cost(m) / ccp.cost(m) - 1.0),
             );
             continue;
         }
@@ -145,7 +143,7 @@ fn main() {
         for r in &result.reports {
             let note = match &r.failure {
                 Some(f) => f.clone(),
-                None if r.kind == result.best => format!("**best** ({wall:.1} s wall)"),
+                None if Some(r.kind) == result.best => format!("**best** ({wall:.1} s wall)"),
                 None => String::new(),
             };
             println!(

@@ -1,6 +1,6 @@
 //! GSCCP: several ensembles of one nest, each solved as an SCCP, the best kept by time or cost.
 
-use std::sync::atomic::AtomicBool;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
 use cutroute_ccp::{CcpOptions, CcpSolver, SolverStatus};
@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 use web_time::Instant;
 
 use crate::segment::{Ensemble, EnsembleKind};
-use crate::solver::{solve_sccp, SccpOptions};
+use crate::solver::{SccpOptions, SccpSearch, SearchStatus, SOLVE_SLICE};
 use crate::SegmentError;
 
 /// Settings of [`solve_gsccp`].
@@ -82,8 +82,9 @@ pub struct GsccpResult {
     /// The best route by the objective; [`PathRoute::problems`] finds nothing wrong with it
     /// but pieces of contour cut twice (see [`EnsembleReport::recut_length`]).
     pub route: PathRoute,
-    /// Which ensemble it came from.
-    pub best: EnsembleKind,
+    /// Which ensemble it came from; `None`: the CCP-Relax route itself (no ensemble did
+    /// better, or the run was cancelled before any ensemble had a route).
+    pub best: Option<EnsembleKind>,
     /// Every ensemble's numbers, in the order of the options' kinds.
     pub reports: Vec<EnsembleReport>,
     /// The CCP-Relax route that seeded the orders, as a path route.
@@ -95,53 +96,348 @@ fn nest_scale(nest: &Nest) -> f64 {
     ((b.max.x - b.min.x).abs() + (b.max.y - b.min.y).abs()).max(1.0)
 }
 
-/// Runs CCP-Relax for its share of the time, then builds and solves every ensemble of
-/// `options.kinds` seeded by its route, checks each route independently and returns the best
-/// by the objective with every ensemble's numbers. A route may compete if the check finds
-/// nothing but contour cut twice (standard cutting of parts with common edges); gaps, cuts
-/// through material and precedence violations disqualify it.
+/// Runs [`GsccpSearch`] to its end (the cancel flag is read between slices): CCP-Relax for its
+/// share of the time, then every ensemble of `options.kinds` seeded by its route, each route
+/// checked independently; returns the best by the objective with every ensemble's numbers. A
+/// route may compete if the check finds nothing but contour cut twice (standard cutting of
+/// parts with common edges); gaps, cuts through material and precedence violations
+/// disqualify it. After a cancel, the ensembles not yet started are reported as not run.
 pub fn solve_gsccp(
     nest: &Nest,
     options: &GsccpOptions,
     cancel: &AtomicBool,
 ) -> Result<GsccpResult, SegmentError> {
-    if !(options.ccp_share > 0.0 && options.ccp_share < 1.0) {
-        return Err(SegmentError::InvalidOption(format!(
-            "ccp_share {} must lie strictly between 0 and 1",
-            options.ccp_share
-        )));
+    let mut search = GsccpSearch::new(nest, options)?;
+    while search.step(SOLVE_SLICE) == SearchStatus::Running {
+        if cancel.load(Ordering::Relaxed) {
+            search.stop();
+        }
     }
-    let started = Instant::now();
-    let limit = options.sccp.time_limit;
-    let ccp = run_ccp(
-        nest,
-        CcpOptions {
-            start: options.sccp.start,
-            finish: options.sccp.finish,
-            time_limit: limit.mul_f64(options.ccp_share),
-            seed: options.seed,
-            machine: options.machine,
-            ..CcpOptions::default()
-        },
-        cancel,
-    )?;
-    let ccp_route =
-        PathRoute::from_route(&ccp, nest).map_err(|e| SegmentError::Ccp(e.to_string()))?;
-    let tolerance = options
-        .check_tolerance
-        .unwrap_or_else(|| 1e-6 * nest_scale(nest));
-    let machine = &options.machine;
-    let mut reports = Vec::new();
-    let mut best: Option<(f64, EnsembleKind, PathRoute)> = None;
-    // Standard cutting starts from CCP-Relax's own local optimum: it needs the least time.
-    let weight = |kind: EnsembleKind| match kind {
-        EnsembleKind::Standard => 1.0,
-        EnsembleKind::Chains => 3.0,
-        EnsembleKind::Junctions => 2.0,
-    };
-    for (k, &kind) in options.kinds.iter().enumerate() {
-        let left = limit.saturating_sub(started.elapsed());
-        let remaining: f64 = options.kinds[k..].iter().map(|&x| weight(x)).sum();
+    search.result()
+}
+
+/// A route GSCCP may return, checked: where it came from and its objective value.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Candidate {
+    /// The ensemble it solves; `None`: the CCP-Relax route that seeds the orders.
+    pub source: Option<EnsembleKind>,
+    /// The route (passed [`PathRoute::problems`] but for contour cut twice).
+    pub route: PathRoute,
+    /// Its time (s) or cost under the options' machine, by the options' objective.
+    pub value: f64,
+}
+
+impl Candidate {
+    /// Whether `self` should replace `other` as the best: a lower value, or an equal one from
+    /// an ensemble against the CCP route (the ensembles exist to improve on it).
+    fn beats(&self, other: &Candidate) -> bool {
+        self.value < other.value
+            || (other.source.is_none() && self.source.is_some() && self.value <= other.value)
+    }
+}
+
+/// How long a running ensemble's improving route waits at least between two checks (a check
+/// is a pass over the whole nest; see [`GsccpSearch::step`]).
+const SNAPSHOT_INTERVAL: Duration = Duration::from_millis(300);
+
+enum Stage {
+    Ccp(Box<CcpSolver>),
+    /// The ensemble at this index of the kinds is to be built next.
+    Build(usize),
+    /// The ensemble at this index is being searched.
+    Search(usize, Box<SccpSearch>, EnsembleReport),
+    Finished,
+}
+
+/// GSCCP as a resumable state machine: CCP-Relax (stepped as [`CcpSolver`] steps), then per
+/// ensemble one step that builds it and steps of its [`SccpSearch`]. Each [`step`](Self::step)
+/// returns after about its budget, but for building an ensemble (one plan-graph construction,
+/// which cannot be cut) and the check of each finished route. [`solve_gsccp`] is a loop over
+/// it; the job engine steps it between the browser worker's messages.
+pub struct GsccpSearch {
+    nest: Nest,
+    options: GsccpOptions,
+    tolerance: f64,
+    started: Instant,
+    stage: Stage,
+    ccp_route: Option<Route>,
+    ccp_path: Option<PathRoute>,
+    reports: Vec<EnsembleReport>,
+    best: Option<Candidate>,
+    /// A checked snapshot of the running ensemble's best route so far.
+    provisional: Option<Candidate>,
+    next_snapshot: Instant,
+    snapshot_idle: f64,
+    failure: Option<SegmentError>,
+}
+
+impl GsccpSearch {
+    /// Checks the options and prepares CCP-Relax (no search yet).
+    pub fn new(nest: &Nest, options: &GsccpOptions) -> Result<Self, SegmentError> {
+        if !(options.ccp_share > 0.0 && options.ccp_share < 1.0) {
+            return Err(SegmentError::InvalidOption(format!(
+                "ccp_share {} must lie strictly between 0 and 1",
+                options.ccp_share
+            )));
+        }
+        let started = Instant::now();
+        let ccp = CcpSolver::new(
+            nest,
+            CcpOptions {
+                start: options.sccp.start,
+                finish: options.sccp.finish,
+                time_limit: options.sccp.time_limit.mul_f64(options.ccp_share),
+                seed: options.seed,
+                machine: options.machine,
+                ..CcpOptions::default()
+            },
+        )
+        .map_err(|e| SegmentError::Ccp(e.to_string()))?;
+        Ok(GsccpSearch {
+            nest: nest.clone(),
+            options: options.clone(),
+            tolerance: options
+                .check_tolerance
+                .unwrap_or_else(|| 1e-6 * nest_scale(nest)),
+            started,
+            stage: Stage::Ccp(Box::new(ccp)),
+            ccp_route: None,
+            ccp_path: None,
+            reports: Vec::new(),
+            best: None,
+            provisional: None,
+            next_snapshot: started,
+            snapshot_idle: f64::INFINITY,
+            failure: None,
+        })
+    }
+
+    /// Works for about `budget`, then returns. Building an ensemble and checking a finished
+    /// route are single pieces of work that may overrun the budget (measured on the real nests
+    /// in `BENCHMARKS.md`). While an ensemble's search improves, its best route is checked at
+    /// most every 300 ms (and at most a tenth of the time) so [`GsccpSearch::best`] follows it.
+    pub fn step(&mut self, budget: Duration) -> SearchStatus {
+        let slice_end = Instant::now() + budget;
+        loop {
+            let now = Instant::now();
+            if matches!(self.stage, Stage::Finished) {
+                return SearchStatus::Finished;
+            }
+            if now >= slice_end {
+                return SearchStatus::Running;
+            }
+            let left = slice_end - now;
+            match std::mem::replace(&mut self.stage, Stage::Finished) {
+                Stage::Finished => {}
+                Stage::Ccp(mut solver) => {
+                    if solver.step(left) == SolverStatus::Finished {
+                        self.ccp_done(&solver);
+                    } else {
+                        self.ccp_snapshot(&solver);
+                        self.stage = Stage::Ccp(solver);
+                    }
+                }
+                Stage::Build(k) => self.build(k),
+                Stage::Search(k, mut search, report) => {
+                    if search.step(left) == SearchStatus::Finished {
+                        self.ensemble_done(k, &search, report);
+                    } else {
+                        self.snapshot(&search, report.kind);
+                        self.stage = Stage::Search(k, search, report);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Ends the run now with the best so far: CCP-Relax is cancelled (its route kept), a
+    /// running ensemble keeps its best route (checked), the ensembles not started are reported
+    /// as not run.
+    pub fn stop(&mut self) {
+        match std::mem::replace(&mut self.stage, Stage::Finished) {
+            Stage::Finished => {}
+            Stage::Ccp(mut solver) => {
+                solver.cancel();
+                while solver.step(Duration::from_millis(10)) != SolverStatus::Finished {}
+                self.ccp_done(&solver);
+                self.stage = Stage::Finished;
+                if self.failure.is_none() {
+                    self.not_run(0);
+                }
+            }
+            Stage::Build(k) => self.not_run(k),
+            Stage::Search(k, mut search, report) => {
+                search.stop();
+                self.ensemble_done(k, &search, report);
+                self.stage = Stage::Finished;
+                self.not_run(k + 1);
+            }
+        }
+    }
+
+    /// Whether the run has ended.
+    pub fn is_finished(&self) -> bool {
+        matches!(self.stage, Stage::Finished)
+    }
+
+    /// The best checked route so far (CCP-Relax's until an ensemble beats it, a running
+    /// ensemble's latest checked snapshot included); `None` before CCP-Relax has a route.
+    pub fn best(&self) -> Option<&Candidate> {
+        match (&self.best, &self.provisional) {
+            (Some(best), Some(p)) => Some(if p.beats(best) { p } else { best }),
+            (best, p) => best.as_ref().or(p.as_ref()),
+        }
+    }
+
+    /// The numbers of every finished ensemble, in the order of the options' kinds.
+    pub fn reports(&self) -> &[EnsembleReport] {
+        &self.reports
+    }
+
+    /// The ensemble being built or searched, if any.
+    pub fn running(&self) -> Option<EnsembleKind> {
+        match &self.stage {
+            Stage::Build(k) => self.options.kinds.get(*k).copied(),
+            Stage::Search(_, _, report) => Some(report.kind),
+            _ => None,
+        }
+    }
+
+    /// The checked snapshot of the running ensemble's best route, or during CCP-Relax of its
+    /// route so far (see [`GsccpSearch::step`]), if any.
+    pub fn provisional(&self) -> Option<&Candidate> {
+        self.provisional.as_ref()
+    }
+
+    /// The CCP-Relax route that seeds the orders, once CCP-Relax has ended.
+    pub fn ccp_route(&self) -> Option<&PathRoute> {
+        self.ccp_path.as_ref()
+    }
+
+    /// Why the run failed, if it did (CCP-Relax gave no usable route).
+    pub fn failure(&self) -> Option<&SegmentError> {
+        self.failure.as_ref()
+    }
+
+    /// What the run is doing, in words.
+    pub fn phase(&self) -> String {
+        match &self.stage {
+            Stage::Ccp(_) => "segment cutting: CCP-Relax seeds the orders".into(),
+            Stage::Build(k) => format!(
+                "segment cutting: building the {} ensemble",
+                self.options.kinds.get(*k).map_or("", |kind| kind.name())
+            ),
+            Stage::Search(_, search, report) => format!(
+                "segment cutting: {} ensemble ({} segments, {} shakes)",
+                report.kind.name(),
+                report.segments,
+                search.solution().shakes
+            ),
+            Stage::Finished => match (&self.failure, self.best()) {
+                (Some(e), _) => format!("segment cutting failed: {e}"),
+                (None, Some(best)) => format!(
+                    "segment cutting: done, best {}",
+                    best.source.map_or("ccp", |k| k.name())
+                ),
+                (None, None) => "segment cutting: no ensemble gave a valid route".into(),
+            },
+        }
+    }
+
+    /// The outcome (after the end; before it, what there is so far).
+    pub fn result(&self) -> Result<GsccpResult, SegmentError> {
+        if let Some(e) = &self.failure {
+            return Err(e.clone());
+        }
+        let (Some(best), Some(ccp_route)) = (self.best(), &self.ccp_path) else {
+            let reasons: Vec<String> = self
+                .reports
+                .iter()
+                .map(|r| {
+                    format!(
+                        "{}: {}",
+                        r.kind.name(),
+                        r.failure.clone().unwrap_or_default()
+                    )
+                })
+                .collect();
+            return Err(SegmentError::NoRoute(reasons.join("; ")));
+        };
+        Ok(GsccpResult {
+            route: best.route.clone(),
+            best: best.source,
+            reports: self.reports.clone(),
+            ccp_route: ccp_route.clone(),
+        })
+    }
+
+    /// The objective's value of a route, if it passes the check (contour cut twice allowed),
+    /// with the length cut twice; else the first problem.
+    fn checked(&self, route: &PathRoute) -> Result<(f64, f64), PathRouteError> {
+        let mut problems = route.problems(&self.nest, self.tolerance);
+        let recut = recut_length(&problems, self.tolerance);
+        problems.retain(|p| !matches!(p, PathRouteError::Overlap { .. }));
+        match problems.into_iter().next() {
+            Some(problem) => Err(problem),
+            None => Ok((
+                self.options.objective.value(
+                    &self.options.machine,
+                    route.cut_length(),
+                    route.idle_length(),
+                    route.pierce_count(),
+                ),
+                recut,
+            )),
+        }
+    }
+
+    fn offer(&mut self, candidate: Candidate) {
+        if self.best.as_ref().is_none_or(|b| candidate.beats(b)) {
+            self.best = Some(candidate);
+        }
+    }
+
+    fn ccp_done(&mut self, solver: &CcpSolver) {
+        self.provisional = None;
+        let route = solver.result().route;
+        match PathRoute::from_route(&route, &self.nest) {
+            Err(e) => {
+                self.failure = Some(SegmentError::Ccp(e.to_string()));
+                self.stage = Stage::Finished;
+            }
+            Ok(path) => {
+                if let Ok((value, _)) = self.checked(&path) {
+                    self.offer(Candidate {
+                        source: None,
+                        route: path.clone(),
+                        value,
+                    });
+                }
+                self.ccp_route = Some(route);
+                self.ccp_path = Some(path);
+                self.stage = Stage::Build(0);
+            }
+        }
+    }
+
+    /// Builds the ensemble at `k` and prepares its search with its share of the time left.
+    fn build(&mut self, k: usize) {
+        let Some(&kind) = self.options.kinds.get(k) else {
+            self.stage = Stage::Finished;
+            return;
+        };
+        // Standard cutting starts from CCP-Relax's own local optimum: it needs the least time.
+        let weight = |kind: EnsembleKind| match kind {
+            EnsembleKind::Standard => 1.0,
+            EnsembleKind::Chains => 3.0,
+            EnsembleKind::Junctions => 2.0,
+        };
+        let left = self
+            .options
+            .sccp
+            .time_limit
+            .saturating_sub(self.started.elapsed());
+        let remaining: f64 = self.options.kinds[k..].iter().map(|&x| weight(x)).sum();
         let share = left.mul_f64(weight(kind) / remaining);
         let mut report = EnsembleReport {
             kind,
@@ -154,66 +450,119 @@ pub fn solve_gsccp(
             recut_length: 0.0,
             failure: None,
         };
-        let outcome = Ensemble::build(nest, kind, options.plan_tolerance.unwrap_or(tolerance))
-            .and_then(|ensemble| {
-                report.segments = ensemble.segments.len();
-                let sccp = SccpOptions {
-                    time_limit: share.max(Duration::from_millis(1)),
-                    ..options.sccp.clone()
-                };
-                solve_sccp(&ensemble, Some(&ccp), &sccp, cancel)
-            });
-        match outcome {
-            Err(e) => report.failure = Some(e.to_string()),
-            Ok(solution) => {
-                let route = solution.route;
-                report.pierces = route.pierce_count();
-                report.idle_length = route.idle_length();
-                report.cut_length = route.cut_length();
-                report.time_s = route.time(machine);
-                report.cost = route.cost(machine);
-                // Cutting a piece of contour twice wastes time but harms nothing: such
-                // routes compete with their true cost. Anything else disqualifies.
-                let mut problems = route.problems(nest, tolerance);
-                report.recut_length = recut_length(&problems, tolerance);
-                problems.retain(|p| !matches!(p, PathRouteError::Overlap { .. }));
-                match problems.first() {
-                    Some(problem) => {
-                        report.failure = Some(format!("the route fails the check: {problem}"))
-                    }
-                    None => {
-                        let value = match options.objective {
-                            Objective::Time => report.time_s,
-                            Objective::Cost => report.cost,
-                        };
-                        if best.as_ref().is_none_or(|b| value < b.0) {
-                            best = Some((value, kind, route));
-                        }
-                    }
-                }
+        let plan_tolerance = self.options.plan_tolerance.unwrap_or(self.tolerance);
+        let search = Ensemble::build(&self.nest, kind, plan_tolerance).and_then(|ensemble| {
+            report.segments = ensemble.segments.len();
+            let sccp = SccpOptions {
+                time_limit: share.max(Duration::from_millis(1)),
+                ..self.options.sccp.clone()
+            };
+            SccpSearch::new(&ensemble, self.ccp_route.as_ref(), &sccp)
+        });
+        match search {
+            Err(e) => {
+                report.failure = Some(e.to_string());
+                self.reports.push(report);
+                self.stage = Stage::Build(k + 1);
+            }
+            Ok(search) => {
+                self.provisional = None;
+                self.snapshot_idle = f64::INFINITY;
+                self.next_snapshot = Instant::now() + SNAPSHOT_INTERVAL;
+                self.stage = Stage::Search(k, Box::new(search), report);
             }
         }
-        reports.push(report);
     }
-    let Some((_, kind, route)) = best else {
-        let reasons: Vec<String> = reports
-            .iter()
-            .map(|r| {
-                format!(
-                    "{}: {}",
-                    r.kind.name(),
-                    r.failure.clone().unwrap_or_default()
-                )
-            })
-            .collect();
-        return Err(SegmentError::NoRoute(reasons.join("; ")));
-    };
-    Ok(GsccpResult {
-        route,
-        best: kind,
-        reports,
-        ccp_route,
-    })
+
+    /// Checks the running search's best route if it improved and the time has come.
+    fn snapshot(&mut self, search: &SccpSearch, kind: EnsembleKind) {
+        let now = Instant::now();
+        let idle = search.best_idle_length();
+        if now < self.next_snapshot || idle >= self.snapshot_idle - self.options.sccp.delta {
+            return;
+        }
+        let route = search.best_route();
+        let checked = self.checked(&route);
+        let took = now.elapsed();
+        self.next_snapshot = Instant::now() + SNAPSHOT_INTERVAL.max(took * 10);
+        self.snapshot_idle = idle;
+        if let Ok((value, _)) = checked {
+            self.provisional = Some(Candidate {
+                source: Some(kind),
+                route,
+                value,
+            });
+        }
+    }
+
+    /// Checks CCP-Relax's route so far if it improved and the time has come.
+    fn ccp_snapshot(&mut self, solver: &CcpSolver) {
+        let now = Instant::now();
+        if now < self.next_snapshot {
+            return;
+        }
+        let progress = solver.progress();
+        if progress.route.steps.is_empty()
+            || progress.best_idle_length >= self.snapshot_idle - self.options.sccp.delta
+        {
+            return;
+        }
+        let checked = PathRoute::from_route(&progress.route, &self.nest)
+            .ok()
+            .and_then(|route| Some((self.checked(&route).ok()?.0, route)));
+        self.next_snapshot = Instant::now() + SNAPSHOT_INTERVAL.max(now.elapsed() * 10);
+        self.snapshot_idle = progress.best_idle_length;
+        if let Some((value, route)) = checked {
+            self.provisional = Some(Candidate {
+                source: None,
+                route,
+                value,
+            });
+        }
+    }
+
+    fn ensemble_done(&mut self, k: usize, search: &SccpSearch, mut report: EnsembleReport) {
+        self.provisional = None;
+        let route = search.solution().route;
+        let machine = &self.options.machine;
+        report.pierces = route.pierce_count();
+        report.idle_length = route.idle_length();
+        report.cut_length = route.cut_length();
+        report.time_s = route.time(machine);
+        report.cost = route.cost(machine);
+        // Cutting a piece of contour twice wastes time but harms nothing: such routes compete
+        // with their true cost. Anything else disqualifies.
+        match self.checked(&route) {
+            Err(problem) => report.failure = Some(format!("the route fails the check: {problem}")),
+            Ok((value, recut)) => {
+                report.recut_length = recut;
+                self.offer(Candidate {
+                    source: Some(report.kind),
+                    route,
+                    value,
+                });
+            }
+        }
+        self.reports.push(report);
+        self.stage = Stage::Build(k + 1);
+    }
+
+    /// Reports the ensembles from index `k` on as not run.
+    fn not_run(&mut self, k: usize) {
+        for &kind in self.options.kinds.iter().skip(k) {
+            self.reports.push(EnsembleReport {
+                kind,
+                segments: 0,
+                pierces: 0,
+                idle_length: f64::NAN,
+                cut_length: f64::NAN,
+                time_s: f64::NAN,
+                cost: f64::NAN,
+                recut_length: 0.0,
+                failure: Some("not run: the run was stopped first".into()),
+            });
+        }
+    }
 }
 
 /// Length cut more than once among `problems` (their [`PathRouteError::Overlap`]s), each
@@ -245,16 +594,4 @@ pub fn recut_length(problems: &[PathRouteError], tolerance: f64) -> f64 {
         }
     }
     total
-}
-
-fn run_ccp(nest: &Nest, options: CcpOptions, cancel: &AtomicBool) -> Result<Route, SegmentError> {
-    let mut solver = CcpSolver::new(nest, options).map_err(|e| SegmentError::Ccp(e.to_string()))?;
-    loop {
-        if cancel.load(std::sync::atomic::Ordering::Relaxed) {
-            solver.cancel();
-        }
-        if solver.step(Duration::from_millis(50)) == SolverStatus::Finished {
-            return Ok(solver.result().route);
-        }
-    }
 }

@@ -39,7 +39,7 @@
 //! // Standard cutting: 3 pierces, 120 mm; common edges cut once: 100 mm in 2 pierces.
 //! let standard = &result.reports[0];
 //! assert_eq!((standard.pierces, standard.cut_length.round()), (3, 120.0));
-//! assert_eq!(result.best, EnsembleKind::Chains);
+//! assert_eq!(result.best, Some(EnsembleKind::Chains));
 //! assert_eq!(result.route.pierce_count(), 2);
 //! assert!((result.route.cut_length() - 100.0).abs() < 1e-9);
 //! assert!(result.route.problems(&nest, 1e-7).is_empty());
@@ -52,9 +52,11 @@ mod segment;
 mod solver;
 
 pub use cutroute_geometry::Objective;
-pub use gsccp::{recut_length, solve_gsccp, EnsembleReport, GsccpOptions, GsccpResult};
+pub use gsccp::{
+    recut_length, solve_gsccp, Candidate, EnsembleReport, GsccpOptions, GsccpResult, GsccpSearch,
+};
 pub use segment::{Ensemble, EnsembleKind, Segment};
-pub use solver::{solve_sccp, SccpOptions, SccpSolution};
+pub use solver::{solve_sccp, SccpOptions, SccpSearch, SccpSolution, SearchStatus, SOLVE_SLICE};
 
 use cutroute_geometry::{Contour, Nest, Part, Vertex};
 use thiserror::Error;

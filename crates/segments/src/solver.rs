@@ -96,6 +96,15 @@ enum Place {
     Open { reversed: bool },
 }
 
+/// Where the tool enters `segment` placed at `place`.
+fn entry_point(segment: &Segment, place: Place) -> Point {
+    match place {
+        Place::Closed { point, .. } => point,
+        Place::Open { reversed: false } => segment.first_point(),
+        Place::Open { reversed: true } => segment.last_point(),
+    }
+}
+
 /// Distance from `p` to a box given by its corners.
 fn box_distance(p: Point, min: Point, max: Point) -> f64 {
     let dx = (min.x - p.x).max(p.x - max.x).max(0.0);
@@ -197,8 +206,8 @@ fn best_point(
     best
 }
 
-struct Search<'a> {
-    segments: &'a [Segment],
+struct Search {
+    segments: Vec<Segment>,
     boxes: Vec<Vec<(Point, Point)>>,
     whole_box: Vec<(Point, Point)>,
     before: Vec<Vec<usize>>,
@@ -207,22 +216,12 @@ struct Search<'a> {
     order: Vec<usize>,
     pos: Vec<usize>,
     place: Vec<Place>,
-    options: &'a SccpOptions,
-    deadline: Instant,
-    cancel: &'a AtomicBool,
+    options: SccpOptions,
 }
 
-impl Search<'_> {
-    fn stopped(&self) -> bool {
-        self.cancel.load(Ordering::Relaxed) || Instant::now() >= self.deadline
-    }
-
+impl Search {
     fn entry(&self, s: usize) -> Point {
-        match self.place[s] {
-            Place::Closed { point, .. } => point,
-            Place::Open { reversed: false } => self.segments[s].first_point(),
-            Place::Open { reversed: true } => self.segments[s].last_point(),
-        }
+        entry_point(&self.segments[s], self.place[s])
     }
 
     fn exit(&self, s: usize) -> Point {
@@ -300,21 +299,6 @@ impl Search<'_> {
         }
     }
 
-    fn relax_full(&mut self) -> f64 {
-        let mut total = 0.0;
-        for _ in 0..self.options.max_relaxation_sweeps {
-            let mut gain = 0.0;
-            for i in 0..self.order.len() {
-                gain += self.relax_at(i);
-            }
-            total += gain;
-            if gain < self.options.delta || self.stopped() {
-                break;
-            }
-        }
-        total
-    }
-
     /// Can the block at positions `[i, i + len)` move to just after position `j` (before
     /// position 0 for `j = usize::MAX`)?
     fn can_move(&self, i: usize, len: usize, j: Option<usize>) -> bool {
@@ -332,27 +316,15 @@ impl Search<'_> {
         }
     }
 
-    /// One pass of block re-insertion; returns whether some move gained.
-    fn or_opt_pass(&mut self) -> bool {
-        let mut improved = false;
-        let mut i = 0;
-        while i < self.order.len() {
-            if self.stopped() {
-                break;
-            }
-            let mut moved = false;
-            for len in 1..=self.options.max_block.min(self.order.len() - i) {
-                if self.try_move_block(i, len) {
-                    moved = true;
-                    improved = true;
-                    break;
-                }
-            }
-            if !moved {
-                i += 1;
+    /// Block re-insertion at position `i` (blocks of 1 to `max_block` segments, the first
+    /// that gains is moved); returns whether a block moved.
+    fn or_opt_at(&mut self, i: usize) -> bool {
+        for len in 1..=self.options.max_block.min(self.order.len() - i) {
+            if self.try_move_block(i, len) {
+                return true;
             }
         }
-        improved
+        false
     }
 
     fn try_move_block(&mut self, i: usize, len: usize) -> bool {
@@ -461,45 +433,40 @@ impl Search<'_> {
         true
     }
 
-    /// One pass of block reversal (2-opt): the block from position `i` to a position `j`
-    /// where the segment before `i` has a near neighbour is cut backwards, open segments
-    /// flipped; only the two joints change. Returns whether some reversal gained.
-    fn two_opt_pass(&mut self) -> bool {
-        let mut improved = false;
-        let n = self.order.len();
-        for i in 0..n {
-            if self.stopped() {
-                break;
+    /// Block reversal (2-opt) from position `i`: the block from `i` to a position `j` where
+    /// the segment before `i` has a near neighbour is cut backwards, open segments flipped;
+    /// only the two joints change. Returns whether a reversal gained.
+    fn two_opt_at(&mut self, i: usize) -> bool {
+        let p = self.before_point(i);
+        let first = self.order[i];
+        let anchors: Vec<usize> = match i.checked_sub(1) {
+            Some(k) => self.neighbours[self.order[k]].clone(),
+            None => self.neighbours[first].clone(),
+        };
+        let mut best: Option<(f64, usize)> = None;
+        for c in anchors {
+            let j = self.pos[c];
+            if j <= i || j - i + 1 > self.options.max_reversal {
+                continue;
             }
-            let p = self.before_point(i);
-            let first = self.order[i];
-            let anchors: Vec<usize> = match i.checked_sub(1) {
-                Some(k) => self.neighbours[self.order[k]].clone(),
-                None => self.neighbours[first].clone(),
-            };
-            let mut best: Option<(f64, usize)> = None;
-            for c in anchors {
-                let j = self.pos[c];
-                if j <= i || j - i + 1 > self.options.max_reversal {
-                    continue;
-                }
-                let last = self.order[j];
-                let next = self.after_point(j);
-                let old = p.distance(self.entry(first))
-                    + next.map_or(0.0, |q| self.exit(last).distance(q));
-                let new = p.distance(self.exit(last))
-                    + next.map_or(0.0, |q| self.entry(first).distance(q));
-                let delta = new - old;
-                if delta < -1e-9 && best.is_none_or(|b| delta < b.0) && self.can_reverse(i, j) {
-                    best = Some((delta, j));
-                }
-            }
-            if let Some((_, j)) = best {
-                self.reverse(i, j);
-                improved = true;
+            let last = self.order[j];
+            let next = self.after_point(j);
+            let old =
+                p.distance(self.entry(first)) + next.map_or(0.0, |q| self.exit(last).distance(q));
+            let new =
+                p.distance(self.exit(last)) + next.map_or(0.0, |q| self.entry(first).distance(q));
+            let delta = new - old;
+            if delta < -1e-9 && best.is_none_or(|b| delta < b.0) && self.can_reverse(i, j) {
+                best = Some((delta, j));
             }
         }
-        improved
+        match best {
+            Some((_, j)) => {
+                self.reverse(i, j);
+                true
+            }
+            None => false,
+        }
     }
 
     /// No precedence pair inside positions `[i, j]`.
@@ -518,21 +485,6 @@ impl Search<'_> {
                 self.place[s] = Place::Open {
                     reversed: !reversed,
                 };
-            }
-        }
-    }
-
-    /// Descends to a local optimum of relaxation, block moves and reversals.
-    fn descend(&mut self) {
-        loop {
-            if self.stopped() {
-                return;
-            }
-            let moved = self.or_opt_pass();
-            let reversed = self.two_opt_pass();
-            let relaxed = self.relax_full();
-            if !moved && !reversed && relaxed < self.options.delta {
-                return;
             }
         }
     }
@@ -577,12 +529,16 @@ impl Search<'_> {
     }
 
     fn route(&self) -> PathRoute {
-        let paths = self
-            .order
+        self.route_of(&self.order, &self.place)
+    }
+
+    /// The route of an order with its places (the current one, or the best kept).
+    fn route_of(&self, order: &[usize], place: &[Place]) -> PathRoute {
+        let paths = order
             .iter()
             .map(|&s| {
                 let segment = &self.segments[s];
-                let spans = match self.place[s] {
+                let spans = match place[s] {
                     Place::Closed { span, t, point } => opened(&segment.spans, span, t, point),
                     Place::Open { reversed: false } => segment.spans.clone(),
                     Place::Open { reversed: true } => {
@@ -590,7 +546,7 @@ impl Search<'_> {
                     }
                 };
                 ToolOnPath {
-                    pierce: self.entry(s),
+                    pierce: entry_point(segment, place[s]),
                     spans,
                 }
             })
@@ -635,264 +591,546 @@ fn hints(route: &Route) -> HashMap<ContourRef, (usize, Point)> {
         .collect()
 }
 
-/// Solves one SCCP. The first order follows `hint` (a route of the nest, e.g. CCP-Relax's:
-/// segments sorted by the earliest step that cuts one of their contours, as far as precedence
-/// allows; a closed segment that is one whole contour starts at that step's pierce point);
-/// without a hint, greedy nearest neighbour. Then descent and VNS (see the module notes) until
-/// the shakes stop paying, `options.time_limit` passes or `cancel` is raised; the route is the
-/// best order found with its relaxed points.
+/// Solves one SCCP: [`SccpSearch`] stepped to its end (the cancel flag is read between
+/// slices of [`SOLVE_SLICE`]; the route is then the best so far). The first order follows
+/// `hint` (see [`SccpSearch::new`]); then descent and VNS (see the module notes) until the
+/// shakes stop paying, `options.time_limit` passes or `cancel` is raised; the route is the best
+/// order found with its relaxed points.
 pub fn solve_sccp(
     ensemble: &Ensemble,
     hint: Option<&Route>,
     options: &SccpOptions,
     cancel: &AtomicBool,
 ) -> Result<SccpSolution, SegmentError> {
-    let segments = &ensemble.segments;
-    let n = segments.len();
-    if let Some(i) = segments.iter().position(|s| s.spans.is_empty()) {
-        return Err(SegmentError::EmptySegment { segment: i });
-    }
-    let started = Instant::now();
-    let mut before = vec![Vec::new(); n];
-    let mut after = vec![Vec::new(); n];
-    for &(a, b) in &ensemble.precedence {
-        if a >= n || b >= n {
-            return Err(SegmentError::UnknownSegment {
-                segment: a.max(b),
-                count: n,
-            });
+    let mut search = SccpSearch::new(ensemble, hint, options)?;
+    while search.step(SOLVE_SLICE) == SearchStatus::Running {
+        if cancel.load(Ordering::Relaxed) {
+            search.stop();
         }
-        after[a].push(b);
-        before[b].push(a);
     }
-    let boxes: Vec<Vec<(Point, Point)>> = segments
-        .iter()
-        .map(|s| {
-            s.spans
-                .iter()
-                .map(|sp| {
-                    let b = sp.bounding_box();
-                    (b.min, b.max)
-                })
-                .collect()
-        })
-        .collect();
-    let whole_box: Vec<(Point, Point)> = boxes
-        .iter()
-        .map(|bs| {
-            bs.iter().fold(
-                (
-                    Point::new(f64::INFINITY, f64::INFINITY),
-                    Point::new(f64::NEG_INFINITY, f64::NEG_INFINITY),
-                ),
-                |(lo, hi), (a, b)| {
-                    (
-                        Point::new(lo.x.min(a.x), lo.y.min(a.y)),
-                        Point::new(hi.x.max(b.x), hi.y.max(b.y)),
-                    )
-                },
-            )
-        })
-        .collect();
-    // Representative points for neighbour lists: the ends of open segments, the box centre
-    // of closed ones.
-    let reps: Vec<Vec<Point>> = segments
-        .iter()
-        .zip(&whole_box)
-        .map(|(s, &(lo, hi))| {
-            if s.closed {
-                vec![lo.midpoint(hi)]
-            } else {
-                vec![s.first_point(), s.last_point()]
-            }
-        })
-        .collect();
-    let k = options.neighbours.min(n.saturating_sub(1));
-    let neighbours: Vec<Vec<usize>> = (0..n)
-        .map(|a| {
-            let mut d: Vec<(f64, usize)> = (0..n)
-                .filter(|&b| b != a)
-                .map(|b| {
-                    let dist = reps[a]
-                        .iter()
-                        .flat_map(|p| reps[b].iter().map(move |q| p.distance(*q)))
-                        .fold(f64::INFINITY, f64::min);
-                    (dist, b)
-                })
-                .collect();
-            if d.len() > k {
-                d.select_nth_unstable_by(k, |x, y| x.0.total_cmp(&y.0));
-                d.truncate(k);
-            }
-            d.into_iter().map(|(_, b)| b).collect()
-        })
-        .collect();
+    Ok(search.solution())
+}
 
-    // First order: by hint rank within precedence (Kahn's algorithm with a priority queue),
-    // or greedy nearest neighbour.
-    let hint_map = hint.map(hints);
-    let mut place: Vec<Place> = segments
-        .iter()
-        .map(|s| {
-            if s.closed {
-                Place::Closed {
-                    span: 0,
-                    t: 0.0,
-                    point: s.first_point(),
-                }
-            } else {
-                Place::Open { reversed: false }
+/// The slice [`solve_sccp`] and [`crate::solve_gsccp`] step their searches by between looks at
+/// the cancel flag.
+pub const SOLVE_SLICE: Duration = Duration::from_millis(20);
+
+/// What a step of a resumable search left behind.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SearchStatus {
+    /// More work to do: call `step` again.
+    Running,
+    /// The search ended (local optimum confirmed by the shakes, time limit, or stopped).
+    Finished,
+}
+
+/// Units of work done between looks at the clock (each is one position of a pass: a few
+/// dozen distance evaluations, or one block move, O(segments)).
+const UNITS_PER_CLOCK_CHECK: usize = 8;
+
+/// Where a relaxation (sweeps of [`Search::relax_at`] over every position) stands.
+#[derive(Clone, Copy, Debug)]
+struct Relaxation {
+    sweep: usize,
+    i: usize,
+    gain: f64,
+    total: f64,
+}
+
+impl Relaxation {
+    const NEW: Relaxation = Relaxation {
+        sweep: 0,
+        i: 0,
+        gain: 0.0,
+        total: 0.0,
+    };
+}
+
+/// Which pass of a descent is under way, and at which position.
+#[derive(Clone, Copy, Debug)]
+enum Pass {
+    OrOpt { i: usize },
+    TwoOpt { i: usize },
+    Relax(Relaxation),
+}
+
+/// A descent to a local optimum: passes of block moves, reversals and relaxation, repeated
+/// until a round changes nothing.
+#[derive(Clone, Copy, Debug)]
+struct Descent {
+    pass: Pass,
+    moved: bool,
+    reversed: bool,
+}
+
+impl Descent {
+    const NEW: Descent = Descent {
+        pass: Pass::OrOpt { i: 0 },
+        moved: false,
+        reversed: false,
+    };
+}
+
+#[derive(Clone, Copy, Debug)]
+enum Stage {
+    /// The first relaxation of the first order.
+    Relaxing(Relaxation),
+    /// The first descent (no best kept yet) or one after a shake.
+    Descending(Descent),
+    Finished,
+}
+
+/// The SCCP search as a resumable state machine: [`SccpSearch::step`] does about `budget` of
+/// work and returns, and resumes exactly where it stopped, so a run stepped in slices of any
+/// size takes the same path as one run in a single call (only the time limit depends on the
+/// clock). A browser worker steps it between messages; [`solve_sccp`] is a loop over it.
+pub struct SccpSearch {
+    search: Search,
+    stage: Stage,
+    started: Instant,
+    deadline: Instant,
+    rng: SplitMix64,
+    /// The best order kept by the VNS (after the first descent): idle, order, places.
+    best: Option<(f64, Vec<usize>, Vec<Place>)>,
+    initial_idle_length: Option<f64>,
+    shakes: usize,
+    fruitless: usize,
+    interrupted: bool,
+}
+
+impl SccpSearch {
+    /// Prepares the search of one SCCP (neighbour lists, precedence, the first order). The
+    /// first order follows `hint` (a route of the nest, e.g. CCP-Relax's: segments sorted by
+    /// the earliest step that cuts one of their contours, as far as precedence allows; a
+    /// closed segment that is one whole contour starts at that step's pierce point); without a
+    /// hint, greedy nearest neighbour. `options.time_limit` counts from this call.
+    pub fn new(
+        ensemble: &Ensemble,
+        hint: Option<&Route>,
+        options: &SccpOptions,
+    ) -> Result<Self, SegmentError> {
+        let segments = &ensemble.segments;
+        let n = segments.len();
+        if let Some(i) = segments.iter().position(|s| s.spans.is_empty()) {
+            return Err(SegmentError::EmptySegment { segment: i });
+        }
+        let started = Instant::now();
+        let mut before = vec![Vec::new(); n];
+        let mut after = vec![Vec::new(); n];
+        for &(a, b) in &ensemble.precedence {
+            if a >= n || b >= n {
+                return Err(SegmentError::UnknownSegment {
+                    segment: a.max(b),
+                    count: n,
+                });
             }
-        })
-        .collect();
-    let mut indegree: Vec<usize> = before.iter().map(Vec::len).collect();
-    let mut order = Vec::with_capacity(n);
-    if let Some(map) = &hint_map {
-        let key: Vec<usize> = segments
+            after[a].push(b);
+            before[b].push(a);
+        }
+        let boxes: Vec<Vec<(Point, Point)>> = segments
             .iter()
             .map(|s| {
-                s.contours
+                s.spans
                     .iter()
-                    .filter_map(|c| map.get(c).map(|h| h.0))
-                    .min()
-                    .unwrap_or(usize::MAX)
+                    .map(|sp| {
+                        let b = sp.bounding_box();
+                        (b.min, b.max)
+                    })
+                    .collect()
             })
             .collect();
-        for (s, segment) in segments.iter().enumerate() {
-            if let ([c], true) = (&segment.contours[..], segment.closed) {
-                if let Some(&(_, pierce)) = map.get(c) {
-                    let best = segment
-                        .spans
+        let whole_box: Vec<(Point, Point)> = boxes
+            .iter()
+            .map(|bs| {
+                bs.iter().fold(
+                    (
+                        Point::new(f64::INFINITY, f64::INFINITY),
+                        Point::new(f64::NEG_INFINITY, f64::NEG_INFINITY),
+                    ),
+                    |(lo, hi), (a, b)| {
+                        (
+                            Point::new(lo.x.min(a.x), lo.y.min(a.y)),
+                            Point::new(hi.x.max(b.x), hi.y.max(b.y)),
+                        )
+                    },
+                )
+            })
+            .collect();
+        // Representative points for neighbour lists: the ends of open segments, the box centre
+        // of closed ones.
+        let reps: Vec<Vec<Point>> = segments
+            .iter()
+            .zip(&whole_box)
+            .map(|(s, &(lo, hi))| {
+                if s.closed {
+                    vec![lo.midpoint(hi)]
+                } else {
+                    vec![s.first_point(), s.last_point()]
+                }
+            })
+            .collect();
+        let k = options.neighbours.min(n.saturating_sub(1));
+        let neighbours: Vec<Vec<usize>> = (0..n)
+            .map(|a| {
+                let mut d: Vec<(f64, usize)> = (0..n)
+                    .filter(|&b| b != a)
+                    .map(|b| {
+                        let dist = reps[a]
+                            .iter()
+                            .flat_map(|p| reps[b].iter().map(move |q| p.distance(*q)))
+                            .fold(f64::INFINITY, f64::min);
+                        (dist, b)
+                    })
+                    .collect();
+                if d.len() > k {
+                    d.select_nth_unstable_by(k, |x, y| x.0.total_cmp(&y.0));
+                    d.truncate(k);
+                }
+                d.into_iter().map(|(_, b)| b).collect()
+            })
+            .collect();
+
+        // First order: by hint rank within precedence (Kahn's algorithm with a priority queue),
+        // or greedy nearest neighbour.
+        let hint_map = hint.map(hints);
+        let mut place: Vec<Place> = segments
+            .iter()
+            .map(|s| {
+                if s.closed {
+                    Place::Closed {
+                        span: 0,
+                        t: 0.0,
+                        point: s.first_point(),
+                    }
+                } else {
+                    Place::Open { reversed: false }
+                }
+            })
+            .collect();
+        let mut indegree: Vec<usize> = before.iter().map(Vec::len).collect();
+        let mut order = Vec::with_capacity(n);
+        if let Some(map) = &hint_map {
+            let key: Vec<usize> = segments
+                .iter()
+                .map(|s| {
+                    s.contours
                         .iter()
-                        .enumerate()
-                        .map(|(i, sp)| (i, sp.nearest_point(pierce)))
-                        .min_by(|x, y| x.1.distance.total_cmp(&y.1.distance));
-                    if let Some((span, q)) = best {
-                        place[s] = Place::Closed {
-                            span,
-                            t: q.t,
-                            point: q.point,
+                        .filter_map(|c| map.get(c).map(|h| h.0))
+                        .min()
+                        .unwrap_or(usize::MAX)
+                })
+                .collect();
+            for (s, segment) in segments.iter().enumerate() {
+                if let ([c], true) = (&segment.contours[..], segment.closed) {
+                    if let Some(&(_, pierce)) = map.get(c) {
+                        let best = segment
+                            .spans
+                            .iter()
+                            .enumerate()
+                            .map(|(i, sp)| (i, sp.nearest_point(pierce)))
+                            .min_by(|x, y| x.1.distance.total_cmp(&y.1.distance));
+                        if let Some((span, q)) = best {
+                            place[s] = Place::Closed {
+                                span,
+                                t: q.t,
+                                point: q.point,
+                            };
+                        }
+                    }
+                }
+            }
+            let mut ready: BinaryHeap<std::cmp::Reverse<(usize, usize)>> = (0..n)
+                .filter(|&s| indegree[s] == 0)
+                .map(|s| std::cmp::Reverse((key[s], s)))
+                .collect();
+            while let Some(std::cmp::Reverse((_, s))) = ready.pop() {
+                order.push(s);
+                for &t in &after[s] {
+                    indegree[t] -= 1;
+                    if indegree[t] == 0 {
+                        ready.push(std::cmp::Reverse((key[t], t)));
+                    }
+                }
+            }
+        } else {
+            let mut ready: Vec<usize> = (0..n).filter(|&s| indegree[s] == 0).collect();
+            let mut at = options.start;
+            while !ready.is_empty() {
+                let (r, _) = ready
+                    .iter()
+                    .enumerate()
+                    .map(|(r, &s)| {
+                        let d = if segments[s].closed {
+                            segments[s]
+                                .spans
+                                .iter()
+                                .map(|sp| sp.start.distance(at))
+                                .fold(f64::INFINITY, f64::min)
+                        } else {
+                            at.distance(segments[s].first_point())
+                                .min(at.distance(segments[s].last_point()))
                         };
+                        (r, d)
+                    })
+                    .min_by(|x, y| x.1.total_cmp(&y.1))
+                    .expect("ready is not empty");
+                let s = ready.swap_remove(r);
+                if !segments[s].closed {
+                    let reversed = at.distance(segments[s].last_point())
+                        < at.distance(segments[s].first_point());
+                    place[s] = Place::Open { reversed };
+                }
+                order.push(s);
+                at = match place[s] {
+                    Place::Open { reversed: false } => segments[s].last_point(),
+                    Place::Open { reversed: true } => segments[s].first_point(),
+                    Place::Closed { point, .. } => point,
+                };
+                for &t in &after[s] {
+                    indegree[t] -= 1;
+                    if indegree[t] == 0 {
+                        ready.push(t);
                     }
                 }
             }
         }
-        let mut ready: BinaryHeap<std::cmp::Reverse<(usize, usize)>> = (0..n)
-            .filter(|&s| indegree[s] == 0)
-            .map(|s| std::cmp::Reverse((key[s], s)))
-            .collect();
-        while let Some(std::cmp::Reverse((_, s))) = ready.pop() {
-            order.push(s);
-            for &t in &after[s] {
-                indegree[t] -= 1;
-                if indegree[t] == 0 {
-                    ready.push(std::cmp::Reverse((key[t], t)));
+        if order.len() != n {
+            return Err(SegmentError::CyclicPrecedence {
+                kind: ensemble.kind,
+                segment: (0..n).find(|&s| indegree[s] > 0).unwrap_or(0),
+            });
+        }
+        let mut pos = vec![0; n];
+        for (k, &s) in order.iter().enumerate() {
+            pos[s] = k;
+        }
+        let search = Search {
+            segments: segments.clone(),
+            boxes,
+            whole_box,
+            before,
+            after,
+            neighbours,
+            order,
+            pos,
+            place,
+            options: options.clone(),
+        };
+        Ok(SccpSearch {
+            search,
+            stage: Stage::Relaxing(Relaxation::NEW),
+            started,
+            deadline: started + options.time_limit,
+            rng: SplitMix64::new(options.seed),
+            best: None,
+            initial_idle_length: None,
+            shakes: 0,
+            fruitless: 0,
+            interrupted: false,
+        })
+    }
+
+    /// Works for about `budget` (the clock is read every few units of work, each far below a
+    /// millisecond on the real nests), then returns; ends at the time limit.
+    pub fn step(&mut self, budget: Duration) -> SearchStatus {
+        let slice_end = Instant::now() + budget;
+        loop {
+            for _ in 0..UNITS_PER_CLOCK_CHECK {
+                if matches!(self.stage, Stage::Finished) {
+                    return SearchStatus::Finished;
+                }
+                self.unit();
+            }
+            let now = Instant::now();
+            if now >= self.deadline {
+                self.stop();
+                return SearchStatus::Finished;
+            }
+            if now >= slice_end {
+                return SearchStatus::Running;
+            }
+        }
+    }
+
+    /// Ends the search now (cancel, or the time limit): the current order is kept if it beats
+    /// the best one, else the best is restored.
+    pub fn stop(&mut self) {
+        if matches!(self.stage, Stage::Finished) {
+            return;
+        }
+        self.interrupted = true;
+        if self.initial_idle_length.is_none() {
+            self.initial_idle_length = Some(self.search.idle_length());
+        }
+        if let Some(best) = self.best.take() {
+            if self.search.idle_length() >= best.0 - self.search.options.delta {
+                self.restore(best);
+            }
+        }
+        self.stage = Stage::Finished;
+    }
+
+    /// Whether the search has ended.
+    pub fn is_finished(&self) -> bool {
+        matches!(self.stage, Stage::Finished)
+    }
+
+    /// Idle length (mm) of the best route so far (the kept best, or during the first descent
+    /// the current order, which only improves).
+    pub fn best_idle_length(&self) -> f64 {
+        match &self.best {
+            Some(best) if !self.is_finished() => best.0,
+            _ => self.search.idle_length(),
+        }
+    }
+
+    /// The best route so far (see [`SccpSearch::best_idle_length`]).
+    pub fn best_route(&self) -> PathRoute {
+        match &self.best {
+            Some((_, order, place)) if !self.is_finished() => self.search.route_of(order, place),
+            _ => self.search.route(),
+        }
+    }
+
+    /// Time since [`SccpSearch::new`].
+    pub fn elapsed(&self) -> Duration {
+        self.started.elapsed()
+    }
+
+    /// The result: after the end, the final route; before it, the best so far (as if stopped).
+    pub fn solution(&self) -> SccpSolution {
+        let (route, order, idle_length) = match &self.best {
+            Some((idle, order, place)) if !self.is_finished() => {
+                (self.search.route_of(order, place), order.clone(), *idle)
+            }
+            _ => (
+                self.search.route(),
+                self.search.order.clone(),
+                self.search.idle_length(),
+            ),
+        };
+        SccpSolution {
+            route,
+            order,
+            idle_length,
+            initial_idle_length: self.initial_idle_length.unwrap_or(idle_length),
+            interrupted: self.interrupted || !self.is_finished(),
+            shakes: self.shakes,
+        }
+    }
+
+    fn restore(&mut self, best: (f64, Vec<usize>, Vec<Place>)) {
+        let search = &mut self.search;
+        search.order = best.1;
+        search.place = best.2;
+        for (k, &s) in search.order.iter().enumerate() {
+            search.pos[s] = k;
+        }
+    }
+
+    /// One unit of work: one position of the current pass, or the end of a pass.
+    fn unit(&mut self) {
+        match self.stage {
+            Stage::Finished => {}
+            Stage::Relaxing(mut relaxation) => {
+                self.stage = match self.relax_unit(&mut relaxation) {
+                    None => Stage::Relaxing(relaxation),
+                    Some(_) => {
+                        self.initial_idle_length = Some(self.search.idle_length());
+                        Stage::Descending(Descent::NEW)
+                    }
+                };
+            }
+            Stage::Descending(mut descent) => {
+                let n = self.search.order.len();
+                match &mut descent.pass {
+                    Pass::OrOpt { i } => {
+                        if *i >= n {
+                            descent.pass = Pass::TwoOpt { i: 0 };
+                        } else if self.search.or_opt_at(*i) {
+                            // The block that moved left a new segment at `i`: try it too.
+                            descent.moved = true;
+                        } else {
+                            *i += 1;
+                        }
+                    }
+                    Pass::TwoOpt { i } => {
+                        if *i >= n {
+                            descent.pass = Pass::Relax(Relaxation::NEW);
+                        } else {
+                            descent.reversed |= self.search.two_opt_at(*i);
+                            *i += 1;
+                        }
+                    }
+                    Pass::Relax(relaxation) => {
+                        if let Some(total) = self.relax_unit(relaxation) {
+                            if !descent.moved
+                                && !descent.reversed
+                                && total < self.search.options.delta
+                            {
+                                self.descent_done();
+                                return;
+                            }
+                            descent = Descent::NEW;
+                        }
+                    }
+                }
+                self.stage = Stage::Descending(descent);
+            }
+        }
+    }
+
+    /// One position of a relaxation sweep, or the end of a sweep; `Some(total gain)` when the
+    /// relaxation has ended (a sweep gained less than δ, or the sweep limit).
+    fn relax_unit(&mut self, relaxation: &mut Relaxation) -> Option<f64> {
+        let options = &self.search.options;
+        if options.max_relaxation_sweeps == 0 {
+            return Some(0.0);
+        }
+        if relaxation.i < self.search.order.len() {
+            relaxation.gain += self.search.relax_at(relaxation.i);
+            relaxation.i += 1;
+            return None;
+        }
+        relaxation.total += relaxation.gain;
+        relaxation.sweep += 1;
+        if relaxation.gain < options.delta || relaxation.sweep >= options.max_relaxation_sweeps {
+            return Some(relaxation.total);
+        }
+        relaxation.i = 0;
+        relaxation.gain = 0.0;
+        None
+    }
+
+    /// A descent reached its local optimum: the first one becomes the best; after a shake the
+    /// result is kept only if shorter (VNS). Then shake again, or end after
+    /// `max_non_improving_shakes` fruitless shakes in a row.
+    fn descent_done(&mut self) {
+        let length = self.search.idle_length();
+        match self.best.take() {
+            None => {
+                self.best = Some((length, self.search.order.clone(), self.search.place.clone()))
+            }
+            Some(best) => {
+                self.shakes += 1;
+                if length < best.0 - self.search.options.delta {
+                    self.best =
+                        Some((length, self.search.order.clone(), self.search.place.clone()));
+                    self.fruitless = 0;
+                } else {
+                    self.fruitless += 1;
+                    self.restore(best.clone());
+                    self.best = Some(best);
                 }
             }
         }
-    } else {
-        let mut ready: Vec<usize> = (0..n).filter(|&s| indegree[s] == 0).collect();
-        let mut at = options.start;
-        while !ready.is_empty() {
-            let (r, _) = ready
-                .iter()
-                .enumerate()
-                .map(|(r, &s)| {
-                    let d = if segments[s].closed {
-                        segments[s]
-                            .spans
-                            .iter()
-                            .map(|sp| sp.start.distance(at))
-                            .fold(f64::INFINITY, f64::min)
-                    } else {
-                        at.distance(segments[s].first_point())
-                            .min(at.distance(segments[s].last_point()))
-                    };
-                    (r, d)
-                })
-                .min_by(|x, y| x.1.total_cmp(&y.1))
-                .expect("ready is not empty");
-            let s = ready.swap_remove(r);
-            if !segments[s].closed {
-                let reversed =
-                    at.distance(segments[s].last_point()) < at.distance(segments[s].first_point());
-                place[s] = Place::Open { reversed };
-            }
-            order.push(s);
-            at = match place[s] {
-                Place::Open { reversed: false } => segments[s].last_point(),
-                Place::Open { reversed: true } => segments[s].first_point(),
-                Place::Closed { point, .. } => point,
-            };
-            for &t in &after[s] {
-                indegree[t] -= 1;
-                if indegree[t] == 0 {
-                    ready.push(t);
-                }
-            }
+        if self.fruitless >= self.search.options.max_non_improving_shakes {
+            self.stage = Stage::Finished;
+            return;
         }
+        self.search.shake(&mut self.rng);
+        self.stage = Stage::Descending(Descent::NEW);
     }
-    if order.len() != n {
-        return Err(SegmentError::CyclicPrecedence {
-            kind: ensemble.kind,
-            segment: (0..n).find(|&s| indegree[s] > 0).unwrap_or(0),
-        });
-    }
-    let mut pos = vec![0; n];
-    for (k, &s) in order.iter().enumerate() {
-        pos[s] = k;
-    }
-    let mut search = Search {
-        segments,
-        boxes,
-        whole_box,
-        before,
-        after,
-        neighbours,
-        order,
-        pos,
-        place,
-        options,
-        deadline: started + options.time_limit,
-        cancel,
-    };
-    search.relax_full();
-    let initial_idle_length = search.idle_length();
-    search.descend();
-    // VNS: shake the best order, descend again, keep the result only if shorter.
-    let mut best = (
-        search.idle_length(),
-        search.order.clone(),
-        search.place.clone(),
-    );
-    let mut rng = SplitMix64::new(options.seed);
-    let (mut shakes, mut fruitless) = (0, 0);
-    while fruitless < options.max_non_improving_shakes && !search.stopped() {
-        search.shake(&mut rng);
-        search.descend();
-        shakes += 1;
-        let length = search.idle_length();
-        if length < best.0 - options.delta {
-            best = (length, search.order.clone(), search.place.clone());
-            fruitless = 0;
-        } else {
-            fruitless += 1;
-            search.order.clone_from(&best.1);
-            search.place.clone_from(&best.2);
-            for (k, &s) in search.order.iter().enumerate() {
-                search.pos[s] = k;
-            }
-        }
-    }
-    let interrupted = fruitless < options.max_non_improving_shakes;
-    Ok(SccpSolution {
-        route: search.route(),
-        idle_length: search.idle_length(),
-        order: search.order,
-        initial_idle_length,
-        interrupted,
-        shakes,
-    })
 }
 
 #[cfg(test)]

@@ -1,0 +1,347 @@
+//! The path-route jobs (sccp, gsccp, aoe) through the engine on real nests: every route shown
+//! passes the independent checker, the progress's numbers are the route's, the lower bound
+//! holds (and is tight where the optimum is known), cancel keeps the best so far, stepping in
+//! tiny slices changes nothing.
+
+use std::path::PathBuf;
+use std::sync::atomic::AtomicBool;
+
+use cutroute_engine::{open_document, run_to_end, start_job, JobStatus};
+use cutroute_geometry::{MachineParameters, Nest, Objective, PathRoute, PathRouteError, Point};
+use cutroute_protocol::{JobRequest, Problem, Progress, SolverKind, SolverParams};
+use web_time::{Duration, Instant};
+
+const NEST01: &str = "nests/tflex/Nest01.tfnesting";
+const NEST02: &str = "nests/tflex/Nest02.tfnesting";
+const NESTED: &str = "nests/dbs/nested.dbs";
+const TEST1: &str = "nests/dbs-json/test1.dbs.json";
+
+fn problem(relative: &str) -> Problem {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/data")
+        .join(relative);
+    let bytes = std::fs::read(&path)
+        .unwrap_or_else(|e| panic!("missing test file {}: {e}", path.display()));
+    open_document(relative, &bytes).expect("opens").problem
+}
+
+fn nest_of(problem: &Problem) -> (&Nest, Point, Option<Point>) {
+    match problem {
+        Problem::Nest {
+            nest,
+            start,
+            finish,
+        } => (nest, *start, *finish),
+        Problem::PcgtspText { .. } => panic!("a nest"),
+    }
+}
+
+fn request(problem: &Problem, solver: SolverKind, params: SolverParams) -> JobRequest {
+    JobRequest {
+        job_id: 5,
+        problem: problem.clone(),
+        solver,
+        params,
+    }
+}
+
+fn params(time_limit_s: f64, objective: Objective) -> SolverParams {
+    SolverParams {
+        time_limit_s,
+        objective,
+        ..SolverParams::default()
+    }
+}
+
+fn value(objective: Objective, machine: &MachineParameters, route: &PathRoute) -> f64 {
+    objective.value(
+        machine,
+        route.cut_length(),
+        route.idle_length(),
+        route.pierce_count(),
+    )
+}
+
+/// Checks a progress report against its own route: the route passes `PathRoute::problems`
+/// (contour cut twice allowed only for routes of whole contours: "ccp", "standard"), the upper
+/// bound is the objective's value of the route, the lower bound does not exceed it, and exactly
+/// one alternative is chosen, with the route's numbers.
+fn check_progress(
+    what: &str,
+    problem: &Problem,
+    params: &SolverParams,
+    progress: &Progress,
+) -> PathRoute {
+    let (nest, start, finish) = nest_of(problem);
+    assert!(progress.route.is_none(), "{what}: a path route only");
+    let route = progress.path_route.clone().expect("a path route");
+    assert_eq!((route.start, route.finish), (start, finish), "{what}");
+    let chosen: Vec<_> = progress.alternatives.iter().filter(|a| a.chosen).collect();
+    assert_eq!(chosen.len(), 1, "{what}: {:?}", progress.alternatives);
+    let chosen = chosen[0];
+    let overlaps_allowed = matches!(chosen.name.as_str(), "ccp" | "standard");
+    // The solvers' own check tolerance: 10⁻⁶ of the nest's width plus height.
+    let b = nest.bounding_box();
+    let tolerance = 1e-6 * ((b.max.x - b.min.x) + (b.max.y - b.min.y)).max(1.0);
+    let problems = route.problems(nest, tolerance);
+    assert!(
+        problems
+            .iter()
+            .all(|p| overlaps_allowed && matches!(p, PathRouteError::Overlap { .. })),
+        "{what}: {problems:?}"
+    );
+    let machine = &params.machine;
+    let expected = value(params.objective, machine, &route);
+    let ub = progress.upper_bound.expect("an upper bound");
+    assert!(
+        (ub - expected).abs() <= 1e-9 * expected,
+        "{what}: {ub} vs {expected}"
+    );
+    let lb = progress.lower_bound.expect("a lower bound");
+    assert!(lb > 0.0 && lb <= ub, "{what}: lb {lb} ub {ub}");
+    assert_eq!(chosen.pierces, route.pierce_count(), "{what}");
+    assert!((chosen.idle_length - route.idle_length()).abs() < 1e-6);
+    assert!((chosen.cut_length - route.cut_length()).abs() < 1e-6);
+    assert!((chosen.time_s - route.time(machine)).abs() < 1e-9 * chosen.time_s.max(1.0));
+    assert!((chosen.cost - route.cost(machine)).abs() < 1e-9 * chosen.cost.max(1.0));
+    route
+}
+
+#[test]
+fn every_path_solver_returns_a_checked_route_with_its_numbers() {
+    for file in [NEST01, NEST02, NESTED, TEST1] {
+        let problem = problem(file);
+        for (solver, names) in [
+            (SolverKind::Sccp, &["ccp", "chains"][..]),
+            (
+                SolverKind::Gsccp,
+                &["ccp", "standard", "chains", "junctions"][..],
+            ),
+            (SolverKind::Aoe, &["aoe"][..]),
+        ] {
+            for objective in [Objective::Time, Objective::Cost] {
+                let params = params(1.0, objective);
+                let what = format!("{file} {} {}", solver.name(), objective.name());
+                let mut job = start_job(&request(&problem, solver, params.clone())).unwrap();
+                let mut reports = 0;
+                let result = run_to_end(job.as_mut(), &mut |p| {
+                    reports += 1;
+                    if p.path_route.is_some() {
+                        check_progress(&what, &problem, &params, p);
+                    }
+                });
+                check_progress(&what, &problem, &params, &result);
+                let listed: Vec<&str> = result
+                    .alternatives
+                    .iter()
+                    .map(|a| a.name.as_str())
+                    .collect();
+                assert_eq!(listed, names, "{what}");
+                assert!(
+                    result.phase.contains(' ') && !result.phase.contains("failed"),
+                    "{what}: {}",
+                    result.phase
+                );
+                if solver == SolverKind::Gsccp {
+                    // The chosen route is the best of the checked candidates by the objective.
+                    let key = |a: &cutroute_protocol::RouteSummary| match objective {
+                        Objective::Time => a.time_s,
+                        Objective::Cost => a.cost,
+                    };
+                    let chosen = result.alternatives.iter().find(|a| a.chosen).unwrap();
+                    for a in result.alternatives.iter().filter(|a| a.failure.is_none()) {
+                        assert!(key(chosen) <= key(a) + 1e-9, "{what}: {a:?}");
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn common_edges_are_cut_once_on_nest01() {
+    let problem = problem(NEST01);
+    let (nest, ..) = nest_of(&problem);
+    let contours: f64 = nest
+        .parts
+        .iter()
+        .flat_map(|p| &p.contours)
+        .map(|c| c.perimeter())
+        .sum();
+    for solver in [SolverKind::Sccp, SolverKind::Gsccp, SolverKind::Aoe] {
+        let params = params(1.0, Objective::Time);
+        let mut job = start_job(&request(&problem, solver, params)).unwrap();
+        let result = run_to_end(job.as_mut(), &mut |_| {});
+        let route = result.path_route.unwrap();
+        assert!(route.pierce_count() < nest.contour_count(), "{solver:?}");
+        assert!(route.cut_length() < contours - 100.0, "{solver:?}");
+    }
+}
+
+/// AOE's lower bound on grids of touching rectangles, whose optimal cut length and pierces are
+/// known: every edge once ((rows + 1)·columns·w + (columns + 1)·rows·h) and one trail per pair
+/// of odd T-junctions ((columns − 1) + (rows − 1)); the bound is exactly that plus the idle
+/// travel to the plan, and the route reaches its pierces and cut.
+#[test]
+fn the_aoe_lower_bound_is_the_known_optimum_of_cut_and_pierces_on_grids() {
+    let machine = MachineParameters::default();
+    for (columns, rows) in [(2, 1), (3, 3), (5, 4), (10, 10)] {
+        let (w, h) = (50.0, 30.0);
+        let nest = cutroute_segments::rectangle_grid(columns, rows, w, h);
+        let start = Point::new(0.0, -20.0);
+        let problem = Problem::Nest {
+            nest,
+            start,
+            finish: None,
+        };
+        let cut = (rows + 1) as f64 * columns as f64 * w + (columns + 1) as f64 * rows as f64 * h;
+        let pierces = (columns - 1) + (rows - 1);
+        for objective in [Objective::Time, Objective::Cost] {
+            let params = params(1.0, objective);
+            let mut job = start_job(&request(&problem, SolverKind::Aoe, params.clone())).unwrap();
+            let result = run_to_end(job.as_mut(), &mut |_| {});
+            let route = check_progress("grid", &problem, &params, &result);
+            assert_eq!(route.pierce_count(), pierces.max(1));
+            assert!((route.cut_length() - cut).abs() < 1e-6);
+            let known = objective.value(&machine, cut, 20.0, pierces.max(1));
+            let lb = result.lower_bound.unwrap();
+            // Equal but for the slack the bound leaves for the plan's merging tolerance (four
+            // tolerances, here 10⁻⁶ of the grid's width plus height, per plan edge).
+            assert!(
+                lb <= known && known - lb <= 1e-4 * known,
+                "{columns}×{rows}: {lb} vs {known}"
+            );
+            // Segment cutting: the weaker bound (routes may cut edges twice) stays below.
+            let mut job = start_job(&request(&problem, SolverKind::Gsccp, params.clone())).unwrap();
+            let result = run_to_end(job.as_mut(), &mut |_| {});
+            check_progress("grid gsccp", &problem, &params, &result);
+        }
+    }
+}
+
+#[test]
+fn cancel_mid_run_keeps_the_best_route_so_far() {
+    let problem = problem(NEST02);
+    let params = params(6.0, Objective::Cost);
+    for solver in [SolverKind::Gsccp, SolverKind::Sccp] {
+        let mut job = start_job(&request(&problem, solver, params.clone())).unwrap();
+        let started = Instant::now();
+        // Step until an ensemble is running (past CCP-Relax), as the worker does, then "cancel":
+        // the worker sends the job's progress without another step.
+        let mut during_ccp = false;
+        loop {
+            assert_eq!(job.step(Duration::from_millis(40)), JobStatus::Running);
+            let progress = job.progress();
+            if progress.phase.contains("CCP") && progress.path_route.is_some() {
+                // The best so far while CCP-Relax runs is its own route, checked.
+                check_progress("during ccp", &problem, &params, &progress);
+                during_ccp = true;
+            }
+            if progress.phase.contains("ensemble (") && started.elapsed().as_secs_f64() > 1.0 {
+                break;
+            }
+            assert!(started.elapsed().as_secs() < 50, "{}", progress.phase);
+        }
+        assert!(during_ccp, "CCP-Relax's route is shown while it runs");
+        let cancelled = job.progress();
+        let route = check_progress("cancelled", &problem, &params, &cancelled);
+        let (nest, ..) = nest_of(&problem);
+        assert!(route.pierce_count() <= nest.contour_count());
+    }
+}
+
+/// Where the run is deterministic (searches that end by their own rules long before the time
+/// limit), the job stepped in 1 ms slices gives exactly `solve_gsccp`'s / `solve_nest`'s route.
+#[test]
+fn stepped_runs_equal_one_shot_runs() {
+    for file in [NEST01, "nests/dbs-json/E1X_6_01.dbs.json"] {
+        let problem = problem(file);
+        let (nest, start, finish) = nest_of(&problem);
+        for solver in [SolverKind::Sccp, SolverKind::Gsccp] {
+            let params = params(120.0, Objective::Time);
+            let mut job = start_job(&request(&problem, solver, params.clone())).unwrap();
+            while job.step(Duration::from_millis(1)) == JobStatus::Running {}
+            let stepped = job.progress();
+            assert!(stepped.elapsed_s < 60.0, "ended by its own rules");
+            let options = cutroute_segments::GsccpOptions {
+                sccp: cutroute_segments::SccpOptions {
+                    start,
+                    finish,
+                    time_limit: Duration::from_secs(120),
+                    seed: params.seed,
+                    ..Default::default()
+                },
+                kinds: if solver == SolverKind::Sccp {
+                    vec![cutroute_segments::EnsembleKind::Chains]
+                } else {
+                    cutroute_segments::EnsembleKind::ALL.to_vec()
+                },
+                machine: params.machine,
+                objective: params.objective,
+                seed: params.seed,
+                ..Default::default()
+            };
+            let one_shot =
+                cutroute_segments::solve_gsccp(nest, &options, &AtomicBool::new(false)).unwrap();
+            assert_eq!(
+                stepped.path_route.as_ref(),
+                Some(&one_shot.route),
+                "{file} {solver:?}"
+            );
+        }
+        let params = params(1.0, Objective::Time);
+        let mut job = start_job(&request(&problem, SolverKind::Aoe, params)).unwrap();
+        while job.step(Duration::from_millis(1)) == JobStatus::Running {}
+        let options = cutroute_aoe::AoeSolveOptions {
+            plan: cutroute_aoe::PlanOptions {
+                tolerance: {
+                    let b = nest.bounding_box();
+                    1e-6 * ((b.max.x - b.min.x) + (b.max.y - b.min.y)).max(1.0)
+                },
+                ..Default::default()
+            },
+            start,
+            finish,
+        };
+        let one_shot = cutroute_aoe::solve_nest(nest, &options).unwrap();
+        assert_eq!(
+            job.progress().path_route,
+            Some(one_shot.route),
+            "{file} aoe"
+        );
+    }
+}
+
+#[test]
+fn runs_in_one_millisecond_slices_stay_valid() {
+    for file in [NESTED, NEST01] {
+        let problem = problem(file);
+        for solver in [SolverKind::Sccp, SolverKind::Gsccp] {
+            let params = params(1.0, Objective::Time);
+            let mut job = start_job(&request(&problem, solver, params.clone())).unwrap();
+            let mut steps = 0;
+            while job.step(Duration::from_millis(1)) == JobStatus::Running {
+                steps += 1;
+                if steps % 97 == 0 {
+                    let p = job.progress();
+                    if p.path_route.is_some() {
+                        check_progress("1 ms", &problem, &params, &p);
+                    }
+                }
+            }
+            assert!(steps > 10, "{file}: {steps} steps");
+            check_progress("1 ms end", &problem, &params, &job.progress());
+        }
+    }
+}
+
+#[test]
+fn path_solvers_refuse_pcgtsp_instances() {
+    let problem = problem("pcgtsp/industrial/e1x_6.pcglns");
+    for solver in [SolverKind::Sccp, SolverKind::Gsccp, SolverKind::Aoe] {
+        let error = start_job(&request(&problem, solver, SolverParams::default()))
+            .err()
+            .expect("refused");
+        assert!(error.to_string().contains("PCGTSP"), "{error}");
+    }
+}
