@@ -166,15 +166,17 @@ pub fn AlternativesTable(alternatives: Signal<Vec<RouteSummary>>) -> impl IntoVi
         let rows = alternatives.get();
         (!rows.is_empty()).then(|| {
             view! {
+                // Scrolls sideways in the narrow panel rather than clipping columns.
+                <div class="table-scroll">
                 <table id="alternatives" aria-label="Candidates the solver weighed">
                     <caption>"Candidates weighed"</caption>
                     <thead>
                         <tr>
-                            <th scope="col">"Candidate"</th>
-                            <th scope="col">"Pierces"</th>
-                            <th scope="col">"Idle, mm"</th>
-                            <th scope="col">"Cut, mm"</th>
-                            <th scope="col">"Time, s"</th>
+                            <th scope="col">"Route"</th>
+                            <th scope="col" title="Pierces">"Pierc."</th>
+                            <th scope="col" title="Idle length, mm">"Idle"</th>
+                            <th scope="col" title="Cut length, mm">"Cut"</th>
+                            <th scope="col" title="Machine time, s">"Time"</th>
                             <th scope="col">"Cost"</th>
                         </tr>
                     </thead>
@@ -183,7 +185,9 @@ pub fn AlternativesTable(alternatives: Signal<Vec<RouteSummary>>) -> impl IntoVi
                             .into_iter()
                             .map(|r| {
                                 let class = if r.chosen { "alternative chosen" } else { "alternative" };
-                                let name = if r.chosen { format!("✓ {} (chosen)", r.name) } else { r.name.clone() };
+                                let mark = r.chosen.then_some("✓ ");
+                                let said = r.chosen.then(|| view! { <span class="visually-hidden">" (chosen)"</span> });
+                                let name = view! { {mark} {r.name.clone()} {said} };
                                 match r.failure {
                                     Some(why) => view! {
                                         <tr class=class data-name=r.name.clone() data-chosen=r.chosen.to_string()>
@@ -208,6 +212,7 @@ pub fn AlternativesTable(alternatives: Signal<Vec<RouteSummary>>) -> impl IntoVi
                             .collect_view()}
                     </tbody>
                 </table>
+                </div>
             }
         })
     }

@@ -199,9 +199,10 @@ test('settings and layers survive a reload; a link opens a sample with solver se
     await page.fill(id, value);
     await page.dispatchEvent(id, 'change');
   }
+  await page.selectOption('#objective', 'cost');
   await page.uncheck('#layer-arrows');
   const link = await page.inputValue('#share-link');
-  assert.match(link, /\?sample=test1\.dbs\.json&solver=exact&time=7&seed=3&step=20$/);
+  assert.match(link, /\?sample=test1\.dbs\.json&solver=exact&time=7&seed=3&step=20&objective=cost$/);
   await page.reload();
   await fileShown(page, 'test1');
   assert.equal(await page.inputValue('#sample'), 'test1.dbs.json');
@@ -209,6 +210,7 @@ test('settings and layers survive a reload; a link opens a sample with solver se
   assert.equal(await page.inputValue('#time-limit'), '7');
   assert.equal(await page.inputValue('#seed'), '3');
   assert.equal(await page.inputValue('#step'), '20');
+  assert.equal(await page.inputValue('#objective'), 'cost');
   assert.equal(await page.isChecked('#layer-arrows'), false);
   assert.match(await page.getAttribute('#nest-view', 'class'), /hide-arrows/);
   assert.equal(await page.locator('#last-file').count(), 0, 'a sample was open: nothing to remind');
