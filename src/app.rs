@@ -314,7 +314,13 @@ pub fn App() -> impl IntoView {
     });
     // What the bounds measure: the objective for the solvers that minimise it, else idle mm.
     let bound_unit = Signal::derive(move || {
-        if solver.get().gives_path_route() {
+        let instance = document.with(|d| {
+            d.as_ref()
+                .is_some_and(|d| matches!(d.problem, Problem::PcgtspText { .. }))
+        });
+        if instance {
+            "tour cost"
+        } else if solver.get().gives_path_route() {
             objective_unit(objective.get())
         } else {
             "mm idle"
@@ -1121,9 +1127,10 @@ fn NestView(
         let step = candidates_step.get()?;
         nest.with(|n| n.as_ref().map(|n| candidate_dots(n, step)))
     };
-    // A route of whole contours: its cuts in one path. Tool-on paths: one element each,
-    // coloured in turn (six hues, distinct in every theme), so where one path ends and the
-    // next begins shows.
+    // A route of whole contours: its cuts in one path. Tool-on paths: coloured in turn (six
+    // hues, distinct in every theme), so where one path ends and the next begins shows; one
+    // element per hue, not per path: 5,000 path elements slowed every animation frame of the
+    // view (Layout and Layerize, BENCHMARKS.md). The pierce marks name each path on hover.
     let cuts = move || {
         if paths.with(Option::is_some) {
             return None;
@@ -1138,18 +1145,19 @@ fn NestView(
         }
         animation.timeline.with(|t| {
             let t = t.as_ref()?;
-            let pieces = cut_paths_by_step(&t.toolpath);
-            let total = pieces.len();
+            let mut hues = vec![(String::new(), 0_usize); PATH_HUES];
+            for (k, d) in cut_paths_by_step(&t.toolpath).into_iter().enumerate() {
+                let (all, count) = &mut hues[k % PATH_HUES];
+                all.push_str(&d);
+                *count += 1;
+            }
             Some(
-                pieces
-                    .into_iter()
+                hues.into_iter()
                     .enumerate()
-                    .map(|(k, d)| {
-                        let title = format!("tool-on path {} of {total}", k + 1);
+                    .filter(|(_, (_, count))| *count > 0)
+                    .map(|(hue, (d, count))| {
                         view! {
-                            <path class=format!("cut tool-on-path hue-{}", k % PATH_HUES) data-path=k + 1 d=d>
-                                <title>{title}</title>
-                            </path>
+                            <path class=format!("cut tool-on-path hue-{hue}") data-paths=count d=d />
                         }
                     })
                     .collect_view(),

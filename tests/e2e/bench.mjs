@@ -162,17 +162,23 @@ async function traceBreakdown(browser, page, kind) {
   return names.filter((n) => total[n] > 0).map((n) => `${n} ${(total[n] / FRAMES).toFixed(2)}`).join(', ');
 }
 
-async function animation(browser, page) {
+/** Solves with `solver`, then plays its route for FRAMES frames (and, with `gestures`, zooms and
+ * pans while it plays). */
+async function animation(browser, page, solver = 'nearest', gestures = true, timeLimit = null) {
   if (await page.locator('#anim-play').count() === 0) return null;
   // The animation plays a route: the nest opened above has none yet, so solve it first with
   // the quickest solver (the play button stays disabled until a route is shown).
   const solveStart = Date.now();
-  await page.selectOption('#solver', 'nearest');
+  await page.selectOption('#solver', solver);
+  if (timeLimit !== null) {
+    await page.fill('#time-limit', String(timeLimit));
+    await page.dispatchEvent('#time-limit', 'change');
+  }
   await page.click('#start');
   await page.waitForFunction(() => document.querySelector('#job-status')?.textContent === 'finished',
     null, { timeout: 300000 });
   await page.waitForFunction(() => !document.querySelector('#anim-play')?.disabled, null, { timeout: 60000 });
-  notes.push(`animation: route by the nearest solver first (${((Date.now() - solveStart) / 1000).toFixed(1)} s to solve and draw)`);
+  notes.push(`animation: route by the ${solver} solver first (${((Date.now() - solveStart) / 1000).toFixed(1)} s to solve and draw)`);
   // Fastest speed the control offers, so the head moves every frame.
   await page.evaluate(() => {
     const speed = document.querySelector('#anim-speed');
@@ -201,8 +207,15 @@ async function animation(browser, page) {
     const step = () => { if (++k > n) resolve(); else requestAnimationFrame(step); };
     requestAnimationFrame(step);
   }), FRAMES));
-  notes.push(`animation trace, ms per frame (a second, traced run): ${trace}`);
+  notes.push(`animation (${solver}) trace, ms per frame (a second, traced run): ${trace}`);
   result.chunks = await page.evaluate(() => document.querySelector('#anim-overlay')?.dataset.chunks);
+  // Pierces = tool-on paths of a path route (drawn in six elements, one per hue).
+  result.toolOnPaths = Number(await page.textContent('#pierces'));
+  result.gestures = null;
+  if (!gestures) {
+    await page.click('#anim-play');
+    return result;
+  }
   // Pan and zoom while it keeps playing: both must stay smooth together.
   result.gestures = {};
   for (const kind of ['zoom', 'pan']) {
@@ -272,6 +285,15 @@ try {
         `${fmt(gs.fps, 1)} fps (mean ${fmt(gs.mean, 1)} ms, p95 ${fmt(gs.p95, 1)} ms)`, '≥ 30 fps', gs.fps >= 30 && g.playing);
       notes.push(`${kind} while animating: ${g.distinctViews} distinct views; the head advanced ${fmt(g.advanced, 1)} s of machine time and was ${g.playing ? 'still playing' : 'NOT playing'} at the end`);
     }
+  }
+  // A route of tool-on paths (issue 8): one drawn element per path, the same animation. SCCP
+  // with a short limit (AOE's plan graph of 5,000 contours takes minutes).
+  const paths = await animation(browser, page, 'sccp', false, 2);
+  if (paths !== null) {
+    const s = frameStats(paths);
+    row(`animation of the SCCP route (${paths.toolOnPaths} tool-on paths) at 5,000 contours, ${FRAMES} frames`,
+      `${fmt(s.fps, 1)} fps (mean ${fmt(s.mean, 1)} ms, p95 ${fmt(s.p95, 1)} ms)`, '≥ 30 fps', s.fps >= 30);
+    notes.push(`animation (sccp): the tool head showed ${paths.distinctTimes} distinct machine times in ${FRAMES} frames; the route is drawn in ${paths.chunks} chunks`);
   }
   if (errors.length) notes.push(`page errors: ${errors.join(' | ')}`);
   await context.close();

@@ -71,9 +71,9 @@ function downloader(page) {
 }
 
 /**
- * The drawing of a route of tool-on paths: one element per path (hues in turn), pierce circles
- * and order numbers per path, and the drawn tool-on length (paths + links, measured by the
- * browser) equal to the stats' cut length. Returns the drawn link length.
+ * The drawing of a route of tool-on paths: paths in six hues taken in turn (one element per hue),
+ * pierce circles and order numbers per path, and the drawn tool-on length (paths + links,
+ * measured by the browser) equal to the stats' cut length. Returns the drawn link length.
  */
 async function checkPathDrawing(page, shown, what) {
   const drawn = await page.evaluate(() => {
@@ -83,7 +83,8 @@ async function checkPathDrawing(page, shown, what) {
     return {
       count: paths.length,
       hues: [...new Set(paths.map((p) => [...p.classList].find((c) => c.startsWith('hue-'))))],
-      numbers: paths.map((p) => Number(p.dataset.path)),
+      perHue: paths.map((p) => Number(p.dataset.paths)),
+      numbers: [...document.querySelectorAll('#nest-view .order text')].map((t) => Number(t.textContent)),
       pathLength: paths.reduce((sum, p) => sum + length(p), 0),
       linkLength: length(link),
       pierces: document.querySelectorAll('#nest-view .route circle.pierce').length,
@@ -91,9 +92,11 @@ async function checkPathDrawing(page, shown, what) {
       plainCut: document.querySelector('#nest-view .route path.cut:not(.tool-on-path)')?.getAttribute('d') ?? '',
     };
   });
-  assert.equal(drawn.count, shown.pierces, `${what}: one element per tool-on path`);
-  assert.deepEqual(drawn.numbers, Array.from({ length: drawn.count }, (_, k) => k + 1), `${what}: numbered in order`);
-  if (drawn.count > 1) assert.ok(drawn.hues.length >= 2, `${what}: neighbouring paths differ (${drawn.hues})`);
+  assert.equal(drawn.count, Math.min(6, shown.pierces), `${what}: one element per hue in use`);
+  assert.equal(drawn.hues.length, drawn.count, `${what}: each element its own hue (${drawn.hues})`);
+  assert.deepEqual(drawn.perHue, Array.from({ length: drawn.count },
+    (_, h) => Math.floor((shown.pierces - 1 - h) / 6) + 1), `${what}: path k takes hue k mod 6`);
+  assert.deepEqual(drawn.numbers, Array.from({ length: shown.pierces }, (_, k) => k + 1), `${what}: numbered in order`);
   assert.equal(drawn.pierces, shown.pierces, `${what}: a pierce mark per path`);
   assert.equal(drawn.labels, shown.pierces, `${what}: an order number per path`);
   assert.equal(drawn.plainCut, '', `${what}: no whole-contour cut path`);
@@ -208,6 +211,14 @@ for (const solver of ['sccp', 'gsccp', 'aoe']) {
     await page.click('.export summary');
     assert.equal(await page.isDisabled('#export-result'), true);
     assert.match(await page.textContent('#export-result-note'), /cannot hold tool-on paths/);
+    // The standalone page animates the same route: its clock ends at the app's machine time,
+    // one pierce mark per path.
+    const html = fs.readFileSync(await downloader(page)('#export-html'), 'utf8');
+    const data = html.match(/<script type="application\/json" id="route-data">([^<]*)<\/script>/);
+    assert.ok(data, `${solver}: the page embeds its route data`);
+    const samples = JSON.parse(data[1]);
+    assert.ok(Math.abs(samples.at(-1)[0] - shown.time) <= 0.01, `${solver}: page's time ${samples.at(-1)[0]} vs ${shown.time}`);
+    assert.equal([...html.matchAll(/<circle class="pierce"/g)].length, shown.pierces, `${solver}: the page's pierces`);
     await page.click('.export summary');
     await screenshot(page, `segments-${solver}.png`);
     await playToEnd(page, shown, solver);
