@@ -3,11 +3,12 @@
 //! [`PlanGraph::route`] fixes *what* each pierce cuts (the OE-route of every component of the
 //! plan graph); this module decides *in which order* the components are visited, so the idle
 //! travel between them is short, and turns the chains into tool-on paths. A component's own
-//! chains keep their OE order (reordering them could enclose an uncut edge). Between components
+//! chains keep their OE order (reordering them could enclose an uncut edge); only a component
+//! that is one simple closed curve may start anywhere on it. Between components
 //! the only rule is containment: a component holding a contour that lies inside a contour of
 //! another component is cut first (the part it frees would otherwise fall with uncut edges).
 
-use cutroute_geometry::{Nest, PathRoute, PathRouteError, Point, ToolOnPath};
+use cutroute_geometry::{BoundingBox, Nest, PathRoute, PathRouteError, Point, Span, ToolOnPath};
 use thiserror::Error;
 
 use crate::{CheckError, CutChain, EmbeddingError, PlanError, PlanGraph, PlanOptions};
@@ -38,7 +39,9 @@ impl Default for AoeSolveOptions {
 pub struct AoeSolution {
     /// The route, accepted by [`PathRoute::problems`].
     pub route: PathRoute,
-    /// The chains in cutting order, accepted by [`PlanGraph::check_route`].
+    /// The chains in cutting order, accepted by [`PlanGraph::check_route`]. A component that
+    /// is one simple closed curve is cut from the point the ordering chose: its path in
+    /// `route` is its chain's spans opened there.
     pub chains: Vec<CutChain>,
     /// Connected components of the plan graph.
     pub components: usize,
@@ -68,16 +71,31 @@ pub enum AoeSolveError {
 
 /// One component's part of the route: its chains, where it is entered and left, and the idle
 /// travel between its own chains (fixed by its OE-route).
+#[derive(Clone)]
 struct Visit {
     chains: Vec<CutChain>,
     entry: Point,
     exit: Point,
     inner_idle: f64,
+    /// For a component that is one simple closed curve (every vertex of degree 2, one chain):
+    /// where the curve is opened. Such a chain may start anywhere on it — no pass can cross,
+    /// and nothing is enclosed before the curve closes — so `entry = exit` is chosen as for
+    /// CCP-Relax's contours.
+    opening: Option<Opening>,
+}
+
+/// Where a closed chain is opened: on span `span` of its spans, at parameter `t`.
+#[derive(Clone, Copy)]
+struct Opening {
+    span: usize,
+    t: f64,
 }
 
 /// Cuts every contour of `nest` along AOE-chains: common edges once, each component of the plan
 /// graph by its OE-route, components ordered inner-first and then by short idle moves (nearest
-/// ready component, improved by moving single components while precedence allows).
+/// ready component, improved by moving single components while precedence allows); a
+/// component that is one simple closed curve (a part with no common edge) is pierced at the
+/// point that shortens the idle travel, as CCP-Relax places its pierce points.
 ///
 /// ```
 /// use cutroute_aoe::{solve_nest, AoeSolveOptions};
@@ -118,11 +136,15 @@ pub fn solve_nest(nest: &Nest, options: &AoeSolveOptions) -> Result<AoeSolution,
             .windows(2)
             .filter_map(|w| Some(w[0].spans.last()?.end.distance(w[1].spans.first()?.start)))
             .sum();
+        let simple_cycle = chains.len() == 1
+            && (0..component.embedding.graph().vertex_count())
+                .all(|v| component.embedding.graph().degree(v) == 2);
         visits.push(Visit {
             chains,
             entry,
             exit,
             inner_idle,
+            opening: simple_cycle.then_some(Opening { span: 0, t: 0.0 }),
         });
         let mut contours: Vec<_> = component
             .edges
@@ -160,31 +182,72 @@ pub fn solve_nest(nest: &Nest, options: &AoeSolveOptions) -> Result<AoeSolution,
         order.sort_by(|&a, &b| enclosed[a].total_cmp(&enclosed[b]));
         order
     };
-    let idle = |order: &[usize]| idle_length(&visits, order, options.start, options.finish);
-    let unordered_idle_length = idle(&area_order);
-    let order = match nearest_ready_order(&visits, &before, options.start) {
-        // A containment cycle cannot come from a valid nest; keep the area order then.
-        Some(greedy) if idle(&greedy) < unordered_idle_length => greedy,
-        _ => area_order,
-    };
-    let order = improve_by_moves(order, &before, |o| idle(o));
+    let (start, finish) = (options.start, options.finish);
+    let unordered_idle_length = idle_length(&visits, &area_order, start, finish);
+    let mut after: Vec<Vec<usize>> = vec![Vec::new(); n];
+    for (b, list) in before.iter().enumerate() {
+        for &a in list {
+            after[a].push(b);
+        }
+    }
+    // Nearest ready component (closed curves entered at their nearest point), then rounds of
+    // single-component moves and relaxation of the closed curves' points, while they gain.
+    // Two starts — closed curves entered at their nearest point, or at their chain's start —
+    // each improved; the shorter wins, and the plain area order if both are longer.
+    let mut best = (unordered_idle_length, visits.clone(), area_order.clone());
+    for choose_points in [true, false] {
+        let mut placed = visits.clone();
+        // A containment cycle cannot come from a valid nest; the area order stays then.
+        let Some(mut order) =
+            nearest_ready_order(&mut placed, &before, &after, start, choose_points)
+        else {
+            continue;
+        };
+        for _ in 0..ORDER_ROUNDS {
+            order = improve_by_moves(order, &before, &after, &placed, start, finish);
+            if relax_openings(&mut placed, &order, start, finish) < 1e-6 {
+                break;
+            }
+        }
+        let idle = idle_length(&placed, &order, start, finish);
+        if idle < best.0 {
+            best = (idle, placed, order);
+        }
+    }
+    let (_, visits, order) = best;
 
     let chains: Vec<CutChain> = order
         .iter()
         .flat_map(|&c| visits[c].chains.iter().cloned())
         .collect();
     plan.check_route(&chains)?;
+    let mut paths = Vec::with_capacity(chains.len());
+    for &c in &order {
+        let visit = &visits[c];
+        match visit.opening {
+            Some(opening) => {
+                let spans = &visit.chains[0].spans;
+                paths.push(ToolOnPath {
+                    pierce: visit.entry,
+                    spans: opened(spans, opening, visit.entry),
+                });
+            }
+            None => paths.extend(
+                visit
+                    .chains
+                    .iter()
+                    .filter(|c| !c.spans.is_empty())
+                    .map(|c| ToolOnPath {
+                        pierce: c.spans[0].start,
+                        spans: c.spans.clone(),
+                    }),
+            ),
+        }
+    }
     let route = PathRoute {
-        start: options.start,
-        paths: chains
-            .iter()
-            .filter(|c| !c.spans.is_empty())
-            .map(|c| ToolOnPath {
-                pierce: c.spans[0].start,
-                spans: c.spans.clone(),
-            })
-            .collect(),
-        finish: options.finish,
+        start,
+        paths,
+        finish,
     };
     let tolerance = (options.plan.tolerance * 10.0).max(1e-6);
     if let Some(problem) = route.problems(nest, tolerance).into_iter().next() {
@@ -214,30 +277,74 @@ fn idle_length(visits: &[Visit], order: &[usize], start: Point, finish: Option<P
     total
 }
 
-/// Nearest ready component first; `None` when the precedence has a cycle.
+/// Where a closed curve is opened, and the point there.
+type Placed = (Opening, Point);
+
+/// Most rounds of component moves and relaxation of the closed curves' points.
+const ORDER_ROUNDS: usize = 8;
+
+/// Nearest ready component first (with `choose_points`, a closed curve is measured to, and
+/// entered at, its nearest point; else at its chain's start); `None` when the precedence has a
+/// cycle.
 fn nearest_ready_order(
-    visits: &[Visit],
+    visits: &mut [Visit],
     before: &[Vec<usize>],
+    after: &[Vec<usize>],
     start: Point,
+    choose_points: bool,
 ) -> Option<Vec<usize>> {
     let n = visits.len();
     let mut waiting: Vec<usize> = before.iter().map(Vec::len).collect();
-    let mut after: Vec<Vec<usize>> = vec![Vec::new(); n];
-    for (b, list) in before.iter().enumerate() {
-        for &a in list {
-            after[a].push(b);
-        }
-    }
     let mut done = vec![false; n];
     let mut order = Vec::with_capacity(n);
     let mut at = start;
+    // A closed curve's distance is at least its box's: the exact nearest point is needed only
+    // for curves whose box is nearer than the best so far.
+    let boxes: Vec<BoundingBox> = visits
+        .iter()
+        .map(|v| {
+            v.chains[0]
+                .spans
+                .iter()
+                .fold(BoundingBox::EMPTY, |b, s| b.union(s.bounding_box()))
+        })
+        .collect();
     while order.len() < n {
-        let next = (0..n)
+        let mut ready: Vec<(f64, usize)> = (0..n)
             .filter(|&c| !done[c] && waiting[c] == 0)
-            .min_by(|&a, &b| {
-                at.distance(visits[a].entry)
-                    .total_cmp(&at.distance(visits[b].entry))
-            })?;
+            .map(|c| match visits[c].opening {
+                Some(_) if choose_points => (box_distance(&boxes[c], at), c),
+                _ => (at.distance(visits[c].entry), c),
+            })
+            .collect();
+        ready.sort_by(|a, b| a.0.total_cmp(&b.0));
+        // (distance, component, where a closed curve is entered)
+        let mut best: Option<(f64, usize, Option<Placed>)> = None;
+        for (lower, c) in ready {
+            if best.as_ref().is_some_and(|b| lower >= b.0) {
+                break;
+            }
+            let bound = best.as_ref().map_or(f64::INFINITY, |b| b.0);
+            let candidate = match visits[c].opening {
+                Some(_) if choose_points => {
+                    match best_point(&visits[c].chains[0].spans, at, None, bound) {
+                        Some((span, t, point, distance)) => {
+                            (distance, c, Some((Opening { span, t }, point)))
+                        }
+                        None => continue,
+                    }
+                }
+                _ => (lower, c, None),
+            };
+            if best.as_ref().is_none_or(|b| candidate.0 < b.0) {
+                best = Some(candidate);
+            }
+        }
+        let (_, next, place) = best?;
+        if let Some((opening, point)) = place {
+            let visit = &mut visits[next];
+            (visit.opening, visit.entry, visit.exit) = (Some(opening), point, point);
+        }
         done[next] = true;
         order.push(next);
         at = visits[next].exit;
@@ -248,54 +355,70 @@ fn nearest_ready_order(
     Some(order)
 }
 
-/// Or-opt with segments of one: move a component to the position that shortens the idle
-/// length most, among the positions after all its predecessors and before all its
-/// successors; repeat until no move helps.
+/// Or-opt with segments of one: move a component to the place that shortens the idle travel
+/// most (evaluated by the four joints that change), among the places after all its
+/// predecessors and before all its successors; passes until no move helps.
 fn improve_by_moves(
     mut order: Vec<usize>,
     before: &[Vec<usize>],
-    idle: impl Fn(&[usize]) -> f64,
+    after: &[Vec<usize>],
+    visits: &[Visit],
+    start: Point,
+    finish: Option<Point>,
 ) -> Vec<usize> {
     let n = order.len();
-    let mut best = idle(&order);
-    // Each pass is O(n²) evaluations of O(n): bound the work on big plans.
-    let passes = if n <= 200 { 20 } else { 2 };
-    for _ in 0..passes {
+    let (entry, exit) = (|c: usize| visits[c].entry, |c: usize| visits[c].exit);
+    // The cost of putting `c` between `u` (an exit) and `v` (the next entry, if any).
+    let joint = |u: Point, c: usize, v: Option<Point>| {
+        u.distance(entry(c)) + v.map_or(0.0, |v| exit(c).distance(v) - u.distance(v))
+    };
+    let mut pos = vec![0; n];
+    for _ in 0..MAX_MOVE_PASSES {
         let mut improved = false;
         for i in 0..n {
             let c = order[i];
-            let mut rest = order.clone();
-            rest.remove(i);
-            let position: Vec<usize> = {
-                let mut p = vec![0; n];
-                for (k, &x) in rest.iter().enumerate() {
-                    p[x] = k;
-                }
-                p
+            let p = if i == 0 { start } else { exit(order[i - 1]) };
+            let q = if i + 1 < n {
+                Some(entry(order[i + 1]))
+            } else {
+                finish
             };
+            let saving = joint(p, c, q);
+            if saving <= 1e-9 {
+                continue;
+            }
+            for (k, &x) in order.iter().enumerate() {
+                pos[x] = k;
+            }
+            // Positions in the order without `c`.
+            let rest = |k: usize| if k < i { order[k] } else { order[k + 1] };
+            let rest_pos = |x: usize| if pos[x] < i { pos[x] } else { pos[x] - 1 };
             let lo = before[c]
                 .iter()
-                .map(|&a| position[a] + 1)
+                .map(|&a| rest_pos(a) + 1)
                 .max()
                 .unwrap_or(0);
-            let hi = (0..n)
-                .filter(|&b| b != c && before[b].contains(&c))
-                .map(|b| position[b])
-                .min()
-                .unwrap_or(rest.len());
-            for k in lo..=hi.min(rest.len()) {
+            let hi = after[c].iter().map(|&b| rest_pos(b)).min().unwrap_or(n - 1);
+            let mut best = (saving - 1e-9, None);
+            for k in lo..=hi.min(n - 1) {
                 if k == i {
                     continue;
                 }
-                let mut candidate = rest.clone();
-                candidate.insert(k, c);
-                let value = idle(&candidate);
-                if value < best - 1e-9 {
-                    best = value;
-                    order = candidate;
-                    improved = true;
-                    break;
+                let u = if k == 0 { start } else { exit(rest(k - 1)) };
+                let v = if k < n - 1 {
+                    Some(entry(rest(k)))
+                } else {
+                    finish
+                };
+                let cost = joint(u, c, v);
+                if cost < best.0 {
+                    best = (cost, Some(k));
                 }
+            }
+            if let (_, Some(k)) = best {
+                order.remove(i);
+                order.insert(k, c);
+                improved = true;
             }
         }
         if !improved {
@@ -303,4 +426,167 @@ fn improve_by_moves(
         }
     }
     order
+}
+
+/// Most passes of [`improve_by_moves`] (each O(n²)).
+const MAX_MOVE_PASSES: usize = 50;
+
+/// Sweeps over the order moving each closed curve's point to the minimiser of
+/// `|previous exit, M| + |M, next entry|` on the curve, until a sweep gains less than 10⁻⁶ mm;
+/// returns the total gain.
+fn relax_openings(
+    visits: &mut [Visit],
+    order: &[usize],
+    start: Point,
+    finish: Option<Point>,
+) -> f64 {
+    let mut total = 0.0;
+    for _ in 0..MAX_RELAXATION_SWEEPS {
+        let mut gain = 0.0;
+        for (i, &c) in order.iter().enumerate() {
+            if visits[c].opening.is_none() {
+                continue;
+            }
+            let a = if i == 0 {
+                start
+            } else {
+                visits[order[i - 1]].exit
+            };
+            let b = order.get(i + 1).map(|&d| visits[d].entry).or(finish);
+            let visit = &visits[c];
+            let old = a.distance(visit.entry) + b.map_or(0.0, |b| visit.exit.distance(b));
+            let Some((span, t, point, value)) = best_point(&visit.chains[0].spans, a, b, old)
+            else {
+                continue;
+            };
+            if value < old - 1e-12 {
+                let visit = &mut visits[c];
+                (visit.opening, visit.entry, visit.exit) =
+                    (Some(Opening { span, t }), point, point);
+                gain += old - value;
+            }
+        }
+        total += gain;
+        if gain < 1e-6 {
+            break;
+        }
+    }
+    total
+}
+
+const MAX_RELAXATION_SWEEPS: usize = 50;
+
+/// The point `M` of a closed chain of spans minimising `|a M| + |M b|` (`|a M|` without `b`):
+/// `(span, t, M, value)`, or `None` if no point beats `bound`. Per span: the nearest point
+/// without `b`; with `b`, the crossing of segment `ab` if any, else golden-section search (on a
+/// line the sum is convex; on an arc, around the best of a few samples). Spans whose box is
+/// already farther than the best value (at first `bound`) are skipped.
+fn best_point(
+    spans: &[Span],
+    a: Point,
+    b: Option<Point>,
+    bound: f64,
+) -> Option<(usize, f64, Point, f64)> {
+    let mut best = (0, 0.0, spans.first()?.start, bound);
+    let mut found = false;
+    for (i, span) in spans.iter().enumerate() {
+        let bb = span.bounding_box();
+        let to_box = |p: Point| box_distance(&bb, p);
+        if to_box(a) + b.map_or(0.0, to_box) >= best.3 {
+            continue;
+        }
+        let (t, value) = match b {
+            None => {
+                let q = span.nearest_point(a);
+                (q.t, q.distance)
+            }
+            Some(b) => {
+                let f = |t: f64| {
+                    let m = span.point_at(t);
+                    a.distance(m) + m.distance(b)
+                };
+                if let Some(x) = span.intersect_segment(a, b).first() {
+                    (x.t_self, f(x.t_self))
+                } else if span.is_line() {
+                    golden(&f, 0.0, 1.0)
+                } else {
+                    let samples =
+                        8 + (span.sweep().abs() / (std::f64::consts::PI / 8.0)).ceil() as usize;
+                    let k = (0..=samples)
+                        .min_by(|&x, &y| {
+                            f(x as f64 / samples as f64).total_cmp(&f(y as f64 / samples as f64))
+                        })
+                        .unwrap_or(0);
+                    golden(
+                        &f,
+                        k.saturating_sub(1) as f64 / samples as f64,
+                        (k + 1).min(samples) as f64 / samples as f64,
+                    )
+                }
+            }
+        };
+        if value < best.3 {
+            best = (i, t, span.point_at(t), value);
+            found = true;
+        }
+    }
+    found.then_some(best)
+}
+
+/// Distance from `p` to a box (0 inside).
+fn box_distance(b: &BoundingBox, p: Point) -> f64 {
+    let dx = (b.min.x - p.x).max(p.x - b.max.x).max(0.0);
+    let dy = (b.min.y - p.y).max(p.y - b.max.y).max(0.0);
+    dx.hypot(dy)
+}
+
+/// Golden-section search for the minimum of a unimodal `f` on `[lo, hi]`; the bracket's ends
+/// are tried too (a monotone `f` is least there): `(t, f(t))`.
+fn golden(f: &impl Fn(f64) -> f64, mut lo: f64, mut hi: f64) -> (f64, f64) {
+    const R: f64 = 0.618_033_988_749_894_8;
+    let (first, last) = (lo, hi);
+    let (mut x1, mut x2) = (hi - R * (hi - lo), lo + R * (hi - lo));
+    let (mut f1, mut f2) = (f(x1), f(x2));
+    for _ in 0..60 {
+        if hi - lo < 1e-12 {
+            break;
+        }
+        if f1 <= f2 {
+            (hi, x2, f2) = (x2, x1, f1);
+            x1 = hi - R * (hi - lo);
+            f1 = f(x1);
+        } else {
+            (lo, x1, f1) = (x1, x2, f2);
+            x2 = lo + R * (hi - lo);
+            f2 = f(x2);
+        }
+    }
+    let mid = 0.5 * (lo + hi);
+    [first, last]
+        .into_iter()
+        .map(|t| (t, f(t)))
+        .fold((mid, f(mid)), |best, x| if x.1 < best.1 { x } else { best })
+}
+
+/// A closed chain of spans opened at `point` (on span `opening.span` at `opening.t`): the rest
+/// of that span, the spans after it round the cycle, the part of that span before the point.
+fn opened(spans: &[Span], opening: Opening, point: Point) -> Vec<Span> {
+    let i = opening.span;
+    let mut out = Vec::with_capacity(spans.len() + 1);
+    let mut at = point;
+    let mut push = |mut s: Span| {
+        if s.length() > 1e-12 {
+            s.start = at;
+            at = s.end;
+            out.push(s);
+        }
+    };
+    push(spans[i].sub_span(opening.t, 1.0));
+    for k in 1..spans.len() {
+        push(spans[(i + k) % spans.len()]);
+    }
+    let mut tail = spans[i].sub_span(0.0, opening.t);
+    tail.end = point;
+    push(tail);
+    out
 }

@@ -142,3 +142,39 @@ fn every_real_nest_gets_a_checked_route_at_the_pierce_lower_bound() {
         );
     }
 }
+
+/// A part with no common edge is one closed curve: it may be pierced anywhere, and the solver
+/// places the point as CCP-Relax would. Two 10 × 10 squares 10 mm apart, the head below the
+/// first: the optimum goes up to the first square, pierces at its lower right corner (the
+/// minimiser of |S M| + |M N|) and crosses the 10 mm gap: √74 + 10 mm.
+#[test]
+fn closed_curves_are_pierced_where_the_idle_travel_is_shortest() {
+    let nest = Nest {
+        sheet: None,
+        parts: vec![
+            part(vec![rect(0.0, 0.0, 10.0, 10.0)]),
+            part(vec![rect(20.0, 0.0, 30.0, 10.0)]),
+        ],
+    };
+    let options = AoeSolveOptions {
+        start: Point::new(5.0, -7.0),
+        ..AoeSolveOptions::default()
+    };
+    let solution = check(&nest, &options);
+    assert_eq!(solution.route.pierce_count(), 2);
+    let idle = solution.route.idle_length();
+    assert!((idle - (74f64.sqrt() + 10.0)).abs() < 1e-6, "idle {idle}");
+    // One square alone: straight up to its nearest point.
+    let one = Nest {
+        sheet: None,
+        parts: vec![part(vec![rect(0.0, 0.0, 10.0, 10.0)])],
+    };
+    let solution = check(&one, &options);
+    assert!((solution.route.idle_length() - 7.0).abs() < 1e-9);
+    assert!(
+        solution.route.paths[0]
+            .pierce
+            .distance(Point::new(5.0, 0.0))
+            < 1e-9
+    );
+}

@@ -17,16 +17,18 @@
 //! idle travel and of cut and per pierce, speeds in mm/s, the pierce time in s.
 //! `sccp` cuts the multi-contour chains of the nest's plan graph (common edges once) as base
 //! segments; `gsccp` also tries standard cutting and contours split at junctions and keeps
-//! the best by `--objective` (`cutroute-segments`); both report the route as tool-on paths
-//! (`PathRoute` JSON) and each ensemble's numbers.
+//! the best by `--objective` (`cutroute-segments`); `aoe` cuts common edges once along
+//! AOE-chains (`cutroute-aoe`). The three run the job engine's path-route jobs, as the app
+//! does, and report the route as tool-on paths (`PathRoute` JSON), `ub`/`lb` in the
+//! objective's unit, and (sccp, gsccp) each ensemble's numbers.
 //! Errors go to stderr with the reader's location, and the exit code is 1.
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use cutroute_engine::{open_document, run_to_end, start_job};
-use cutroute_geometry::{Entry, MachineParameters, Nest, Route};
+use cutroute_engine::{open_document, run_to_end, start_job, AoeJob, SegmentJob};
+use cutroute_geometry::{Entry, MachineParameters, Nest, Objective, Route};
 use cutroute_protocol::{Document, JobRequest, Problem, Progress, SolverKind, SolverParams};
 use serde_json::{json, Value};
 
@@ -120,7 +122,8 @@ enum Command {
         /// A RouteManager task JSON whose speeds and pierce time are the defaults.
         #[arg(long)]
         task: Option<PathBuf>,
-        /// What gsccp minimises when it picks an ensemble: time or cost.
+        /// What gsccp minimises when it picks an ensemble, and the unit of the path-route
+        /// solvers' (sccp, gsccp, aoe) bounds: time or cost.
         #[arg(long, default_value = "time")]
         objective: String,
         /// Print one JSON object instead of text.
@@ -179,16 +182,21 @@ fn main() -> ExitCode {
             json,
         } => machine_parameters(cost.as_deref(), speeds.as_deref(), task.as_deref()).and_then(
             |machine| {
+                let objective = match objective.as_str() {
+                    "time" => Objective::Time,
+                    "cost" => Objective::Cost,
+                    other => return Err(format!("--objective {other:?}: expected time or cost")),
+                };
                 let params = SolverParams {
                     time_limit_s: time_limit,
                     seed,
                     discretisation_step_mm: step,
                     initial_upper_bound: ub,
                     machine,
-                    objective: Default::default(),
+                    objective,
                 };
                 match solver.as_str() {
-                    "sccp" | "gsccp" => solve_segments(&file, &solver, &params, &objective, json),
+                    "sccp" | "gsccp" | "aoe" => solve_path(&file, &solver, params, json),
                     _ => solve(&file, &solver, params, json),
                 }
             },
@@ -510,9 +518,6 @@ fn solve(
     as_json: bool,
 ) -> Result<(), String> {
     let document = open(path)?;
-    if solver_name == "aoe" {
-        return solve_aoe(&document, &params.machine, as_json);
-    }
     let solver = solver_kind(solver_name)?;
     let machine = params.machine;
     let request = JobRequest {
@@ -522,78 +527,11 @@ fn solve(
         params,
     };
     let mut job = start_job(&request).map_err(|e| e.to_string())?;
-    let mut last_report = -1.0;
-    let result = run_to_end(job.as_mut(), &mut |progress| {
-        if !as_json && progress.elapsed_s - last_report >= 1.0 {
-            last_report = progress.elapsed_s;
-            eprintln!(
-                "{:8.2} s  ub {:>12}  lb {:>12}  {}",
-                progress.elapsed_s,
-                fmt(progress.upper_bound),
-                fmt(progress.lower_bound),
-                progress.phase
-            );
-        }
-    });
+    let result = run_to_end(job.as_mut(), &mut progress_printer(as_json));
     let report = match &document.problem {
         Problem::PcgtspText { .. } => tour_report(solver_name, &result),
         Problem::Nest { nest, .. } => route_report(solver_name, nest, &machine, &result)?,
     };
-    print_report(&report, as_json);
-    Ok(())
-}
-
-/// `--solver aoe`: common edges cut once along AOE-chains (`cutroute_aoe::solve_nest`), the
-/// same report keys as the other nest solvers, the route as tool-on paths of spans.
-fn solve_aoe(
-    document: &Document,
-    machine: &MachineParameters,
-    as_json: bool,
-) -> Result<(), String> {
-    let Problem::Nest {
-        nest,
-        start,
-        finish,
-    } = &document.problem
-    else {
-        return Err("the aoe solver routes nests, not PCGTSP instances".into());
-    };
-    let started = std::time::Instant::now();
-    let scale = nest_scale(nest);
-    let options = cutroute_aoe::AoeSolveOptions {
-        plan: cutroute_aoe::PlanOptions {
-            tolerance: 1e-6 * scale,
-            ..cutroute_aoe::PlanOptions::default()
-        },
-        start: *start,
-        finish: *finish,
-    };
-    let solution = cutroute_aoe::solve_nest(nest, &options).map_err(|e| e.to_string())?;
-    let route = &solution.route;
-    // Checked again here, as every route the CLI prints.
-    route
-        .validate(nest, 1e-5 * scale)
-        .map_err(|e| format!("invalid route: {e}"))?;
-    let (idle_length, cut_length, pierces) = (
-        route.idle_length(),
-        route.cut_length(),
-        route.pierce_count(),
-    );
-    let report = json!({
-        "solver": "aoe",
-        "idle_length": idle_length,
-        "cut_length": cut_length,
-        "pierces": pierces,
-        "time_s": machine.time(cut_length, idle_length, pierces),
-        "cost": machine.cost(cut_length, idle_length, pierces),
-        "machine": machine_json(machine),
-        "pierce_lower_bound": solution.pierce_lower_bound,
-        "components": solution.components,
-        "route": route,
-        "ub": idle_length,
-        "lb": null,
-        "elapsed_s": started.elapsed().as_secs_f64(),
-    });
     print_report(&report, as_json);
     Ok(())
 }
@@ -689,63 +627,117 @@ fn nest_scale(nest: &Nest) -> f64 {
     ((b.max.x - b.min.x).abs() + (b.max.y - b.min.y).abs()).max(1.0)
 }
 
-/// `--solver sccp|gsccp`: segment cutting (`cutroute-segments`). sccp solves the multi-contour
-/// chain ensemble alone, gsccp every ensemble, keeping the best by `objective`. The report's
-/// numbers are recomputed from the route, which must pass `PathRoute::problems` but for
-/// contour cut twice (standard cutting of common edges, reported as `recut_length`).
-fn solve_segments(
+/// Prints a progress line to stderr about once a second (text mode only).
+fn progress_printer(as_json: bool) -> impl FnMut(&Progress) {
+    let mut last_report = -1.0;
+    move |progress: &Progress| {
+        if !as_json && progress.elapsed_s - last_report >= 1.0 {
+            last_report = progress.elapsed_s;
+            eprintln!(
+                "{:8.2} s  ub {:>12}  lb {:>12}  {}",
+                progress.elapsed_s,
+                fmt(progress.upper_bound),
+                fmt(progress.lower_bound),
+                progress.phase
+            );
+        }
+    }
+}
+
+/// `--solver sccp|gsccp|aoe`: the engine's path-route jobs (the app's code path), stepped to
+/// their end. sccp solves the multi-contour chain ensemble alone, gsccp every ensemble,
+/// keeping the best by `--objective`; aoe cuts common edges once along AOE-chains. The
+/// report's numbers are recomputed from the route, which must pass `PathRoute::problems` but
+/// for contour cut twice (standard cutting of common edges, reported as `recut_length`);
+/// `ub` and `lb` are the job's bounds in the objective's unit (s or cost).
+fn solve_path(
     path: &Path,
     solver_name: &str,
-    params: &SolverParams,
-    objective: &str,
+    params: SolverParams,
     as_json: bool,
 ) -> Result<(), String> {
-    use cutroute_segments::{EnsembleKind, GsccpOptions, Objective, SccpOptions};
     let document = open(path)?;
-    let Problem::Nest {
-        nest,
-        start,
-        finish,
-    } = &document.problem
-    else {
+    let Problem::Nest { nest, .. } = &document.problem else {
         return Err(format!(
             "the {solver_name} solver routes nests, not PCGTSP instances"
         ));
     };
-    let objective = match objective {
-        "time" => Objective::Time,
-        "cost" => Objective::Cost,
-        other => return Err(format!("--objective {other:?}: expected time or cost")),
-    };
-    if !(params.time_limit_s.is_finite() && params.time_limit_s > 0.0) {
+    let solver = solver_kind(solver_name)?;
+    if solver != SolverKind::Aoe && !(params.time_limit_s.is_finite() && params.time_limit_s > 0.0)
+    {
         return Err(format!(
             "--time-limit {}: must be a positive number of seconds",
             params.time_limit_s
         ));
     }
-    let kinds = if solver_name == "sccp" {
-        vec![EnsembleKind::Chains]
-    } else {
-        EnsembleKind::ALL.to_vec()
-    };
-    let options = GsccpOptions {
-        sccp: SccpOptions {
-            start: *start,
-            finish: *finish,
-            time_limit: std::time::Duration::from_secs_f64(params.time_limit_s),
-            seed: params.seed,
-            ..SccpOptions::default()
-        },
-        kinds,
-        machine: params.machine,
-        objective,
-        seed: params.seed,
-        ..GsccpOptions::default()
+    let machine = params.machine;
+    let objective = params.objective;
+    let request = JobRequest {
+        job_id: 1,
+        problem: document.problem.clone(),
+        solver,
+        params,
     };
     let started = std::time::Instant::now();
-    let result = cutroute_segments::solve_gsccp(nest, &options, &Default::default())
-        .map_err(|e| e.to_string())?;
-    let route = &result.route;
+    let mut on_progress = progress_printer(as_json);
+    let mut extra = serde_json::Map::new();
+    let progress = if solver == SolverKind::Aoe {
+        let mut job = AoeJob::from_request(&request).map_err(|e| e.to_string())?;
+        let progress = run_to_end(&mut job, &mut on_progress);
+        let (solution, _) = match job.outcome() {
+            Some(Ok(solved)) => solved,
+            Some(Err(e)) => return Err(e.clone()),
+            None => return Err("the aoe job did not run".into()),
+        };
+        extra.insert(
+            "pierce_lower_bound".into(),
+            json!(solution.pierce_lower_bound),
+        );
+        extra.insert("components".into(), json!(solution.components));
+        progress
+    } else {
+        let mut job = SegmentJob::from_request(&request).map_err(|e| e.to_string())?;
+        let progress = run_to_end(&mut job, &mut on_progress);
+        let result = job.search().result().map_err(|e| e.to_string())?;
+        extra.insert(
+            "ensemble".into(),
+            json!(result.best.map_or("ccp", |kind| kind.name())),
+        );
+        extra.insert(
+            "ensembles".into(),
+            json!(result
+                .reports
+                .iter()
+                .map(|r| json!({
+                    "kind": r.kind.name(),
+                    "segments": r.segments,
+                    "pierces": r.pierces,
+                    "idle_length": finite(r.idle_length),
+                    "cut_length": finite(r.cut_length),
+                    "recut_length": r.recut_length,
+                    "time_s": finite(r.time_s),
+                    "cost": finite(r.cost),
+                    "failure": r.failure,
+                }))
+                .collect::<Vec<_>>()),
+        );
+        extra.insert(
+            "ccp".into(),
+            json!({
+                "idle_length": result.ccp_route.idle_length(),
+                "cut_length": result.ccp_route.cut_length(),
+                "pierces": result.ccp_route.pierce_count(),
+                "time_s": result.ccp_route.time(&machine),
+                "cost": result.ccp_route.cost(&machine),
+            }),
+        );
+        progress
+    };
+    let route = progress
+        .path_route
+        .as_ref()
+        .ok_or_else(|| format!("the solver found no route ({})", progress.phase))?;
+    // Checked again here, as every route the CLI prints.
     let tolerance = 1e-6 * nest_scale(nest);
     let problems = route.problems(nest, tolerance);
     if let Some(other) = problems
@@ -755,13 +747,12 @@ fn solve_segments(
         return Err(format!("invalid route: {other}"));
     }
     let recut_length = cutroute_segments::recut_length(&problems, tolerance);
-    let machine = &params.machine;
     let (idle_length, cut_length, pierces) = (
         route.idle_length(),
         route.cut_length(),
         route.pierce_count(),
     );
-    let report = json!({
+    let mut report = json!({
         "solver": solver_name,
         "idle_length": idle_length,
         "cut_length": cut_length,
@@ -769,30 +760,17 @@ fn solve_segments(
         "pierces": pierces,
         "time_s": machine.time(cut_length, idle_length, pierces),
         "cost": machine.cost(cut_length, idle_length, pierces),
-        "objective": match objective { Objective::Time => "time", Objective::Cost => "cost" },
-        "machine": machine_json(machine),
-        "ensemble": result.best.map_or("ccp", |kind| kind.name()),
-        "ensembles": result.reports.iter().map(|r| json!({
-            "kind": r.kind.name(),
-            "segments": r.segments,
-            "pierces": r.pierces,
-            "idle_length": finite(r.idle_length),
-            "cut_length": finite(r.cut_length),
-            "recut_length": r.recut_length,
-            "time_s": finite(r.time_s),
-            "cost": finite(r.cost),
-            "failure": r.failure,
-        })).collect::<Vec<_>>(),
-        "ccp": {
-            "idle_length": result.ccp_route.idle_length(),
-            "cut_length": result.ccp_route.cut_length(),
-            "pierces": result.ccp_route.pierce_count(),
-            "time_s": result.ccp_route.time(machine),
-            "cost": result.ccp_route.cost(machine),
-        },
+        "objective": objective.name(),
+        "machine": machine_json(&machine),
         "route": serde_json::to_value(route).map_err(|e| e.to_string())?,
+        "ub": progress.upper_bound,
+        "lb": progress.lower_bound,
+        "phase": progress.phase,
         "elapsed_s": started.elapsed().as_secs_f64(),
     });
+    if let Value::Object(fields) = &mut report {
+        fields.extend(extra);
+    }
     print_report(&report, as_json);
     Ok(())
 }

@@ -127,3 +127,32 @@ fn segment_solvers_refuse_what_they_cannot_route() {
     let (ok, _, stderr) = cutroute(&["solve", &nest, "--solver", "gsccp", "--time-limit", "0"]);
     assert!(!ok && stderr.contains("--time-limit"), "{stderr}");
 }
+
+#[test]
+fn path_solvers_report_bounds_in_the_objectives_unit() {
+    // The engine's path-route jobs: `ub` is the route's time (s) or cost, `lb` bounds it.
+    let nest = data("nests/tflex/Nest01.tfnesting");
+    for solver in ["sccp", "gsccp", "aoe"] {
+        for (objective, key) in [("time", "time_s"), ("cost", "cost")] {
+            let v = json(&[
+                "solve",
+                &nest,
+                "--solver",
+                solver,
+                "--time-limit",
+                "1",
+                "--objective",
+                objective,
+                "--json",
+            ]);
+            check_route(&nest, &v);
+            let (ub, lb) = (number(&v, "ub"), number(&v, "lb"));
+            assert!(
+                (ub - number(&v, key)).abs() <= 1e-9 * ub,
+                "{solver} {objective}"
+            );
+            assert!(lb > 0.0 && lb <= ub, "{solver} {objective}: {lb} > {ub}");
+            assert_eq!(v["objective"], objective);
+        }
+    }
+}

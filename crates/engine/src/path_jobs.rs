@@ -224,16 +224,17 @@ impl SegmentJob {
 
 impl Job for SegmentJob {
     fn step(&mut self, budget: Duration) -> JobStatus {
-        let began = Instant::now();
         if self.bound.is_none() {
+            // A plan graph: one piece of work, a step of its own.
             self.bound = Some(PlanBound::new(
                 &self.nest,
                 self.start,
                 self.finish,
                 self.tolerance,
             ));
+            return JobStatus::Running;
         }
-        match self.search.step(budget.saturating_sub(began.elapsed())) {
+        match self.search.step(budget) {
             SearchStatus::Running => JobStatus::Running,
             SearchStatus::Finished => JobStatus::Done,
         }

@@ -345,3 +345,32 @@ fn path_solvers_refuse_pcgtsp_instances() {
         assert!(error.to_string().contains("PCGTSP"), "{error}");
     }
 }
+
+/// One rectangle with the head straight below its lower edge: the optimum is known (its
+/// perimeter, one pierce, the 7 mm up to the edge), and every path solver's lower bound and
+/// route both reach it.
+#[test]
+fn bounds_meet_at_the_known_optimum_of_one_rectangle() {
+    let machine = MachineParameters::default();
+    let problem = Problem::Nest {
+        nest: cutroute_segments::rectangle_grid(1, 1, 50.0, 30.0),
+        start: Point::new(20.0, -7.0),
+        finish: None,
+    };
+    for solver in [SolverKind::Sccp, SolverKind::Gsccp, SolverKind::Aoe] {
+        for objective in [Objective::Time, Objective::Cost] {
+            let params = params(1.0, objective);
+            let mut job = start_job(&request(&problem, solver, params.clone())).unwrap();
+            let result = run_to_end(job.as_mut(), &mut |_| {});
+            check_progress("rectangle", &problem, &params, &result);
+            let optimum = objective.value(&machine, 160.0, 7.0, 1);
+            let (lb, ub) = (result.lower_bound.unwrap(), result.upper_bound.unwrap());
+            assert!((ub - optimum).abs() <= 1e-9 * optimum, "{solver:?}: {ub}");
+            // Equal but for the slack the bound leaves for the plan's merging tolerance.
+            assert!(
+                lb <= optimum && optimum - lb <= 1e-5 * optimum,
+                "{solver:?}: {lb}"
+            );
+        }
+    }
+}

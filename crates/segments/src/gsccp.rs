@@ -214,7 +214,7 @@ impl GsccpSearch {
 
     /// Works for about `budget`, then returns. Building an ensemble and checking a finished
     /// route are single pieces of work that may overrun the budget (measured on the real nests
-    /// in `BENCHMARKS.md`). While an ensemble's search improves, its best route is checked at
+    /// in `BENCHMARKS.md`); a step that does one returns right after it. While an ensemble's search improves, its best route is checked at
     /// most every 300 ms (and at most a tenth of the time) so [`GsccpSearch::best`] follows it.
     pub fn step(&mut self, budget: Duration) -> SearchStatus {
         let slice_end = Instant::now() + budget;
@@ -229,22 +229,27 @@ impl GsccpSearch {
             let left = slice_end - now;
             match std::mem::replace(&mut self.stage, Stage::Finished) {
                 Stage::Finished => {}
+                // Ending a phase (a check over the whole nest) and building an ensemble (a
+                // plan graph) cannot be cut: each ends the step, so a step holds at most one.
                 Stage::Ccp(mut solver) => {
                     if solver.step(left) == SolverStatus::Finished {
                         self.ccp_done(&solver);
-                    } else {
-                        self.ccp_snapshot(&solver);
-                        self.stage = Stage::Ccp(solver);
+                        return self.status();
                     }
+                    self.ccp_snapshot(&solver);
+                    self.stage = Stage::Ccp(solver);
                 }
-                Stage::Build(k) => self.build(k),
+                Stage::Build(k) => {
+                    self.build(k);
+                    return self.status();
+                }
                 Stage::Search(k, mut search, report) => {
                     if search.step(left) == SearchStatus::Finished {
                         self.ensemble_done(k, &search, report);
-                    } else {
-                        self.snapshot(&search, report.kind);
-                        self.stage = Stage::Search(k, search, report);
+                        return self.status();
                     }
+                    self.snapshot(&search, report.kind);
+                    self.stage = Stage::Search(k, search, report);
                 }
             }
         }
@@ -272,6 +277,14 @@ impl GsccpSearch {
                 self.stage = Stage::Finished;
                 self.not_run(k + 1);
             }
+        }
+    }
+
+    fn status(&self) -> SearchStatus {
+        if self.is_finished() {
+            SearchStatus::Finished
+        } else {
+            SearchStatus::Running
         }
     }
 
@@ -331,7 +344,7 @@ impl GsccpSearch {
                 "segment cutting: {} ensemble ({} segments, {} shakes)",
                 report.kind.name(),
                 report.segments,
-                search.solution().shakes
+                search.shakes()
             ),
             Stage::Finished => match (&self.failure, self.best()) {
                 (Some(e), _) => format!("segment cutting failed: {e}"),

@@ -992,6 +992,11 @@ impl SccpSearch {
         }
     }
 
+    /// Shakes tried so far.
+    pub fn shakes(&self) -> usize {
+        self.shakes
+    }
+
     /// Time since [`SccpSearch::new`].
     pub fn elapsed(&self) -> Duration {
         self.started.elapsed()
