@@ -188,7 +188,9 @@ struct Overlap {
 
 /// Sub-intervals of `on` that lie on `other` within `tolerance`: the candidates are the ends of
 /// `on` and the projections of `other`'s ends; a piece between candidates lies on `other` when
-/// three interior points do (two distinct circles or lines share at most two points).
+/// its ends and three interior points do (two distinct circles or lines share at most two
+/// points). The ends matter for short pieces: next to `other`'s end, interior points of a piece
+/// up to 4/3 of `tolerance` long are within `tolerance` of `other` although the piece is not on it.
 fn pieces_on(on: &Span, other: &Span, tolerance: f64) -> Vec<(f64, f64)> {
     let mut cuts = vec![0.0, 1.0];
     for p in [other.start, other.end] {
@@ -205,7 +207,7 @@ fn pieces_on(on: &Span, other: &Span, tolerance: f64) -> Vec<(f64, f64)> {
         if !((b - a) * length > tolerance) {
             continue;
         }
-        let lies = [0.25, 0.5, 0.75]
+        let lies = [0.0, 0.25, 0.5, 0.75, 1.0]
             .iter()
             .all(|f| other.distance_to(on.point_at(a + (b - a) * f)) <= tolerance);
         if lies {
@@ -809,6 +811,43 @@ mod tests {
         good.paths.push(polyline(&[(100.0, 0.0), (0.0, 0.0)]));
         assert_eq!(good.problems(&nest, TOL), vec![]);
         assert_eq!(good.pierce_count(), 4);
+    }
+
+    #[test]
+    fn a_contour_opened_just_past_a_vertex_is_cut_once() {
+        // The last piece (vertex → pierce) is 1.3 tolerances long: its interior lies within
+        // the tolerance of the first span's line extension, yet it is not cut twice.
+        let tolerance = 0.01;
+        let nest = Nest {
+            sheet: None,
+            parts: vec![part(vec![rect(0.0, 0.0, 10.0, 10.0)])],
+        };
+        let pierce = 1.3 * tolerance;
+        let route = PathRoute {
+            start: p(0.0, 0.0),
+            paths: vec![polyline(&[
+                (pierce, 10.0),
+                (10.0, 10.0),
+                (10.0, 0.0),
+                (0.0, 0.0),
+                (0.0, 10.0),
+                (pierce, 10.0),
+            ])],
+            finish: None,
+        };
+        assert_eq!(route.problems(&nest, tolerance), vec![]);
+        // Cutting that short piece a second time is still an overlap.
+        let mut twice = route.clone();
+        twice.paths[0]
+            .spans
+            .push(Span::line(p(pierce, 10.0), p(0.0, 10.0)));
+        twice.paths[0]
+            .spans
+            .push(Span::line(p(0.0, 10.0), p(pierce, 10.0)));
+        assert!(twice
+            .problems(&nest, tolerance)
+            .iter()
+            .any(|e| matches!(e, PathRouteError::Overlap { .. })));
     }
 
     #[test]
