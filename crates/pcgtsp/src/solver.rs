@@ -2,6 +2,7 @@
 
 use crate::bounds::{Model, ResidualBounder};
 use crate::check::check_tour;
+use crate::completion::{PositionBound, PositionBoundOptions};
 use crate::dp::{Dp, DpStatus, Incumbent};
 use crate::heuristic;
 use crate::instance::Instance;
@@ -48,6 +49,10 @@ pub struct ExactOptions {
     /// `None` = `time_limit`. Set it when the run is stopped by another clock (e.g. CPU time)
     /// and `time_limit` is only a backstop.
     pub budget_seconds: Option<f64>,
+    /// Subgradient iterations of the position-indexed completion bound (`completion.rs`, a
+    /// per-state bound that sees precedence); 0 disables it. Used only when the lattice bound
+    /// is not built.
+    pub position_iterations: usize,
 }
 
 impl ExactOptions {
@@ -80,6 +85,13 @@ impl ExactOptions {
         (seconds * 2e7).clamp(1e7, 1e9)
     }
 
+    /// Work budget (arc relaxations) of the position bound's subgradient optimisation:
+    /// 5·10⁷ steps per second of the time limit, 10⁸–3·10⁹ (up to a few seconds).
+    fn effective_position_work(&self) -> f64 {
+        let seconds = self.budget_seconds_or(f64::INFINITY);
+        (seconds * 5e7).clamp(1e8, 3e9)
+    }
+
     /// The lattice work budget after resolving the automatic setting.
     fn effective_lattice_work(&self) -> usize {
         if self.lattice_work > 0 {
@@ -103,6 +115,7 @@ impl Default for ExactOptions {
             lattice_work: 0,
             penalty_iterations: 400,
             budget_seconds: None,
+            position_iterations: 3000,
         }
     }
 }
@@ -227,6 +240,15 @@ impl Engine {
         }
     }
 
+    fn set_position_bound(&mut self, model: &Model, position: Rc<PositionBound>) {
+        match self {
+            Engine::W1(dp) => dp.set_position_bound(model, position),
+            Engine::W2(dp) => dp.set_position_bound(model, position),
+            Engine::W4(dp) => dp.set_position_bound(model, position),
+            Engine::Unsupported => {}
+        }
+    }
+
     fn run(&mut self, model: &Model, incumbent: &mut Incumbent, work: u64) -> DpStatus {
         match self {
             Engine::W1(dp) => dp.run(model, incumbent, work),
@@ -296,6 +318,8 @@ struct Run {
     subset: Option<Rc<SubsetBound>>,
     /// Node penalties for the per-state assignment bounds (when the run has no lattice).
     penalties: Option<Rc<NodePenalties>>,
+    /// The position-indexed completion bound (when the run has no lattice).
+    position: Option<Rc<PositionBound>>,
     root_bound: f64,
     engine: Option<Engine>,
     finished_bound: Option<f64>,
@@ -336,6 +360,7 @@ impl Run {
         if store.root_bound().is_none() {
             // Without the lattice the DP bounds its states by assignments: strengthen them.
             self.build_penalties(instance, options, upper_bound);
+            self.build_position_bound(options, upper_bound);
         }
         if let Some(root) = store.root_bound() {
             self.root_bound = self.root_bound.max(self.model.round_bound(root));
@@ -410,6 +435,34 @@ impl Run {
         }
     }
 
+    /// The position-indexed completion bound (`completion.rs`).
+    fn build_position_bound(&mut self, options: &ExactOptions, upper_bound: f64) {
+        if options.position_iterations == 0 || self.model.m > 256 {
+            return;
+        }
+        let began = Instant::now();
+        let position = PositionBound::build(
+            &self.model,
+            upper_bound,
+            PositionBoundOptions {
+                iterations: options.position_iterations,
+                work: options.effective_position_work(),
+            },
+        );
+        if let Some(p) = &position {
+            self.root_bound = self.root_bound.max(self.model.round_bound(p.root_bound));
+            debug_log(|| {
+                format!(
+                    "position bound in {:?}: root {} ({} iterations)",
+                    began.elapsed(),
+                    p.root_bound,
+                    p.iterations
+                )
+            });
+        }
+        self.position = position.map(Rc::new);
+    }
+
     /// A new DP engine with every bound this run has.
     fn engine(&mut self, beam: Option<usize>, memory: usize, use_l2: bool) -> Engine {
         let store = self
@@ -422,6 +475,9 @@ impl Run {
         }
         if let Some(penalties) = &self.penalties {
             engine.set_penalties(&self.model, penalties.clone());
+        }
+        if let Some(position) = &self.position {
+            engine.set_position_bound(&self.model, position.clone());
         }
         engine
     }
@@ -471,6 +527,7 @@ impl ExactSolver {
                 preparation: None,
                 subset: None,
                 penalties: None,
+                position: None,
                 root_bound,
                 engine: None,
                 finished_bound: None,
@@ -528,6 +585,14 @@ impl ExactSolver {
     /// incumbent's cost.
     pub fn offer_lower_bound(&mut self, bound: f64) {
         self.external_bound = self.external_bound.max(bound);
+    }
+
+    /// Whether a proven lower bound (external, or every run's root bound) reaches the
+    /// incumbent's cost, so the incumbent is optimal without further search.
+    fn bounds_meet_incumbent(&self) -> bool {
+        let ub = self.incumbent.upper_bound;
+        ub.is_finite()
+            && (self.external_bound >= ub || self.runs.iter().all(|r| r.root_bound >= ub))
     }
 
     /// Stops the search at the next `step`.
@@ -624,8 +689,8 @@ impl ExactSolver {
                 self.elapsed += began.elapsed();
                 return SolverStatus::Running;
             }
-            if self.external_bound >= self.incumbent.upper_bound {
-                // A bound from outside already meets the incumbent: it is optimal.
+            if self.bounds_meet_incumbent() {
+                // A bound (from outside, or a root bound) already meets the incumbent.
                 self.elapsed += began.elapsed();
                 let status = SolverStatus::Finished {
                     proven_optimal: true,
