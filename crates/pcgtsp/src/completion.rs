@@ -42,6 +42,11 @@ pub(crate) struct PositionBoundOptions {
     pub iterations: usize,
     /// Stop once this many elementary steps (arc relaxations) are spent.
     pub work: f64,
+    /// After this many steps, stop unless the bound is within 1 % of `known_bound`: where
+    /// another root bound is clearly stronger, the rest of the budget would be wasted.
+    pub probe_work: f64,
+    /// The best root bound known from other relaxations (`-INF` if none).
+    pub known_bound: f64,
 }
 
 /// The completion table and its penalties.
@@ -144,6 +149,10 @@ impl PositionBound {
             && (iterations as f64 + 2.0) * per_pass <= options.work
         {
             if upper_bound.is_finite() && model.round_bound(best.0) >= upper_bound {
+                break;
+            }
+            let behind = best.0 < options.known_bound - 0.01 * options.known_bound.abs();
+            if behind && (iterations as f64 + 1.0) * per_pass > options.probe_work {
                 break;
             }
             let gradient: Vec<f64> = (0..m)
@@ -408,6 +417,8 @@ pub fn position_bounds(
     let options = PositionBoundOptions {
         iterations,
         work: f64::INFINITY,
+        probe_work: f64::INFINITY,
+        known_bound: -INF,
     };
     let mut result = PositionBounds {
         root: INF,

@@ -16,6 +16,9 @@ use std::time::Duration;
 use web_time::Instant;
 
 const INF: f64 = f64::INFINITY;
+/// Work (arc relaxations, about a second) after which the position bound's subgradient stops
+/// if it is still clearly below the other root bounds (ft53.*, kro124p.*: 12 s otherwise).
+const POSITION_PROBE_WORK: f64 = 1e9;
 
 /// Settings of the exact solver.
 #[derive(Clone, Debug, PartialEq)]
@@ -447,6 +450,8 @@ impl Run {
             PositionBoundOptions {
                 iterations: options.position_iterations,
                 work: options.effective_position_work(),
+                probe_work: POSITION_PROBE_WORK,
+                known_bound: self.root_bound,
             },
         );
         if let Some(p) = &position {

@@ -121,7 +121,7 @@ fn position_bound_never_exceeds_known_optima_or_pcglns_tours() {
         // Larger instances get fewer subgradient steps (the test checks validity, not strength;
         // a pass costs about m·n² steps).
         let pass = (instance.clusters.len() * instance.node_count * instance.node_count) as f64;
-        let iterations = if pass > 2e7 { 3 } else { 100 };
+        let iterations = if pass > 5e6 { 3 } else { 30 };
         let b = position_bounds(&instance, Some(&r.pcglns_tour), r.pcglns_cost, iterations)
             .unwrap_or_else(|e| panic!("{}: {e}", r.instance));
         let limit = trusted_optimum(r).unwrap_or(r.pcglns_cost);
