@@ -363,7 +363,6 @@ impl Run {
         if store.root_bound().is_none() {
             // Without the lattice the DP bounds its states by assignments: strengthen them.
             self.build_penalties(instance, options, upper_bound);
-            self.build_position_bound(options, upper_bound);
         }
         if let Some(root) = store.root_bound() {
             self.root_bound = self.root_bound.max(self.model.round_bound(root));
@@ -372,6 +371,15 @@ impl Run {
             self.root_bound = self
                 .root_bound
                 .max(self.model.round_bound(subset.root_bound));
+        }
+        let exact_subset = self
+            .subset
+            .as_ref()
+            .is_some_and(|s| s.tracked_count() == self.model.m);
+        if store.root_bound().is_none() && !exact_subset && self.root_bound < upper_bound {
+            // Neither the lattice nor an exact subset bound (which tracks every cluster, as on
+            // most industrial orders) sees precedence per state: add the position bound.
+            self.build_position_bound(options, upper_bound);
         }
         debug_log(|| {
             format!(
@@ -481,7 +489,9 @@ impl Run {
         if let Some(penalties) = &self.penalties {
             engine.set_penalties(&self.model, penalties.clone());
         }
-        if let Some(position) = &self.position {
+        // Only the exact search: ranking the beams by it (and without the assignments) made
+        // them miss ESC47's 1063 tour (1144) in the library run.
+        if let (None, Some(position)) = (beam, &self.position) {
             engine.set_position_bound(&self.model, position.clone());
         }
         engine
