@@ -11,6 +11,7 @@
 //! parent index of every state, for reconstruction.
 
 use crate::bounds::{Model, ResidualBounder};
+use crate::completion::{PositionBound, PositionQuery};
 use crate::lagrange::NodePenalties;
 use crate::lattice::Lattice;
 use crate::subset::{SubsetBound, SubsetQuery};
@@ -177,6 +178,13 @@ pub(crate) struct Dp<const W: usize> {
     subset_query: SubsetQuery,
     /// Node penalties: when set, the assignment bounds are computed on the penalised costs.
     penalties: Option<Rc<NodePenalties>>,
+    /// The position-indexed completion bound (precedence-aware, O(candidates) per state).
+    position: Option<Rc<PositionBound>>,
+    position_query: PositionQuery,
+    /// Position bound of every node of the group being expanded.
+    position_lbs: Vec<f64>,
+    /// The position bound's root is at least the penalised assignment root: skip assignments.
+    position_replaces_assignment: bool,
 }
 
 impl<const W: usize> Dp<W> {
@@ -241,7 +249,22 @@ impl<const W: usize> Dp<W> {
             subset: None,
             subset_query: SubsetQuery::default(),
             penalties: None,
+            position: None,
+            position_query: PositionQuery::default(),
+            position_lbs: Vec::new(),
+            position_replaces_assignment: false,
         }
+    }
+
+    /// Adds the position-indexed completion bound: every state created from now on is
+    /// bounded by it too, and groups it prunes entirely skip the assignment bounds.
+    pub fn set_position_bound(&mut self, model: &Model, position: Rc<PositionBound>) {
+        self.layer_bound = self.layer_bound.max(model.round_bound(position.root_bound));
+        self.position_replaces_assignment = self
+            .penalties
+            .as_ref()
+            .is_some_and(|p| position.root_bound >= p.root_bound);
+        self.position = Some(position);
     }
 
     /// Computes the per-state assignment bounds on penalised costs from now on.
@@ -381,6 +404,31 @@ impl<const W: usize> Dp<W> {
             return work;
         }
         let complete = self.layer + 1 == model.m;
+        self.position_lbs.clear();
+        if let (false, Some(position)) = (complete, self.position.clone()) {
+            // The cheap precedence-aware bound first: a group it prunes needs no assignment.
+            position.prepare(
+                model,
+                |c| ideal.contains(c),
+                self.layer + 1,
+                v,
+                &mut self.position_query,
+            );
+            let mut survivors = false;
+            for (&x, &g) in nodes.iter().zip(&self.costs) {
+                let lb = if g.is_finite() {
+                    g + position.bound(model, &self.position_query, x)
+                } else {
+                    INF
+                };
+                survivors |= !Self::prunable(model, lb, upper_bound);
+                self.position_lbs.push(lb);
+            }
+            let probe = (self.position_query.candidate_count() * width) as u64;
+            if !survivors {
+                return work + probe;
+            }
+        }
         let group_bound;
         let mut use_lattice = false;
         let mut cheap = false;
@@ -398,6 +446,12 @@ impl<const W: usize> Dp<W> {
         } else if self.beam_width.is_some() && model.m > 60 {
             // A beam without the lattice on many clusters ranks by path cost alone: assignments
             // per group (O(m³)) would make the heuristic slower than the search it seeds.
+            cheap = true;
+            group_bound = 0.0;
+            self.bounder.l2 = -INF;
+        } else if self.position_replaces_assignment && !self.position_lbs.is_empty() {
+            // The position bound is the stronger one (at the root) and far cheaper: the
+            // O(m³) assignments per group would cost more than the states they prune.
             cheap = true;
             group_bound = 0.0;
             self.bounder.l2 = -INF;
@@ -456,6 +510,10 @@ impl<const W: usize> Dp<W> {
             };
             let lb = match subset {
                 Some(subset) => lb.max(g + subset.bound(&self.subset_query, j, x)),
+                None => lb,
+            };
+            let lb = match self.position_lbs.get(j) {
+                Some(&position) => lb.max(position),
                 None => lb,
             };
             if Self::prunable(model, lb, upper_bound) {

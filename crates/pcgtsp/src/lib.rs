@@ -17,7 +17,10 @@
 //!   and two Lagrangian bounds for orders too large for the lattice: node penalties (relaxing
 //!   "a tour leaves every node it enters") that strengthen the per-state assignment bounds, and
 //!   a Held–Karp style spanning-arborescence bound on the cluster graph with out-degrees
-//!   relaxed, both optimised by subgradient ascent ([`RootBounds`]);
+//!   relaxed, both optimised by subgradient ascent ([`RootBounds`]); and a position-indexed
+//!   completion bound that sees precedence (every cluster confined to the tour positions its
+//!   order allows, cluster penalties by subgradient ascent) for every search state
+//!   ([`position_bounds`]);
 //! - the exact solver: a DP over order ideals with node-level states, per-state bounding
 //!   against the incumbent, a memory cap and an anytime, resumable API ([`ExactSolver`],
 //!   [`solve`]); and the breadth-first branch-and-bound variant ([`solve_bnb`]).
@@ -46,6 +49,7 @@ mod assignment;
 mod bnb;
 mod bounds;
 mod check;
+mod completion;
 mod dp;
 mod heuristic;
 mod instance;
@@ -62,6 +66,7 @@ pub use assignment::Assignment;
 pub use bnb::{solve_bnb, BnbOptions};
 pub use bounds::{root_bounds, RootBounds};
 pub use check::{check_tour, TourError};
+pub use completion::{position_bounds, PositionBounds};
 pub use instance::Instance;
 pub use lattice::count_ideals;
 pub use order::{ClusterSet, OrderError, PrecedenceOrder};

@@ -12,7 +12,7 @@ use web_time::Instant;
 
 /// A subset bound whose root is at least this share of the incumbent's cost prunes more than
 /// a coarse pierce-group lattice ...
-const STRONG_SUBSET_SHARE: f64 = 0.85;
+pub(crate) const STRONG_SUBSET_SHARE: f64 = 0.85;
 /// ... one with fewer groups per cluster than this share of the average cluster size (on
 /// large orders with big clusters the lattice affords only 2–3 groups and costs seconds; with
 /// small clusters it is nearly exact and still worth building).

@@ -2,19 +2,23 @@
 
 use crate::bounds::{Model, ResidualBounder};
 use crate::check::check_tour;
+use crate::completion::{PositionBound, PositionBoundOptions};
 use crate::dp::{Dp, DpStatus, Incumbent};
 use crate::heuristic;
 use crate::instance::Instance;
 use crate::lagrange::{self, NodePenalties, PenaltyOptions};
 use crate::lattice::Lattice;
 use crate::order::OrderError;
-use crate::prepare::{LatticeLimits, Preparation};
+use crate::prepare::{LatticeLimits, Preparation, STRONG_SUBSET_SHARE};
 use crate::subset::SubsetBound;
 use std::rc::Rc;
 use std::time::Duration;
 use web_time::Instant;
 
 const INF: f64 = f64::INFINITY;
+/// Work (arc relaxations, about a second) after which the position bound's subgradient stops
+/// if it is still clearly below the other root bounds (ft53.*, kro124p.*: 12 s otherwise).
+const POSITION_PROBE_WORK: f64 = 1e9;
 
 /// Settings of the exact solver.
 #[derive(Clone, Debug, PartialEq)]
@@ -48,6 +52,10 @@ pub struct ExactOptions {
     /// `None` = `time_limit`. Set it when the run is stopped by another clock (e.g. CPU time)
     /// and `time_limit` is only a backstop.
     pub budget_seconds: Option<f64>,
+    /// Subgradient iterations of the position-indexed completion bound (`completion.rs`, a
+    /// per-state bound that sees precedence); 0 disables it. Used only when the lattice bound
+    /// is not built.
+    pub position_iterations: usize,
 }
 
 impl ExactOptions {
@@ -80,6 +88,13 @@ impl ExactOptions {
         (seconds * 2e7).clamp(1e7, 1e9)
     }
 
+    /// Work budget (arc relaxations) of the position bound's subgradient optimisation:
+    /// 5·10⁷ steps per second of the time limit, 10⁸–3·10⁹ (up to a few seconds).
+    fn effective_position_work(&self) -> f64 {
+        let seconds = self.budget_seconds_or(f64::INFINITY);
+        (seconds * 5e7).clamp(1e8, 3e9)
+    }
+
     /// The lattice work budget after resolving the automatic setting.
     fn effective_lattice_work(&self) -> usize {
         if self.lattice_work > 0 {
@@ -103,6 +118,7 @@ impl Default for ExactOptions {
             lattice_work: 0,
             penalty_iterations: 400,
             budget_seconds: None,
+            position_iterations: 3000,
         }
     }
 }
@@ -227,6 +243,15 @@ impl Engine {
         }
     }
 
+    fn set_position_bound(&mut self, model: &Model, position: Rc<PositionBound>) {
+        match self {
+            Engine::W1(dp) => dp.set_position_bound(model, position),
+            Engine::W2(dp) => dp.set_position_bound(model, position),
+            Engine::W4(dp) => dp.set_position_bound(model, position),
+            Engine::Unsupported => {}
+        }
+    }
+
     fn run(&mut self, model: &Model, incumbent: &mut Incumbent, work: u64) -> DpStatus {
         match self {
             Engine::W1(dp) => dp.run(model, incumbent, work),
@@ -296,6 +321,8 @@ struct Run {
     subset: Option<Rc<SubsetBound>>,
     /// Node penalties for the per-state assignment bounds (when the run has no lattice).
     penalties: Option<Rc<NodePenalties>>,
+    /// The position-indexed completion bound (when the run has no lattice).
+    position: Option<Rc<PositionBound>>,
     root_bound: f64,
     engine: Option<Engine>,
     finished_bound: Option<f64>,
@@ -344,6 +371,15 @@ impl Run {
             self.root_bound = self
                 .root_bound
                 .max(self.model.round_bound(subset.root_bound));
+        }
+        let strong_subset = self.subset.as_ref().is_some_and(|s| {
+            s.tracked_count() == self.model.m || s.root_bound >= STRONG_SUBSET_SHARE * upper_bound
+        });
+        if store.root_bound().is_none() && !strong_subset && self.root_bound < upper_bound {
+            // Neither the lattice nor a strong subset bound (exact, or within 15 % of the
+            // incumbent, as on the industrial orders) sees precedence per state: add the
+            // position bound (on e1x_4, ec_2, … its root stays 17–35 % below the subset's).
+            self.build_position_bound(options, upper_bound);
         }
         debug_log(|| {
             format!(
@@ -410,6 +446,36 @@ impl Run {
         }
     }
 
+    /// The position-indexed completion bound (`completion.rs`).
+    fn build_position_bound(&mut self, options: &ExactOptions, upper_bound: f64) {
+        if options.position_iterations == 0 || self.model.m > 256 {
+            return;
+        }
+        let began = Instant::now();
+        let position = PositionBound::build(
+            &self.model,
+            upper_bound,
+            PositionBoundOptions {
+                iterations: options.position_iterations,
+                work: options.effective_position_work(),
+                probe_work: POSITION_PROBE_WORK,
+                known_bound: self.root_bound,
+            },
+        );
+        if let Some(p) = &position {
+            self.root_bound = self.root_bound.max(self.model.round_bound(p.root_bound));
+            debug_log(|| {
+                format!(
+                    "position bound in {:?}: root {} ({} iterations)",
+                    began.elapsed(),
+                    p.root_bound,
+                    p.iterations
+                )
+            });
+        }
+        self.position = position.map(Rc::new);
+    }
+
     /// A new DP engine with every bound this run has.
     fn engine(&mut self, beam: Option<usize>, memory: usize, use_l2: bool) -> Engine {
         let store = self
@@ -422,6 +488,11 @@ impl Run {
         }
         if let Some(penalties) = &self.penalties {
             engine.set_penalties(&self.model, penalties.clone());
+        }
+        // Only the exact search: ranking the beams by it (and without the assignments) made
+        // them miss ESC47's 1063 tour (1144) in the library run.
+        if let (None, Some(position)) = (beam, &self.position) {
+            engine.set_position_bound(&self.model, position.clone());
         }
         engine
     }
@@ -471,6 +542,7 @@ impl ExactSolver {
                 preparation: None,
                 subset: None,
                 penalties: None,
+                position: None,
                 root_bound,
                 engine: None,
                 finished_bound: None,
@@ -528,6 +600,14 @@ impl ExactSolver {
     /// incumbent's cost.
     pub fn offer_lower_bound(&mut self, bound: f64) {
         self.external_bound = self.external_bound.max(bound);
+    }
+
+    /// Whether a proven lower bound (external, or every run's root bound) reaches the
+    /// incumbent's cost, so the incumbent is optimal without further search.
+    fn bounds_meet_incumbent(&self) -> bool {
+        let ub = self.incumbent.upper_bound;
+        ub.is_finite()
+            && (self.external_bound >= ub || self.runs.iter().all(|r| r.root_bound >= ub))
     }
 
     /// Stops the search at the next `step`.
@@ -624,8 +704,8 @@ impl ExactSolver {
                 self.elapsed += began.elapsed();
                 return SolverStatus::Running;
             }
-            if self.external_bound >= self.incumbent.upper_bound {
-                // A bound from outside already meets the incumbent: it is optimal.
+            if self.bounds_meet_incumbent() {
+                // A bound (from outside, or a root bound) already meets the incumbent.
                 self.elapsed += began.elapsed();
                 let status = SolverStatus::Finished {
                     proven_optimal: true,
