@@ -178,3 +178,31 @@ fn closed_curves_are_pierced_where_the_idle_travel_is_shortest() {
             < 1e-9
     );
 }
+
+#[test]
+fn a_thousand_contour_sheet_gets_a_checked_route() {
+    // Over 400 components the order is improved through nearest-neighbour places, and the
+    // cross-component check finds holders through an R-tree; the tolerance is the engine's
+    // (10⁻⁶ of width plus height), where pierce points relaxed a few hundredths of a millimetre
+    // past a vertex once read as cut twice.
+    let nest = cutroute_geometry::generate_nest(1000, 1);
+    let b = nest.bounding_box();
+    let tolerance = 1e-6 * ((b.max.x - b.min.x) + (b.max.y - b.min.y));
+    let options = AoeSolveOptions {
+        plan: PlanOptions {
+            tolerance,
+            ..PlanOptions::default()
+        },
+        start: b.min,
+        finish: None,
+    };
+    let solution = solve_nest(&nest, &options).unwrap_or_else(|e| panic!("{e}"));
+    solution
+        .route
+        .validate(&nest, 10.0 * tolerance)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let plan = PlanGraph::from_nest(&nest, &options.plan).unwrap();
+    plan.check_route(&solution.chains).unwrap();
+    assert!(solution.components > 400);
+    assert!(solution.route.idle_length() <= solution.unordered_idle_length + 1e-9);
+}
