@@ -164,6 +164,10 @@ pub struct CcpSolver {
     restarts_left: usize,
     shakes: u64,
     relaxation_sweeps: usize,
+    /// Sweeps done by the full relaxation that ends a local search, while it runs: it may take
+    /// up to `max_relaxation_sweeps` sweeps (over a second on Nest02), so it runs one sweep
+    /// per iteration of the step loop, across slices.
+    full_relaxation_sweeps: Option<usize>,
     cancelled: bool,
 }
 
@@ -229,6 +233,7 @@ impl CcpSolver {
             restarts_left,
             shakes: 0,
             relaxation_sweeps: 0,
+            full_relaxation_sweeps: None,
             cancelled: false,
         })
     }
@@ -306,15 +311,25 @@ impl CcpSolver {
                     }
                 }
                 CcpPhase::LocalSearch | CcpPhase::Shaking => {
-                    if !self.descend(t0, budget) {
+                    if self.full_relaxation_sweeps.is_none() && !self.descend(t0, budget) {
                         return self.end_slice(t0);
                     }
                     // The queue is empty: a local optimum of every neighbourhood. A full
-                    // relaxation queues the contours whose pierce points still moved.
-                    // (After a shake only the neighbourhood of the shake moved: the local
-                    // relaxation of the moves already covers it.)
+                    // relaxation (`Search::relax_full`, a sweep at a time) queues the contours
+                    // whose pierce points still moved. (After a shake only the neighbourhood
+                    // of the shake moved: the local relaxation of the moves already covers it.)
                     if self.phase == CcpPhase::LocalSearch {
-                        self.search.relax_full();
+                        let sweeps = self.full_relaxation_sweeps.unwrap_or(0) + 1;
+                        let gain = self.search.sweep();
+                        let params = &self.search.params;
+                        if gain > params.delta && sweeps < params.max_relaxation_sweeps {
+                            self.full_relaxation_sweeps = Some(sweeps);
+                            if self.out_of_time(t0, budget) {
+                                return self.end_slice(t0);
+                            }
+                            continue;
+                        }
+                        self.full_relaxation_sweeps = None;
                         if !self.search.queue.is_empty() {
                             continue;
                         }

@@ -603,9 +603,15 @@ pub fn solve_sccp(
     cancel: &AtomicBool,
 ) -> Result<SccpSolution, SegmentError> {
     let mut search = SccpSearch::new(ensemble, hint, options)?;
-    while search.step(SOLVE_SLICE) == SearchStatus::Running {
+    // The flag is read before every slice, the first included: a run cancelled before it
+    // starts returns the starting order (a small ensemble can finish within one slice).
+    loop {
         if cancel.load(Ordering::Relaxed) {
             search.stop();
+            break;
+        }
+        if search.step(SOLVE_SLICE) != SearchStatus::Running {
+            break;
         }
     }
     Ok(search.solution())
