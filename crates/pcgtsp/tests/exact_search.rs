@@ -9,65 +9,18 @@ use cutroute_pcgtsp::{
 };
 use std::time::Duration;
 
-/// A small deterministic generator (the test must not depend on an RNG crate's stream).
-struct Lcg(u64);
-
-impl Lcg {
-    fn next(&mut self, bound: u64) -> u64 {
-        self.0 = self
-            .0
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (self.0 >> 33) % bound
-    }
-}
-
-/// `m` clusters of 1–4 nodes (the depot has 1 or 2), integer asymmetric costs with some
-/// forbidden arcs, random precedence pairs consistent with a random order.
+/// The instances of these tests: costs 5–64, a quarter of the pairs ordered.
 fn random_instance(seed: u64, m: usize) -> Instance {
-    let mut rng = Lcg(seed.wrapping_mul(7919).wrapping_add(17));
-    let mut clusters = Vec::new();
-    let mut node_cluster = Vec::new();
-    for c in 0..m {
-        let size = if c == 0 {
-            1 + rng.next(2) as usize
-        } else {
-            1 + rng.next(4) as usize
-        };
-        let nodes: Vec<usize> = (node_cluster.len()..node_cluster.len() + size).collect();
-        node_cluster.extend(std::iter::repeat_n(c, size));
-        clusters.push(nodes);
-    }
-    let n = node_cluster.len();
-    let mut cost = vec![f64::INFINITY; n * n];
-    for a in 0..n {
-        for b in 0..n {
-            if a != b && rng.next(8) != 0 {
-                cost[a * n + b] = (5 + rng.next(60)) as f64;
-            }
-        }
-    }
-    let mut order: Vec<usize> = (1..m).collect();
-    for i in (1..order.len()).rev() {
-        order.swap(i, rng.next(i as u64 + 1) as usize);
-    }
-    let mut precedence = Vec::new();
-    for i in 0..order.len() {
-        for j in i + 1..order.len() {
-            if rng.next(4) == 0 {
-                precedence.push((order[i], order[j]));
-            }
-        }
-    }
-    Instance {
-        name: format!("random-{seed}"),
-        node_count: n,
-        cost,
-        clusters,
-        node_cluster,
-        precedence,
-        depot: 0,
-    }
+    common::random_instance(
+        seed,
+        m,
+        common::RandomShape {
+            salt: 17,
+            cost_base: 5,
+            cost_range: 60,
+            pair_odds: 4,
+        },
+    )
 }
 
 #[test]
