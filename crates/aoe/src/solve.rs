@@ -545,10 +545,9 @@ fn relax_openings(
 const MAX_RELAXATION_SWEEPS: usize = 50;
 
 /// The point `M` of a closed chain of spans minimising `|a M| + |M b|` (`|a M|` without `b`):
-/// `(span, t, M, value)`, or `None` if no point beats `bound`. Per span: the nearest point
-/// without `b`; with `b`, the crossing of segment `ab` if any, else golden-section search (on a
-/// line the sum is convex; on an arc, around the best of a few samples). Spans whose box is
-/// already farther than the best value (at first `bound`) are skipped.
+/// `(span, t, M, value)`, or `None` if no point beats `bound`; per span
+/// [`Span::detour_minimum`]. Spans whose box is already farther than the best value (at first
+/// `bound`) are skipped.
 fn best_point(
     spans: &[Span],
     a: Point,
@@ -563,36 +562,7 @@ fn best_point(
         if to_box(a) + b.map_or(0.0, to_box) >= best.3 {
             continue;
         }
-        let (t, value) = match b {
-            None => {
-                let q = span.nearest_point(a);
-                (q.t, q.distance)
-            }
-            Some(b) => {
-                let f = |t: f64| {
-                    let m = span.point_at(t);
-                    a.distance(m) + m.distance(b)
-                };
-                if let Some(x) = span.intersect_segment(a, b).first() {
-                    (x.t_self, f(x.t_self))
-                } else if span.is_line() {
-                    golden(&f, 0.0, 1.0)
-                } else {
-                    let samples =
-                        8 + (span.sweep().abs() / (std::f64::consts::PI / 8.0)).ceil() as usize;
-                    let k = (0..=samples)
-                        .min_by(|&x, &y| {
-                            f(x as f64 / samples as f64).total_cmp(&f(y as f64 / samples as f64))
-                        })
-                        .unwrap_or(0);
-                    golden(
-                        &f,
-                        k.saturating_sub(1) as f64 / samples as f64,
-                        (k + 1).min(samples) as f64 / samples as f64,
-                    )
-                }
-            }
-        };
+        let (t, value) = span.detour_minimum(a, b);
         if value < best.3 {
             best = (i, t, span.point_at(t), value);
             found = true;
@@ -606,34 +576,6 @@ fn box_distance(b: &BoundingBox, p: Point) -> f64 {
     let dx = (b.min.x - p.x).max(p.x - b.max.x).max(0.0);
     let dy = (b.min.y - p.y).max(p.y - b.max.y).max(0.0);
     dx.hypot(dy)
-}
-
-/// Golden-section search for the minimum of a unimodal `f` on `[lo, hi]`; the bracket's ends
-/// are tried too (a monotone `f` is least there): `(t, f(t))`.
-fn golden(f: &impl Fn(f64) -> f64, mut lo: f64, mut hi: f64) -> (f64, f64) {
-    const R: f64 = 0.618_033_988_749_894_8;
-    let (first, last) = (lo, hi);
-    let (mut x1, mut x2) = (hi - R * (hi - lo), lo + R * (hi - lo));
-    let (mut f1, mut f2) = (f(x1), f(x2));
-    for _ in 0..60 {
-        if hi - lo < 1e-12 {
-            break;
-        }
-        if f1 <= f2 {
-            (hi, x2, f2) = (x2, x1, f1);
-            x1 = hi - R * (hi - lo);
-            f1 = f(x1);
-        } else {
-            (lo, x1, f1) = (x1, x2, f2);
-            x2 = lo + R * (hi - lo);
-            f2 = f(x2);
-        }
-    }
-    let mid = 0.5 * (lo + hi);
-    [first, last]
-        .into_iter()
-        .map(|t| (t, f(t)))
-        .fold((mid, f(mid)), |best, x| if x.1 < best.1 { x } else { best })
 }
 
 /// A closed chain of spans opened at `point` (on span `opening.span` at `opening.t`): the rest

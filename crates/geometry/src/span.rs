@@ -153,6 +153,34 @@ fn quadratic_roots(a: f64, b: f64, c: f64) -> Vec<f64> {
     vec![q / a, c / q]
 }
 
+/// Golden-section search for the least value of `f` on `[lo, hi]`, where it is unimodal; the
+/// bracket's ends are tried too (a monotone `f` is least there): `(t, f(t))`.
+fn golden_section(f: &impl Fn(f64) -> f64, mut lo: f64, mut hi: f64) -> (f64, f64) {
+    const R: f64 = 0.618_033_988_749_894_8;
+    let (first, last) = (lo, hi);
+    let (mut x1, mut x2) = (hi - R * (hi - lo), lo + R * (hi - lo));
+    let (mut f1, mut f2) = (f(x1), f(x2));
+    for _ in 0..60 {
+        if hi - lo < 1e-12 {
+            break;
+        }
+        if f1 <= f2 {
+            (hi, x2, f2) = (x2, x1, f1);
+            x1 = hi - R * (hi - lo);
+            f1 = f(x1);
+        } else {
+            (lo, x1, f1) = (x1, x2, f2);
+            x2 = lo + R * (hi - lo);
+            f2 = f(x2);
+        }
+    }
+    let mid = 0.5 * (lo + hi);
+    [first, last]
+        .into_iter()
+        .map(|t| (t, f(t)))
+        .fold((mid, f(mid)), |best, x| if x.1 < best.1 { x } else { best })
+}
+
 impl Span {
     /// A span from `start` to `end` with the given bulge.
     pub const fn new(start: Point, end: Point, bulge: f64) -> Self {
@@ -512,6 +540,38 @@ impl Span {
     /// Distance from `p` to the span.
     pub fn distance_to(&self, p: Point) -> f64 {
         self.nearest_point(p).distance
+    }
+
+    /// The point of the span where a detour from `a` to `b` is shortest: `(t, value)` with
+    /// `value = |a s(t)| + |s(t) b|` least over `t ∈ [0, 1]` (`|a s(t)|` alone without `b`):
+    /// where a pierce point on this span costs the least idle travel between the previous exit
+    /// `a` and the next entry `b`. A span crossing the segment `ab` gives `|ab|` at the
+    /// crossing; otherwise the sum is convex along a line (golden-section search) and, on an
+    /// arc, is searched around the best of samples every π/8 at most.
+    pub fn detour_minimum(&self, a: Point, b: Option<Point>) -> (f64, f64) {
+        let Some(b) = b else {
+            let q = self.nearest_point(a);
+            return (q.t, q.distance);
+        };
+        if let Some(x) = self.intersect_segment(a, b).first() {
+            return (x.t_self, a.distance(x.point) + x.point.distance(b));
+        }
+        let f = |t: f64| {
+            let m = self.point_at(t);
+            a.distance(m) + m.distance(b)
+        };
+        if self.is_line() {
+            return golden_section(&f, 0.0, 1.0);
+        }
+        let n = 8 + (self.sweep().abs() / (std::f64::consts::PI / 8.0)).ceil() as usize;
+        let k = (0..=n)
+            .min_by(|&x, &y| f(x as f64 / n as f64).total_cmp(&f(y as f64 / n as f64)))
+            .unwrap_or(0);
+        golden_section(
+            &f,
+            k.saturating_sub(1) as f64 / n as f64,
+            (k + 1).min(n) as f64 / n as f64,
+        )
     }
 
     /// The span's circle (or line) as `a·|q|² + g·q + h = 0` with `q = p − origin`.

@@ -111,6 +111,26 @@ proptest! {
     }
 
     #[test]
+    fn detour_minimum_is_the_least_detour_over_the_span(
+        s in span(),
+        ax in -300.0..300.0f64, ay in -300.0..300.0f64,
+        bx in -300.0..300.0f64, by in -300.0..300.0f64,
+        open in any::<bool>(),
+    ) {
+        let (a, b) = (Point::new(ax, ay), Point::new(bx, by));
+        let b = (!open).then_some(b);
+        let f = |t: f64| {
+            let m = s.point_at(t);
+            a.distance(m) + b.map_or(0.0, |b| m.distance(b))
+        };
+        let (t, value) = s.detour_minimum(a, b);
+        prop_assert!((0.0..=1.0).contains(&t));
+        prop_assert!((f(t) - value).abs() <= 1e-9 * (1.0 + value));
+        let sampled = (0..=4000).map(|k| f(k as f64 / 4000.0)).fold(f64::INFINITY, f64::min);
+        prop_assert!(value <= sampled + 1e-7 * (1.0 + sampled), "{} vs sampled {}", value, sampled);
+    }
+
+    #[test]
     fn span_bounding_box_is_exact(s in span()) {
         let b = s.bounding_box();
         let pts = samples(&s, 4000);

@@ -112,47 +112,6 @@ fn box_distance(p: Point, min: Point, max: Point) -> f64 {
     dx.hypot(dy)
 }
 
-/// Minimum of `|a − s(t)| + |s(t) − b|` over `t ∈ [lo, hi]` where it is unimodal.
-fn golden(span: &Span, a: Point, b: Point, mut lo: f64, mut hi: f64) -> (f64, f64) {
-    let f = |t: f64| {
-        let m = span.point_at(t);
-        a.distance(m) + m.distance(b)
-    };
-    const R: f64 = 0.618_033_988_749_894_8;
-    let (first, last) = (lo, hi);
-    let mut x1 = hi - R * (hi - lo);
-    let mut x2 = lo + R * (hi - lo);
-    let (mut f1, mut f2) = (f(x1), f(x2));
-    for _ in 0..60 {
-        if hi - lo < 1e-12 {
-            break;
-        }
-        if f1 <= f2 {
-            hi = x2;
-            x2 = x1;
-            f2 = f1;
-            x1 = hi - R * (hi - lo);
-            f1 = f(x1);
-        } else {
-            lo = x1;
-            x1 = x2;
-            f1 = f2;
-            x2 = lo + R * (hi - lo);
-            f2 = f(x2);
-        }
-    }
-    let t = 0.5 * (lo + hi);
-    let mut best = (t, f(t));
-    // The search never evaluates the bracket's own ends, where a monotone f is least.
-    for t in [first, last] {
-        let v = f(t);
-        if v < best.1 {
-            best = (t, v);
-        }
-    }
-    best
-}
-
 /// The point of a closed segment minimising `|a M| + |M b|` (or `|a M|` without `b`), starting
 /// from the value `current` to prune spans: `(span, t, point, value)`, or `None` if no span
 /// beats `current`.
@@ -172,32 +131,7 @@ fn best_point(
         if lower.partial_cmp(&(bound - 1e-12)) != Some(std::cmp::Ordering::Less) {
             continue;
         }
-        let (t, value) = match b {
-            None => {
-                let q = span.nearest_point(a);
-                (q.t, q.distance)
-            }
-            Some(b) => {
-                if let Some(x) = span.intersect_segment(a, b).first() {
-                    (x.t_self, a.distance(x.point) + x.point.distance(b))
-                } else if span.is_line() {
-                    golden(span, a, b, 0.0, 1.0)
-                } else {
-                    // An arc: sample, then refine around the best sample.
-                    let n = 8 + (span.sweep().abs() / (std::f64::consts::PI / 8.0)).ceil() as usize;
-                    let f = |t: f64| {
-                        let m = span.point_at(t);
-                        a.distance(m) + m.distance(b)
-                    };
-                    let k = (0..=n)
-                        .min_by(|&x, &y| f(x as f64 / n as f64).total_cmp(&f(y as f64 / n as f64)))
-                        .unwrap_or(0);
-                    let lo = k.saturating_sub(1) as f64 / n as f64;
-                    let hi = ((k + 1).min(n)) as f64 / n as f64;
-                    golden(span, a, b, lo, hi)
-                }
-            }
-        };
+        let (t, value) = span.detour_minimum(a, b);
         if value < bound {
             bound = value;
             best = Some((i, t, span.point_at(t), value));
