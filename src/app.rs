@@ -506,6 +506,9 @@ pub fn App() -> impl IntoView {
     };
 
     // Presentation mode: large fonts and the whole screen (F toggles it outside text fields).
+    // While a request for full screen is pending, a "left full screen" event is the late echo
+    // of an earlier exit (F pressed twice quickly), not the user pressing Esc.
+    let entering_fullscreen = StoredValue::new(false);
     Effect::new(move |_| {
         let on = presentation.get();
         let Some(doc) = web_sys::window().and_then(|w| w.document()) else {
@@ -518,7 +521,8 @@ pub fn App() -> impl IntoView {
                 root.remove_attribute("data-presentation")
             };
             if on && doc.fullscreen_element().is_none() {
-                request_fullscreen(&root);
+                entering_fullscreen.set_value(true);
+                request_fullscreen(&root, move || entering_fullscreen.set_value(false));
             } else if !on && doc.fullscreen_element().is_some() {
                 doc.exit_fullscreen();
             }
@@ -543,7 +547,7 @@ pub fn App() -> impl IntoView {
         let full = web_sys::window()
             .and_then(|w| w.document())
             .is_some_and(|d| d.fullscreen_element().is_some());
-        if !full && presentation.get_untracked() {
+        if !full && presentation.get_untracked() && !entering_fullscreen.get_value() {
             presentation.set(false);
         }
     });
@@ -982,21 +986,26 @@ fn format_bound(value: Option<f64>) -> String {
         .unwrap_or_else(|| "—".into())
 }
 
-/// Asks for full screen; a refusal (no user gesture, a browser without it) is awaited and
-/// ignored, so it never surfaces as an unhandled rejection: large fonts still apply.
-fn request_fullscreen(element: &web_sys::Element) {
+/// Asks for full screen and calls `settled` once the request is granted or refused; a
+/// refusal (no user gesture, a browser without it) is ignored, so it never surfaces as an
+/// unhandled rejection: large fonts still apply.
+fn request_fullscreen(element: &web_sys::Element, settled: impl FnOnce() + 'static) {
     let Ok(method) = js_sys::Reflect::get(element, &"requestFullscreen".into()) else {
-        return;
+        return settled();
     };
     let Some(method) = method.dyn_ref::<js_sys::Function>() else {
-        return;
+        return settled();
     };
-    if let Ok(answer) = method.call0(element) {
-        if let Ok(promise) = answer.dyn_into::<js_sys::Promise>() {
-            leptos::task::spawn_local(async move {
-                let _ = wasm_bindgen_futures::JsFuture::from(promise).await;
-            });
-        }
+    match method
+        .call0(element)
+        .ok()
+        .and_then(|answer| answer.dyn_into::<js_sys::Promise>().ok())
+    {
+        Some(promise) => leptos::task::spawn_local(async move {
+            let _ = wasm_bindgen_futures::JsFuture::from(promise).await;
+            settled();
+        }),
+        None => settled(),
     }
 }
 
