@@ -215,7 +215,7 @@ test('settings and layers survive a reload; a link opens a sample with solver se
   assert.match(await page.getAttribute('#nest-view', 'class'), /hide-arrows/);
   assert.equal(await page.locator('#last-file').count(), 0, 'a sample was open: nothing to remind');
   // A local file is remembered by name (browsers cannot reopen it alone).
-  const local = path.resolve(projectRoot, '..', 'shared', 'data', 'nests', 'dbs', 'nested.dbs');
+  const local = path.resolve(projectRoot, 'data', 'nests', 'dbs', 'nested.dbs');
   assert.ok(fs.existsSync(local), `missing test file ${local}`);
   await page.setInputFiles('#file-input', local);
   await fileShown(page, 'nested.dbs (DBS binary)');
@@ -324,7 +324,7 @@ for (const [width, height] of [[1024, 768], [1920, 1080], [3840, 2160]]) {
 test('several files at once: a task JSON is combined with its result file', async () => {
   const { page, errors, context } = await freshPage();
   await fileShown(page, 'E1X_6_01');
-  const nests = path.resolve(projectRoot, '..', 'shared', 'data', 'nests');
+  const nests = path.resolve(projectRoot, 'data', 'nests');
   const task = path.join(nests, 'task-json', 'E1X_6_01.task.json');
   const result = path.join(nests, 'result-json', 'E1X_6_01.result.json');
   for (const f of [task, result]) assert.ok(fs.existsSync(f), `missing test file ${f}`);

@@ -12,9 +12,9 @@ import path from 'node:path';
 import { watchErrors, projectRoot, useApp, screenshot } from './harness.mjs';
 
 const app = useApp(before, after);
-const nests = path.resolve(projectRoot, '..', 'shared', 'data', 'nests');
+const nests = path.resolve(projectRoot, 'data', 'nests');
 
-/** A file of `../shared/data/nests`; fails loudly when it is missing. */
+/** A file of `data/nests`; fails loudly when it is missing. */
 function shared(relative) {
   const file = path.join(nests, relative);
   assert.ok(fs.existsSync(file), `missing test file ${file}`);

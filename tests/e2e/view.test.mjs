@@ -6,7 +6,7 @@ import os from 'node:os';
 import path from 'node:path';
 import { watchErrors, projectRoot, useApp, screenshot } from './harness.mjs';
 
-const shared = path.resolve(projectRoot, '..', 'shared', 'data', 'nests');
+const shared = path.resolve(projectRoot, 'data', 'nests');
 const app = useApp(before, after);
 
 async function fileShown(page, name) {

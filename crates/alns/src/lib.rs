@@ -312,12 +312,12 @@ pub fn solve_until(
     })
 }
 
-/// A reference instance of `shared/data/pcgtsp/<set>/<name>.pcglns` for the unit tests; panics
+/// A reference instance of `data/pcgtsp/<set>/<name>.pcglns` for the unit tests; panics
 /// loudly when the file is missing.
 #[cfg(test)]
 pub(crate) fn reference_instance(set: &str, name: &str) -> cutroute_pcgtsp::Instance {
     let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/data/pcgtsp")
+        .join("../../data/pcgtsp")
         .join(set)
         .join(format!("{name}.pcglns"));
     let text = std::fs::read_to_string(&path)

@@ -9,9 +9,9 @@ use cutroute_alns::{
 };
 use cutroute_pcgtsp::{check_tour, Instance};
 
-/// The reference data directory (`../shared/data/pcgtsp` beside the repository root).
+/// The reference data directory (`data/pcgtsp` beside the repository root).
 fn data_dir() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/pcgtsp")
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../data/pcgtsp")
 }
 
 /// Reads an instance of the reference data; fails loudly if the file is missing.

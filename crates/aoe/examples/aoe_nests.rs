@@ -16,7 +16,7 @@ use cutroute_aoe::{check_route, oe_route, solve_nest, AoeSolveOptions, PlanGraph
 use cutroute_geometry::{Contour, MachineParameters, Nest, Part, Vertex};
 
 fn load(relative: &str) -> Nest {
-    let path = format!("../shared/data/nests/{relative}");
+    let path = format!("data/nests/{relative}");
     let bytes = std::fs::read(&path).unwrap_or_else(|e| panic!("{path} is missing: {e}"));
     if relative.ends_with(".tfnesting") {
         cutroute_cad::tflex::read_tfnesting(&bytes)

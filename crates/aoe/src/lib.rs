@@ -3,7 +3,7 @@
 //! When parts of a nest share edges, the cutting plan is a plane graph: curves are edges,
 //! touching and crossing points are vertices, and the cyclic order of curves around each point
 //! is the embedding. One pierce can then cut a whole cluster of parts along an *AOE-chain*
-//! (Makarovskikh 2019, seed 001; digest `shared/spec/aoe-chains.md`): an Euler trail that never
+//! (Makarovskikh 2019, seed 001; digest `docs/science/aoe-chains.md`): an Euler trail that never
 //! crosses itself (consecutive edges are neighbours around their vertex, the A-condition) and
 //! whose every prefix encloses no uncut edge (ordered enclosing, OE).
 //!

@@ -1,4 +1,4 @@
-//! Plane graphs of the real nests in `shared/data/nests`: every component is plane, and the
+//! Plane graphs of the real nests in `data/nests`: every component is plane, and the
 //! edges account for every contour's perimeter exactly once per contour they belong to.
 
 use cutroute_aoe::{PlanGraph, PlanOptions};

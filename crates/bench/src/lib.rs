@@ -145,7 +145,7 @@ mod tests {
 
     fn load(set: &str, name: &str) -> Instance {
         let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-            .join("../../../shared/data/pcgtsp")
+            .join("../../data/pcgtsp")
             .join(set)
             .join(format!("{name}.pcglns"));
         let text = std::fs::read_to_string(&path)

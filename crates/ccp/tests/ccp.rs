@@ -293,7 +293,7 @@ fn permute(v: &mut Vec<usize>, k: usize, f: &mut dyn FnMut(&[usize])) {
 
 fn read_nest(path: &str) -> Nest {
     let full = format!(
-        "{}/../../../shared/data/nests/{path}",
+        "{}/../../data/nests/{path}",
         env!("CARGO_MANIFEST_DIR")
     );
     let bytes = std::fs::read(&full).unwrap_or_else(|e| panic!("missing test file {full}: {e}"));
@@ -352,7 +352,7 @@ fn empty_and_single_contour_nests() {
 /// A T-FLEX nesting project's first sheet, oriented as the app reads it.
 fn read_tflex(path: &str) -> Nest {
     let full = format!(
-        "{}/../../../shared/data/nests/{path}",
+        "{}/../../data/nests/{path}",
         env!("CARGO_MANIFEST_DIR")
     );
     let bytes = std::fs::read(&full).unwrap_or_else(|e| panic!("missing test file {full}: {e}"));

@@ -26,7 +26,7 @@
 //!    between the members' inner contours and their parent where the chain is the smallest
 //!    idle detour, and keeps the change only if the route's cost drops.
 //!
-//! The printed pseudo-code's defects (`../shared/spec/chain-cutting-and-ccp-paper.md` §A.6.3)
+//! The printed pseudo-code's defects (`docs/science/chain-cutting-and-ccp-paper.md` §A.6.3)
 //! are avoided by construction: the route is rebuilt from scratch for each group (no growing
 //! `resultPath`), groups are processed once each instead of by a moving index, the link test
 //! uses the obstacle-avoiding length between consecutive chain members only, the tool comes from

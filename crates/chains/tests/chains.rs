@@ -236,7 +236,7 @@ fn links_go_round_a_wall_between_two_parts() {
 
 fn read_nest(path: &str) -> Nest {
     let full = format!(
-        "{}/../../../shared/data/nests/{path}",
+        "{}/../../data/nests/{path}",
         env!("CARGO_MANIFEST_DIR")
     );
     let bytes = std::fs::read(&full).unwrap_or_else(|e| panic!("missing test file {full}: {e}"));
@@ -311,7 +311,7 @@ fn tflex_nests_with_touching_parts_chain_validly() {
     // once let a link through a neighbour within the region's old end tolerance.
     for file in ["Nest02.tfnesting", "Nest03.tfnesting"] {
         let full = format!(
-            "{}/../../../shared/data/nests/tflex/{file}",
+            "{}/../../data/nests/tflex/{file}",
             env!("CARGO_MANIFEST_DIR")
         );
         let bytes =

@@ -6,7 +6,7 @@ mod common;
 use common::{cutroute, json};
 use serde_json::Value;
 
-/// A file under `shared/data/` as a command-line argument.
+/// A file under `data/` as a command-line argument.
 fn data(relative: &str) -> String {
     common::data(relative).to_string_lossy().into_owned()
 }

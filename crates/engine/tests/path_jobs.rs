@@ -18,7 +18,7 @@ const TEST1: &str = "nests/dbs-json/test1.dbs.json";
 
 fn problem(relative: &str) -> Problem {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/data")
+        .join("../../data")
         .join(relative);
     let bytes = std::fs::read(&path)
         .unwrap_or_else(|e| panic!("missing test file {}: {e}", path.display()));

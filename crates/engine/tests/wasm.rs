@@ -9,7 +9,7 @@ use wasm_bindgen_test::{wasm_bindgen_test, wasm_bindgen_test_configure};
 
 wasm_bindgen_test_configure!(run_in_browser);
 
-const SAMPLE: &[u8] = include_bytes!("../../../../shared/data/nests/dbs-json/E1X_6_01.dbs.json");
+const SAMPLE: &[u8] = include_bytes!("../../../data/nests/dbs-json/E1X_6_01.dbs.json");
 
 #[wasm_bindgen_test]
 fn opens_a_sample_and_routes_it_in_the_browser() {

@@ -1,4 +1,4 @@
-//! Every file under `shared/data/nests` (DBS, geometry JSON, task JSON, result JSON) is read and
+//! Every file under `data/nests` (DBS, geometry JSON, task JSON, result JSON) is read and
 //! checked against facts known about it. A missing file fails the test with its path.
 
 use std::path::PathBuf;
@@ -7,7 +7,7 @@ use cutroute_formats::*;
 use cutroute_geometry::{Nest, Point};
 
 fn nests_dir() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/nests")
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../data/nests")
 }
 
 fn read(rel: &str) -> Vec<u8> {

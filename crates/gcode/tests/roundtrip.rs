@@ -20,7 +20,7 @@ const NESTS: [&str; 5] = [
 
 fn data(relative: &str) -> (String, Vec<u8>) {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/data")
+        .join("../../data")
         .join(relative);
     let bytes = std::fs::read(&path)
         .unwrap_or_else(|e| panic!("missing test file {}: {e}", path.display()));

@@ -1,4 +1,4 @@
-//! Checks on the real nests of `../shared/data/nests/dbs-json` (geometry JSON: an array of
+//! Checks on the real nests of `data/nests/dbs-json` (geometry JSON: an array of
 //! `{partid, paths: [[[x, y, bulge], …]]}`, the first part being the sheet).
 
 use std::path::PathBuf;
@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use cutroute_geometry::{Contour, Nest, Part, Vertex};
 
 fn data_dir() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/nests/dbs-json")
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../data/nests/dbs-json")
 }
 
 /// Reads a geometry JSON nest; panics (fails the test) when the file is missing.

@@ -843,7 +843,7 @@ mod tests {
     fn reference_rows() -> Vec<(String, String, Vec<usize>, f64)> {
         let path = concat!(
             env!("CARGO_MANIFEST_DIR"),
-            "/../../../shared/data/pcgtsp/reference.csv"
+            "/../../data/pcgtsp/reference.csv"
         );
         let text = std::fs::read_to_string(path)
             .unwrap_or_else(|e| panic!("required test data {path} is missing: {e}"));
@@ -876,7 +876,7 @@ mod tests {
         assert_eq!(industrial.len(), 25);
         for (set, name, tour, _) in industrial {
             let path = format!(
-                "{}/../../../shared/data/pcgtsp/{set}/{name}.pcglns",
+                "{}/../../data/pcgtsp/{set}/{name}.pcglns",
                 env!("CARGO_MANIFEST_DIR")
             );
             let text = std::fs::read_to_string(&path)

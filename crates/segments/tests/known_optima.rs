@@ -259,7 +259,7 @@ fn the_objective_decides_between_ensembles() {
 
 /// Every nest file of the shared data, opened as the app and the CLI open it.
 fn real_nests() -> Vec<(String, Nest, Point, Option<Point>)> {
-    let root = format!("{}/../../../shared/data/nests", env!("CARGO_MANIFEST_DIR"));
+    let root = format!("{}/../../data/nests", env!("CARGO_MANIFEST_DIR"));
     let mut out = Vec::new();
     for dir in ["dbs-json", "dbs", "tflex"] {
         let mut names: Vec<String> = std::fs::read_dir(format!("{root}/{dir}"))

@@ -699,14 +699,14 @@ mod tests {
     use super::*;
     use std::path::PathBuf;
 
-    /// A file under `shared/data/nests/`; panics naming the file when it is missing.
+    /// A file under `data/nests/`; panics naming the file when it is missing.
     fn nests_file(relative: &str) -> (String, Vec<u8>) {
         let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-            .join("../../../shared/data/nests")
+            .join("../../data/nests")
             .join(relative);
         let bytes = std::fs::read(&path).unwrap_or_else(|e| {
             panic!(
-                "reference file {} is missing or unreadable ({e}); the tests need ../shared/data beside the repository",
+                "reference file {} is missing or unreadable ({e}); the tests need data/ of the repository",
                 path.display()
             )
         });

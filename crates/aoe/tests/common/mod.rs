@@ -33,10 +33,10 @@ pub fn part(contours: Vec<Contour>) -> Part {
     }
 }
 
-/// A nest of `shared/data/nests` by its path there; panics loudly when the file is missing.
+/// A nest of `data/nests` by its path there; panics loudly when the file is missing.
 pub fn load_nest(relative: &str) -> Nest {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/data/nests")
+        .join("../../data/nests")
         .join(relative);
     let bytes = std::fs::read(&path)
         .unwrap_or_else(|e| panic!("required test data {} is missing: {e}", path.display()));

@@ -15,14 +15,14 @@
 //!
 //! Arguments: `--quick` skips the 20,000-contour nest; `--real-only` skips the synthetic nests; `--vns-seconds S` sets CCP's budget
 //! after the local optimum (default 5); `--synthetic N` runs CCP on one synthetic nest only, `--peer-synthetic N` runs only the peer on one synthetic nest, `--nest PATH` CCP on one real nest (path under
-//! `shared/data/nests`), `--discrete-nest PATH` the discrete model alone on one real nest.
+//! `data/nests`), `--discrete-nest PATH` the discrete model alone on one real nest.
 
 use std::time::{Duration, Instant};
 
 use cutroute_ccp::{build_pcgtsp, solve, CcpOptions, CcpResult, DiscretisationOptions};
 use cutroute_geometry::{generate_nest, Nest, Point, Route};
 
-const SHARED: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/nests");
+const SHARED: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../data/nests");
 
 /// Any nest format, read as the app and the CLI read it (orientation normalised).
 fn read(path: &str) -> Nest {
@@ -230,7 +230,7 @@ fn discrete(
     Some((route.idle_length(), inst.instance.node_count))
 }
 
-/// Every multi-contour nest of shared/data/nests: (name, path).
+/// Every multi-contour nest of data/nests: (name, path).
 const REAL: [(&str, &str); 13] = [
     ("nested.dbs", "dbs/nested.dbs"),
     ("seven.dbs", "dbs/seven.dbs"),

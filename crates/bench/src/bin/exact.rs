@@ -1,4 +1,4 @@
-//! Benchmark: the exact PCGTSP solver on every instance of `shared/data/pcgtsp`.
+//! Benchmark: the exact PCGTSP solver on every instance of `data/pcgtsp`.
 //!
 //! `cargo run --release -p cutroute-bench --bin exact -- [--time-limit 60] [--filter NAME[,NAME…]]
 //! [--skip NAME] [--set industrial|pcgtsplib] [--no-l2] [--no-heuristic] [--memory-mb 2048] [--data DIR]
@@ -38,7 +38,7 @@ pub fn main() {
     let mut skip: Vec<String> = Vec::new();
     let mut only_set: Option<String> = None;
     let mut options = ExactOptions::default();
-    let mut data = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/pcgtsp");
+    let mut data = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../data/pcgtsp");
     let mut alns_seconds = 0.0f64;
     let mut restricted_seconds = 0.0f64;
     let mut cpu_limit = false;

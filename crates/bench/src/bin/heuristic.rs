@@ -1,5 +1,5 @@
 //! Benchmark of the ALNS heuristic (`cutroute-alns`) on the 59 PCGTSP instances of
-//! `../shared/data/pcgtsp`, next to PCGLNS and the known optima of `reference.csv`.
+//! `data/pcgtsp`, next to PCGLNS and the known optima of `reference.csv`.
 //!
 //! ```text
 //! cargo run --release -p cutroute-bench --bin heuristic -- [--seeds 5] [--limits 1,5,30]
@@ -44,7 +44,7 @@ struct Reference {
 }
 
 fn data_dir() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/pcgtsp")
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../data/pcgtsp")
 }
 
 fn read_reference() -> Vec<Reference> {

@@ -8,17 +8,17 @@ use cutroute_geometry::{Contour, Point};
 /// A file of the shared reference data; panics loudly when it is missing.
 pub fn shared_file(relative: &str) -> Vec<u8> {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/data")
+        .join("../../data")
         .join(relative);
     std::fs::read(&path).unwrap_or_else(|e| {
-        panic!("reference file {} is missing or unreadable ({e}); the tests need ../shared/data beside the repository", path.display())
+        panic!("reference file {} is missing or unreadable ({e}); the tests need data/ of the repository", path.display())
     })
 }
 
 /// Every file of a shared-data folder with the extension, sorted; panics if the folder is missing.
 pub fn shared_dir_files(relative: &str, extension: &str) -> Vec<String> {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/data")
+        .join("../../data")
         .join(relative);
     let mut names: Vec<String> = std::fs::read_dir(&path)
         .unwrap_or_else(|e| panic!("reference folder {} is missing ({e})", path.display()))

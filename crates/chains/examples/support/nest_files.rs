@@ -1,13 +1,13 @@
 //! Helpers shared by the benchmark examples of `cutroute-chains` and `cutroute-segments`
 //! (included by path: examples cannot share a module otherwise): the real nests of
-//! `shared/data/nests`, opened as the app and the CLI open them.
+//! `data/nests`, opened as the app and the CLI open them.
 
 use cutroute_geometry::{Nest, Point};
 use cutroute_protocol::Problem;
 
 /// Every nest file of the shared data: DBS, geometry JSON and T-FLEX projects.
 pub fn nest_files() -> Vec<String> {
-    let root = format!("{}/../../../shared/data/nests", env!("CARGO_MANIFEST_DIR"));
+    let root = format!("{}/../../data/nests", env!("CARGO_MANIFEST_DIR"));
     let mut files = Vec::new();
     for dir in ["dbs-json", "dbs", "tflex"] {
         let entries = std::fs::read_dir(format!("{root}/{dir}"))

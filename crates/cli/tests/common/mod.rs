@@ -7,10 +7,10 @@ use std::process::Command;
 
 use serde_json::Value;
 
-/// A file under `shared/data/`; panics naming the file when it is missing.
+/// A file under `data/`; panics naming the file when it is missing.
 pub fn data(relative: &str) -> PathBuf {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/data")
+        .join("../../data")
         .join(relative);
     assert!(path.exists(), "missing test file {}", path.display());
     path

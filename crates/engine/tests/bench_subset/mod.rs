@@ -10,7 +10,7 @@ macro_rules! instance {
         (
             $name,
             include_str!(concat!(
-                "../../../../../shared/data/pcgtsp/industrial/",
+                "../../../../data/pcgtsp/industrial/",
                 $name,
                 ".pcglns"
             )),

@@ -4,12 +4,12 @@
 use cutroute_pcgtsp::Instance;
 use std::path::PathBuf;
 
-/// `shared/data/` beside the checkout.
+/// `data/` beside the checkout.
 pub fn data_dir() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data")
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../data")
 }
 
-/// Reads a file under `shared/data/`, panicking with the path if it is missing.
+/// Reads a file under `data/`, panicking with the path if it is missing.
 pub fn read_data(relative: &str) -> String {
     let path = data_dir().join(relative);
     std::fs::read_to_string(&path)
@@ -30,7 +30,7 @@ pub struct Reference {
 }
 
 impl Reference {
-    /// Path relative to `shared/data/`.
+    /// Path relative to `data/`.
     pub fn relative_path(&self) -> String {
         format!("pcgtsp/{}/{}.pcglns", self.set, self.instance)
     }
