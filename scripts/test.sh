@@ -6,8 +6,10 @@ cd "$(dirname "$0")/.."
 scripts/setup.sh
 export PATH="$HOME/.cargo/bin:$PATH"
 
-echo "== native tests (web-free crates and the CLI)"
-cargo test
+echo "== native tests (every crate of the workspace, natively)"
+mkdir -p target
+cargo test --workspace 2>&1 | tee target/native-tests.log
+scripts/check-tested-crates.py target/native-tests.log
 
 echo "== wasm tests in headless Chromium"
 (

@@ -20,7 +20,7 @@ use crate::export::ExportMenu;
 use crate::pan_zoom::PanZoom;
 use crate::settings::{objective_from_name, Layer, Settings};
 use crate::stats::{AlternativesTable, StatsPanel};
-use crate::worker_client::{spawn, SolverWorker, WorkerRequest};
+use crate::worker_client::{spawn, SolverWorker};
 
 /// Bundled sample nests (files under `assets/samples/`), the first is opened on start.
 pub const SAMPLES: [(&str, &str); 4] = [
@@ -109,18 +109,12 @@ pub fn App() -> impl IntoView {
     let next_id = StoredValue::new(1_u64);
     // The result a Continue started from, and how many runs the current result took.
     let continued_from = StoredValue::new(None::<Progress>);
-    // A task file opened with the next document: (its name, start point, finish point).
-    let pending_task = StoredValue::new(None::<(String, Point, Option<Point>)>);
     let runs = StoredValue::new(0_u64);
     let kept = RwSignal::new(Vec::<Kept>::new());
     let machine = RwSignal::new(MachineParameters::default());
     let objective = RwSignal::new(objective_from_name(&initial.objective).unwrap_or_default());
-    // The tool-on paths a G-code file holds when they are not whole contours (see
-    // `reopened_paths`).
+    // The tool-on paths a G-code file holds when they are not whole contours.
     let file_paths = RwSignal::new(None::<PathRoute>);
-    // A G-code file being opened: (request id, its program's tool-on paths), compared with
-    // what the worker makes of it (see `program_paths_note`).
-    let pending_program = StoredValue::new(None::<(u64, PathRoute)>);
     let presentation = RwSignal::new(false);
 
     // Everything remembered is saved whenever it changes.
@@ -158,30 +152,14 @@ pub fn App() -> impl IntoView {
         StoredValue::new_local(std::rc::Rc::new(move |message: FromWorker| match message {
             FromWorker::Opened {
                 document: mut opened,
-                request_id,
+                ..
             } => {
-                let program = pending_program
-                    .get_value()
-                    .filter(|(id, _)| *id == request_id)
-                    .map(|(_, paths)| paths);
-                pending_program.set_value(None);
-                // A program that cuts open paths: the worker's nest holds only the loops they
-                // close, so the program's own tool-on paths are shown.
-                let program = program.and_then(|paths| {
-                    let note = program_paths_note(&opened, &paths)?;
-                    opened.warnings.push(note);
-                    Some(paths)
-                });
-                if let Some((task_name, task_start, task_finish)) = pending_task.get_value() {
-                    pending_task.set_value(None);
-                    if let Problem::Nest { start, finish, .. } = &mut opened.problem {
-                        *start = task_start;
-                        *finish = task_finish;
-                    }
-                    opened.format = format!("{}) + {task_name} (task JSON", opened.format);
+                // A task file in the batch brings the machine's speeds (its start and finish
+                // are already the document's).
+                if let Some(speeds) = opened.task_speeds {
+                    machine.update(|m| *m = speeds.applied_to(*m));
                 }
                 open_error.set(None);
-                file_paths.set(None);
                 progress.set(None);
                 samples.set(Vec::new());
                 continued_from.set_value(None);
@@ -190,48 +168,10 @@ pub fn App() -> impl IntoView {
                 if !same_nest {
                     kept.set(Vec::new());
                 }
+                file_paths.set(opened.paths.take());
                 document.set(Some(opened));
-                file_paths.set(program);
             }
-            FromWorker::OpenFailed {
-                message,
-                request_id,
-            } => {
-                pending_task.set_value(None);
-                let program = pending_program
-                    .get_value()
-                    .filter(|(id, _)| *id == request_id);
-                pending_program.set_value(None);
-                match program {
-                    // No closed contour to make a nest of: the program's paths alone.
-                    Some((_, paths)) if !paths.paths.is_empty() => {
-                        open_error.set(None);
-                        progress.set(None);
-                        samples.set(Vec::new());
-                        continued_from.set_value(None);
-                        kept.set(Vec::new());
-                        document.set(Some(Document {
-                            file_name: last_file.get_untracked().unwrap_or_default(),
-                            format: "G-code".into(),
-                            problem: Problem::Nest {
-                                nest: Nest::default(),
-                                start: paths.start,
-                                finish: paths.finish,
-                            },
-                            route: None,
-                            warnings: vec![
-                                message,
-                                format!(
-                                    "shown as the program's {} tool-on paths (open paths: segment or common-edge cutting); there is no nest to solve",
-                                    paths.paths.len()
-                                ),
-                            ],
-                        }));
-                        file_paths.set(Some(paths));
-                    }
-                    _ => open_error.set(Some(message)),
-                }
-            }
+            FromWorker::OpenFailed { message, .. } => open_error.set(Some(message)),
             FromWorker::Progress(update) => {
                 if job_state.get_untracked() == JobState::Running(update.job_id) {
                     let update = merged(update);
@@ -356,11 +296,10 @@ pub fn App() -> impl IntoView {
             let url = format!("./assets/samples/{file_name}");
             match fetch_bytes(&url).await {
                 Ok(bytes) => bridge.with_value(|b| {
-                    b.send(WorkerRequest::Protocol(ToWorker::Open {
+                    b.send(ToWorker::Open {
                         request_id,
-                        file_name,
-                        bytes,
-                    }))
+                        files: vec![(file_name, bytes)],
+                    })
                 }),
                 Err(message) => open_error.set(Some(format!("{url}: {message}"))),
             }
@@ -368,9 +307,9 @@ pub fn App() -> impl IntoView {
     };
     open_sample(initial.sample.clone());
 
-    // Local files (picker or drag and drop) go to the worker as bytes: parsing happens there.
-    // A task JSON opened together with a geometry or result file is combined with it, as the
-    // old viewer did: the task brings the machine's speeds and the start and finish points.
+    // Local files (picker or drag and drop) go to the worker as bytes, all in one request: the
+    // engine's one door decides what they are and how they combine (a nest with its task and
+    // a PCGLNS result, an instance with its result), off the UI thread.
     let open_files = move |files: web_sys::FileList| {
         let files: Vec<web_sys::File> = (0..files.length()).filter_map(|i| files.item(i)).collect();
         leptos::task::spawn_local(async move {
@@ -381,66 +320,18 @@ pub fn App() -> impl IntoView {
                     Err(message) => open_error.set(Some(format!("{}: {message}", file.name()))),
                 }
             }
-            let is_task = |bytes: &[u8]| {
-                cutroute_formats::detect(bytes) == cutroute_formats::Format::TaskJson
-            };
-            // The task's speeds become the machine's (its start and finish go with the nest).
-            let take_speeds = |task: &cutroute_formats::RmTask| {
-                let data = &task.task_data;
-                machine.update(|m| {
-                    m.idle_speed = data.tool_idling_speed;
-                    m.cut_speed = data.tool_cut_speed;
-                    m.pierce_time = data.piercing_duration;
-                });
-            };
-            // A PCGTSP instance or a PCGLNS result with other files: the worker combines the
-            // whole batch (the tour is checked there and drawn on the nest when a task places
-            // its nodes).
-            let is_pcgtsp = |bytes: &[u8]| {
-                cutroute_formats::detect(bytes) == cutroute_formats::Format::Pcglns
-                    || is_pcglns_result(bytes)
-            };
-            if batch.len() > 1 && batch.iter().any(|(_, b)| is_pcgtsp(b.as_slice())) {
-                for (_, bytes) in batch.iter().filter(|(_, b)| is_task(b.as_slice())) {
-                    if let Ok(task) = cutroute_formats::read_task_json(bytes) {
-                        take_speeds(&task);
-                    }
-                }
-                let names: Vec<String> = batch.iter().map(|(n, _)| n.clone()).collect();
-                last_file.set(Some(names.join(" + ")));
-                let request_id = take_id();
-                bridge.with_value(|b| {
-                    b.send(WorkerRequest::OpenTogether {
-                        request_id,
-                        files: batch,
-                    })
-                });
+            if batch.is_empty() {
                 return;
             }
-            let has_geometry = batch.iter().any(|(_, b)| !is_task(b.as_slice()));
-            for (file_name, bytes) in batch {
-                if has_geometry && is_task(bytes.as_slice()) {
-                    match cutroute_formats::read_task_json(&bytes) {
-                        Ok(task) => {
-                            take_speeds(&task);
-                            let data = &task.task_data;
-                            pending_task.set_value(Some((file_name, data.start(), data.finish())));
-                        }
-                        Err(e) => open_error.set(Some(format!("{file_name}: {e}"))),
-                    }
-                    continue;
-                }
-                last_file.set(Some(file_name.clone()));
-                let request_id = take_id();
-                pending_program.set_value(gcode_paths(&bytes).map(|p| (request_id, p)));
-                bridge.with_value(|b| {
-                    b.send(WorkerRequest::Protocol(ToWorker::Open {
-                        request_id,
-                        file_name,
-                        bytes,
-                    }))
-                });
-            }
+            let names: Vec<String> = batch.iter().map(|(n, _)| n.clone()).collect();
+            last_file.set(Some(names.join(" + ")));
+            let request_id = take_id();
+            bridge.with_value(|b| {
+                b.send(ToWorker::Open {
+                    request_id,
+                    files: batch,
+                })
+            });
         });
     };
 
@@ -478,15 +369,16 @@ pub fn App() -> impl IntoView {
             solver: solver.get_untracked(),
             params,
         };
-        bridge.with_value(|b| b.send(WorkerRequest::Protocol(ToWorker::Start(request))));
+        bridge.with_value(|b| b.send(ToWorker::Start(request)));
     };
     let stop = move |_| {
         if let JobState::Running(job_id) = job_state.get_untracked() {
-            bridge.with_value(|b| b.send(WorkerRequest::Protocol(ToWorker::Cancel { job_id })));
+            bridge.with_value(|b| b.send(ToWorker::Cancel { job_id }));
             // The worker answers between solver steps; a step that runs long (a big chain
-            // group, a bound build) would hold Stop up. After 200 ms the job is dropped with
+            // group, a bound build) would hold Stop up. After 150 ms the job is dropped with
             // the best result already received and a fresh worker takes over (the old one is
-            // told to close, and its late messages name a job that is no longer running).
+            // told to close, and its late messages name a job that is no longer running), so
+            // Stop takes effect within the promised 200 ms, page updates included.
             set_timeout(
                 move || {
                     if job_state.get_untracked() == JobState::Running(job_id) {
@@ -494,7 +386,7 @@ pub fn App() -> impl IntoView {
                         job_state.set(JobState::Cancelled);
                     }
                 },
-                std::time::Duration::from_millis(200),
+                std::time::Duration::from_millis(150),
             );
         }
     };
@@ -811,7 +703,10 @@ pub fn App() -> impl IntoView {
                     <dd id="lower-bound">{move || format_bound(progress.get().and_then(|p| p.lower_bound))}</dd>
                     <dt>"Gap"</dt>
                     <dd id="gap">
-                        {move || progress.get().and_then(|p| p.gap()).map(|g| format!("{:.2} %", g * 100.0)).unwrap_or_else(|| "—".into())}
+                        {move || progress.get().and_then(|p| {
+                            let gap = format!("{:.2} %", p.gap()? * 100.0);
+                            Some(if p.proven_optimal { format!("{gap} · proven optimal") } else { gap })
+                        }).unwrap_or_else(|| "—".into())}
                     </dd>
                     <dt>"Elapsed"</dt>
                     <dd id="elapsed">{move || progress.get().map(|p| format!("{:.2} s", p.elapsed_s)).unwrap_or_default()}</dd>
@@ -843,55 +738,6 @@ pub fn App() -> impl IntoView {
 
 /// Hues the tool-on paths of a path route take in turn (`.hue-0` … `.hue-5` in `style/`).
 const PATH_HUES: usize = 6;
-
-/// The tool-on paths of a G-code program (read as the worker reads it, from the origin), or
-/// `None` when the bytes are some other format or not a program that pierces.
-fn gcode_paths(bytes: &[u8]) -> Option<PathRoute> {
-    if cutroute_formats::detect(bytes) != cutroute_formats::Format::Unknown {
-        return None;
-    }
-    let text = std::str::from_utf8(bytes).ok()?;
-    let program = cutroute_gcode::read_gcode(text, &cutroute_gcode::ReadOptions::default()).ok()?;
-    let paths = program.path_route();
-    (!paths.paths.is_empty()).then_some(paths)
-}
-
-/// Differences of tool-on length (mm) between the worker's loops and a program's own paths
-/// that are rounding, not a lost path.
-const PROGRAM_LENGTH_NOISE_MM: f64 = 0.05;
-
-/// When the worker's reading of a G-code program (closed loops as contours, the rest left
-/// out) loses tool-on length or pierces that the program's own paths have, a note saying the
-/// paths are shown instead; `None` when the worker's route is the whole program.
-fn program_paths_note(opened: &Document, paths: &PathRoute) -> Option<String> {
-    let Problem::Nest { nest, .. } = &opened.problem else {
-        return None;
-    };
-    let (cut, pierces) = opened
-        .route
-        .as_ref()
-        .and_then(|r| Toolpath::new(r, nest).ok())
-        .map_or((0.0, 0), |t| (t.cut_length(), t.pierce_count()));
-    // Loops the worker closes within its point tolerance may differ from the program's spans by
-    // rounding; what it leaves out is at least a whole span or path.
-    let lost = paths.cut_length() - cut;
-    let noise = PROGRAM_LENGTH_NOISE_MM.max(1e-6 * cut);
-    (lost > noise || pierces != paths.pierce_count()).then(|| {
-        format!(
-            "the program cuts open tool-on paths (segment or common-edge cutting): shown as its {} paths ({:.1} mm tool-on); as contours it would keep {:.1} mm in {} pierces",
-            paths.paths.len(),
-            paths.cut_length(),
-            cut,
-            pierces
-        )
-    })
-}
-
-/// Whether the bytes are a PCGLNS run summary (the same test as the worker's).
-fn is_pcglns_result(bytes: &[u8]) -> bool {
-    cutroute_formats::detect(bytes) == cutroute_formats::Format::Unknown
-        && std::str::from_utf8(bytes).is_ok_and(|t| t.contains("Tour Ordering"))
-}
 
 /// A labelled positive number input with a tooltip.
 #[component]

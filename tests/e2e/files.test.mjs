@@ -6,7 +6,7 @@ import assert from 'node:assert/strict';
 import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
-import { watchErrors, projectRoot, useApp, screenshot } from './harness.mjs';
+import { watchErrors, projectRoot, useApp, screenshot, cli, assertRounded } from './harness.mjs';
 
 const app = useApp(before, after);
 const nests = path.resolve(projectRoot, 'data', 'nests');
@@ -76,8 +76,11 @@ test('a PCGTSP instance with its PCGLNS result: the tour is checked; a bad tour 
   await page.setInputFiles('#file-input', instance);
   await fileShown(page, 'E1X_6_01.pcgtsp (PCGTSP instance)');
   await solve(page, 'heuristic', 1);
-  const upper = Number(await page.textContent('#upper-bound'));
-  assert.ok(upper > 1400 && upper < 1700, `a tour of the instance: ${upper}`);
+  // The oracle: the CLI's exact solver proves this instance's optimum, which ALNS reaches on
+  // these 16 clusters within the second.
+  const optimum = cli('solve', 'data/nests/pcgtsp/E1X_6_01.pcgtsp', '--solver', 'exact', '--time-limit', '20', '--json');
+  assert.equal(optimum.proven_optimal, true);
+  assertRounded(await page.textContent('#upper-bound'), optimum.ub, 1, 'the heuristic\'s tour');
 
   // Together with the result: the checker recomputes the tour's cost on the instance's weights
   // (PCGLNS rounds them and reports 1514).
@@ -145,8 +148,14 @@ test('a nest, its task and a PCGLNS result: the tour becomes a checked cutting r
   assert.equal(await page.textContent('#pierces'), '23');
   // The route is animated like any other (from near its end: at ×100 the whole route of
   // test1 would take half a minute).
+  // Its machine time, from the task's own speeds and pierce time (read here, not from the page)
+  // applied to the route's lengths, is where the animation clock ends.
+  const taskData = JSON.parse(fs.readFileSync(shared('task-json/test1.task.json'), 'utf8')).TaskData;
+  const test1 = await figures(page);
+  const expectedTime = test1.cut / taskData.ToolCutSpeed + test1.idle / taskData.ToolIdlingSpeed
+    + 23 * taskData.PiercingDuration;
   const total = Number(await page.getAttribute('#anim-clock', 'data-total'));
-  assert.ok(total > 0, `machine time ${total}`);
+  assertRounded(total.toFixed(3), expectedTime, 3, 'animation clock total');
   await page.locator('#anim-scrub').fill(String(total * 0.95));
   await page.selectOption('#anim-speed', '100');
   await page.click('#anim-play');
@@ -162,8 +171,11 @@ test('G-code and standalone HTML exports read back: same pierces, lengths and ma
   const { page, errors, context } = await freshPage();
   await solve(page, 'nearest');
   const shown = await figures(page);
-  assert.equal(shown.pierces, 16);
-  assert.ok(shown.idle > 0 && shown.cut > 0 && shown.time > 0, JSON.stringify(shown));
+  const oracle = cli('solve', 'data/nests/dbs-json/E1X_6_01.dbs.json', '--solver', 'nearest', '--json');
+  assert.equal(shown.pierces, oracle.pierces);
+  assertRounded(shown.idle, oracle.idle_length, 3, 'idle length');
+  assertRounded(shown.cut, oracle.cut_length, 3, 'cut length');
+  assertRounded(shown.time, oracle.time_s, 3, 'machine time');
   await page.click('.export summary');
   const download = downloader(page);
 
@@ -218,8 +230,12 @@ test('the chain solver runs and its G-code (links included) reads back as the sa
   const { page, errors, context } = await freshPage();
   await solve(page, 'chain', 2);
   const shown = await figures(page);
-  assert.ok(shown.pierces >= 1 && shown.pierces <= 16, `chain pierces ${shown.pierces}`);
-  assert.ok(Number(await page.textContent('#upper-bound')) > 0, 'a result');
+  // The oracle: the CLI's chain cutting of the same nest with the same seed and limit.
+  const oracle = cli('solve', 'data/nests/dbs-json/E1X_6_01.dbs.json', '--solver', 'chain', '--time-limit', '2', '--json');
+  assert.equal(shown.pierces, oracle.pierces, 'chain pierces');
+  assertRounded(shown.idle, oracle.idle_length, 3, 'idle length');
+  assertRounded(shown.cut, oracle.cut_length, 3, 'cut length (links included)');
+  assertRounded(await page.textContent('#upper-bound'), oracle.ub, 1, 'upper bound');
   await page.click('.export summary');
   const program = await downloader(page)('#export-gcode');
   await page.setInputFiles('#file-input', program);
@@ -236,12 +252,18 @@ test('the chain solver runs and its G-code (links included) reads back as the sa
 test('every bundled sample of the gallery opens and solves', async () => {
   const { page, errors, context } = await freshPage();
   const samples = await page.locator('#sample option').evaluateAll((options) => options.map((o) => o.value));
-  assert.ok(samples.length >= 4, `samples: ${samples}`);
+  const bundled = fs.readdirSync(path.join(projectRoot, 'assets', 'samples'));
+  assert.deepEqual([...samples].sort(), [...bundled].sort(), 'the gallery offers every bundled sample');
   for (const sample of samples) {
     await page.selectOption('#sample', sample);
     await fileShown(page, sample);
-    assert.ok(await page.locator('#nest-view path.part').count() > 0, `${sample} draws parts`);
+    const facts = cli('inspect', `assets/samples/${sample}`, '--json');
+    // Every part but the sheet is drawn as a part.
+    assert.equal(await page.locator('#nest-view path.part').count(), facts.parts - 1, `${sample} draws its parts`);
     await solve(page, 'nearest');
+    const oracle = cli('solve', `assets/samples/${sample}`, '--solver', 'nearest', '--json');
+    assert.equal(Number(await page.textContent('#pierces')), oracle.pierces, `${sample}: pierces`);
+    assertRounded(await page.getAttribute('#idle-length', 'data-mm'), oracle.idle_length, 3, `${sample}: idle`);
     const contours = await page.evaluate(() => (document.querySelector('#nest-view path.arrows')?.getAttribute('d')?.match(/M/g) ?? []).length);
     assert.equal(Number(await page.textContent('#pierces')), contours, `${sample}: one pierce per contour`);
   }

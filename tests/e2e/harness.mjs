@@ -4,6 +4,7 @@ import http from 'node:http';
 import fs from 'node:fs';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
+import { execFileSync } from 'node:child_process';
 import { chromium } from 'playwright-core';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
@@ -105,4 +106,31 @@ export async function screenshot(page, name) {
     throw new Error(`screenshot ${file} looks blank: ${JSON.stringify(seen)}`);
   }
   return file;
+}
+
+/**
+ * The oracle outside the page: runs the native `cutroute` CLI (built on first use) with `args`
+ * and returns its JSON report. e2e tests compare what the page shows with it.
+ */
+export function cli(...args) {
+  const binary = path.join(projectRoot, 'target', 'debug', 'cutroute');
+  if (!cliBuilt) {
+    execFileSync('cargo', ['build', '--quiet', '-p', 'cutroute-cli'], { cwd: projectRoot, stdio: 'inherit' });
+    cliBuilt = true;
+  }
+  const out = execFileSync(binary, args, { cwd: projectRoot, encoding: 'utf8', maxBuffer: 64 << 20 });
+  return JSON.parse(out);
+}
+let cliBuilt = false;
+
+/**
+ * Display rounding of the page's figures: `shown` (the page's text, `decimals` places) must be
+ * `exact` rounded, i.e. within half a unit of the last place shown.
+ */
+export function assertRounded(shown, exact, decimals, what) {
+  const value = Number(String(shown).replace(/[^0-9eE.+-]/g, ''));
+  const half = 0.5 * 10 ** -decimals;
+  if (!Number.isFinite(value) || !(Math.abs(value - exact) <= half + 1e-9 * Math.abs(exact))) {
+    throw new Error(`${what}: the page shows ${shown}, the oracle ${exact} (±${half})`);
+  }
 }

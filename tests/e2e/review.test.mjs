@@ -5,7 +5,7 @@ import assert from 'node:assert/strict';
 import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
-import { watchErrors, projectRoot, useApp, screenshot } from './harness.mjs';
+import { watchErrors, projectRoot, useApp, screenshot, cli, assertRounded } from './harness.mjs';
 
 const app = useApp(before, after);
 
@@ -75,7 +75,8 @@ test('animation: play reaches the end on the machine clock; steps and scrub move
   await solve(page, 'nearest');
   const clock = page.locator('#anim-clock');
   const total = Number(await clock.getAttribute('data-total'));
-  assert.ok(total > 0, `machine time of the route: ${total}`);
+  const oracle = cli('solve', 'data/nests/dbs-json/E1X_6_01.dbs.json', '--solver', 'nearest', '--json');
+  assertRounded(total.toFixed(3), oracle.time_s, 3, 'the animation lasts the route\'s machine time');
   // Steps land on contour starts, in order.
   await page.click('#anim-next');
   const first = Number(await clock.getAttribute('data-time'));
@@ -256,7 +257,8 @@ test('Continue restarts from the best result; kept results are compared and over
   assert.equal(await rows.count(), 2);
   assert.equal(await rows.nth(1).locator('td').nth(1).textContent(), 'Discrete heuristic (ALNS)');
   const idles = (await page.locator('#compare-table .kept-idle').allTextContents()).map(Number);
-  assert.ok(idles.every((v) => v > 0), `idle lengths ${idles}`);
+  const nearest = cli('solve', 'data/nests/dbs-json/E1X_6_01.dbs.json', '--solver', 'nearest', '--json');
+  assertRounded(idles[0], nearest.idle_length, 1, 'the kept nearest-neighbour route');
   assert.equal(idles[1], second, 'the kept figure is the result shown');
   const excess = await page.locator('#compare-table tbody tr td:nth-child(4)').allTextContents();
   assert.ok(excess.includes('+0.0 %'), `the best result is 0 % over the best: ${excess}`);
@@ -336,7 +338,10 @@ test('several files at once: a task JSON is combined with its result file', asyn
   await fileShown(page, 'E1X_6_01.result.json (result JSON) + E1X_6_01.task.json (task JSON)');
   assert.equal(await page.inputValue('#idle-speed'), '500');
   assert.equal(await page.locator('#nest-view path.part').count(), 8);
-  assert.ok(await page.locator('#nest-view .route circle.pierce').count() > 0, 'the result\'s route is drawn');
+  // The result's route is drawn: one pierce wherever the file's toolpath goes from air to cut.
+  const moves = Object.values(JSON.parse(fs.readFileSync(result, 'utf8')).results)[0].toolpath.map((m) => m.mode);
+  const filePierces = moves.filter((m, i) => m.startsWith('cut') && (i === 0 || moves[i - 1] === 'air')).length;
+  assert.equal(await page.locator('#nest-view .route circle.pierce').count(), filePierces, 'the result\'s route is drawn');
   // The combined problem can be solved.
   await solve(page, 'nearest');
   assert.equal(await page.locator('#nest-view .route circle.pierce').count(), 16);
@@ -368,7 +373,8 @@ test('standalone HTML and G-code exports; G-code options and preview', async () 
   const viewer = await context.newPage();
   const viewerErrors = watchErrors(viewer);
   await viewer.goto(`file://${htmlFile}`);
-  assert.ok(await viewer.locator('svg path').count() > 0, 'the page draws the nest');
+  assert.equal(await viewer.locator('svg path').count(), (html.match(/<path[\s>]/g) ?? []).length, 'the page draws every path it holds');
+  assert.equal(await viewer.locator('svg path.part').count(), 8, 'the page draws the 8 parts');
   assert.match(await viewer.title(), /E1X_6_01/);
   assert.deepEqual(viewerErrors, []);
   await viewer.close();
@@ -377,8 +383,10 @@ test('standalone HTML and G-code exports; G-code options and preview', async () 
   await page.click('#gcode-preview-button');
   const preview = await page.locator('#gcode-preview').textContent();
   const lines = preview.split('\n');
-  assert.ok(lines.length > 3 && lines.length <= 12, `${lines.length} preview lines`);
   assert.ok(lines.includes('G90'), preview);
+  // The preview is the first 12 lines of the very program the button writes.
+  const absolute = fs.readFileSync(await download('#export-gcode'), 'utf8').split('\n');
+  assert.deepEqual(lines, absolute.slice(0, 12), 'the preview shows the program\'s first lines');
   // Options reach the post-processor: incremental, R arcs, custom torch codes and dwell.
   await page.selectOption('#gcode-distance', 'incremental');
   await page.selectOption('#gcode-arcs', 'r');

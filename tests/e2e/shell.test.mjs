@@ -2,7 +2,7 @@
 // sample, runs a solver job in the Web Worker, draws the route, and cancels a running job.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { watchErrors, useApp, screenshot } from './harness.mjs';
+import { watchErrors, useApp, screenshot, cli, assertRounded } from './harness.mjs';
 
 const app = useApp(before, after);
 
@@ -26,16 +26,22 @@ test('opens the default sample, solves in the worker, draws the route, cancels',
   assert.equal(pierces, 16, 'one pierce point per contour (16 contours)');
   const idle = await page.locator('#nest-view .route path.idle').getAttribute('d');
   assert.equal((idle.match(/L/g) ?? []).length, 16, 'idle path visits every pierce point');
-  const upper = Number(await page.locator('#upper-bound').textContent());
-  assert.ok(upper > 0, `upper bound shown (${upper})`);
+  // The oracle: the CLI's nearest-neighbour route of the same nest (deterministic).
+  const oracle = cli('solve', 'data/nests/dbs-json/E1X_6_01.dbs.json', '--solver', 'nearest', '--json');
+  assertRounded(await page.locator('#upper-bound').textContent(), oracle.idle_length, 1, 'upper bound');
   // Statistics of the shown route, recomputed from the geometry, follow the machine parameters.
-  assert.equal(await page.locator('#pierces').textContent(), '16');
-  assert.equal(Number((await page.locator('#idle-length').textContent()).replace(' mm', '')), upper);
-  const timeBefore = await page.locator('#machine-time').textContent();
+  assert.equal(await page.locator('#pierces').textContent(), String(oracle.pierces));
+  assertRounded(await page.getAttribute('#idle-length', 'data-mm'), oracle.idle_length, 3, 'idle length');
+  assertRounded(await page.getAttribute('#cut-length', 'data-mm'), oracle.cut_length, 3, 'cut length');
+  assertRounded(await page.getAttribute('#machine-time', 'data-s'), oracle.time_s, 3, 'machine time');
   await page.click('.machine summary');
   await page.fill('#cut-speed', '50');
   await page.dispatchEvent('#cut-speed', 'change');
-  assert.notEqual(await page.locator('#machine-time').textContent(), timeBefore, 'faster cutting, shorter time');
+  const faster = cli('solve', 'data/nests/dbs-json/E1X_6_01.dbs.json', '--solver', 'nearest', '--json',
+    '--speeds', `${oracle.machine.idle_speed},50,${oracle.machine.pierce_time}`);
+  await page.waitForFunction((s) => document.querySelector('#machine-time')?.dataset.s === s,
+    faster.time_s.toFixed(3), { timeout: 5000 }).catch(() => {});
+  assertRounded(await page.getAttribute('#machine-time', 'data-s'), faster.time_s, 3, 'machine time at 50 mm/s');
   await screenshot(page, 'shell-route.png');
 
   // Second job: a long one, cancelled while it runs; the answer must come promptly.
@@ -43,14 +49,19 @@ test('opens the default sample, solves in the worker, draws the route, cancels',
   await page.fill('#time-limit', '60');
   await page.dispatchEvent('#time-limit', 'change');
   await page.click('#start');
-  await page.waitForFunction(() => document.querySelector('#job-status')?.textContent === 'running');
-  await page.waitForTimeout(500);
-  const cancelAt = Date.now();
-  await page.click('#stop');
-  await page.waitForFunction(() => document.querySelector('#job-status')?.textContent === 'cancelled',
-    null, { timeout: 5000 });
-  const cancelMs = Date.now() - cancelAt;
-  assert.ok(cancelMs < 1000, `cancel answered in ${cancelMs} ms`);
+  // Wait until the job has reported a route (a state, not a fixed sleep), then time Stop inside
+  // the page: from the click to the status that says the worker answered.
+  await page.waitForFunction(() => document.querySelector('#job-status')?.textContent === 'running'
+    && Number.isFinite(Number(document.querySelector('#upper-bound')?.textContent)), null, { timeout: 20000 });
+  const cancelMs = await page.evaluate(() => new Promise((resolve) => {
+    const status = document.querySelector('#job-status');
+    const clicked = performance.now();
+    new MutationObserver((_, observer) => {
+      if (status.textContent === 'cancelled') { observer.disconnect(); resolve(performance.now() - clicked); }
+    }).observe(status, { childList: true, characterData: true, subtree: true });
+    document.querySelector('#stop').click();
+  }));
+  assert.ok(cancelMs <= 200, `Stop took effect in ${cancelMs.toFixed(1)} ms (promise: 200 ms)`);
   await screenshot(page, 'shell-cancelled.png');
   assert.deepEqual(errors, [], 'no errors in the page');
 });

@@ -4,7 +4,7 @@ import assert from 'node:assert/strict';
 import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
-import { watchErrors, projectRoot, useApp, screenshot } from './harness.mjs';
+import { watchErrors, projectRoot, useApp, screenshot, cli, assertRounded } from './harness.mjs';
 
 const shared = path.resolve(projectRoot, 'data', 'nests');
 const app = useApp(before, after);
@@ -108,7 +108,7 @@ test('the theme switch restyles the page and survives a reload', async () => {
   }
 });
 
-test('the exact solver reports both bounds and the chart draws them', async () => {
+test('the exact solver proves the optimum of E1X_6_01, and the chart draws both bounds', async () => {
   const page = await app.browser.newPage({ viewport: { width: 1280, height: 800 } });
   const errors = watchErrors(page);
   await page.goto(app.baseUrl);
@@ -117,11 +117,19 @@ test('the exact solver reports both bounds and the chart draws them', async () =
   await page.fill('#time-limit', '20');
   await page.dispatchEvent('#time-limit', 'change');
   await page.click('#start');
-  await page.waitForFunction(() => ['finished', 'cancelled'].includes(document.querySelector('#job-status')?.textContent),
+  await page.waitForFunction(() => /^(finished|cancelled|failed)/.test(document.querySelector('#job-status')?.textContent ?? ''),
     null, { timeout: 60000 });
-  const upper = Number(await page.locator('#upper-bound').textContent());
-  const lower = Number(await page.locator('#lower-bound').textContent());
-  assert.ok(lower > 0 && lower <= upper + 1e-6, `0 < LB ${lower} <= UB ${upper}`);
+  assert.equal(await page.locator('#job-status').textContent(), 'finished');
+  // Two oracles: the known optimum of the discretised nest (1005.6 at the default step), and the
+  // CLI's exact solver on the same file with the same settings.
+  const oracle = cli('solve', 'data/nests/dbs-json/E1X_6_01.dbs.json', '--solver', 'exact', '--time-limit', '20', '--json');
+  assert.equal(oracle.proven_optimal, true, 'the CLI proves it');
+  assertRounded(oracle.ub, 1005.6, 1, 'the CLI finds the known optimum');
+  const upper = await page.locator('#upper-bound').textContent();
+  assert.equal(upper, '1005.6');
+  assertRounded(upper, oracle.ub, 1, 'upper bound');
+  assertRounded(await page.locator('#lower-bound').textContent(), oracle.ub, 1, 'lower bound meets it');
+  assert.equal(await page.locator('#gap').textContent(), '0.00 % · proven optimal');
   assert.ok((await page.locator('.chart-ub').getAttribute('d')).startsWith('M'), 'upper bound drawn');
   assert.ok((await page.locator('.chart-lb').getAttribute('d')).startsWith('M'), 'lower bound drawn');
   assert.equal(await page.locator('#nest-view .route circle.pierce').count(), 16);

@@ -4,7 +4,7 @@
 mod common;
 
 use common::{hole, load_nest, part, rect, REAL_NESTS};
-use cutroute_aoe::{solve_nest, AoeSolveOptions, PlanGraph, PlanOptions};
+use cutroute_aoe::{solve_nest, AoeSolveOptions, PlanGraph, PlanOptions, PlaneGraph};
 use cutroute_geometry::{Nest, Point};
 
 /// `n × m` rectangles of `w × h` sharing their edges.
@@ -127,11 +127,13 @@ fn every_real_nest_gets_a_checked_route_at_the_pierce_lower_bound() {
             .route
             .validate(&nest, 1e-5 * scale.max(1.0))
             .unwrap_or_else(|e| panic!("{name}: {e}"));
-        assert_eq!(
-            solution.route.pierce_count(),
-            solution.pierce_lower_bound,
-            "{name}"
-        );
+        // The fewest pierces of any route, counted here from the plan graph alone: per
+        // connected component (found by union-find over the edge ends, not by the solver's
+        // own components), half its odd-degree vertices, and at least one.
+        let plan = PlanGraph::from_nest(&nest, &options.plan).unwrap();
+        let fewest = fewest_pierces(plan.graph());
+        assert_eq!(solution.route.pierce_count(), fewest, "{name}");
+        assert_eq!(solution.pierce_lower_bound, fewest, "{name}");
         assert!(
             solution.route.pierce_count() <= nest.contour_count(),
             "{name}"
@@ -205,4 +207,31 @@ fn a_thousand_contour_sheet_gets_a_checked_route() {
     plan.check_route(&solution.chains).unwrap();
     assert!(solution.components > 400);
     assert!(solution.route.idle_length() <= solution.unordered_idle_length + 1e-9);
+}
+
+/// Half the odd-degree vertices of each connected component (at least one per component with
+/// an edge): an Euler trail decomposition's pierce count, the minimum of any route.
+fn fewest_pierces(graph: &PlaneGraph) -> usize {
+    let n = graph.vertex_count();
+    let mut parent: Vec<usize> = (0..n).collect();
+    fn root(parent: &mut [usize], mut v: usize) -> usize {
+        while parent[v] != v {
+            parent[v] = parent[parent[v]];
+            v = parent[v];
+        }
+        v
+    }
+    let mut degree = vec![0usize; n];
+    for e in 0..graph.edge_count() {
+        let (a, b) = graph.ends(e);
+        degree[a] += 1;
+        degree[b] += 1;
+        let (ra, rb) = (root(&mut parent, a), root(&mut parent, b));
+        parent[ra] = rb;
+    }
+    let mut odd = std::collections::HashMap::<usize, usize>::new();
+    for v in (0..n).filter(|&v| degree[v] > 0) {
+        *odd.entry(root(&mut parent, v)).or_default() += degree[v] % 2;
+    }
+    odd.values().map(|&k| (k / 2).max(1)).sum()
 }

@@ -6,8 +6,11 @@
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 
+use cutroute_aoe::{PlanGraph, PlanOptions};
 use cutroute_engine::{open_document, run_to_end, start_job, JobStatus};
-use cutroute_geometry::{MachineParameters, Nest, Objective, PathRoute, PathRouteError, Point};
+use cutroute_geometry::{
+    MachineParameters, Nest, Objective, PathRoute, PathRouteError, Point, Span,
+};
 use cutroute_protocol::{JobRequest, Problem, Progress, SolverKind, SolverParams};
 use web_time::{Duration, Instant};
 
@@ -162,19 +165,34 @@ fn every_path_solver_returns_a_checked_route_with_its_numbers() {
 fn common_edges_are_cut_once_on_nest01() {
     let problem = problem(NEST01);
     let (nest, ..) = nest_of(&problem);
-    let contours: f64 = nest
-        .parts
+    // The plan graph merges the edges two parts share; every piece of such a common edge must be
+    // under exactly one tool-on span of the route (twice would be the standard cut of both
+    // contours, zero an uncut edge).
+    let plan = PlanGraph::from_nest(nest, &PlanOptions::default()).expect("a plan graph");
+    let common_edges: Vec<usize> = (0..plan.graph().edge_count())
+        .filter(|&e| plan.edge_contours(e).len() == 2)
+        .collect();
+    // Five parts in a row, each touching the next along y = 0.
+    assert_eq!(common_edges.len(), 4, "Nest01's common edges");
+    let common: Vec<Point> = common_edges
         .iter()
-        .flat_map(|p| &p.contours)
-        .map(|c| c.perimeter())
-        .sum();
+        .flat_map(|&e| plan.edge_spans(e))
+        .flat_map(|s| [0.1, 0.3, 0.5, 0.7, 0.9].map(|t| s.point_at(t)))
+        .collect();
+    let near = 1e-2;
     for solver in [SolverKind::Sccp, SolverKind::Gsccp, SolverKind::Aoe] {
         let params = params(1.0, Objective::Time);
         let mut job = start_job(&request(&problem, solver, params)).unwrap();
         let result = run_to_end(job.as_mut(), &mut |_| {});
         let route = result.path_route.unwrap();
-        assert!(route.pierce_count() < nest.contour_count(), "{solver:?}");
-        assert!(route.cut_length() < contours - 100.0, "{solver:?}");
+        let spans: Vec<&Span> = route.paths.iter().flat_map(|p| &p.spans).collect();
+        for (i, &m) in common.iter().enumerate() {
+            let cuts = spans.iter().filter(|s| s.distance_to(m) <= near).count();
+            assert_eq!(
+                cuts, 1,
+                "{solver:?}: common piece {i} at {m:?} cut {cuts} times"
+            );
+        }
     }
 }
 

@@ -4,7 +4,7 @@
 #![cfg(target_arch = "wasm32")]
 
 use cutroute_engine::{open_document, run_to_end, start_job};
-use cutroute_protocol::{JobRequest, SolverKind, SolverParams};
+use cutroute_protocol::{JobRequest, Problem, SolverKind, SolverParams};
 use wasm_bindgen_test::{wasm_bindgen_test, wasm_bindgen_test_configure};
 
 wasm_bindgen_test_configure!(run_in_browser);
@@ -14,6 +14,10 @@ const SAMPLE: &[u8] = include_bytes!("../../../data/nests/dbs-json/E1X_6_01.dbs.
 #[wasm_bindgen_test]
 fn opens_a_sample_and_routes_it_in_the_browser() {
     let document = open_document("E1X_6_01.dbs.json", SAMPLE).expect("sample opens");
+    let Problem::Nest { nest, .. } = &document.problem else {
+        panic!("the sample is a nest")
+    };
+    let nest = nest.clone();
     let request = JobRequest {
         job_id: 1,
         problem: document.problem,
@@ -24,6 +28,15 @@ fn opens_a_sample_and_routes_it_in_the_browser() {
     let result = run_to_end(job.as_mut(), &mut |_| {});
     let route = result.route.expect("a route");
     assert_eq!(route.steps.len(), 16);
-    assert!(result.upper_bound.unwrap() > 0.0);
+    // The route computed in the browser passes the same independent checker as natively, and
+    // the bound the page would show is its idle length.
+    let problems = route.problems(&nest, &nest.containment_forest(), 1e-3);
+    assert!(problems.is_empty(), "{problems:?}");
+    let idle = route.idle_length();
+    let reported = result.upper_bound.expect("an upper bound");
+    assert!(
+        (reported - idle).abs() <= 1e-6 * idle,
+        "{reported} vs {idle}"
+    );
     assert!(result.elapsed_s >= 0.0);
 }
