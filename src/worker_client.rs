@@ -1,19 +1,14 @@
 //! The page's end of the solver worker: spawns `worker.js` and routes its answers to callbacks.
 
-use cutroute_protocol::FromWorker;
+use cutroute_protocol::{FromWorker, ToWorker};
 use gloo_worker::{Spawnable, WorkerBridge};
-
-// The worker's own message type, compiled here from the worker's source so both ends agree.
-#[path = "../crates/worker/src/request.rs"]
-mod request;
-pub use request::WorkerRequest;
 
 /// The worker type, named only for its message types; its code lives in `crates/worker`.
 pub struct SolverWorker;
 
 impl gloo_worker::Worker for SolverWorker {
     type Message = ();
-    type Input = WorkerRequest;
+    type Input = ToWorker;
     type Output = FromWorker;
 
     fn create(_scope: &gloo_worker::WorkerScope<Self>) -> Self {
@@ -23,7 +18,7 @@ impl gloo_worker::Worker for SolverWorker {
     fn received(
         &mut self,
         _scope: &gloo_worker::WorkerScope<Self>,
-        _msg: WorkerRequest,
+        _msg: ToWorker,
         _id: gloo_worker::HandlerId,
     ) {
     }

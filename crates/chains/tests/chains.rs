@@ -235,10 +235,7 @@ fn links_go_round_a_wall_between_two_parts() {
 }
 
 fn read_nest(path: &str) -> Nest {
-    let full = format!(
-        "{}/../../data/nests/{path}",
-        env!("CARGO_MANIFEST_DIR")
-    );
+    let full = format!("{}/../../data/nests/{path}", env!("CARGO_MANIFEST_DIR"));
     let bytes = std::fs::read(&full).unwrap_or_else(|e| panic!("missing test file {full}: {e}"));
     cutroute_formats::read_nest(&bytes).unwrap_or_else(|e| panic!("cannot read {full}: {e}"))
 }

@@ -28,7 +28,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use cutroute_engine::{open_document, run_to_end, start_job, AoeJob, SegmentJob};
-use cutroute_geometry::{Entry, MachineParameters, Nest, Objective, Route};
+use cutroute_geometry::{Entry, MachineParameters, Nest, Objective, PathRoute, Route};
 use cutroute_protocol::{Document, JobRequest, Problem, Progress, SolverKind, SolverParams};
 use serde_json::{json, Value};
 
@@ -273,7 +273,20 @@ fn open(path: &Path) -> Result<Document, String> {
 fn inspect(path: &Path, as_json: bool) -> Result<(), String> {
     let document = open(path)?;
     let summary = match &document.problem {
-        Problem::Nest { nest, .. } => nest_summary(&document.format, nest),
+        Problem::Nest { nest, .. } => {
+            let mut summary = nest_summary(&document.format, nest);
+            // A program's own route: its tool-on paths and pierces, as the machine runs it.
+            let route = (document.paths.clone()).or_else(|| {
+                let route = document.route.as_ref()?;
+                PathRoute::from_route(route, nest).ok()
+            });
+            if let (Some(route), Value::Object(fields)) = (route, &mut summary) {
+                fields.insert("route_pierces".into(), json!(route.pierce_count()));
+                fields.insert("route_cut_length".into(), json!(route.cut_length()));
+                fields.insert("route_idle_length".into(), json!(route.idle_length()));
+            }
+            summary
+        }
         Problem::PcgtspText { text } => {
             let instance = cutroute_pcgtsp::Instance::parse(text).map_err(|e| e.to_string())?;
             json!({
@@ -423,15 +436,12 @@ fn convert(
         })?,
     };
     // The route of the G-code and HTML outputs: solved when asked, else the file's own.
-    let routed = || -> Result<Route, String> {
-        let route = match (solver, &document.route) {
-            (None, Some(route)) => route.clone(),
-            (name, _) => solved_route(&document, name.unwrap_or("ccp"), params.clone())?,
-        };
-        route
-            .validate(nest, 1e-6 * nest_scale(nest))
-            .map_err(|e| format!("invalid route: {e}"))?;
-        Ok(route)
+    let routed = || -> Result<Routed, String> {
+        match (solver, &document.route, &document.paths) {
+            (None, _, Some(paths)) => Ok(Routed::Paths(paths.clone())),
+            (None, Some(route), None) => Ok(Routed::Contours(route.clone())),
+            (name, ..) => solved(&document, name.unwrap_or("ccp"), params.clone()),
+        }
     };
     let bytes: Vec<u8> = match format.as_str() {
         "dbs" => cutroute_formats::write_dbs(nest).map_err(|e| e.to_string())?,
@@ -450,9 +460,12 @@ fn convert(
         .into_bytes(),
         "gcode" => {
             let options = gcode.options()?;
-            cutroute_gcode::route_gcode(nest, &routed()?, &options)
-                .map_err(|e| e.to_string())?
-                .into_bytes()
+            match routed()? {
+                Routed::Contours(route) => cutroute_gcode::route_gcode(nest, &route, &options),
+                Routed::Paths(paths) => cutroute_gcode::path_route_gcode(&paths, &options),
+            }
+            .map_err(|e| e.to_string())?
+            .into_bytes()
         }
         "html" => {
             let options = cutroute_formats::HtmlOptions {
@@ -461,9 +474,17 @@ fn convert(
                     .map_or_else(|| "route".into(), |n| n.to_string_lossy().into_owned()),
                 ..Default::default()
             };
-            cutroute_formats::route_html(nest, &routed()?, &options)
-                .map_err(|e| e.to_string())?
-                .into_bytes()
+            match routed()? {
+                Routed::Contours(route) => cutroute_formats::route_html(nest, &route, &options)
+                    .map_err(|e| e.to_string())?,
+                Routed::Paths(paths) => cutroute_formats::toolpath_html(
+                    nest,
+                    &cutroute_geometry::Toolpath::from_path_route(&paths),
+                    &[],
+                    &options,
+                ),
+            }
+            .into_bytes()
         }
         other => {
             return Err(format!(
@@ -474,12 +495,18 @@ fn convert(
     std::fs::write(output, bytes).map_err(|e| format!("{}: {e}", output.display()))
 }
 
-/// Routes the document's nest with the named solver and returns the best route found.
-fn solved_route(
-    document: &Document,
-    solver_name: &str,
-    params: SolverParams,
-) -> Result<Route, String> {
+/// What a G-code or HTML output draws: a route of whole contours, or tool-on paths (segment
+/// and common-edge cutting, G-code programs of open paths).
+enum Routed {
+    Contours(Route),
+    Paths(PathRoute),
+}
+
+/// Routes the document's nest with the named solver; the best route found, checked.
+fn solved(document: &Document, solver_name: &str, params: SolverParams) -> Result<Routed, String> {
+    let Problem::Nest { nest, .. } = &document.problem else {
+        return Err("only nests are routed".into());
+    };
     let solver = solver_kind(solver_name)?;
     let request = JobRequest {
         job_id: 1,
@@ -488,9 +515,29 @@ fn solved_route(
         params,
     };
     let mut job = start_job(&request).map_err(|e| e.to_string())?;
-    run_to_end(job.as_mut(), &mut |_| {})
-        .route
-        .ok_or_else(|| format!("the {solver_name} solver found no route"))
+    let progress = run_to_end(job.as_mut(), &mut |_| {});
+    let tolerance = 1e-6 * nest_scale(nest);
+    match (progress.route, progress.path_route) {
+        (Some(route), _) => {
+            route
+                .validate(nest, tolerance)
+                .map_err(|e| format!("invalid route: {e}"))?;
+            Ok(Routed::Contours(route))
+        }
+        (None, Some(paths)) => {
+            // As `solve` checks path routes: a contour cut twice (standard cutting of common
+            // edges) is allowed, nothing else.
+            let problems = paths.problems(nest, tolerance);
+            if let Some(other) = problems
+                .iter()
+                .find(|p| !matches!(p, cutroute_geometry::PathRouteError::Overlap { .. }))
+            {
+                return Err(format!("invalid route: {other}"));
+            }
+            Ok(Routed::Paths(paths))
+        }
+        (None, None) => Err(format!("the {solver_name} solver found no route")),
+    }
 }
 
 /// The solver a CLI name selects; "discrete" is the heuristic on a discretised nest.
@@ -618,6 +665,8 @@ fn route_report(
         "certified_contours": result.certified.iter().filter(|c| **c).count(),
         "ub": result.upper_bound,
         "lb": result.lower_bound,
+        "gap": result.gap(),
+        "proven_optimal": result.proven_optimal,
         "elapsed_s": result.elapsed_s,
     }))
 }

@@ -34,6 +34,7 @@
 mod jobs;
 mod nearest;
 mod open;
+mod open_files;
 mod path_jobs;
 
 use cutroute_protocol::{JobRequest, Problem, Progress, SolverKind};
@@ -41,7 +42,10 @@ use web_time::Duration;
 
 pub use jobs::{CcpJob, ChainJob, DiscreteJob, DiscreteMode};
 pub use nearest::NearestNeighbourJob;
-pub use open::{format_name, open_document, OpenError};
+pub use open::{format_name, OpenError};
+pub use open_files::{
+    is_pcglns_result, open_document, open_gcode, open_together, task_instance, POINT_TOLERANCE_MM,
+};
 pub use path_jobs::{AoeJob, PlanBound, SegmentJob};
 
 /// How long one [`Job::step`] may run before it returns, so cancel requests are seen quickly.

@@ -25,12 +25,104 @@ pub enum OpenError {
     TaskWithoutGeometry(String),
     /// Nothing recognisable.
     #[error(
-        "{0}: unknown format (expected DBS, geometry/task/result JSON, DXF, T-FLEX or PCGLNS)"
+        "{0}: unknown format (expected DBS, geometry/task/result JSON, DXF, T-FLEX, a PCGLNS/PCGTSPLIB \
+         instance or result, or G-code)"
     )]
     UnknownFormat(String),
     /// The file reads but holds nothing to cut.
     #[error("{0}: the file holds no closed contours to cut")]
     NothingToCut(String),
+    /// A G-code program that does not read.
+    #[error("{file_name} (G-code): {message}")]
+    Gcode {
+        /// The file's name.
+        file_name: String,
+        /// The reader's error with its line and column.
+        message: String,
+    },
+    /// A G-code program that never cuts a closed contour.
+    #[error("{0} (G-code): the program cuts no closed contour")]
+    GcodeCutsNothing(String),
+    /// A PCGLNS result opened with nothing to check its tour against.
+    #[error(
+        "{0}: a PCGLNS result holds only a tour; open it together with its instance \
+         (.pcglns/.pcgtsp), or with its nest and task JSON"
+    )]
+    TourAlone(String),
+    /// Two files of one kind in a batch.
+    #[error("{first} and {second} are both {kind}: open one {kind} at a time")]
+    TwoOfAKind {
+        /// The kind, in words.
+        kind: &'static str,
+        /// The first file.
+        first: String,
+        /// The second file.
+        second: String,
+    },
+    /// A file of a batch that is none of the kinds a batch combines.
+    #[error("{0}: cannot be combined with the other files (expected a nest, a task JSON, a PCGTSP instance or a PCGLNS result)")]
+    NotCombinable(String),
+    /// The tour fails the independent checker.
+    #[error("{file_name}: the tour is not feasible for {against}: {reason} (nodes and clusters counted from 0)")]
+    InfeasibleTour {
+        /// The result file.
+        file_name: String,
+        /// What it was checked against (the instance's or the task's file name).
+        against: String,
+        /// The checker's finding.
+        reason: String,
+    },
+    /// The checked cost of the tour differs from what the result file reports.
+    #[error("{file_name}: the file reports cost {reported} but the tour costs {checked:.3} on {against}")]
+    CostMismatch {
+        /// The result file.
+        file_name: String,
+        /// What it was checked against.
+        against: String,
+        /// The cost in the file.
+        reported: f64,
+        /// The cost recomputed by the checker.
+        checked: f64,
+    },
+    /// An instance whose nodes are not the task's pierce points plus the start.
+    #[error("{instance} has {nodes} nodes but {task} has {points} pierce points plus the start: they do not belong together")]
+    InstanceNotOfTask {
+        /// The instance file.
+        instance: String,
+        /// Its node count.
+        nodes: usize,
+        /// The task file.
+        task: String,
+        /// The task's pierce points.
+        points: usize,
+    },
+    /// A task contour that lies on no contour of the nest.
+    #[error("{task}: contour {index} (pierce point ({x:.3}, {y:.3})) is on no contour of {nest}: they do not belong together")]
+    TaskNotOnNest {
+        /// The task file.
+        task: String,
+        /// The task contour's 1-based `Index`.
+        index: i64,
+        /// Its first pierce point.
+        x: f64,
+        /// Its first pierce point.
+        y: f64,
+        /// The nest file.
+        nest: String,
+    },
+    /// The tour, as a cutting route, fails the route checker.
+    #[error("{file_name}: as a cutting route of {nest} the tour is not valid: {reason}")]
+    InvalidRoute {
+        /// The result file.
+        file_name: String,
+        /// The nest file.
+        nest: String,
+        /// The route checker's finding.
+        reason: String,
+    },
+    /// A task or a tour with no nest to draw it on, and no instance either.
+    #[error("{0}: a cutting task holds no geometry; open it together with its nest (geometry JSON or DBS)")]
+    TaskWithoutNest(String),
 }
 
 /// The format's name for people.
@@ -47,11 +139,12 @@ pub fn format_name(format: Format) -> &'static str {
     }
 }
 
-/// Read a file whose format is recognised from its content (the name is only reported).
+/// Read a file of one of the model formats, recognised from its content (the name is only
+/// reported); [`crate::open_document`] is the door that also opens G-code programs.
 ///
 /// Nests come back with contours oriented by nesting depth (outer clockwise, holes
 /// counter-clockwise), since some real files store every contour clockwise.
-pub fn open_document(file_name: &str, bytes: &[u8]) -> Result<Document, OpenError> {
+pub(crate) fn open_model_file(file_name: &str, bytes: &[u8]) -> Result<Document, OpenError> {
     let format = detect(bytes);
     let unreadable = |message: String| OpenError::Unreadable {
         file_name: file_name.to_string(),
@@ -106,6 +199,8 @@ pub fn open_document(file_name: &str, bytes: &[u8]) -> Result<Document, OpenErro
                     text: text.to_string(),
                 },
                 route: None,
+                paths: None,
+                task_speeds: None,
                 warnings,
             });
         }
@@ -126,6 +221,8 @@ pub fn open_document(file_name: &str, bytes: &[u8]) -> Result<Document, OpenErro
             finish: None,
         },
         route,
+        paths: None,
+        task_speeds: None,
         warnings,
     })
 }

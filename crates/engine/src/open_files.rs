@@ -1,128 +1,23 @@
-//! Opening what `cutroute-engine` does not open alone: a G-code program (shown as the nest its
-//! cuts trace, with the program's own route), and several files opened together — a nest with
-//! its task JSON and a PCGLNS result, or a PCGTSP instance with a PCGLNS result. Tours are
-//! checked by the independent checker (`cutroute_pcgtsp::check_tour`) and routes by
-//! `Route::validate` before anything is shown.
-//!
-//! Plain code (no web APIs): the worker calls it, and it is tested natively.
+//! The one door for files: [`open_document`] opens any single file the app or the CLI can open
+//! (every nest format, PCGTSP instances, and G-code programs, shown as the nest their cuts trace
+//! with the program's own route), and [`open_together`] several files opened as one document —
+//! a nest with its task JSON and a PCGLNS result, or a PCGTSP instance with a PCGLNS result.
+//! Tours are checked by the independent checker (`cutroute_pcgtsp::check_tour`) and routes by
+//! `Route::problems` before anything is shown.
 
-use cutroute_engine::{format_name, open_document, OpenError};
+use crate::open::{format_name, open_model_file, OpenError};
 use cutroute_formats::{detect, read_task_json, Format, RmTask};
 use cutroute_gcode::{read_gcode, Motion, ReadOptions};
 use cutroute_geometry::{
-    Contour, ContourRef, CutStep, Entry, Nest, Part, Point, Route, RouteError, Span, Vertex,
+    Contour, ContourRef, CutStep, Entry, Nest, Part, PathRoute, Point, Route, RouteError, Span,
+    Toolpath, Vertex,
 };
 use cutroute_pcgtsp::{check_tour, Instance, PcglnsResult};
-use cutroute_protocol::{Document, Problem};
+use cutroute_protocol::{Document, Problem, TaskSpeeds};
 
 /// Pierce points of a task and the end points of G-code moves count as "the same point" within
 /// this distance, mm (files round coordinates to a few decimals).
 pub const POINT_TOLERANCE_MM: f64 = 0.01;
-
-/// Why files could not be opened; every message names the file.
-#[derive(Debug, thiserror::Error, PartialEq)]
-pub enum OpenFilesError {
-    /// The engine's reader refused a file.
-    #[error(transparent)]
-    Engine(#[from] OpenError),
-    /// Nothing the engine or this module recognises.
-    #[error(
-        "{0}: unknown format (expected DBS, geometry/task/result JSON, DXF, T-FLEX, a PCGLNS/PCGTSPLIB \
-         instance or result, or G-code)"
-    )]
-    UnknownFormat(String),
-    /// A G-code program that does not read.
-    #[error("{file_name} (G-code): {message}")]
-    Gcode {
-        /// The file's name.
-        file_name: String,
-        /// The reader's error with its line and column.
-        message: String,
-    },
-    /// A G-code program that never cuts a closed contour.
-    #[error("{0} (G-code): the program cuts no closed contour")]
-    GcodeCutsNothing(String),
-    /// A PCGLNS result opened with nothing to check its tour against.
-    #[error(
-        "{0}: a PCGLNS result holds only a tour; open it together with its instance \
-         (.pcglns/.pcgtsp), or with its nest and task JSON"
-    )]
-    TourAlone(String),
-    /// Two files of one kind in a batch.
-    #[error("{first} and {second} are both {kind}: open one {kind} at a time")]
-    TwoOfAKind {
-        /// The kind, in words.
-        kind: &'static str,
-        /// The first file.
-        first: String,
-        /// The second file.
-        second: String,
-    },
-    /// A file of a batch that is none of the kinds a batch combines.
-    #[error("{0}: cannot be combined with the other files (expected a nest, a task JSON, a PCGTSP instance or a PCGLNS result)")]
-    NotCombinable(String),
-    /// The tour fails the independent checker.
-    #[error("{file_name}: the tour is not feasible for {against}: {reason} (nodes and clusters counted from 0)")]
-    InfeasibleTour {
-        /// The result file.
-        file_name: String,
-        /// What it was checked against (the instance's or the task's file name).
-        against: String,
-        /// The checker's finding.
-        reason: String,
-    },
-    /// The checked cost of the tour differs from what the result file reports.
-    #[error("{file_name}: the file reports cost {reported} but the tour costs {checked:.3} on {against}")]
-    CostMismatch {
-        /// The result file.
-        file_name: String,
-        /// What it was checked against.
-        against: String,
-        /// The cost in the file.
-        reported: f64,
-        /// The cost recomputed by the checker.
-        checked: f64,
-    },
-    /// An instance whose nodes are not the task's pierce points plus the start.
-    #[error("{instance} has {nodes} nodes but {task} has {points} pierce points plus the start: they do not belong together")]
-    InstanceNotOfTask {
-        /// The instance file.
-        instance: String,
-        /// Its node count.
-        nodes: usize,
-        /// The task file.
-        task: String,
-        /// The task's pierce points.
-        points: usize,
-    },
-    /// A task contour that lies on no contour of the nest.
-    #[error("{task}: contour {index} (pierce point ({x:.3}, {y:.3})) is on no contour of {nest}: they do not belong together")]
-    TaskNotOnNest {
-        /// The task file.
-        task: String,
-        /// The task contour's 1-based `Index`.
-        index: i64,
-        /// Its first pierce point.
-        x: f64,
-        /// Its first pierce point.
-        y: f64,
-        /// The nest file.
-        nest: String,
-    },
-    /// The tour, as a cutting route, fails the route checker.
-    #[error("{file_name}: as a cutting route of {nest} the tour is not valid: {reason}")]
-    InvalidRoute {
-        /// The result file.
-        file_name: String,
-        /// The nest file.
-        nest: String,
-        /// The route checker's finding.
-        reason: String,
-    },
-    /// A task or a tour with no nest to draw it on, and no instance either.
-    #[error("{0}: a cutting task holds no geometry; open it together with its nest (geometry JSON or DBS)")]
-    TaskWithoutNest(String),
-}
 
 /// Whether the text is a PCGLNS run summary (`*.pcglns.result.txt`).
 pub fn is_pcglns_result(bytes: &[u8]) -> bool {
@@ -132,18 +27,18 @@ pub fn is_pcglns_result(bytes: &[u8]) -> bool {
 
 /// Opens one file: what the engine reads, else a G-code program, else a PCGLNS result (which
 /// needs company, so it is an error alone).
-pub fn open_file(file_name: &str, bytes: &[u8]) -> Result<Document, OpenFilesError> {
-    match open_document(file_name, bytes) {
+pub fn open_document(file_name: &str, bytes: &[u8]) -> Result<Document, OpenError> {
+    match open_model_file(file_name, bytes) {
         Err(OpenError::UnknownFormat(name)) => {
             if is_pcglns_result(bytes) {
-                return Err(OpenFilesError::TourAlone(name));
+                return Err(OpenError::TourAlone(name));
             }
             match std::str::from_utf8(bytes) {
                 Ok(text) if looks_like_gcode(text) => open_gcode(file_name, text),
-                _ => Err(OpenFilesError::UnknownFormat(name)),
+                _ => Err(OpenError::UnknownFormat(name)),
             }
         }
-        other => Ok(other?),
+        other => other,
     }
 }
 
@@ -167,8 +62,8 @@ fn looks_like_gcode(text: &str) -> bool {
 /// a tool-on path from one loop to the next in the same torch-on run a chain link. The cut
 /// direction is the program's own. Tool-on paths that close no loop are left out with a
 /// warning.
-pub fn open_gcode(file_name: &str, text: &str) -> Result<Document, OpenFilesError> {
-    let program = read_gcode(text, &ReadOptions::default()).map_err(|e| OpenFilesError::Gcode {
+pub fn open_gcode(file_name: &str, text: &str) -> Result<Document, OpenError> {
+    let program = read_gcode(text, &ReadOptions::default()).map_err(|e| OpenError::Gcode {
         file_name: file_name.to_string(),
         message: e.to_string(),
     })?;
@@ -241,8 +136,29 @@ pub fn open_gcode(file_name: &str, text: &str) -> Result<Document, OpenFilesErro
         }
     }
     finish_run(run.take(), &mut warnings);
+    let program_paths = program.path_route();
     if loops.is_empty() {
-        return Err(OpenFilesError::GcodeCutsNothing(file_name.to_string()));
+        if program_paths.paths.is_empty() {
+            return Err(OpenError::GcodeCutsNothing(file_name.to_string()));
+        }
+        // No closed contour to make a nest of: the program's paths alone, to review.
+        warnings.push(format!(
+            "the program cuts no closed contour: shown as its {} tool-on paths (open paths: segment or common-edge cutting); there is no nest to solve",
+            program_paths.paths.len()
+        ));
+        return Ok(Document {
+            file_name: file_name.to_string(),
+            format: GCODE.to_string(),
+            problem: Problem::Nest {
+                nest: Nest::default(),
+                start: program_paths.start,
+                finish: program_paths.finish,
+            },
+            route: None,
+            paths: Some(program_paths),
+            task_speeds: None,
+            warnings,
+        });
     }
     let (nest, refs) = nest_of_loops(loops.iter().map(|(c, _)| c.clone()).collect());
     let steps: Vec<CutStep> = loops
@@ -262,16 +178,53 @@ pub fn open_gcode(file_name: &str, text: &str) -> Result<Document, OpenFilesErro
         steps,
         finish,
     };
+    // A program that cuts open paths: the nest holds only the loops they close, so the
+    // program's own tool-on paths are what to show.
+    let paths = open_paths_note(&nest, &route, &program_paths).map(|note| {
+        warnings.push(note);
+        program_paths
+    });
     Ok(Document {
         file_name: file_name.to_string(),
-        format: "G-code".to_string(),
+        format: GCODE.to_string(),
         problem: Problem::Nest {
             nest,
             start: program.start,
             finish,
         },
         route: Some(route),
+        paths,
+        task_speeds: None,
         warnings,
+    })
+}
+
+/// The format's name for people.
+const GCODE: &str = "G-code";
+
+/// Differences of tool-on length (mm) between a program's closed loops and its own paths that
+/// are rounding, not a lost path.
+const PROGRAM_LENGTH_NOISE_MM: f64 = 0.05;
+
+/// When the loops of a program (as contours, the rest left out) lose tool-on length or pierces
+/// that the program's own paths have, a note saying the paths are shown instead; `None` when
+/// the loops' route is the whole program.
+fn open_paths_note(nest: &Nest, route: &Route, paths: &PathRoute) -> Option<String> {
+    let (cut, pierces) = Toolpath::new(route, nest)
+        .ok()
+        .map_or((0.0, 0), |t| (t.cut_length(), t.pierce_count()));
+    // Loops closed within the point tolerance may differ from the program's spans by
+    // rounding; what is left out is at least a whole span or path.
+    let lost = paths.cut_length() - cut;
+    let noise = PROGRAM_LENGTH_NOISE_MM.max(1e-6 * cut);
+    (lost > noise || pierces != paths.pierce_count()).then(|| {
+        format!(
+            "the program cuts open tool-on paths (segment or common-edge cutting): shown as its {} paths ({:.1} mm tool-on); as contours it would keep {:.1} mm in {} pierces",
+            paths.paths.len(),
+            paths.cut_length(),
+            cut,
+            pierces
+        )
     })
 }
 
@@ -341,10 +294,10 @@ enum Piece {
 /// Opens several files as one document: a nest (any nest format) with its task JSON (start,
 /// finish) and optionally a PCGLNS result whose tour becomes the shown route; or a PCGTSP
 /// instance with a PCGLNS result (the tour is checked and reported; with a nest and task too,
-/// it is also drawn). One file alone opens as [`open_file`] does.
-pub fn open_together(files: &[(String, Vec<u8>)]) -> Result<Document, OpenFilesError> {
+/// it is also drawn). One file alone opens as [`open_document`] does.
+pub fn open_together(files: &[(String, Vec<u8>)]) -> Result<Document, OpenError> {
     if let [(name, bytes)] = files {
-        return open_file(name, bytes);
+        return open_document(name, bytes);
     }
     let mut nest: Option<(String, Document)> = None;
     let mut task: Option<(String, RmTask)> = None;
@@ -377,9 +330,9 @@ pub fn open_together(files: &[(String, Vec<u8>)]) -> Result<Document, OpenFilesE
                     })?,
                 )
             }
-            _ => match open_file(name, bytes)? {
+            _ => match open_document(name, bytes)? {
                 d if matches!(d.problem, Problem::Nest { .. }) => Piece::Nest(d),
-                _ => return Err(OpenFilesError::NotCombinable(name.clone())),
+                _ => return Err(OpenError::NotCombinable(name.clone())),
             },
         };
         let kind = match &piece {
@@ -389,7 +342,7 @@ pub fn open_together(files: &[(String, Vec<u8>)]) -> Result<Document, OpenFilesE
             Piece::Tour(_) => "PCGLNS result".to_string(),
         };
         labels.push((name.clone(), kind));
-        let two = |kind: &'static str, first: &str| OpenFilesError::TwoOfAKind {
+        let two = |kind: &'static str, first: &str| OpenError::TwoOfAKind {
             kind,
             first: first.to_string(),
             second: name.clone(),
@@ -431,7 +384,7 @@ pub fn open_together(files: &[(String, Vec<u8>)]) -> Result<Document, OpenFilesE
             if let Some((task_name, t)) = &task {
                 let points = t.pierce_point_count();
                 if inst.node_count != points + 1 {
-                    return Err(OpenFilesError::InstanceNotOfTask {
+                    return Err(OpenError::InstanceNotOfTask {
                         instance: instance_name.clone(),
                         nodes: inst.node_count,
                         task: task_name.clone(),
@@ -449,9 +402,7 @@ pub fn open_together(files: &[(String, Vec<u8>)]) -> Result<Document, OpenFilesE
             notes.push(tour_note(tour_name, task_name, result, cost));
             Some(result.tour.clone())
         }
-        (Some((tour_name, _)), None, None) => {
-            return Err(OpenFilesError::TourAlone(tour_name.clone()))
-        }
+        (Some((tour_name, _)), None, None) => return Err(OpenError::TourAlone(tour_name.clone())),
         (None, ..) => None,
     };
     let Some((nest_name, mut document)) = nest else {
@@ -461,17 +412,25 @@ pub fn open_together(files: &[(String, Vec<u8>)]) -> Result<Document, OpenFilesE
                 format,
                 problem: Problem::PcgtspText { text },
                 route: None,
+                paths: None,
+                task_speeds: None,
                 warnings: notes,
             });
         }
         let (task_name, _) = task.expect("a batch of two or more files has a piece");
-        return Err(OpenFilesError::TaskWithoutNest(task_name));
+        return Err(OpenError::TaskWithoutNest(task_name));
     };
     if let Some((task_name, t)) = &task {
         if let Problem::Nest { start, finish, .. } = &mut document.problem {
             *start = t.task_data.start();
             *finish = t.task_data.finish();
         }
+        let data = &t.task_data;
+        document.task_speeds = Some(TaskSpeeds {
+            idle_speed: data.tool_idling_speed,
+            cut_speed: data.tool_cut_speed,
+            pierce_time: data.piercing_duration,
+        });
         if let (Some(tour_nodes), Some((tour_name, _))) = (&checked_tour, &tour) {
             let Problem::Nest {
                 nest,
@@ -493,7 +452,7 @@ pub fn open_together(files: &[(String, Vec<u8>)]) -> Result<Document, OpenFilesE
                         left_out.push(contour)
                     }
                     other => {
-                        return Err(OpenFilesError::InvalidRoute {
+                        return Err(OpenError::InvalidRoute {
                             file_name: tour_name.clone(),
                             nest: nest_name.clone(),
                             reason: other.to_string(),
@@ -533,8 +492,8 @@ fn checked(
     against: &str,
     instance: &Instance,
     result: &PcglnsResult,
-) -> Result<f64, OpenFilesError> {
-    let cost = check_tour(instance, &result.tour).map_err(|e| OpenFilesError::InfeasibleTour {
+) -> Result<f64, OpenError> {
+    let cost = check_tour(instance, &result.tour).map_err(|e| OpenError::InfeasibleTour {
         file_name: tour_name.to_string(),
         against: against.to_string(),
         reason: e.to_string(),
@@ -543,7 +502,7 @@ fn checked(
     // per arc at most.
     let slack = 0.5 * result.tour.len() as f64 + 1e-6;
     if (cost - result.cost).abs() > slack {
-        return Err(OpenFilesError::CostMismatch {
+        return Err(OpenError::CostMismatch {
             file_name: tour_name.to_string(),
             against: against.to_string(),
             reported: result.cost,
@@ -625,7 +584,7 @@ fn tour_route(
     start: Point,
     finish: Option<Point>,
     tour: &[usize],
-) -> Result<(Route, Vec<ContourRef>), OpenFilesError> {
+) -> Result<(Route, Vec<ContourRef>), OpenError> {
     let refs: Vec<ContourRef> = nest.contour_refs().collect();
     // Global index → (pierce point on the nest, nest contour).
     let mut placed: Vec<Option<(Point, ContourRef)>> = vec![None; task.pierce_point_count()];
@@ -645,7 +604,7 @@ fn tour_route(
             .min_by(|a, b| a.0.total_cmp(&b.0));
         let Some((_, r)) = best.filter(|(d, _)| *d <= POINT_TOLERANCE_MM) else {
             let first = points.first().copied().unwrap_or(Point::new(0.0, 0.0));
-            return Err(OpenFilesError::TaskNotOnNest {
+            return Err(OpenError::TaskNotOnNest {
                 task: task_name.to_string(),
                 index: c.contour.index,
                 x: first.x,
@@ -756,10 +715,7 @@ mod tests {
             (name, text.into_bytes()),
         ];
         let error = open_together(&files).unwrap_err();
-        assert!(
-            matches!(error, OpenFilesError::InfeasibleTour { .. }),
-            "{error}"
-        );
+        assert!(matches!(error, OpenError::InfeasibleTour { .. }), "{error}");
         // Arcs that break the order are forbidden in the matrix: that is what the checker meets.
         assert!(error.to_string().contains("is forbidden"), "{error}");
     }
@@ -767,8 +723,8 @@ mod tests {
     #[test]
     fn a_tour_alone_asks_for_its_instance() {
         let (name, bytes) = nests_file("pcgtsp/test1.pcglns.result.txt");
-        let error = open_file(&name, &bytes).unwrap_err();
-        assert_eq!(error, OpenFilesError::TourAlone(name));
+        let error = open_document(&name, &bytes).unwrap_err();
+        assert_eq!(error, OpenError::TourAlone(name));
     }
 
     #[test]
@@ -882,14 +838,12 @@ mod tests {
             solver: cutroute_protocol::SolverKind::NearestNeighbour,
             params: Default::default(),
         };
-        let mut job = cutroute_engine::start_job(&request).unwrap();
-        let route = cutroute_engine::run_to_end(job.as_mut(), &mut |_| {})
-            .route
-            .unwrap();
+        let mut job = crate::start_job(&request).unwrap();
+        let route = crate::run_to_end(job.as_mut(), &mut |_| {}).route.unwrap();
         let program =
             cutroute_gcode::route_gcode(&nest, &route, &cutroute_gcode::GcodeOptions::default())
                 .unwrap();
-        let document = open_file("E1X_6_01.nc", program.as_bytes()).unwrap();
+        let document = open_document("E1X_6_01.nc", program.as_bytes()).unwrap();
         assert_eq!(document.format, "G-code");
         let Problem::Nest { nest: read, .. } = &document.problem else {
             panic!("a nest")
@@ -905,14 +859,14 @@ mod tests {
 
     #[test]
     fn unknown_files_list_what_is_understood() {
-        let error = open_file("notes.txt", b"just some words").unwrap_err();
-        assert_eq!(error, OpenFilesError::UnknownFormat("notes.txt".into()));
+        let error = open_document("notes.txt", b"just some words").unwrap_err();
+        assert_eq!(error, OpenError::UnknownFormat("notes.txt".into()));
         assert!(error.to_string().contains("G-code"), "{error}");
     }
 
     #[test]
     fn broken_gcode_names_its_line() {
-        let error = open_file("bad.nc", b"G90\nG01 X10 Y\n").unwrap_err();
+        let error = open_document("bad.nc", b"G90\nG01 X10 Y\n").unwrap_err();
         assert!(
             error.to_string().starts_with("bad.nc (G-code): "),
             "{error}"

@@ -544,8 +544,8 @@ fn copies_cannot_blow_up_the_nest() {
 
 #[test]
 fn flipping_any_byte_of_a_real_file_never_panics() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../data/nests/dbs/ring.dbs");
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/nests/dbs/ring.dbs");
     let bytes = std::fs::read(&path)
         .unwrap_or_else(|e| panic!("required data file {} is missing: {e}", path.display()));
     for at in 0..bytes.len() {

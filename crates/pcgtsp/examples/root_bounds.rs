@@ -3,8 +3,7 @@
 use cutroute_pcgtsp::{root_bounds, Instance};
 
 fn main() {
-    let data =
-        std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../data/pcgtsp");
+    let data = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../data/pcgtsp");
     for set in ["industrial", "pcgtsplib"] {
         let mut entries: Vec<_> = std::fs::read_dir(data.join(set))
             .expect("data directory")

@@ -39,15 +39,16 @@ pub enum ToWorker {
         /// The job to stop.
         job_id: JobId,
     },
-    /// Read a file (large files are parsed here, off the UI thread); answered by `Opened` or
-    /// `OpenFailed` with the same `request_id`.
+    /// Read one file, or several as one document (a nest with its task and a PCGLNS result, an
+    /// instance with its result), through `cutroute_engine::open_together`; parsed in the
+    /// worker, off the UI thread. Answered by `Opened` or `OpenFailed` with the same
+    /// `request_id`.
     Open {
         /// Chosen by the sender; echoed in the answer.
         request_id: u64,
-        /// The file's name (its extension is a hint; the format is detected from the content).
-        file_name: String,
-        /// The file's bytes.
-        bytes: Vec<u8>,
+        /// Each file's name (its extension is only a hint: formats are detected from the
+        /// content) and bytes.
+        files: Vec<(String, Vec<u8>)>,
     },
 }
 
@@ -62,8 +63,38 @@ pub struct Document {
     pub problem: Problem,
     /// A route the file already holds (result files), to show or compare.
     pub route: Option<Route>,
+    /// A G-code program's own tool-on paths, when they are more than the closed loops `route`
+    /// makes of them (open paths of segment or common-edge cutting): the page shows these.
+    #[serde(default)]
+    pub paths: Option<PathRoute>,
+    /// The speeds and pierce time a task file of the batch sets for the machine.
+    #[serde(default)]
+    pub task_speeds: Option<TaskSpeeds>,
     /// What the reader skipped, approximated or could not close, in plain words.
     pub warnings: Vec<String>,
+}
+
+/// The machine settings a RouteManager task file carries (its prices are not the file's).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TaskSpeeds {
+    /// Idle (air-move) speed, mm/s.
+    pub idle_speed: f64,
+    /// Cutting speed, mm/s.
+    pub cut_speed: f64,
+    /// Time of one pierce, s.
+    pub pierce_time: f64,
+}
+
+impl TaskSpeeds {
+    /// `machine` with these speeds and pierce time, its prices kept.
+    pub fn applied_to(&self, machine: MachineParameters) -> MachineParameters {
+        MachineParameters {
+            idle_speed: self.idle_speed,
+            cut_speed: self.cut_speed,
+            pierce_time: self.pierce_time,
+            ..machine
+        }
+    }
 }
 
 /// A message from the solver worker.

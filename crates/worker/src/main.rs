@@ -4,28 +4,19 @@
 //! Between two slices the worker awaits a zero-delay timer, which hands control back to the
 //! browser's event loop: that is how a Cancel message reaches a job that is still running.
 //!
-//! Files are opened here too ([`open_files`]): what the engine reads, G-code programs, and
-//! several files combined into one document.
-
-// Natively only the tests use the opening code (the worker itself is wasm only).
-#![cfg_attr(not(target_arch = "wasm32"), allow(dead_code))]
-
-mod open_files;
-mod request;
+//! Files are opened here too, off the UI thread, through the engine's one door
+//! (`cutroute_engine::open_together`).
 
 #[cfg(target_arch = "wasm32")]
 mod web {
     use std::collections::HashMap;
 
-    use cutroute_engine::{start_job, Job, JobStatus, DEFAULT_SLICE};
+    use cutroute_engine::{open_together, start_job, Job, JobStatus, OpenError, DEFAULT_SLICE};
     use cutroute_protocol::{Document, FromWorker, JobId, ToWorker};
     use gloo_worker::{HandlerId, Worker, WorkerScope};
     use web_time::{Duration, Instant};
 
-    use crate::open_files::{open_file, open_together, OpenFilesError};
-    use crate::request::WorkerRequest;
-
-    fn opened(request_id: u64, result: Result<Document, OpenFilesError>) -> FromWorker {
+    fn opened(request_id: u64, result: Result<Document, OpenError>) -> FromWorker {
         match result {
             Ok(document) => FromWorker::Opened {
                 request_id,
@@ -69,7 +60,7 @@ mod web {
 
     impl Worker for SolverWorker {
         type Message = Tick;
-        type Input = WorkerRequest;
+        type Input = ToWorker;
         type Output = FromWorker;
 
         fn create(_scope: &WorkerScope<Self>) -> Self {
@@ -111,13 +102,6 @@ mod web {
         }
 
         fn received(&mut self, scope: &WorkerScope<Self>, msg: Self::Input, requester: HandlerId) {
-            let msg = match msg {
-                WorkerRequest::Protocol(msg) => msg,
-                WorkerRequest::OpenTogether { request_id, files } => {
-                    scope.respond(requester, opened(request_id, open_together(&files)));
-                    return;
-                }
-            };
             match msg {
                 ToWorker::Start(request) => match start_job(&request) {
                     Ok(job) => {
@@ -143,12 +127,8 @@ mod web {
                         },
                     ),
                 },
-                ToWorker::Open {
-                    request_id,
-                    file_name,
-                    bytes,
-                } => {
-                    scope.respond(requester, opened(request_id, open_file(&file_name, &bytes)));
+                ToWorker::Open { request_id, files } => {
+                    scope.respond(requester, opened(request_id, open_together(&files)));
                 }
                 ToWorker::Cancel { job_id } => {
                     if let Some(running) = self.jobs.remove(&job_id) {
