@@ -335,7 +335,8 @@ test('several files at once: a task JSON is combined with its result file', asyn
   await page.fill('#idle-speed', '123');
   await page.dispatchEvent('#idle-speed', 'change');
   await page.setInputFiles('#file-input', [task, result]);
-  await fileShown(page, 'E1X_6_01.result.json (result JSON) + E1X_6_01.task.json (task JSON)');
+  // One document from the batch, named for its files in the order given.
+  await fileShown(page, 'E1X_6_01.task.json + E1X_6_01.result.json (task JSON + result JSON)');
   assert.equal(await page.inputValue('#idle-speed'), '500');
   assert.equal(await page.locator('#nest-view path.part').count(), 8);
   // The result's route is drawn: one pierce wherever the file's toolpath goes from air to cut.
