@@ -79,7 +79,8 @@ mod solver;
 pub use discrete::{build_pcgtsp, DiscreteInstance, DiscreteNode, DiscretisationOptions};
 pub use route::{idle_length, route_certificates, route_metrics, ContourCertificate, RouteMetrics};
 pub use solver::{
-    solve, solve_with_cancel, CcpOptions, CcpPhase, CcpProgress, CcpResult, CcpSolver, SolverStatus,
+    solve, solve_with_cancel, CcpOptions, CcpPhase, CcpProgress, CcpResult, CcpSolver, HeatPenalty,
+    SolverStatus,
 };
 
 use cutroute_geometry::{ContourRef, Nest};
