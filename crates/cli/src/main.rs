@@ -24,7 +24,7 @@
 //! objective's unit, and (sccp, gsccp) each ensemble's numbers.
 //! Every nest report adds the heat load `heat` (σ = 50 mm, τ = 60 s unless given), the rule
 //! violations and each step's machine time `t` (`cutroute-thermal`); `--thermal-weight` makes
-//! ccp and chain minimise objective + W·H, `--rules-hard` repairs the route until the rules hold.
+//! nearest, ccp and chain minimise objective + W·H, `--rules-hard` repairs the route until the rules hold.
 //! Errors go to stderr with the reader's location, and the exit code is 1.
 
 use std::path::{Path, PathBuf};

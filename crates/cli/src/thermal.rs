@@ -3,7 +3,7 @@
 //! per-step `t`.
 
 use cutroute_ccp::{CcpSolver, HeatPenalty};
-use cutroute_engine::{ccp_options, CcpJob, ChainJob, Job};
+use cutroute_engine::{ccp_options, CcpJob, ChainJob, Job, NearestNeighbourJob};
 use cutroute_geometry::{MachineParameters, Nest, Objective, Route};
 use cutroute_protocol::{JobRequest, Problem, SolverKind};
 use cutroute_thermal::{check_rules, enforce_rules, route_pierces, HeatModel, RuleParams, RuleSet};
@@ -18,7 +18,7 @@ pub struct ThermalArgs {
     /// Cooling time τ of the heat model, s.
     #[arg(long, value_name = "S", default_value_t = 60.0)]
     thermal_tau: f64,
-    /// ccp and chain minimise their objective + W·H (W in objective units per unit of H;
+    /// nearest, ccp and chain minimise their objective + W·H (W in objective units per unit of H;
     /// 0: plain CCP-Relax).
     #[arg(long, value_name = "W", default_value_t = 0.0)]
     thermal_weight: f64,
@@ -60,31 +60,44 @@ impl ThermalArgs {
 }
 
 impl Thermal {
-    /// A ccp or chain job with the heat penalty, when the weight is positive (else `None`:
-    /// the engine's own job, unchanged).
+    /// A nearest, ccp or chain job with the heat penalty, when the weight is positive (else
+    /// `None`: the engine's own job, unchanged).
     pub fn heated_job(&self, request: &JobRequest) -> Result<Option<Box<dyn Job>>, String> {
-        let (
-            Problem::Nest {
-                nest,
-                start,
-                finish,
-            },
-            SolverKind::Ccp | SolverKind::Chain,
-        ) = (&request.problem, request.solver)
+        let Problem::Nest {
+            nest,
+            start,
+            finish,
+        } = &request.problem
         else {
             return Ok(None);
         };
-        if self.weight <= 0.0 {
+        if self.weight <= 0.0
+            || !matches!(
+                request.solver,
+                SolverKind::Ccp | SolverKind::Chain | SolverKind::NearestNeighbour
+            )
+        {
             return Ok(None);
         }
         let params = &request.params;
-        let time_limit = std::time::Duration::from_secs_f64(params.time_limit_s.clamp(0.0, 1.0e7));
-        let mut options = ccp_options(*start, *finish, time_limit, params.seed, params.machine);
-        options.heat = Some(HeatPenalty {
+        let penalty = HeatPenalty {
             model: self.model,
             weight: self.weight,
             objective: params.objective,
-        });
+        };
+        if request.solver == SolverKind::NearestNeighbour {
+            let job = NearestNeighbourJob::new(request.job_id, nest.clone(), *start, *finish)
+                .map_err(|e| e.to_string())?
+                .with_heat(
+                    self.model,
+                    penalty.weight_mm(&params.machine),
+                    params.machine,
+                );
+            return Ok(Some(Box::new(job)));
+        }
+        let time_limit = std::time::Duration::from_secs_f64(params.time_limit_s.clamp(0.0, 1.0e7));
+        let mut options = ccp_options(*start, *finish, time_limit, params.seed, params.machine);
+        options.heat = Some(penalty);
         let ccp = CcpSolver::new(nest, options).map_err(|e| e.to_string())?;
         Ok(Some(if request.solver == SolverKind::Chain {
             Box::new(ChainJob::new(

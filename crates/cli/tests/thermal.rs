@@ -42,7 +42,15 @@ fn heat_matches_an_independent_recomputation_for_every_route_solver() {
         ("ccp", vec![]),
         ("ccp", vec!["--thermal-sigma", "30", "--thermal-tau", "20"]),
     ] {
-        let mut args = vec!["solve", &file, "--solver", solver, "--time-limit", "2", "--json"];
+        let mut args = vec![
+            "solve",
+            &file,
+            "--solver",
+            solver,
+            "--time-limit",
+            "2",
+            "--json",
+        ];
         args.extend(extra.iter().copied());
         let report = json(&args);
         let (sigma, tau) = if extra.is_empty() {
@@ -66,7 +74,15 @@ fn heat_matches_an_independent_recomputation_for_every_route_solver() {
 #[test]
 fn the_weight_lowers_heat_and_hard_rules_leave_no_violation() {
     let file = data("nests/dbs-json/test1.dbs.json");
-    let base = ["solve", &file, "--solver", "ccp", "--time-limit", "3", "--json"];
+    let base = [
+        "solve",
+        &file,
+        "--solver",
+        "ccp",
+        "--time-limit",
+        "3",
+        "--json",
+    ];
     let plain = json(&base);
     let mut heated_args = base.to_vec();
     heated_args.extend(["--thermal-weight", "100"]);
@@ -79,9 +95,31 @@ fn the_weight_lowers_heat_and_hard_rules_leave_no_violation() {
     heated_args.push("--rules-hard");
     let hard = json(&heated_args);
     for group in ["part", "sheet", "islands"] {
-        assert_eq!(hard["rule_violations"][group], 0, "{}", hard["rule_violations"]);
+        assert_eq!(
+            hard["rule_violations"][group], 0,
+            "{}",
+            hard["rule_violations"]
+        );
     }
     assert_eq!(hard["thermal"]["rules_hard"], true);
+}
+
+#[test]
+fn nearest_honours_the_weight_and_weight_zero_changes_nothing() {
+    let file = data("nests/dbs/nested.dbs");
+    let base = ["solve", &file, "--solver", "nearest", "--json"];
+    let plain = json(&base);
+    let mut zero = base.to_vec();
+    zero.extend(["--thermal-weight", "0"]);
+    assert_eq!(json(&zero)["route"], plain["route"]);
+    let mut heated = base.to_vec();
+    heated.extend(["--thermal-weight", "100"]);
+    let heated = json(&heated);
+    let (h0, h1) = (
+        plain["heat"].as_f64().unwrap(),
+        heated["heat"].as_f64().unwrap(),
+    );
+    assert!(h1 <= 0.7 * h0, "H {h1} with the penalty vs {h0}");
 }
 
 #[test]

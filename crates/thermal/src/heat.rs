@@ -90,18 +90,27 @@ impl HeatModel {
     /// (each would add less than `exp(−max_exponent)`): what a search evaluating H thousands
     /// of times a second can afford. Times must be non-decreasing.
     pub fn load_truncated(&self, pierces: &[Pierce], max_exponent: f64) -> f64 {
+        pierces
+            .iter()
+            .enumerate()
+            .map(|(i, a)| self.added_load(&pierces[..i], a.point, a.time, max_exponent))
+            .sum()
+    }
+
+    /// What a source at `p` switched on at time `t` adds to H after the `earlier` ones (in
+    /// time order, all at or before `t`), without kernels below `exp(−max_exponent)`. Greedy
+    /// solvers price their next pierce with it.
+    pub fn added_load(&self, earlier: &[Pierce], p: Point, t: f64, max_exponent: f64) -> f64 {
         let (space, time) = (0.5 / (self.sigma_mm * self.sigma_mm), 1.0 / self.tau_s);
         let mut total = 0.0;
-        for (i, a) in pierces.iter().enumerate() {
-            for b in pierces[..i].iter().rev() {
-                let t = (a.time - b.time) * time;
-                if t > max_exponent {
-                    break;
-                }
-                let exponent = (a.point - b.point).norm_squared() * space + t;
-                if exponent <= max_exponent {
-                    total += (-exponent).exp();
-                }
+        for b in earlier.iter().rev() {
+            let dt = (t - b.time) * time;
+            if dt > max_exponent {
+                break;
+            }
+            let exponent = (p - b.point).norm_squared() * space + dt;
+            if exponent <= max_exponent {
+                total += (-exponent).exp();
             }
         }
         total
@@ -117,16 +126,12 @@ impl HeatModel {
         Ok(self.load(&route_pierces(route, nest, machine)?))
     }
 
-    /// The temperature field of the sources at point `p` and time `t` (same units as H: the
-    /// sum of the kernels of the sources switched on at or before `t`). This is what a heat-map
-    /// layer draws, frame by frame.
+    /// The temperature field of the sources (in time order) at point `p` and time `t` (same
+    /// units as H: the sum of the kernels of the sources switched on at or before `t`). This is
+    /// what a heat-map layer draws, frame by frame.
     pub fn temperature_at(&self, pierces: &[Pierce], p: Point, t: f64) -> f64 {
-        let cutoff = TIME_CUTOFF_TAUS * self.tau_s;
-        pierces
-            .iter()
-            .filter(|s| s.time <= t && t - s.time <= cutoff)
-            .map(|s| self.kernel((p - s.point).norm_squared(), t - s.time))
-            .sum()
+        let switched_on = pierces.partition_point(|s| s.time <= t);
+        self.added_load(&pierces[..switched_on], p, t, TIME_CUTOFF_TAUS)
     }
 }
 
