@@ -204,6 +204,8 @@ pub struct CcpSolver {
     /// per iteration of the step loop, across slices.
     full_relaxation_sweeps: Option<usize>,
     cancelled: bool,
+    /// The final route's pierce points were relaxed under the heat penalty.
+    heat_relaxed: bool,
 }
 
 impl CcpSolver {
@@ -297,6 +299,7 @@ impl CcpSolver {
             relaxation_sweeps: 0,
             full_relaxation_sweeps: None,
             cancelled: false,
+            heat_relaxed: false,
         })
     }
 
@@ -313,6 +316,9 @@ impl CcpSolver {
             || self.route.steps.is_empty()
         {
             self.refresh_route();
+        }
+        if self.phase == CcpPhase::Done {
+            self.relax_heat();
         }
         self.elapsed += t0.elapsed();
         result
@@ -521,6 +527,31 @@ impl CcpSolver {
         };
         self.route_length = len;
         self.route = route;
+        self.heat_relaxed = false;
+    }
+
+    /// With a heat penalty, the final route's pierce points (outer contours restored by step 4
+    /// included) move along their contours where idle + weight · H falls
+    /// (`cutroute_thermal::relax_pierce_points`); the search's relaxation minimises idle only.
+    fn relax_heat(&mut self) {
+        let Some(heat) = self.options.heat.filter(|h| h.weight > 0.0) else {
+            return;
+        };
+        if self.heat_relaxed {
+            return;
+        }
+        let weight_mm = heat.weight_mm(&self.options.machine);
+        if let Ok(route) = cutroute_thermal::relax_pierce_points(
+            &self.nest,
+            &self.route,
+            &self.options.machine,
+            &heat.model,
+            weight_mm,
+            3,
+        ) {
+            self.route = route;
+        }
+        self.heat_relaxed = true;
     }
 
     /// The current snapshot.

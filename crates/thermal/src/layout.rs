@@ -128,3 +128,15 @@ pub(crate) fn box_distance(b: &BoundingBox, p: Point) -> f64 {
     let dy = (b.min.y - p.y).max(p.y - b.max.y).max(0.0);
     dx.hypot(dy)
 }
+
+/// Candidate points of a contour: every ≤ 5 mm of arc length (at least 16, at most 400) and its
+/// vertices.
+pub(crate) fn samples(contour: &Contour) -> Vec<Point> {
+    let perimeter = contour.perimeter();
+    let n = ((perimeter / 5.0).ceil() as usize).clamp(16, 400);
+    let mut points: Vec<Point> = (0..n)
+        .filter_map(|k| contour.point_at_length(perimeter * k as f64 / n as f64))
+        .collect();
+    points.extend(contour.vertices.iter().map(|v| v.point));
+    points
+}

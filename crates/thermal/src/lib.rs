@@ -15,6 +15,8 @@
 //! - [`check_rules`]: part rigidity, sheet rigidity 1–3 and islands/strips (sheet rule 4) as
 //!   [`Violation`]s with counts per group ([`RuleReport::counts`]); the module `rules` documents
 //!   the precise definition chosen for each vague phrase and why.
+//! - [`relax_pierce_points`]: pierce points moved along their contours to lower idle + weight·H
+//!   (the relaxation step of a penalised search).
 //! - [`enforce_rules`]: hard-rule mode as a repair of a finished route (whole parts reordered,
 //!   pierce points moved), reporting what is left.
 //!
@@ -61,9 +63,11 @@
 mod heat;
 mod islands;
 mod layout;
+mod pierce;
 pub mod rules;
 
 pub use heat::{path_route_pierces, route_pierces, HeatModel, Pierce};
+pub use pierce::relax_pierce_points;
 pub use rules::{
     check_rules, enforce_rules, Enforced, RuleCounts, RuleParams, RuleReport, RuleSet, Side,
     Violation,

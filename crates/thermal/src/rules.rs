@@ -51,7 +51,7 @@ use cutroute_geometry::{Contour, ContourRef, Entry, Nest, Point, Route};
 use serde::{Deserialize, Serialize};
 
 use crate::islands::IslandGrid;
-use crate::layout::{along, box_distance, Layout};
+use crate::layout::{along, box_distance, samples, Layout};
 use crate::ThermalError;
 
 /// The parameters of the rules (see the module documentation for what each one means).
@@ -312,17 +312,6 @@ fn check_steps(route: &Route, nest: &Nest) -> Result<(), ThermalError> {
         }
     }
     Ok(())
-}
-
-/// Points of a contour every ≤ 5 mm (at least 16, at most 400) and its vertices.
-fn samples(contour: &Contour) -> Vec<Point> {
-    let perimeter = contour.perimeter();
-    let n = ((perimeter / 5.0).ceil() as usize).clamp(16, 400);
-    let mut points: Vec<Point> = (0..n)
-        .filter_map(|k| contour.point_at_length(perimeter * k as f64 / n as f64))
-        .collect();
-    points.extend(contour.vertices.iter().map(|v| v.point));
-    points
 }
 
 /// Per even-depth step: the distance of the pierce point and of the contour's best sample to

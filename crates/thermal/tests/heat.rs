@@ -178,3 +178,60 @@ fn bad_parameters_and_routes_are_typed_errors() {
         Err(ThermalError::Route(_))
     ));
 }
+
+#[test]
+fn relaxed_pierce_points_lower_the_penalised_objective() {
+    use cutroute_thermal::relax_pierce_points;
+    // A 200 mm plate with a small hole near its left edge: cut the hole, then the plate,
+    // pierced right next to the hole.
+    let plate = cutroute_geometry::Contour::new(vec![
+        cutroute_geometry::Vertex::line(0.0, 0.0),
+        cutroute_geometry::Vertex::line(0.0, 200.0),
+        cutroute_geometry::Vertex::line(200.0, 200.0),
+        cutroute_geometry::Vertex::line(200.0, 0.0),
+    ]);
+    let hole = cutroute_geometry::Contour::circle(Point::new(20.0, 100.0), 5.0, false);
+    let nest = Nest {
+        sheet: None,
+        parts: vec![cutroute_geometry::Part {
+            name: String::new(),
+            contours: vec![plate, hole],
+        }],
+    };
+    let route = Route {
+        start: Point::new(-50.0, 100.0),
+        steps: vec![
+            CutStep::pierced(
+                ContourRef {
+                    part: 0,
+                    contour: 1,
+                },
+                Point::new(15.0, 100.0),
+            ),
+            CutStep::pierced(
+                ContourRef {
+                    part: 0,
+                    contour: 0,
+                },
+                Point::new(0.0, 100.0),
+            ),
+        ],
+        finish: None,
+    };
+    let machine = MachineParameters::default();
+    let model = HeatModel::default();
+    let weight_mm = 100.0 * machine.idle_speed;
+    let objective =
+        |r: &Route| r.idle_length() + weight_mm * model.route_load(r, &nest, &machine).unwrap();
+    let relaxed = relax_pierce_points(&nest, &route, &machine, &model, weight_mm, 3).unwrap();
+    relaxed.validate(&nest, 1e-6).unwrap();
+    let (h0, h1) = (
+        model.route_load(&route, &nest, &machine).unwrap(),
+        model.route_load(&relaxed, &nest, &machine).unwrap(),
+    );
+    assert!(h1 < 0.1 * h0, "{h1} vs {h0}");
+    assert!(objective(&relaxed) < objective(&route));
+    // Without weight nothing pays for a longer idle path: the route stays as short.
+    let unweighted = relax_pierce_points(&nest, &route, &machine, &model, 0.0, 3).unwrap();
+    assert!(unweighted.idle_length() <= route.idle_length() + 1e-9);
+}
