@@ -37,7 +37,9 @@ pub fn relax_pierce_points(
     let n = current.steps.len();
     let (space, time) = (0.5 / (model.sigma_mm * model.sigma_mm), 1.0 / model.tau_s);
     for _ in 0..passes {
-        let pierces = route_pierces(&current, nest, machine)?;
+        // Times from the pass's start (a moved point shifts later times by a few idle
+        // milliseconds); points kept current, so each step sees its neighbours' new places.
+        let mut pierces = route_pierces(&current, nest, machine)?;
         let mut moved = false;
         for i in 0..n {
             let linked = |k: usize| {
@@ -90,6 +92,7 @@ pub fn relax_pierce_points(
             if let Some((value, x)) = best {
                 if value < here - 1e-9 {
                     current.steps[i].pierce_point = x;
+                    pierces[i].point = x;
                     moved = true;
                 }
             }
