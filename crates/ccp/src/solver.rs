@@ -548,6 +548,7 @@ impl CcpSolver {
             &heat.model,
             weight_mm,
             3,
+            None,
         ) {
             self.route = route;
         }

@@ -546,7 +546,7 @@ fn solve(
         Problem::PcgtspText { .. } => tour_report(solver_name, &result),
         Problem::Nest { nest, .. } => {
             if let Some(route) = result.route.take() {
-                let route = thermal.enforce(nest, route)?;
+                let route = thermal.enforce(nest, route, &machine, objective)?;
                 if !result.certified.is_empty() {
                     // Certificates of the route reported, not of the one before the repair.
                     let certified = cutroute_ccp::route_certificates(nest, &route)

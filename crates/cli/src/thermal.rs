@@ -6,7 +6,10 @@ use cutroute_ccp::{CcpSolver, HeatPenalty};
 use cutroute_engine::{ccp_options, CcpJob, ChainJob, Job, NearestNeighbourJob};
 use cutroute_geometry::{MachineParameters, Nest, Objective, Route};
 use cutroute_protocol::{JobRequest, Problem, SolverKind};
-use cutroute_thermal::{check_rules, enforce_rules, route_pierces, HeatModel, RuleParams, RuleSet};
+use cutroute_thermal::{
+    admissible_pierce_points, check_rules, enforce_rules, relax_pierce_points, route_pierces,
+    HeatModel, RuleParams, RuleSet,
+};
 use serde_json::{json, Value};
 
 /// The thermal flags of `solve`.
@@ -112,16 +115,46 @@ impl Thermal {
     }
 
     /// With `--rules-hard`, the route repaired until the rules hold (what is left is reported
-    /// by [`Thermal::report`]); else the route as it is.
-    pub fn enforce(&self, nest: &Nest, route: Route) -> Result<Route, String> {
+    /// by [`Thermal::report`]), then, with a heat weight, its pierce points relaxed on
+    /// objective + W·H among those the part rule admits; else the route as it is.
+    pub fn enforce(
+        &self,
+        nest: &Nest,
+        route: Route,
+        machine: &MachineParameters,
+        objective: Objective,
+    ) -> Result<Route, String> {
         if !self.hard {
             return Ok(route);
         }
-        Ok(
-            enforce_rules(nest, &route, self.rules, &RuleParams::default())
-                .map_err(|e| e.to_string())?
-                .route,
+        let params = RuleParams::default();
+        let route = enforce_rules(nest, &route, self.rules, &params)
+            .map_err(|e| e.to_string())?
+            .route;
+        if self.weight <= 0.0 {
+            return Ok(route);
+        }
+        let candidates = if self.rules.part {
+            Some(admissible_pierce_points(nest, &route, &params).map_err(|e| e.to_string())?)
+        } else {
+            None
+        };
+        let weight_mm = HeatPenalty {
+            model: self.model,
+            weight: self.weight,
+            objective,
+        }
+        .weight_mm(machine);
+        relax_pierce_points(
+            nest,
+            &route,
+            machine,
+            &self.model,
+            weight_mm,
+            3,
+            candidates.as_deref(),
         )
+        .map_err(|e| e.to_string())
     }
 
     /// Adds `heat` (one source per tool-on path) and each path's `t` to a path-route report;

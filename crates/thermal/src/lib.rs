@@ -69,8 +69,8 @@ pub mod rules;
 pub use heat::{path_route_pierces, route_pierces, HeatModel, Pierce};
 pub use pierce::relax_pierce_points;
 pub use rules::{
-    check_rules, enforce_rules, Enforced, RuleCounts, RuleParams, RuleReport, RuleSet, Side,
-    Violation,
+    admissible_pierce_points, check_rules, enforce_rules, Enforced, RuleCounts, RuleParams,
+    RuleReport, RuleSet, Side, Violation,
 };
 
 /// What can go wrong.

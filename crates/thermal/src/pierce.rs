@@ -8,7 +8,7 @@
 //! with the steps near it in time, and keeps the result only if the route's whole objective
 //! (idle + weight · H, recomputed) fell.
 
-use cutroute_geometry::{Entry, MachineParameters, Nest, Route};
+use cutroute_geometry::{Entry, MachineParameters, Nest, Point, Route};
 
 use crate::layout::samples;
 use crate::{route_pierces, HeatModel, ThermalError};
@@ -18,8 +18,9 @@ const MAX_EXPONENT: f64 = 12.0;
 
 /// `route` with pierce points moved along their contours to lower
 /// `idle length + weight_mm · H` (`passes` sweeps over the steps). Steps entered by a tool-on
-/// link, and those a link leaves from, keep their points. Returns the route unchanged when no
-/// move lowers the objective.
+/// link, and those a link leaves from, keep their points. `candidates` (per step; `None` = the
+/// contour's sample points) restricts the choice, e.g. to [`crate::admissible_pierce_points`].
+/// Returns the route unchanged when no move lowers the objective.
 pub fn relax_pierce_points(
     nest: &Nest,
     route: &Route,
@@ -27,6 +28,7 @@ pub fn relax_pierce_points(
     model: &HeatModel,
     weight_mm: f64,
     passes: usize,
+    candidates: Option<&[Option<Vec<Point>>]>,
 ) -> Result<Route, ThermalError> {
     model.validate()?;
     let objective = |r: &Route| -> Result<f64, ThermalError> {
@@ -64,7 +66,7 @@ pub fn relax_pierce_points(
                 None => current.finish,
             };
             let t = pierces[i].time;
-            let cost = |x: cutroute_geometry::Point| {
+            let cost = |x: Point| {
                 let idle = previous.distance(x) + next.map_or(0.0, |q| x.distance(q));
                 let mut heat = 0.0;
                 let near = pierces[..i]
@@ -85,7 +87,11 @@ pub fn relax_pierce_points(
                 idle + weight_mm * heat
             };
             let here = cost(current.steps[i].pierce_point);
-            let best = samples(contour)
+            let points = match candidates.and_then(|c| c.get(i)) {
+                Some(Some(points)) => points.clone(),
+                _ => samples(contour),
+            };
+            let best = points
                 .into_iter()
                 .map(|x| (cost(x), x))
                 .min_by(|a, b| a.0.total_cmp(&b.0));

@@ -314,12 +314,22 @@ fn check_steps(route: &Route, nest: &Nest) -> Result<(), ThermalError> {
     Ok(())
 }
 
-/// Per even-depth step: the distance of the pierce point and of the contour's best sample to
-/// the free edge; the violations beyond the margin.
-fn part_rigidity(layout: &Layout, route: &Route, params: &RuleParams) -> Vec<Violation> {
+/// What the part rule sees at one step: the contour's sample points with their distance to the
+/// free edge, the least of them, and the pierce point's distance.
+struct Rigidity {
+    step: usize,
+    contour: ContourRef,
+    points: Vec<(Point, f64)>,
+    best: (Point, f64),
+    here: f64,
+}
+
+/// The steps the part rule constrains (even-depth contours with a free edge), in order. The
+/// free edges depend on the order only, never on pierce points.
+fn rigidity(layout: &Layout, route: &Route) -> Vec<Rigidity> {
     let forest = &layout.forest;
     let mut cut: Vec<(Option<ContourRef>, &Contour)> = Vec::new();
-    let mut violations = Vec::new();
+    let mut out = Vec::new();
     for (step, s) in route.steps.iter().enumerate() {
         let (Some(depth), Some(contour)) =
             (forest.depth(s.contour), layout.nest.contour(s.contour))
@@ -335,9 +345,9 @@ fn part_rigidity(layout: &Layout, route: &Route, params: &RuleParams) -> Vec<Vio
             .filter(|(p, _)| *p == parent)
             .map(|(_, c)| *c)
             .collect();
+        cut.push((parent, contour));
         if parent.is_some() && earlier.is_empty() {
             // A part in a hole with no free edge yet: the rule says nothing.
-            cut.push((parent, contour));
             continue;
         }
         let free = |q: Point| {
@@ -353,23 +363,61 @@ fn part_rigidity(layout: &Layout, route: &Route, params: &RuleParams) -> Vec<Vio
             }
             best
         };
-        let (best_point, best) = samples(contour)
-            .into_iter()
-            .map(|q| (q, free(q)))
+        let points: Vec<(Point, f64)> =
+            samples(contour).into_iter().map(|q| (q, free(q))).collect();
+        let best = points
+            .iter()
+            .copied()
             .min_by(|a, b| a.1.total_cmp(&b.1))
             .unwrap_or((s.pierce_point, 0.0));
-        let here = free(s.pierce_point);
-        if here > best + params.part_margin_mm {
-            violations.push(Violation::PartRigidity {
-                step,
-                contour: s.contour,
-                excess_mm: here - best - params.part_margin_mm,
-                best: best_point,
-            });
-        }
-        cut.push((parent, contour));
+        out.push(Rigidity {
+            step,
+            contour: s.contour,
+            points,
+            best,
+            here: free(s.pierce_point),
+        });
     }
-    violations
+    out
+}
+
+fn part_rigidity(layout: &Layout, route: &Route, params: &RuleParams) -> Vec<Violation> {
+    rigidity(layout, route)
+        .into_iter()
+        .filter(|r| r.here > r.best.1 + params.part_margin_mm)
+        .map(|r| Violation::PartRigidity {
+            step: r.step,
+            contour: r.contour,
+            excess_mm: r.here - r.best.1 - params.part_margin_mm,
+            best: r.best.0,
+        })
+        .collect()
+}
+
+/// Per step of `route`, the pierce points the part rule admits for the route's order (sample
+/// points of the contour, every ≤ 5 mm, within the margin of the free edge's nearest); `None`
+/// where the rule does not constrain the step. Heat-aware relaxation under hard rules picks
+/// among these: the forbidden pierce points of the dissertation's formalisation.
+pub fn admissible_pierce_points(
+    nest: &Nest,
+    route: &Route,
+    params: &RuleParams,
+) -> Result<Vec<Option<Vec<Point>>>, ThermalError> {
+    params.validate()?;
+    check_steps(route, nest)?;
+    let layout = Layout::new(nest);
+    let mut out = vec![None; route.steps.len()];
+    for r in rigidity(&layout, route) {
+        let limit = r.best.1 + params.part_margin_mm;
+        out[r.step] = Some(
+            r.points
+                .into_iter()
+                .filter(|p| p.1 <= limit)
+                .map(|p| p.0)
+                .collect(),
+        );
+    }
+    Ok(out)
 }
 
 /// Per unit: long and near a narrow border (rule 1).

@@ -223,7 +223,7 @@ fn relaxed_pierce_points_lower_the_penalised_objective() {
     let weight_mm = 100.0 * machine.idle_speed;
     let objective =
         |r: &Route| r.idle_length() + weight_mm * model.route_load(r, &nest, &machine).unwrap();
-    let relaxed = relax_pierce_points(&nest, &route, &machine, &model, weight_mm, 3).unwrap();
+    let relaxed = relax_pierce_points(&nest, &route, &machine, &model, weight_mm, 3, None).unwrap();
     relaxed.validate(&nest, 1e-6).unwrap();
     let (h0, h1) = (
         model.route_load(&route, &nest, &machine).unwrap(),
@@ -232,6 +232,6 @@ fn relaxed_pierce_points_lower_the_penalised_objective() {
     assert!(h1 < 0.1 * h0, "{h1} vs {h0}");
     assert!(objective(&relaxed) < objective(&route));
     // Without weight nothing pays for a longer idle path: the route stays as short.
-    let unweighted = relax_pierce_points(&nest, &route, &machine, &model, 0.0, 3).unwrap();
+    let unweighted = relax_pierce_points(&nest, &route, &machine, &model, 0.0, 3, None).unwrap();
     assert!(unweighted.idle_length() <= route.idle_length() + 1e-9);
 }

@@ -2,7 +2,8 @@
 
 use cutroute_geometry::{Contour, ContourRef, CutStep, Nest, Part, Point, Route, Vertex};
 use cutroute_thermal::{
-    check_rules, enforce_rules, RuleParams, RuleSet, Side, ThermalError, Violation,
+    admissible_pierce_points, check_rules, enforce_rules, RuleParams, RuleSet, Side, ThermalError,
+    Violation,
 };
 
 /// A clockwise rectangle.
@@ -97,6 +98,11 @@ fn part_rigidity_counts_pierce_points_far_from_the_free_edge() {
     // one: pierced on its left it is fine; the first part, cut second, pierced left: fine.
     let report = check_rules(&nest, &route(&nest, &[1, 0], left), rules, &params).unwrap();
     assert_eq!(report.counts().part, Some(0));
+    // The admissible pierce points of the first part face the border: within 2 + 10 mm of it.
+    let admissible =
+        admissible_pierce_points(&nest, &route(&nest, &[0, 1], right), &params).unwrap();
+    let first = admissible[0].as_ref().expect("the rule constrains part 0");
+    assert!(!first.is_empty() && first.iter().all(|p| p.x <= 12.0 + 1e-9));
     // The repair moves both pierce points and leaves a valid route.
     let fixed = enforce_rules(&nest, &route(&nest, &[0, 1], right), rules, &params).unwrap();
     assert_eq!(fixed.report.counts().part, Some(0));
