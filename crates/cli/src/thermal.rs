@@ -74,12 +74,17 @@ impl Thermal {
         else {
             return Ok(None);
         };
-        if self.weight <= 0.0
-            || !matches!(
-                request.solver,
-                SolverKind::Ccp | SolverKind::Chain | SolverKind::NearestNeighbour
-            )
-        {
+        if self.weight <= 0.0 {
+            return Ok(None);
+        }
+        if !matches!(
+            request.solver,
+            SolverKind::Ccp | SolverKind::Chain | SolverKind::NearestNeighbour
+        ) {
+            eprintln!(
+                "cutroute: --thermal-weight is honoured by nearest, ccp and chain; {} only reports H",
+                request.solver.name()
+            );
             return Ok(None);
         }
         let params = &request.params;
