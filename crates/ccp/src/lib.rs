@@ -58,6 +58,17 @@
 //! double bridge), descends again and keeps the result only if shorter, and restarts from a
 //! randomised nearest-neighbour order after `max_non_improving_shakes` failures.
 //!
+//! # Heat penalty
+//! With [`CcpOptions::heat`] set ([`HeatPenalty`], issue #19) the search minimises the idle
+//! length plus the weight times the thermal load H of `cutroute-thermal`, converted to
+//! millimetres of idle: H depends on the whole partial route (each pierce's time is the sum of
+//! everything before it), so it is a *dynamic* penalty and no fixed-point delta bounds it. Every
+//! move is therefore checked exactly (apply, relax, recompute H, keep or undo) and shakes and
+//! restarts compare the penalised objective; the pierce point relaxation itself stays the
+//! exact idle-length minimiser. Without the option (or with weight 0) nothing changes: same
+//! moves, same screens, same route. The Conditions 1 and 2 certificates speak of the idle
+//! length only.
+//!
 //! # Geometry
 //! Arc data (centre, radius, sweep), exact span boxes, contour area and perimeter,
 //! point-in-contour and the containment forest all come from `cutroute-geometry`. The solver
@@ -79,7 +90,8 @@ mod solver;
 pub use discrete::{build_pcgtsp, DiscreteInstance, DiscreteNode, DiscretisationOptions};
 pub use route::{idle_length, route_certificates, route_metrics, ContourCertificate, RouteMetrics};
 pub use solver::{
-    solve, solve_with_cancel, CcpOptions, CcpPhase, CcpProgress, CcpResult, CcpSolver, SolverStatus,
+    solve, solve_with_cancel, CcpOptions, CcpPhase, CcpProgress, CcpResult, CcpSolver, HeatPenalty,
+    SolverStatus,
 };
 
 use cutroute_geometry::{ContourRef, Nest};

@@ -9,6 +9,9 @@
 
 use std::collections::VecDeque;
 
+use cutroute_geometry::{MachineParameters, Nest, Point};
+use cutroute_thermal::{HeatModel, Pierce};
+
 use crate::geom::{Shape, V};
 use crate::problem::{nearest_lists, nearest_neighbour_order, Problem};
 use crate::relax::{best_on_shape, cost};
@@ -20,6 +23,27 @@ pub(crate) const START: i64 = -1;
 pub(crate) const END: i64 = -2;
 /// An improvement must beat this (mm) to count: guards against float noise cycling.
 const IMPROVE: f64 = 1e-7;
+/// The search's H skips pairs whose kernel is below e⁻¹² (≈ 6·10⁻⁶ each).
+const HEAT_MAX_EXPONENT: f64 = 12.0;
+
+/// The heat penalty term of the objective (issue #19): `weight_mm · H` over the route's
+/// sources in order (see `HeatPenalty` in the solver).
+pub(crate) struct HeatTerm {
+    model: HeatModel,
+    /// Millimetres of idle per unit of H.
+    weight_mm: f64,
+    idle_speed: f64,
+    /// Per problem contour: the seconds its pierce and cut take.
+    busy: Vec<f64>,
+    /// Per problem contour: nesting depth among the removed contours (inner ones restored first).
+    depth: Vec<usize>,
+    /// The current penalty, mm.
+    value: f64,
+    /// Scratch: per problem contour, the last position of a kept contour inside it.
+    last: Vec<i64>,
+    events: Vec<(u32, std::cmp::Reverse<usize>, u32)>,
+    sources: Vec<Pierce>,
+}
 
 /// Tuning of the search (a subset of the public options).
 #[derive(Clone, Debug)]
@@ -110,6 +134,8 @@ pub(crate) struct Search {
     collecting: Option<Vec<(f64, Move)>>,
     /// Explore each neighbourhood fully and apply its best move (instead of the first).
     pub best_improvement: bool,
+    /// The heat penalty, when the objective has one (`None`: plain idle length).
+    heat: Option<HeatTerm>,
 }
 
 impl Search {
@@ -154,7 +180,111 @@ impl Search {
             accepted: 0,
             collecting: None,
             best_improvement: false,
+            heat: None,
         }
+    }
+
+    /// Adds `weight_mm · H` to the objective.
+    pub fn set_heat(
+        &mut self,
+        nest: &Nest,
+        model: HeatModel,
+        weight_mm: f64,
+        machine: &MachineParameters,
+    ) {
+        let busy = self
+            .prob
+            .refs
+            .iter()
+            .map(|&r| {
+                machine.pierce_time
+                    + nest.contour(r).map_or(0.0, |c| c.perimeter()) / machine.cut_speed
+            })
+            .collect();
+        let mut depth = vec![0; self.prob.refs.len()];
+        for (c, d) in depth.iter_mut().enumerate() {
+            let mut p = self.prob.parent[c];
+            while let Some(a) = p {
+                *d += 1;
+                p = self.prob.parent[a];
+            }
+        }
+        self.heat = Some(HeatTerm {
+            model,
+            weight_mm,
+            idle_speed: machine.idle_speed,
+            busy,
+            depth,
+            value: 0.0,
+            last: vec![-1; self.prob.refs.len()],
+            events: Vec::new(),
+            sources: Vec::new(),
+        });
+        self.refresh_heat();
+    }
+
+    /// What the search minimises: the idle length, plus the heat penalty if any.
+    #[inline]
+    pub fn objective(&self) -> f64 {
+        match &self.heat {
+            None => self.total,
+            Some(h) => self.total + h.value,
+        }
+    }
+
+    /// Recomputes the heat penalty of the current order and points; returns it (0 without).
+    fn refresh_heat(&mut self) -> f64 {
+        let Some(mut h) = self.heat.take() else {
+            return 0.0;
+        };
+        // Outer contours come back right after the last kept contour inside them.
+        for &r in &self.prob.removed {
+            h.last[r] = -1;
+        }
+        for (p, &k) in self.order.iter().enumerate() {
+            for &a in &self.ancestors[k as usize] {
+                h.last[a] = p as i64;
+            }
+        }
+        h.events.clear();
+        for &r in &self.prob.removed {
+            if h.last[r] >= 0 {
+                h.events
+                    .push((h.last[r] as u32, std::cmp::Reverse(h.depth[r]), r as u32));
+            }
+        }
+        h.events.sort_unstable();
+        h.sources.clear();
+        let (mut t, mut at, mut e) = (0.0, self.start, 0);
+        let visit = |x: V, c: usize, t: &mut f64, at: &mut V, sources: &mut Vec<Pierce>| {
+            *t += at.dist(x) / h.idle_speed;
+            sources.push(Pierce {
+                point: Point::new(x.x, x.y),
+                time: *t,
+            });
+            *t += h.busy[c];
+            *at = x;
+        };
+        for (p, &k) in self.order.iter().enumerate() {
+            let x = self.pts[k as usize];
+            visit(
+                x,
+                self.prob.kept[k as usize],
+                &mut t,
+                &mut at,
+                &mut h.sources,
+            );
+            while e < h.events.len() && h.events[e].0 as usize == p {
+                let r = h.events[e].2 as usize;
+                let y = self.prob.shapes[r].nearest(at);
+                visit(y, r, &mut t, &mut at, &mut h.sources);
+                e += 1;
+            }
+        }
+        h.value = h.weight_mm * h.model.load_truncated(&h.sources, HEAT_MAX_EXPONENT);
+        let value = h.value;
+        self.heat = Some(h);
+        value
     }
 
     pub fn len(&self) -> usize {
@@ -186,6 +316,7 @@ impl Search {
         self.pts = pts;
         self.reindex(0, self.order.len());
         self.total = self.recompute_total();
+        self.refresh_heat();
     }
 
     fn reindex(&mut self, lo: usize, hi: usize) {
@@ -303,6 +434,7 @@ impl Search {
                 self.push(k);
             }
         }
+        self.refresh_heat();
         before - self.total
     }
 
@@ -566,7 +698,8 @@ impl Search {
             }
         }
         let mut estimate = d0;
-        if d0 >= -IMPROVE {
+        // With a heat penalty a longer route may still be better: every move is checked.
+        if d0 >= -IMPROVE && self.heat.is_none() {
             // Estimate what relaxing each junction could win against its new neighbours.
             let mut targets = [(V::default(), None::<V>, 0usize); 12];
             let mut ub = 0.0;
@@ -617,6 +750,8 @@ impl Search {
         // Exact check: apply, relax the junctions, keep or undo.
         self.exact_checks += 1;
         let before = self.total;
+        let before_objective = self.objective();
+        let heat_before = self.heat.as_ref().map(|h| h.value);
         let (lo, hi) = self.range(m);
         self.saved_slice.clear();
         self.saved_slice.extend_from_slice(&self.order[lo..=hi]);
@@ -630,7 +765,12 @@ impl Search {
         }
         self.relax_local(&seeds[..nj]);
         self.recording = false;
-        if self.total < before - IMPROVE {
+        let improved = if self.heat.is_some() {
+            self.total + self.refresh_heat() < before_objective - IMPROVE
+        } else {
+            self.total < before - IMPROVE
+        };
+        if improved {
             self.accepted += 1;
             for &c in &junctions[..nj] {
                 let p = self.pos[c as usize] as isize;
@@ -650,6 +790,9 @@ impl Search {
                 self.pts[k as usize] = x;
             }
             self.total = before;
+            if let (Some(h), Some(value)) = (self.heat.as_mut(), heat_before) {
+                h.value = value;
+            }
             false
         }
     }
@@ -677,6 +820,7 @@ impl Search {
             }
         }
         self.relax_local(&seeds);
+        self.refresh_heat();
         true
     }
 
@@ -1006,17 +1150,23 @@ impl Search {
         })
     }
 
-    /// A copy of the route state.
+    /// A copy of the route state; its third element is the objective (the idle length when
+    /// there is no heat penalty).
     pub fn snapshot(&self) -> (Vec<u32>, Vec<V>, f64) {
-        (self.order.clone(), self.pts.clone(), self.total)
+        (self.order.clone(), self.pts.clone(), self.objective())
     }
 
     /// Restores a copy made by `snapshot`.
     pub fn restore(&mut self, snap: &(Vec<u32>, Vec<V>, f64)) {
         self.order.clone_from(&snap.0);
         self.pts.clone_from(&snap.1);
-        self.total = snap.2;
         self.reindex(0, self.order.len());
+        if self.heat.is_some() {
+            self.total = self.recompute_total();
+            self.refresh_heat();
+        } else {
+            self.total = snap.2;
+        }
         while self.pop().is_some() {}
     }
 }

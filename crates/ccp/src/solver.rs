@@ -3,7 +3,8 @@
 
 use std::time::Duration;
 
-use cutroute_geometry::{MachineParameters, Nest, Point, Route};
+use cutroute_geometry::{MachineParameters, Nest, Objective, Point, Route};
+use cutroute_thermal::HeatModel;
 use serde::{Deserialize, Serialize};
 use web_time::Instant;
 
@@ -52,6 +53,39 @@ pub struct CcpOptions {
     pub best_improvement: bool,
     /// Machine speeds and pierce time of the time model.
     pub machine: MachineParameters,
+    /// The heat penalty of issue #19 (`None`: plain CCP-Relax, unchanged).
+    #[serde(default)]
+    pub heat: Option<HeatPenalty>,
+}
+
+/// Minimise the objective plus `weight · H` (H: the thermal load of `cutroute-thermal` on the
+/// machine clock of `CcpOptions::machine`).
+///
+/// CCP-Relax cuts every contour once with one pierce each, so time and cost differ from the
+/// idle length only by a constant and a factor: the penalty enters the search as
+/// `weight · H` converted to millimetres of idle travel (× V_off for time, ÷ C_off per mm for
+/// cost). The search's H runs over the innermost contours in order, each outer contour counted
+/// right after the last contour inside it (where step 4 restores it, near the route's last
+/// crossing); pairs whose kernel is below e⁻¹² are skipped. The reported H is recomputed on the
+/// final route.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct HeatPenalty {
+    /// σ and τ.
+    pub model: HeatModel,
+    /// Objective units per unit of H (s for time, price units for cost).
+    pub weight: f64,
+    /// What the weight's unit is.
+    pub objective: Objective,
+}
+
+impl HeatPenalty {
+    /// The weight in millimetres of idle travel per unit of H under `machine`.
+    pub fn weight_mm(&self, machine: &MachineParameters) -> f64 {
+        match self.objective {
+            Objective::Time => self.weight * machine.idle_speed,
+            Objective::Cost => self.weight / (machine.idle_price_per_metre * 1e-3),
+        }
+    }
 }
 
 impl Default for CcpOptions {
@@ -72,6 +106,7 @@ impl Default for CcpOptions {
             max_shake_strength: 5,
             best_improvement: false,
             machine: MachineParameters::default(),
+            heat: None,
         }
     }
 }
@@ -169,6 +204,8 @@ pub struct CcpSolver {
     /// per iteration of the step loop, across slices.
     full_relaxation_sweeps: Option<usize>,
     cancelled: bool,
+    /// The final route's pierce points were relaxed under the heat penalty.
+    heat_relaxed: bool,
 }
 
 impl CcpSolver {
@@ -197,6 +234,25 @@ impl CcpSolver {
                 "neighbours ≥ 1, 1 ≤ max_block ≤ 5 and cycle_window ≤ 14 are required".into(),
             ));
         }
+        if let Some(heat) = &options.heat {
+            heat.model
+                .validate()
+                .map_err(|e| CcpError::InvalidOption(e.to_string()))?;
+            let weight = heat.weight_mm(&options.machine);
+            let m = &options.machine;
+            let valid = weight >= 0.0
+                && weight.is_finite()
+                && m.idle_speed > 0.0
+                && m.cut_speed > 0.0
+                && m.pierce_time >= 0.0;
+            if !valid {
+                return Err(CcpError::InvalidOption(
+                    "the heat weight must be finite and non-negative (and the idle price positive \
+                     for cost), speeds positive"
+                        .into(),
+                ));
+            }
+        }
         let t0 = Instant::now();
         let start = V::from(options.start);
         let finish = options.finish.map(V::from);
@@ -211,6 +267,14 @@ impl CcpSolver {
         };
         let mut search = Search::new(prob, start, finish, params, options.seed);
         search.best_improvement = options.best_improvement;
+        if let Some(heat) = options.heat.filter(|h| h.weight > 0.0) {
+            search.set_heat(
+                nest,
+                heat.model,
+                heat.weight_mm(&options.machine),
+                &options.machine,
+            );
+        }
         let restarts_left = options.restarts;
         Ok(CcpSolver {
             nest: nest.clone(),
@@ -235,6 +299,7 @@ impl CcpSolver {
             relaxation_sweeps: 0,
             full_relaxation_sweeps: None,
             cancelled: false,
+            heat_relaxed: false,
         })
     }
 
@@ -251,6 +316,9 @@ impl CcpSolver {
             || self.route.steps.is_empty()
         {
             self.refresh_route();
+        }
+        if self.phase == CcpPhase::Done {
+            self.relax_heat();
         }
         self.elapsed += t0.elapsed();
         result
@@ -378,7 +446,7 @@ impl CcpSolver {
     /// Compares the descended shake with the best; keeps or reverts; restarts or stops.
     fn after_shake(&mut self) {
         let best_len = self.best.as_ref().map_or(f64::INFINITY, |b| b.2);
-        if self.search.total < best_len - 1e-6 {
+        if self.search.objective() < best_len - 1e-6 {
             self.best = Some(self.search.snapshot());
             self.fails = 0;
             self.strength = 1;
@@ -437,7 +505,7 @@ impl CcpSolver {
 
     fn finish_run(&mut self) {
         if let Some(b) = &self.best {
-            if b.2 < self.search.total {
+            if b.2 < self.search.objective() {
                 self.search.restore(b);
             }
         }
@@ -447,8 +515,8 @@ impl CcpSolver {
     /// Rebuilds the cached route from the best state when it changed.
     fn refresh_route(&mut self) {
         let (len, use_best) = match &self.best {
-            Some(b) if b.2 <= self.search.total => (b.2, true),
-            _ => (self.search.total, false),
+            Some(b) if b.2 <= self.search.objective() => (b.2, true),
+            _ => (self.search.objective(), false),
         };
         if !self.route.steps.is_empty() && (len - self.route_length).abs() < 1e-9 {
             return;
@@ -459,6 +527,32 @@ impl CcpSolver {
         };
         self.route_length = len;
         self.route = route;
+        self.heat_relaxed = false;
+    }
+
+    /// With a heat penalty, the final route's pierce points (outer contours restored by step 4
+    /// included) move along their contours where idle + weight · H falls
+    /// (`cutroute_thermal::relax_pierce_points`); the search's relaxation minimises idle only.
+    fn relax_heat(&mut self) {
+        let Some(heat) = self.options.heat.filter(|h| h.weight > 0.0) else {
+            return;
+        };
+        if self.heat_relaxed {
+            return;
+        }
+        let weight_mm = heat.weight_mm(&self.options.machine);
+        if let Ok(route) = cutroute_thermal::relax_pierce_points(
+            &self.nest,
+            &self.route,
+            &self.options.machine,
+            &heat.model,
+            weight_mm,
+            3,
+            None,
+        ) {
+            self.route = route;
+        }
+        self.heat_relaxed = true;
     }
 
     /// The current snapshot.

@@ -10,7 +10,8 @@
 //! cutroute solve FILE --solver nearest|ccp|heuristic|exact|discrete|chain|aoe|sccp|gsccp
 //!                     [--time-limit S] [--seed N] [--ub N] [--step MM] [--cost C_off,C_on,C_pt]
 //!                     [--speeds V_off,V_on,t_pt] [--task TASK.json] [--objective time|cost]
-//!                     [--json]
+//!                     [--thermal-sigma MM] [--thermal-tau S] [--thermal-weight W]
+//!                     [--rules part,sheet,islands] [--rules-hard] [--json]
 //! ```
 //! The time and cost model (`--speeds`, `--cost`) defaults to the task file's speeds and pierce
 //! time when `--task` is given, else to `MachineParameters::default()`; prices are per metre of
@@ -21,6 +22,9 @@
 //! AOE-chains (`cutroute-aoe`). The three run the job engine's path-route jobs, as the app
 //! does, and report the route as tool-on paths (`PathRoute` JSON), `ub`/`lb` in the
 //! objective's unit, and (sccp, gsccp) each ensemble's numbers.
+//! Every nest report adds the heat load `heat` (σ = 50 mm, τ = 60 s unless given), the rule
+//! violations and each step's machine time `t` (`cutroute-thermal`); `--thermal-weight` makes
+//! nearest, ccp and chain minimise objective + W·H, `--rules-hard` repairs the route until the rules hold.
 //! Errors go to stderr with the reader's location, and the exit code is 1.
 
 use std::path::{Path, PathBuf};
@@ -31,6 +35,8 @@ use cutroute_engine::{open_document, run_to_end, start_job, AoeJob, SegmentJob};
 use cutroute_geometry::{Entry, MachineParameters, Nest, Objective, PathRoute, Route};
 use cutroute_protocol::{Document, JobRequest, Problem, Progress, SolverKind, SolverParams};
 use serde_json::{json, Value};
+
+mod thermal;
 
 #[derive(Parser)]
 #[command(
@@ -129,6 +135,8 @@ enum Command {
         /// Print one JSON object instead of text.
         #[arg(long)]
         json: bool,
+        #[command(flatten)]
+        thermal: thermal::ThermalArgs,
     },
 }
 
@@ -180,8 +188,10 @@ fn main() -> ExitCode {
             task,
             objective,
             json,
+            thermal,
         } => machine_parameters(cost.as_deref(), speeds.as_deref(), task.as_deref()).and_then(
             |machine| {
+                let thermal = thermal.parse()?;
                 let objective = match objective.as_str() {
                     "time" => Objective::Time,
                     "cost" => Objective::Cost,
@@ -196,8 +206,8 @@ fn main() -> ExitCode {
                     objective,
                 };
                 match solver.as_str() {
-                    "sccp" | "gsccp" | "aoe" => solve_path(&file, &solver, params, json),
-                    _ => solve(&file, &solver, params, json),
+                    "sccp" | "gsccp" | "aoe" => solve_path(&file, &solver, params, json, &thermal),
+                    _ => solve(&file, &solver, params, json, &thermal),
                 }
             },
         ),
@@ -563,21 +573,41 @@ fn solve(
     solver_name: &str,
     params: SolverParams,
     as_json: bool,
+    thermal: &thermal::Thermal,
 ) -> Result<(), String> {
     let document = open(path)?;
     let solver = solver_kind(solver_name)?;
-    let machine = params.machine;
+    let (machine, objective) = (params.machine, params.objective);
     let request = JobRequest {
         job_id: 1,
         problem: document.problem.clone(),
         solver,
         params,
     };
-    let mut job = start_job(&request).map_err(|e| e.to_string())?;
-    let result = run_to_end(job.as_mut(), &mut progress_printer(as_json));
+    let mut job = match thermal.heated_job(&request)? {
+        Some(job) => job,
+        None => start_job(&request).map_err(|e| e.to_string())?,
+    };
+    let mut result = run_to_end(job.as_mut(), &mut progress_printer(as_json));
     let report = match &document.problem {
         Problem::PcgtspText { .. } => tour_report(solver_name, &result),
-        Problem::Nest { nest, .. } => route_report(solver_name, nest, &machine, &result)?,
+        Problem::Nest { nest, .. } => {
+            if let Some(route) = result.route.take() {
+                let route = thermal.enforce(nest, route, &machine, objective)?;
+                if !result.certified.is_empty() {
+                    // Certificates of the route reported, not of the one before the repair.
+                    let certified = cutroute_ccp::route_certificates(nest, &route)
+                        .map_err(|e| e.to_string())?;
+                    result.certified = certified.iter().map(|c| c.condition1).collect();
+                }
+                result.route = Some(route);
+            }
+            let mut report = route_report(solver_name, nest, &machine, &result)?;
+            if let Some(route) = &result.route {
+                thermal.report(&mut report, nest, route, &machine, objective)?;
+            }
+            report
+        }
     };
     print_report(&report, as_json);
     Ok(())
@@ -704,6 +734,7 @@ fn solve_path(
     solver_name: &str,
     params: SolverParams,
     as_json: bool,
+    thermal: &thermal::Thermal,
 ) -> Result<(), String> {
     let document = open(path)?;
     let Problem::Nest { nest, .. } = &document.problem else {
@@ -820,6 +851,7 @@ fn solve_path(
     if let Value::Object(fields) = &mut report {
         fields.extend(extra);
     }
+    thermal.report_paths(&mut report, route, &machine);
     print_report(&report, as_json);
     Ok(())
 }

@@ -40,7 +40,7 @@ mod path_jobs;
 use cutroute_protocol::{JobRequest, Problem, Progress, SolverKind};
 use web_time::Duration;
 
-pub use jobs::{CcpJob, ChainJob, DiscreteJob, DiscreteMode};
+pub use jobs::{ccp_options, CcpJob, ChainJob, DiscreteJob, DiscreteMode};
 pub use nearest::NearestNeighbourJob;
 pub use open::{format_name, OpenError};
 pub use open_files::{

@@ -2,14 +2,18 @@
 
 use std::collections::HashMap;
 
-use cutroute_geometry::{ContourRef, CutStep, Nest, Point, Route};
+use cutroute_geometry::{ContourRef, CutStep, MachineParameters, Nest, Point, Route};
 use cutroute_protocol::{JobId, Progress};
+use cutroute_thermal::{HeatModel, Pierce};
 use web_time::{Duration, Instant};
 
 use crate::{EngineError, Job, JobStatus};
 
 /// Greedy routing: from the current tool position, cut the nearest contour that may be cut now
-/// (only once every contour inside it is cut), piercing at its nearest vertex.
+/// (only once every contour inside it is cut), piercing at its nearest vertex. With a heat
+/// penalty ([`NearestNeighbourJob::with_heat`]) "nearest" means the least idle length plus the
+/// weight times the heat the pierce adds to the route's load H (`cutroute-thermal`), on the
+/// machine clock of the route so far.
 pub struct NearestNeighbourJob {
     job_id: JobId,
     nest: Nest,
@@ -18,7 +22,19 @@ pub struct NearestNeighbourJob {
     started: Instant,
     route: Option<Route>,
     idle_length: f64,
+    heat: Option<NearestHeat>,
 }
+
+/// The heat penalty of the greedy choice.
+struct NearestHeat {
+    model: HeatModel,
+    /// Millimetres of idle per unit of H.
+    weight_mm: f64,
+    machine: MachineParameters,
+}
+
+/// Heat kernels below e⁻¹² are not worth summing for a greedy choice.
+const HEAT_MAX_EXPONENT: f64 = 12.0;
 
 impl NearestNeighbourJob {
     /// Prepare the job; fails on a nest with no contours.
@@ -39,7 +55,24 @@ impl NearestNeighbourJob {
             started: Instant::now(),
             route: None,
             idle_length: 0.0,
+            heat: None,
         })
+    }
+
+    /// Adds `weight_mm` millimetres of idle per unit of heat load H to each choice (time of
+    /// the pierces under `machine`). A zero weight changes nothing.
+    pub fn with_heat(
+        mut self,
+        model: HeatModel,
+        weight_mm: f64,
+        machine: MachineParameters,
+    ) -> Self {
+        self.heat = (weight_mm > 0.0).then_some(NearestHeat {
+            model,
+            weight_mm,
+            machine,
+        });
+        self
     }
 
     fn solve(&mut self) {
@@ -53,6 +86,9 @@ impl NearestNeighbourJob {
         let mut position = self.start;
         let mut steps = Vec::with_capacity(remaining.len());
         let mut idle_length = 0.0;
+        // The heat sources so far and the machine clock (heat penalty only).
+        let mut sources: Vec<Pierce> = Vec::new();
+        let mut clock = 0.0;
         while !remaining.is_empty() {
             let mut best: Option<(usize, Point, f64)> = None;
             for (index, contour_ref) in remaining.iter().enumerate() {
@@ -62,15 +98,37 @@ impl NearestNeighbourJob {
                 let contour = &self.nest.parts[contour_ref.part].contours[contour_ref.contour];
                 for vertex in &contour.vertices {
                     let d = distance(position, vertex.point);
-                    if best.is_none_or(|(_, _, best_d)| d < best_d) {
-                        best = Some((index, vertex.point, d));
+                    let value = match &self.heat {
+                        None => d,
+                        Some(h) => {
+                            let t = clock + d / h.machine.idle_speed;
+                            d + h.weight_mm
+                                * h.model
+                                    .added_load(&sources, vertex.point, t, HEAT_MAX_EXPONENT)
+                        }
+                    };
+                    if best.is_none_or(|(_, _, best_value)| value < best_value) {
+                        best = Some((index, vertex.point, value));
                     }
                 }
             }
-            let Some((index, pierce_point, d)) = best else {
+            let Some((index, pierce_point, _)) = best else {
                 break; // only contours without vertices remain
             };
+            let d = distance(position, pierce_point);
             let contour_ref = remaining.swap_remove(index);
+            if let Some(h) = &self.heat {
+                clock += d / h.machine.idle_speed;
+                sources.push(Pierce {
+                    point: pierce_point,
+                    time: clock,
+                });
+                let perimeter = self
+                    .nest
+                    .contour(contour_ref)
+                    .map_or(0.0, |c| c.perimeter());
+                clock += h.machine.pierce_time + perimeter / h.machine.cut_speed;
+            }
             if let Some(left) = forest
                 .parent(contour_ref)
                 .and_then(|p| inner_left.get_mut(&p))

@@ -1,0 +1,220 @@
+//! `cutroute solve`'s thermal options (issue #19): the heat penalty of CCP-Relax, the shop
+//! rules as a check or as a hard repair, and the report's `heat`, `rule_violations` and
+//! per-step `t`.
+
+use cutroute_ccp::{CcpSolver, HeatPenalty};
+use cutroute_engine::{ccp_options, CcpJob, ChainJob, Job, NearestNeighbourJob};
+use cutroute_geometry::{MachineParameters, Nest, Objective, Route};
+use cutroute_protocol::{JobRequest, Problem, SolverKind};
+use cutroute_thermal::{
+    admissible_pierce_points, check_rules, enforce_rules, relax_pierce_points, route_pierces,
+    HeatModel, RuleParams, RuleSet,
+};
+use serde_json::{json, Value};
+
+/// The thermal flags of `solve`.
+#[derive(clap::Args, Clone, Debug)]
+pub struct ThermalArgs {
+    /// Heat-affected radius σ of the heat model, mm (H is reported for every solver).
+    #[arg(long, value_name = "MM", default_value_t = 50.0)]
+    thermal_sigma: f64,
+    /// Cooling time τ of the heat model, s.
+    #[arg(long, value_name = "S", default_value_t = 60.0)]
+    thermal_tau: f64,
+    /// nearest, ccp and chain minimise their objective + W·H (W in objective units per unit of H;
+    /// 0: plain CCP-Relax).
+    #[arg(long, value_name = "W", default_value_t = 0.0)]
+    thermal_weight: f64,
+    /// The rules checked (and enforced with --rules-hard): part,sheet,islands.
+    #[arg(long, value_name = "LIST", default_value = "part,sheet,islands")]
+    rules: String,
+    /// Repair the solver's route until the rules hold (whole parts reordered, pierce points
+    /// moved); bounds and certificates stay those of the problem without rules.
+    #[arg(long)]
+    rules_hard: bool,
+}
+
+/// The parsed thermal settings.
+pub struct Thermal {
+    model: HeatModel,
+    weight: f64,
+    rules: RuleSet,
+    hard: bool,
+}
+
+impl ThermalArgs {
+    pub fn parse(&self) -> Result<Thermal, String> {
+        let model = HeatModel::new(self.thermal_sigma, self.thermal_tau)
+            .map_err(|e| format!("--thermal-sigma/--thermal-tau: {e}"))?;
+        if !(self.thermal_weight >= 0.0 && self.thermal_weight.is_finite()) {
+            return Err(format!(
+                "--thermal-weight {}: must be finite and non-negative",
+                self.thermal_weight
+            ));
+        }
+        let rules = RuleSet::parse(&self.rules).map_err(|e| format!("--rules: {e}"))?;
+        Ok(Thermal {
+            model,
+            weight: self.thermal_weight,
+            rules,
+            hard: self.rules_hard,
+        })
+    }
+}
+
+impl Thermal {
+    /// A nearest, ccp or chain job with the heat penalty, when the weight is positive (else
+    /// `None`: the engine's own job, unchanged).
+    pub fn heated_job(&self, request: &JobRequest) -> Result<Option<Box<dyn Job>>, String> {
+        let Problem::Nest {
+            nest,
+            start,
+            finish,
+        } = &request.problem
+        else {
+            return Ok(None);
+        };
+        if self.weight <= 0.0 {
+            return Ok(None);
+        }
+        if !matches!(
+            request.solver,
+            SolverKind::Ccp | SolverKind::Chain | SolverKind::NearestNeighbour
+        ) {
+            eprintln!(
+                "cutroute: --thermal-weight is honoured by nearest, ccp and chain; {} only reports H",
+                request.solver.name()
+            );
+            return Ok(None);
+        }
+        let params = &request.params;
+        let penalty = HeatPenalty {
+            model: self.model,
+            weight: self.weight,
+            objective: params.objective,
+        };
+        if request.solver == SolverKind::NearestNeighbour {
+            let job = NearestNeighbourJob::new(request.job_id, nest.clone(), *start, *finish)
+                .map_err(|e| e.to_string())?
+                .with_heat(
+                    self.model,
+                    penalty.weight_mm(&params.machine),
+                    params.machine,
+                );
+            return Ok(Some(Box::new(job)));
+        }
+        let time_limit = std::time::Duration::from_secs_f64(params.time_limit_s.clamp(0.0, 1.0e7));
+        let mut options = ccp_options(*start, *finish, time_limit, params.seed, params.machine);
+        options.heat = Some(penalty);
+        let ccp = CcpSolver::new(nest, options).map_err(|e| e.to_string())?;
+        Ok(Some(if request.solver == SolverKind::Chain {
+            Box::new(ChainJob::new(
+                request.job_id,
+                ccp,
+                nest.clone(),
+                params.machine,
+            ))
+        } else {
+            Box::new(CcpJob::new(request.job_id, ccp))
+        }))
+    }
+
+    /// With `--rules-hard`, the route repaired until the rules hold (what is left is reported
+    /// by [`Thermal::report`]), then, with a heat weight, its pierce points relaxed on
+    /// objective + W·H among those the part rule admits; else the route as it is.
+    pub fn enforce(
+        &self,
+        nest: &Nest,
+        route: Route,
+        machine: &MachineParameters,
+        objective: Objective,
+    ) -> Result<Route, String> {
+        if !self.hard {
+            return Ok(route);
+        }
+        let params = RuleParams::default();
+        let route = enforce_rules(nest, &route, self.rules, &params)
+            .map_err(|e| e.to_string())?
+            .route;
+        if self.weight <= 0.0 {
+            return Ok(route);
+        }
+        let candidates = if self.rules.part {
+            Some(admissible_pierce_points(nest, &route, &params).map_err(|e| e.to_string())?)
+        } else {
+            None
+        };
+        let weight_mm = HeatPenalty {
+            model: self.model,
+            weight: self.weight,
+            objective,
+        }
+        .weight_mm(machine);
+        relax_pierce_points(
+            nest,
+            &route,
+            machine,
+            &self.model,
+            weight_mm,
+            3,
+            candidates.as_deref(),
+        )
+        .map_err(|e| e.to_string())
+    }
+
+    /// Adds `heat` (one source per tool-on path) and each path's `t` to a path-route report;
+    /// the rules are defined on contour routes, so `rule_violations` is null.
+    pub fn report_paths(
+        &self,
+        report: &mut Value,
+        route: &cutroute_geometry::PathRoute,
+        machine: &MachineParameters,
+    ) {
+        let pierces = cutroute_thermal::path_route_pierces(route, machine);
+        report["heat"] = json!(self.model.load(&pierces));
+        report["rule_violations"] = Value::Null;
+        if let Some(paths) = report["route"]["paths"].as_array_mut() {
+            for (path, pierce) in paths.iter_mut().zip(&pierces) {
+                path["t"] = json!(pierce.time);
+            }
+        }
+    }
+
+    /// Adds `heat`, `thermal`, `rule_violations` and each step's `t` to a route report.
+    pub fn report(
+        &self,
+        report: &mut Value,
+        nest: &Nest,
+        route: &Route,
+        machine: &MachineParameters,
+        objective: Objective,
+    ) -> Result<(), String> {
+        let pierces = route_pierces(route, nest, machine).map_err(|e| e.to_string())?;
+        let counts = check_rules(nest, route, self.rules, &RuleParams::default())
+            .map_err(|e| e.to_string())?
+            .counts();
+        report["heat"] = json!(self.model.load(&pierces));
+        report["thermal"] = json!({
+            "sigma_mm": self.model.sigma_mm,
+            "tau_s": self.model.tau_s,
+            "weight": self.weight,
+            "weight_unit": format!("{} per unit of H", objective.name()),
+            "rules_hard": self.hard,
+        });
+        if self.hard {
+            report["thermal"]["bounds"] =
+                json!("lb and certificates are those of the problem without the rules");
+        }
+        report["rule_violations"] = json!({
+            "part": counts.part,
+            "sheet": counts.sheet,
+            "islands": counts.islands,
+        });
+        if let Some(steps) = report["route"].as_array_mut() {
+            for (step, pierce) in steps.iter_mut().zip(&pierces) {
+                step["t"] = json!(pierce.time);
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,729 @@
+//! The shop rules of Krotov and Gurtovenko as checks with counted violations, and a repair that
+//! makes a route obey them (hard-rule mode).
+//!
+//! The dissertation states the rules in words; these are the precise definitions used here,
+//! each with its reason.
+//!
+//! **Units.** A *unit* is a root of the containment forest (a part's outer contour) with every
+//! contour inside it. Cutting the root frees the part: from that step on its area is cut out
+//! of the sheet. Holes are not free edges for their own part: a hole is cut while the part is
+//! still held by the sheet, and the rule is about what holds the part.
+//!
+//! **Part rigidity** (one check per outer contour of a part, i.e. per even-depth contour). The
+//! *free edge* at a step is the sheet border (the sheet's outer contour, or the parts' box
+//! when the file has no sheet) together with every sibling outer contour cut before it (for a
+//! part inside a hole: the earlier-cut siblings only, the hole is cut later). The rule asks to
+//! cut the sections nearest the free edge first and to finish on the section bordering rigid
+//! material. A contour cut whole from one pierce point starts and finishes at that point and
+//! runs one way round, so the two clauses are one choice: the pierce point. It is a violation
+//! when the pierce point is more than `part_margin_mm` farther from the free edge than the
+//! contour's nearest point to it (the contour is sampled every ≤ 5 mm and at its vertices).
+//! Then the cut starts next to the free edge and ends there too, having gone round through the
+//! material that is still rigid. The margin (10 mm) absorbs sampling and makes "closest"
+//! tolerant of equal-distance sides (a part parallel to the border).
+//!
+//! **Sheet rigidity.** The sheet's long axis is the longer side of its box.
+//! 1. A unit is *long* when its box's longer side is at least `long_ratio` (10, as the
+//!    dissertation says) times its shorter side; it is *near a narrow border* when the strip of
+//!    sheet between its box and the nearest sheet side is at most `border_band_mm` wide (50 mm:
+//!    a strip of that width is what bends most, and "narrow border" reads as the narrow strip
+//!    of material along the edge). Each such unit cut after a unit that is not one counts one
+//!    violation.
+//! 2. The sheet has a *large scrap* when the part-free margin at one end of its long axis is at
+//!    least `large_scrap_fraction` (25 %) of the sheet's length: a quarter of the sheet left
+//!    whole is a rigid remainder worth ending at. The start must then lie in the half of the
+//!    parts' extent away from that end.
+//! 3. Otherwise, the start must lie in the half of the parts' extent (along the long axis)
+//!    whose units have the larger total perimeter (cut length is heat released, and more small
+//!    parts mean more perimeter), unless the halves differ by less than `heat_balance` (10 %)
+//!    of the total, when either side will do.
+//!
+//!    The *start* is the first unit cut that is not a rule-1 unit (rule 1 decides what comes
+//!    before it); it lies in a half when its box's centre does. A wrong start is one violation.
+//! 4. Rule 4 (no narrow strips or islands) is the islands rule below, counted there.
+//!
+//! **Islands and strips.** After each cut of a unit, an uncut unit is on an island when no
+//! material at least `strip_width_mm` (20 mm) wide joins it to the sheet's edge: see the
+//! module `islands` for the raster definition. Each unit counts once, at the step that first
+//! cuts it off; units smaller than a raster cell are never counted.
+
+use cutroute_geometry::{Contour, ContourRef, Entry, Nest, Point, Route};
+use serde::{Deserialize, Serialize};
+
+use crate::islands::IslandGrid;
+use crate::layout::{along, box_distance, samples, Layout};
+use crate::ThermalError;
+
+/// The parameters of the rules (see the module documentation for what each one means).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RuleParams {
+    /// Part rigidity: how much farther from the free edge than the contour's nearest point a
+    /// pierce point may be, mm.
+    pub part_margin_mm: f64,
+    /// Sheet rule 1: the aspect ratio from which a part is long.
+    pub long_ratio: f64,
+    /// Sheet rule 1: the widest strip between a part and the sheet edge that counts as a narrow
+    /// border, mm.
+    pub border_band_mm: f64,
+    /// Sheet rule 2: the part-free end margin, as a fraction of the sheet's length, from which
+    /// the scrap is large.
+    pub large_scrap_fraction: f64,
+    /// Sheet rule 3: the smallest difference between the halves' perimeters, as a fraction of
+    /// the total, that makes one side the required start.
+    pub heat_balance: f64,
+    /// Islands: the narrowest material that still holds a part, mm.
+    pub strip_width_mm: f64,
+    /// Islands: the largest number of raster cells (the cell grows beyond w/4 to respect it).
+    pub max_grid_cells: usize,
+}
+
+impl Default for RuleParams {
+    fn default() -> Self {
+        RuleParams {
+            part_margin_mm: 10.0,
+            long_ratio: 10.0,
+            border_band_mm: 50.0,
+            large_scrap_fraction: 0.25,
+            heat_balance: 0.1,
+            strip_width_mm: 20.0,
+            max_grid_cells: 250_000,
+        }
+    }
+}
+
+impl RuleParams {
+    /// Checks that every parameter is finite and in range.
+    pub fn validate(&self) -> Result<(), ThermalError> {
+        let checks = [
+            (
+                "part_margin",
+                self.part_margin_mm,
+                self.part_margin_mm >= 0.0,
+            ),
+            ("long_ratio", self.long_ratio, self.long_ratio >= 1.0),
+            (
+                "border_band",
+                self.border_band_mm,
+                self.border_band_mm >= 0.0,
+            ),
+            (
+                "large_scrap_fraction",
+                self.large_scrap_fraction,
+                self.large_scrap_fraction > 0.0 && self.large_scrap_fraction <= 1.0,
+            ),
+            (
+                "heat_balance",
+                self.heat_balance,
+                (0.0..=1.0).contains(&self.heat_balance),
+            ),
+            (
+                "strip_width",
+                self.strip_width_mm,
+                self.strip_width_mm > 0.0,
+            ),
+        ];
+        for (name, value, ok) in checks {
+            if !(ok && value.is_finite()) {
+                return Err(ThermalError::InvalidParameter {
+                    name,
+                    value,
+                    expected: "see RuleParams",
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Which rules to check or enforce.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct RuleSet {
+    /// Part rigidity.
+    pub part: bool,
+    /// Sheet rigidity 1–3.
+    pub sheet: bool,
+    /// Islands and strips (sheet rule 4).
+    pub islands: bool,
+}
+
+impl RuleSet {
+    /// Every rule.
+    pub const ALL: RuleSet = RuleSet {
+        part: true,
+        sheet: true,
+        islands: true,
+    };
+
+    /// Parses a comma-separated list of `part`, `sheet`, `islands` (the CLI's `--rules`).
+    pub fn parse(text: &str) -> Result<RuleSet, ThermalError> {
+        let mut set = RuleSet {
+            part: false,
+            sheet: false,
+            islands: false,
+        };
+        for name in text.split(',').map(str::trim).filter(|n| !n.is_empty()) {
+            match name {
+                "part" => set.part = true,
+                "sheet" => set.sheet = true,
+                "islands" => set.islands = true,
+                other => return Err(ThermalError::UnknownRule(other.to_string())),
+            }
+        }
+        Ok(set)
+    }
+}
+
+/// The half of the parts' extent along the sheet's long axis.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Side {
+    /// Towards smaller coordinates.
+    Low,
+    /// Towards larger coordinates.
+    High,
+}
+
+/// One broken rule.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Violation {
+    /// Part rigidity: the pierce point is `excess_mm` farther from the free edge than the
+    /// contour's nearest point (beyond the margin), which is `best`.
+    PartRigidity {
+        /// The step.
+        step: usize,
+        /// Its contour.
+        contour: ContourRef,
+        /// How much farther than allowed, mm.
+        excess_mm: f64,
+        /// The contour's point nearest the free edge.
+        best: Point,
+    },
+    /// Sheet rule 1: a long part near a narrow border is cut after another part.
+    LongPartLate {
+        /// The step cutting its outer contour.
+        step: usize,
+        /// Its outer contour.
+        part: ContourRef,
+    },
+    /// Sheet rule 2 or 3: the route starts on the wrong side.
+    WrongStartSide {
+        /// The step cutting the start unit's outer contour.
+        step: usize,
+        /// Its outer contour.
+        part: ContourRef,
+        /// Where the start should be.
+        required: Side,
+        /// Rule 2 (large scrap) or 3 (heat release).
+        rule: u8,
+    },
+    /// Islands: an uncut part is cut off from the sheet's edge by the cut at `step`.
+    Island {
+        /// The step whose cut isolates it.
+        step: usize,
+        /// The isolated part's outer contour.
+        part: ContourRef,
+    },
+}
+
+/// Violation counts per rule group (`None` for a group not checked).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct RuleCounts {
+    /// Part rigidity.
+    pub part: Option<usize>,
+    /// Sheet rigidity 1–3.
+    pub sheet: Option<usize>,
+    /// Islands and strips.
+    pub islands: Option<usize>,
+}
+
+impl RuleCounts {
+    /// Violations of the checked rules together.
+    pub fn total(&self) -> usize {
+        self.part.unwrap_or(0) + self.sheet.unwrap_or(0) + self.islands.unwrap_or(0)
+    }
+}
+
+/// The outcome of a check.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RuleReport {
+    /// Which rules were checked.
+    pub rules: RuleSet,
+    /// Every violation found, by rule group then step.
+    pub violations: Vec<Violation>,
+}
+
+impl RuleReport {
+    /// The counts per checked group.
+    pub fn counts(&self) -> RuleCounts {
+        let count = |f: fn(&Violation) -> bool| self.violations.iter().filter(|v| f(v)).count();
+        RuleCounts {
+            part: self
+                .rules
+                .part
+                .then(|| count(|v| matches!(v, Violation::PartRigidity { .. }))),
+            sheet: self.rules.sheet.then(|| {
+                count(|v| {
+                    matches!(
+                        v,
+                        Violation::LongPartLate { .. } | Violation::WrongStartSide { .. }
+                    )
+                })
+            }),
+            islands: self
+                .rules
+                .islands
+                .then(|| count(|v| matches!(v, Violation::Island { .. }))),
+        }
+    }
+}
+
+/// Checks `route` over `nest` against the selected rules. The route should be valid
+/// (`Route::problems` empty); contours it does not cut are treated as never cut.
+pub fn check_rules(
+    nest: &Nest,
+    route: &Route,
+    rules: RuleSet,
+    params: &RuleParams,
+) -> Result<RuleReport, ThermalError> {
+    params.validate()?;
+    check_steps(route, nest)?;
+    let layout = Layout::new(nest);
+    let mut violations = Vec::new();
+    if rules.part {
+        violations.extend(part_rigidity(&layout, route, params));
+    }
+    if rules.sheet {
+        violations.extend(sheet_rigidity(&layout, route, params));
+    }
+    if rules.islands {
+        violations.extend(islands(&layout, route, params));
+    }
+    Ok(RuleReport { rules, violations })
+}
+
+fn check_steps(route: &Route, nest: &Nest) -> Result<(), ThermalError> {
+    for (step, s) in route.steps.iter().enumerate() {
+        if nest.contour(s.contour).is_none() {
+            return Err(ThermalError::Route(
+                cutroute_geometry::RouteError::UnknownContour {
+                    step,
+                    contour: s.contour,
+                },
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// What the part rule sees at one step: the contour's sample points with their distance to the
+/// free edge, the least of them, and the pierce point's distance.
+struct Rigidity {
+    step: usize,
+    contour: ContourRef,
+    points: Vec<(Point, f64)>,
+    best: (Point, f64),
+    here: f64,
+}
+
+/// The steps the part rule constrains (even-depth contours with a free edge), in order. The
+/// free edges depend on the order only, never on pierce points.
+fn rigidity(layout: &Layout, route: &Route) -> Vec<Rigidity> {
+    let forest = &layout.forest;
+    let mut cut: Vec<(Option<ContourRef>, &Contour)> = Vec::new();
+    let mut out = Vec::new();
+    for (step, s) in route.steps.iter().enumerate() {
+        let (Some(depth), Some(contour)) =
+            (forest.depth(s.contour), layout.nest.contour(s.contour))
+        else {
+            continue;
+        };
+        if depth % 2 == 1 {
+            continue;
+        }
+        let parent = forest.parent(s.contour);
+        let earlier: Vec<&Contour> = cut
+            .iter()
+            .filter(|(p, _)| *p == parent)
+            .map(|(_, c)| *c)
+            .collect();
+        cut.push((parent, contour));
+        if parent.is_some() && earlier.is_empty() {
+            // A part in a hole with no free edge yet: the rule says nothing.
+            continue;
+        }
+        let free = |q: Point| {
+            let mut best = if parent.is_none() {
+                layout.border_distance(q)
+            } else {
+                f64::INFINITY
+            };
+            for e in &earlier {
+                if box_distance(&e.bounding_box(), q) < best {
+                    best = best.min(e.distance_to(q));
+                }
+            }
+            best
+        };
+        let points: Vec<(Point, f64)> =
+            samples(contour).into_iter().map(|q| (q, free(q))).collect();
+        let best = points
+            .iter()
+            .copied()
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .unwrap_or((s.pierce_point, 0.0));
+        out.push(Rigidity {
+            step,
+            contour: s.contour,
+            points,
+            best,
+            here: free(s.pierce_point),
+        });
+    }
+    out
+}
+
+fn part_rigidity(layout: &Layout, route: &Route, params: &RuleParams) -> Vec<Violation> {
+    rigidity(layout, route)
+        .into_iter()
+        .filter(|r| r.here > r.best.1 + params.part_margin_mm)
+        .map(|r| Violation::PartRigidity {
+            step: r.step,
+            contour: r.contour,
+            excess_mm: r.here - r.best.1 - params.part_margin_mm,
+            best: r.best.0,
+        })
+        .collect()
+}
+
+/// Per step of `route`, the pierce points the part rule admits for the route's order (sample
+/// points of the contour, every ≤ 5 mm, within the margin of the free edge's nearest); `None`
+/// where the rule does not constrain the step. Heat-aware relaxation under hard rules picks
+/// among these: the forbidden pierce points of the dissertation's formalisation.
+pub fn admissible_pierce_points(
+    nest: &Nest,
+    route: &Route,
+    params: &RuleParams,
+) -> Result<Vec<Option<Vec<Point>>>, ThermalError> {
+    params.validate()?;
+    check_steps(route, nest)?;
+    let layout = Layout::new(nest);
+    let mut out = vec![None; route.steps.len()];
+    for r in rigidity(&layout, route) {
+        let limit = r.best.1 + params.part_margin_mm;
+        out[r.step] = Some(
+            r.points
+                .into_iter()
+                .filter(|p| p.1 <= limit)
+                .map(|p| p.0)
+                .collect(),
+        );
+    }
+    Ok(out)
+}
+
+/// Per unit: long and near a narrow border (rule 1).
+fn rule1_units(layout: &Layout, params: &RuleParams) -> Vec<bool> {
+    let s = layout.sheet_box;
+    layout
+        .units
+        .iter()
+        .map(|u| {
+            let b = u.bbox;
+            let (long_side, short_side) = (b.width().max(b.height()), b.width().min(b.height()));
+            let long = long_side > 0.0 && long_side >= params.long_ratio * short_side;
+            let gap = (b.min.x - s.min.x)
+                .min(s.max.x - b.max.x)
+                .min(b.min.y - s.min.y)
+                .min(s.max.y - b.max.y);
+            long && gap <= params.border_band_mm
+        })
+        .collect()
+}
+
+/// The start side rules 2 and 3 require, and which rule requires it.
+fn required_side(layout: &Layout, params: &RuleParams) -> Option<(Side, u8, f64)> {
+    let axis = layout.long_axis();
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for u in &layout.units {
+        lo = lo.min(along(u.bbox.min, axis));
+        hi = hi.max(along(u.bbox.max, axis));
+    }
+    if !(lo < hi) {
+        return None;
+    }
+    let mid = 0.5 * (lo + hi);
+    let (s_lo, s_hi) = (
+        along(layout.sheet_box.min, axis),
+        along(layout.sheet_box.max, axis),
+    );
+    let length = s_hi - s_lo;
+    let (gap_lo, gap_hi) = (lo - s_lo, s_hi - hi);
+    if length > 0.0 && gap_lo.max(gap_hi) >= params.large_scrap_fraction * length {
+        let side = if gap_hi >= gap_lo {
+            Side::Low
+        } else {
+            Side::High
+        };
+        return Some((side, 2, mid));
+    }
+    let (mut p_lo, mut p_hi) = (0.0, 0.0);
+    for u in &layout.units {
+        if along(u.bbox.centre(), axis) < mid {
+            p_lo += u.perimeter;
+        } else {
+            p_hi += u.perimeter;
+        }
+    }
+    if (p_lo - p_hi).abs() <= params.heat_balance * (p_lo + p_hi) {
+        return None;
+    }
+    Some((if p_lo > p_hi { Side::Low } else { Side::High }, 3, mid))
+}
+
+fn side_of(layout: &Layout, u: usize, mid: f64) -> Side {
+    if along(layout.units[u].bbox.centre(), layout.long_axis()) < mid {
+        Side::Low
+    } else {
+        Side::High
+    }
+}
+
+fn sheet_rigidity(layout: &Layout, route: &Route, params: &RuleParams) -> Vec<Violation> {
+    let steps = layout.root_steps(route);
+    let long = rule1_units(layout, params);
+    let mut violations = Vec::new();
+    let first_other = (0..layout.units.len())
+        .filter(|&u| !long[u])
+        .filter_map(|u| steps[u].map(|s| (s, u)))
+        .min();
+    for (u, &is_long) in long.iter().enumerate() {
+        if let (true, Some(step), Some((other, _))) = (is_long, steps[u], first_other) {
+            if other < step {
+                violations.push(Violation::LongPartLate {
+                    step,
+                    part: layout.units[u].root,
+                });
+            }
+        }
+    }
+    if let (Some((required, rule, mid)), Some((step, u))) =
+        (required_side(layout, params), first_other)
+    {
+        if side_of(layout, u, mid) != required {
+            violations.push(Violation::WrongStartSide {
+                step,
+                part: layout.units[u].root,
+                required,
+                rule,
+            });
+        }
+    }
+    violations.sort_by_key(|v| match v {
+        Violation::LongPartLate { step, .. } | Violation::WrongStartSide { step, .. } => *step,
+        _ => 0,
+    });
+    violations
+}
+
+fn islands(layout: &Layout, route: &Route, params: &RuleParams) -> Vec<Violation> {
+    let mut grid = IslandGrid::new(layout, params.strip_width_mm, params.max_grid_cells);
+    let steps = layout.root_steps(route);
+    let mut order: Vec<(usize, usize)> = steps
+        .iter()
+        .enumerate()
+        .filter_map(|(u, s)| s.map(|s| (s, u)))
+        .collect();
+    order.sort();
+    let mut uncut = vec![true; layout.units.len()];
+    let mut counted = vec![false; layout.units.len()];
+    let mut violations = Vec::new();
+    for (step, u) in order {
+        grid.cut(u);
+        uncut[u] = false;
+        for v in grid.islanded(&uncut) {
+            if !counted[v] {
+                counted[v] = true;
+                violations.push(Violation::Island {
+                    step,
+                    part: layout.units[v].root,
+                });
+            }
+        }
+    }
+    violations
+}
+
+/// What [`enforce_rules`] did.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Enforced {
+    /// The repaired route (a valid route stays valid: whole units move, pierce points stay on
+    /// their contours).
+    pub route: Route,
+    /// Violations left (the repair is greedy; see [`enforce_rules`]).
+    pub report: RuleReport,
+}
+
+/// Hard-rule mode as a repair of a finished route:
+/// 1. sheet rule 1: the long parts near a narrow border move to the front (whole units, in
+///    their order); rules 2/3: if the start is on the wrong side, the unit on the required side
+///    nearest the route's start point moves to just after them;
+/// 2. islands: units are replayed in order on the raster; when the next unit's cut would cut
+///    off uncut units, those move before it (their cut cannot isolate anything the cut of the
+///    unit would not), repeatedly; if the units isolate each other, the one isolating the
+///    fewest goes first;
+/// 3. part rigidity: each violating pierce point moves to the contour's point nearest the
+///    free edge.
+///
+/// Moving whole units keeps "inner before outer". A step entered by a tool-on link whose
+/// predecessor changes is entered by a pierce instead; part-rigidity repairs skip steps next
+/// to links. The violations left are reported, not hidden.
+pub fn enforce_rules(
+    nest: &Nest,
+    route: &Route,
+    rules: RuleSet,
+    params: &RuleParams,
+) -> Result<Enforced, ThermalError> {
+    params.validate()?;
+    check_steps(route, nest)?;
+    let layout = Layout::new(nest);
+    let steps = layout.root_steps(route);
+    // Units in route order (by their root's step; units never cut go last).
+    let mut units: Vec<usize> = (0..layout.units.len()).collect();
+    units.sort_by_key(|&u| (steps[u].unwrap_or(usize::MAX), u));
+    if rules.sheet {
+        let long = rule1_units(&layout, params);
+        let (mut order, rest): (Vec<usize>, Vec<usize>) = units.iter().partition(|&&u| long[u]);
+        let mut rest = rest;
+        if let (Some((required, _, mid)), Some(&first)) =
+            (required_side(&layout, params), rest.first())
+        {
+            if side_of(&layout, first, mid) != required {
+                let start = route.start;
+                if let Some(pick) = rest
+                    .iter()
+                    .position(|&u| side_of(&layout, u, mid) == required)
+                    .map(|_| {
+                        (0..rest.len())
+                            .filter(|&i| side_of(&layout, rest[i], mid) == required)
+                            .min_by(|&a, &b| {
+                                box_distance(&layout.units[rest[a]].bbox, start)
+                                    .total_cmp(&box_distance(&layout.units[rest[b]].bbox, start))
+                            })
+                            .unwrap_or(0)
+                    })
+                {
+                    let u = rest.remove(pick);
+                    rest.insert(0, u);
+                }
+            }
+        }
+        order.extend(rest);
+        units = order;
+    }
+    if rules.islands {
+        units = island_order(&layout, &units, params);
+    }
+    let mut repaired = reorder(&layout, route, &units);
+    if rules.part {
+        for v in part_rigidity(&layout, &repaired, params) {
+            let Violation::PartRigidity { step, best, .. } = v else {
+                continue;
+            };
+            let linked = |i: usize| {
+                repaired
+                    .steps
+                    .get(i)
+                    .is_some_and(|s| matches!(s.entry, Entry::Link(_)))
+            };
+            if !linked(step) && !linked(step + 1) {
+                repaired.steps[step].pierce_point = best;
+            }
+        }
+    }
+    let report = check_rules(nest, &repaired, rules, params)?;
+    Ok(Enforced {
+        route: repaired,
+        report,
+    })
+}
+
+/// The island repair of [`enforce_rules`] over units in order.
+fn island_order(layout: &Layout, units: &[usize], params: &RuleParams) -> Vec<usize> {
+    let mut grid = IslandGrid::new(layout, params.strip_width_mm, params.max_grid_cells);
+    let mut uncut = vec![true; layout.units.len()];
+    let mut pending: Vec<usize> = units.to_vec();
+    let mut done = Vec::with_capacity(units.len());
+    while !pending.is_empty() {
+        let mut tried: Vec<(usize, usize)> = Vec::new(); // (unit, islands it makes)
+        let choice = loop {
+            let u = pending[0];
+            let saved = grid.save();
+            grid.cut(u);
+            uncut[u] = false;
+            let isolated = grid.islanded(&uncut);
+            grid.restore(saved);
+            uncut[u] = true;
+            if isolated.is_empty() {
+                break 0;
+            }
+            tried.push((u, isolated.len()));
+            let fresh: Vec<usize> = isolated
+                .iter()
+                .copied()
+                .filter(|v| !tried.iter().any(|t| t.0 == *v))
+                .collect();
+            if fresh.is_empty() || tried.len() > 8 {
+                // They isolate each other: the least harmful first.
+                let (best, _) = tried.iter().min_by_key(|t| t.1).copied().unwrap_or((u, 0));
+                break pending.iter().position(|&p| p == best).unwrap_or(0);
+            }
+            // The isolated units go first, in their current order.
+            let (mut front, back): (Vec<usize>, Vec<usize>) =
+                pending.iter().partition(|p| fresh.contains(p));
+            front.extend(back);
+            pending = front;
+        };
+        let u = pending.remove(choice);
+        grid.cut(u);
+        uncut[u] = false;
+        done.push(u);
+    }
+    done
+}
+
+/// The route with its steps grouped by unit in `units` order (each unit's steps in their
+/// original order); links whose predecessor changed become pierces.
+fn reorder(layout: &Layout, route: &Route, units: &[usize]) -> Route {
+    let mut rank = vec![usize::MAX; layout.units.len()];
+    for (i, &u) in units.iter().enumerate() {
+        rank[u] = i;
+    }
+    let unit_rank = |r: ContourRef| {
+        layout
+            .forest
+            .index_of(r)
+            .and_then(|i| rank.get(layout.unit_of[i]).copied())
+            .unwrap_or(usize::MAX)
+    };
+    let mut indexed: Vec<(usize, usize)> = route
+        .steps
+        .iter()
+        .enumerate()
+        .map(|(i, s)| (unit_rank(s.contour), i))
+        .collect();
+    indexed.sort();
+    let mut steps = Vec::with_capacity(route.steps.len());
+    let mut previous: Option<usize> = None;
+    for &(_, i) in &indexed {
+        let mut s = route.steps[i].clone();
+        if matches!(s.entry, Entry::Link(_)) && previous != Some(i.wrapping_sub(1)) {
+            s.entry = Entry::Pierce;
+        }
+        previous = Some(i);
+        steps.push(s);
+    }
+    Route {
+        start: route.start,
+        steps,
+        finish: route.finish,
+    }
+}
