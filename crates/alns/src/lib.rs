@@ -53,7 +53,6 @@ mod local_search;
 mod nodes;
 mod operators;
 mod problem;
-mod rng;
 mod solver;
 
 use std::time::Duration;

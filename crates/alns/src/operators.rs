@@ -6,7 +6,7 @@
 //! never empty because the closure orders every predecessor before every successor.
 
 use crate::problem::Problem;
-use crate::rng::Rng;
+use cutroute_geometry::Xoshiro256 as Rng;
 
 /// How clusters are chosen for removal.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

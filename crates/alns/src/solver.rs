@@ -9,8 +9,8 @@ use crate::local_search::{eps, LocalSearch};
 use crate::nodes::NodeChoice;
 use crate::operators::{Insertion, Operators, Removal, Selection, INSERTIONS, REMOVALS};
 use crate::problem::Problem;
-use crate::rng::Rng;
 use crate::{AlnsError, AlnsOptions, AlnsProgress, SolverStatus, StopReason};
+use cutroute_geometry::Xoshiro256 as Rng;
 
 /// Adaptive weights of one family of operators (Ropke & Pisinger's segment scheme).
 #[derive(Clone, Debug)]

@@ -82,7 +82,6 @@ mod discrete;
 mod geom;
 mod problem;
 mod relax;
-mod rng;
 mod route;
 mod search;
 mod solver;

@@ -2,7 +2,7 @@
 //! forest, the kept (innermost) and removed (outer) contours, a uniform grid, k-nearest
 //! candidate lists and the nearest-neighbour construction.
 
-use cutroute_geometry::{ContourRef, Nest};
+use cutroute_geometry::{ContourRef, Nest, SplitMix64};
 
 use crate::geom::{BBox, Shape, V};
 
@@ -244,7 +244,7 @@ pub(crate) fn nearest_neighbour_order(
     shapes: &[&Shape],
     bounds: BBox,
     start: V,
-    mut rng: Option<&mut crate::rng::Rng>,
+    mut rng: Option<&mut SplitMix64>,
 ) -> (Vec<u32>, Vec<V>) {
     let n = shapes.len();
     let mut grid = Grid::new(bounds, n, 2.0);
@@ -289,7 +289,7 @@ pub(crate) fn nearest_neighbour_order(
             r += 1;
         }
         let take_second =
-            second.1 != usize::MAX && rng.as_deref_mut().is_some_and(|g| g.below(4) == 0);
+            second.1 != usize::MAX && rng.as_deref_mut().is_some_and(|g| g.index_below(4) == 0);
         let pick = if take_second { second } else { best };
         visited[pick.1] = true;
         order.push(pick.1 as u32);

@@ -15,7 +15,7 @@ use cutroute_thermal::{HeatModel, Pierce};
 use crate::geom::{Shape, V};
 use crate::problem::{nearest_lists, nearest_neighbour_order, Problem};
 use crate::relax::{best_on_shape, cost};
-use crate::rng::Rng;
+use cutroute_geometry::SplitMix64;
 
 /// The start pseudo-node.
 pub(crate) const START: i64 = -1;
@@ -119,7 +119,7 @@ pub(crate) struct Search {
     pub total: f64,
     pub queue: VecDeque<u32>,
     queued: Vec<bool>,
-    pub rng: Rng,
+    pub rng: SplitMix64,
     recording: bool,
     saved_pts: Vec<(u32, V)>,
     saved_slice: Vec<u32>,
@@ -170,7 +170,8 @@ impl Search {
             total: 0.0,
             queue: VecDeque::new(),
             queued: vec![false; k],
-            rng: Rng::new(seed),
+            // CCP-Relax has always started its stream one golden-ratio step off the seed.
+            rng: SplitMix64::new(seed ^ 0x9E37_79B9_7F4A_7C15),
             recording: false,
             saved_pts: Vec::new(),
             saved_slice: Vec::new(),
@@ -1118,25 +1119,25 @@ impl Search {
             return None;
         }
         let width = hi - lo + 1;
-        let a = lo + self.rng.below(width);
-        let b = lo + self.rng.below(width);
+        let a = lo + self.rng.index_below(width);
+        let b = lo + self.rng.index_below(width);
         let (x, y) = (a.min(b), a.max(b));
         if x == y {
             return None;
         }
-        Some(match self.rng.below(3) {
+        Some(match self.rng.index_below(3) {
             0 => Move::Reverse { i: x, j: y },
             1 => {
-                let len = 1 + self.rng.below(3).min(y - x - 1);
+                let len = 1 + self.rng.index_below(3).min(y - x - 1);
                 Move::Relocate {
                     i: x,
                     j: x + len - 1,
                     k: y as isize,
-                    rev: self.rng.below(2) == 1,
+                    rev: self.rng.index_below(2) == 1,
                 }
             }
             _ => {
-                let l1 = 1 + self.rng.below(2);
+                let l1 = 1 + self.rng.index_below(2);
                 if x + l1 + 1 > y {
                     return None;
                 }
@@ -1193,7 +1194,7 @@ mod tests {
             // A random order and arbitrary pierce points (first vertices).
             let mut order: Vec<u32> = (0..n as u32).collect();
             for i in (1..n).rev() {
-                let j = s.rng.below(i + 1);
+                let j = s.rng.index_below(i + 1);
                 order.swap(i, j);
             }
             s.order = order;
@@ -1201,7 +1202,7 @@ mod tests {
             s.reindex(0, n);
             s.total = s.recompute_total();
             for _ in 0..3000 {
-                let i = s.rng.below(n);
+                let i = s.rng.index_below(n);
                 let before = s.total;
                 s.relax_at(i);
                 assert!(s.total <= before + 1e-12);

@@ -481,10 +481,10 @@ impl CcpSolver {
         }
         if self.strength == self.options.max_shake_strength && n >= 8 {
             // The strongest shake exchanges two blocks anywhere in the order (a double bridge).
-            let len1 = 1 + self.search.rng.below(3);
-            let len2 = 1 + self.search.rng.below(3);
-            let i = self.search.rng.below(n - len1 - len2 - 1);
-            let k = i + len1 + 1 + self.search.rng.below(n - i - len1 - len2);
+            let len1 = 1 + self.search.rng.index_below(3);
+            let len2 = 1 + self.search.rng.index_below(3);
+            let i = self.search.rng.index_below(n - len1 - len2 - 1);
+            let k = i + len1 + 1 + self.search.rng.index_below(n - i - len1 - len2);
             let m = Move::Exchange {
                 i,
                 j: i + len1 - 1,
@@ -494,7 +494,7 @@ impl CcpSolver {
             self.search.force_move(&m);
             return;
         }
-        let centre = self.search.rng.below(n);
+        let centre = self.search.rng.index_below(n);
         let span = 8 + 4 * self.strength;
         for _ in 0..self.strength {
             if let Some(m) = self.search.random_move(centre, span) {

@@ -74,6 +74,7 @@ mod forest;
 mod generator;
 mod path_route;
 mod point;
+mod rng;
 mod route;
 mod span;
 mod toolpath;
@@ -85,8 +86,9 @@ pub use contour::{
     ClosureError, ContourError, ContourPosition, ContourProjection, SelfIntersection,
 };
 pub use forest::ContainmentForest;
-pub use generator::{generate_nest, SplitMix64};
+pub use generator::generate_nest;
 pub use path_route::{PathRoute, PathRouteError, ToolOnPath};
+pub use rng::{SplitMix64, Xoshiro256};
 pub use route::{
     in_scrap_region, is_scrap_region, ContourRef, CutStep, Entry, MachineParameters, Objective,
     Route, RouteError,
