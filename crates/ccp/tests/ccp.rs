@@ -292,10 +292,7 @@ fn permute(v: &mut Vec<usize>, k: usize, f: &mut dyn FnMut(&[usize])) {
 }
 
 fn read_nest(path: &str) -> Nest {
-    let full = format!(
-        "{}/../../data/nests/{path}",
-        env!("CARGO_MANIFEST_DIR")
-    );
+    let full = format!("{}/../../data/nests/{path}", env!("CARGO_MANIFEST_DIR"));
     let bytes = std::fs::read(&full).unwrap_or_else(|e| panic!("missing test file {full}: {e}"));
     cutroute_formats::read_nest(&bytes).unwrap_or_else(|e| panic!("cannot read {full}: {e}"))
 }
@@ -351,10 +348,7 @@ fn empty_and_single_contour_nests() {
 
 /// A T-FLEX nesting project's first sheet, oriented as the app reads it.
 fn read_tflex(path: &str) -> Nest {
-    let full = format!(
-        "{}/../../data/nests/{path}",
-        env!("CARGO_MANIFEST_DIR")
-    );
+    let full = format!("{}/../../data/nests/{path}", env!("CARGO_MANIFEST_DIR"));
     let bytes = std::fs::read(&full).unwrap_or_else(|e| panic!("missing test file {full}: {e}"));
     let mut project = cutroute_cad::tflex::read_tfnesting_project(&bytes)
         .unwrap_or_else(|e| panic!("cannot read {full}: {e}"));
