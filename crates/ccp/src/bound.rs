@@ -71,7 +71,8 @@ pub struct LowerBoundOptions {
     pub start: Point,
     /// Where it ends with an idle move (`None`: open route, it ends at its last cut).
     pub finish: Option<Point>,
-    /// Pieces per kept contour in the first stage.
+    /// Pieces in the first stage, shared among the kept contours by perimeter (at least 2
+    /// each).
     pub initial_pieces: usize,
     /// Refinement stops adding pieces at this many PCGTSP nodes (the cost matrix is dense).
     pub max_nodes: usize,
@@ -79,6 +80,9 @@ pub struct LowerBoundOptions {
     pub memory_limit_bytes: usize,
     /// Time share of the first stage's exact search; each later stage gets twice the previous.
     pub first_stage: Duration,
+    /// Seconds the whole computation is expected to run: the exact solver sizes its bounds'
+    /// work for it (the lattice of ideals is built only when there is time for it).
+    pub budget_seconds: f64,
 }
 
 impl Default for LowerBoundOptions {
@@ -86,10 +90,11 @@ impl Default for LowerBoundOptions {
         LowerBoundOptions {
             start: Point::new(0.0, 0.0),
             finish: None,
-            initial_pieces: 4,
+            initial_pieces: 400,
             max_nodes: 2500,
             memory_limit_bytes: 256 << 20,
             first_stage: Duration::from_millis(500),
+            budget_seconds: 10.0,
         }
     }
 }
@@ -275,16 +280,16 @@ impl CcpLowerBound {
             .enumerate()
             .map(|(i, l)| (l.contour_ref, i))
             .collect();
-        let per = options
-            .initial_pieces
-            .min((options.max_nodes - 1) / leaves.len().max(1))
-            .max(1);
+        let total: f64 = leaves.iter().map(Leaf::perimeter).sum();
+        let budget = options.initial_pieces.min(options.max_nodes - 1) as f64;
         let pieces = leaves
             .iter()
             .map(|l| {
                 let p = l.perimeter();
-                (0..per)
-                    .map(|k| (p * k as f64 / per as f64, p * (k + 1) as f64 / per as f64))
+                let share = if total > 0.0 { budget * p / total } else { 1.0 };
+                let n = (share.round() as usize).max(2);
+                (0..n)
+                    .map(|k| (p * k as f64 / n as f64, p * (k + 1) as f64 / n as f64))
                     .collect()
             })
             .collect();
@@ -389,7 +394,21 @@ impl CcpLowerBound {
                         return true;
                     }
                     self.stages_done += 1;
-                    let tour = s.solver.progress().best_tour;
+                    let progress = s.solver.progress();
+                    debug_log(|| {
+                        format!(
+                            "stage {} ({} nodes, {:.2} s of {:.2} s): relaxed lb {:.3} ub {:.3}, best {:.3}, incumbent {:.3}",
+                            self.stages_done,
+                            s.instance.node_count,
+                            s.spent.as_secs_f64(),
+                            s.share.as_secs_f64(),
+                            progress.lower_bound,
+                            progress.upper_bound,
+                            self.best,
+                            self.incumbent_length
+                        )
+                    });
+                    let tour = progress.best_tour;
                     // With no piece left to split, the next stage reruns the same pieces
                     // with twice the time.
                     self.refine(&s.node_piece, tour.as_deref());
@@ -492,7 +511,7 @@ impl CcpLowerBound {
         let share = self.options.first_stage * (1u32 << self.stages_done.min(16));
         let options = ExactOptions {
             time_limit: Some(share),
-            budget_seconds: Some(share.as_secs_f64()),
+            budget_seconds: Some(self.options.budget_seconds.max(share.as_secs_f64())),
             memory_limit_bytes: self.options.memory_limit_bytes,
             heuristic: false,
             ..ExactOptions::default()
@@ -552,15 +571,22 @@ impl CcpLowerBound {
         status != SolverStatus::Running || s.spent >= s.share
     }
 
-    /// Halves the pieces of the relaxed tour and those holding the incumbent's pierce points;
-    /// false when no piece can be split any more.
+    /// Splits the pieces of the relaxed tour and those holding the incumbent's pierce points
+    /// in four, and halves their neighbours along the contour (the next relaxed optimum tends
+    /// to move next door); false when no piece could be split (node limit or tiny pieces).
     fn refine(&mut self, node_piece: &[(usize, usize)], tour: Option<&[usize]>) -> bool {
-        let mut marked: Vec<Vec<bool>> = self.pieces.iter().map(|p| vec![false; p.len()]).collect();
+        // Parts per piece: 1 keeps it, 2 halves it, 4 quarters it.
+        let mut parts: Vec<Vec<usize>> = self.pieces.iter().map(|p| vec![1; p.len()]).collect();
+        let mut mark = |leaf: usize, k: usize, pieces: &[(f64, f64)]| {
+            let n = pieces.len();
+            parts[leaf][k] = 4;
+            for j in [(k + n - 1) % n, (k + 1) % n] {
+                parts[leaf][j] = parts[leaf][j].max(2);
+            }
+        };
         for &v in tour.unwrap_or(&[]) {
-            if v >= 1 {
-                if let Some(&(leaf, k)) = node_piece.get(v - 1) {
-                    marked[leaf][k] = true;
-                }
+            if let Some(&(leaf, k)) = v.checked_sub(1).and_then(|i| node_piece.get(i)) {
+                mark(leaf, k, &self.pieces[leaf]);
             }
         }
         for &(leaf, s) in &self.incumbent {
@@ -568,20 +594,29 @@ impl CcpLowerBound {
                 .iter()
                 .position(|&(a, b)| a <= s && s <= b)
             {
-                marked[leaf][k] = true;
+                mark(leaf, k, &self.pieces[leaf]);
             }
         }
         let mut nodes = self.node_count();
         let mut split_any = false;
         for (leaf, pieces) in self.pieces.iter_mut().enumerate() {
             let min_length = 1e-6 * (1.0 + self.leaves[leaf].perimeter());
-            let mut out = Vec::with_capacity(pieces.len() + 2);
+            let mut out = Vec::with_capacity(pieces.len() + 8);
             for (k, &(a, b)) in pieces.iter().enumerate() {
-                if marked[leaf][k] && b - a > min_length && nodes < self.options.max_nodes {
-                    let m = 0.5 * (a + b);
-                    out.push((a, m));
-                    out.push((m, b));
-                    nodes += 1;
+                let n = parts[leaf][k];
+                if n > 1 && b - a > n as f64 * min_length && nodes + n - 1 <= self.options.max_nodes
+                {
+                    out.extend((0..n).map(|i| {
+                        (
+                            a + (b - a) * i as f64 / n as f64,
+                            if i + 1 == n {
+                                b
+                            } else {
+                                a + (b - a) * (i + 1) as f64 / n as f64
+                            },
+                        )
+                    }));
+                    nodes += n - 1;
                     split_any = true;
                 } else {
                     out.push((a, b));
@@ -590,5 +625,12 @@ impl CcpLowerBound {
             *pieces = out;
         }
         split_any
+    }
+}
+
+/// Per-stage numbers on stderr when `CCP_BOUND_DEBUG` is set (benchmark diagnostics).
+fn debug_log(message: impl FnOnce() -> String) {
+    if std::env::var_os("CCP_BOUND_DEBUG").is_some() {
+        eprintln!("[ccp bound] {}", message());
     }
 }

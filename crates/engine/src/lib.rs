@@ -154,6 +154,11 @@ pub fn start_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
                 cutroute_ccp::LowerBoundOptions {
                     start: *start,
                     finish: *finish,
+                    budget_seconds: time_limit.as_secs_f64(),
+                    first_stage: (time_limit / 10).clamp(
+                        web_time::Duration::from_millis(500),
+                        web_time::Duration::from_secs(5),
+                    ),
                     ..Default::default()
                 },
             )
