@@ -514,6 +514,8 @@ impl CcpLowerBound {
             budget_seconds: Some(self.options.budget_seconds.max(share.as_secs_f64())),
             memory_limit_bytes: self.options.memory_limit_bytes,
             heuristic: false,
+            penalty_iterations: 0,
+            position_iterations: 0,
             ..ExactOptions::default()
         };
         let solver = ExactSolver::new(&instance, options).ok()?;
