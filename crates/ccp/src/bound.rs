@@ -334,6 +334,15 @@ impl CcpLowerBound {
         1 + self.pieces.iter().map(Vec::len).sum::<usize>()
     }
 
+    /// The relaxed PCGTSP instance of the stage under way, once built (for inspection and
+    /// experiments with other bounds on it).
+    pub fn relaxed_instance(&self) -> Option<&Instance> {
+        match &self.stage {
+            Some(Stage::Solving(s)) => Some(&s.instance),
+            _ => None,
+        }
+    }
+
     /// Time spent in `step` so far.
     pub fn elapsed(&self) -> Duration {
         self.elapsed
