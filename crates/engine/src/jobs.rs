@@ -72,6 +72,11 @@ impl Job for CcpJob {
         } else {
             budget
         };
+        if self.bound.is_some() && self.started.elapsed() >= self.time_limit {
+            // The solver counts only its own share of the slices: the job's limit is wall
+            // time, so end the VNS here (its best route stays).
+            self.solver.cancel();
+        }
         if !self.solver_done {
             self.solver_done = self.solver.step(share) == cutroute_ccp::SolverStatus::Finished;
         }
