@@ -108,6 +108,28 @@ test('the theme switch restyles the page and survives a reload', async () => {
   }
 });
 
+test('ccp on nested.dbs reports a certified lower bound: the chart draws both bounds, the stats the gap', async () => {
+  const page = await app.browser.newPage({ viewport: { width: 1280, height: 800 } });
+  const errors = watchErrors(page);
+  await page.goto(app.baseUrl);
+  await fileShown(page, 'E1X_6_01');
+  await page.selectOption('#sample', 'nested.dbs');
+  await fileShown(page, 'nested.dbs');
+  await page.selectOption('#solver', 'ccp');
+  await page.fill('#time-limit', '6');
+  await page.dispatchEvent('#time-limit', 'change');
+  await page.click('#start');
+  await page.waitForFunction(() => ['finished', 'cancelled'].includes(document.querySelector('#job-status')?.textContent),
+    null, { timeout: 60000 });
+  const upper = Number(await page.locator('#upper-bound').textContent());
+  const lower = Number(await page.locator('#lower-bound').textContent());
+  assert.ok(lower > 0 && lower <= upper + 1e-6, `0 < LB ${lower} <= UB ${upper}`);
+  assert.match(await page.locator('#gap').textContent(), /^\d+\.\d\d %$/);
+  assert.ok((await page.locator('.chart-ub').getAttribute('d')).startsWith('M'), 'upper bound drawn');
+  assert.ok((await page.locator('.chart-lb').getAttribute('d')).startsWith('M'), 'lower bound drawn');
+  assert.deepEqual(errors, []);
+});
+
 test('the exact solver reports both bounds and the chart draws them', async () => {
   const page = await app.browser.newPage({ viewport: { width: 1280, height: 800 } });
   const errors = watchErrors(page);
