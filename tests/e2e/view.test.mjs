@@ -136,3 +136,32 @@ test('the exact solver proves the optimum of E1X_6_01, and the chart draws both 
   await screenshot(page, 'exact-bounds.png');
   assert.deepEqual(errors, []);
 });
+
+test('ccp on nested.dbs reports a certified lower bound: the chart draws both bounds, the stats the gap', async () => {
+  const page = await app.browser.newPage({ viewport: { width: 1280, height: 800 } });
+  const errors = watchErrors(page);
+  await page.goto(app.baseUrl);
+  await fileShown(page, 'E1X_6_01');
+  await page.selectOption('#sample', 'nested.dbs');
+  await fileShown(page, 'nested.dbs');
+  await page.selectOption('#solver', 'ccp');
+  await page.fill('#time-limit', '6');
+  await page.dispatchEvent('#time-limit', 'change');
+  await page.click('#start');
+  await page.waitForFunction(() => /^(finished|cancelled|failed)/.test(document.querySelector('#job-status')?.textContent ?? ''),
+    null, { timeout: 60000 });
+  assert.equal(await page.locator('#job-status').textContent(), 'finished');
+  const upper = Number(await page.locator('#upper-bound').textContent());
+  const lower = Number(await page.locator('#lower-bound').textContent());
+  // Sound: never above the route shown, nor above the best route the CLI's ccp finds.
+  const oracle = cli('solve', 'data/nests/dbs/nested.dbs', '--solver', 'ccp', '--time-limit', '3', '--json');
+  assert.ok(lower > 0 && lower <= upper + 0.05 && lower <= oracle.idle_length + 0.05,
+    `0 < LB ${lower} <= UB ${upper} and <= the CLI's route ${oracle.idle_length}`);
+  // The upper bound is the route's idle length, and the gap is the one the two bounds make.
+  assertRounded(upper, Number(await page.getAttribute('#idle-length', 'data-mm')), 1, 'UB is the route shown');
+  // (from the rounded bounds: within a tenth of a percent)
+  assertRounded(await page.locator('#gap').textContent(), ((upper - lower) / upper) * 100, 1, 'gap');
+  assert.ok((await page.locator('.chart-ub').getAttribute('d')).startsWith('M'), 'upper bound drawn');
+  assert.ok((await page.locator('.chart-lb').getAttribute('d')).startsWith('M'), 'lower bound drawn');
+  assert.deepEqual(errors, []);
+});

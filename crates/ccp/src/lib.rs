@@ -78,6 +78,7 @@
 //! queries (module `problem`) is the solver's own.
 #![deny(missing_docs)]
 
+mod bound;
 mod discrete;
 mod geom;
 mod problem;
@@ -86,6 +87,7 @@ mod route;
 mod search;
 mod solver;
 
+pub use bound::{CcpLowerBound, LowerBoundOptions};
 pub use discrete::{build_pcgtsp, DiscreteInstance, DiscreteNode, DiscretisationOptions};
 pub use route::{idle_length, route_certificates, route_metrics, ContourCertificate, RouteMetrics};
 pub use solver::{

@@ -1,7 +1,7 @@
 //! The solver jobs: each wraps one resumable solver (or two that cooperate) behind [`Job`].
 
 use cutroute_alns::{AlnsOptions, AlnsSolver};
-use cutroute_ccp::{CcpOptions, CcpSolver, DiscreteInstance};
+use cutroute_ccp::{CcpLowerBound, CcpOptions, CcpSolver, DiscreteInstance};
 use cutroute_chains::{ChainOptions, Chained, Chaining};
 use cutroute_geometry::{MachineParameters, Nest, Route};
 use cutroute_pcgtsp::{ExactOptions, ExactSolver, Instance};
@@ -10,10 +10,22 @@ use web_time::{Duration, Instant};
 
 use crate::{Job, JobStatus};
 
-/// CCP-Relax on a nest.
+/// CCP-Relax on a nest, and beside it (when given) the certified lower bound of the interval
+/// relaxation (`cutroute_ccp::CcpLowerBound`), each slice shared half and half; the bound
+/// learns every improved route (its pierce points guide the refinement). When the VNS ends
+/// before the time limit, the bound gets the rest of it; the job ends early when the bound
+/// meets the route.
 pub struct CcpJob {
     job_id: JobId,
     solver: CcpSolver,
+    solver_done: bool,
+    bound: Option<CcpLowerBound>,
+    /// Whether the bound may still improve (false once it has nothing left to do).
+    bound_running: bool,
+    /// The whole job's limit, for the bound's running on alone.
+    time_limit: Duration,
+    offered_length: f64,
+    started: Instant,
     done: bool,
 }
 
@@ -23,18 +35,73 @@ impl CcpJob {
         Self {
             job_id,
             solver,
+            solver_done: false,
+            bound: None,
+            bound_running: false,
+            time_limit: Duration::ZERO,
+            offered_length: f64::INFINITY,
+            started: Instant::now(),
             done: false,
         }
+    }
+
+    /// Adds the lower bound of the same nest, start and finish, computed until `time_limit`
+    /// (the solver's own limit) from now.
+    pub fn with_lower_bound(mut self, bound: CcpLowerBound, time_limit: Duration) -> Self {
+        self.bound = Some(bound);
+        self.bound_running = true;
+        self.time_limit = time_limit;
+        self.started = Instant::now();
+        self
+    }
+
+    /// The bound is within `relative` of the best route offered to it.
+    fn bound_within(&self, relative: f64) -> bool {
+        let lb = self.bound.as_ref().map_or(0.0, |b| b.lower_bound());
+        lb > 0.0 && lb >= self.offered_length * (1.0 - relative)
     }
 }
 
 impl Job for CcpJob {
     fn step(&mut self, budget: Duration) -> JobStatus {
-        if self.done || self.solver.step(budget) == cutroute_ccp::SolverStatus::Finished {
-            self.done = true;
+        if self.done {
             return JobStatus::Done;
         }
-        JobStatus::Running
+        let share = if self.bound_running && !self.solver_done {
+            budget / 2
+        } else {
+            budget
+        };
+        if self.bound.is_some() && self.started.elapsed() >= self.time_limit {
+            // The solver counts only its own share of the slices: the job's limit is wall
+            // time, so end the VNS here (its best route stays).
+            self.solver.cancel();
+        }
+        if !self.solver_done {
+            self.solver_done = self.solver.step(share) == cutroute_ccp::SolverStatus::Finished;
+        }
+        if let Some(bound) = self.bound.as_mut().filter(|_| self.bound_running) {
+            let state = self.solver.progress();
+            if !state.route.steps.is_empty() && state.best_idle_length < self.offered_length {
+                self.offered_length = state.best_idle_length;
+                bound.offer_route(&state.route);
+            }
+            let left = self.time_limit.saturating_sub(self.started.elapsed());
+            let slice = if self.solver_done {
+                budget
+            } else {
+                budget - share
+            };
+            self.bound_running = !left.is_zero() && bound.step(slice.min(left));
+        }
+        // Within 10⁻⁶ nothing a user can see is left to prove (the distances carry a 10⁻⁹
+        // margin): stop rather than refine pieces for the last micrometres.
+        self.done = (self.solver_done && !self.bound_running) || self.bound_within(1e-6);
+        if self.done {
+            JobStatus::Done
+        } else {
+            JobStatus::Running
+        }
     }
 
     fn progress(&self) -> Progress {
@@ -59,13 +126,17 @@ impl Job for CcpJob {
         };
         Progress {
             job_id: self.job_id,
-            elapsed_s: state.elapsed.as_secs_f64(),
+            elapsed_s: if self.bound.is_some() {
+                self.started.elapsed().as_secs_f64()
+            } else {
+                state.elapsed.as_secs_f64()
+            },
             upper_bound: has_route.then_some(state.best_idle_length),
-            lower_bound: None,
+            lower_bound: self.bound.as_ref().map(|b| b.lower_bound()),
             phase: format!("{:?}", state.phase).to_lowercase(),
             route: has_route.then_some(state.route),
             tour: None,
-            proven_optimal: false,
+            proven_optimal: has_route && self.bound_within(1e-9),
             states: None,
             certified,
             path_route: None,
@@ -318,6 +389,8 @@ impl Job for ChainJob {
             let r = &chained.report;
             progress.elapsed_s = self.started.elapsed().as_secs_f64();
             progress.upper_bound = Some(chained.route.idle_length());
+            // Links are tool-on travel: no bound on standard cutting's idle length holds here.
+            progress.lower_bound = None;
             progress.phase = format!(
                 "chained: {} of {} pierces saved, {} chains, cost {:.2} → {:.2}",
                 r.pierces_before - r.pierces_after,

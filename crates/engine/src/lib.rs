@@ -153,7 +153,23 @@ pub fn start_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
                     params.machine,
                 )));
             }
-            Ok(Box::new(CcpJob::new(request.job_id, ccp)))
+            let bound = cutroute_ccp::CcpLowerBound::new(
+                nest,
+                cutroute_ccp::LowerBoundOptions {
+                    start: *start,
+                    finish: *finish,
+                    budget_seconds: time_limit.as_secs_f64(),
+                    first_stage: (time_limit / 10).clamp(
+                        web_time::Duration::from_millis(500),
+                        web_time::Duration::from_secs(5),
+                    ),
+                    ..Default::default()
+                },
+            )
+            .map_err(|e| refused(e.to_string()))?;
+            Ok(Box::new(
+                CcpJob::new(request.job_id, ccp).with_lower_bound(bound, time_limit),
+            ))
         }
         (Problem::Nest { .. }, SolverKind::Sccp | SolverKind::Gsccp) => {
             Ok(Box::new(SegmentJob::from_request(request)?))

@@ -70,6 +70,12 @@ fn every_nest_solver_returns_a_valid_route() {
             "{file}: CCP {ccp_idle} should beat nearest neighbour {nearest_idle}"
         );
         assert_eq!(ccp.certified.len(), ccp.route.as_ref().unwrap().steps.len());
+        // The interval relaxation's bound on the same objective (idle mm), below the route.
+        let lb = ccp.lower_bound.expect("CCP reports a lower bound");
+        assert!(
+            lb > 0.0 && lb <= ccp_idle,
+            "{file}: bound {lb} vs route {ccp_idle}"
+        );
     }
 }
 

@@ -108,6 +108,22 @@ impl BoundingBox {
         !other.is_empty() && self.contains_point(other.min) && self.contains_point(other.max)
     }
 
+    /// The least distance between a point of this box and a point of `other` (0 when they
+    /// overlap; infinite when either is empty): a lower bound on the distance between any
+    /// shapes they contain.
+    pub fn distance_to_box(&self, other: &BoundingBox) -> f64 {
+        if self.is_empty() || other.is_empty() {
+            return f64::INFINITY;
+        }
+        let dx = (other.min.x - self.max.x)
+            .max(self.min.x - other.max.x)
+            .max(0.0);
+        let dy = (other.min.y - self.max.y)
+            .max(self.min.y - other.max.y)
+            .max(0.0);
+        dx.hypot(dy)
+    }
+
     /// The closed boxes share at least one point.
     pub fn intersects(&self, other: &BoundingBox) -> bool {
         self.min.x <= other.max.x

@@ -131,6 +131,28 @@ proptest! {
     }
 
     #[test]
+    fn distance_between_spans_is_the_least_over_samples(
+        s in span(),
+        o in span(),
+        shift in prop_oneof![Just(Point::new(0.0, 0.0)), point(), point().prop_map(|p| p * 3.0)],
+    ) {
+        let o = Span::new(o.start + shift, o.end + shift, o.bulge);
+        let d = s.distance_to_span(&o);
+        prop_assert!((d - o.distance_to_span(&s)).abs() <= 1e-7 * (1.0 + d));
+        // Never above any sampled pair (it is a true distance between points of the spans) …
+        let (ps, po) = (samples(&s, 600), samples(&o, 600));
+        let sampled = ps
+            .iter()
+            .map(|p| o.distance_to(*p))
+            .chain(po.iter().map(|p| s.distance_to(*p)))
+            .fold(f64::INFINITY, f64::min);
+        prop_assert!(d <= sampled + 1e-7 * (1.0 + sampled), "{} above sampled {}", d, sampled);
+        // … and never below the sampled minimum by more than the sampling step allows.
+        let step = s.length().max(o.length()) / 600.0;
+        prop_assert!(d >= sampled - step - 1e-7, "{} far below sampled {}", d, sampled);
+    }
+
+    #[test]
     fn span_bounding_box_is_exact(s in span()) {
         let b = s.bounding_box();
         let pts = samples(&s, 4000);

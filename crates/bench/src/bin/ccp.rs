@@ -230,6 +230,92 @@ fn discrete(
     Some((route.idle_length(), inst.instance.node_count))
 }
 
+/// The nests of the `--bound` table: every real multi-contour nest of at most 100 contours
+/// (then Nest02 and Nest03, 460 contours, with their own budget).
+const BOUND_NESTS: [(&str, &str); 13] = [
+    ("nested.dbs", "dbs/nested.dbs"),
+    ("seven.dbs", "dbs/seven.dbs"),
+    ("test0", "dbs-json/test0.dbs.json"),
+    ("test1", "dbs-json/test1.dbs.json"),
+    ("E1X_6_01", "dbs-json/E1X_6_01.dbs.json"),
+    ("propeller.dxf", "dxf/propeller.dxf"),
+    ("cross.dxf", "dxf/cross.dxf"),
+    ("planka.dxf", "dxf/planka.dxf"),
+    ("kompas.dxf", "dxf/kompas.dxf"),
+    ("f26.dxf", "dxf/f26.dxf"),
+    ("cone.dxf", "dxf/cone.dxf"),
+    ("Nest02", "tflex/Nest02.tfnesting"),
+    ("Nest03", "tflex/Nest03.tfnesting"),
+];
+
+/// `--bound [S] [S_BIG]`: the engine's CCP job (the CLI's and the app's code path: CCP-Relax
+/// and the interval relaxation's lower bound sharing each slice) on every nest of
+/// `BOUND_NESTS`, `S` seconds for nests of at most 100 contours, `S_BIG` for larger ones;
+/// open routes from the origin. Prints UB, LB, gap, the small nests' k!-orders bound and
+/// the wall time.
+fn print_bound_table(small_seconds: f64, big_seconds: f64, only: Option<&String>) {
+    use cutroute_protocol::{JobRequest, SolverKind, SolverParams};
+    println!("| nest | contours | kept | time limit s | UB (CCP idle) | LB | gap | k!-orders bound | wall s | longest slice s |");
+    println!("|---|---|---|---|---|---|---|---|---|---|");
+    for (name, path) in BOUND_NESTS {
+        if only.is_some_and(|o| o != name) {
+            continue;
+        }
+        let nest = read(path);
+        let contours = nest.contour_count();
+        if contours < 2 {
+            continue;
+        }
+        let seconds = if contours <= 100 {
+            small_seconds
+        } else {
+            big_seconds
+        };
+        let request = JobRequest {
+            job_id: 1,
+            problem: cutroute_protocol::Problem::Nest {
+                nest: nest.clone(),
+                start: Point::new(0.0, 0.0),
+                finish: None,
+            },
+            solver: SolverKind::Ccp,
+            params: SolverParams {
+                time_limit_s: seconds,
+                ..SolverParams::default()
+            },
+        };
+        let t = Instant::now();
+        let mut job = cutroute_engine::start_job(&request).expect("a CCP job");
+        // The engine's loop, timing each slice (Stop is answered between slices).
+        let mut longest = Duration::ZERO;
+        loop {
+            let slice = Instant::now();
+            let status = job.step(cutroute_engine::DEFAULT_SLICE);
+            longest = longest.max(slice.elapsed());
+            if status == cutroute_engine::JobStatus::Done {
+                break;
+            }
+        }
+        let progress = job.progress();
+        let wall = t.elapsed().as_secs_f64();
+        let route = progress.route.as_ref().expect("a route");
+        assert!(route.validate(&nest, 1e-6).is_ok(), "invalid CCP route");
+        let (ub, lb) = (
+            progress.upper_bound.unwrap_or(f64::NAN),
+            progress.lower_bound.unwrap_or(f64::NAN),
+        );
+        assert!(lb <= ub + 1e-6, "{name}: bound {lb} above the route {ub}");
+        let exact = small_nest_lower_bound(&nest, Point::new(0.0, 0.0), 6)
+            .map_or("—".to_string(), |(b, _)| format!("{b:.1}"));
+        println!(
+            "| {name} | {contours} | {} | {seconds:.0} | {ub:.1} | {lb:.1} | {:.2} % | {exact} | {wall:.1} | {:.2} |",
+            nest.containment_forest().leaves().len(),
+            100.0 * (ub - lb) / ub,
+            longest.as_secs_f64(),
+        );
+    }
+}
+
 /// Every multi-contour nest of data/nests: (name, path).
 const REAL: [(&str, &str); 13] = [
     ("nested.dbs", "dbs/nested.dbs"),
@@ -347,6 +433,19 @@ fn main() {
         return;
     }
     let real = REAL;
+    if let Some(i) = args.iter().position(|a| a == "--bound") {
+        let seconds = |at: usize, default: f64| {
+            args.get(at)
+                .and_then(|s| s.parse::<f64>().ok())
+                .unwrap_or(default)
+        };
+        let only = args
+            .iter()
+            .position(|a| a == "--only")
+            .and_then(|i| args.get(i + 1));
+        print_bound_table(seconds(i + 1, 60.0), seconds(i + 2, 120.0), only);
+        return;
+    }
     if args.iter().any(|a| a == "--lower-bounds") {
         let mut rows = Vec::new();
         for (name, path) in real {

@@ -1,0 +1,647 @@
+//! A certified lower bound on the idle length of continuous cutting (CCP): the *interval
+//! relaxation*, solved by `cutroute-pcgtsp`'s exact machinery and refined adaptively.
+//!
+//! Why it is sound, step by step (the objective is the route's idle length: start → pierce
+//! points in order → finish if any, as [`crate::idle_length`] measures it):
+//!
+//! 1. **Only the innermost contours** (the leaves of the containment forest) are kept. Removing
+//!    the other pierce points from a route's air polyline can only shorten it (triangle
+//!    inequality). After the last kept contour the route still has to reach the outermost
+//!    contour around it (holes before their outer contour), and the finish: that tail costs at
+//!    least `max(d(piece, finish), d(piece, outermost) + d(outermost, finish))`, or
+//!    `d(piece, outermost)` on an open route. Leaves have no precedence among themselves. (The
+//!    relaxation loses nothing here: CCP-Relax restores outer contours at the route's last
+//!    crossing with them at no extra length.)
+//! 2. **Pieces**: each kept contour is split into arcs of the contour (intervals of arc
+//!    length). A pierce point lies in one piece, and the tool enters and leaves the contour
+//!    there, so charging each idle move by the least distance between the piece it leaves and
+//!    the piece it enters ([`Span::distance_to_span`]) can only undercount. That is a PCGTSP
+//!    (clusters = kept contours, nodes = pieces, depot = the start point, the return arc = the
+//!    tail above) whose optimum is at most the continuous optimum, for any pieces.
+//! 3. Any proven lower bound of that PCGTSP (`ExactSolver::progress().lower_bound`: assignment,
+//!    Lagrangian, position and lattice bounds, the DP over ideals) is therefore a lower bound
+//!    for the continuous problem. Each arc cost is lowered by a tiny margin so that rounding
+//!    in the distance computations cannot lift it above the true set distance.
+//!
+//! **Refinement.** A stage builds the instance (row by row, in slices), then runs the exact
+//! solver for a doubling time share. Then the pieces holding the best route's pierce points and
+//! the pieces of the relaxed tour are halved, and the next stage starts. Finer pieces only raise
+//! the relaxed optimum; the reported bound is the best over all stages.
+//!
+//! ```
+//! use cutroute_ccp::{CcpLowerBound, LowerBoundOptions};
+//! use cutroute_geometry::{Contour, Nest, Part, Point, Vertex};
+//! use web_time::Duration;
+//!
+//! let square = |x: f64| Part {
+//!     name: format!("square at {x}"),
+//!     contours: vec![Contour::new(vec![
+//!         Vertex::line(x, 0.0),
+//!         Vertex::line(x, 10.0),
+//!         Vertex::line(x + 10.0, 10.0),
+//!         Vertex::line(x + 10.0, 0.0),
+//!     ])],
+//! };
+//! let nest = Nest { sheet: None, parts: vec![square(40.0), square(0.0), square(20.0)] };
+//! let options = LowerBoundOptions { start: Point::new(-10.0, 5.0), ..Default::default() };
+//! let mut bound = CcpLowerBound::new(&nest, options).unwrap();
+//! while bound.step(Duration::from_millis(50)) && bound.stages() < 4 {}
+//! // The best route is 50 mm (the straight line through the squares); the bound is below it.
+//! assert!(bound.lower_bound() <= 50.0 + 1e-9);
+//! assert!(bound.lower_bound() >= 49.0);
+//! ```
+
+use std::collections::HashMap;
+
+use cutroute_geometry::{BoundingBox, Contour, ContourRef, Nest, Point, Route, Span};
+use cutroute_pcgtsp::{ExactOptions, ExactSolver, Instance, SolverStatus};
+use web_time::{Duration, Instant};
+
+use crate::CcpError;
+
+/// How much each relaxed arc cost is lowered so that rounding in the distance maths (true
+/// distances between computed points, at most a few ulps above the exact set distance) can
+/// never lift it above the true value; relative to the nest's size.
+const COST_MARGIN: f64 = 1e-9;
+
+/// Settings of [`CcpLowerBound`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct LowerBoundOptions {
+    /// Where the route starts.
+    pub start: Point,
+    /// Where it ends with an idle move (`None`: open route, it ends at its last cut).
+    pub finish: Option<Point>,
+    /// Pieces in the first stage, shared among the kept contours by perimeter (at least 2
+    /// each).
+    pub initial_pieces: usize,
+    /// Refinement stops adding pieces at this many PCGTSP nodes (the cost matrix is dense).
+    pub max_nodes: usize,
+    /// Memory the exact solver of a stage may use.
+    pub memory_limit_bytes: usize,
+    /// Time share of the first stage's exact search; each later stage gets twice the previous.
+    pub first_stage: Duration,
+    /// Seconds the whole computation is expected to run: the exact solver sizes its bounds'
+    /// work for it (the lattice of ideals is built only when there is time for it).
+    pub budget_seconds: f64,
+}
+
+impl Default for LowerBoundOptions {
+    fn default() -> Self {
+        LowerBoundOptions {
+            start: Point::new(0.0, 0.0),
+            finish: None,
+            initial_pieces: 400,
+            max_nodes: 2500,
+            memory_limit_bytes: 256 << 20,
+            first_stage: Duration::from_millis(500),
+            budget_seconds: 10.0,
+        }
+    }
+}
+
+/// One kept (innermost) contour.
+struct Leaf {
+    contour_ref: ContourRef,
+    contour: Contour,
+    spans: Vec<Span>,
+    /// Arc length at the start of each span, and the perimeter last.
+    offsets: Vec<f64>,
+    /// Least tail after this contour when it is cut last, per piece (computed with the pieces).
+    outermost: Option<ContourRef>,
+}
+
+impl Leaf {
+    fn perimeter(&self) -> f64 {
+        *self.offsets.last().unwrap_or(&0.0)
+    }
+
+    /// The spans of the piece `[a, b]` of arc length.
+    fn piece_spans(&self, a: f64, b: f64) -> Vec<Span> {
+        let mut out = Vec::new();
+        for (i, span) in self.spans.iter().enumerate() {
+            let (s0, s1) = (self.offsets[i], self.offsets[i + 1]);
+            let len = s1 - s0;
+            if s1 < a || s0 > b {
+                continue;
+            }
+            if len <= 0.0 {
+                out.push(*span);
+                continue;
+            }
+            let t0 = ((a - s0) / len).clamp(0.0, 1.0);
+            let t1 = ((b - s0) / len).clamp(0.0, 1.0);
+            out.push(if t0 == 0.0 && t1 == 1.0 {
+                *span
+            } else {
+                span.sub_span(t0, t1)
+            });
+        }
+        if out.is_empty() {
+            out.push(Span::line(self.spans[0].start, self.spans[0].start));
+        }
+        out
+    }
+
+    /// Arc length of the point of this contour nearest to `p`.
+    fn length_of(&self, p: Point) -> f64 {
+        self.contour
+            .nearest_point(p)
+            .map_or(0.0, |q| self.contour.length_at(q.position))
+    }
+}
+
+/// A piece with its geometry, for distances.
+struct PieceShape {
+    spans: Vec<Span>,
+    boxes: Vec<BoundingBox>,
+    bbox: BoundingBox,
+}
+
+impl PieceShape {
+    fn new(spans: Vec<Span>) -> Self {
+        let boxes: Vec<BoundingBox> = spans.iter().map(|s| s.bounding_box()).collect();
+        let bbox = boxes
+            .iter()
+            .fold(BoundingBox::default(), |acc, b| acc.union(*b));
+        PieceShape { spans, boxes, bbox }
+    }
+
+    fn distance_to_point(&self, p: Point) -> f64 {
+        self.spans
+            .iter()
+            .map(|s| s.distance_to(p))
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// Least distance to another piece (or contour), skipping span pairs whose boxes are
+    /// already farther than the best pair found.
+    fn distance_to(&self, other: &PieceShape) -> f64 {
+        let mut best = f64::INFINITY;
+        for (s, sb) in self.spans.iter().zip(&self.boxes) {
+            if sb.distance_to_box(&other.bbox) >= best {
+                continue;
+            }
+            for (o, ob) in other.spans.iter().zip(&other.boxes) {
+                if sb.distance_to_box(ob) < best {
+                    best = best.min(s.distance_to_span(o));
+                }
+            }
+        }
+        best
+    }
+}
+
+/// A stage's instance under construction (rows of the cost matrix, in slices).
+struct Building {
+    /// Per node (after the depot): (leaf, piece index).
+    node_piece: Vec<(usize, usize)>,
+    shapes: Vec<PieceShape>,
+    cost: Vec<f64>,
+    next_row: usize,
+}
+
+/// A stage's exact search on its instance.
+struct Solving {
+    node_piece: Vec<(usize, usize)>,
+    instance: Instance,
+    solver: ExactSolver,
+    spent: Duration,
+    share: Duration,
+}
+
+enum Stage {
+    Building(Building),
+    Solving(Box<Solving>),
+}
+
+/// The resumable lower-bound computation for one nest (see the module documentation).
+pub struct CcpLowerBound {
+    leaves: Vec<Leaf>,
+    by_ref: HashMap<ContourRef, usize>,
+    outermost_shapes: HashMap<ContourRef, PieceShape>,
+    options: LowerBoundOptions,
+    margin: f64,
+    /// Per leaf: the pieces as sorted, contiguous intervals of arc length covering the contour.
+    pieces: Vec<Vec<(f64, f64)>>,
+    stage: Option<Stage>,
+    stages_done: usize,
+    best: f64,
+    /// The best route's pierce points on kept contours, in route order: (leaf, arc length).
+    incumbent: Vec<(usize, f64)>,
+    incumbent_length: f64,
+    incumbent_offered: bool,
+    elapsed: Duration,
+}
+
+impl CcpLowerBound {
+    /// Prepares the kept contours and the first pieces (no distances computed yet).
+    pub fn new(nest: &Nest, options: LowerBoundOptions) -> Result<CcpLowerBound, CcpError> {
+        let finite = |p: Point| p.x.is_finite() && p.y.is_finite();
+        if !finite(options.start) || options.finish.is_some_and(|f| !finite(f)) {
+            return Err(CcpError::InvalidOption(
+                "start and finish must be finite".into(),
+            ));
+        }
+        if options.initial_pieces == 0 || options.max_nodes < 2 {
+            return Err(CcpError::InvalidOption(
+                "initial_pieces ≥ 1 and max_nodes ≥ 2 are required".into(),
+            ));
+        }
+        let forest = nest.containment_forest();
+        let mut leaves = Vec::new();
+        let mut outermost_shapes = HashMap::new();
+        for r in forest.leaves() {
+            let Some(contour) = nest.contour(r).filter(|c| !c.vertices.is_empty()) else {
+                continue;
+            };
+            let spans: Vec<Span> = contour.spans().collect();
+            let mut offsets = vec![0.0];
+            for s in &spans {
+                offsets.push(offsets.last().copied().unwrap_or(0.0) + s.length());
+            }
+            let outermost = forest.ancestors(r).last();
+            if let Some(o) = outermost {
+                if let Some(c) = nest.contour(o) {
+                    outermost_shapes
+                        .entry(o)
+                        .or_insert_with(|| PieceShape::new(c.spans().collect()));
+                }
+            }
+            leaves.push(Leaf {
+                contour_ref: r,
+                contour: contour.clone(),
+                spans,
+                offsets,
+                outermost,
+            });
+        }
+        let by_ref = leaves
+            .iter()
+            .enumerate()
+            .map(|(i, l)| (l.contour_ref, i))
+            .collect();
+        let total: f64 = leaves.iter().map(Leaf::perimeter).sum();
+        let budget = options.initial_pieces.min(options.max_nodes - 1) as f64;
+        let pieces = leaves
+            .iter()
+            .map(|l| {
+                let p = l.perimeter();
+                let share = if total > 0.0 { budget * p / total } else { 1.0 };
+                let n = (share.round() as usize).max(2);
+                (0..n)
+                    .map(|k| (p * k as f64 / n as f64, p * (k + 1) as f64 / n as f64))
+                    .collect()
+            })
+            .collect();
+        let b = nest.bounding_box();
+        let scale = b
+            .max
+            .x
+            .abs()
+            .max(b.max.y.abs())
+            .max(b.min.x.abs())
+            .max(b.min.y.abs())
+            + options.start.x.abs().max(options.start.y.abs());
+        Ok(CcpLowerBound {
+            leaves,
+            by_ref,
+            outermost_shapes,
+            margin: COST_MARGIN * (1.0 + if scale.is_finite() { scale } else { 0.0 }),
+            options,
+            pieces,
+            stage: None,
+            stages_done: 0,
+            best: 0.0,
+            incumbent: Vec::new(),
+            incumbent_length: f64::INFINITY,
+            incumbent_offered: false,
+            elapsed: Duration::ZERO,
+        })
+    }
+
+    /// The best certified lower bound so far (mm of idle travel; 0 before the first stage).
+    pub fn lower_bound(&self) -> f64 {
+        self.best
+    }
+
+    /// Stages (instances solved, each with finer pieces) completed so far.
+    pub fn stages(&self) -> usize {
+        self.stages_done
+    }
+
+    /// Nodes (pieces + depot) of the current stage's instance.
+    pub fn node_count(&self) -> usize {
+        1 + self.pieces.iter().map(Vec::len).sum::<usize>()
+    }
+
+    /// The relaxed PCGTSP instance of the stage under way, once built (for inspection and
+    /// experiments with other bounds on it).
+    pub fn relaxed_instance(&self) -> Option<&Instance> {
+        match &self.stage {
+            Some(Stage::Solving(s)) => Some(&s.instance),
+            _ => None,
+        }
+    }
+
+    /// Time spent in `step` so far.
+    pub fn elapsed(&self) -> Duration {
+        self.elapsed
+    }
+
+    /// Tells the bound about a route (the solver's best): its pierce points guide refinement
+    /// and its relaxed cost is the exact search's incumbent. Routes no shorter than the last
+    /// one offered are ignored.
+    pub fn offer_route(&mut self, route: &Route) {
+        let length = route.idle_length();
+        if length.is_nan() || length >= self.incumbent_length {
+            return;
+        }
+        self.incumbent_length = length;
+        self.incumbent = route
+            .steps
+            .iter()
+            .filter_map(|s| {
+                let &leaf = self.by_ref.get(&s.contour)?;
+                Some((leaf, self.leaves[leaf].length_of(s.pierce_point)))
+            })
+            .collect();
+        self.incumbent_offered = false;
+    }
+
+    /// Works for about `budget`; returns false when nothing is left to do (the bound is exact
+    /// for the pieces' limit, or there is nothing to bound).
+    pub fn step(&mut self, budget: Duration) -> bool {
+        let began = Instant::now();
+        let deadline = began + budget;
+        let more = self.step_until(deadline);
+        self.elapsed += began.elapsed();
+        more
+    }
+
+    fn step_until(&mut self, deadline: Instant) -> bool {
+        if self.leaves.is_empty() {
+            return false;
+        }
+        loop {
+            match self.stage.take() {
+                None => self.stage = Some(Stage::Building(self.start_building())),
+                Some(Stage::Building(mut b)) => {
+                    if self.build_rows(&mut b, deadline) {
+                        match self.start_solving(b) {
+                            Some(s) => self.stage = Some(Stage::Solving(Box::new(s))),
+                            None => return false,
+                        }
+                    } else {
+                        self.stage = Some(Stage::Building(b));
+                        return true;
+                    }
+                }
+                Some(Stage::Solving(mut s)) => {
+                    let finished = self.solve_slice(&mut s, deadline);
+                    if !finished {
+                        self.stage = Some(Stage::Solving(s));
+                        return true;
+                    }
+                    self.stages_done += 1;
+                    let progress = s.solver.progress();
+                    debug_log(|| {
+                        format!(
+                            "stage {} ({} nodes, {:.2} s of {:.2} s): relaxed lb {:.3} ub {:.3}, best {:.3}, incumbent {:.3}",
+                            self.stages_done,
+                            s.instance.node_count,
+                            s.spent.as_secs_f64(),
+                            s.share.as_secs_f64(),
+                            progress.lower_bound,
+                            progress.upper_bound,
+                            self.best,
+                            self.incumbent_length
+                        )
+                    });
+                    let tour = progress.best_tour;
+                    // With no piece left to split, the next stage reruns the same pieces
+                    // with twice the time.
+                    self.refine(&s.node_piece, tour.as_deref());
+                }
+            }
+            if Instant::now() >= deadline {
+                return true;
+            }
+        }
+    }
+
+    fn start_building(&self) -> Building {
+        let mut node_piece = Vec::new();
+        let mut shapes = Vec::new();
+        for (leaf, pieces) in self.pieces.iter().enumerate() {
+            for (k, &(a, b)) in pieces.iter().enumerate() {
+                node_piece.push((leaf, k));
+                shapes.push(PieceShape::new(self.leaves[leaf].piece_spans(a, b)));
+            }
+        }
+        let n = 1 + node_piece.len();
+        Building {
+            node_piece,
+            shapes,
+            cost: vec![f64::INFINITY; n * n],
+            next_row: 0,
+        }
+    }
+
+    /// The least tail after the last kept contour when it is cut from `piece`.
+    fn tail(&self, leaf: usize, piece: &PieceShape) -> f64 {
+        let to_outermost = self.leaves[leaf]
+            .outermost
+            .and_then(|o| self.outermost_shapes.get(&o));
+        match (self.options.finish, to_outermost) {
+            (None, None) => 0.0,
+            (None, Some(o)) => piece.distance_to(o),
+            (Some(f), None) => piece.distance_to_point(f),
+            (Some(f), Some(o)) => piece
+                .distance_to_point(f)
+                .max(piece.distance_to(o) + o.distance_to_point(f)),
+        }
+    }
+
+    /// Fills rows of the cost matrix until `deadline`; true when complete.
+    fn build_rows(&self, b: &mut Building, deadline: Instant) -> bool {
+        let n = 1 + b.node_piece.len();
+        while b.next_row < n {
+            let a = b.next_row;
+            for c in 0..n {
+                let value = match (a, c) {
+                    (0, 0) => continue,
+                    (0, c) => b.shapes[c - 1].distance_to_point(self.options.start),
+                    (a, 0) => self.tail(b.node_piece[a - 1].0, &b.shapes[a - 1]),
+                    (a, c) if b.node_piece[a - 1].0 == b.node_piece[c - 1].0 => continue,
+                    // Symmetric: the lower triangle was filled from the upper one.
+                    (a, c) if c < a => b.cost[c * n + a],
+                    (a, c) => b.shapes[a - 1].distance_to(&b.shapes[c - 1]),
+                };
+                b.cost[a * n + c] = value;
+            }
+            b.next_row += 1;
+            if Instant::now() >= deadline {
+                return b.next_row >= n;
+            }
+        }
+        true
+    }
+
+    fn start_solving(&mut self, b: Building) -> Option<Solving> {
+        let n = 1 + b.node_piece.len();
+        let margin = self.margin;
+        let cost: Vec<f64> = b
+            .cost
+            .iter()
+            .map(|&c| {
+                if c.is_finite() {
+                    (c - margin).max(0.0)
+                } else {
+                    c
+                }
+            })
+            .collect();
+        let mut clusters: Vec<Vec<usize>> = vec![Vec::new(); 1 + self.leaves.len()];
+        clusters[0].push(0);
+        let mut node_cluster = vec![0usize; n];
+        for (v, &(leaf, _)) in b.node_piece.iter().enumerate() {
+            clusters[leaf + 1].push(v + 1);
+            node_cluster[v + 1] = leaf + 1;
+        }
+        let instance = Instance {
+            name: "ccp-interval-relaxation".into(),
+            node_count: n,
+            cost,
+            clusters,
+            node_cluster,
+            precedence: Vec::new(),
+            depot: 0,
+        };
+        let share = self.options.first_stage * (1u32 << self.stages_done.min(16));
+        let options = ExactOptions {
+            time_limit: Some(share),
+            budget_seconds: Some(self.options.budget_seconds.max(share.as_secs_f64())),
+            memory_limit_bytes: self.options.memory_limit_bytes,
+            heuristic: false,
+            penalty_iterations: 0,
+            position_iterations: 0,
+            ..ExactOptions::default()
+        };
+        let solver = ExactSolver::new(&instance, options).ok()?;
+        self.best = self.best.max(solver.root_bound());
+        self.incumbent_offered = false;
+        Some(Solving {
+            node_piece: b.node_piece,
+            instance,
+            solver,
+            spent: Duration::ZERO,
+            share,
+        })
+    }
+
+    /// The incumbent route as a tour of the stage's instance (its pierce points' pieces).
+    fn incumbent_tour(&self, node_piece: &[(usize, usize)]) -> Option<Vec<usize>> {
+        let mut first_node = Vec::with_capacity(self.leaves.len());
+        let mut next = 1;
+        for pieces in &self.pieces {
+            first_node.push(next);
+            next += pieces.len();
+        }
+        if next != node_piece.len() + 1 || self.incumbent.len() != self.leaves.len() {
+            return None;
+        }
+        let mut tour = vec![0];
+        for &(leaf, s) in &self.incumbent {
+            let pieces = &self.pieces[leaf];
+            let k = pieces
+                .iter()
+                .position(|&(a, b)| a <= s && s <= b)
+                .unwrap_or(pieces.len() - 1);
+            tour.push(first_node[leaf] + k);
+        }
+        Some(tour)
+    }
+
+    /// Runs the stage's exact search until `deadline`; true when the stage is over.
+    fn solve_slice(&mut self, s: &mut Solving, deadline: Instant) -> bool {
+        if !self.incumbent_offered {
+            if let Some(tour) = self.incumbent_tour(&s.node_piece) {
+                let cost = cutroute_pcgtsp::check_tour(&s.instance, &tour).unwrap_or(f64::INFINITY);
+                s.solver.offer_incumbent(&tour, cost);
+            }
+            self.incumbent_offered = true;
+        }
+        let now = Instant::now();
+        let slice = deadline.saturating_duration_since(now);
+        let status = s.solver.step(slice.max(Duration::from_millis(1)));
+        s.spent += now.elapsed();
+        let progress = s.solver.progress();
+        if progress.lower_bound.is_finite() {
+            self.best = self.best.max(progress.lower_bound);
+        }
+        status != SolverStatus::Running || s.spent >= s.share
+    }
+
+    /// Splits the pieces of the relaxed tour and those holding the incumbent's pierce points
+    /// in four, and halves their neighbours along the contour (the next relaxed optimum tends
+    /// to move next door); false when no piece could be split (node limit or tiny pieces).
+    fn refine(&mut self, node_piece: &[(usize, usize)], tour: Option<&[usize]>) -> bool {
+        // Parts per piece: 1 keeps it, 2 halves it, 4 quarters it.
+        let mut parts: Vec<Vec<usize>> = self.pieces.iter().map(|p| vec![1; p.len()]).collect();
+        let mut mark = |leaf: usize, k: usize, pieces: &[(f64, f64)]| {
+            let n = pieces.len();
+            parts[leaf][k] = 4;
+            for j in [(k + n - 1) % n, (k + 1) % n] {
+                parts[leaf][j] = parts[leaf][j].max(2);
+            }
+        };
+        for &v in tour.unwrap_or(&[]) {
+            if let Some(&(leaf, k)) = v.checked_sub(1).and_then(|i| node_piece.get(i)) {
+                mark(leaf, k, &self.pieces[leaf]);
+            }
+        }
+        for &(leaf, s) in &self.incumbent {
+            if let Some(k) = self.pieces[leaf]
+                .iter()
+                .position(|&(a, b)| a <= s && s <= b)
+            {
+                mark(leaf, k, &self.pieces[leaf]);
+            }
+        }
+        let mut nodes = self.node_count();
+        let mut split_any = false;
+        for (leaf, pieces) in self.pieces.iter_mut().enumerate() {
+            let min_length = 1e-6 * (1.0 + self.leaves[leaf].perimeter());
+            let mut out = Vec::with_capacity(pieces.len() + 8);
+            for (k, &(a, b)) in pieces.iter().enumerate() {
+                let n = parts[leaf][k];
+                if n > 1 && b - a > n as f64 * min_length && nodes + n - 1 <= self.options.max_nodes
+                {
+                    out.extend((0..n).map(|i| {
+                        (
+                            a + (b - a) * i as f64 / n as f64,
+                            if i + 1 == n {
+                                b
+                            } else {
+                                a + (b - a) * (i + 1) as f64 / n as f64
+                            },
+                        )
+                    }));
+                    nodes += n - 1;
+                    split_any = true;
+                } else {
+                    out.push((a, b));
+                }
+            }
+            *pieces = out;
+        }
+        split_any
+    }
+}
+
+/// Per-stage numbers on stderr when `CCP_BOUND_DEBUG` is set (benchmark diagnostics).
+fn debug_log(message: impl FnOnce() -> String) {
+    if std::env::var_os("CCP_BOUND_DEBUG").is_some() {
+        eprintln!("[ccp bound] {}", message());
+    }
+}

@@ -1,0 +1,273 @@
+//! The interval relaxation's lower bound (`CcpLowerBound`) is sound and converges: never above
+//! a brute-force route (every feasible order × finely sampled pierce points) on random small
+//! nests, within a few percent of it after a few stages, and never above CCP-Relax's route on
+//! the real nests.
+
+use std::time::Duration;
+
+use cutroute_ccp::{containment_pairs, solve, CcpLowerBound, CcpOptions, LowerBoundOptions};
+use cutroute_geometry::{Contour, ContourRef, Nest, Part, Point, Vertex};
+
+/// xorshift64*: a few random numbers without a dependency.
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> f64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    fn range(&mut self, a: f64, b: f64) -> f64 {
+        a + (b - a) * self.next()
+    }
+}
+
+/// A convex polygon of `n` corners around `centre` (some sides bulged outwards), clockwise as
+/// outer contours are after opening; `hole` gives the counter-clockwise orientation of holes.
+fn polygon(rng: &mut Rng, centre: Point, radius: f64, n: usize, hole: bool) -> Contour {
+    let turn = rng.range(0.0, std::f64::consts::TAU);
+    let mut vertices: Vec<Vertex> = (0..n)
+        .map(|k| {
+            let a = turn - std::f64::consts::TAU * k as f64 / n as f64;
+            // Clockwise sides bulge outwards with a negative bulge.
+            let bulge = if rng.next() < 0.4 {
+                -rng.range(0.05, 0.4)
+            } else {
+                0.0
+            };
+            Vertex::arc(
+                centre.x + radius * a.cos(),
+                centre.y + radius * a.sin(),
+                bulge,
+            )
+        })
+        .collect();
+    if hole {
+        vertices = Contour::new(vertices).reversed().vertices;
+    }
+    Contour::new(vertices)
+}
+
+/// 2–4 parts in separate cells of a grid; sometimes one has a hole with a small part in it.
+fn random_nest(seed: u64) -> Nest {
+    let mut rng = Rng(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1);
+    let count = 2 + (rng.next() * 3.0) as usize;
+    let mut parts = Vec::new();
+    for i in 0..count {
+        let centre = Point::new(
+            60.0 * (i % 2) as f64 + rng.range(-8.0, 8.0),
+            60.0 * (i / 2) as f64 + rng.range(-8.0, 8.0) + 20.0,
+        );
+        let corners = 3 + (rng.next() * 4.0) as usize;
+        let radius = rng.range(10.0, 20.0);
+        let mut contours = vec![polygon(&mut rng, centre, radius, corners, false)];
+        if i == 0 && rng.next() < 0.6 {
+            contours.push(polygon(&mut rng, centre, 0.5 * radius, 5, true));
+            parts.push(Part {
+                name: "inner".into(),
+                contours: vec![polygon(&mut rng, centre, 0.2 * radius, 4, false)],
+            });
+        }
+        parts.push(Part {
+            name: format!("part {i}"),
+            contours,
+        });
+    }
+    Nest { sheet: None, parts }
+}
+
+/// The shortest route over every order of the contours that cuts inner contours first, with
+/// pierce points sampled every `h` mm: a feasible route, so no lower bound may exceed it.
+fn brute_force(nest: &Nest, start: Point, finish: Option<Point>, h: f64) -> f64 {
+    let refs: Vec<ContourRef> = nest.contour_refs().collect();
+    let samples: Vec<Vec<Point>> = refs
+        .iter()
+        .map(|&r| {
+            let c = nest.contour(r).unwrap();
+            let n = (c.perimeter() / h).ceil() as usize;
+            (0..n)
+                .map(|k| {
+                    c.point_at_length(c.perimeter() * k as f64 / n as f64)
+                        .unwrap()
+                })
+                .collect()
+        })
+        .collect();
+    let pairs: Vec<(usize, usize)> = containment_pairs(nest)
+        .into_iter()
+        .map(|(a, b)| {
+            (
+                refs.iter().position(|&r| r == a).unwrap(),
+                refs.iter().position(|&r| r == b).unwrap(),
+            )
+        })
+        .collect();
+    let mut best = f64::INFINITY;
+    let mut order: Vec<usize> = (0..refs.len()).collect();
+    permute(&mut order, 0, &mut |order| {
+        let at = |c: usize| order.iter().position(|&o| o == c).unwrap();
+        if pairs.iter().any(|&(inner, outer)| at(inner) > at(outer)) {
+            return;
+        }
+        let mut cur: Vec<f64> = samples[order[0]]
+            .iter()
+            .map(|p| p.distance(start))
+            .collect();
+        for w in order.windows(2) {
+            let (from, to) = (&samples[w[0]], &samples[w[1]]);
+            cur = to
+                .iter()
+                .map(|q| {
+                    from.iter()
+                        .zip(&cur)
+                        .map(|(p, d)| d + p.distance(*q))
+                        .fold(f64::INFINITY, f64::min)
+                })
+                .collect();
+        }
+        let last = &samples[*order.last().unwrap()];
+        let value = cur
+            .iter()
+            .zip(last)
+            .map(|(d, p)| d + finish.map_or(0.0, |f| p.distance(f)))
+            .fold(f64::INFINITY, f64::min);
+        best = best.min(value);
+    });
+    best
+}
+
+fn permute(v: &mut [usize], k: usize, f: &mut dyn FnMut(&[usize])) {
+    if k == v.len() {
+        f(v);
+        return;
+    }
+    for i in k..v.len() {
+        v.swap(k, i);
+        permute(v, k + 1, f);
+        v.swap(k, i);
+    }
+}
+
+/// Runs the bound for up to `stages` stages or `limit` of its own time.
+fn run_bound(bound: &mut CcpLowerBound, stages: usize, limit: Duration) -> f64 {
+    while bound.stages() < stages
+        && bound.elapsed() < limit
+        && bound.step(Duration::from_millis(50))
+    {}
+    bound.lower_bound()
+}
+
+#[test]
+fn never_above_brute_force_and_close_to_it_on_random_small_nests() {
+    for seed in 1..=12u64 {
+        let nest = random_nest(seed);
+        let start = Point::new(-30.0, -10.0);
+        let finish = (seed % 3 == 0).then_some(Point::new(150.0, -20.0));
+        let brute = brute_force(&nest, start, finish, 0.25);
+        let options = LowerBoundOptions {
+            start,
+            finish,
+            budget_seconds: 2.0,
+            ..LowerBoundOptions::default()
+        };
+        let mut bound = CcpLowerBound::new(&nest, options).unwrap();
+        // The best CCP route guides the refinement, as in the engine's job.
+        let ccp = solve(
+            &nest,
+            CcpOptions {
+                start,
+                finish,
+                time_limit: Duration::from_secs(1),
+                ..CcpOptions::default()
+            },
+            &mut |_| {},
+        )
+        .unwrap();
+        bound.offer_route(&ccp.route);
+        let lb = run_bound(&mut bound, 8, Duration::from_secs(3));
+        assert!(
+            lb <= brute + 1e-9,
+            "seed {seed}: bound {lb} above the brute-force route {brute}"
+        );
+        assert!(
+            lb <= ccp.metrics.idle_length + 1e-9,
+            "seed {seed}: bound {lb} above CCP's route {}",
+            ccp.metrics.idle_length
+        );
+        assert!(
+            lb >= 0.97 * brute,
+            "seed {seed}: bound {lb} more than 3 % below the brute-force route {brute} after {} stages",
+            bound.stages()
+        );
+    }
+}
+
+fn read_nest(path: &str) -> Nest {
+    let full = format!("{}/../../data/nests/{path}", env!("CARGO_MANIFEST_DIR"));
+    let bytes = std::fs::read(&full).unwrap_or_else(|e| panic!("missing test file {full}: {e}"));
+    let mut nest =
+        cutroute_formats::read_nest(&bytes).unwrap_or_else(|e| panic!("cannot read {full}: {e}"));
+    nest.normalize_orientation();
+    nest
+}
+
+#[test]
+fn never_above_the_ccp_route_on_the_real_nests() {
+    for path in [
+        "dbs/nested.dbs",
+        "dbs/seven.dbs",
+        "dbs-json/test0.dbs.json",
+        "dbs-json/test1.dbs.json",
+        "dbs-json/E1X_6_01.dbs.json",
+        "dbs/seven_3717.dbs",
+        "dbs/Graph_5x7.DBS",
+    ] {
+        let nest = read_nest(path);
+        let start = Point::new(0.0, 0.0);
+        for finish in [None, Some(start)] {
+            let ccp = solve(
+                &nest,
+                CcpOptions {
+                    start,
+                    finish,
+                    time_limit: Duration::from_secs(2),
+                    ..CcpOptions::default()
+                },
+                &mut |_| {},
+            )
+            .unwrap();
+            let options = LowerBoundOptions {
+                start,
+                finish,
+                budget_seconds: 2.0,
+                ..LowerBoundOptions::default()
+            };
+            let mut bound = CcpLowerBound::new(&nest, options).unwrap();
+            bound.offer_route(&ccp.route);
+            let lb = run_bound(&mut bound, 4, Duration::from_secs(2));
+            let ub = ccp.metrics.idle_length;
+            assert!(lb > 0.0, "{path}: no bound");
+            assert!(
+                lb <= ub + 1e-9,
+                "{path} {finish:?}: bound {lb} above CCP's {ub}"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_nest_without_contours_has_nothing_to_bound() {
+    let mut bound = CcpLowerBound::new(&Nest::default(), LowerBoundOptions::default()).unwrap();
+    assert!(!bound.step(Duration::from_millis(10)));
+    assert_eq!(bound.lower_bound(), 0.0);
+    let refused = CcpLowerBound::new(
+        &Nest::default(),
+        LowerBoundOptions {
+            start: Point::new(f64::NAN, 0.0),
+            ..LowerBoundOptions::default()
+        },
+    );
+    assert!(refused.is_err());
+}
