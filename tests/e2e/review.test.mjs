@@ -82,7 +82,12 @@ test('animation: play reaches the end on the machine clock; steps and scrub move
   const first = Number(await clock.getAttribute('data-time'));
   await page.click('#anim-next');
   const second = Number(await clock.getAttribute('data-time'));
-  assert.ok(first > 0 && second > first, `contour starts ${first} < ${second}`);
+  // The first pierce starts after the idle move from the machine's home (the sheet's lower-left
+  // corner) to the oracle's first pierce point; the second comes later.
+  const home = cli('inspect', 'data/nests/dbs-json/E1X_6_01.dbs.json', '--json').sheet;
+  const [x1, y1] = oracle.route[0].pierce;
+  assertRounded(first, Math.hypot(x1 - home[0], y1 - home[1]) / oracle.machine.idle_speed, 3, 'first pierce starts');
+  assert.ok(second > first, `contour starts ${first} < ${second}`);
   assert.match(await page.locator('#anim-contour').textContent(), /^contour 2 of 16$/);
   await page.click('#anim-prev');
   assert.equal(Number(await clock.getAttribute('data-time')), first);

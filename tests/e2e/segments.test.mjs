@@ -12,6 +12,15 @@ import path from 'node:path';
 import { watchErrors, projectRoot, useApp, screenshot, cli, assertRounded } from './harness.mjs';
 
 const app = useApp(before, after);
+
+/** The themes the stylesheets define besides the base one, in the app's order. */
+function themeSheets() {
+  const order = ['dark', 'high-contrast', 'print'];
+  const sheets = fs.readdirSync(path.join(projectRoot, 'style'))
+    .filter((f) => f.startsWith('theme-')).map((f) => f.slice('theme-'.length, -'.css'.length));
+  assert.deepEqual([...sheets].sort(), [...order].sort(), 'the theme stylesheets');
+  return order;
+}
 const nests = path.resolve(projectRoot, 'data', 'nests');
 
 /** A file of `data/nests`; fails loudly when it is missing. */
@@ -270,7 +279,8 @@ test('the objective is chosen, remembered, used by GSCCP and by the comparison; 
   // in every theme.
   await solve(page, 'aoe');
   const themes = await page.locator('#theme option').evaluateAll((os) => os.map((o) => o.value));
-  assert.ok(themes.length >= 4, `themes: ${themes}`);
+  // One theme per stylesheet: light (the base) and each theme-*.css.
+  assert.deepEqual(themes, ['light', ...themeSheets()]);
   for (const theme of themes) {
     await page.selectOption('#theme', theme);
     const styles = await page.evaluate(() => {
@@ -286,7 +296,8 @@ test('the objective is chosen, remembered, used by GSCCP and by the comparison; 
         idle: look(document.querySelector('#nest-view .route path.idle')),
       };
     });
-    if (styles.hue1) assert.notEqual(styles.hue0, styles.hue1, `${theme}: paths 1 and 2 look different`);
+    assert.ok(styles.hue0 && styles.hue1, `${theme}: AOE's 4 paths use at least two hues`);
+    assert.notEqual(styles.hue0, styles.hue1, `${theme}: paths 1 and 2 look different`);
     assert.notEqual(styles.link, styles.idle, `${theme}: links vs idle moves`);
     assert.notEqual(styles.link, styles.hue0, `${theme}: links vs tool-on paths`);
     await screenshot(page, `segments-theme-${theme}.png`);
