@@ -255,7 +255,7 @@ impl Chaining {
             });
         }
         let forest = nest.containment_forest();
-        let scale = nest_scale(nest);
+        let scale = nest.scale();
         let tolerance = 1e-6 * scale;
         if let Some(e) = route.problems(nest, &forest, tolerance).into_iter().next() {
             return Err(ChainError::InvalidRoute(e));
@@ -466,10 +466,6 @@ fn point_box_distance(p: Point, b: &BoundingBox) -> f64 {
     dx.hypot(dy)
 }
 
-fn nest_scale(nest: &Nest) -> f64 {
-    let b = nest.bounding_box();
-    ((b.max.x - b.min.x).abs() + (b.max.y - b.min.y).abs()).max(1.0)
-}
 
 /// What every group needs.
 struct Context<'a> {

@@ -14,12 +14,6 @@ use web_time::{Duration, Instant};
 
 use crate::{EngineError, Job, JobStatus};
 
-/// The check and plan tolerance of a nest (mm): 10⁻⁶ of its width plus height, as the CLI and
-/// `cutroute-segments` use.
-fn nest_tolerance(nest: &Nest) -> f64 {
-    let b = nest.bounding_box();
-    1e-6 * ((b.max.x - b.min.x).abs() + (b.max.y - b.min.y).abs()).max(1.0)
-}
 
 /// What every route of a plan must at least cut and pierce, from the nest's plane graph
 /// (`cutroute-aoe`'s [`PlanGraph`]: contours split at touchings and crossings, common edges
@@ -205,7 +199,7 @@ impl SegmentJob {
             finish,
             machine: params.machine,
             objective: params.objective,
-            tolerance: nest_tolerance(nest),
+            tolerance: nest.check_tolerance(),
             bound: None,
             started: Instant::now(),
         })
@@ -309,7 +303,7 @@ impl AoeJob {
             nest: nest.clone(),
             options: AoeSolveOptions {
                 plan: PlanOptions {
-                    tolerance: nest_tolerance(nest),
+                    tolerance: nest.check_tolerance(),
                     ..PlanOptions::default()
                 },
                 start,

@@ -29,6 +29,19 @@ impl Nest {
             .fold(BoundingBox::EMPTY, |b, p| b.union(p.bounding_box()))
     }
 
+    /// The nest's size for tolerances: width plus height of the parts' box, at least 1 mm.
+    pub fn scale(&self) -> f64 {
+        let b = self.bounding_box();
+        ((b.max.x - b.min.x).abs() + (b.max.y - b.min.y).abs()).max(1.0)
+    }
+
+    /// The distance under which solvers and checkers take two points of this nest as one:
+    /// 10⁻⁶ of its [`scale`](Nest::scale), so rounding in files and arc maths never reads as a
+    /// gap, and any real gap does.
+    pub fn check_tolerance(&self) -> f64 {
+        1e-6 * self.scale()
+    }
+
     /// Orients every part contour by its depth in the nest's containment forest: even depth
     /// (outer contours, parts placed in holes) clockwise, odd depth (holes) counter-clockwise,
     /// as the DBS convention "material on the right" requires. The sheet is left alone.

@@ -91,10 +91,6 @@ pub struct GsccpResult {
     pub ccp_route: PathRoute,
 }
 
-fn nest_scale(nest: &Nest) -> f64 {
-    let b = nest.bounding_box();
-    ((b.max.x - b.min.x).abs() + (b.max.y - b.min.y).abs()).max(1.0)
-}
 
 /// Runs [`GsccpSearch`] to its end (the cancel flag is read between slices): CCP-Relax for its
 /// share of the time, then every ensemble of `options.kinds` seeded by its route, each route
@@ -198,7 +194,7 @@ impl GsccpSearch {
             options: options.clone(),
             tolerance: options
                 .check_tolerance
-                .unwrap_or_else(|| 1e-6 * nest_scale(nest)),
+                .unwrap_or_else(|| nest.check_tolerance()),
             started,
             stage: Stage::Ccp(Box::new(ccp)),
             ccp_route: None,
