@@ -76,7 +76,9 @@ mod route;
 mod search;
 mod solver;
 
-pub use discrete::{build_pcgtsp, DiscreteInstance, DiscreteNode, DiscretisationOptions};
+pub use discrete::{
+    build_pcgtsp, DiscreteInstance, DiscreteNode, DiscretisationOptions, MAX_DISCRETE_NODES,
+};
 pub use route::{idle_length, route_certificates, route_metrics, ContourCertificate, RouteMetrics};
 pub use solver::{
     solve, solve_with_cancel, CcpOptions, CcpPhase, CcpProgress, CcpResult, CcpSolver, SolverStatus,

@@ -4,6 +4,8 @@ use std::collections::HashMap;
 
 use cutroute_geometry::{ContourRef, CutStep, Nest, Point, Route};
 use cutroute_protocol::{JobId, Progress};
+use rstar::primitives::GeomWithData;
+use rstar::RTree;
 use web_time::{Duration, Instant};
 
 use crate::{EngineError, Job, JobStatus};
@@ -42,42 +44,66 @@ impl NearestNeighbourJob {
         })
     }
 
+    /// O(V log V) for V vertices: an R-tree holds the vertices of the contours that may be cut
+    /// now (every contour inside them cut) and are not cut yet; a contour's vertices enter
+    /// when its last inner contour is cut and leave when it is cut (a quadratic scan took 39 s
+    /// on 30,000 contours). Ties go to the lowest (part, contour, vertex), so runs repeat.
     fn solve(&mut self) {
         let forest = self.nest.containment_forest();
-        let mut remaining: Vec<ContourRef> = self.nest.contour_refs().collect();
+        let refs: Vec<ContourRef> = self.nest.contour_refs().collect();
         // Contours still to cut inside each contour: it waits for them (inner before outer).
-        let mut inner_left: HashMap<ContourRef, usize> = remaining
+        let mut inner_left: HashMap<ContourRef, usize> = refs
             .iter()
             .map(|&r| (r, forest.children(r).len()))
             .collect();
+        let vertices_of = |r: ContourRef| {
+            let contour = &self.nest.parts[r.part].contours[r.contour];
+            contour
+                .vertices
+                .iter()
+                .enumerate()
+                .map(move |(k, v)| ReadyVertex::new([v.point.x, v.point.y], (r, k)))
+        };
+        let mut ready: RTree<ReadyVertex> = RTree::bulk_load(
+            refs.iter()
+                .filter(|r| inner_left[r] == 0)
+                .flat_map(|&r| vertices_of(r))
+                .collect(),
+        );
         let mut position = self.start;
-        let mut steps = Vec::with_capacity(remaining.len());
+        let mut steps = Vec::with_capacity(refs.len());
         let mut idle_length = 0.0;
-        while !remaining.is_empty() {
-            let mut best: Option<(usize, Point, f64)> = None;
-            for (index, contour_ref) in remaining.iter().enumerate() {
-                if inner_left.get(contour_ref).is_some_and(|&left| left > 0) {
-                    continue;
+        loop {
+            let query = [position.x, position.y];
+            let mut nearest = ready.nearest_neighbor_iter_with_distance_2(&query);
+            let Some((first, d2)) = nearest.next() else {
+                break; // every contour with vertices is cut
+            };
+            let mut best = first;
+            for (other, other_d2) in nearest {
+                if other_d2 > d2 {
+                    break;
                 }
-                let contour = &self.nest.parts[contour_ref.part].contours[contour_ref.contour];
-                for vertex in &contour.vertices {
-                    let d = distance(position, vertex.point);
-                    if best.is_none_or(|(_, _, best_d)| d < best_d) {
-                        best = Some((index, vertex.point, d));
+                if other.data < best.data {
+                    best = other;
+                }
+            }
+            let (contour_ref, _) = best.data;
+            let pierce_point = Point::new(best.geom()[0], best.geom()[1]);
+            for vertex in vertices_of(contour_ref).collect::<Vec<_>>() {
+                ready.remove(&vertex);
+            }
+            if let Some(parent) = forest.parent(contour_ref) {
+                if let Some(left) = inner_left.get_mut(&parent) {
+                    *left -= 1;
+                    if *left == 0 {
+                        for vertex in vertices_of(parent) {
+                            ready.insert(vertex);
+                        }
                     }
                 }
             }
-            let Some((index, pierce_point, d)) = best else {
-                break; // only contours without vertices remain
-            };
-            let contour_ref = remaining.swap_remove(index);
-            if let Some(left) = forest
-                .parent(contour_ref)
-                .and_then(|p| inner_left.get_mut(&p))
-            {
-                *left -= 1;
-            }
-            idle_length += d;
+            idle_length += distance(position, pierce_point);
             position = pierce_point;
             steps.push(CutStep {
                 contour: contour_ref,
@@ -96,6 +122,9 @@ impl NearestNeighbourJob {
         });
     }
 }
+
+/// A vertex of a contour that may be cut now: (contour, vertex index).
+type ReadyVertex = GeomWithData<[f64; 2], (ContourRef, usize)>;
 
 fn distance(a: Point, b: Point) -> f64 {
     (a.x - b.x).hypot(a.y - b.y)
