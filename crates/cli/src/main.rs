@@ -65,7 +65,7 @@ enum Command {
         to: Option<String>,
         /// Solver of the route for gcode/html: nearest, ccp, heuristic or discrete (default: the
         /// route the file holds, else ccp).
-        #[arg(long)]
+        #[arg(long, value_parser = clap::builder::PossibleValuesParser::new(ROUTE_SOLVERS))]
         solver: Option<String>,
         /// Wall-clock limit of the solver, seconds: finite and positive, or `inf` (until proven
         /// optimal or stopped by Ctrl-C).
@@ -101,7 +101,7 @@ enum Command {
         /// chain (ccp, then chain cutting), aoe (common edges cut once along AOE-chains),
         /// sccp (segment cutting along the plan's common edges) or gsccp (the best of several
         /// segment ensembles).
-        #[arg(long, default_value = "ccp")]
+        #[arg(long, default_value = "ccp", value_parser = clap::builder::PossibleValuesParser::new(SOLVERS))]
         solver: String,
         /// Wall-clock limit in seconds: finite and positive, or `inf` (until proven optimal or
         /// stopped by Ctrl-C, which keeps the best route so far).
@@ -128,13 +128,29 @@ enum Command {
         task: Option<PathBuf>,
         /// What gsccp minimises when it picks an ensemble, and the unit of the path-route
         /// solvers' (sccp, gsccp, aoe) bounds: time or cost.
-        #[arg(long, default_value = "time")]
+        #[arg(long, default_value = "time", value_parser = ["time", "cost"])]
         objective: String,
         /// Print one JSON object instead of text.
         #[arg(long)]
         json: bool,
     },
 }
+
+/// The `--solver` names of `solve`.
+const SOLVERS: [&str; 9] = [
+    "nearest",
+    "ccp",
+    "heuristic",
+    "exact",
+    "discrete",
+    "chain",
+    "aoe",
+    "sccp",
+    "gsccp",
+];
+
+/// The `--solver` names of `convert`: the solvers whose routes are whole contours.
+const ROUTE_SOLVERS: [&str; 6] = ["nearest", "ccp", "heuristic", "exact", "discrete", "chain"];
 
 /// Most contours `generate` writes: a million contours are about 200 MB of geometry JSON.
 const MAX_GENERATED_CONTOURS: u64 = 1_000_000;
@@ -297,6 +313,8 @@ struct JobRun {
     earlier_routes: Vec<Route>,
     /// Why the run ended early: `None` when the solver ended by itself.
     stopped: Option<&'static str>,
+    /// The limit it ran under, s (for messages).
+    time_limit_s: f64,
 }
 
 /// How many improving routes a run keeps, at least half a second apart.
@@ -407,10 +425,13 @@ fn run_bounded<T: Send + 'static>(
 fn bounded_job_run(request: JobRequest, as_json: bool) -> Result<JobRun, Failure> {
     let time_limit_s = request.params.time_limit_s;
     let outcome = run_bounded(time_limit_s, move |watch| {
-        let mut job = start_job(&request).map_err(|e| Failure::Error(e.to_string()))?;
+        let mut job = start_job(&request)
+            .map_err(|e| Failure::Error(format!("--solver {}: {e}", request.solver.name())))?;
         Ok(run_job(job.as_mut(), watch, &mut progress_printer(as_json)))
     })?;
-    Ok(outcome.unwrap_or_else(|snapshot| snapshot))
+    let mut run = outcome.unwrap_or_else(|snapshot| snapshot);
+    run.time_limit_s = time_limit_s;
+    Ok(run)
 }
 
 /// The run's route if it passes the checker, else the newest earlier route that does (with
@@ -419,7 +440,10 @@ fn bounded_job_run(request: JobRequest, as_json: bool) -> Result<JobRun, Failure
 fn checked_route(run: &JobRun, nest: &Nest) -> Result<(Route, Option<String>), String> {
     let tolerance = 1e-6 * nest_scale(nest);
     let no_route = || match run.stopped {
-        Some(why) => format!("the solver found no route before it was stopped ({why})"),
+        Some(why) => format!(
+            "--time-limit {}: the solver found no route before it was stopped ({why})",
+            run.time_limit_s
+        ),
         None => "the solver found no route".to_string(),
     };
     let route = run
@@ -622,7 +646,7 @@ fn convert(
     let document = open(input)?;
     let Problem::Nest { nest, .. } = &document.problem else {
         return Err(format!(
-            "{}: not a nest; only nests can be converted",
+            "{}: line 1 starts a PCGTSP instance, not a nest; only nests can be converted",
             input.display()
         ));
     };
@@ -812,7 +836,8 @@ fn tour_report(solver: &str, text: &str, run: &JobRun) -> Result<Value, Failure>
     let instance = cutroute_pcgtsp::Instance::parse(text).map_err(|e| e.to_string())?;
     let Some(result) = &run.last else {
         return Err(Failure::Infeasible(format!(
-            "the {solver} solver found no tour before it was stopped"
+            "--time-limit {}: the {solver} solver found no tour before it was stopped",
+            run.time_limit_s
         )));
     };
     let Some(tour) = &result.tour else {
@@ -923,7 +948,7 @@ fn solve_path(
     let document = open(path)?;
     let Problem::Nest { nest, .. } = &document.problem else {
         return Err(format!(
-            "the {solver_name} solver routes nests, not PCGTSP instances"
+            "--solver {solver_name}: routes nests, not PCGTSP instances"
         ));
     };
     let solver = solver_kind(solver_name)?;
@@ -941,7 +966,8 @@ fn solve_path(
         let mut on_progress = progress_printer(as_json);
         let mut extra = serde_json::Map::new();
         let progress = if solver == SolverKind::Aoe {
-            let mut job = AoeJob::from_request(&request).map_err(|e| e.to_string())?;
+            let mut job =
+                AoeJob::from_request(&request).map_err(|e| format!("--solver aoe: {e}"))?;
             let progress = run_job(&mut job, watch, &mut on_progress).last;
             let (solution, _) = match job.outcome() {
                 Some(Ok(solved)) => solved,
@@ -955,7 +981,8 @@ fn solve_path(
             extra.insert("components".into(), json!(solution.components));
             progress
         } else {
-            let mut job = SegmentJob::from_request(&request).map_err(|e| e.to_string())?;
+            let mut job = SegmentJob::from_request(&request)
+                .map_err(|e| format!("--solver {}: {e}", request.solver.name()))?;
             let progress = run_job(&mut job, watch, &mut on_progress).last;
             let result = job
                 .search()
@@ -1007,7 +1034,8 @@ fn solve_path(
     };
     let progress = progress.ok_or_else(|| {
         format!(
-            "the {solver_name} solver found no route before it was stopped ({})",
+            "--time-limit {time_limit_s}: the {solver_name} solver found no route before it \
+             was stopped ({})",
             stopped.unwrap_or("")
         )
     })?;
@@ -1060,5 +1088,78 @@ fn finite(value: f64) -> Value {
         json!(value)
     } else {
         Value::Null
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use cutroute_geometry::{Contour, ContourRef, CutStep, Part, Point, Vertex};
+
+    fn square(x: f64) -> Contour {
+        Contour::new(vec![
+            Vertex::line(x, 0.0),
+            Vertex::line(x, 10.0),
+            Vertex::line(x + 10.0, 10.0),
+            Vertex::line(x + 10.0, 0.0),
+        ])
+    }
+
+    fn route(parts: &[usize]) -> Route {
+        Route {
+            start: Point::new(0.0, 0.0),
+            steps: parts
+                .iter()
+                .map(|&part| {
+                    CutStep::pierced(
+                        ContourRef { part, contour: 0 },
+                        Point::new(part as f64 * 20.0, 0.0),
+                    )
+                })
+                .collect(),
+            finish: None,
+        }
+    }
+
+    fn run_ending_with(last: Route, earlier: Vec<Route>) -> JobRun {
+        JobRun {
+            last: Some(Progress {
+                route: Some(last),
+                ..Progress::default()
+            }),
+            earlier_routes: earlier,
+            stopped: None,
+            time_limit_s: 1.0,
+        }
+    }
+
+    /// Item 13 of issue #15: a final route that fails the checker never hides a valid one.
+    #[test]
+    fn a_failing_final_route_gives_way_to_the_newest_valid_earlier_route() {
+        let nest = Nest {
+            sheet: None,
+            parts: (0..2)
+                .map(|i| Part {
+                    name: format!("P{i}"),
+                    contours: vec![square(i as f64 * 20.0)],
+                })
+                .collect(),
+        };
+        let valid = route(&[0, 1]);
+        let (chosen, rejected) =
+            checked_route(&run_ending_with(valid.clone(), vec![]), &nest).unwrap();
+        assert_eq!((chosen, rejected), (valid.clone(), None));
+
+        let invalid = route(&[0]); // part 1 never cut
+        let run = run_ending_with(invalid.clone(), vec![route(&[1]), valid.clone()]);
+        let (chosen, rejected) = checked_route(&run, &nest).unwrap();
+        assert_eq!(chosen, valid);
+        assert!(rejected.unwrap().starts_with("invalid route"));
+
+        // Nothing valid at all: a clear error, never the invalid route.
+        let run = run_ending_with(invalid.clone(), vec![route(&[1])]);
+        assert!(checked_route(&run, &nest)
+            .unwrap_err()
+            .starts_with("invalid route"));
     }
 }

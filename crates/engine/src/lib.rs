@@ -47,6 +47,9 @@ pub use path_jobs::{AoeJob, PlanBound, SegmentJob};
 /// How long one [`Job::step`] may run before it returns, so cancel requests are seen quickly.
 pub const DEFAULT_SLICE: Duration = Duration::from_millis(40);
 
+/// The share of a chain job's time limit its CCP phase gets; chain cutting has the rest.
+pub const CHAIN_CCP_SHARE: f64 = 0.6;
+
 /// What a step left behind.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum JobStatus {
@@ -137,8 +140,14 @@ pub fn start_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
             },
             SolverKind::Ccp | SolverKind::Chain,
         ) => {
+            // Chain cutting runs after CCP within the same limit: CCP gets its share of it.
+            let ccp_limit = if solver == SolverKind::Chain {
+                time_limit.mul_f64(CHAIN_CCP_SHARE)
+            } else {
+                time_limit
+            };
             let options =
-                jobs::ccp_options(*start, *finish, time_limit, params.seed, params.machine);
+                jobs::ccp_options(*start, *finish, ccp_limit, params.seed, params.machine);
             let ccp =
                 cutroute_ccp::CcpSolver::new(nest, options).map_err(|e| refused(e.to_string()))?;
             if solver == SolverKind::Chain {

@@ -106,7 +106,8 @@ pub fn open_document(file_name: &str, bytes: &[u8]) -> Result<Document, OpenErro
             first.nest
         }
         Format::Pcglns => {
-            let text = std::str::from_utf8(bytes).map_err(|e| unreadable(e.to_string()))?;
+            let text = std::str::from_utf8(bytes)
+                .map_err(|e| unreadable(format!("byte {}: not UTF-8 text", e.valid_up_to())))?;
             Instance::parse(text).map_err(|e| unreadable(e.to_string()))?;
             return Ok(Document {
                 file_name: file_name.to_string(),
