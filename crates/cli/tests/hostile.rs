@@ -413,3 +413,94 @@ fn infeasible_instances_exit_3_without_a_claim_of_optimality() {
     assert_eq!(out.code, 1);
     assert!(out.stderr.contains("line 8"), "{}", out.stderr);
 }
+
+/// Item 11: a contour just above the smallest the readers accept (0.001 mm) is cut by every
+/// solver, path solvers included; smaller ones are refused by the reader, for every solver.
+#[test]
+fn the_smallest_accepted_contour_is_cut_by_every_solver() {
+    let nest = |side: f64| {
+        let far = 500.0 + side;
+        format!(
+            r#"[{{"partid":"sheet","paths":[[[0,0],[0,1000],[2000,1000],[2000,0],[0,0]]]}},
+               {{"partid":"tiny","paths":[[[500,500],[500,{far}],[{far},{far}],[{far},500],[500,500]]]}},
+               {{"partid":"p1","paths":[[[100,100],[100,200],[200,200],[200,100],[100,100]]]}}]"#
+        )
+    };
+    let accepted = scratch("tiny-accepted.dbs.json");
+    std::fs::write(&accepted, nest(0.0011)).unwrap();
+    let refused = scratch("tiny-refused.dbs.json");
+    std::fs::write(&refused, nest(0.0009)).unwrap();
+    for solver in SOLVERS {
+        let args = |file: &Path| {
+            vec![
+                "solve".to_string(),
+                file.to_str().unwrap().to_string(),
+                "--solver".into(),
+                solver.into(),
+                "--time-limit".into(),
+                "0.5".into(),
+                "--json".into(),
+            ]
+        };
+        let accepted_args = args(&accepted);
+        let accepted_args: Vec<&str> = accepted_args.iter().map(String::as_str).collect();
+        let out = run(&accepted_args);
+        assert_eq!(out.code, 0, "{solver}: {}", out.stderr);
+        let report: Value = serde_json::from_str(&out.stdout).unwrap();
+        let cuts = match &report["route"] {
+            Value::Array(steps) => steps.len(),
+            route => route["paths"].as_array().unwrap().len(),
+        };
+        assert_eq!(cuts, 2, "{solver} left a contour out: {report}");
+        check(&accepted_args, Some(&accepted));
+        let refused_args = args(&refused);
+        let refused_args: Vec<&str> = refused_args.iter().map(String::as_str).collect();
+        let out = run(&refused_args);
+        assert_eq!(out.code, 1, "{solver}: {}", out.stdout);
+        assert!(out.stderr.contains("[1].paths[0]"), "{}", out.stderr);
+    }
+}
+
+/// Item 8: `--time-limit inf` runs until proven or stopped; the first Ctrl-C stops the solver
+/// and the best route so far is printed, checked.
+#[cfg(unix)]
+#[test]
+fn ctrl_c_stops_an_unlimited_run_and_keeps_its_best_route() {
+    let nest = data("nests/dbs/nested.dbs");
+    let child = Command::new(env!("CARGO_BIN_EXE_cutroute"))
+        .args([
+            "solve",
+            nest.to_str().unwrap(),
+            "--solver",
+            "ccp",
+            "--time-limit",
+            "inf",
+            "--json",
+        ])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(1500));
+    let interrupted = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(interrupted.success());
+    let started = Instant::now();
+    let out = child.wait_with_output().unwrap();
+    assert!(
+        started.elapsed() < Duration::from_secs(2),
+        "Ctrl-C took long"
+    );
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let report: Value = serde_json::from_str(&stdout).unwrap();
+    assert_eq!(report["stopped"], "Ctrl-C", "{report}");
+    check_result(&["solve", "--json"], &nest, &stdout);
+}

@@ -95,6 +95,8 @@ pub enum EngineError {
 pub fn start_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
     let params = &request.params;
     let time_limit = Duration::from_secs_f64(params.time_limit_s.clamp(0.0, 1.0e7));
+    // Building the problem (a discretisation's dense matrix) counts against the limit.
+    let started = web_time::Instant::now();
     let solver = request.solver;
     let refused = |message: String| EngineError::SolverRefused {
         solver: solver.name(),
@@ -111,7 +113,10 @@ pub fn start_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
             instance,
             discrete,
             mode,
-            time_limit,
+            // At least a tenth of the limit, for a first tour after a long build.
+            time_limit
+                .saturating_sub(started.elapsed())
+                .max(time_limit / 10),
             params.seed,
             params.initial_upper_bound,
         )
