@@ -28,7 +28,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use cutroute_engine::{open_document, start_job, AoeJob, SegmentJob};
-use cutroute_geometry::{Entry, MachineParameters, Nest, Objective, Route};
+use cutroute_geometry::{ContainmentForest, Entry, MachineParameters, Nest, Objective, Route};
 use cutroute_protocol::{Document, JobRequest, Problem, Progress, SolverKind, SolverParams};
 use serde_json::{json, Value};
 
@@ -437,8 +437,13 @@ fn bounded_job_run(request: JobRequest, as_json: bool) -> Result<JobRun, Failure
 /// The run's route if it passes the checker, else the newest earlier route that does (with
 /// the final route's problem, reported as `final_route_rejected`): a solver's last word never
 /// loses a valid route it had. An error when no route passes.
-fn checked_route(run: &JobRun, nest: &Nest) -> Result<(Route, Option<String>), String> {
+fn checked_route(
+    run: &JobRun,
+    nest: &Nest,
+    forest: &ContainmentForest,
+) -> Result<(Route, Option<String>), String> {
     let tolerance = 1e-6 * nest_scale(nest);
+    let first_problem = |route: &Route| route.problems(nest, forest, tolerance).into_iter().next();
     let no_route = || match run.stopped {
         Some(why) => format!(
             "--time-limit {}: the solver found no route before it was stopped ({why})",
@@ -451,16 +456,36 @@ fn checked_route(run: &JobRun, nest: &Nest) -> Result<(Route, Option<String>), S
         .as_ref()
         .and_then(|p| p.route.as_ref())
         .ok_or_else(no_route)?;
-    let problem = match route.validate(nest, tolerance) {
-        Ok(()) => return Ok((route.clone(), None)),
-        Err(e) => format!("invalid route: {e}"),
+    let problem = match first_problem(route) {
+        None => return Ok((route.clone(), None)),
+        Some(e) => format!("invalid route: {e}"),
     };
     run.earlier_routes
         .iter()
         .rev()
-        .find(|earlier| earlier.validate(nest, tolerance).is_ok())
+        .find(|earlier| first_problem(earlier).is_none())
         .map(|earlier| (earlier.clone(), Some(problem.clone())))
         .ok_or(problem)
+}
+
+/// The checker's containment forest of a nest, built on its own thread while the solver runs:
+/// on 100,000 contours building it after the solver stopped broke the time-limit promise.
+fn forest_in_background(problem: &Problem) -> Option<std::thread::JoinHandle<ContainmentForest>> {
+    let Problem::Nest { nest, .. } = problem else {
+        return None;
+    };
+    let nest = nest.clone();
+    Some(std::thread::spawn(move || nest.containment_forest()))
+}
+
+/// The forest [`forest_in_background`] built (built here if its thread failed).
+fn joined_forest(
+    handle: Option<std::thread::JoinHandle<ContainmentForest>>,
+    nest: &Nest,
+) -> ContainmentForest {
+    handle
+        .and_then(|h| h.join().ok())
+        .unwrap_or_else(|| nest.containment_forest())
 }
 
 /// Three comma-separated finite non-negative numbers.
@@ -746,13 +771,14 @@ fn solved_route(
         solver,
         params,
     };
+    let forest = forest_in_background(&request.problem);
     let run = bounded_job_run(request, true).map_err(|f| match f {
         Failure::Error(m) | Failure::Infeasible(m) => m,
     })?;
     let Problem::Nest { nest, .. } = &document.problem else {
         return Err("only nests are routed".into());
     };
-    checked_route(&run, nest)
+    checked_route(&run, nest, &joined_forest(forest, nest))
         .map(|(route, _)| route)
         .map_err(|e| format!("the {solver_name} solver: {e}"))
 }
@@ -790,10 +816,14 @@ fn solve(
         solver,
         params,
     };
+    let forest = forest_in_background(&request.problem);
     let run = bounded_job_run(request, as_json)?;
     let report = match &document.problem {
         Problem::PcgtspText { text } => tour_report(solver_name, text, &run)?,
-        Problem::Nest { nest, .. } => route_report(solver_name, nest, &machine, &run)?,
+        Problem::Nest { nest, .. } => {
+            let forest = joined_forest(forest, nest);
+            route_report(solver_name, nest, &machine, &run, &forest)?
+        }
     };
     print_report(&report, as_json);
     Ok(())
@@ -876,8 +906,9 @@ fn route_report(
     nest: &Nest,
     machine: &MachineParameters,
     run: &JobRun,
+    forest: &ContainmentForest,
 ) -> Result<Value, String> {
-    let (route, final_route_rejected) = checked_route(run, nest)?;
+    let (route, final_route_rejected) = checked_route(run, nest, forest)?;
     let result = run.last.as_ref().ok_or("the solver found no route")?;
     let route = &route;
     let idle_length = route.idle_length();
@@ -1145,20 +1176,21 @@ mod tests {
                 })
                 .collect(),
         };
+        let forest = nest.containment_forest();
         let valid = route(&[0, 1]);
         let (chosen, rejected) =
-            checked_route(&run_ending_with(valid.clone(), vec![]), &nest).unwrap();
+            checked_route(&run_ending_with(valid.clone(), vec![]), &nest, &forest).unwrap();
         assert_eq!((chosen, rejected), (valid.clone(), None));
 
         let invalid = route(&[0]); // part 1 never cut
         let run = run_ending_with(invalid.clone(), vec![route(&[1]), valid.clone()]);
-        let (chosen, rejected) = checked_route(&run, &nest).unwrap();
+        let (chosen, rejected) = checked_route(&run, &nest, &forest).unwrap();
         assert_eq!(chosen, valid);
         assert!(rejected.unwrap().starts_with("invalid route"));
 
         // Nothing valid at all: a clear error, never the invalid route.
         let run = run_ending_with(invalid.clone(), vec![route(&[1])]);
-        assert!(checked_route(&run, &nest)
+        assert!(checked_route(&run, &nest, &forest)
             .unwrap_err()
             .starts_with("invalid route"));
     }
