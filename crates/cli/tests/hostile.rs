@@ -414,7 +414,7 @@ fn infeasible_instances_exit_3_without_a_claim_of_optimality() {
     assert!(out.stderr.contains("line 8"), "{}", out.stderr);
 }
 
-/// Item 11: a contour just above the smallest the readers accept (0.001 mm) is cut by every
+/// Item 11: a contour just above the smallest the readers accept (0.05 mm) is cut by every
 /// solver, path solvers included; smaller ones are refused by the reader, for every solver.
 #[test]
 fn the_smallest_accepted_contour_is_cut_by_every_solver() {
@@ -427,9 +427,9 @@ fn the_smallest_accepted_contour_is_cut_by_every_solver() {
         )
     };
     let accepted = scratch("tiny-accepted.dbs.json");
-    std::fs::write(&accepted, nest(0.0011)).unwrap();
+    std::fs::write(&accepted, nest(0.051)).unwrap();
     let refused = scratch("tiny-refused.dbs.json");
-    std::fs::write(&refused, nest(0.0009)).unwrap();
+    std::fs::write(&refused, nest(0.049)).unwrap();
     for solver in SOLVERS {
         let args = |file: &Path| {
             vec![

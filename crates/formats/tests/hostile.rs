@@ -102,7 +102,7 @@ fn geometry_json_refuses_values_outside_the_shared_domain_with_a_json_path() {
                   {"partid":"P","paths":[[[5,5],[5,5],[5,5],[5,5]]]}]"#;
     let error = read_geometry_json(dot.as_bytes()).unwrap_err().to_string();
     assert!(
-        error.contains("[1].paths[0]") && error.contains("0.001 mm"),
+        error.contains("[1].paths[0]") && error.contains("0.05 mm"),
         "{error}"
     );
 }

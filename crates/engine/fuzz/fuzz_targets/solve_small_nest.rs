@@ -1,9 +1,9 @@
 //! Fuzzed small nests into every solver (issue #15): the bytes pick a solver and place up to
-//! 12 shapes (rectangles, circles, bulged quadrilaterals, tiny to large, some as holes of the
-//! shape before) on a grid, so contours never cross. A nest outside the readers' domain is
-//! refused as the readers refuse it; any other nest must give, within 100 ms of stepping
-//! (plus the longest single step), a route that passes the independent checker, or a clean
-//! error — never a panic, a hang or an invalid route.
+//! 12 shapes (rectangles, circles, bulged quadrilaterals, tiny to large, some nested: a hole
+//! of the part before, or a part in that hole) on a grid, so contours never cross. A nest
+//! outside the readers' domain is refused as the readers refuse it; any other nest must
+//! give, within 100 ms of stepping (plus the longest single step), a route that passes the
+//! independent checker, or a clean error: never a panic, a hang or an invalid route.
 #![no_main]
 
 use cutroute_engine::{start_job, JobStatus, DEFAULT_SLICE};
@@ -51,18 +51,27 @@ fuzz_target!(|data: &[u8]| {
     let mut parts: Vec<Part> = Vec::new();
     for (i, r) in records.chunks_exact(4).take(12).enumerate() {
         let (kind, scale, skew, hole) = (r[0], r[1], r[2], r[3]);
-        // 1e-6 mm to 90 mm: below the domain's 0.001 mm the nest is refused like a file.
+        // 1e-6 mm to 90 mm: below the domain's 0.05 mm the nest is refused like a file.
         let size = 90.0 * 10f64.powf(-f64::from(scale % 64) / 8.0);
         if hole % 4 == 0 && !parts.is_empty() {
-            // A hole: a smaller shape centred in the previous part's outer contour.
-            let outer = parts.last().unwrap().contours[0].bounding_box();
-            let side = (outer.max.x - outer.min.x).min(outer.max.y - outer.min.y) * 0.3;
+            // Inside the innermost contour so far, centred and smaller: a hole of the last
+            // part, or, when that part has its hole already, a part in that hole.
+            let last = parts.last().unwrap();
+            let inner = last.contours.last().unwrap().bounding_box();
+            let side = (inner.max.x - inner.min.x).min(inner.max.y - inner.min.y) * 0.3;
             let (cx, cy) = (
-                (outer.min.x + outer.max.x) / 2.0,
-                (outer.min.y + outer.max.y) / 2.0,
+                (inner.min.x + inner.max.x) / 2.0,
+                (inner.min.y + inner.max.y) / 2.0,
             );
-            let inner = shape(kind, cx - side / 2.0, cy - side / 2.0, side, skew).reversed();
-            parts.last_mut().unwrap().contours.push(inner);
+            let contour = shape(kind, cx - side / 2.0, cy - side / 2.0, side, skew);
+            if last.contours.len() == 1 {
+                parts.last_mut().unwrap().contours.push(contour.reversed());
+            } else {
+                parts.push(Part {
+                    name: format!("P{i}"),
+                    contours: vec![contour],
+                });
+            }
             continue;
         }
         let (x0, y0) = ((i % 4) as f64 * 100.0, (i / 4) as f64 * 100.0);
