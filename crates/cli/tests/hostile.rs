@@ -504,3 +504,30 @@ fn ctrl_c_stops_an_unlimited_run_and_keeps_its_best_route() {
     assert_eq!(report["stopped"], "Ctrl-C", "{report}");
     check_result(&["solve", "--json"], &nest, &stdout);
 }
+
+/// Item 13: on `ccp_chain_invalid_route_spike.dbs` (a vertex of nested.dbs moved into a
+/// spike) ccp's and chain's final routes cut a hole after its outer contour; the CLI reports the
+/// newest earlier route that passes the checker instead (`final_route_rejected` says why), and
+/// exits 0 only with a checked route.
+#[test]
+fn a_final_route_that_fails_the_checker_gives_way_to_a_valid_earlier_one() {
+    let spike = data("hostile/ccp_chain_invalid_route_spike.dbs");
+    for solver in ["ccp", "chain"] {
+        let args = [
+            "solve",
+            spike.to_str().unwrap(),
+            "--solver",
+            solver,
+            "--time-limit",
+            "2",
+            "--json",
+        ];
+        let out = run(&args);
+        assert_eq!(out.code, 0, "{solver}: {}", out.stderr);
+        check_result(&args, &spike, &out.stdout);
+        let report: Value = serde_json::from_str(&out.stdout).unwrap();
+        if let Some(why) = report["final_route_rejected"].as_str() {
+            assert!(why.starts_with("invalid route"), "{why}");
+        }
+    }
+}
