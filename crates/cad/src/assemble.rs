@@ -394,8 +394,34 @@ fn group_into_parts(
     let mut parent: Vec<Option<usize>> = vec![None; placed.len()];
     let mut depth: Vec<usize> = vec![0; placed.len()];
     let mut duplicate = vec![false; placed.len()];
+    // Candidate containers come from an R-tree of the boxes: checking every larger contour
+    // was quadratic (a 224-byte MINSERT of 400 × 400 circles ran for minutes).
+    let boxes = rstar::RTree::bulk_load(
+        placed
+            .iter()
+            .enumerate()
+            .map(|(j, p)| {
+                rstar::primitives::GeomWithData::new(
+                    rstar::primitives::Rectangle::from_corners([p.lo.x, p.lo.y], [p.hi.x, p.hi.y]),
+                    j,
+                )
+            })
+            .collect(),
+    );
     for i in 0..placed.len() {
-        for j in (0..i).rev() {
+        let (lo, hi) = (placed[i].lo, placed[i].hi);
+        let query = rstar::AABB::from_corners(
+            [lo.x - tolerance, lo.y - tolerance],
+            [hi.x + tolerance, hi.y + tolerance],
+        );
+        // Same order as the scan they replace: the nearest larger contour first.
+        let mut candidates: Vec<usize> = boxes
+            .locate_in_envelope_intersecting(&query)
+            .map(|g| g.data)
+            .filter(|&j| j < i)
+            .collect();
+        candidates.sort_unstable_by(|a, b| b.cmp(a));
+        for j in candidates {
             if duplicate[j] {
                 continue;
             }

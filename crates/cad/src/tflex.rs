@@ -34,7 +34,7 @@ use crate::shape::{dist, reversed, signed_area};
 
 const XSI: &str = "http://www.w3.org/2001/XMLSchema-instance";
 /// Largest accepted coordinate magnitude (mm): far beyond any sheet, far below overflow.
-const MAX_MAGNITUDE: f64 = 1e9;
+const MAX_MAGNITUDE: f64 = cutroute_geometry::MAX_COORDINATE;
 /// Most vertices all placed parts together may have: placements multiply part definitions, so
 /// a small hostile file could otherwise ask for billions.
 const MAX_PLACED_VERTICES: usize = 5_000_000;
@@ -195,7 +195,9 @@ pub fn read_tfnesting_project(bytes: &[u8]) -> Result<TflexProject, TflexError> 
     let doc = Document::parse(text).map_err(|e| {
         let (line, column) = match e {
             // The parser places this at the start; the truncation is at the end of the text.
-            roxmltree::Error::UnclosedRootNode => end_position(text),
+            roxmltree::Error::UnclosedRootNode | roxmltree::Error::UnexpectedEndOfStream => {
+                end_position(text)
+            }
             _ => (e.pos().row, e.pos().col),
         };
         TflexError::Xml {

@@ -89,6 +89,10 @@ fn candidates(shape: &Shape, step: f64, vertices: bool) -> Vec<V> {
     out
 }
 
+/// Most nodes (candidate points + depot) of a discretisation: its dense cost matrix is n² f64,
+/// 3.2 GB at this size.
+pub const MAX_DISCRETE_NODES: usize = 20_000;
+
 /// Builds the PCGTSP instance of a nest: clusters are the contours plus the depot, costs are
 /// Euclidean idle distances, precedence is "inner before outer" for every containment pair.
 /// The cost matrix is dense (n² f64): Nest02/Nest03 at ε = 25 mm give 12,288 nodes, 1.2 GB;
@@ -103,6 +107,31 @@ pub fn build_pcgtsp(
     let start = V::from(options.start);
     let finish = options.finish.map(V::from);
     let prob = Problem::new(nest, start, finish);
+    // Sized before anything is allocated: a contour gives at most one point per step of its
+    // perimeter, one more, and (with vertices) one per span.
+    let perimeter: f64 = prob
+        .shapes
+        .iter()
+        .flat_map(|shape| shape.spans.iter().map(|span| span.length()))
+        .sum();
+    let fixed: usize = prob.shapes.iter().map(|shape| shape.spans.len() + 2).sum();
+    let bound = perimeter / options.step + fixed as f64 + 1.0;
+    if fixed + 1 >= MAX_DISCRETE_NODES {
+        return Err(CcpError::InvalidOption(format!(
+            "{} contours of {} spans need more than the {MAX_DISCRETE_NODES} candidate points \
+             of a dense cost matrix at any step",
+            prob.shapes.len(),
+            fixed - 2 * prob.shapes.len()
+        )));
+    }
+    if bound.is_nan() || bound > MAX_DISCRETE_NODES as f64 {
+        let smallest = perimeter / (MAX_DISCRETE_NODES - fixed - 1) as f64;
+        return Err(CcpError::InvalidOption(format!(
+            "step {} mm gives up to {bound:.0} candidate points, above the {MAX_DISCRETE_NODES} \
+             of a dense cost matrix; use a step of at least {smallest:.3} mm for this nest",
+            options.step
+        )));
+    }
     let mut nodes = vec![DiscreteNode::Depot(options.start)];
     let mut points = vec![start];
     let mut clusters = vec![vec![0usize]];
@@ -121,7 +150,7 @@ pub fn build_pcgtsp(
         clusters.push(cl);
     }
     let n = points.len();
-    if n.checked_mul(n).is_none_or(|nn| nn > 400_000_000) {
+    if n > MAX_DISCRETE_NODES {
         return Err(CcpError::InvalidOption(format!(
             "{n} candidate points: the dense cost matrix is too large"
         )));

@@ -88,7 +88,9 @@ mod search;
 mod solver;
 
 pub use bound::{CcpLowerBound, LowerBoundOptions};
-pub use discrete::{build_pcgtsp, DiscreteInstance, DiscreteNode, DiscretisationOptions};
+pub use discrete::{
+    build_pcgtsp, DiscreteInstance, DiscreteNode, DiscretisationOptions, MAX_DISCRETE_NODES,
+};
 pub use route::{idle_length, route_certificates, route_metrics, ContourCertificate, RouteMetrics};
 pub use solver::{
     solve, solve_with_cancel, CcpOptions, CcpPhase, CcpProgress, CcpResult, CcpSolver, HeatPenalty,

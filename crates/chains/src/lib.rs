@@ -466,7 +466,6 @@ fn point_box_distance(p: Point, b: &BoundingBox) -> f64 {
     dx.hypot(dy)
 }
 
-
 /// What every group needs.
 struct Context<'a> {
     nest: &'a Nest,

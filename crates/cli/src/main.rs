@@ -31,8 +31,10 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use cutroute_engine::{open_document, run_to_end, start_job, AoeJob, SegmentJob};
-use cutroute_geometry::{Entry, MachineParameters, Nest, Objective, PathRoute, Route};
+use cutroute_engine::{open_document, start_job, AoeJob, Job, SegmentJob};
+use cutroute_geometry::{
+    ContainmentForest, Entry, MachineParameters, Nest, Objective, PathRoute, Route,
+};
 use cutroute_protocol::{Document, JobRequest, Problem, Progress, SolverKind, SolverParams};
 use serde_json::{json, Value};
 
@@ -71,25 +73,27 @@ enum Command {
         to: Option<String>,
         /// Solver of the route for gcode/html: nearest, ccp, heuristic or discrete (default: the
         /// route the file holds, else ccp).
-        #[arg(long)]
+        #[arg(long, value_parser = clap::builder::PossibleValuesParser::new(ROUTE_SOLVERS))]
         solver: Option<String>,
-        /// Wall-clock limit of the solver, seconds.
-        #[arg(long, default_value_t = 10.0)]
+        /// Wall-clock limit of the solver, seconds: finite and positive, or `inf` (until proven
+        /// optimal or stopped by Ctrl-C).
+        #[arg(long, default_value = "10", value_parser = time_limit_seconds)]
         time_limit: f64,
         /// Seed of the solver's random choices.
         #[arg(long, default_value_t = 1)]
         seed: u64,
-        /// Spacing of candidate pierce points for the discrete solvers, mm.
-        #[arg(long, default_value_t = 50.0)]
+        /// Spacing of candidate pierce points for the discrete solvers, mm (positive; at
+        /// least the nest's perimeter / 20,000, see the error).
+        #[arg(long, default_value = "50", value_parser = step_mm)]
         step: f64,
         #[command(flatten)]
         gcode: GcodeArgs,
     },
     /// Write a seeded synthetic nest (geometry JSON) for tests and benchmarks.
     Generate {
-        /// Number of contours.
-        #[arg(long)]
-        contours: usize,
+        /// Number of contours, 1 to 1,000,000.
+        #[arg(long, value_parser = clap::value_parser!(u64).range(1..=MAX_GENERATED_CONTOURS))]
+        contours: u64,
         /// Seed of the generator.
         #[arg(long, default_value_t = 1)]
         seed: u64,
@@ -105,19 +109,21 @@ enum Command {
         /// chain (ccp, then chain cutting), aoe (common edges cut once along AOE-chains),
         /// sccp (segment cutting along the plan's common edges) or gsccp (the best of several
         /// segment ensembles).
-        #[arg(long, default_value = "ccp")]
+        #[arg(long, default_value = "ccp", value_parser = clap::builder::PossibleValuesParser::new(SOLVERS))]
         solver: String,
-        /// Wall-clock limit in seconds.
-        #[arg(long, default_value_t = 10.0)]
+        /// Wall-clock limit in seconds: finite and positive, or `inf` (until proven optimal or
+        /// stopped by Ctrl-C, which keeps the best route so far).
+        #[arg(long, default_value = "10", value_parser = time_limit_seconds)]
         time_limit: f64,
         /// Seed of the solver's random choices.
         #[arg(long, default_value_t = 1)]
         seed: u64,
-        /// A known upper bound (exact solver).
-        #[arg(long)]
+        /// A known upper bound (exact solver), finite and non-negative.
+        #[arg(long, value_parser = finite_non_negative)]
         ub: Option<f64>,
-        /// Spacing of candidate pierce points for the discrete solvers on nests, mm.
-        #[arg(long, default_value_t = 50.0)]
+        /// Spacing of candidate pierce points for the discrete solvers on nests, mm (positive;
+        /// at least the nest's perimeter / 20,000, see the error).
+        #[arg(long, default_value = "50", value_parser = step_mm)]
         step: f64,
         /// Prices: idle travel per metre, cut per metre, one pierce (C_off,C_on,C_pt).
         #[arg(long, value_name = "C_off,C_on,C_pt")]
@@ -130,7 +136,7 @@ enum Command {
         task: Option<PathBuf>,
         /// What gsccp minimises when it picks an ensemble, and the unit of the path-route
         /// solvers' (sccp, gsccp, aoe) bounds: time or cost.
-        #[arg(long, default_value = "time")]
+        #[arg(long, default_value = "time", value_parser = ["time", "cost"])]
         objective: String,
         /// Print one JSON object instead of text.
         #[arg(long)]
@@ -140,10 +146,76 @@ enum Command {
     },
 }
 
+/// The `--solver` names of `solve`.
+const SOLVERS: [&str; 9] = [
+    "nearest",
+    "ccp",
+    "heuristic",
+    "exact",
+    "discrete",
+    "chain",
+    "aoe",
+    "sccp",
+    "gsccp",
+];
+
+/// The `--solver` names of `convert`: the solvers whose routes are whole contours.
+const ROUTE_SOLVERS: [&str; 6] = ["nearest", "ccp", "heuristic", "exact", "discrete", "chain"];
+
+/// Most contours `generate` writes: a million contours are about 200 MB of geometry JSON.
+const MAX_GENERATED_CONTOURS: u64 = 1_000_000;
+
+/// `--time-limit`: a finite positive number of seconds, or `inf` / `infinity` (until proven
+/// optimal or stopped by Ctrl-C).
+fn time_limit_seconds(text: &str) -> Result<f64, String> {
+    let value: f64 = text.trim().parse().map_err(|e| format!("{e}"))?;
+    if value == f64::INFINITY || (value.is_finite() && value > 0.0) {
+        Ok(value)
+    } else {
+        Err("expected a finite number of seconds above 0, or inf".into())
+    }
+}
+
+/// `--step`: a finite positive length, mm (the nest bounds it from below, see `build_pcgtsp`).
+fn step_mm(text: &str) -> Result<f64, String> {
+    let value: f64 = text.trim().parse().map_err(|e| format!("{e}"))?;
+    if value.is_finite() && value > 0.0 {
+        Ok(value)
+    } else {
+        Err("expected a finite length above 0 mm".into())
+    }
+}
+
+/// A finite non-negative number.
+fn finite_non_negative(text: &str) -> Result<f64, String> {
+    let value: f64 = text.trim().parse().map_err(|e| format!("{e}"))?;
+    if value.is_finite() && value >= 0.0 {
+        Ok(value)
+    } else {
+        Err("expected a finite number of at least 0".into())
+    }
+}
+
+/// Exit code of a PCGTSP instance without a feasible tour (errors are 1, usage errors 2).
+const EXIT_INFEASIBLE: u8 = 3;
+
+/// Why the CLI failed: an error (exit 1) or a proof that no tour exists (exit 3).
+enum Failure {
+    Error(String),
+    Infeasible(String),
+}
+
+impl From<String> for Failure {
+    fn from(message: String) -> Self {
+        Failure::Error(message)
+    }
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    install_stop_handler();
     let outcome = match cli.command {
-        Command::Inspect { file, json } => inspect(&file, json),
+        Command::Inspect { file, json } => inspect(&file, json).map_err(Failure::Error),
         Command::Convert {
             input,
             output,
@@ -170,12 +242,13 @@ fn main() -> ExitCode {
                 params,
                 &gcode,
             )
+            .map_err(Failure::Error)
         }
         Command::Generate {
             contours,
             seed,
             out,
-        } => generate(contours, seed, &out),
+        } => generate(contours as usize, seed, &out).map_err(Failure::Error),
         Command::Solve {
             file,
             solver,
@@ -189,36 +262,246 @@ fn main() -> ExitCode {
             objective,
             json,
             thermal,
-        } => machine_parameters(cost.as_deref(), speeds.as_deref(), task.as_deref()).and_then(
-            |machine| {
-                let thermal = thermal.parse()?;
-                let objective = match objective.as_str() {
-                    "time" => Objective::Time,
-                    "cost" => Objective::Cost,
-                    other => return Err(format!("--objective {other:?}: expected time or cost")),
-                };
-                let params = SolverParams {
-                    time_limit_s: time_limit,
-                    seed,
-                    discretisation_step_mm: step,
-                    initial_upper_bound: ub,
-                    machine,
-                    objective,
-                };
-                match solver.as_str() {
-                    "sccp" | "gsccp" | "aoe" => solve_path(&file, &solver, params, json, &thermal),
-                    _ => solve(&file, &solver, params, json, &thermal),
+        } => (|| {
+            let machine = machine_parameters(cost.as_deref(), speeds.as_deref(), task.as_deref())?;
+            let thermal = thermal.parse()?;
+            let objective = match objective.as_str() {
+                "time" => Objective::Time,
+                "cost" => Objective::Cost,
+                other => {
+                    return Err(Failure::Error(format!(
+                        "--objective {other:?}: expected time or cost"
+                    )))
                 }
-            },
-        ),
+            };
+            let params = SolverParams {
+                time_limit_s: time_limit,
+                seed,
+                discretisation_step_mm: step,
+                initial_upper_bound: ub,
+                machine,
+                objective,
+            };
+            match solver.as_str() {
+                "sccp" | "gsccp" | "aoe" => Ok(solve_path(&file, &solver, params, json, &thermal)?),
+                _ => solve(&file, &solver, params, json, &thermal),
+            }
+        })(),
     };
     match outcome {
         Ok(()) => ExitCode::SUCCESS,
-        Err(message) => {
+        Err(Failure::Error(message)) => {
             eprintln!("cutroute: {message}");
             ExitCode::FAILURE
         }
+        Err(Failure::Infeasible(message)) => {
+            eprintln!("cutroute: {message}");
+            ExitCode::from(EXIT_INFEASIBLE)
+        }
     }
+}
+
+/// Set by the first Ctrl-C: the running solver stops and its best route so far is reported.
+static STOP_REQUESTED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// First Ctrl-C: ask the solver loop to stop (it prints the best route so far); a second one
+/// exits at once with 130, as a shell's SIGINT would.
+fn install_stop_handler() {
+    use std::sync::atomic::Ordering;
+    // Without a handler (e.g. no signal support) Ctrl-C simply ends the process as before.
+    let _ = ctrlc::set_handler(|| {
+        if STOP_REQUESTED.swap(true, Ordering::SeqCst) {
+            std::process::exit(130);
+        }
+        eprintln!("cutroute: stopping; Ctrl-C again to quit without a result");
+    });
+}
+
+/// A job's final (or latest) state, and earlier routes kept in case it fails the checker.
+#[derive(Default)]
+struct JobRun {
+    last: Option<Progress>,
+    /// Improving routes seen while the job ran, oldest first, at most [`KEPT_ROUTES`].
+    earlier_routes: Vec<Route>,
+    /// Why the run ended early: `None` when the solver ended by itself.
+    stopped: Option<&'static str>,
+    /// The limit it ran under, s (for messages).
+    time_limit_s: f64,
+}
+
+/// How many improving routes a run keeps, at least half a second apart.
+const KEPT_ROUTES: usize = 8;
+
+/// How long past its limit a solver may take to return to the CLI before the CLI reports the
+/// best state it published and exits (the promise is limit + 1 s, report included).
+const GRACE: std::time::Duration = std::time::Duration::from_millis(300);
+
+/// What the CLI's main thread and the solver's thread share.
+#[derive(Default)]
+struct Watch {
+    /// Set by the main thread at the limit or on Ctrl-C: the solver stops at its next slice.
+    stop: std::sync::atomic::AtomicBool,
+    /// Why: set before `stop`.
+    reason: std::sync::Mutex<Option<&'static str>>,
+    /// The latest published state.
+    seen: std::sync::Mutex<JobRun>,
+}
+
+/// Steps a job until it ends or the watch says stop, publishing each slice's state and, now
+/// and then, an improving route (only checked if the final route fails, see
+/// [`checked_route`]).
+fn run_job(job: &mut dyn Job, watch: &Watch, on_progress: &mut dyn FnMut(&Progress)) -> JobRun {
+    use std::sync::atomic::Ordering;
+    let started = std::time::Instant::now();
+    let mut kept_ub = f64::INFINITY;
+    let mut kept_at = -1.0;
+    loop {
+        let status = job.step(cutroute_engine::DEFAULT_SLICE);
+        let progress = job.progress();
+        on_progress(&progress);
+        let elapsed = started.elapsed().as_secs_f64();
+        let mut seen = watch.seen.lock().unwrap_or_else(|e| e.into_inner());
+        if let (Some(route), Some(ub)) = (&progress.route, progress.upper_bound) {
+            if ub < kept_ub && elapsed - kept_at >= 0.5 {
+                if seen.earlier_routes.len() == KEPT_ROUTES {
+                    seen.earlier_routes.remove(0);
+                }
+                seen.earlier_routes.push(route.clone());
+                (kept_ub, kept_at) = (ub, elapsed);
+            }
+        }
+        seen.last = Some(progress);
+        let stop = watch.stop.load(Ordering::SeqCst);
+        if status == cutroute_engine::JobStatus::Done || stop {
+            if stop {
+                seen.stopped = *watch.reason.lock().unwrap_or_else(|e| e.into_inner());
+            }
+            return std::mem::take(&mut *seen);
+        }
+    }
+}
+
+/// Runs `work` (which builds and steps a solver, see [`run_job`]) on its own thread, so the
+/// CLI keeps its promises whatever the solver does: at `time_limit_s` after the start, or at
+/// the first Ctrl-C, the watch asks the solver to stop; if it has not returned [`GRACE`]
+/// later, the latest state it published is taken (and the thread ends with the process).
+/// Build phases (matrices, lattices, discretisations) count against the limit.
+fn run_bounded<T: Send + 'static>(
+    time_limit_s: f64,
+    work: impl FnOnce(&Watch) -> Result<T, Failure> + Send + 'static,
+) -> Result<Result<T, JobRun>, Failure> {
+    use std::sync::atomic::Ordering;
+    use std::sync::Arc;
+    let watch = Arc::new(Watch::default());
+    let (done, result) = std::sync::mpsc::channel();
+    let shared = Arc::clone(&watch);
+    std::thread::spawn(move || {
+        let _ = done.send(work(&shared));
+    });
+    let started = std::time::Instant::now();
+    let mut stop_at: Option<std::time::Instant> = None;
+    loop {
+        match result.recv_timeout(std::time::Duration::from_millis(10)) {
+            Ok(outcome) => return outcome.map(Ok),
+            // A panic in the solver's thread: reported as an error, not as a crash.
+            Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => {
+                return Err(Failure::Error("the solver failed (internal error)".into()))
+            }
+            Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {}
+        }
+        let limit_passed = started.elapsed().as_secs_f64() >= time_limit_s;
+        if stop_at.is_none() && (limit_passed || STOP_REQUESTED.load(Ordering::SeqCst)) {
+            *watch.reason.lock().unwrap_or_else(|e| e.into_inner()) =
+                Some(if limit_passed { "time limit" } else { "Ctrl-C" });
+            watch.stop.store(true, Ordering::SeqCst);
+            stop_at = Some(std::time::Instant::now());
+        }
+        if stop_at.is_some_and(|at| at.elapsed() >= GRACE) {
+            let mut seen = watch.seen.lock().unwrap_or_else(|e| e.into_inner());
+            let mut run = std::mem::take(&mut *seen);
+            run.stopped = Some(if limit_passed {
+                "time limit (the solver was still in a long step)"
+            } else {
+                "Ctrl-C"
+            });
+            return Ok(Err(run));
+        }
+    }
+}
+
+/// The run of the request's job on the solver's thread, bounded by [`run_bounded`]: the job
+/// `make_job` builds (a heated one), else the engine's own.
+fn bounded_job_run(
+    request: JobRequest,
+    as_json: bool,
+    make_job: impl FnOnce(&JobRequest) -> Result<Option<Box<dyn Job>>, String> + Send + 'static,
+) -> Result<JobRun, Failure> {
+    let time_limit_s = request.params.time_limit_s;
+    let outcome = run_bounded(time_limit_s, move |watch| {
+        let mut job = match make_job(&request).map_err(Failure::Error)? {
+            Some(job) => job,
+            None => start_job(&request)
+                .map_err(|e| Failure::Error(format!("--solver {}: {e}", request.solver.name())))?,
+        };
+        Ok(run_job(job.as_mut(), watch, &mut progress_printer(as_json)))
+    })?;
+    let mut run = outcome.unwrap_or_else(|snapshot| snapshot);
+    run.time_limit_s = time_limit_s;
+    Ok(run)
+}
+
+/// The run's route if it passes the checker, else the newest earlier route that does (with
+/// the final route's problem, reported as `final_route_rejected`): a solver's last word never
+/// loses a valid route it had. An error when no route passes.
+fn checked_route(
+    run: &JobRun,
+    nest: &Nest,
+    forest: &ContainmentForest,
+) -> Result<(Route, Option<String>), String> {
+    let tolerance = 1e-6 * nest_scale(nest);
+    let first_problem = |route: &Route| route.problems(nest, forest, tolerance).into_iter().next();
+    let no_route = || match run.stopped {
+        Some(why) => format!(
+            "--time-limit {}: the solver found no route before it was stopped ({why})",
+            run.time_limit_s
+        ),
+        None => "the solver found no route".to_string(),
+    };
+    let route = run
+        .last
+        .as_ref()
+        .and_then(|p| p.route.as_ref())
+        .ok_or_else(no_route)?;
+    let problem = match first_problem(route) {
+        None => return Ok((route.clone(), None)),
+        Some(e) => format!("invalid route: {e}"),
+    };
+    run.earlier_routes
+        .iter()
+        .rev()
+        .find(|earlier| first_problem(earlier).is_none())
+        .map(|earlier| (earlier.clone(), Some(problem.clone())))
+        .ok_or(problem)
+}
+
+/// The checker's containment forest of a nest, built on its own thread while the solver runs:
+/// on 100,000 contours building it after the solver stopped broke the time-limit promise.
+fn forest_in_background(problem: &Problem) -> Option<std::thread::JoinHandle<ContainmentForest>> {
+    let Problem::Nest { nest, .. } = problem else {
+        return None;
+    };
+    let nest = nest.clone();
+    Some(std::thread::spawn(move || nest.containment_forest()))
+}
+
+/// The forest [`forest_in_background`] built (built here if its thread failed).
+fn joined_forest(
+    handle: Option<std::thread::JoinHandle<ContainmentForest>>,
+    nest: &Nest,
+) -> ContainmentForest {
+    handle
+        .and_then(|h| h.join().ok())
+        .unwrap_or_else(|| nest.containment_forest())
 }
 
 /// Three comma-separated finite non-negative numbers.
@@ -417,7 +700,7 @@ fn convert(
     let document = open(input)?;
     let Problem::Nest { nest, .. } = &document.problem else {
         return Err(format!(
-            "{}: not a nest; only nests can be converted",
+            "{}: line 1 starts a PCGTSP instance, not a nest; only nests can be converted",
             input.display()
         ));
     };
@@ -454,7 +737,14 @@ fn convert(
         }
     };
     let bytes: Vec<u8> = match format.as_str() {
-        "dbs" => cutroute_formats::write_dbs(nest).map_err(|e| e.to_string())?,
+        // DBS names are 8 CP866 characters: longer names are cut, others written as `?`.
+        "dbs" => cutroute_formats::write_dbs_with(
+            nest,
+            &cutroute_formats::DbsWriteOptions {
+                truncate_long_names: true,
+            },
+        )
+        .map_err(|e| e.to_string())?,
         "json" => cutroute_formats::write_geometry_json(nest)
             .map_err(|e| e.to_string())?
             .into_bytes(),
@@ -524,30 +814,25 @@ fn solved(document: &Document, solver_name: &str, params: SolverParams) -> Resul
         solver,
         params,
     };
-    let mut job = start_job(&request).map_err(|e| e.to_string())?;
-    let progress = run_to_end(job.as_mut(), &mut |_| {});
-    let tolerance = 1e-6 * nest_scale(nest);
-    match (progress.route, progress.path_route) {
-        (Some(route), _) => {
-            route
-                .validate(nest, tolerance)
-                .map_err(|e| format!("invalid route: {e}"))?;
-            Ok(Routed::Contours(route))
+    let forest = forest_in_background(&request.problem);
+    let run = bounded_job_run(request, true, |_| Ok(None)).map_err(|f| match f {
+        Failure::Error(m) | Failure::Infeasible(m) => m,
+    })?;
+    if let Some(paths) = run.last.as_ref().and_then(|p| p.path_route.clone()) {
+        // As `solve` checks path routes: a contour cut twice (standard cutting of common
+        // edges) is allowed, nothing else.
+        let problems = paths.problems(nest, nest.check_tolerance());
+        if let Some(other) = problems
+            .iter()
+            .find(|p| !matches!(p, cutroute_geometry::PathRouteError::Overlap { .. }))
+        {
+            return Err(format!("the {solver_name} solver: invalid route: {other}"));
         }
-        (None, Some(paths)) => {
-            // As `solve` checks path routes: a contour cut twice (standard cutting of common
-            // edges) is allowed, nothing else.
-            let problems = paths.problems(nest, tolerance);
-            if let Some(other) = problems
-                .iter()
-                .find(|p| !matches!(p, cutroute_geometry::PathRouteError::Overlap { .. }))
-            {
-                return Err(format!("invalid route: {other}"));
-            }
-            Ok(Routed::Paths(paths))
-        }
-        (None, None) => Err(format!("the {solver_name} solver found no route")),
+        return Ok(Routed::Paths(paths));
     }
+    checked_route(&run, nest, &joined_forest(forest, nest))
+        .map(|(route, _)| Routed::Contours(route))
+        .map_err(|e| format!("the {solver_name} solver: {e}"))
 }
 
 /// The solver a CLI name selects; "discrete" is the heuristic on a discretised nest.
@@ -574,7 +859,7 @@ fn solve(
     params: SolverParams,
     as_json: bool,
     thermal: &thermal::Thermal,
-) -> Result<(), String> {
+) -> Result<(), Failure> {
     let document = open(path)?;
     let solver = solver_kind(solver_name)?;
     let (machine, objective) = (params.machine, params.objective);
@@ -584,26 +869,28 @@ fn solve(
         solver,
         params,
     };
-    let mut job = match thermal.heated_job(&request)? {
-        Some(job) => job,
-        None => start_job(&request).map_err(|e| e.to_string())?,
-    };
-    let mut result = run_to_end(job.as_mut(), &mut progress_printer(as_json));
+    let forest = forest_in_background(&request.problem);
+    let heated = thermal.clone();
+    let mut run = bounded_job_run(request, as_json, move |r| heated.heated_job(r))?;
     let report = match &document.problem {
-        Problem::PcgtspText { .. } => tour_report(solver_name, &result),
+        Problem::PcgtspText { text } => tour_report(solver_name, text, &run)?,
         Problem::Nest { nest, .. } => {
-            if let Some(route) = result.route.take() {
-                let route = thermal.enforce(nest, route, &machine, objective)?;
-                if !result.certified.is_empty() {
-                    // Certificates of the route reported, not of the one before the repair.
-                    let certified = cutroute_ccp::route_certificates(nest, &route)
-                        .map_err(|e| e.to_string())?;
-                    result.certified = certified.iter().map(|c| c.condition1).collect();
+            let forest = joined_forest(forest, nest);
+            // With `--rules-hard`, the route repaired until the rules hold (and its
+            // certificates recomputed): the report describes the route it prints.
+            if let Some(last) = run.last.as_mut() {
+                if let Some(route) = last.route.take() {
+                    let route = thermal.enforce(nest, route, &machine, objective)?;
+                    if !last.certified.is_empty() {
+                        let certified = cutroute_ccp::route_certificates(nest, &route)
+                            .map_err(|e| e.to_string())?;
+                        last.certified = certified.iter().map(|c| c.condition1).collect();
+                    }
+                    last.route = Some(route);
                 }
-                result.route = Some(route);
             }
-            let mut report = route_report(solver_name, nest, &machine, &result)?;
-            if let Some(route) = &result.route {
+            let mut report = route_report(solver_name, nest, &machine, &run, &forest)?;
+            if let Some(route) = run.last.as_ref().and_then(|p| p.route.as_ref()) {
                 thermal.report(&mut report, nest, route, &machine, objective)?;
             }
             report
@@ -643,18 +930,43 @@ fn fmt(value: Option<f64>) -> String {
         .unwrap_or_else(|| "—".into())
 }
 
-/// The PCGTSP report: tour as 1-based node ids of the instance, starting at the depot.
-fn tour_report(solver: &str, result: &Progress) -> Value {
-    json!({
+/// The PCGTSP report: tour as 1-based node ids of the instance, starting at the depot, and
+/// checked by `check_tour`. No tour is a failure: infeasibility when the exact search ended
+/// without one (exit 3), else "none found" within the limit (exit 3 too: no tour to report).
+fn tour_report(solver: &str, text: &str, run: &JobRun) -> Result<Value, Failure> {
+    let instance = cutroute_pcgtsp::Instance::parse(text).map_err(|e| e.to_string())?;
+    let Some(result) = &run.last else {
+        return Err(Failure::Infeasible(format!(
+            "--time-limit {}: the {solver} solver found no tour before it was stopped",
+            run.time_limit_s
+        )));
+    };
+    let Some(tour) = &result.tour else {
+        return Err(Failure::Infeasible(
+            if result.proven_optimal && run.stopped.is_none() {
+                format!("the {solver} solver proved that the instance has no feasible tour")
+            } else {
+                format!(
+                "the {solver} solver found no feasible tour in {:.1} s (not a proof that none exists)",
+                result.elapsed_s
+            )
+            },
+        ));
+    };
+    let cost = cutroute_pcgtsp::check_tour(&instance, tour)
+        .map_err(|e| format!("the {solver} solver's tour fails the checker: {e}"))?;
+    Ok(json!({
         "solver": solver,
         "ub": result.upper_bound,
         "lb": result.lower_bound,
         "gap": result.gap(),
         "proven_optimal": result.proven_optimal,
-        "tour": result.tour.as_ref().map(|t| t.iter().map(|n| n + 1).collect::<Vec<_>>()),
+        "cost": cost,
+        "tour": tour.iter().map(|n| n + 1).collect::<Vec<_>>(),
         "elapsed_s": result.elapsed_s,
         "states": result.states,
-    })
+        "stopped": run.stopped,
+    }))
 }
 
 /// The nest report: lengths recomputed from the route itself, not taken from the solver; time
@@ -664,12 +976,12 @@ fn route_report(
     solver: &str,
     nest: &Nest,
     machine: &MachineParameters,
-    result: &Progress,
+    run: &JobRun,
+    forest: &ContainmentForest,
 ) -> Result<Value, String> {
-    let route: &Route = result.route.as_ref().ok_or("the solver found no route")?;
-    route
-        .validate(nest, 1e-6 * nest_scale(nest))
-        .map_err(|e| format!("invalid route: {e}"))?;
+    let (route, final_route_rejected) = checked_route(run, nest, forest)?;
+    let result = run.last.as_ref().ok_or("the solver found no route")?;
+    let route = &route;
     let idle_length = route.idle_length();
     let cut_length = route.cut_length(nest);
     let pierces = route.pierce_count();
@@ -693,11 +1005,13 @@ fn route_report(
             step
         }).collect::<Vec<_>>(),
         "certified_contours": result.certified.iter().filter(|c| **c).count(),
-        "ub": result.upper_bound,
+        "ub": if final_route_rejected.is_some() { Some(route.idle_length()) } else { result.upper_bound },
         "lb": result.lower_bound,
         "gap": result.gap(),
         "proven_optimal": result.proven_optimal,
         "elapsed_s": result.elapsed_s,
+        "final_route_rejected": final_route_rejected,
+        "stopped": run.stopped,
     }))
 }
 
@@ -739,18 +1053,12 @@ fn solve_path(
     let document = open(path)?;
     let Problem::Nest { nest, .. } = &document.problem else {
         return Err(format!(
-            "the {solver_name} solver routes nests, not PCGTSP instances"
+            "--solver {solver_name}: routes nests, not PCGTSP instances"
         ));
     };
     let solver = solver_kind(solver_name)?;
-    if solver != SolverKind::Aoe && !(params.time_limit_s.is_finite() && params.time_limit_s > 0.0)
-    {
-        return Err(format!(
-            "--time-limit {}: must be a positive number of seconds",
-            params.time_limit_s
-        ));
-    }
     let machine = params.machine;
+    let time_limit_s = params.time_limit_s;
     let objective = params.objective;
     let request = JobRequest {
         job_id: 1,
@@ -759,60 +1067,83 @@ fn solve_path(
         params,
     };
     let started = std::time::Instant::now();
-    let mut on_progress = progress_printer(as_json);
-    let mut extra = serde_json::Map::new();
-    let progress = if solver == SolverKind::Aoe {
-        let mut job = AoeJob::from_request(&request).map_err(|e| e.to_string())?;
-        let progress = run_to_end(&mut job, &mut on_progress);
-        let (solution, _) = match job.outcome() {
-            Some(Ok(solved)) => solved,
-            Some(Err(e)) => return Err(e.clone()),
-            None => return Err("the aoe job did not run".into()),
+    let outcome = run_bounded(time_limit_s, move |watch| {
+        let mut on_progress = progress_printer(as_json);
+        let mut extra = serde_json::Map::new();
+        let progress = if solver == SolverKind::Aoe {
+            let mut job =
+                AoeJob::from_request(&request).map_err(|e| format!("--solver aoe: {e}"))?;
+            let progress = run_job(&mut job, watch, &mut on_progress).last;
+            let (solution, _) = match job.outcome() {
+                Some(Ok(solved)) => solved,
+                Some(Err(e)) => return Err(Failure::Error(format!("--solver aoe: {e}"))),
+                None => return Err(Failure::Error("the aoe job did not run".into())),
+            };
+            extra.insert(
+                "pierce_lower_bound".into(),
+                json!(solution.pierce_lower_bound),
+            );
+            extra.insert("components".into(), json!(solution.components));
+            progress
+        } else {
+            let mut job = SegmentJob::from_request(&request)
+                .map_err(|e| format!("--solver {}: {e}", request.solver.name()))?;
+            let progress = run_job(&mut job, watch, &mut on_progress).last;
+            let result = job
+                .search()
+                .result()
+                .map_err(|e| format!("--solver {}: {e}", request.solver.name()))?;
+            extra.insert(
+                "ensemble".into(),
+                json!(result.best.map_or("ccp", |kind| kind.name())),
+            );
+            extra.insert(
+                "ensembles".into(),
+                json!(result
+                    .reports
+                    .iter()
+                    .map(|r| json!({
+                        "kind": r.kind.name(),
+                        "segments": r.segments,
+                        "pierces": r.pierces,
+                        "idle_length": finite(r.idle_length),
+                        "cut_length": finite(r.cut_length),
+                        "recut_length": r.recut_length,
+                        "time_s": finite(r.time_s),
+                        "cost": finite(r.cost),
+                        "failure": r.failure,
+                    }))
+                    .collect::<Vec<_>>()),
+            );
+            extra.insert(
+                "ccp".into(),
+                json!({
+                    "idle_length": result.ccp_route.idle_length(),
+                    "cut_length": result.ccp_route.cut_length(),
+                    "pierces": result.ccp_route.pierce_count(),
+                    "time_s": result.ccp_route.time(&machine),
+                    "cost": result.ccp_route.cost(&machine),
+                }),
+            );
+            progress
         };
-        extra.insert(
-            "pierce_lower_bound".into(),
-            json!(solution.pierce_lower_bound),
-        );
-        extra.insert("components".into(), json!(solution.components));
-        progress
-    } else {
-        let mut job = SegmentJob::from_request(&request).map_err(|e| e.to_string())?;
-        let progress = run_to_end(&mut job, &mut on_progress);
-        let result = job.search().result().map_err(|e| e.to_string())?;
-        extra.insert(
-            "ensemble".into(),
-            json!(result.best.map_or("ccp", |kind| kind.name())),
-        );
-        extra.insert(
-            "ensembles".into(),
-            json!(result
-                .reports
-                .iter()
-                .map(|r| json!({
-                    "kind": r.kind.name(),
-                    "segments": r.segments,
-                    "pierces": r.pierces,
-                    "idle_length": finite(r.idle_length),
-                    "cut_length": finite(r.cut_length),
-                    "recut_length": r.recut_length,
-                    "time_s": finite(r.time_s),
-                    "cost": finite(r.cost),
-                    "failure": r.failure,
-                }))
-                .collect::<Vec<_>>()),
-        );
-        extra.insert(
-            "ccp".into(),
-            json!({
-                "idle_length": result.ccp_route.idle_length(),
-                "cut_length": result.ccp_route.cut_length(),
-                "pierces": result.ccp_route.pierce_count(),
-                "time_s": result.ccp_route.time(&machine),
-                "cost": result.ccp_route.cost(&machine),
-            }),
-        );
-        progress
+        Ok((progress, extra))
+    })
+    .map_err(|f| match f {
+        Failure::Error(m) | Failure::Infeasible(m) => m,
+    })?;
+    // Stopped in a long step: the latest published state, without the job's own extras.
+    let (progress, extra, stopped) = match outcome {
+        Ok((progress, extra)) => (progress, extra, None),
+        Err(run) => (run.last, serde_json::Map::new(), run.stopped),
     };
+    let progress = progress.ok_or_else(|| {
+        format!(
+            "--time-limit {time_limit_s}: the {solver_name} solver found no route before it \
+             was stopped ({})",
+            stopped.unwrap_or("")
+        )
+    })?;
     let route = progress
         .path_route
         .as_ref()
@@ -847,6 +1178,7 @@ fn solve_path(
         "lb": progress.lower_bound,
         "phase": progress.phase,
         "elapsed_s": started.elapsed().as_secs_f64(),
+        "stopped": stopped,
     });
     if let Value::Object(fields) = &mut report {
         fields.extend(extra);
@@ -862,5 +1194,79 @@ fn finite(value: f64) -> Value {
         json!(value)
     } else {
         Value::Null
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use cutroute_geometry::{Contour, ContourRef, CutStep, Part, Point, Vertex};
+
+    fn square(x: f64) -> Contour {
+        Contour::new(vec![
+            Vertex::line(x, 0.0),
+            Vertex::line(x, 10.0),
+            Vertex::line(x + 10.0, 10.0),
+            Vertex::line(x + 10.0, 0.0),
+        ])
+    }
+
+    fn route(parts: &[usize]) -> Route {
+        Route {
+            start: Point::new(0.0, 0.0),
+            steps: parts
+                .iter()
+                .map(|&part| {
+                    CutStep::pierced(
+                        ContourRef { part, contour: 0 },
+                        Point::new(part as f64 * 20.0, 0.0),
+                    )
+                })
+                .collect(),
+            finish: None,
+        }
+    }
+
+    fn run_ending_with(last: Route, earlier: Vec<Route>) -> JobRun {
+        JobRun {
+            last: Some(Progress {
+                route: Some(last),
+                ..Progress::default()
+            }),
+            earlier_routes: earlier,
+            stopped: None,
+            time_limit_s: 1.0,
+        }
+    }
+
+    /// Item 13 of issue #15: a final route that fails the checker never hides a valid one.
+    #[test]
+    fn a_failing_final_route_gives_way_to_the_newest_valid_earlier_route() {
+        let nest = Nest {
+            sheet: None,
+            parts: (0..2)
+                .map(|i| Part {
+                    name: format!("P{i}"),
+                    contours: vec![square(i as f64 * 20.0)],
+                })
+                .collect(),
+        };
+        let forest = nest.containment_forest();
+        let valid = route(&[0, 1]);
+        let (chosen, rejected) =
+            checked_route(&run_ending_with(valid.clone(), vec![]), &nest, &forest).unwrap();
+        assert_eq!((chosen, rejected), (valid.clone(), None));
+
+        let invalid = route(&[0]); // part 1 never cut
+        let run = run_ending_with(invalid.clone(), vec![route(&[1]), valid.clone()]);
+        let (chosen, rejected) = checked_route(&run, &nest, &forest).unwrap();
+        assert_eq!(chosen, valid);
+        assert!(rejected.unwrap().starts_with("invalid route"));
+
+        // Nothing valid at all: a clear error, never the invalid route.
+        let run = run_ending_with(invalid.clone(), vec![route(&[1])]);
+        assert!(checked_route(&run, &nest, &forest)
+            .unwrap_err()
+            .starts_with("invalid route"));
     }
 }

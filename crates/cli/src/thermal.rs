@@ -35,6 +35,7 @@ pub struct ThermalArgs {
 }
 
 /// The parsed thermal settings.
+#[derive(Clone)]
 pub struct Thermal {
     model: HeatModel,
     weight: f64,

@@ -51,6 +51,9 @@ pub use path_jobs::{AoeJob, PlanBound, SegmentJob};
 /// How long one [`Job::step`] may run before it returns, so cancel requests are seen quickly.
 pub const DEFAULT_SLICE: Duration = Duration::from_millis(40);
 
+/// The share of a chain job's time limit its CCP phase gets; chain cutting has the rest.
+pub const CHAIN_CCP_SHARE: f64 = 0.6;
+
 /// What a step left behind.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum JobStatus {
@@ -96,6 +99,8 @@ pub enum EngineError {
 pub fn start_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
     let params = &request.params;
     let time_limit = Duration::from_secs_f64(params.time_limit_s.clamp(0.0, 1.0e7));
+    // Building the problem (a discretisation's dense matrix) counts against the limit.
+    let started = web_time::Instant::now();
     let solver = request.solver;
     let refused = |message: String| EngineError::SolverRefused {
         solver: solver.name(),
@@ -112,7 +117,10 @@ pub fn start_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
             instance,
             discrete,
             mode,
-            time_limit,
+            // At least a tenth of the limit, for a first tour after a long build.
+            time_limit
+                .saturating_sub(started.elapsed())
+                .max(time_limit / 10),
             params.seed,
             params.initial_upper_bound,
         )
@@ -141,8 +149,14 @@ pub fn start_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
             },
             SolverKind::Ccp | SolverKind::Chain,
         ) => {
+            // Chain cutting runs after CCP within the same limit: CCP gets its share of it.
+            let ccp_limit = if solver == SolverKind::Chain {
+                time_limit.mul_f64(CHAIN_CCP_SHARE)
+            } else {
+                time_limit
+            };
             let options =
-                jobs::ccp_options(*start, *finish, time_limit, params.seed, params.machine);
+                jobs::ccp_options(*start, *finish, ccp_limit, params.seed, params.machine);
             let ccp =
                 cutroute_ccp::CcpSolver::new(nest, options).map_err(|e| refused(e.to_string()))?;
             if solver == SolverKind::Chain {

@@ -5,6 +5,8 @@ use std::collections::HashMap;
 use cutroute_geometry::{ContourRef, CutStep, MachineParameters, Nest, Point, Route};
 use cutroute_protocol::{JobId, Progress};
 use cutroute_thermal::{HeatModel, Pierce};
+use rstar::primitives::GeomWithData;
+use rstar::RTree;
 use web_time::{Duration, Instant};
 
 use crate::{EngineError, Job, JobStatus};
@@ -76,6 +78,94 @@ impl NearestNeighbourJob {
     }
 
     fn solve(&mut self) {
+        if self.heat.is_some() {
+            self.solve_scan();
+        } else {
+            self.solve_indexed();
+        }
+    }
+
+    /// O(V log V) for V vertices: an R-tree holds the vertices of the contours that may be cut
+    /// now (every contour inside them cut) and are not cut yet; a contour's vertices enter
+    /// when its last inner contour is cut and leave when it is cut (a quadratic scan took 39 s
+    /// on 30,000 contours). Ties go to the lowest (part, contour, vertex), so runs repeat.
+    fn solve_indexed(&mut self) {
+        let forest = self.nest.containment_forest();
+        let refs: Vec<ContourRef> = self.nest.contour_refs().collect();
+        // Contours still to cut inside each contour: it waits for them (inner before outer).
+        let mut inner_left: HashMap<ContourRef, usize> = refs
+            .iter()
+            .map(|&r| (r, forest.children(r).len()))
+            .collect();
+        let vertices_of = |r: ContourRef| {
+            let contour = &self.nest.parts[r.part].contours[r.contour];
+            contour
+                .vertices
+                .iter()
+                .enumerate()
+                .map(move |(k, v)| ReadyVertex::new([v.point.x, v.point.y], (r, k)))
+        };
+        let mut ready: RTree<ReadyVertex> = RTree::bulk_load(
+            refs.iter()
+                .filter(|r| inner_left[r] == 0)
+                .flat_map(|&r| vertices_of(r))
+                .collect(),
+        );
+        let mut position = self.start;
+        let mut steps = Vec::with_capacity(refs.len());
+        let mut idle_length = 0.0;
+        loop {
+            let query = [position.x, position.y];
+            let mut nearest = ready.nearest_neighbor_iter_with_distance_2(&query);
+            let Some((first, d2)) = nearest.next() else {
+                break; // every contour with vertices is cut
+            };
+            let mut best = first;
+            for (other, other_d2) in nearest {
+                if other_d2 > d2 {
+                    break;
+                }
+                if other.data < best.data {
+                    best = other;
+                }
+            }
+            let (contour_ref, _) = best.data;
+            let pierce_point = Point::new(best.geom()[0], best.geom()[1]);
+            for vertex in vertices_of(contour_ref).collect::<Vec<_>>() {
+                ready.remove(&vertex);
+            }
+            if let Some(parent) = forest.parent(contour_ref) {
+                if let Some(left) = inner_left.get_mut(&parent) {
+                    *left -= 1;
+                    if *left == 0 {
+                        for vertex in vertices_of(parent) {
+                            ready.insert(vertex);
+                        }
+                    }
+                }
+            }
+            idle_length += distance(position, pierce_point);
+            position = pierce_point;
+            steps.push(CutStep {
+                contour: contour_ref,
+                pierce_point,
+                entry: Default::default(),
+            });
+        }
+        if let Some(finish) = self.finish {
+            idle_length += distance(position, finish);
+        }
+        self.idle_length = idle_length;
+        self.route = Some(Route {
+            start: self.start,
+            steps,
+            finish: self.finish,
+        });
+    }
+
+    /// The heat-aware choice: a scan of every vertex of every contour that may be cut now
+    /// (quadratic; the heat term is not a distance an index could order by).
+    fn solve_scan(&mut self) {
         let forest = self.nest.containment_forest();
         let mut remaining: Vec<ContourRef> = self.nest.contour_refs().collect();
         // Contours still to cut inside each contour: it waits for them (inner before outer).
@@ -154,6 +244,9 @@ impl NearestNeighbourJob {
         });
     }
 }
+
+/// A vertex of a contour that may be cut now: (contour, vertex index).
+type ReadyVertex = GeomWithData<[f64; 2], (ContourRef, usize)>;
 
 fn distance(a: Point, b: Point) -> f64 {
     (a.x - b.x).hypot(a.y - b.y)

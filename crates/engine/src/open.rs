@@ -25,10 +25,19 @@ pub enum OpenError {
     TaskWithoutGeometry(String),
     /// Nothing recognisable.
     #[error(
-        "{0}: unknown format (expected DBS, geometry/task/result JSON, DXF, T-FLEX, a PCGLNS/PCGTSPLIB \
-         instance or result, or G-code)"
+        "{0}: unknown format from byte 0 (expected DBS, geometry/task/result JSON, DXF, T-FLEX, \
+         a PCGLNS/PCGTSPLIB instance or result, or G-code)"
     )]
     UnknownFormat(String),
+    /// A JSON object that does not parse, or parses as none of the JSON formats: the message
+    /// gives the line and column.
+    #[error("{file_name} (JSON): {message}")]
+    MalformedJson {
+        /// The file's name.
+        file_name: String,
+        /// What is wrong, with line and column.
+        message: String,
+    },
     /// The file reads but holds nothing to cut.
     #[error("{0}: the file holds no closed contours to cut")]
     NothingToCut(String),
@@ -190,7 +199,8 @@ pub(crate) fn open_model_file(file_name: &str, bytes: &[u8]) -> Result<Document,
             first.nest
         }
         Format::Pcglns => {
-            let text = std::str::from_utf8(bytes).map_err(|e| unreadable(e.to_string()))?;
+            let text = std::str::from_utf8(bytes)
+                .map_err(|e| unreadable(format!("byte {}: not UTF-8 text", e.valid_up_to())))?;
             Instance::parse(text).map_err(|e| unreadable(e.to_string()))?;
             return Ok(Document {
                 file_name: file_name.to_string(),
@@ -205,8 +215,11 @@ pub(crate) fn open_model_file(file_name: &str, bytes: &[u8]) -> Result<Document,
             });
         }
         Format::TaskJson => return Err(OpenError::TaskWithoutGeometry(file_name.to_string())),
-        Format::Unknown => return Err(OpenError::UnknownFormat(file_name.to_string())),
+        Format::Unknown => return Err(unknown_format(file_name, bytes)),
     };
+    // Every reader checks its own values with a location; this catches what a reader builds
+    // (DXF and T-FLEX transforms, arcs) against the same domain, located by part and contour.
+    nest.check_domain().map_err(|e| unreadable(e.to_string()))?;
     let nest = oriented(nest);
     if nest.contour_count() == 0 {
         return Err(OpenError::NothingToCut(file_name.to_string()));
@@ -225,6 +238,30 @@ pub(crate) fn open_model_file(file_name: &str, bytes: &[u8]) -> Result<Document,
         task_speeds: None,
         warnings,
     })
+}
+
+/// Why a file is of no known format, located: a JSON object that does not parse gets serde's
+/// line and column, one that parses gets the keys it lacks; anything else is unknown from
+/// byte 0.
+fn unknown_format(file_name: &str, bytes: &[u8]) -> OpenError {
+    let first = bytes.iter().find(|b| !b.is_ascii_whitespace());
+    if first != Some(&b'{') {
+        return OpenError::UnknownFormat(file_name.to_string());
+    }
+    let message = match serde_json::from_slice::<serde::de::IgnoredAny>(bytes) {
+        Err(e) => format!(
+            "line {} column {}: malformed JSON: {e}",
+            e.line(),
+            e.column()
+        ),
+        Ok(_) => "line 1 column 1: a JSON object with neither `TaskData` and `Contours` (task) \
+                  nor `job` and `results` (result)"
+            .to_string(),
+    };
+    OpenError::MalformedJson {
+        file_name: file_name.to_string(),
+        message,
+    }
 }
 
 fn oriented(mut nest: Nest) -> Nest {

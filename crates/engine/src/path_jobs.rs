@@ -14,7 +14,6 @@ use web_time::{Duration, Instant};
 
 use crate::{EngineError, Job, JobStatus};
 
-
 /// What every route of a plan must at least cut and pierce, from the nest's plane graph
 /// (`cutroute-aoe`'s [`PlanGraph`]: contours split at touchings and crossings, common edges
 /// merged).

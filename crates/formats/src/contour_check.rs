@@ -2,7 +2,7 @@
 //! reader applies to it. The readers wrap a [`ContourProblem`] into their own error type together
 //! with the location (byte offset or JSON path).
 
-use cutroute_geometry::{Contour, Vertex};
+use cutroute_geometry::{domain, Contour, DomainError, Vertex};
 
 /// How far apart (mm) the first and last stored points may be for the contour to count as closed.
 pub const DEFAULT_CLOSURE_TOLERANCE: f64 = 1e-3;
@@ -28,6 +28,10 @@ pub enum ContourProblem {
         /// Index of the offending point in the stored list.
         index: usize,
     },
+    /// A coordinate, bulge or the contour's size is outside the readers' domain
+    /// (`cutroute_geometry::domain`).
+    #[error("contour {0}")]
+    Domain(#[from] DomainError),
     /// The contour crosses or touches itself.
     #[error("contour intersects itself: spans {first_span} and {second_span} meet at ({x}, {y})")]
     SelfIntersecting {
@@ -52,6 +56,11 @@ pub(crate) fn closed_contour(
     if let Some(index) = points.iter().position(|p| p.iter().any(|v| !v.is_finite())) {
         return Err(ContourProblem::NonFinite { index });
     }
+    for (index, p) in points.iter().enumerate() {
+        domain::check_coordinate(index, p[0])?;
+        domain::check_coordinate(index, p[1])?;
+        domain::check_bulge(index, p[2])?;
+    }
     let (first, last) = match (points.first(), points.last()) {
         (Some(f), Some(l)) if points.len() >= 2 => (f, l),
         _ => {
@@ -75,6 +84,7 @@ pub(crate) fn closed_contour(
         });
     }
     let contour = Contour::new(vertices);
+    domain::check_contour(&contour)?;
     if check_self_intersection {
         if let Some(hit) = contour.first_self_intersection() {
             return Err(ContourProblem::SelfIntersecting {

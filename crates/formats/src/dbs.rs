@@ -290,8 +290,10 @@ pub enum DbsWriteError {
         /// Part index (the sheet is 0 when present).
         part: usize,
     },
-    /// The name does not fit 8 single-byte characters.
-    #[error("part {part} name {name:?} does not fit 8 single-byte characters")]
+    /// The name does not fit 8 CP866 characters (ASCII and Russian letters).
+    #[error(
+        "part {part} name {name:?} does not fit 8 CP866 characters (ASCII and Russian letters)"
+    )]
     NameNotRepresentable {
         /// Part index (the sheet is 0 when present).
         part: usize,
@@ -303,7 +305,8 @@ pub enum DbsWriteError {
 /// Options of [`write_dbs_with`].
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct DbsWriteOptions {
-    /// Cut names longer than 8 characters instead of failing.
+    /// Cut names longer than 8 characters, and write characters CP866 lacks as `?`, instead
+    /// of failing.
     pub truncate_long_names: bool,
 }
 
@@ -549,7 +552,7 @@ pub fn read_dbs_with(bytes: &[u8], options: &DbsReadOptions) -> Result<DbsFile, 
                 }
                 let raw = &bytes[pos + HEADER_LEN..pos + HEADER_LEN + 8];
                 // Characters are stored pair-swapped: «CIRCLE1» is «ICCREL 1».
-                let name: String = (0..8).map(|i| char::from(raw[i ^ 1])).collect();
+                let name: String = (0..8).map(|i| cp866_char(raw[i ^ 1])).collect();
                 let name = name
                     .trim_matches(|c: char| c == ' ' || c == '\0')
                     .to_string();
@@ -907,11 +910,14 @@ pub fn write_dbs_with(nest: &Nest, options: &DbsWriteOptions) -> Result<Vec<u8>,
     Ok(out)
 }
 
-/// The 8 stored bytes of a name: space-padded, characters swapped within each pair.
+/// The 8 stored bytes of a name: CP866 (the DOS code page of the «Сириус» CAD that made the
+/// format, so Cyrillic names fit one byte per letter), space-padded, characters swapped within
+/// each pair. Fails on names over 8 characters or with characters CP866 lacks, unless
+/// `truncate`: then the name is cut to its first 8 characters and such characters become `?`.
 fn encode_name(name: &str, truncate: bool) -> Option<[u8; 8]> {
     let chars: Vec<u8> = name
         .chars()
-        .map(|c| u8::try_from(u32::from(c)).ok())
+        .map(|c| cp866_byte(c).or(truncate.then_some(b'?')))
         .collect::<Option<_>>()?;
     if chars.len() > 8 && !truncate {
         return None;
@@ -925,4 +931,31 @@ fn encode_name(name: &str, truncate: bool) -> Option<[u8; 8]> {
         stored[i] = plain[i ^ 1];
     }
     Some(stored)
+}
+
+/// The CP866 byte of an ASCII character or a Russian letter.
+fn cp866_byte(c: char) -> Option<u8> {
+    let code = u32::from(c);
+    let byte = match code {
+        0x00..=0x7F => code,
+        0x0410..=0x043F => code - 0x0410 + 0x80, // А–Я, а–п
+        0x0440..=0x044F => code - 0x0440 + 0xE0, // р–я
+        0x0401 => 0xF0,                          // Ё
+        0x0451 => 0xF1,                          // ё
+        _ => return None,
+    };
+    u8::try_from(byte).ok()
+}
+
+/// The character of a stored name byte: CP866 letters are Russian letters, other bytes above
+/// 0x7F (CP866 box drawing, never in names) read as Latin-1, as before CP866 was known.
+fn cp866_char(byte: u8) -> char {
+    let code = match byte {
+        0x80..=0xAF => u32::from(byte) - 0x80 + 0x0410,
+        0xE0..=0xEF => u32::from(byte) - 0xE0 + 0x0440,
+        0xF0 => 0x0401,
+        0xF1 => 0x0451,
+        _ => return char::from(byte),
+    };
+    char::from_u32(code).unwrap_or(char::REPLACEMENT_CHARACTER)
 }

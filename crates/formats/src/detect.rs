@@ -59,14 +59,17 @@ pub fn detect(bytes: &[u8]) -> Format {
         Some(b'[') => return Format::GeometryJson,
         Some(b'{') => return json_object_kind(bytes),
         Some(b'<') => {
+            // A T-FLEX project cut before its first `Nest` still starts as a `Project`: its
+            // reader, not "unknown format", says where it breaks.
             return if contains(bytes, b"Nest")
+                || contains(bytes, b"<Project")
                 || contains(bytes, b"TFlex")
                 || contains(bytes, b"tfnesting")
             {
                 Format::TflexXml
             } else {
                 Format::Unknown
-            }
+            };
         }
         _ => {}
     }

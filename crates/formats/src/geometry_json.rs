@@ -1,12 +1,16 @@
 //! The geometry JSON of parts and nests (`dbs.json` schema, thesis Listing Г.1): an array of
 //! `{partid, paths}` whose first element is the sheet; each path is a list of `[x, y, bulge]`
-//! points (bulge optional) with the closing point repeated.
+//! points (bulge optional) with the closing point repeated. A first element without paths
+//! means the nest has no sheet (written so by [`write_geometry_json`]).
 
 use cutroute_geometry::{Nest, Part};
 use serde::{Deserialize, Serialize};
 
 use crate::contour_check::{self, DEFAULT_CLOSURE_TOLERANCE};
 use crate::json::{self, JsonError, JsonWriteError};
+
+/// The `partid` of the element without paths that stands for "no sheet" in first place.
+pub const NO_SHEET: &str = "no sheet";
 
 /// One element of the file, as stored.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -117,8 +121,9 @@ pub fn read_geometry_json_with(
         });
     }
     let mut parts = parts.into_iter();
+    // A first element without paths is the writer's marker of a nest without a sheet.
     let sheet = if options.first_part_is_sheet {
-        parts.next()
+        parts.next().filter(|sheet| !sheet.contours.is_empty())
     } else {
         None
     };
@@ -128,10 +133,17 @@ pub fn read_geometry_json_with(
     })
 }
 
-/// Writes a nest as geometry JSON (sheet first when present), one point per line.
+/// Writes a nest as geometry JSON, one point per line. The format's first element is the
+/// sheet: a nest without one gets an element without paths there ([`NO_SHEET`]), which the
+/// reader takes for "no sheet", so its first part is not read back as the sheet.
 pub fn write_geometry_json(nest: &Nest) -> Result<String, JsonWriteError> {
     let mut out = String::from("[");
-    for (i, part) in nest.sheet.iter().chain(&nest.parts).enumerate() {
+    let no_sheet = Part {
+        name: NO_SHEET.into(),
+        contours: Vec::new(),
+    };
+    let sheet = nest.sheet.as_ref().unwrap_or(&no_sheet);
+    for (i, part) in std::iter::once(sheet).chain(&nest.parts).enumerate() {
         if i > 0 {
             out.push(',');
         }

@@ -5,7 +5,7 @@
 //! The schema forbids extra properties; real files add `CircuitPointX/Y` and `FinishCutX/Y` to
 //! pierce points, which are accepted here. Anything else unknown is rejected with its path.
 
-use cutroute_geometry::Point;
+use cutroute_geometry::{domain, Point};
 use serde::{Deserialize, Serialize};
 
 use crate::json::{self, JsonError, JsonWriteError};
@@ -179,21 +179,45 @@ fn validate(task: &RmTask) -> Result<(), JsonError> {
         ("ToolIdlingSpeed", d.tool_idling_speed),
         ("ToolCutSpeed", d.tool_cut_speed),
     ] {
-        if v <= 0.0 {
+        // `!(v > 0)` also refuses NaN.
+        if !(v > 0.0 && v <= MAX_SPEED) {
             return Err(JsonError::Inconsistent {
                 path: format!("TaskData.{name}"),
-                message: format!("speed {v} is not positive"),
+                message: format!("speed {v} is not within (0, {MAX_SPEED:e}] mm/s"),
             });
         }
     }
-    if d.piercing_duration < 0.0 {
+    if !(d.piercing_duration >= 0.0 && d.piercing_duration <= MAX_PIERCE_DURATION_S) {
         return Err(JsonError::Inconsistent {
             path: "TaskData.PiercingDuration".into(),
-            message: "negative duration".into(),
+            message: format!(
+                "duration {} is not within [0, {MAX_PIERCE_DURATION_S:e}] s",
+                d.piercing_duration
+            ),
         });
+    }
+    for (name, v) in [
+        ("StartX", d.start_x),
+        ("StartY", d.start_y),
+        ("FinishX", d.finish_x),
+        ("FinishY", d.finish_y),
+        ("SheetMinX", d.sheet_min_x),
+        ("SheetMaxX", d.sheet_max_x),
+        ("SheetMinY", d.sheet_min_y),
+        ("SheetMaxY", d.sheet_max_y),
+    ] {
+        domain::check_coordinate(0, v).map_err(|_| JsonError::Inconsistent {
+            path: format!("TaskData.{name}"),
+            message: format!("{v} is not a finite coordinate within ±1e9 mm"),
+        })?;
     }
     check_contours(&task.contours, "Contours")
 }
+
+/// Largest idle or cutting speed a task may give, mm/s (1,000 km/s: no machine comes near).
+pub const MAX_SPEED: f64 = 1e9;
+/// Longest pierce a task may give, s (about 11.6 days).
+pub const MAX_PIERCE_DURATION_S: f64 = 1e6;
 
 fn check_contours(contours: &[TaskContour], path: &str) -> Result<(), JsonError> {
     if contours.is_empty() {
@@ -216,6 +240,12 @@ fn check_contours(contours: &[TaskContour], path: &str) -> Result<(), JsonError>
         }
         for (j, p) in c.points.iter().enumerate() {
             let at = format!("{here}.Points[{j}]");
+            for (name, v) in [("X", p.x), ("Y", p.y)] {
+                domain::check_coordinate(j, v).map_err(|_| JsonError::Inconsistent {
+                    path: format!("{at}.{name}"),
+                    message: format!("{v} is not a finite coordinate within ±1e9 mm"),
+                })?;
+            }
             if p.index != p.zero_based_index + 1 || p.global_index != p.zero_based_global_index + 1
             {
                 return Err(JsonError::Inconsistent {

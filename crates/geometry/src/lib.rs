@@ -70,6 +70,7 @@
 
 mod bbox;
 mod contour;
+pub mod domain;
 mod forest;
 mod generator;
 mod path_route;
@@ -85,6 +86,7 @@ pub use bbox::BoundingBox;
 pub use contour::{
     ClosureError, ContourError, ContourPosition, ContourProjection, SelfIntersection,
 };
+pub use domain::{DomainError, NestDomainError, MAX_BULGE, MAX_COORDINATE, MIN_CONTOUR_EXTENT};
 pub use forest::ContainmentForest;
 pub use generator::generate_nest;
 pub use path_route::{PathRoute, PathRouteError, ToolOnPath};

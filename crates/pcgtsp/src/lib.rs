@@ -70,7 +70,7 @@ pub use completion::{position_bounds, PositionBounds};
 pub use instance::Instance;
 pub use lattice::count_ideals;
 pub use order::{ClusterSet, OrderError, PrecedenceOrder};
-pub use parse::{ParseError, PcglnsResult, MAX_NODES};
+pub use parse::{ParseError, PcglnsResult, MAX_NODES, MAX_WEIGHT};
 pub use restricted::{
     restricted_bound, RestrictedBound, RestrictedBoundError, RestrictedBoundOptions,
 };

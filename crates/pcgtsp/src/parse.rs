@@ -285,15 +285,20 @@ fn parse_int(token: &str, line: usize, expected: &'static str) -> Result<i64, Pa
     })
 }
 
+/// Largest arc or node weight read: a tour of a million arcs then costs at most 1e18, so no
+/// sum of weights overflows to ∞ (weights near f64::MAX made every tour cost ∞, and the
+/// solvers then "proved" a tour that was not one).
+pub const MAX_WEIGHT: f64 = 1e12;
+
 fn parse_weight(token: &str, line: usize) -> Result<f64, ParseError> {
     let value = token
         .parse::<f64>()
         .ok()
-        .filter(|v| v.is_finite())
+        .filter(|v| v.is_finite() && *v <= MAX_WEIGHT)
         .ok_or_else(|| ParseError::InvalidNumber {
             line,
             token: token.chars().take(40).collect(),
-            expected: "finite weight",
+            expected: "finite weight of at most 1e12 (or -1 = forbidden)",
         })?;
     if value == -1.0 {
         return Ok(f64::INFINITY);

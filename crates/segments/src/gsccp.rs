@@ -91,7 +91,6 @@ pub struct GsccpResult {
     pub ccp_route: PathRoute,
 }
 
-
 /// Runs [`GsccpSearch`] to its end (the cancel flag is read between slices): CCP-Relax for its
 /// share of the time, then every ensemble of `options.kinds` seeded by its route, each route
 /// checked independently; returns the best by the objective with every ensemble's numbers. A

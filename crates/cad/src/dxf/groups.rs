@@ -4,7 +4,7 @@ use super::DxfError;
 
 /// Largest magnitude accepted for any real value: a kilometre-sized sheet is 1e6 mm, and staying
 /// far below f64's range means no later sum or product can overflow to infinity.
-pub(crate) const MAX_MAGNITUDE: f64 = 1e9;
+pub(crate) const MAX_MAGNITUDE: f64 = cutroute_geometry::MAX_COORDINATE;
 
 /// One group: its code, its value's text (trimmed) and the 1-based line of the code.
 #[derive(Clone, Copy, Debug)]

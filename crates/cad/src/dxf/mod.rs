@@ -223,7 +223,13 @@ pub fn read_dxf(bytes: &[u8], options: &DxfOptions) -> Result<DxfImport, DxfErro
             .open_chains
             .first()
             .map(|c| c.to_string())
-            .unwrap_or_else(|| "nothing drawn".to_owned());
+            // Without an open chain, the first refused entity is why nothing was drawn: its
+            // warning carries the entity's line.
+            .or_else(|| warnings.first().map(|w| format!("nothing drawn; {w}")))
+            .unwrap_or_else(|| {
+                let lines = bytes.iter().filter(|&&b| b == b'\n').count() + 1;
+                format!("nothing drawn in lines 1 to {lines}")
+            });
         return Err(DxfError::NothingClosed {
             open: assembled.open_chains.len(),
             first,
