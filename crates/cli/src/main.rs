@@ -73,7 +73,7 @@ enum Command {
         to: Option<String>,
         /// Solver of the route for gcode/html: nearest, ccp, heuristic or discrete (default: the
         /// route the file holds, else ccp).
-        #[arg(long, value_parser = clap::builder::PossibleValuesParser::new(ROUTE_SOLVERS))]
+        #[arg(long, value_parser = clap::builder::PossibleValuesParser::new(SOLVERS))]
         solver: Option<String>,
         /// Wall-clock limit of the solver, seconds: finite and positive, or `inf` (until proven
         /// optimal or stopped by Ctrl-C).
@@ -158,9 +158,6 @@ const SOLVERS: [&str; 9] = [
     "sccp",
     "gsccp",
 ];
-
-/// The `--solver` names of `convert`: the solvers whose routes are whole contours.
-const ROUTE_SOLVERS: [&str; 6] = ["nearest", "ccp", "heuristic", "exact", "discrete", "chain"];
 
 /// Most contours `generate` writes: a million contours are about 200 MB of geometry JSON.
 const MAX_GENERATED_CONTOURS: u64 = 1_000_000;
