@@ -50,6 +50,8 @@ fn heat_matches_an_independent_recomputation_for_every_route_solver() {
             "--time-limit",
             "2",
             "--json",
+            "--rules",
+            "part,sheet,islands",
         ];
         args.extend(extra.iter().copied());
         let report = json(&args);
