@@ -345,7 +345,7 @@ test('several files at once: a task JSON is combined with its result file', asyn
   assert.equal(await page.inputValue('#idle-speed'), '500');
   assert.equal(await page.locator('#nest-view path.part').count(), 8);
   // The result's route is drawn: one pierce wherever the file's toolpath goes from air to cut.
-  const moves = Object.values(JSON.parse(fs.readFileSync(result, 'utf8')).results)[0].toolpath.map((m) => m.mode);
+  const moves = JSON.parse(fs.readFileSync(result, 'utf8')).results.toolpath.map((m) => m.mode);
   const filePierces = moves.filter((m, i) => m.startsWith('cut') && (i === 0 || moves[i - 1] === 'air')).length;
   assert.equal(await page.locator('#nest-view .route circle.pierce').count(), filePierces, 'the result\'s route is drawn');
   // The combined problem can be solved.
