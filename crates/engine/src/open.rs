@@ -1,6 +1,7 @@
 //! Opening files: bytes in, a solvable [`Document`] out, whatever the format.
 
 use cutroute_cad::dxf::{read_dxf, DxfOptions};
+use cutroute_cad::svg::{read_svg, SvgOptions};
 use cutroute_cad::tflex::read_tfnesting_project;
 use cutroute_formats::{detect, read_nest, read_result_json, Format};
 use cutroute_geometry::{Nest, Point};
@@ -25,7 +26,7 @@ pub enum OpenError {
     TaskWithoutGeometry(String),
     /// Nothing recognisable.
     #[error(
-        "{0}: unknown format (expected DBS, geometry/task/result JSON, DXF, T-FLEX, a PCGLNS/PCGTSPLIB \
+        "{0}: unknown format (expected DBS, geometry/task/result JSON, DXF, SVG, T-FLEX, a PCGLNS/PCGTSPLIB \
          instance or result, or G-code)"
     )]
     UnknownFormat(String),
@@ -134,6 +135,7 @@ pub fn format_name(format: Format) -> &'static str {
         Format::ResultJson => "result JSON",
         Format::Dxf => "DXF",
         Format::TflexXml => "T-FLEX nesting",
+        Format::Svg => "SVG",
         Format::Pcglns => "PCGTSP instance",
         Format::Unknown => "unknown",
     }
@@ -171,6 +173,18 @@ pub(crate) fn open_model_file(file_name: &str, bytes: &[u8]) -> Result<Document,
                     .open_chains
                     .iter()
                     .map(|chain| format!("open chain left out: {chain:?}")),
+            );
+            import.nest
+        }
+        Format::Svg => {
+            let import =
+                read_svg(bytes, &SvgOptions::default()).map_err(|e| unreadable(e.to_string()))?;
+            warnings.extend(import.warnings.iter().map(ToString::to_string));
+            warnings.extend(
+                import
+                    .open_chains
+                    .iter()
+                    .map(|chain| format!("open chain left out: {chain}")),
             );
             import.nest
         }

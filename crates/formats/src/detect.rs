@@ -23,6 +23,8 @@ pub enum Format {
     Dxf,
     /// T-FLEX nesting project, XML (read by the CAD crate).
     TflexXml,
+    /// SVG drawing of a nest (read by the CAD crate).
+    Svg,
     /// PCGLNS / PCGTSPLIB text instance (read by the PCGTSP crate).
     Pcglns,
     /// None of the above.
@@ -59,14 +61,17 @@ pub fn detect(bytes: &[u8]) -> Format {
         Some(b'[') => return Format::GeometryJson,
         Some(b'{') => return json_object_kind(bytes),
         Some(b'<') => {
-            return if contains(bytes, b"Nest")
+            // An SVG element anywhere: T-FLEX projects never embed one.
+            return if contains(bytes, b"<svg") {
+                Format::Svg
+            } else if contains(bytes, b"Nest")
                 || contains(bytes, b"TFlex")
                 || contains(bytes, b"tfnesting")
             {
                 Format::TflexXml
             } else {
                 Format::Unknown
-            }
+            };
         }
         _ => {}
     }
