@@ -121,6 +121,16 @@ pub enum OpenError {
         /// The route checker's finding.
         reason: String,
     },
+    /// A sheet the file does not have.
+    #[error("{file_name}: there is no sheet {sheet} (the file has {count}; sheets count from 1)")]
+    NoSuchSheet {
+        /// The file's name.
+        file_name: String,
+        /// The sheet asked for, counted from 1.
+        sheet: usize,
+        /// How many sheets the file has.
+        count: usize,
+    },
     /// A task or a tour with no nest to draw it on, and no instance either.
     #[error("{0}: a cutting task holds no geometry; open it together with its nest (geometry JSON or DBS)")]
     TaskWithoutNest(String),
@@ -146,8 +156,24 @@ pub fn format_name(format: Format) -> &'static str {
 ///
 /// Nests come back with contours oriented by nesting depth (outer clockwise, holes
 /// counter-clockwise), since some real files store every contour clockwise.
-pub(crate) fn open_model_file(file_name: &str, bytes: &[u8]) -> Result<Document, OpenError> {
+///
+/// `sheet` (from 0) picks one sheet of a multi-sheet file (T-FLEX projects); files of one sheet
+/// have only sheet 0.
+pub(crate) fn open_model_file(
+    file_name: &str,
+    bytes: &[u8],
+    sheet: usize,
+) -> Result<Document, OpenError> {
     let format = detect(bytes);
+    let no_such_sheet = |count: usize| OpenError::NoSuchSheet {
+        file_name: file_name.to_string(),
+        sheet: sheet + 1,
+        count,
+    };
+    if sheet > 0 && format != Format::TflexXml && format != Format::Unknown {
+        return Err(no_such_sheet(1));
+    }
+    let mut sheets = Vec::new();
     let unreadable = |message: String| OpenError::Unreadable {
         file_name: file_name.to_string(),
         format: format_name(format),
@@ -191,17 +217,27 @@ pub(crate) fn open_model_file(file_name: &str, bytes: &[u8]) -> Result<Document,
         Format::TflexXml => {
             let project = read_tfnesting_project(bytes).map_err(|e| unreadable(e.to_string()))?;
             let count = project.layouts.len();
-            let mut layouts = project.layouts.into_iter();
-            let first = layouts
-                .next()
-                .ok_or_else(|| OpenError::NothingToCut(file_name.to_string()))?;
+            if count == 0 {
+                return Err(OpenError::NothingToCut(file_name.to_string()));
+            }
             if count > 1 {
+                sheets = project
+                    .layouts
+                    .iter()
+                    .map(|l| l.sheet_name.clone())
+                    .collect();
                 warnings.push(format!(
-                    "the project has {count} sheets; showing the first ({})",
-                    first.sheet_name
+                    "the project has {count} sheets; showing sheet {} ({})",
+                    sheet + 1,
+                    sheets.get(sheet).map_or("", String::as_str)
                 ));
             }
-            first.nest
+            project
+                .layouts
+                .into_iter()
+                .nth(sheet)
+                .ok_or_else(|| no_such_sheet(count))?
+                .nest
         }
         Format::Pcglns => {
             let text = std::str::from_utf8(bytes).map_err(|e| unreadable(e.to_string()))?;
@@ -216,6 +252,8 @@ pub(crate) fn open_model_file(file_name: &str, bytes: &[u8]) -> Result<Document,
                 paths: None,
                 task_speeds: None,
                 warnings,
+                sheets: Vec::new(),
+                sheet: 0,
             });
         }
         Format::TaskJson => return Err(OpenError::TaskWithoutGeometry(file_name.to_string())),
@@ -238,6 +276,8 @@ pub(crate) fn open_model_file(file_name: &str, bytes: &[u8]) -> Result<Document,
         paths: None,
         task_speeds: None,
         warnings,
+        sheets,
+        sheet,
     })
 }
 
