@@ -1241,6 +1241,10 @@ fn endpoint_arc(
     if large == sweep {
         k = -k;
     }
+    if !(rx.is_finite() && ry.is_finite() && k.is_finite()) {
+        // Radii far below the chord (1e-300) overflow the scaling: the arc is the chord.
+        return Segment::Line(from, to);
+    }
     let cx1 = k * rx * y1 / ry;
     let cy1 = -k * ry * x1 / rx;
     let center = Point::new(
@@ -1378,6 +1382,31 @@ mod tests {
             read_svg(deep.as_bytes(), &SvgOptions::default()),
             Err(SvgError::TooDeep { .. })
         ));
+    }
+
+    #[test]
+    fn hostile_input_fails_cleanly() {
+        let cases = [
+            wrap(r#"<path d="M0 0 A1e-300 1e-300 0 0 1 1e8 0 Z"/>"#),
+            wrap(r#"<g transform="scale(1e6)"><g transform="scale(1e6)"><rect width="1" height="1"/></g></g>"#),
+            wrap(r#"<rect width="1" height="1" transform="skewX(90)"/>"#),
+            wrap(r#"<path d="M0 0 C 1e9 1e9 -1e9 1e9 0 0 Z"/>"#),
+            wrap(r#"<polygon points="0,0"/>"#),
+            wrap(r#"<path d="M0 0 1"/>"#),
+            wrap(r#"<path d="M0,0 L1,0 Z 5"/>"#),
+            wrap(r#"<circle r="-1"/>"#),
+            wrap(r#"<path d="M0 0 a 5 5 0 2 0 10 0"/>"#),
+            r#"<svg xmlns="http://www.w3.org/2000/svg" width="1e300mm" viewBox="0 0 1e-300 1"><rect width="1" height="1"/></svg>"#.to_owned(),
+            r#"<!DOCTYPE svg [<!ENTITY a "aaaaaaaaaa"><!ENTITY b "&a;&a;&a;&a;&a;&a;&a;&a;&a;&a;"><!ENTITY c "&b;&b;&b;&b;&b;&b;&b;&b;&b;&b;">]><svg>&c;</svg>"#.to_owned(),
+        ];
+        let options = SvgOptions {
+            max_spans: 10_000,
+            ..SvgOptions::default()
+        };
+        for text in cases {
+            // Either outcome is fine; what matters is no panic and no hang.
+            let _ = read_svg(text.as_bytes(), &options);
+        }
     }
 
     #[test]
