@@ -36,7 +36,7 @@ fn converted_svg_reads_back_with_the_same_contours() {
 
 #[test]
 fn inspect_lists_the_sheets_and_sheet_picks_one() {
-    let project = data("nests/tflex/two-sheets.tfnesting");
+    let project = data("nests/tflex-multi/two-sheets.tfnesting");
     let first = json(&["inspect", s(&project), "--json"]);
     assert_eq!(first["sheets"].as_array().unwrap().len(), 2);
     assert_eq!(first["sheet"], 1);

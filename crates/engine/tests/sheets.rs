@@ -21,7 +21,7 @@ fn part_count(problem: &Problem) -> usize {
 
 #[test]
 fn each_sheet_of_a_project_opens() {
-    let bytes = data("nests/tflex/two-sheets.tfnesting");
+    let bytes = data("nests/tflex-multi/two-sheets.tfnesting");
     let first = open_document("two-sheets.tfnesting", &bytes).unwrap();
     assert_eq!(first.sheets.len(), 2);
     assert_eq!(first.sheet, 0);
