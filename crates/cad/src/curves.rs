@@ -279,6 +279,43 @@ pub(crate) fn approximate(
     Ok(out)
 }
 
+/// An elliptic arc (already in world coordinates) as arcs: exact circular spans when it is
+/// circular, otherwise the approximation within `tolerance`, split in eighths of its sweep so
+/// each piece is free of inflections in curvature direction.
+///
+/// `budget` is the number of spans the caller still allows; only the approximation draws on it
+/// (exact spans are at most a handful per arc).
+pub(crate) fn elliptic_spans(
+    arc: &EllipticArc,
+    tolerance: f64,
+    budget: &mut usize,
+) -> Result<Vec<Span>, ApproxFailure> {
+    if let Some(spans) = arc.as_circular_spans() {
+        return Ok(spans);
+    }
+    approximate_elliptic(arc, tolerance, budget)
+}
+
+/// The approximation half of [`elliptic_spans`], also used for arcs that an uneven scale made
+/// elliptic even though their circular form is known.
+pub(crate) fn approximate_elliptic(
+    arc: &EllipticArc,
+    tolerance: f64,
+    budget: &mut usize,
+) -> Result<Vec<Span>, ApproxFailure> {
+    let breaks: Vec<f64> = (1..8)
+        .map(|k| arc.t0 + (arc.t1 - arc.t0) * k as f64 / 8.0)
+        .collect();
+    approximate(
+        &|t| arc.point_at(t),
+        arc.t0,
+        arc.t1,
+        &breaks,
+        tolerance,
+        budget,
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -8,6 +8,8 @@
 //! - [`dxf::read_dxf`] reads an ASCII DXF drawing: it approximates splines and ellipses by arcs
 //!   within a tolerance, expands block inserts, joins loose entities into closed contours, orients
 //!   them, groups them into parts by containment, and reports what stayed open.
+//! - [`svg::read_svg`] reads an SVG nest (DeepNest, SVGnest, cutroute's export): paths,
+//!   basic shapes and transforms, curves approximated by arcs as for DXF, y turned up.
 //! - [`tflex::read_tfnesting`] reads a T-FLEX nesting project (`.tfnesting` XML) and places every
 //!   part on its sheet, one nest per sheet layout.
 //!
@@ -38,6 +40,7 @@ mod assemble;
 mod curves;
 pub mod dxf;
 mod shape;
+pub mod svg;
 pub mod tflex;
 
 pub use assemble::{EntityRef, OpenChain};

@@ -1,8 +1,9 @@
 //! `cutroute`: inspect, convert and route cutting plans and PCGTSP instances from the shell.
 //!
 //! ```text
-//! cutroute inspect FILE [--json]
+//! cutroute inspect FILE [--json] [--sheet N]              # lists a project's sheets
 //! cutroute convert IN OUT [--to dbs|json|svg|gcode|html]   # default: by OUT's extension
+//!                  [--sheet N] [--profile FILE.json] [--preset NAME]
 //!                  [--solver nearest|ccp|heuristic|discrete] [--time-limit S] [--seed N] [--step MM]
 //!                  [--incremental] [--arcs ij|r|lines] [--decimals N] [--line-numbers]
 //!                  [--feed MM_PER_MIN] [--dwell S] [--torch-on CODE] [--torch-off CODE]
@@ -12,6 +13,7 @@
 //!                     [--speeds V_off,V_on,t_pt] [--task TASK.json] [--objective time|cost]
 //!                     [--thermal-sigma MM] [--thermal-tau S] [--thermal-weight W]
 //!                     [--rules part,sheet,islands] [--rules-hard] [--json]
+//!                     [--sheet N] [--profile FILE.json]
 //! ```
 //! The time and cost model (`--speeds`, `--cost`) defaults to the task file's speeds and pierce
 //! time when `--task` is given, else to `MachineParameters::default()`; prices are per metre of
@@ -25,19 +27,22 @@
 //! Every nest report adds the heat load `heat` (σ = 50 mm, τ = 60 s unless given), the rule
 //! violations and each step's machine time `t` (`cutroute-thermal`); `--thermal-weight` makes
 //! nearest, ccp and chain minimise objective + W·H, `--rules-hard` repairs the route until the rules hold.
+//! `--sheet`, `--profile` and `--preset` are described in `inputs.rs` (profile < task <
+//! flags; `--preset` < the G-code flags).
 //! Errors go to stderr with the reader's location, and the exit code is 1.
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use cutroute_engine::{open_document, start_job, AoeJob, Job, SegmentJob};
+use cutroute_engine::{open_sheet, start_job, AoeJob, Job, SegmentJob};
 use cutroute_geometry::{
     ContainmentForest, Entry, MachineParameters, Nest, Objective, PathRoute, Route,
 };
 use cutroute_protocol::{Document, JobRequest, Problem, Progress, SolverKind, SolverParams};
 use serde_json::{json, Value};
 
+mod inputs;
 mod thermal;
 
 #[derive(Parser)]
@@ -60,6 +65,8 @@ enum Command {
         /// Print one JSON object instead of text.
         #[arg(long)]
         json: bool,
+        #[command(flatten)]
+        sheet: inputs::SheetArg,
     },
     /// Convert a nest between formats (.dbs, .json, .svg), or route it and write the route as
     /// G-code (.nc, .gcode, .ngc, .tap) or a standalone HTML page (.html).
@@ -88,6 +95,10 @@ enum Command {
         step: f64,
         #[command(flatten)]
         gcode: GcodeArgs,
+        #[command(flatten)]
+        sheet: inputs::SheetArg,
+        #[command(flatten)]
+        profile: inputs::ProfileArg,
     },
     /// Write a seeded synthetic nest (geometry JSON) for tests and benchmarks.
     Generate {
@@ -143,6 +154,10 @@ enum Command {
         json: bool,
         #[command(flatten)]
         thermal: thermal::ThermalArgs,
+        #[command(flatten)]
+        sheet: inputs::SheetArg,
+        #[command(flatten)]
+        profile: inputs::ProfileArg,
     },
 }
 
@@ -212,7 +227,9 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     install_stop_handler();
     let outcome = match cli.command {
-        Command::Inspect { file, json } => inspect(&file, json).map_err(Failure::Error),
+        Command::Inspect { file, json, sheet } => {
+            inspect(&file, sheet.index(), json).map_err(Failure::Error)
+        }
         Command::Convert {
             input,
             output,
@@ -222,25 +239,30 @@ fn main() -> ExitCode {
             seed,
             step,
             gcode,
-        } => {
-            let params = SolverParams {
-                time_limit_s: time_limit,
-                seed,
-                discretisation_step_mm: step,
-                initial_upper_bound: None,
-                machine: Default::default(),
-                objective: Default::default(),
-            };
-            convert(
-                &input,
-                &output,
-                to.as_deref(),
-                solver.as_deref(),
-                params,
-                &gcode,
-            )
-            .map_err(Failure::Error)
-        }
+            sheet,
+            profile,
+        } => profile
+            .load()
+            .and_then(|profile| {
+                let params = SolverParams {
+                    time_limit_s: time_limit,
+                    seed,
+                    discretisation_step_mm: step,
+                    initial_upper_bound: None,
+                    machine: inputs::base_machine(profile.as_ref()),
+                    objective: Default::default(),
+                };
+                let gcode = gcode.options(profile.as_ref(), &params.machine)?;
+                convert(
+                    (&input, sheet.index()),
+                    &output,
+                    to.as_deref(),
+                    solver.as_deref(),
+                    params,
+                    &gcode,
+                )
+            })
+            .map_err(Failure::Error),
         Command::Generate {
             contours,
             seed,
@@ -259,8 +281,12 @@ fn main() -> ExitCode {
             objective,
             json,
             thermal,
+            sheet,
+            profile,
         } => (|| {
-            let machine = machine_parameters(cost.as_deref(), speeds.as_deref(), task.as_deref())?;
+            let base = inputs::base_machine(profile.load()?.as_ref());
+            let machine =
+                machine_parameters(base, cost.as_deref(), speeds.as_deref(), task.as_deref())?;
             let thermal = thermal.parse()?;
             let objective = match objective.as_str() {
                 "time" => Objective::Time,
@@ -279,9 +305,10 @@ fn main() -> ExitCode {
                 machine,
                 objective,
             };
+            let input = (file.as_path(), sheet.index());
             match solver.as_str() {
-                "sccp" | "gsccp" | "aoe" => Ok(solve_path(&file, &solver, params, json, &thermal)?),
-                _ => solve(&file, &solver, params, json, &thermal),
+                "sccp" | "gsccp" | "aoe" => Ok(solve_path(input, &solver, params, json, &thermal)?),
+                _ => solve(input, &solver, params, json, &thermal),
             }
         })(),
     };
@@ -521,13 +548,15 @@ fn triple(flag: &str, text: &str) -> Result<[f64; 3], String> {
     Ok([a, b, c])
 }
 
-/// The time and cost model: defaults, then the task file's speeds, then the flags.
+/// The time and cost model: `base` (defaults or the profile), then the task file's speeds,
+/// then the flags.
 fn machine_parameters(
+    base: MachineParameters,
     cost: Option<&str>,
     speeds: Option<&str>,
     task: Option<&Path>,
 ) -> Result<MachineParameters, String> {
-    let mut machine = MachineParameters::default();
+    let mut machine = base;
     if let Some(path) = task {
         let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
         let task = cutroute_formats::read_task_json(&bytes)
@@ -554,14 +583,15 @@ fn machine_parameters(
     Ok(machine)
 }
 
-fn open(path: &Path) -> Result<Document, String> {
+/// Opens sheet `sheet` (from 0) of the file; every file has sheet 0.
+fn open((path, sheet): (&Path, usize)) -> Result<Document, String> {
     let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
     let name = path.display().to_string();
-    open_document(&name, &bytes).map_err(|e| e.to_string())
+    open_sheet(&name, &bytes, sheet).map_err(|e| e.to_string())
 }
 
-fn inspect(path: &Path, as_json: bool) -> Result<(), String> {
-    let document = open(path)?;
+fn inspect(path: &Path, sheet: usize, as_json: bool) -> Result<(), String> {
+    let document = open((path, sheet))?;
     let summary = match &document.problem {
         Problem::Nest { nest, .. } => {
             let mut summary = nest_summary(&document.format, nest);
@@ -587,6 +617,8 @@ fn inspect(path: &Path, as_json: bool) -> Result<(), String> {
             })
         }
     };
+    let mut summary = summary;
+    inputs::add_sheets(&mut summary, &document.sheets, document.sheet);
     if as_json {
         println!("{summary}");
     } else {
@@ -627,18 +659,22 @@ fn nest_summary(format: &str, nest: &Nest) -> Value {
 /// G-code settings of `convert --to gcode` (see `cutroute_gcode::GcodeOptions`).
 #[derive(clap::Args)]
 struct GcodeArgs {
+    /// Post-processor preset (G-code dialect); the flags below override it.
+    #[arg(long, value_enum, value_name = "NAME")]
+    preset: Option<inputs::PresetArg>,
     /// Incremental coordinates (G91) instead of absolute (G90).
     #[arg(long)]
     incremental: bool,
-    /// Arcs as G02/G03 with I/J ("ij"), with R ("r"), or as G01 chords ("lines").
-    #[arg(long, default_value = "ij")]
-    arcs: String,
+    /// Arcs as G02/G03 with I/J ("ij"), with R ("r"), or as G01 chords ("lines")
+    /// [default: the preset's, ij].
+    #[arg(long)]
+    arcs: Option<String>,
     /// Largest chord deviation of --arcs lines, mm.
     #[arg(long, default_value_t = 0.01)]
     chord_tolerance: f64,
-    /// Decimals of coordinates.
-    #[arg(long, default_value_t = 3)]
-    decimals: usize,
+    /// Decimals of coordinates [default: the preset's, 3].
+    #[arg(long)]
+    decimals: Option<usize>,
     /// Number the lines (N10, N20, …).
     #[arg(long)]
     line_numbers: bool,
@@ -648,53 +684,68 @@ struct GcodeArgs {
     /// Pierce dwell, seconds (default: the machine's pierce time).
     #[arg(long)]
     dwell: Option<f64>,
-    /// Torch-on line.
-    #[arg(long, default_value = "M03")]
-    torch_on: String,
-    /// Torch-off line.
-    #[arg(long, default_value = "M05")]
-    torch_off: String,
+    /// Torch-on line [default: the preset's, M03].
+    #[arg(long)]
+    torch_on: Option<String>,
+    /// Torch-off line [default: the preset's, M05].
+    #[arg(long)]
+    torch_off: Option<String>,
 }
 
 impl GcodeArgs {
-    fn options(&self) -> Result<cutroute_gcode::GcodeOptions, String> {
-        use cutroute_gcode::{ArcOutput, DistanceMode, GcodeOptions};
-        let defaults = GcodeOptions::default();
-        let arcs = match self.arcs.as_str() {
-            "ij" => ArcOutput::CentreOffsets,
-            "r" => ArcOutput::Radius,
-            "lines" => ArcOutput::Lines {
-                tolerance_mm: self.chord_tolerance,
-            },
-            other => return Err(format!("unknown --arcs {other:?} (ij, r, lines)")),
-        };
-        Ok(GcodeOptions {
-            distance_mode: if self.incremental {
-                DistanceMode::Incremental
-            } else {
-                DistanceMode::Absolute
-            },
-            arcs,
-            decimals: self.decimals,
-            line_numbers: self.line_numbers,
-            cut_feed_mm_per_min: self.feed.unwrap_or(defaults.cut_feed_mm_per_min),
-            pierce_dwell_s: self.dwell.unwrap_or(defaults.pierce_dwell_s),
-            torch_on: self.torch_on.clone(),
-            torch_off: self.torch_off.clone(),
-            ..defaults
-        })
+    /// The preset's (or profile's) options for `machine`, then the flags given.
+    fn options(
+        &self,
+        profile: Option<&cutroute_protocol::MachineProfile>,
+        machine: &MachineParameters,
+    ) -> Result<cutroute_gcode::GcodeOptions, String> {
+        use cutroute_gcode::{ArcOutput, DistanceMode};
+        let mut options = inputs::preset_options(self.preset, profile, machine)?;
+        match self.arcs.as_deref() {
+            None => {}
+            Some("ij") => options.arcs = ArcOutput::CentreOffsets,
+            Some("r") => options.arcs = ArcOutput::Radius,
+            Some("lines") => {
+                options.arcs = ArcOutput::Lines {
+                    tolerance_mm: self.chord_tolerance,
+                }
+            }
+            Some(other) => return Err(format!("unknown --arcs {other:?} (ij, r, lines)")),
+        }
+        if self.incremental {
+            options.distance_mode = DistanceMode::Incremental;
+        }
+        if self.line_numbers {
+            options.line_numbers = true;
+        }
+        if let Some(decimals) = self.decimals {
+            options.decimals = decimals;
+        }
+        if let Some(feed) = self.feed {
+            options.cut_feed_mm_per_min = feed;
+        }
+        if let Some(dwell) = self.dwell {
+            options.pierce_dwell_s = dwell;
+        }
+        if let Some(code) = &self.torch_on {
+            options.torch_on = code.clone();
+        }
+        if let Some(code) = &self.torch_off {
+            options.torch_off = code.clone();
+        }
+        Ok(options)
     }
 }
 
 fn convert(
-    input: &Path,
+    (input, sheet): (&Path, usize),
     output: &Path,
     to: Option<&str>,
     solver: Option<&str>,
     params: SolverParams,
-    gcode: &GcodeArgs,
+    gcode: &cutroute_gcode::GcodeOptions,
 ) -> Result<(), String> {
-    let document = open(input)?;
+    let document = open((input, sheet))?;
     let Problem::Nest { nest, .. } = &document.problem else {
         return Err(format!(
             "{}: line 1 starts a PCGTSP instance, not a nest; only nests can be converted",
@@ -755,15 +806,12 @@ fn convert(
             }
         }
         .into_bytes(),
-        "gcode" => {
-            let options = gcode.options()?;
-            match routed()? {
-                Routed::Contours(route) => cutroute_gcode::route_gcode(nest, &route, &options),
-                Routed::Paths(paths) => cutroute_gcode::path_route_gcode(&paths, &options),
-            }
-            .map_err(|e| e.to_string())?
-            .into_bytes()
+        "gcode" => match routed()? {
+            Routed::Contours(route) => cutroute_gcode::route_gcode(nest, &route, gcode),
+            Routed::Paths(paths) => cutroute_gcode::path_route_gcode(&paths, gcode),
         }
+        .map_err(|e| e.to_string())?
+        .into_bytes(),
         "html" => {
             let options = cutroute_formats::HtmlOptions {
                 title: input
@@ -851,13 +899,13 @@ fn generate(contours: usize, seed: u64, out: &Path) -> Result<(), String> {
 }
 
 fn solve(
-    path: &Path,
+    input: (&Path, usize),
     solver_name: &str,
     params: SolverParams,
     as_json: bool,
     thermal: &thermal::Thermal,
 ) -> Result<(), Failure> {
-    let document = open(path)?;
+    let document = open(input)?;
     let solver = solver_kind(solver_name)?;
     let (machine, objective) = (params.machine, params.objective);
     let request = JobRequest {
@@ -1041,13 +1089,13 @@ fn progress_printer(as_json: bool) -> impl FnMut(&Progress) {
 /// for contour cut twice (standard cutting of common edges, reported as `recut_length`);
 /// `ub` and `lb` are the job's bounds in the objective's unit (s or cost).
 fn solve_path(
-    path: &Path,
+    input: (&Path, usize),
     solver_name: &str,
     params: SolverParams,
     as_json: bool,
     thermal: &thermal::Thermal,
 ) -> Result<(), String> {
-    let document = open(path)?;
+    let document = open(input)?;
     let Problem::Nest { nest, .. } = &document.problem else {
         return Err(format!(
             "--solver {solver_name}: routes nests, not PCGTSP instances"

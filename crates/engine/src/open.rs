@@ -1,6 +1,7 @@
 //! Opening files: bytes in, a solvable [`Document`] out, whatever the format.
 
 use cutroute_cad::dxf::{read_dxf, DxfOptions};
+use cutroute_cad::svg::{read_svg, SvgOptions};
 use cutroute_cad::tflex::read_tfnesting_project;
 use cutroute_formats::{detect, read_nest, read_result_json, Format};
 use cutroute_geometry::{Nest, Point};
@@ -25,8 +26,8 @@ pub enum OpenError {
     TaskWithoutGeometry(String),
     /// Nothing recognisable.
     #[error(
-        "{0}: unknown format from byte 0 (expected DBS, geometry/task/result JSON, DXF, T-FLEX, \
-         a PCGLNS/PCGTSPLIB instance or result, or G-code)"
+        "{0}: unknown format from byte 0 (expected DBS, geometry/task/result JSON, DXF, SVG, \
+         T-FLEX, a PCGLNS/PCGTSPLIB instance or result, or G-code)"
     )]
     UnknownFormat(String),
     /// A JSON object that does not parse, or parses as none of the JSON formats: the message
@@ -129,6 +130,16 @@ pub enum OpenError {
         /// The route checker's finding.
         reason: String,
     },
+    /// A sheet the file does not have.
+    #[error("{file_name}: there is no sheet {sheet} (the file has {count}; sheets count from 1)")]
+    NoSuchSheet {
+        /// The file's name.
+        file_name: String,
+        /// The sheet asked for, counted from 1.
+        sheet: usize,
+        /// How many sheets the file has.
+        count: usize,
+    },
     /// A task or a tour with no nest to draw it on, and no instance either.
     #[error("{0}: a cutting task holds no geometry; open it together with its nest (geometry JSON or DBS)")]
     TaskWithoutNest(String),
@@ -143,6 +154,7 @@ pub fn format_name(format: Format) -> &'static str {
         Format::ResultJson => "result JSON",
         Format::Dxf => "DXF",
         Format::TflexXml => "T-FLEX nesting",
+        Format::Svg => "SVG",
         Format::Pcglns => "PCGTSP instance",
         Format::Unknown => "unknown",
     }
@@ -153,8 +165,24 @@ pub fn format_name(format: Format) -> &'static str {
 ///
 /// Nests come back with contours oriented by nesting depth (outer clockwise, holes
 /// counter-clockwise), since some real files store every contour clockwise.
-pub(crate) fn open_model_file(file_name: &str, bytes: &[u8]) -> Result<Document, OpenError> {
+///
+/// `sheet` (from 0) picks one sheet of a multi-sheet file (T-FLEX projects); files of one sheet
+/// have only sheet 0.
+pub(crate) fn open_model_file(
+    file_name: &str,
+    bytes: &[u8],
+    sheet: usize,
+) -> Result<Document, OpenError> {
     let format = detect(bytes);
+    let no_such_sheet = |count: usize| OpenError::NoSuchSheet {
+        file_name: file_name.to_string(),
+        sheet: sheet + 1,
+        count,
+    };
+    if sheet > 0 && format != Format::TflexXml && format != Format::Unknown {
+        return Err(no_such_sheet(1));
+    }
+    let mut sheets = Vec::new();
     let unreadable = |message: String| OpenError::Unreadable {
         file_name: file_name.to_string(),
         format: format_name(format),
@@ -183,20 +211,42 @@ pub(crate) fn open_model_file(file_name: &str, bytes: &[u8]) -> Result<Document,
             );
             import.nest
         }
+        Format::Svg => {
+            let import =
+                read_svg(bytes, &SvgOptions::default()).map_err(|e| unreadable(e.to_string()))?;
+            warnings.extend(import.warnings.iter().map(ToString::to_string));
+            warnings.extend(
+                import
+                    .open_chains
+                    .iter()
+                    .map(|chain| format!("open chain left out: {chain}")),
+            );
+            import.nest
+        }
         Format::TflexXml => {
             let project = read_tfnesting_project(bytes).map_err(|e| unreadable(e.to_string()))?;
             let count = project.layouts.len();
-            let mut layouts = project.layouts.into_iter();
-            let first = layouts
-                .next()
-                .ok_or_else(|| OpenError::NothingToCut(file_name.to_string()))?;
+            if count == 0 {
+                return Err(OpenError::NothingToCut(file_name.to_string()));
+            }
             if count > 1 {
+                sheets = project
+                    .layouts
+                    .iter()
+                    .map(|l| l.sheet_name.clone())
+                    .collect();
                 warnings.push(format!(
-                    "the project has {count} sheets; showing the first ({})",
-                    first.sheet_name
+                    "the project has {count} sheets; showing sheet {} ({})",
+                    sheet + 1,
+                    sheets.get(sheet).map_or("", String::as_str)
                 ));
             }
-            first.nest
+            project
+                .layouts
+                .into_iter()
+                .nth(sheet)
+                .ok_or_else(|| no_such_sheet(count))?
+                .nest
         }
         Format::Pcglns => {
             let text = std::str::from_utf8(bytes)
@@ -212,6 +262,8 @@ pub(crate) fn open_model_file(file_name: &str, bytes: &[u8]) -> Result<Document,
                 paths: None,
                 task_speeds: None,
                 warnings,
+                sheets: Vec::new(),
+                sheet: 0,
             });
         }
         Format::TaskJson => return Err(OpenError::TaskWithoutGeometry(file_name.to_string())),
@@ -237,6 +289,8 @@ pub(crate) fn open_model_file(file_name: &str, bytes: &[u8]) -> Result<Document,
         paths: None,
         task_speeds: None,
         warnings,
+        sheets,
+        sheet,
     })
 }
 

@@ -28,12 +28,23 @@ pub fn is_pcglns_result(bytes: &[u8]) -> bool {
 /// Opens one file: what the engine reads, else a G-code program, else a PCGLNS result (which
 /// needs company, so it is an error alone).
 pub fn open_document(file_name: &str, bytes: &[u8]) -> Result<Document, OpenError> {
-    match open_model_file(file_name, bytes) {
+    open_sheet(file_name, bytes, 0)
+}
+
+/// [`open_document`] for sheet `sheet` (from 0) of a multi-sheet file (T-FLEX projects list
+/// their sheets in [`Document::sheets`]); every other file has only sheet 0.
+pub fn open_sheet(file_name: &str, bytes: &[u8], sheet: usize) -> Result<Document, OpenError> {
+    match open_model_file(file_name, bytes, sheet) {
         Err(OpenError::UnknownFormat(name)) => {
             if is_pcglns_result(bytes) {
                 return Err(OpenError::TourAlone(name));
             }
             match std::str::from_utf8(bytes) {
+                Ok(_) if sheet > 0 => Err(OpenError::NoSuchSheet {
+                    file_name: name,
+                    sheet: sheet + 1,
+                    count: 1,
+                }),
                 Ok(text) if looks_like_gcode(text) => open_gcode(file_name, text),
                 _ => Err(OpenError::UnknownFormat(name)),
             }
@@ -158,6 +169,8 @@ pub fn open_gcode(file_name: &str, text: &str) -> Result<Document, OpenError> {
             paths: Some(program_paths),
             task_speeds: None,
             warnings,
+            sheets: Vec::new(),
+            sheet: 0,
         });
     }
     let (nest, refs) = nest_of_loops(loops.iter().map(|(c, _)| c.clone()).collect());
@@ -196,6 +209,8 @@ pub fn open_gcode(file_name: &str, text: &str) -> Result<Document, OpenError> {
         paths,
         task_speeds: None,
         warnings,
+        sheets: Vec::new(),
+        sheet: 0,
     })
 }
 
@@ -285,7 +300,8 @@ fn nest_of_loops(loops: Vec<Contour>) -> (Nest, Vec<ContourRef>) {
 
 /// One file of a batch, as recognised from its content.
 enum Piece {
-    Nest(Document),
+    /// Boxed: a document is far larger than the other pieces.
+    Nest(Box<Document>),
     Task(RmTask),
     Instance(Instance, String),
     Tour(PcglnsResult),
@@ -331,7 +347,7 @@ pub fn open_together(files: &[(String, Vec<u8>)]) -> Result<Document, OpenError>
                 )
             }
             _ => match open_document(name, bytes)? {
-                d if matches!(d.problem, Problem::Nest { .. }) => Piece::Nest(d),
+                d if matches!(d.problem, Problem::Nest { .. }) => Piece::Nest(Box::new(d)),
                 _ => return Err(OpenError::NotCombinable(name.clone())),
             },
         };
@@ -350,7 +366,7 @@ pub fn open_together(files: &[(String, Vec<u8>)]) -> Result<Document, OpenError>
         match piece {
             Piece::Nest(d) => match &nest {
                 Some((first, _)) => return Err(two("nests", first)),
-                None => nest = Some((name.clone(), d)),
+                None => nest = Some((name.clone(), *d)),
             },
             Piece::Task(t) => match &task {
                 Some((first, _)) => return Err(two("task files", first)),
@@ -415,6 +431,8 @@ pub fn open_together(files: &[(String, Vec<u8>)]) -> Result<Document, OpenError>
                 paths: None,
                 task_speeds: None,
                 warnings: notes,
+                sheets: Vec::new(),
+                sheet: 0,
             });
         }
         let (task_name, _) = task.expect("a batch of two or more files has a piece");

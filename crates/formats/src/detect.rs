@@ -23,6 +23,8 @@ pub enum Format {
     Dxf,
     /// T-FLEX nesting project, XML (read by the CAD crate).
     TflexXml,
+    /// SVG drawing of a nest (read by the CAD crate).
+    Svg,
     /// PCGLNS / PCGTSPLIB text instance (read by the PCGTSP crate).
     Pcglns,
     /// None of the above.
@@ -61,7 +63,9 @@ pub fn detect(bytes: &[u8]) -> Format {
         Some(b'<') => {
             // A T-FLEX project cut before its first `Nest` still starts as a `Project`: its
             // reader, not "unknown format", says where it breaks.
-            return if contains(bytes, b"Nest")
+            return if root_is_svg(text_start) {
+                Format::Svg
+            } else if contains(bytes, b"Nest")
                 || contains(bytes, b"<Project")
                 || contains(bytes, b"TFlex")
                 || contains(bytes, b"tfnesting")
@@ -86,6 +90,38 @@ pub fn detect(bytes: &[u8]) -> Format {
         return Format::Pcglns;
     }
     Format::Unknown
+}
+
+/// Whether the first element of an XML text is `<svg>` (after the declaration, comments,
+/// processing instructions and a DOCTYPE): an HTML page with inline SVG is not an SVG file.
+fn root_is_svg(text: &[u8]) -> bool {
+    let mut rest = &text[..text.len().min(1 << 16)];
+    loop {
+        let skip = |rest: &[u8], end: &[u8]| {
+            rest.windows(end.len())
+                .position(|w| w == end)
+                .map(|i| i + end.len())
+        };
+        let next = if rest.starts_with(b"<?") {
+            skip(rest, b"?>")
+        } else if rest.starts_with(b"<!--") {
+            skip(rest, b"-->")
+        } else if rest.starts_with(b"<!") {
+            // A DOCTYPE, with an internal subset in brackets when one comes before its `>`.
+            let bracket = rest.iter().position(|&b| b == b'[');
+            let close = rest.iter().position(|&b| b == b'>');
+            match (bracket, close) {
+                (Some(b), Some(c)) if b < c => skip(rest, b"]>"),
+                _ => close.map(|c| c + 1),
+            }
+        } else {
+            return rest.starts_with(b"<svg") || rest.starts_with(b"<svg:svg");
+        };
+        let Some(next) = next else { return false };
+        rest = &rest[next..];
+        let start = rest.iter().position(|b| !b.is_ascii_whitespace());
+        rest = start.map_or(&[][..], |i| &rest[i..]);
+    }
 }
 
 fn contains(hay: &[u8], needle: &[u8]) -> bool {
@@ -130,5 +166,22 @@ pub fn read_nest(bytes: &[u8]) -> Result<Nest, ReadError> {
         Format::ResultJson => Ok(result_json::read_result_json(bytes)?.nest()?),
         Format::TaskJson => Err(ReadError::NoGeometry(Format::TaskJson)),
         other => Err(ReadError::Unsupported(other)),
+    }
+}
+
+#[cfg(test)]
+mod svg_detection {
+    use super::*;
+
+    #[test]
+    fn svg_files_are_recognised_and_html_pages_are_not() {
+        let svg = b"<?xml version=\"1.0\"?>\n<!-- made by hand -->\n<!DOCTYPE svg PUBLIC \"-//W3C//DTD SVG 1.1//EN\" \"x.dtd\" [<!ENTITY a \"b\">]>\n<svg xmlns=\"http://www.w3.org/2000/svg\"/>";
+        assert_eq!(detect(svg), Format::Svg);
+        assert_eq!(detect(b"<svg/>"), Format::Svg);
+        assert_eq!(
+            detect(b"<!DOCTYPE html><html><body><svg></svg></body></html>"),
+            Format::Unknown
+        );
+        assert_eq!(detect(b"<?xml version=\"1.0\"?>"), Format::Unknown);
     }
 }

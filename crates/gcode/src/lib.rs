@@ -11,6 +11,9 @@
 //! pierce. Coordinates are rounded once to the last written digit and tracked as integers, so an
 //! incremental program does not drift and arc centres fit the rounded start exactly.
 //!
+//! Named dialects ([`GcodePreset`]: GRBL laser, LinuxCNC QtPlasmaC, Mach3 plasma, Fanuc-style
+//! dwell in ms, the gas cutter «Комета» with CNC 2P32M) fill these options for a machine.
+//!
 //! The reader ([`read_gcode`]) understands that subset and common variants (see its module
 //! notes), reports errors with line and column, and never panics.
 //!
@@ -43,13 +46,16 @@
 //! ```
 #![deny(missing_docs)]
 
+mod preset;
 mod read;
 mod write;
 
 #[cfg(doc)]
 use cutroute_geometry::Toolpath;
 
+pub use preset::{GcodePreset, UnknownPreset};
 pub use read::{read_gcode, GcodeReadError, Motion, Program, ReadOptions};
 pub use write::{
-    path_route_gcode, route_gcode, write_gcode, ArcOutput, DistanceMode, GcodeError, GcodeOptions,
+    path_route_gcode, route_gcode, write_gcode, ArcOutput, DistanceMode, DwellFormat, GcodeError,
+    GcodeOptions,
 };

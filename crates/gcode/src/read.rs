@@ -27,6 +27,9 @@ pub struct ReadOptions {
     /// Largest difference between an arc's start radius and end radius, mm (arcs written with
     /// rounded coordinates never match exactly).
     pub arc_tolerance_mm: f64,
+    /// `G04 P` counts milliseconds (Fanuc-style controllers), not seconds; `G04 X` stays
+    /// seconds.
+    pub dwell_p_milliseconds: bool,
 }
 
 impl Default for ReadOptions {
@@ -37,6 +40,7 @@ impl Default for ReadOptions {
             torch_on: vec![3, 4],
             torch_off: vec![5],
             arc_tolerance_mm: 0.01,
+            dwell_p_milliseconds: false,
         }
     }
 }
@@ -602,7 +606,14 @@ impl State<'_> {
                 });
             }
             // Fanuc-style `G04 X<seconds>` is the X word of a dwell block.
-            let seconds = get('P').or(get('X')).map(|w| w.value);
+            let p_scale = if self.options.dwell_p_milliseconds {
+                1e-3
+            } else {
+                1.0
+            };
+            let seconds = get('P')
+                .map(|w| w.value * p_scale)
+                .or(get('X').map(|w| w.value));
             match seconds {
                 Some(s) if s >= 0.0 => self.motions.push(Motion::Dwell { seconds: s, line }),
                 _ => return Err(GcodeReadError::InvalidDwell { line, column }),

@@ -39,6 +39,21 @@ pub enum ArcOutput {
     },
 }
 
+/// How the pierce dwell is written.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum DwellFormat {
+    /// `G04 P<seconds>` with three decimals (LinuxCNC, GRBL, Mach3 by default).
+    #[default]
+    PSeconds,
+    /// `G04 X<seconds>` with three decimals (Fanuc-style controllers accept it as seconds).
+    XSeconds,
+    /// `G04 P<milliseconds>`, an integer (Fanuc-style controllers, Mach3 set to ms); read it
+    /// back with [`crate::ReadOptions::dwell_p_milliseconds`].
+    PMilliseconds,
+    /// No dwell line: the controller times the pierce itself (its torch-on code pierces).
+    Omitted,
+}
+
 /// Settings of the post-processor. The defaults suit a LinuxCNC/Mach3-style plasma or laser
 /// controller with the machine parameters of [`MachineParameters::default`].
 ///
@@ -77,6 +92,8 @@ pub struct GcodeOptions {
     /// Dwell after switching the torch on, seconds (`G04 P<seconds>`; 0 writes no dwell).
     /// Fanuc-style controllers read `P` in milliseconds: set this in their unit if needed.
     pub pierce_dwell_s: f64,
+    /// How the dwell is written.
+    pub dwell_format: DwellFormat,
     /// Lines after the units and distance-mode lines (e.g. work offset, torch height).
     pub header: Vec<String>,
     /// Lines at the end, after the torch is off.
@@ -107,6 +124,7 @@ impl GcodeOptions {
             torch_on: "M03".into(),
             torch_off: "M05".into(),
             pierce_dwell_s: 0.0,
+            dwell_format: DwellFormat::PSeconds,
             header: Vec::new(),
             footer: vec!["M30".into()],
             comments: true,
@@ -275,8 +293,14 @@ fn write_labelled(
                 w.line(options.torch_on.clone());
                 w.tool_on = true;
                 w.feed_written = false;
-                if options.pierce_dwell_s > 0.0 {
-                    w.line(format!("G04 P{:.3}", options.pierce_dwell_s));
+                let dwell = options.pierce_dwell_s;
+                if dwell > 0.0 {
+                    match options.dwell_format {
+                        DwellFormat::PSeconds => w.line(format!("G04 P{dwell:.3}")),
+                        DwellFormat::XSeconds => w.line(format!("G04 X{dwell:.3}")),
+                        DwellFormat::PMilliseconds => w.line(format!("G04 P{:.0}", dwell * 1000.0)),
+                        DwellFormat::Omitted => {}
+                    }
                 }
             }
             ToolMove::Cut { span, .. } => {

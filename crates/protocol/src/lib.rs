@@ -26,6 +26,10 @@
 use cutroute_geometry::{MachineParameters, Nest, Objective, PathRoute, Point, Route};
 use serde::{Deserialize, Serialize};
 
+mod profile;
+
+pub use profile::{MachineProfile, ProfileError};
+
 /// Identifies one job for the lifetime of a worker; chosen by the sender, echoed in every answer.
 pub type JobId = u64;
 
@@ -72,6 +76,13 @@ pub struct Document {
     pub task_speeds: Option<TaskSpeeds>,
     /// What the reader skipped, approximated or could not close, in plain words.
     pub warnings: Vec<String>,
+    /// The names of the file's sheets when it holds several (T-FLEX projects), in file order;
+    /// empty for files of one sheet. The engine's `open_sheet` opens any of them.
+    #[serde(default)]
+    pub sheets: Vec<String>,
+    /// Which of `sheets` the problem is, counted from 0 (0 when `sheets` is empty).
+    #[serde(default)]
+    pub sheet: usize,
 }
 
 /// The machine settings a RouteManager task file carries (its prices are not the file's).

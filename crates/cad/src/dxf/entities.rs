@@ -7,7 +7,7 @@ use cutroute_geometry::Point;
 use super::groups::{decode_text, Codepage, Group};
 use super::{DxfError, DxfOptions, DxfWarning};
 use crate::assemble::{Piece, SourceRef};
-use crate::curves::{approximate, ApproxFailure, EllipticArc, Nurbs};
+use crate::curves::{approximate, approximate_elliptic, ApproxFailure, EllipticArc, Nurbs};
 use crate::shape::{dist, Span};
 
 /// Deepest chain of blocks inserting blocks; real drawings use 3–5 levels.
@@ -753,15 +753,8 @@ impl Expander<'_, '_> {
             t0: arc.t0,
             t1: arc.t1,
         };
-        // Quarter-turn breaks keep each piece free of inflections in curvature direction.
-        let breaks: Vec<f64> = (1..8)
-            .map(|k| world.t0 + (world.t1 - world.t0) * k as f64 / 8.0)
-            .collect();
-        approximate(
-            &|t| world.point_at(t),
-            world.t0,
-            world.t1,
-            &breaks,
+        approximate_elliptic(
+            &world,
             self.options.approximation_tolerance,
             &mut self.span_budget,
         )
