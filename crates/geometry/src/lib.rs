@@ -72,6 +72,8 @@ mod bbox;
 mod contour;
 mod forest;
 mod generator;
+mod kerf;
+mod leads;
 mod path_route;
 mod point;
 mod route;
@@ -86,6 +88,11 @@ pub use contour::{
 };
 pub use forest::ContainmentForest;
 pub use generator::{generate_nest, SplitMix64};
+pub use kerf::{clearance, equidistant, in_clear_scrap, OffsetError};
+pub use leads::{
+    chain_spans, opened_at, KerfSettings, LeadError, LeadFitter, LeadProblem, LeadShape, LeadSpec,
+    StepLeads,
+};
 pub use path_route::{PathRoute, PathRouteError, ToolOnPath};
 pub use route::{
     in_scrap_region, is_scrap_region, ContourRef, CutStep, Entry, MachineParameters, Objective,
