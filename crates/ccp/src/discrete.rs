@@ -186,7 +186,7 @@ impl DiscreteInstance {
                 steps.push(CutStep {
                     contour,
                     pierce_point: point,
-                    entry: Default::default(),
+                    entry: Default::default(), leads: None,
                 });
             }
         }

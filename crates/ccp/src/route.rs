@@ -168,7 +168,7 @@ pub(crate) fn assemble_route(s: &Search, order: &[u32], pts: &[V]) -> Route {
             steps.push(CutStep {
                 contour: prob.refs[c],
                 pierce_point: poly[t].into(),
-                entry: Default::default(),
+                entry: Default::default(), leads: None,
             });
         }
         if t < moves {
@@ -178,7 +178,7 @@ pub(crate) fn assemble_route(s: &Search, order: &[u32], pts: &[V]) -> Route {
                 steps.push(CutStep {
                     contour: prob.refs[c],
                     pierce_point: x.into(),
-                    entry: Default::default(),
+                    entry: Default::default(), leads: None,
                 });
             }
         }
@@ -197,7 +197,7 @@ pub(crate) fn assemble_route(s: &Search, order: &[u32], pts: &[V]) -> Route {
         steps.push(CutStep {
             contour: prob.refs[c],
             pierce_point: x.into(),
-            entry: Default::default(),
+            entry: Default::default(), leads: None,
         });
         cur = x;
     }

@@ -743,7 +743,7 @@ impl Context<'_> {
             steps.push(CutStep {
                 contour,
                 pierce_point: points[k],
-                entry,
+                entry, leads: None,
             });
         }
         let mut new_steps = rest;

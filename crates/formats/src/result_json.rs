@@ -490,7 +490,7 @@ impl RmResult {
                     steps.push(CutStep {
                         contour,
                         pierce_point: m.from,
-                        entry,
+                        entry, leads: None,
                     });
                     current = Some(contour);
                 }

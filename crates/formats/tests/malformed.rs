@@ -824,7 +824,7 @@ fn route_errors_name_the_step() {
                 contour: 3,
             },
             pierce_point: Point::new(1.0, 1.5),
-            entry: Default::default(),
+            entry: Default::default(), leads: None,
         }],
         finish: None,
     };

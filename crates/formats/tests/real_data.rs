@@ -359,7 +359,7 @@ fn e1x_task_pierce_points_lie_on_the_e1x_contours() {
                     steps: vec![cutroute_geometry::CutStep {
                         contour: c,
                         pierce_point: p,
-                        entry: Default::default(),
+                        entry: Default::default(), leads: None,
                     }],
                     finish: None,
                 };

@@ -39,11 +39,13 @@
 //! assert!(fitter.problems(r, &leads).is_empty());
 //! ```
 
+use std::borrow::Cow;
+
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use crate::kerf::{clearance, equidistant, in_clear_scrap, OffsetError};
-use crate::{ContainmentForest, Contour, ContourRef, Nest, Point, Span, Vertex};
+use crate::{ContainmentForest, Contour, ContourRef, CutStep, Nest, Point, Route, Span, Vertex};
 
 /// The shape of a lead-in or lead-out.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -164,6 +166,12 @@ pub struct StepLeads {
     /// How far the cut runs on past the entry, mm.
     #[serde(default)]
     pub overcut: f64,
+    /// d₁ the pierce point was placed under (the checker holds the step to it), mm.
+    #[serde(default)]
+    pub pierce_clearance: f64,
+    /// d₂ the switch-off point was placed under, mm.
+    #[serde(default)]
+    pub switch_off_clearance: f64,
 }
 
 /// Spans of a vertex chain (each vertex's bulge shapes the span to the next; the last vertex
@@ -175,6 +183,24 @@ pub fn chain_spans(chain: &[Vertex]) -> impl Iterator<Item = Span> + '_ {
 }
 
 impl StepLeads {
+    /// The rules these leads were built under (kerf, d₁, d₂; shapes are not rules), which
+    /// the route checker holds them to.
+    pub fn rules(&self) -> KerfSettings {
+        KerfSettings {
+            kerf: 2.0 * self.offset,
+            pierce_clearance: self.pierce_clearance,
+            switch_off_clearance: self.switch_off_clearance,
+            overcut: self.overcut,
+            ..KerfSettings::default()
+        }
+    }
+
+    /// Length of the tool-on path of the step: lead-in, the equidistant's perimeter, the
+    /// overcut and the lead-out, mm.
+    pub fn cut_length(&self, equidistant: &Contour) -> f64 {
+        self.lead_in_length() + equidistant.perimeter() + self.overcut + self.lead_out_length()
+    }
+
     /// Length of the lead-in, mm.
     pub fn lead_in_length(&self) -> f64 {
         chain_spans(&self.lead_in).map(|s| s.length()).sum()
@@ -331,7 +357,7 @@ const TOLERANCE: f64 = 1e-6;
 /// [`KerfSettings`]; also checks given leads (the route checker's geometric part).
 pub struct LeadFitter<'a> {
     nest: &'a Nest,
-    forest: ContainmentForest,
+    forest: Cow<'a, ContainmentForest>,
     settings: KerfSettings,
 }
 
@@ -340,7 +366,20 @@ impl<'a> LeadFitter<'a> {
     pub fn new(nest: &'a Nest, settings: KerfSettings) -> LeadFitter<'a> {
         LeadFitter {
             nest,
-            forest: nest.containment_forest(),
+            forest: Cow::Owned(nest.containment_forest()),
+            settings,
+        }
+    }
+
+    /// A fitter for `nest` that reuses its containment forest.
+    pub fn with_forest(
+        nest: &'a Nest,
+        forest: &'a ContainmentForest,
+        settings: KerfSettings,
+    ) -> LeadFitter<'a> {
+        LeadFitter {
+            nest,
+            forest: Cow::Borrowed(forest),
             settings,
         }
     }
@@ -438,6 +477,8 @@ impl<'a> LeadFitter<'a> {
             lead_out,
             offset: self.settings.kerf / 2.0,
             overcut: self.settings.overcut,
+            pierce_clearance: self.settings.pierce_clearance,
+            switch_off_clearance: self.settings.switch_off_clearance,
         })
     }
 
@@ -488,6 +529,8 @@ impl<'a> LeadFitter<'a> {
             switch_off,
             offset: self.settings.kerf / 2.0,
             overcut: 0.0,
+            pierce_clearance: self.settings.pierce_clearance,
+            switch_off_clearance: self.settings.switch_off_clearance,
         })
     }
 
@@ -565,6 +608,51 @@ impl<'a> LeadFitter<'a> {
             }
         }
         None
+    }
+
+    /// The leads of one step: fitted with the entry as near as the rules allow to the step's
+    /// pierce point, which then moves to the contour point under the entry.
+    pub fn attach_to_step(&self, step: &CutStep) -> Result<CutStep, LeadError> {
+        let leads = self.fit(step.contour, step.pierce_point)?;
+        let contour = self
+            .nest
+            .contour(step.contour)
+            .ok_or(LeadError::UnknownContour {
+                contour: step.contour,
+            })?;
+        let on_contour = contour
+            .nearest_point(leads.entry)
+            .map_or(step.pierce_point, |p| p.point);
+        Ok(CutStep {
+            pierce_point: on_contour,
+            leads: Some(leads),
+            ..step.clone()
+        })
+    }
+
+    /// `route` with leads attached to every pierced step ("solve, then attach leads"); steps
+    /// entered by a tool-on link keep none. Every contour where no lead fits is reported.
+    pub fn attach(&self, route: &Route) -> Result<Route, Vec<LeadError>> {
+        let mut errors = Vec::new();
+        let mut steps = Vec::with_capacity(route.steps.len());
+        for step in &route.steps {
+            if !step.is_pierced() {
+                steps.push(step.clone());
+                continue;
+            }
+            match self.attach_to_step(step) {
+                Ok(s) => steps.push(s),
+                Err(e) => errors.push(e),
+            }
+        }
+        if errors.is_empty() {
+            Ok(Route {
+                steps,
+                ..route.clone()
+            })
+        } else {
+            Err(errors)
+        }
     }
 
     /// Every rule that `leads` breaks as the leads of contour `r` (the checker used by

@@ -396,7 +396,7 @@ mod tests {
                         contour: 0,
                     },
                     pierce_point: Point::new(0.0, 0.0),
-                    entry: Default::default(),
+                    entry: Default::default(), leads: None,
                 }],
                 finish: None,
             }),
