@@ -97,6 +97,17 @@ impl LeadSpec {
         }
     }
 
+    /// How far the lead takes its free end from the equidistant, along the normal, mm.
+    pub fn reach(self) -> f64 {
+        let (radius, sweep) = self.arc();
+        match self.shape {
+            LeadShape::None => 0.0,
+            LeadShape::Line => self.length * self.angle.to_radians().cos().max(0.0),
+            LeadShape::Arc => radius * (1.0 - sweep.cos()),
+            LeadShape::LineArc => radius + self.length,
+        }
+    }
+
     /// The arc's radius and sweep (radians).
     fn arc(self) -> (f64, f64) {
         let quarter = std::f64::consts::FRAC_PI_2;
@@ -608,6 +619,69 @@ impl<'a> LeadFitter<'a> {
             }
         }
         None
+    }
+
+    /// The nest of *pierce curves*: every contour replaced by its offset at kerf/2 plus the
+    /// lead-in's reach (at least d₁), on the scrap side — where the pierce points M of
+    /// unobstructed leads lie. A solver of idealised routes run on it places M and orders the
+    /// contours with the leads' idle legs priced; [`LeadFitter::project`] and
+    /// [`LeadFitter::attach`] then bring its route back to this nest. Contours whose curve
+    /// does not exist, or would change which contour holds which, keep their own shape, so
+    /// the precedence of the curve nest is that of the nest.
+    pub fn pierce_curve_nest(&self) -> Nest {
+        let reach = (self.settings.kerf / 2.0 + self.settings.lead_in.reach())
+            .max(self.settings.pierce_clearance);
+        let mut curves = self.nest.clone();
+        for part in &mut curves.parts {
+            for contour in &mut part.contours {
+                if let Ok(curve) = equidistant(contour, reach) {
+                    *contour = curve;
+                }
+            }
+        }
+        // Undo the curves that change the containment forest (a part near the wall of the
+        // hole it sits in), until none does.
+        loop {
+            let forest = curves.containment_forest();
+            let changed: Vec<ContourRef> = self
+                .nest
+                .contour_refs()
+                .filter(|&r| forest.parent(r) != self.forest.parent(r))
+                .collect();
+            if changed.is_empty() {
+                return curves;
+            }
+            let mut undone = 0;
+            for r in changed {
+                for c in [Some(r), self.forest.parent(r)].into_iter().flatten() {
+                    let original = &self.nest.parts[c.part].contours[c.contour];
+                    let slot = &mut curves.parts[c.part].contours[c.contour];
+                    if slot != original {
+                        *slot = original.clone();
+                        undone += 1;
+                    }
+                }
+            }
+            if undone == 0 {
+                return self.nest.clone();
+            }
+        }
+    }
+
+    /// `route` (over [`LeadFitter::pierce_curve_nest`] or any nest of the same contours) with
+    /// every pierce point moved to the nearest point of its own contour in this nest.
+    pub fn project(&self, route: &Route) -> Route {
+        let mut projected = route.clone();
+        for step in &mut projected.steps {
+            if let Some(p) = self
+                .nest
+                .contour(step.contour)
+                .and_then(|c| c.nearest_point(step.pierce_point))
+            {
+                step.pierce_point = p.point;
+            }
+        }
+        projected
     }
 
     /// The leads of one step: fitted with the entry as near as the rules allow to the step's

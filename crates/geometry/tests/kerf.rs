@@ -329,3 +329,27 @@ fn the_checker_rejects_a_pierce_point_in_material_or_too_near_a_part() {
         }
     )));
 }
+
+#[test]
+fn the_pierce_curve_nest_keeps_the_precedence_and_lies_at_the_pierce_distance() {
+    let nest = generate_nest(200, 9);
+    let fitter = LeadFitter::new(&nest, plasma());
+    let curves = fitter.pierce_curve_nest();
+    let (forest, curve_forest) = (nest.containment_forest(), curves.containment_forest());
+    for r in nest.contour_refs() {
+        assert_eq!(forest.parent(r), curve_forest.parent(r), "{r:?}");
+    }
+    // Most contours have their curve: kerf/2 + the quarter arc's radius 16/π ≥ d₁ = 5.
+    let reach = 1.0 + 16.0 / std::f64::consts::PI;
+    let moved = nest
+        .contour_refs()
+        .filter(|&r| {
+            let p = curves.contour(r).unwrap().vertices[0].point;
+            (nest.contour(r).unwrap().distance_to(p) - reach).abs() < 1e-6
+        })
+        .count();
+    assert!(moved * 10 >= nest.contour_count() * 7, "{moved}");
+    // Routes over the curves come back onto the contours.
+    let projected = fitter.project(&idealised_route(&curves));
+    assert_eq!(projected.problems(&nest, &forest, 1e-6), vec![]);
+}
