@@ -12,6 +12,10 @@
 //!                     [--speeds V_off,V_on,t_pt] [--task TASK.json] [--objective time|cost]
 //!                     [--thermal-sigma MM] [--thermal-tau S] [--thermal-weight W]
 //!                     [--rules part,sheet,islands] [--rules-hard] [--json]
+//!                     [--kerf MM] [--pierce-clearance MM] [--switch-off-clearance MM]
+//!                     [--lead-in arc|line|line-arc|none] [--lead-in-length MM]
+//!                     [--lead-out arc|line|line-arc|none] [--lead-out-length MM]
+//!                     [--overcut MM] [--leads-after]   # also on convert
 //! ```
 //! The time and cost model (`--speeds`, `--cost`) defaults to the task file's speeds and pierce
 //! time when `--task` is given, else to `MachineParameters::default()`; prices are per metre of
@@ -25,6 +29,9 @@
 //! Every nest report adds the heat load `heat` (σ = 50 mm, τ = 60 s unless given), the rule
 //! violations and each step's machine time `t` (`cutroute-thermal`); `--thermal-weight` makes
 //! nearest, ccp and chain minimise objective + W·H, `--rules-hard` repairs the route until the rules hold.
+//! With `--kerf`/leads on (`kerf.rs`), nearest, ccp, heuristic and discrete optimise the full
+//! route (pierce points off the contours, leads, cut on the equidistants) and each route step
+//! carries `pierce` (M), `entry`, `lead_in`, `lead_out` and `switch_off`.
 //! Errors go to stderr with the reader's location, and the exit code is 1.
 
 use std::path::{Path, PathBuf};
@@ -36,6 +43,7 @@ use cutroute_geometry::{Entry, MachineParameters, Nest, Objective, PathRoute, Ro
 use cutroute_protocol::{Document, JobRequest, Problem, Progress, SolverKind, SolverParams};
 use serde_json::{json, Value};
 
+mod kerf;
 mod thermal;
 
 #[derive(Parser)]
@@ -84,6 +92,8 @@ enum Command {
         step: f64,
         #[command(flatten)]
         gcode: GcodeArgs,
+        #[command(flatten)]
+        kerf: kerf::KerfArgs,
     },
     /// Write a seeded synthetic nest (geometry JSON) for tests and benchmarks.
     Generate {
@@ -137,6 +147,8 @@ enum Command {
         json: bool,
         #[command(flatten)]
         thermal: thermal::ThermalArgs,
+        #[command(flatten)]
+        kerf: kerf::KerfArgs,
     },
 }
 
@@ -153,7 +165,8 @@ fn main() -> ExitCode {
             seed,
             step,
             gcode,
-        } => {
+            kerf,
+        } => kerf.parse().and_then(|kerf| {
             let params = SolverParams {
                 time_limit_s: time_limit,
                 seed,
@@ -169,8 +182,9 @@ fn main() -> ExitCode {
                 solver.as_deref(),
                 params,
                 &gcode,
+                &kerf,
             )
-        }
+        }),
         Command::Generate {
             contours,
             seed,
@@ -189,9 +203,11 @@ fn main() -> ExitCode {
             objective,
             json,
             thermal,
+            kerf,
         } => machine_parameters(cost.as_deref(), speeds.as_deref(), task.as_deref()).and_then(
             |machine| {
                 let thermal = thermal.parse()?;
+                let kerf = kerf.parse()?;
                 let objective = match objective.as_str() {
                     "time" => Objective::Time,
                     "cost" => Objective::Cost,
@@ -206,8 +222,11 @@ fn main() -> ExitCode {
                     objective,
                 };
                 match solver.as_str() {
+                    "sccp" | "gsccp" | "aoe" if kerf.is_on() => Err(format!(
+                        "--solver {solver} does not cut with kerf and leads yet"
+                    )),
                     "sccp" | "gsccp" | "aoe" => solve_path(&file, &solver, params, json, &thermal),
-                    _ => solve(&file, &solver, params, json, &thermal),
+                    _ => solve(&file, &solver, params, json, &thermal, &kerf),
                 }
             },
         ),
@@ -413,6 +432,7 @@ fn convert(
     solver: Option<&str>,
     params: SolverParams,
     gcode: &GcodeArgs,
+    kerf: &kerf::Kerf,
 ) -> Result<(), String> {
     let document = open(input)?;
     let Problem::Nest { nest, .. } = &document.problem else {
@@ -450,8 +470,17 @@ fn convert(
         match (solver, &document.route, &document.paths) {
             (None, _, Some(paths)) => Ok(Routed::Paths(paths.clone())),
             (None, Some(route), None) => Ok(Routed::Contours(route.clone())),
-            (name, ..) => solved(&document, name.unwrap_or("ccp"), params.clone()),
+            (name, ..) => solved(&document, name.unwrap_or("ccp"), params.clone(), kerf),
         }
+        .and_then(|routed| match routed {
+            Routed::Contours(route) if kerf.is_on() => Ok(Routed::Contours(
+                kerf.attach(nest, kerf.project(nest, route))?,
+            )),
+            Routed::Paths(_) if kerf.is_on() => {
+                Err("path routes (sccp, gsccp, aoe) do not cut with kerf and leads yet".into())
+            }
+            routed => Ok(routed),
+        })
     };
     let bytes: Vec<u8> = match format.as_str() {
         "dbs" => cutroute_formats::write_dbs(nest).map_err(|e| e.to_string())?,
@@ -513,7 +542,12 @@ enum Routed {
 }
 
 /// Routes the document's nest with the named solver; the best route found, checked.
-fn solved(document: &Document, solver_name: &str, params: SolverParams) -> Result<Routed, String> {
+fn solved(
+    document: &Document,
+    solver_name: &str,
+    params: SolverParams,
+    kerf: &kerf::Kerf,
+) -> Result<Routed, String> {
     let Problem::Nest { nest, .. } = &document.problem else {
         return Err("only nests are routed".into());
     };
@@ -524,11 +558,13 @@ fn solved(document: &Document, solver_name: &str, params: SolverParams) -> Resul
         solver,
         params,
     };
+    let request = kerf.request(request, solver_name)?;
     let mut job = start_job(&request).map_err(|e| e.to_string())?;
     let progress = run_to_end(job.as_mut(), &mut |_| {});
     let tolerance = 1e-6 * nest_scale(nest);
     match (progress.route, progress.path_route) {
         (Some(route), _) => {
+            let route = kerf.project(nest, route);
             route
                 .validate(nest, tolerance)
                 .map_err(|e| format!("invalid route: {e}"))?;
@@ -574,6 +610,7 @@ fn solve(
     params: SolverParams,
     as_json: bool,
     thermal: &thermal::Thermal,
+    kerf: &kerf::Kerf,
 ) -> Result<(), String> {
     let document = open(path)?;
     let solver = solver_kind(solver_name)?;
@@ -584,6 +621,7 @@ fn solve(
         solver,
         params,
     };
+    let request = kerf.request(request, solver_name)?;
     let mut job = match thermal.heated_job(&request)? {
         Some(job) => job,
         None => start_job(&request).map_err(|e| e.to_string())?,
@@ -593,6 +631,7 @@ fn solve(
         Problem::PcgtspText { .. } => tour_report(solver_name, &result),
         Problem::Nest { nest, .. } => {
             if let Some(route) = result.route.take() {
+                let route = kerf.project(nest, route);
                 let route = thermal.enforce(nest, route, &machine, objective)?;
                 if !result.certified.is_empty() {
                     // Certificates of the route reported, not of the one before the repair.
@@ -600,11 +639,12 @@ fn solve(
                         .map_err(|e| e.to_string())?;
                     result.certified = certified.iter().map(|c| c.condition1).collect();
                 }
-                result.route = Some(route);
+                result.route = Some(kerf.attach(nest, route)?);
             }
             let mut report = route_report(solver_name, nest, &machine, &result)?;
             if let Some(route) = &result.route {
                 thermal.report(&mut report, nest, route, &machine, objective)?;
+                kerf.report(&mut report, route);
             }
             report
         }
