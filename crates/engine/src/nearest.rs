@@ -140,7 +140,8 @@ impl NearestNeighbourJob {
             steps.push(CutStep {
                 contour: contour_ref,
                 pierce_point,
-                entry: Default::default(), leads: None,
+                entry: Default::default(),
+                leads: None,
             });
         }
         if let Some(finish) = self.finish {

@@ -45,6 +45,12 @@ pub enum OffsetError {
         /// The distance asked.
         distance: f64,
     },
+    /// The offset library failed on this contour (degenerate geometry).
+    #[error("the offset by {distance} mm failed on degenerate geometry")]
+    Failed {
+        /// The distance asked.
+        distance: f64,
+    },
     /// The offset falls apart into several closed loops (a hole with a narrow waist), so one
     /// cut cannot follow it.
     #[error("the contour splits into {pieces} loops when offset by {distance} mm")]
@@ -85,7 +91,16 @@ pub fn equidistant(contour: &Contour, distance: f64) -> Result<Contour, OffsetEr
     if distance == 0.0 {
         return Ok(contour.clone());
     }
-    let mut loops = to_polyline(contour).parallel_offset(distance);
+    // Repeated and collinear vertices (files have them) trip cavalier's internal asserts:
+    // drop them first, within a relative epsilon of the contour's size.
+    let pline = to_polyline(contour);
+    let scale = contour.bounding_box().width() + contour.bounding_box().height();
+    let eps = 1e-9 * scale.max(1.0);
+    let pline = pline.remove_redundant(eps).unwrap_or(pline);
+    // A last guard where unwinding exists (native): a panic inside the library is an error,
+    // not a crash of the caller.
+    let mut loops = std::panic::catch_unwind(|| pline.parallel_offset(distance))
+        .map_err(|_| OffsetError::Failed { distance })?;
     match loops.len() {
         0 => Err(OffsetError::Vanishes { distance }),
         1 => Ok(from_polyline(&loops.remove(0))),

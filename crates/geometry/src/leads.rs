@@ -108,6 +108,18 @@ impl LeadSpec {
         }
     }
 
+    /// How far behind the entry (against the cut direction) the lead-in's pierce point lies,
+    /// mm: the entry for a pierce point over arc length s lies at s + this.
+    pub fn lag(self) -> f64 {
+        let (radius, sweep) = self.arc();
+        match self.shape {
+            LeadShape::None => 0.0,
+            LeadShape::Line => self.length * self.angle.to_radians().sin(),
+            LeadShape::Arc => radius * sweep.sin(),
+            LeadShape::LineArc => radius,
+        }
+    }
+
     /// The arc's radius and sweep (radians).
     fn arc(self) -> (f64, f64) {
         let quarter = std::f64::consts::FRAC_PI_2;
@@ -410,8 +422,8 @@ impl<'a> LeadFitter<'a> {
             .map_err(|source| LeadError::Offset { contour: r, source })
     }
 
-    /// Leads for contour `r` with the entry as near as the rules allow to `near` (a point the
-    /// tool comes from, or a wanted entry). Tries the asked leads at the nearest entry, then
+    /// Leads for contour `r` with the pierce point M as near as the rules allow to `near` (a
+    /// point the tool comes from, or a wanted pierce point). Tries the asked leads at the nearest entry, then
     /// shorter and turned ones, then entries further along the equidistant, then (in a hole)
     /// a pierce at the hole's centre.
     pub fn fit(&self, r: ContourRef, near: Point) -> Result<StepLeads, LeadError> {
@@ -422,9 +434,11 @@ impl<'a> LeadFitter<'a> {
     /// [`LeadFitter::fit`] with the equidistant already built.
     pub fn fit_on(&self, r: ContourRef, eq: &Contour, near: Point) -> Result<StepLeads, LeadError> {
         let perimeter = eq.perimeter();
+        // The entry that puts the asked lead-in's M over `near`.
         let s0 = eq
             .nearest_point(near)
-            .map_or(0.0, |p| eq.length_at(p.position));
+            .map_or(0.0, |p| eq.length_at(p.position))
+            + self.settings.lead_in.lag();
         const POSITIONS: usize = 24;
         let mut reason = LeadProblem::Disjoint;
         for k in 0..POSITIONS {
