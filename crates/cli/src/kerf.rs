@@ -5,7 +5,8 @@
 //! With leads on, the contour solvers (nearest, ccp, heuristic, discrete) optimise the full
 //! route: they run over the nest of pierce curves (`LeadFitter::pierce_curve_nest`), so the
 //! idle legs they price run between pierce points off the contours; the route is brought back
-//! onto the nest and every step gets its fitted leads. `--leads-after` instead solves the
+//! onto the nest, every step gets its fitted leads, and the leads are moved along the
+//! equidistants where that shortens the idle legs from M* to the next M. `--leads-after` instead solves the
 //! idealised route and attaches leads to it (the comparison of the benchmark).
 
 use cutroute_geometry::{
@@ -134,8 +135,16 @@ impl Kerf {
         if !self.is_on() {
             return Ok(route);
         }
-        LeadFitter::new(nest, self.settings)
+        let fitter = LeadFitter::new(nest, self.settings);
+        fitter
             .attach(&route)
+            .map(|route| {
+                if self.after {
+                    route
+                } else {
+                    fitter.relax(&route, 2, 24)
+                }
+            })
             .map_err(|errors| {
                 let list: Vec<String> = errors.iter().map(LeadError::to_string).collect();
                 format!(

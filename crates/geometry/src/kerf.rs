@@ -51,8 +51,8 @@ pub enum OffsetError {
         /// The distance asked.
         distance: f64,
     },
-    /// The offset falls apart into several closed loops (a hole with a narrow waist), so one
-    /// cut cannot follow it.
+    /// An inward offset falls apart into several closed loops (a hole with a narrow waist),
+    /// so one cut cannot follow it. (Outward, the loop round the outside is the equidistant.)
     #[error("the contour splits into {pieces} loops when offset by {distance} mm")]
     Splits {
         /// The distance asked.
@@ -83,7 +83,8 @@ fn from_polyline(pline: &Polyline<f64>) -> Contour {
 
 /// The equidistant of `contour` at `distance` on its left side (the scrap side of an
 /// oriented contour): a closed contour in the same direction, with exact arcs. Distance 0
-/// returns the contour itself.
+/// returns the contour itself. Outward (clockwise contours), notches narrower than twice the
+/// distance close, and the loop round the outside is returned.
 pub fn equidistant(contour: &Contour, distance: f64) -> Result<Contour, OffsetError> {
     if !(distance >= 0.0) || !distance.is_finite() {
         return Err(OffsetError::BadDistance { distance });
@@ -92,18 +93,37 @@ pub fn equidistant(contour: &Contour, distance: f64) -> Result<Contour, OffsetEr
         return Ok(contour.clone());
     }
     // Repeated and collinear vertices (files have them) trip cavalier's internal asserts:
-    // drop them first, within a relative epsilon of the contour's size.
+    // drop them first, within an epsilon relative to the contour's size, and retry with a
+    // coarser one if the library still fails.
     let pline = to_polyline(contour);
-    let scale = contour.bounding_box().width() + contour.bounding_box().height();
-    let eps = 1e-9 * scale.max(1.0);
-    let pline = pline.remove_redundant(eps).unwrap_or(pline);
-    // A last guard where unwinding exists (native): a panic inside the library is an error,
-    // not a crash of the caller.
-    let mut loops = std::panic::catch_unwind(|| pline.parallel_offset(distance))
-        .map_err(|_| OffsetError::Failed { distance })?;
+    let scale = (contour.bounding_box().width() + contour.bounding_box().height()).max(1.0);
+    let mut loops = None;
+    for relative_eps in [1e-9, 1e-6, 1e-4] {
+        let cleaned = pline
+            .remove_redundant(relative_eps * scale)
+            .unwrap_or_else(|| pline.clone());
+        // A guard where unwinding exists (native): a panic inside the library is an error
+        // of this contour, not a crash of the caller.
+        if let Ok(result) = std::panic::catch_unwind(|| cleaned.parallel_offset(distance)) {
+            loops = Some(result);
+            break;
+        }
+    }
+    let mut loops = loops.ok_or(OffsetError::Failed { distance })?;
     match loops.len() {
         0 => Err(OffsetError::Vanishes { distance }),
         1 => Ok(from_polyline(&loops.remove(0))),
+        // Outward (a clockwise contour's left): a notch narrower than twice the distance
+        // closes and leaves an enclosed loop the tool never reaches; the path is the loop
+        // round the outside, the largest.
+        _ if contour.is_clockwise() => {
+            let outside = loops
+                .iter()
+                .map(from_polyline)
+                .max_by(|a, b| a.area().total_cmp(&b.area()))
+                .expect("several loops");
+            Ok(outside)
+        }
         pieces => Err(OffsetError::Splits { distance, pieces }),
     }
 }

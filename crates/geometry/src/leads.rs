@@ -743,6 +743,60 @@ impl<'a> LeadFitter<'a> {
         }
     }
 
+    /// Moves the leads of every pierced step of `route` (a route with leads) along its
+    /// equidistant to shorten the idle legs around it, `passes` sweeps over the route: each
+    /// step tries `positions` entries evenly spread round its equidistant, keeping the one
+    /// with the least |previous M* → M| + |M* → next M| among those whose leads fit. The
+    /// order is kept; leads stay valid.
+    pub fn relax(&self, route: &Route, passes: usize, positions: usize) -> Route {
+        let mut route = route.clone();
+        let n = route.steps.len();
+        for _ in 0..passes {
+            for i in 0..n {
+                let step = &route.steps[i];
+                let (Some(current), true) = (&step.leads, step.is_pierced()) else {
+                    continue;
+                };
+                let Ok(eq) = self.equidistant(step.contour) else {
+                    continue;
+                };
+                let before = if i == 0 {
+                    route.start
+                } else {
+                    route.steps[i - 1].switch_off_point()
+                };
+                let after = match route.steps.get(i + 1) {
+                    Some(next) if next.is_pierced() => Some(next.switch_on_point()),
+                    Some(_) => None,
+                    None => route.finish,
+                };
+                let legs = |l: &StepLeads| {
+                    before.distance(l.pierce) + after.map_or(0.0, |a| l.switch_off.distance(a))
+                };
+                let perimeter = eq.perimeter();
+                let mut best = (legs(current), None);
+                for k in 0..positions {
+                    let s = perimeter * k as f64 / positions as f64;
+                    if let Ok(leads) = self.fit_at(step.contour, &eq, s) {
+                        let value = legs(&leads);
+                        if value < best.0 - 1e-9 {
+                            best = (value, Some(leads));
+                        }
+                    }
+                }
+                if let Some(leads) = best.1 {
+                    let contour = self.nest.contour(step.contour).expect("fitted contour");
+                    let step = &mut route.steps[i];
+                    if let Some(p) = contour.nearest_point(leads.entry) {
+                        step.pierce_point = p.point;
+                    }
+                    step.leads = Some(leads);
+                }
+            }
+        }
+        route
+    }
+
     /// Every rule that `leads` breaks as the leads of contour `r` (the checker used by
     /// [`crate::Route::problems`]): M ∈ G_M, M* ∈ G_M*, the leads clear of every contour by
     /// kerf/2, the entry and exit on the equidistant, the chains joined to their points.

@@ -56,7 +56,7 @@ proptest! {
                     prop_assert_eq!(contour.contains(p), hole);
                 }
             }
-            // Only a hole can close up or fall apart.
+            // Only a hole (inward) can close up or fall apart.
             Err(OffsetError::Vanishes { .. } | OffsetError::Splits { .. }) => prop_assert!(hole),
             Err(e) => prop_assert!(false, "{}", e),
         }
@@ -352,4 +352,55 @@ fn the_pierce_curve_nest_keeps_the_precedence_and_lies_at_the_pierce_distance() 
     // Routes over the curves come back onto the contours.
     let projected = fitter.project(&idealised_route(&curves));
     assert_eq!(projected.problems(&nest, &forest, 1e-6), vec![]);
+}
+
+#[test]
+fn relaxing_the_leads_never_lengthens_the_idle_and_keeps_the_route_valid() {
+    let nest = generate_nest(40, 5);
+    let settings = KerfSettings {
+        pierce_clearance: 2.0,
+        lead_in: LeadSpec::new(LeadShape::Arc, 4.0),
+        ..plasma()
+    };
+    let fitter = LeadFitter::new(&nest, settings);
+    let route = fitter.attach(&idealised_route(&nest)).unwrap();
+    let relaxed = fitter.relax(&route, 2, 16);
+    assert!(relaxed.idle_length() <= route.idle_length() + 1e-9);
+    assert!(relaxed.idle_length() < route.idle_length() - 1.0);
+    assert_eq!(
+        relaxed.problems(&nest, &nest.containment_forest(), 1e-6),
+        vec![]
+    );
+}
+
+#[test]
+fn an_outward_offset_closes_a_narrow_notch_and_follows_the_outside() {
+    // A clockwise 20 × 20 square with a notch 1 mm wide and 10 mm deep from the top.
+    let notched = Contour::new(
+        [
+            (0.0, 0.0),
+            (0.0, 20.0),
+            (9.5, 20.0),
+            (9.5, 10.0),
+            (10.5, 10.0),
+            (10.5, 20.0),
+            (20.0, 20.0),
+            (20.0, 0.0),
+        ]
+        .iter()
+        .map(|&(x, y)| Vertex::line(x, y))
+        .collect(),
+    );
+    assert!(notched.is_clockwise());
+    let offset = equidistant(&notched, 1.0).unwrap();
+    assert!(offset.is_clockwise());
+    for p in samples(&offset) {
+        assert!((notched.distance_to(p) - 1.0).abs() < 1e-6);
+        assert!(!notched.contains(p));
+    }
+    // Round the outside: the rounded 22 × 22 square (4·20 + 2π) but for a shallow dip where
+    // the arcs round the notch's two top corners meet above it.
+    let rounded_square = 80.0 + std::f64::consts::TAU;
+    assert!(offset.perimeter() > rounded_square - 1.0 && offset.perimeter() < rounded_square + 1.0);
+    assert!(offset.bounding_box().height() > 21.9);
 }
