@@ -20,6 +20,10 @@
 //!   cut span by span) on the machine's time axis, for animation, G-code and exports.
 //! - [`PathRoute`]: segment cutting (SCCP/GSCCP): tool-on paths of arbitrary spans, each from
 //!   one pierce, with lengths, time, cost and an independent coverage/scrap/precedence check.
+//! - The full cutting route (issue #17): [`equidistant`] (exact offsets at kerf/2), the pierce
+//!   and switch-off regions ([`in_clear_scrap`]), lead-ins and lead-outs ([`LeadSpec`]) fitted
+//!   by [`LeadFitter`] into [`StepLeads`] on a [`CutStep`]; [`KerfSettings::default`] is the
+//!   idealised model.
 //! - [`generate_nest`]: deterministic synthetic nests of up to tens of thousands of contours.
 //!
 //! Sign conventions: [`Contour::signed_area`] is positive for counter-clockwise contours (the
