@@ -122,3 +122,30 @@ fn convert_writes_gcode_with_leads_that_reads_back() {
     );
     assert!((read - cut).abs() < 1e-2, "{read} vs {cut}");
 }
+
+/// The target: on every real nest the routes with kerf 2, d₁ 5, d₂ 1 and arc
+/// lead-ins pass the checker (the CLI checks every route before printing it); a nest with no
+/// room for the kerf (`ring.dbs`, a 4 mm ring) names the contour instead.
+#[test]
+fn every_real_nest_routes_with_plasma_leads_or_names_the_contour_without_room() {
+    let root = common::data("nests");
+    let mut files: Vec<std::path::PathBuf> = ["dbs", "dbs-json"]
+        .iter()
+        .flat_map(|d| std::fs::read_dir(root.join(d)).unwrap())
+        .map(|e| e.unwrap().path())
+        .collect();
+    files.sort();
+    for path in files {
+        let file = path.to_string_lossy().into_owned();
+        for solver in ["nearest", "ccp"] {
+            let mut args = vec!["solve", &file, "--solver", solver, "--time-limit", "0.3"];
+            args.extend(PLASMA);
+            let (ok, _, err) = cutroute(&args);
+            if file.ends_with("ring.dbs") {
+                assert!(!ok && err.contains("ContourRef"), "{file}: {err}");
+            } else {
+                assert!(ok, "{file} {solver}: {err}");
+            }
+        }
+    }
+}
