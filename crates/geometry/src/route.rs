@@ -47,8 +47,9 @@ pub struct CutStep {
     /// equidistant, switch-off point M*) when the route is cut with kerf and leads; `None` in
     /// the idealised model, where the tool pierces and switches off at `pierce_point` on the
     /// contour. With leads, `pierce_point` is the contour point the entry lies over. Routes
-    /// written before leads have no such field.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    /// written before leads have no such field. (Always written, even as `null`: the worker's
+    /// bincode transport is not self-describing and cannot skip fields.)
+    #[serde(default)]
     pub leads: Option<StepLeads>,
 }
 
