@@ -468,32 +468,18 @@ impl<'a> LeadFitter<'a> {
         let (entry, tangent) = frame_at(eq, s);
         let perimeter = eq.perimeter();
         let (exit, exit_tangent) = frame_at(eq, (s + self.settings.overcut).rem_euclid(perimeter));
-        let lead_in = self
-            .variants(self.settings.lead_in)
-            .map(|spec| lead_in_chain(spec, entry, tangent))
-            .try_fold(LeadProblem::Disjoint, |_, chain| {
-                match self.chain_problem(r, &chain, true) {
-                    None => Err(chain),
-                    Some(p) => Ok(p),
-                }
-            });
-        let lead_in = match lead_in {
-            Err(chain) => chain,
-            Ok(problem) => return Err(problem),
-        };
-        let lead_out = self
-            .variants(self.settings.lead_out)
-            .map(|spec| lead_out_chain(spec, exit, exit_tangent))
-            .try_fold(LeadProblem::Disjoint, |_, chain| {
-                match self.chain_problem(r, &chain, false) {
-                    None => Err(chain),
-                    Some(p) => Ok(p),
-                }
-            });
-        let lead_out = match lead_out {
-            Err(chain) => chain,
-            Ok(problem) => return Err(problem),
-        };
+        let lead_in = self.first_fitting(
+            r,
+            true,
+            self.variants(self.settings.lead_in)
+                .map(|spec| lead_in_chain(spec, entry, tangent)),
+        )?;
+        let lead_out = self.first_fitting(
+            r,
+            false,
+            self.variants(self.settings.lead_out)
+                .map(|spec| lead_out_chain(spec, exit, exit_tangent)),
+        )?;
         Ok(StepLeads {
             pierce: lead_in[0].point,
             entry,
@@ -505,6 +491,23 @@ impl<'a> LeadFitter<'a> {
             pierce_clearance: self.settings.pierce_clearance,
             switch_off_clearance: self.settings.switch_off_clearance,
         })
+    }
+
+    /// The first chain that breaks no rule, else the problem of the last one tried.
+    fn first_fitting(
+        &self,
+        r: ContourRef,
+        lead_in: bool,
+        chains: impl Iterator<Item = Vec<Vertex>>,
+    ) -> Result<Vec<Vertex>, LeadProblem> {
+        let mut last = LeadProblem::Disjoint;
+        for chain in chains {
+            match self.chain_problem(r, &chain, lead_in) {
+                None => return Ok(chain),
+                Some(problem) => last = problem,
+            }
+        }
+        Err(last)
     }
 
     /// The asked lead, then shorter ones, then (lines) turned ones, then a line for an arc.
