@@ -216,6 +216,7 @@ impl DiscreteInstance {
                     contour,
                     pierce_point: point,
                     entry: Default::default(),
+                    leads: None,
                 });
             }
         }

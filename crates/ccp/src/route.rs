@@ -169,6 +169,7 @@ pub(crate) fn assemble_route(s: &Search, order: &[u32], pts: &[V]) -> Route {
                 contour: prob.refs[c],
                 pierce_point: poly[t].into(),
                 entry: Default::default(),
+                leads: None,
             });
         }
         if t < moves {
@@ -179,6 +180,7 @@ pub(crate) fn assemble_route(s: &Search, order: &[u32], pts: &[V]) -> Route {
                     contour: prob.refs[c],
                     pierce_point: x.into(),
                     entry: Default::default(),
+                    leads: None,
                 });
             }
         }
@@ -198,6 +200,7 @@ pub(crate) fn assemble_route(s: &Search, order: &[u32], pts: &[V]) -> Route {
             contour: prob.refs[c],
             pierce_point: x.into(),
             entry: Default::default(),
+            leads: None,
         });
         cur = x;
     }

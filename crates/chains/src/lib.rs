@@ -739,6 +739,7 @@ impl Context<'_> {
                 contour,
                 pierce_point: points[k],
                 entry,
+                leads: None,
             });
         }
         let mut new_steps = rest;

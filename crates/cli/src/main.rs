@@ -13,6 +13,10 @@
 //!                     [--speeds V_off,V_on,t_pt] [--task TASK.json] [--objective time|cost]
 //!                     [--thermal-sigma MM] [--thermal-tau S] [--thermal-weight W]
 //!                     [--rules part,sheet,islands] [--rules-hard] [--json]
+//!                     [--kerf MM] [--pierce-clearance MM] [--switch-off-clearance MM]
+//!                     [--lead-in arc|line|line-arc|none] [--lead-in-length MM]
+//!                     [--lead-out arc|line|line-arc|none] [--lead-out-length MM]
+//!                     [--overcut MM] [--leads-after]   # also on convert
 //!                     [--sheet N] [--profile FILE.json]
 //! ```
 //! The time and cost model (`--speeds`, `--cost`) defaults to the task file's speeds and pierce
@@ -27,6 +31,9 @@
 //! Every nest report adds the heat load `heat` (σ = 50 mm, τ = 60 s unless given), the rule
 //! violations and each step's machine time `t` (`cutroute-thermal`); `--thermal-weight` makes
 //! nearest, ccp and chain minimise objective + W·H, `--rules-hard` repairs the route until the rules hold.
+//! With `--kerf`/leads on (`kerf.rs`), nearest, ccp, heuristic and discrete optimise the full
+//! route (pierce points off the contours, leads, cut on the equidistants) and each route step
+//! carries `pierce` (M), `entry`, `lead_in`, `lead_out` and `switch_off`.
 //! `--sheet`, `--profile` and `--preset` are described in `inputs.rs` (profile < task <
 //! flags; `--preset` < the G-code flags).
 //! Errors go to stderr with the reader's location, and the exit code is 1.
@@ -43,6 +50,7 @@ use cutroute_protocol::{Document, JobRequest, Problem, Progress, SolverKind, Sol
 use serde_json::{json, Value};
 
 mod inputs;
+mod kerf;
 mod thermal;
 
 #[derive(Parser)]
@@ -95,6 +103,8 @@ enum Command {
         step: f64,
         #[command(flatten)]
         gcode: GcodeArgs,
+        #[command(flatten)]
+        kerf: kerf::KerfArgs,
         #[command(flatten)]
         sheet: inputs::SheetArg,
         #[command(flatten)]
@@ -154,6 +164,8 @@ enum Command {
         json: bool,
         #[command(flatten)]
         thermal: thermal::ThermalArgs,
+        #[command(flatten)]
+        kerf: kerf::KerfArgs,
         #[command(flatten)]
         sheet: inputs::SheetArg,
         #[command(flatten)]
@@ -239,11 +251,13 @@ fn main() -> ExitCode {
             seed,
             step,
             gcode,
+            kerf,
             sheet,
             profile,
         } => profile
             .load()
             .and_then(|profile| {
+                let kerf = kerf.parse()?;
                 let params = SolverParams {
                     time_limit_s: time_limit,
                     seed,
@@ -260,6 +274,7 @@ fn main() -> ExitCode {
                     solver.as_deref(),
                     params,
                     &gcode,
+                    &kerf,
                 )
             })
             .map_err(Failure::Error),
@@ -281,9 +296,11 @@ fn main() -> ExitCode {
             objective,
             json,
             thermal,
+            kerf,
             sheet,
             profile,
         } => (|| {
+            let kerf = kerf.parse()?;
             let base = inputs::base_machine(profile.load()?.as_ref());
             let machine =
                 machine_parameters(base, cost.as_deref(), speeds.as_deref(), task.as_deref())?;
@@ -307,8 +324,11 @@ fn main() -> ExitCode {
             };
             let input = (file.as_path(), sheet.index());
             match solver.as_str() {
+                "sccp" | "gsccp" | "aoe" if kerf.is_on() => Err(Failure::Error(format!(
+                    "--solver {solver} does not cut with kerf and leads yet"
+                ))),
                 "sccp" | "gsccp" | "aoe" => Ok(solve_path(input, &solver, params, json, &thermal)?),
-                _ => solve(input, &solver, params, json, &thermal),
+                _ => solve(input, &solver, params, json, &thermal, &kerf),
             }
         })(),
     };
@@ -744,6 +764,7 @@ fn convert(
     solver: Option<&str>,
     params: SolverParams,
     gcode: &cutroute_gcode::GcodeOptions,
+    kerf: &kerf::Kerf,
 ) -> Result<(), String> {
     let document = open((input, sheet))?;
     let Problem::Nest { nest, .. } = &document.problem else {
@@ -781,8 +802,17 @@ fn convert(
         match (solver, &document.route, &document.paths) {
             (None, _, Some(paths)) => Ok(Routed::Paths(paths.clone())),
             (None, Some(route), None) => Ok(Routed::Contours(route.clone())),
-            (name, ..) => solved(&document, name.unwrap_or("ccp"), params.clone()),
+            (name, ..) => solved(&document, name.unwrap_or("ccp"), params.clone(), kerf),
         }
+        .and_then(|routed| match routed {
+            Routed::Contours(route) if kerf.is_on() => Ok(Routed::Contours(
+                kerf.attach(nest, kerf.project(nest, route))?,
+            )),
+            Routed::Paths(_) if kerf.is_on() => {
+                Err("path routes (sccp, gsccp, aoe) do not cut with kerf and leads yet".into())
+            }
+            routed => Ok(routed),
+        })
     };
     let bytes: Vec<u8> = match format.as_str() {
         // DBS names are 8 CP866 characters: longer names are cut, others written as `?`.
@@ -848,7 +878,12 @@ enum Routed {
 }
 
 /// Routes the document's nest with the named solver; the best route found, checked.
-fn solved(document: &Document, solver_name: &str, params: SolverParams) -> Result<Routed, String> {
+fn solved(
+    document: &Document,
+    solver_name: &str,
+    params: SolverParams,
+    kerf: &kerf::Kerf,
+) -> Result<Routed, String> {
     let Problem::Nest { nest, .. } = &document.problem else {
         return Err("only nests are routed".into());
     };
@@ -859,8 +894,11 @@ fn solved(document: &Document, solver_name: &str, params: SolverParams) -> Resul
         solver,
         params,
     };
-    let forest = forest_in_background(&request.problem);
-    let run = bounded_job_run(request, true, |_| Ok(None)).map_err(|f| match f {
+    // The checker's forest is the real nest's: with leads on, the solver runs over the
+    // pierce curves and its routes are projected back before they are checked.
+    let forest = forest_in_background(&document.problem);
+    let request = kerf.request(request, solver_name)?;
+    let mut run = bounded_job_run(request, true, |_| Ok(None)).map_err(|f| match f {
         Failure::Error(m) | Failure::Infeasible(m) => m,
     })?;
     if let Some(paths) = run.last.as_ref().and_then(|p| p.path_route.clone()) {
@@ -875,6 +913,7 @@ fn solved(document: &Document, solver_name: &str, params: SolverParams) -> Resul
         }
         return Ok(Routed::Paths(paths));
     }
+    project_routes(&mut run, nest, kerf);
     checked_route(&run, nest, &joined_forest(forest, nest))
         .map(|(route, _)| Routed::Contours(route))
         .map_err(|e| format!("the {solver_name} solver: {e}"))
@@ -898,12 +937,29 @@ fn generate(contours: usize, seed: u64, out: &Path) -> Result<(), String> {
     std::fs::write(out, text).map_err(|e| format!("{}: {e}", out.display()))
 }
 
+/// With leads on, the solver ran over the pierce curves: its routes (the last and the earlier
+/// ones kept for the checker's fallback) are brought back onto the real contours.
+fn project_routes(run: &mut JobRun, nest: &Nest, kerf: &kerf::Kerf) {
+    if !kerf.is_on() {
+        return;
+    }
+    if let Some(last) = run.last.as_mut() {
+        if let Some(route) = last.route.take() {
+            last.route = Some(kerf.project(nest, route));
+        }
+    }
+    for route in &mut run.earlier_routes {
+        *route = kerf.project(nest, std::mem::take(route));
+    }
+}
+
 fn solve(
     input: (&Path, usize),
     solver_name: &str,
     params: SolverParams,
     as_json: bool,
     thermal: &thermal::Thermal,
+    kerf: &kerf::Kerf,
 ) -> Result<(), Failure> {
     let document = open(input)?;
     let solver = solver_kind(solver_name)?;
@@ -914,13 +970,17 @@ fn solve(
         solver,
         params,
     };
-    let forest = forest_in_background(&request.problem);
+    // The checker's forest is the real nest's (with leads on the solver runs over the pierce
+    // curves; its routes are projected back, see `project_routes`).
+    let forest = forest_in_background(&document.problem);
+    let request = kerf.request(request, solver_name)?;
     let heated = thermal.clone();
     let mut run = bounded_job_run(request, as_json, move |r| heated.heated_job(r))?;
     let report = match &document.problem {
         Problem::PcgtspText { text } => tour_report(solver_name, text, &run)?,
         Problem::Nest { nest, .. } => {
             let forest = joined_forest(forest, nest);
+            project_routes(&mut run, nest, kerf);
             // With `--rules-hard`, the route repaired until the rules hold (and its
             // certificates recomputed): the report describes the route it prints.
             if let Some(last) = run.last.as_mut() {
@@ -931,12 +991,13 @@ fn solve(
                             .map_err(|e| e.to_string())?;
                         last.certified = certified.iter().map(|c| c.condition1).collect();
                     }
-                    last.route = Some(route);
+                    last.route = Some(kerf.attach(nest, route)?);
                 }
             }
             let mut report = route_report(solver_name, nest, &machine, &run, &forest)?;
             if let Some(route) = run.last.as_ref().and_then(|p| p.route.as_ref()) {
                 thermal.report(&mut report, nest, route, &machine, objective)?;
+                kerf.report(&mut report, route);
             }
             report
         }

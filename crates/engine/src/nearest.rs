@@ -146,11 +146,7 @@ impl NearestNeighbourJob {
             }
             idle_length += distance(position, pierce_point);
             position = pierce_point;
-            steps.push(CutStep {
-                contour: contour_ref,
-                pierce_point,
-                entry: Default::default(),
-            });
+            steps.push(CutStep::pierced(contour_ref, pierce_point));
         }
         if let Some(finish) = self.finish {
             idle_length += distance(position, finish);
@@ -231,6 +227,7 @@ impl NearestNeighbourJob {
                 contour: contour_ref,
                 pierce_point,
                 entry: Default::default(),
+                leads: None,
             });
         }
         if let Some(finish) = self.finish {

@@ -181,6 +181,7 @@ pub fn open_gcode(file_name: &str, text: &str) -> Result<Document, OpenError> {
             contour: r,
             pierce_point: contour.vertices[0].point,
             entry,
+            leads: None,
         })
         .collect();
     let last_exit = steps.last().map(|s| s.pierce_point);

@@ -491,6 +491,7 @@ impl RmResult {
                         contour,
                         pierce_point: m.from,
                         entry,
+                        leads: None,
                     });
                     current = Some(contour);
                 }

@@ -46,11 +46,13 @@ fn chained_route() -> Route {
                 contour: c(1),
                 pierce_point: Point::new(40.0, 20.0),
                 entry: Entry::Link(vec![]),
+                leads: None,
             },
             CutStep {
                 contour: c(2),
                 pierce_point: Point::new(70.0, 20.0),
                 entry: Entry::Link(vec![Point::new(35.0, 35.0), Point::new(65.0, 35.0)]),
+                leads: None,
             },
         ],
         finish: Some(Point::new(0.0, 0.0)),

@@ -825,6 +825,7 @@ fn route_errors_name_the_step() {
             },
             pierce_point: Point::new(1.0, 1.5),
             entry: Default::default(),
+            leads: None,
         }],
         finish: None,
     };

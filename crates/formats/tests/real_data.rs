@@ -360,6 +360,7 @@ fn e1x_task_pierce_points_lie_on_the_e1x_contours() {
                         contour: c,
                         pierce_point: p,
                         entry: Default::default(),
+                        leads: None,
                     }],
                     finish: None,
                 };

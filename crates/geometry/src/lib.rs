@@ -20,6 +20,10 @@
 //!   cut span by span) on the machine's time axis, for animation, G-code and exports.
 //! - [`PathRoute`]: segment cutting (SCCP/GSCCP): tool-on paths of arbitrary spans, each from
 //!   one pierce, with lengths, time, cost and an independent coverage/scrap/precedence check.
+//! - The full cutting route (issue #17): [`equidistant`] (exact offsets at kerf/2), the pierce
+//!   and switch-off regions ([`in_clear_scrap`]), lead-ins and lead-outs ([`LeadSpec`]) fitted
+//!   by [`LeadFitter`] into [`StepLeads`] on a [`CutStep`]; [`KerfSettings::default`] is the
+//!   idealised model.
 //! - [`generate_nest`]: deterministic synthetic nests of up to tens of thousands of contours.
 //!
 //! Sign conventions: [`Contour::signed_area`] is positive for counter-clockwise contours (the
@@ -73,6 +77,8 @@ mod contour;
 pub mod domain;
 mod forest;
 mod generator;
+mod kerf;
+mod leads;
 mod path_route;
 mod point;
 mod rng;
@@ -89,6 +95,11 @@ pub use contour::{
 pub use domain::{DomainError, NestDomainError, MAX_BULGE, MAX_COORDINATE, MIN_CONTOUR_EXTENT};
 pub use forest::ContainmentForest;
 pub use generator::generate_nest;
+pub use kerf::{clearance, equidistant, in_clear_scrap, OffsetError};
+pub use leads::{
+    chain_spans, opened_at, KerfSettings, LeadError, LeadFitter, LeadProblem, LeadShape, LeadSpec,
+    StepLeads,
+};
 pub use path_route::{PathRoute, PathRouteError, ToolOnPath};
 pub use rng::{SplitMix64, Xoshiro256};
 pub use route::{

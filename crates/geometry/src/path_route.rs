@@ -1005,6 +1005,7 @@ mod tests {
                     },
                     pierce_point: p(20.0, 0.0),
                     entry: Entry::Link(vec![p(0.0, -5.0), p(20.0, -5.0)]),
+                    leads: None,
                 },
             ],
             finish: None,

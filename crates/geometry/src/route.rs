@@ -3,7 +3,7 @@
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
-use crate::{ContainmentForest, Nest, Point};
+use crate::{ContainmentForest, Contour, LeadFitter, LeadProblem, Nest, Point, StepLeads};
 
 /// Identifies one contour of a nest: `part` indexes `Nest::parts`, `contour` that part's contours.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
@@ -43,6 +43,14 @@ pub struct CutStep {
     /// read as [`Entry::Pierce`].
     #[serde(default)]
     pub entry: Entry,
+    /// The full-route elements (pierce point M off the contour, leads, the cut on the
+    /// equidistant, switch-off point M*) when the route is cut with kerf and leads; `None` in
+    /// the idealised model, where the tool pierces and switches off at `pierce_point` on the
+    /// contour. With leads, `pierce_point` is the contour point the entry lies over. Routes
+    /// written before leads have no such field. (Always written, even as `null`: the worker's
+    /// bincode transport is not self-describing and cannot skip fields.)
+    #[serde(default)]
+    pub leads: Option<StepLeads>,
 }
 
 impl CutStep {
@@ -52,12 +60,39 @@ impl CutStep {
             contour,
             pierce_point,
             entry: Entry::Pierce,
+            leads: None,
         }
     }
 
     /// Whether the torch pierces at this step (it does unless the step is entered by a link).
     pub fn is_pierced(&self) -> bool {
         matches!(self.entry, Entry::Pierce)
+    }
+
+    /// Where the tool is switched on for this step: the pierce point M of its leads, or
+    /// `pierce_point` on the contour in the idealised model.
+    pub fn switch_on_point(&self) -> Point {
+        self.leads.as_ref().map_or(self.pierce_point, |l| l.pierce)
+    }
+
+    /// Where the tool leaves this step: the switch-off point M* of its leads, or
+    /// `pierce_point` (where a closed contour's cut ends) in the idealised model.
+    pub fn switch_off_point(&self) -> Point {
+        self.leads
+            .as_ref()
+            .map_or(self.pierce_point, |l| l.switch_off)
+    }
+
+    /// Tool-on length of this step on `contour` (its own contour): the perimeter, or with
+    /// leads the lead-in, the equidistant, the overcut and the lead-out.
+    pub fn cut_length_on(&self, contour: &Contour) -> f64 {
+        match &self.leads {
+            None => contour.perimeter(),
+            Some(leads) => match crate::equidistant(contour, leads.offset) {
+                Ok(eq) => leads.cut_length(&eq),
+                Err(_) => f64::NAN,
+            },
+        }
     }
 }
 
@@ -206,6 +241,17 @@ pub enum RouteError {
         /// Step at which that is cut.
         outer_step: usize,
     },
+    /// A step's full-route elements break the model (M ∉ G_M, M* ∉ G_M*, a lead closer than
+    /// kerf/2 to a contour, the entry off the equidistant).
+    #[error("step {step} on contour {contour:?}: {problem}")]
+    Lead {
+        /// Index of the step.
+        step: usize,
+        /// Its contour.
+        contour: ContourRef,
+        /// What is wrong.
+        problem: LeadProblem,
+    },
     /// The first step is entered by a link, but there is no previous cut to link from.
     #[error("step 0 is entered by a tool-on link, but no contour was cut before it")]
     LinkWithoutPrevious,
@@ -253,7 +299,7 @@ impl Route {
     /// where a step is entered by a link (see [`Route::idle_moves`]).
     pub fn idle_points(&self) -> impl Iterator<Item = Point> + '_ {
         std::iter::once(self.start)
-            .chain(self.steps.iter().map(|s| s.pierce_point))
+            .chain(self.steps.iter().map(|s| s.switch_on_point()))
             .chain(self.finish)
     }
 
@@ -264,9 +310,9 @@ impl Route {
         let mut at = self.start;
         for s in &self.steps {
             if s.is_pierced() {
-                moves.push((at, s.pierce_point));
+                moves.push((at, s.switch_on_point()));
             }
-            at = s.pierce_point;
+            at = s.switch_off_point();
         }
         if let Some(finish) = self.finish {
             moves.push((at, finish));
@@ -289,9 +335,9 @@ impl Route {
         };
         let previous = self.steps.get(step.checked_sub(1)?)?;
         let mut path = Vec::with_capacity(corners.len() + 2);
-        path.push(previous.pierce_point);
+        path.push(previous.switch_off_point());
         path.extend_from_slice(corners);
-        path.push(s.pierce_point);
+        path.push(s.switch_on_point());
         Some(path)
     }
 
@@ -308,13 +354,13 @@ impl Route {
         self.steps.iter().filter(|s| s.is_pierced()).count()
     }
 
-    /// Total cut length: the perimeters of the contours cut plus the tool-on links, mm.
-    /// Unknown contours count 0 (see [`Route::validate`]).
+    /// Total cut length: the perimeters of the contours cut (with leads: the equidistants,
+    /// overcuts and leads) plus the tool-on links, mm. Unknown contours count 0 (see
+    /// [`Route::validate`]).
     pub fn cut_length(&self, nest: &Nest) -> f64 {
         self.steps
             .iter()
-            .filter_map(|s| nest.contour(s.contour))
-            .map(|c| c.perimeter())
+            .filter_map(|s| Some(s.cut_length_on(nest.contour(s.contour)?)))
             .sum::<f64>()
             + self.link_length()
     }
@@ -367,6 +413,19 @@ impl Route {
                     second_step: step,
                 }),
                 None => step_of[index] = Some(step),
+            }
+            if let Some(leads) = &s.leads {
+                let fitter = LeadFitter::with_forest(nest, forest, leads.rules());
+                problems.extend(
+                    fitter
+                        .problems(s.contour, leads)
+                        .into_iter()
+                        .map(|problem| RouteError::Lead {
+                            step,
+                            contour: s.contour,
+                            problem,
+                        }),
+                );
             }
             let distance = contour.distance_to(s.pierce_point);
             if !(distance <= tolerance) {

@@ -6,7 +6,9 @@
 //! every contour from the pierce point round to the pierce point again. [`ToolClock`] puts the moves on the machine's time axis (idle and cut
 //! speeds, pierce time) so a viewer can ask where the head is at any moment.
 
-use crate::{MachineParameters, Nest, PathRoute, Point, Route, RouteError, Span};
+use crate::{
+    chain_spans, opened_at, MachineParameters, Nest, PathRoute, Point, Route, RouteError, Span,
+};
 
 /// One move of the machine.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -133,24 +135,14 @@ impl Toolpath {
                     }
                 }
                 None => {
-                    if at != cut.pierce_point {
-                        moves.push(ToolMove::Idle {
-                            from: at,
-                            to: cut.pierce_point,
-                        });
+                    let on = cut.switch_on_point();
+                    if at != on {
+                        moves.push(ToolMove::Idle { from: at, to: on });
                     }
-                    moves.push(ToolMove::Pierce {
-                        at: cut.pierce_point,
-                        step,
-                    });
+                    moves.push(ToolMove::Pierce { at: on, step });
                 }
             }
-            at = cut.pierce_point;
-            let Some(entry) = contour.nearest_point(cut.pierce_point) else {
-                continue;
-            };
-            let spans: Vec<Span> = contour.spans().collect();
-            let (i, t) = (entry.position.span, entry.position.t);
+            at = cut.switch_off_point();
             let mut push = |span: Span| {
                 if span.length() > MIN_PIECE_LENGTH {
                     moves.push(ToolMove::Cut {
@@ -160,13 +152,24 @@ impl Toolpath {
                     });
                 }
             };
-            // Open the contour at the entry: the rest of span i, the spans after it round the
-            // cycle, then the part of span i before the entry.
-            push(spans[i].sub_span(t, 1.0));
-            for k in 1..spans.len() {
-                push(spans[(i + k) % spans.len()]);
+            match &cut.leads {
+                None => opened_at(contour, cut.pierce_point, MIN_PIECE_LENGTH)
+                    .into_iter()
+                    .for_each(&mut push),
+                Some(leads) => {
+                    // The lead-in, the equidistant from the entry round (and the overcut),
+                    // the lead-out; an equidistant that does not exist is reported by the
+                    // checker, and the step then cuts its leads only.
+                    chain_spans(&leads.lead_in).for_each(&mut push);
+                    if let Ok(eq) = crate::equidistant(contour, leads.offset) {
+                        leads
+                            .equidistant_cut(&eq, MIN_PIECE_LENGTH)
+                            .into_iter()
+                            .for_each(&mut push);
+                    }
+                    chain_spans(&leads.lead_out).for_each(&mut push);
+                }
             }
-            push(spans[i].sub_span(0.0, t));
         }
         if let Some(finish) = route.finish {
             if at != finish {
@@ -496,6 +499,7 @@ mod tests {
                     contour: b,
                     pierce_point: Point::new(12.0, 5.0),
                     entry: Entry::Link(vec![Point::new(11.0, 5.0)]),
+                    leads: None,
                 },
             ],
             finish: None,

@@ -45,16 +45,19 @@ fn good_route() -> Route {
                 contour: r(0, 1),
                 pierce_point: p(60.0, 50.0),
                 entry: Default::default(),
+                leads: None,
             },
             CutStep {
                 contour: r(0, 0),
                 pierce_point: p(100.0, 50.0),
                 entry: Default::default(),
+                leads: None,
             },
             CutStep {
                 contour: r(1, 0),
                 pierce_point: p(195.0, 50.0),
                 entry: Default::default(),
+                leads: None,
             },
         ],
         finish: Some(p(0.0, -100.0)),
@@ -161,6 +164,7 @@ fn inner_first_route_on_a_generated_nest_is_valid() {
             contour: c,
             pierce_point: n.contour(c).unwrap().vertices[0].point,
             entry: Default::default(),
+            leads: None,
         })
         .collect();
     let route = Route {
@@ -252,6 +256,7 @@ fn linked(contour: ContourRef, at: Point, corners: Vec<Point>) -> CutStep {
         contour,
         pierce_point: at,
         entry: Entry::Link(corners),
+        leads: None,
     }
 }
 

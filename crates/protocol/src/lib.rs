@@ -408,6 +408,7 @@ mod tests {
                     },
                     pierce_point: Point::new(0.0, 0.0),
                     entry: Default::default(),
+                    leads: None,
                 }],
                 finish: None,
             }),
@@ -443,6 +444,45 @@ mod tests {
             bincode::deserialize::<FromWorker>(&bytes).unwrap(),
             progress
         );
+    }
+
+    #[test]
+    fn routes_with_leads_survive_the_worker_codec() {
+        use cutroute_geometry::{ContourRef, CutStep, Route, StepLeads, Vertex};
+        let mut step = CutStep::pierced(
+            ContourRef {
+                part: 0,
+                contour: 0,
+            },
+            Point::new(1.0, 0.0),
+        );
+        step.leads = Some(StepLeads {
+            pierce: Point::new(-4.0, 0.0),
+            entry: Point::new(0.0, 0.0),
+            lead_in: vec![Vertex::arc(-4.0, 0.0, 0.4), Vertex::line(0.0, 0.0)],
+            lead_out: vec![Vertex::line(0.0, 0.0), Vertex::line(-2.0, 0.0)],
+            switch_off: Point::new(-2.0, 0.0),
+            offset: 1.0,
+            overcut: 0.5,
+            pierce_clearance: 5.0,
+            switch_off_clearance: 1.0,
+        });
+        let route = Route {
+            start: Point::default(),
+            steps: vec![
+                step,
+                CutStep::pierced(
+                    ContourRef {
+                        part: 1,
+                        contour: 0,
+                    },
+                    Point::new(9.0, 9.0),
+                ),
+            ],
+            finish: None,
+        };
+        let bytes = bincode::serialize(&route).unwrap();
+        assert_eq!(bincode::deserialize::<Route>(&bytes).unwrap(), route);
     }
 
     #[test]

@@ -135,8 +135,9 @@ impl HeatModel {
     }
 }
 
-/// The heat sources of a route: per step, its entry point and the machine time the head gets
-/// there (pierce start, or end of the step's tool-on link). Fails on an unknown contour.
+/// The heat sources of a route: per step, where the torch goes on (the pierce point M of its
+/// leads, else its point on the contour) and the machine time the head gets there (pierce
+/// start, or end of the step's tool-on link). Fails on an unknown contour.
 pub fn route_pierces(
     route: &Route,
     nest: &Nest,
@@ -147,7 +148,7 @@ pub fn route_pierces(
         .into_iter()
         .zip(&route.steps)
         .map(|(time, step)| Pierce {
-            point: step.pierce_point,
+            point: step.switch_on_point(),
             time,
         })
         .collect())

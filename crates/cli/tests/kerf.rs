@@ -1,0 +1,151 @@
+//! `cutroute solve`/`convert` with kerf and leads: every step carries its full-route elements,
+//! checked here independently of the library; the defaults change nothing.
+
+mod common;
+
+use common::{cutroute, json};
+use serde_json::Value;
+
+fn data(relative: &str) -> String {
+    common::data(relative).to_string_lossy().into_owned()
+}
+
+const PLASMA: [&str; 12] = [
+    "--kerf",
+    "2",
+    "--pierce-clearance",
+    "5",
+    "--switch-off-clearance",
+    "1",
+    "--lead-in",
+    "arc",
+    "--lead-in-length",
+    "8",
+    "--lead-out",
+    "line",
+];
+
+fn point(v: &Value) -> (f64, f64) {
+    (v[0].as_f64().unwrap(), v[1].as_f64().unwrap())
+}
+
+#[test]
+fn with_leads_every_step_carries_pierce_entry_leads_and_switch_off() {
+    let file = data("nests/dbs-json/E1X_6_01.dbs.json");
+    for solver in ["nearest", "ccp"] {
+        let mut args = vec![
+            "solve",
+            &file,
+            "--solver",
+            solver,
+            "--time-limit",
+            "1",
+            "--json",
+        ];
+        args.extend(PLASMA);
+        let report = json(&args);
+        let steps = report["route"].as_array().unwrap();
+        assert!(!steps.is_empty());
+        // idle_length is the start leg plus every switch-off → next pierce leg.
+        let mut at = point(&report["start"]);
+        let mut idle = 0.0;
+        for step in steps {
+            let m = point(&step["pierce"]);
+            idle += (m.0 - at.0).hypot(m.1 - at.1);
+            let lead_in = step["lead_in"].as_array().unwrap();
+            assert_eq!(point(&lead_in[0]), m, "{solver}: the lead-in starts at M");
+            assert_eq!(point(lead_in.last().unwrap()), point(&step["entry"]));
+            let lead_out = step["lead_out"].as_array().unwrap();
+            assert_eq!(point(lead_out.last().unwrap()), point(&step["switch_off"]));
+            // M is off the contour, at least d₁ = 5 from the point of the contour it serves.
+            let c = point(&step["contour_point"]);
+            assert!(
+                (m.0 - c.0).hypot(m.1 - c.1) >= 5.0 - 1e-6,
+                "{solver}: {m:?} vs {c:?}"
+            );
+            at = point(&step["switch_off"]);
+        }
+        if let Some(finish) = report.get("finish").filter(|f| !f.is_null()) {
+            let f = point(finish);
+            idle += (f.0 - at.0).hypot(f.1 - at.1);
+        }
+        let reported = report["idle_length"].as_f64().unwrap();
+        assert!(
+            (idle - reported).abs() < 1e-6,
+            "{solver}: {idle} vs {reported}"
+        );
+        assert!(report["lead_in_length"].as_f64().unwrap() > 0.0);
+    }
+}
+
+#[test]
+fn the_defaults_keep_the_idealised_report() {
+    let file = data("nests/dbs-json/E1X_6_01.dbs.json");
+    let report = json(&["solve", &file, "--solver", "nearest", "--json"]);
+    assert!(report.get("kerf").is_none());
+    assert!(report["route"][0].get("lead_in").is_none());
+}
+
+#[test]
+fn path_solvers_and_bad_flags_are_refused_with_leads() {
+    let file = data("nests/dbs-json/E1X_6_01.dbs.json");
+    let mut args = vec!["solve", &file, "--solver", "aoe"];
+    args.extend(PLASMA);
+    let (ok, _, err) = cutroute(&args);
+    assert!(!ok && err.contains("kerf"), "{err}");
+    let (ok, _, err) = cutroute(&["solve", &file, "--lead-in", "spiral"]);
+    assert!(!ok && err.contains("--lead-in"), "{err}");
+    let (ok, _, err) = cutroute(&["solve", &file, "--kerf=-1"]);
+    assert!(!ok && err.contains("--kerf"), "{err}");
+}
+
+#[test]
+fn convert_writes_gcode_with_leads_that_reads_back() {
+    let file = data("nests/dbs-json/E1X_6_01.dbs.json");
+    let out = std::env::temp_dir().join(format!("cutroute-kerf-{}.nc", std::process::id()));
+    let out_s = out.to_string_lossy().into_owned();
+    let mut args = vec!["convert", &file, &out_s, "--solver", "nearest"];
+    args.extend(PLASMA);
+    let (ok, _, err) = cutroute(&args);
+    assert!(ok, "{err}");
+    let report = json(&["inspect", &out_s, "--json"]);
+    let solved = {
+        let mut a = vec!["solve", &file, "--solver", "nearest", "--json"];
+        a.extend(PLASMA);
+        json(&a)
+    };
+    let _ = std::fs::remove_file(&out);
+    assert_eq!(report["route_pierces"], solved["pierces"]);
+    let (read, cut) = (
+        report["route_cut_length"].as_f64().unwrap(),
+        solved["cut_length"].as_f64().unwrap(),
+    );
+    assert!((read - cut).abs() < 1e-2, "{read} vs {cut}");
+}
+
+/// The target: on every real nest the routes with kerf 2, d₁ 5, d₂ 1 and arc
+/// lead-ins pass the checker (the CLI checks every route before printing it); a nest with no
+/// room for the kerf (`ring.dbs`, a 4 mm ring) names the contour instead.
+#[test]
+fn every_real_nest_routes_with_plasma_leads_or_names_the_contour_without_room() {
+    let root = common::data("nests");
+    let mut files: Vec<std::path::PathBuf> = ["dbs", "dbs-json"]
+        .iter()
+        .flat_map(|d| std::fs::read_dir(root.join(d)).unwrap())
+        .map(|e| e.unwrap().path())
+        .collect();
+    files.sort();
+    for path in files {
+        let file = path.to_string_lossy().into_owned();
+        for solver in ["nearest", "ccp"] {
+            let mut args = vec!["solve", &file, "--solver", solver, "--time-limit", "0.3"];
+            args.extend(PLASMA);
+            let (ok, _, err) = cutroute(&args);
+            if file.ends_with("ring.dbs") {
+                assert!(!ok && err.contains("ContourRef"), "{file}: {err}");
+            } else {
+                assert!(ok, "{file} {solver}: {err}");
+            }
+        }
+    }
+}

@@ -1,0 +1,66 @@
+//! Routes with kerf and leads written as G-code and read back: the program cuts on the
+//! equidistants with the leads, and reads back with the same lengths and pierces.
+
+use cutroute_gcode::{read_gcode, route_gcode, ArcOutput, DistanceMode, GcodeOptions, ReadOptions};
+use cutroute_geometry::{
+    generate_nest, ContourRef, CutStep, KerfSettings, LeadFitter, LeadShape, LeadSpec, Point,
+    Route, Toolpath,
+};
+
+#[test]
+fn a_route_with_leads_reads_back_with_the_same_lengths_and_pierces() {
+    let nest = generate_nest(40, 11);
+    let forest = nest.containment_forest();
+    let mut refs: Vec<ContourRef> = nest.contour_refs().collect();
+    refs.sort_by_key(|&r| std::cmp::Reverse(forest.depth(r)));
+    let route = Route {
+        start: Point::new(0.0, 0.0),
+        steps: refs
+            .into_iter()
+            .map(|r| CutStep::pierced(r, nest.contour(r).unwrap().vertices[0].point))
+            .collect(),
+        finish: Some(Point::new(0.0, 0.0)),
+    };
+    let settings = KerfSettings {
+        kerf: 2.0,
+        pierce_clearance: 2.0,
+        switch_off_clearance: 1.0,
+        lead_in: LeadSpec::new(LeadShape::Arc, 4.0),
+        lead_out: LeadSpec::new(LeadShape::Line, 2.0),
+        overcut: 0.5,
+    };
+    let route = LeadFitter::new(&nest, settings).attach(&route).unwrap();
+    route.validate(&nest, 1e-6).unwrap();
+    let path = Toolpath::new(&route, &nest).unwrap();
+    for distance_mode in [DistanceMode::Absolute, DistanceMode::Incremental] {
+        for arcs in [ArcOutput::CentreOffsets, ArcOutput::Radius] {
+            let options = GcodeOptions {
+                distance_mode,
+                arcs,
+                decimals: 6,
+                ..GcodeOptions::default()
+            };
+            let text = route_gcode(&nest, &route, &options).unwrap();
+            let program = read_gcode(&text, &ReadOptions::default()).unwrap();
+            let what = format!("{distance_mode:?} {arcs:?}");
+            assert!(
+                (program.cut_length() - route.cut_length(&nest)).abs() < 1e-3,
+                "{what}"
+            );
+            assert!(
+                (program.idle_length() - route.idle_length()).abs() < 1e-3,
+                "{what}"
+            );
+            assert!(
+                (program.cut_length() - path.cut_length()).abs() < 1e-3,
+                "{what}"
+            );
+            assert_eq!(program.pierce_count(), route.pierce_count(), "{what}");
+            // The torch goes on at the pierce points M, off the contours.
+            for (read, step) in program.pierce_points().iter().zip(&route.steps) {
+                let m = step.leads.as_ref().unwrap().pierce;
+                assert!(read.distance(m) < 1e-4, "{what}: {read:?} vs {m:?}");
+            }
+        }
+    }
+}

@@ -1,0 +1,905 @@
+//! Lead-ins and lead-outs: how the tool gets from its pierce point M onto the equidistant, and
+//! off it again to the switch-off point M* (dissertation §2.3, constraints (1.5)–(1.6)).
+//!
+//! A lead lies on the scrap side of its contour (outside an outer contour, inside a hole),
+//! which after orientation is always the left of the cut direction. Shapes ([`LeadShape`]):
+//! a straight line at an angle to the normal, an arc tangent to the equidistant at the entry,
+//! or a straight line followed by that arc.
+//!
+//! [`LeadFitter`] fits leads automatically: where the asked lead would come closer than kerf/2
+//! to a contour, leave the scrap, or put M closer than d₁ (M* closer than d₂) to a part, it
+//! shortens the lead, turns a line, falls back from an arc to a line, moves the entry along
+//! the contour, and in a hole tries a pierce at the hole's centre. A contour where nothing fits
+//! is reported ([`LeadError::NoFit`]), never dropped.
+//!
+//! ```
+//! use cutroute_geometry::{Contour, ContourRef, KerfSettings, LeadFitter, LeadShape, LeadSpec,
+//!     Nest, Part, Point};
+//! let square = Contour::new(vec![
+//!     cutroute_geometry::Vertex::line(0.0, 0.0),
+//!     cutroute_geometry::Vertex::line(0.0, 50.0),
+//!     cutroute_geometry::Vertex::line(50.0, 50.0),
+//!     cutroute_geometry::Vertex::line(50.0, 0.0),
+//! ]);
+//! let nest = Nest { sheet: None, parts: vec![Part { name: "p".into(), contours: vec![square] }] };
+//! let settings = KerfSettings {
+//!     kerf: 2.0,
+//!     pierce_clearance: 5.0,
+//!     switch_off_clearance: 1.0,
+//!     lead_in: LeadSpec::new(LeadShape::Arc, 10.0),
+//!     lead_out: LeadSpec::new(LeadShape::Line, 3.0),
+//!     overcut: 0.0,
+//! };
+//! let fitter = LeadFitter::new(&nest, settings);
+//! let r = ContourRef { part: 0, contour: 0 };
+//! let leads = fitter.fit(r, Point::new(-20.0, 25.0)).unwrap();
+//! // The entry lies on the equidistant at kerf/2 = 1 from the square, M at least d₁ = 5 from it.
+//! assert!((nest.contour(r).unwrap().distance_to(leads.entry) - 1.0).abs() < 1e-9);
+//! assert!(nest.contour(r).unwrap().distance_to(leads.pierce) >= 5.0);
+//! assert!(fitter.problems(r, &leads).is_empty());
+//! ```
+
+use std::borrow::Cow;
+
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+use crate::kerf::{clearance, equidistant, in_clear_scrap, OffsetError};
+use crate::{ContainmentForest, Contour, ContourRef, CutStep, Nest, Point, Route, Span, Vertex};
+
+/// The shape of a lead-in or lead-out.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum LeadShape {
+    /// No lead: the tool pierces (or switches off) on the equidistant.
+    #[default]
+    None,
+    /// A straight line, at [`LeadSpec::angle`] from the contour's normal.
+    Line,
+    /// A circular arc tangent to the equidistant at the entry (exit).
+    Arc,
+    /// A straight line of [`LeadSpec::length`] continuing the tangent arc of
+    /// [`LeadSpec::radius`].
+    LineArc,
+}
+
+/// The asked shape and size of a lead; the fitter may shrink or turn it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct LeadSpec {
+    /// The shape.
+    pub shape: LeadShape,
+    /// Length of the lead (of its straight part for [`LeadShape::LineArc`]), mm.
+    pub length: f64,
+    /// Angle between a straight lead and the contour's normal, degrees: 0 is perpendicular,
+    /// positive leans the lead back along the contour.
+    pub angle: f64,
+    /// Radius of the arc, mm; 0 means a quarter circle of the lead's length (radius 2L/π).
+    pub radius: f64,
+}
+
+impl LeadSpec {
+    /// A lead of this shape and length, perpendicular for lines, a quarter circle for arcs.
+    pub fn new(shape: LeadShape, length: f64) -> LeadSpec {
+        LeadSpec {
+            shape,
+            length,
+            angle: 0.0,
+            radius: 0.0,
+        }
+    }
+
+    /// This lead scaled by `factor` (lengths and radius).
+    fn scaled(self, factor: f64) -> LeadSpec {
+        LeadSpec {
+            length: self.length * factor,
+            radius: self.radius * factor,
+            ..self
+        }
+    }
+
+    /// How far the lead takes its free end from the equidistant, along the normal, mm.
+    pub fn reach(self) -> f64 {
+        let (radius, sweep) = self.arc();
+        match self.shape {
+            LeadShape::None => 0.0,
+            LeadShape::Line => self.length * self.angle.to_radians().cos().max(0.0),
+            LeadShape::Arc => radius * (1.0 - sweep.cos()),
+            LeadShape::LineArc => radius + self.length,
+        }
+    }
+
+    /// How far behind the entry (against the cut direction) the lead-in's pierce point lies,
+    /// mm: the entry for a pierce point over arc length s lies at s + this.
+    pub fn lag(self) -> f64 {
+        let (radius, sweep) = self.arc();
+        match self.shape {
+            LeadShape::None => 0.0,
+            LeadShape::Line => self.length * self.angle.to_radians().sin(),
+            LeadShape::Arc => radius * sweep.sin(),
+            LeadShape::LineArc => radius,
+        }
+    }
+
+    /// The arc's radius and sweep (radians).
+    fn arc(self) -> (f64, f64) {
+        let quarter = std::f64::consts::FRAC_PI_2;
+        match self.shape {
+            LeadShape::Arc if self.radius > 0.0 => (
+                self.radius,
+                (self.length / self.radius).min(std::f64::consts::PI),
+            ),
+            LeadShape::Arc => (self.length / quarter, quarter),
+            LeadShape::LineArc if self.radius > 0.0 => (self.radius, quarter),
+            LeadShape::LineArc => (self.length / 2.0, quarter),
+            _ => (0.0, 0.0),
+        }
+    }
+}
+
+/// Machine and material settings of the full cutting route. The default is the idealised
+/// model (kerf 0, no leads, no clearances, no overcut), under which a route is cut on the
+/// contours themselves.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct KerfSettings {
+    /// Kerf width, mm: the tool centre runs at kerf/2 from the contour.
+    pub kerf: f64,
+    /// d₁: least distance from every contour to a pierce point, mm.
+    pub pierce_clearance: f64,
+    /// d₂: least distance from every contour to a switch-off point, mm.
+    pub switch_off_clearance: f64,
+    /// The lead-in, from M to the entry on the equidistant.
+    pub lead_in: LeadSpec,
+    /// The lead-out, from the exit to M*.
+    pub lead_out: LeadSpec,
+    /// How far the cut runs on past the entry before the lead-out, mm.
+    pub overcut: f64,
+}
+
+impl KerfSettings {
+    /// Whether these settings are the idealised model: cut on the contour, pierce on it.
+    pub fn is_idealised(&self) -> bool {
+        self.kerf == 0.0
+            && self.pierce_clearance == 0.0
+            && self.switch_off_clearance == 0.0
+            && self.lead_in.shape == LeadShape::None
+            && self.lead_out.shape == LeadShape::None
+            && self.overcut == 0.0
+    }
+}
+
+/// The full-route elements of one step: M, the lead-in, the entry on the equidistant, the
+/// cut round the equidistant (and the overcut), the lead-out, M*.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct StepLeads {
+    /// Pierce point M.
+    pub pierce: Point,
+    /// Where the lead-in meets the equidistant; the cut starts here.
+    pub entry: Point,
+    /// Lead-in spans as vertices `[x, y, bulge]` from M to the entry (the last vertex is the
+    /// entry, bulge 0); just `[entry]` without a lead.
+    #[serde(with = "vertex_triples")]
+    pub lead_in: Vec<Vertex>,
+    /// Lead-out spans from the exit (entry + overcut along the equidistant) to M*.
+    #[serde(with = "vertex_triples")]
+    pub lead_out: Vec<Vertex>,
+    /// Switch-off point M*.
+    pub switch_off: Point,
+    /// Half the kerf: the distance of the equidistant from the contour, mm.
+    pub offset: f64,
+    /// How far the cut runs on past the entry, mm.
+    #[serde(default)]
+    pub overcut: f64,
+    /// d₁ the pierce point was placed under (the checker holds the step to it), mm.
+    #[serde(default)]
+    pub pierce_clearance: f64,
+    /// d₂ the switch-off point was placed under, mm.
+    #[serde(default)]
+    pub switch_off_clearance: f64,
+}
+
+/// Spans of a vertex chain (each vertex's bulge shapes the span to the next; the last vertex
+/// only ends the chain).
+pub fn chain_spans(chain: &[Vertex]) -> impl Iterator<Item = Span> + '_ {
+    chain
+        .windows(2)
+        .map(|w| Span::new(w[0].point, w[1].point, w[0].bulge))
+}
+
+impl StepLeads {
+    /// The rules these leads were built under (kerf, d₁, d₂; shapes are not rules), which
+    /// the route checker holds them to.
+    pub fn rules(&self) -> KerfSettings {
+        KerfSettings {
+            kerf: 2.0 * self.offset,
+            pierce_clearance: self.pierce_clearance,
+            switch_off_clearance: self.switch_off_clearance,
+            overcut: self.overcut,
+            ..KerfSettings::default()
+        }
+    }
+
+    /// Length of the tool-on path of the step: lead-in, the equidistant's perimeter, the
+    /// overcut and the lead-out, mm.
+    pub fn cut_length(&self, equidistant: &Contour) -> f64 {
+        self.lead_in_length() + equidistant.perimeter() + self.overcut + self.lead_out_length()
+    }
+
+    /// Length of the lead-in, mm.
+    pub fn lead_in_length(&self) -> f64 {
+        chain_spans(&self.lead_in).map(|s| s.length()).sum()
+    }
+
+    /// Length of the lead-out, mm.
+    pub fn lead_out_length(&self) -> f64 {
+        chain_spans(&self.lead_out).map(|s| s.length()).sum()
+    }
+
+    /// The exit point: where the lead-out leaves the equidistant.
+    pub fn exit(&self) -> Point {
+        self.lead_out.first().map_or(self.entry, |v| v.point)
+    }
+
+    /// The cut of `equidistant` for this step: from the entry round to the entry, then the
+    /// overcut. Pieces shorter than `min_piece` are dropped.
+    pub fn equidistant_cut(&self, equidistant: &Contour, min_piece: f64) -> Vec<Span> {
+        let mut cut = opened_at(equidistant, self.entry, min_piece);
+        let mut left = self.overcut;
+        let round = cut.clone();
+        for span in round {
+            if !(left > min_piece) {
+                break;
+            }
+            let l = span.length();
+            if l <= left {
+                cut.push(span);
+                left -= l;
+            } else {
+                cut.push(span.sub_span(0.0, left / l));
+                left = 0.0;
+            }
+        }
+        cut
+    }
+}
+
+/// The spans of `contour` opened at the point nearest to `at`: the rest of that span, the
+/// spans after it round the cycle, then the part of that span before `at`.
+pub fn opened_at(contour: &Contour, at: Point, min_piece: f64) -> Vec<Span> {
+    let Some(entry) = contour.nearest_point(at) else {
+        return Vec::new();
+    };
+    let spans: Vec<Span> = contour.spans().collect();
+    let (i, t) = (entry.position.span, entry.position.t);
+    let mut out = Vec::with_capacity(spans.len() + 1);
+    out.push(spans[i].sub_span(t, 1.0));
+    for k in 1..spans.len() {
+        out.push(spans[(i + k) % spans.len()]);
+    }
+    out.push(spans[i].sub_span(0.0, t));
+    out.retain(|s| s.length() > min_piece);
+    out
+}
+
+mod vertex_triples {
+    //! Lead vertices as `[x, y, bulge]` triples, the issue's JSON form.
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    use crate::Vertex;
+
+    pub fn serialize<S: Serializer>(v: &[Vertex], s: S) -> Result<S::Ok, S::Error> {
+        v.iter()
+            .map(|v| [v.point.x, v.point.y, v.bulge])
+            .collect::<Vec<_>>()
+            .serialize(s)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<Vertex>, D::Error> {
+        let triples = Vec::<[f64; 3]>::deserialize(d)?;
+        Ok(triples
+            .into_iter()
+            .map(|[x, y, b]| Vertex::arc(x, y, b))
+            .collect())
+    }
+}
+
+/// Why the full-route elements of a contour could not be built.
+#[derive(Clone, Debug, PartialEq, Error)]
+pub enum LeadError {
+    /// The nest has no such contour.
+    #[error("the nest has no contour {contour:?}")]
+    UnknownContour {
+        /// The reference.
+        contour: ContourRef,
+    },
+    /// The contour has no single equidistant at kerf/2.
+    #[error("contour {contour:?} has no equidistant: {source}")]
+    Offset {
+        /// The contour.
+        contour: ContourRef,
+        /// Why.
+        source: OffsetError,
+    },
+    /// No lead-in/lead-out pair fits anywhere on the contour.
+    #[error("no lead fits contour {contour:?}: {reason}")]
+    NoFit {
+        /// The contour.
+        contour: ContourRef,
+        /// What failed at the last position tried.
+        reason: LeadProblem,
+    },
+}
+
+/// One way the full-route elements of a step break the model's rules.
+#[derive(Clone, Copy, Debug, PartialEq, Error)]
+pub enum LeadProblem {
+    /// M is not in G_M: closer than d₁ to a contour, or not in the contour's scrap region.
+    #[error("pierce point ({x}, {y}) is not in the pierce region G_M")]
+    PierceOutsideRegion {
+        /// M, x.
+        x: f64,
+        /// M, y.
+        y: f64,
+    },
+    /// M* is not in G_M*.
+    #[error("switch-off point ({x}, {y}) is not in the switch-off region G_M*")]
+    SwitchOffOutsideRegion {
+        /// M*, x.
+        x: f64,
+        /// M*, y.
+        y: f64,
+    },
+    /// A lead comes closer than kerf/2 to a contour or crosses it.
+    #[error("a lead comes {distance} mm from a contour near ({x}, {y}), closer than kerf/2")]
+    LeadTooClose {
+        /// Where, x.
+        x: f64,
+        /// Where, y.
+        y: f64,
+        /// Its distance to the nearest contour.
+        distance: f64,
+    },
+    /// The entry (or exit) is not on the equidistant.
+    #[error("the entry ({x}, {y}) is {distance} mm off the equidistant")]
+    EntryOffEquidistant {
+        /// Entry, x.
+        x: f64,
+        /// Entry, y.
+        y: f64,
+        /// Its distance from the equidistant.
+        distance: f64,
+    },
+    /// The lead chain does not run from M to the entry, or from the exit to M*.
+    #[error("a lead does not join its end points")]
+    Disjoint,
+}
+
+/// Relative tolerance of the checks, times the nest's scale (1 mm).
+const TOLERANCE: f64 = 1e-6;
+
+/// Builds equidistants and fits leads for the contours of one nest under one set of
+/// [`KerfSettings`]; also checks given leads (the route checker's geometric part).
+pub struct LeadFitter<'a> {
+    nest: &'a Nest,
+    forest: Cow<'a, ContainmentForest>,
+    settings: KerfSettings,
+}
+
+impl<'a> LeadFitter<'a> {
+    /// A fitter for `nest`; builds the containment forest once.
+    pub fn new(nest: &'a Nest, settings: KerfSettings) -> LeadFitter<'a> {
+        LeadFitter {
+            nest,
+            forest: Cow::Owned(nest.containment_forest()),
+            settings,
+        }
+    }
+
+    /// A fitter for `nest` that reuses its containment forest.
+    pub fn with_forest(
+        nest: &'a Nest,
+        forest: &'a ContainmentForest,
+        settings: KerfSettings,
+    ) -> LeadFitter<'a> {
+        LeadFitter {
+            nest,
+            forest: Cow::Borrowed(forest),
+            settings,
+        }
+    }
+
+    /// The settings.
+    pub fn settings(&self) -> &KerfSettings {
+        &self.settings
+    }
+
+    /// The equidistant of contour `r` at kerf/2 on its scrap side.
+    pub fn equidistant(&self, r: ContourRef) -> Result<Contour, LeadError> {
+        let contour = self
+            .nest
+            .contour(r)
+            .ok_or(LeadError::UnknownContour { contour: r })?;
+        equidistant(contour, self.settings.kerf / 2.0)
+            .map_err(|source| LeadError::Offset { contour: r, source })
+    }
+
+    /// Leads for contour `r` with the pierce point M as near as the rules allow to `near` (a
+    /// point the tool comes from, or a wanted pierce point). Tries the asked leads at the nearest entry, then
+    /// shorter and turned ones, then entries further along the equidistant, then (in a hole)
+    /// a pierce at the hole's centre.
+    pub fn fit(&self, r: ContourRef, near: Point) -> Result<StepLeads, LeadError> {
+        let eq = self.equidistant(r)?;
+        self.fit_on(r, &eq, near)
+    }
+
+    /// [`LeadFitter::fit`] with the equidistant already built.
+    pub fn fit_on(&self, r: ContourRef, eq: &Contour, near: Point) -> Result<StepLeads, LeadError> {
+        let perimeter = eq.perimeter();
+        // The entry that puts the asked lead-in's M over `near`.
+        let s0 = eq
+            .nearest_point(near)
+            .map_or(0.0, |p| eq.length_at(p.position))
+            + self.settings.lead_in.lag();
+        const POSITIONS: usize = 24;
+        let mut reason = LeadProblem::Disjoint;
+        for k in 0..POSITIONS {
+            // 0, +1, −1, +2, −2, … steps of perimeter/POSITIONS round the equidistant.
+            let step = (k as f64 / 2.0).ceil() * if k % 2 == 1 { 1.0 } else { -1.0 };
+            let s = (s0 + step * perimeter / POSITIONS as f64).rem_euclid(perimeter.max(1e-12));
+            match self.fit_at(r, eq, s) {
+                Ok(leads) => return Ok(leads),
+                Err(problem) => reason = problem,
+            }
+        }
+        if self.is_hole(r) {
+            if let Some(leads) = self.centre_pierce(r, eq) {
+                return Ok(leads);
+            }
+        }
+        Err(LeadError::NoFit { contour: r, reason })
+    }
+
+    fn is_hole(&self, r: ContourRef) -> bool {
+        self.forest.depth(r).is_some_and(|d| d % 2 == 1)
+    }
+
+    /// Leads with the entry at arc length `s` of the equidistant, trying the variants of each
+    /// lead in order.
+    fn fit_at(&self, r: ContourRef, eq: &Contour, s: f64) -> Result<StepLeads, LeadProblem> {
+        let (entry, tangent) = frame_at(eq, s);
+        let perimeter = eq.perimeter();
+        let (exit, exit_tangent) = frame_at(eq, (s + self.settings.overcut).rem_euclid(perimeter));
+        let lead_in = self.first_fitting(
+            r,
+            true,
+            self.variants(self.settings.lead_in)
+                .map(|spec| lead_in_chain(spec, entry, tangent)),
+        )?;
+        let lead_out = self.first_fitting(
+            r,
+            false,
+            self.variants(self.settings.lead_out)
+                .map(|spec| lead_out_chain(spec, exit, exit_tangent)),
+        )?;
+        Ok(StepLeads {
+            pierce: lead_in[0].point,
+            entry,
+            switch_off: lead_out.last().map_or(exit, |v| v.point),
+            lead_in,
+            lead_out,
+            offset: self.settings.kerf / 2.0,
+            overcut: self.settings.overcut,
+            pierce_clearance: self.settings.pierce_clearance,
+            switch_off_clearance: self.settings.switch_off_clearance,
+        })
+    }
+
+    /// The first chain that breaks no rule, else the problem of the last one tried.
+    fn first_fitting(
+        &self,
+        r: ContourRef,
+        lead_in: bool,
+        chains: impl Iterator<Item = Vec<Vertex>>,
+    ) -> Result<Vec<Vertex>, LeadProblem> {
+        let mut last = LeadProblem::Disjoint;
+        for chain in chains {
+            match self.chain_problem(r, &chain, lead_in) {
+                None => return Ok(chain),
+                Some(problem) => last = problem,
+            }
+        }
+        Err(last)
+    }
+
+    /// The asked lead, then shorter ones, then (lines) turned ones, then a line for an arc.
+    fn variants(&self, spec: LeadSpec) -> impl Iterator<Item = LeadSpec> {
+        let mut out = vec![spec];
+        if spec.shape != LeadShape::None {
+            out.extend([0.75, 0.5].map(|f| spec.scaled(f)));
+            let line = LeadSpec {
+                shape: LeadShape::Line,
+                ..spec
+            };
+            for angle in [30.0, -30.0, 60.0, -60.0] {
+                out.push(LeadSpec { angle, ..line });
+            }
+            if spec.shape != LeadShape::Line {
+                out.push(LeadSpec { angle: 0.0, ..line });
+            }
+        }
+        out.into_iter()
+    }
+
+    /// A lead-in from the hole's centre (the centre of its equidistant's box) straight to the
+    /// nearest point of the equidistant, and a lead-out back towards the centre.
+    fn centre_pierce(&self, r: ContourRef, eq: &Contour) -> Option<StepLeads> {
+        let centre = eq.bounding_box().centre();
+        let entry = eq.nearest_point(centre)?.point;
+        let lead_in = vec![Vertex::arc(centre.x, centre.y, 0.0), vertex(entry)];
+        self.chain_problem(r, &lead_in, true)
+            .is_none()
+            .then_some(())?;
+        let to_centre = centre - entry;
+        let reach = self.settings.lead_out.length.min(to_centre.norm());
+        let switch_off = entry + to_centre.normalized() * reach;
+        let lead_out = if reach > 0.0 {
+            vec![vertex(entry), vertex(switch_off)]
+        } else {
+            vec![vertex(entry)]
+        };
+        self.chain_problem(r, &lead_out, false)
+            .is_none()
+            .then_some(())?;
+        Some(StepLeads {
+            pierce: centre,
+            entry,
+            lead_in,
+            lead_out,
+            switch_off,
+            offset: self.settings.kerf / 2.0,
+            overcut: 0.0,
+            pierce_clearance: self.settings.pierce_clearance,
+            switch_off_clearance: self.settings.switch_off_clearance,
+        })
+    }
+
+    /// The first rule a lead chain breaks: its free end (M for a lead-in, M* for a lead-out)
+    /// must lie in the region, and every span must keep kerf/2 from every contour.
+    fn chain_problem(&self, r: ContourRef, chain: &[Vertex], lead_in: bool) -> Option<LeadProblem> {
+        let (free, distance) = if lead_in {
+            (chain.first()?.point, self.settings.pierce_clearance)
+        } else {
+            (chain.last()?.point, self.settings.switch_off_clearance)
+        };
+        if !in_clear_scrap(self.nest, &self.forest, r, free, distance - TOLERANCE) {
+            return Some(if lead_in {
+                LeadProblem::PierceOutsideRegion {
+                    x: free.x,
+                    y: free.y,
+                }
+            } else {
+                LeadProblem::SwitchOffOutsideRegion {
+                    x: free.x,
+                    y: free.y,
+                }
+            });
+        }
+        let half = self.settings.kerf / 2.0;
+        for span in chain_spans(chain) {
+            let samples = ((span.length() / (half / 4.0).clamp(0.05, 0.5)).ceil() as usize).max(2);
+            for i in 0..=samples {
+                let p = span.point_at(i as f64 / samples as f64);
+                let d = clearance(self.nest, p, half + 1.0);
+                if d < half - TOLERANCE {
+                    return Some(LeadProblem::LeadTooClose {
+                        x: p.x,
+                        y: p.y,
+                        distance: d,
+                    });
+                }
+            }
+            // With no kerf, sampling cannot see a crossing: test it exactly, away from the
+            // lead's end on its own contour.
+            if half <= TOLERANCE {
+                if let Some(p) = self.crossing(r, &span, lead_in) {
+                    return Some(LeadProblem::LeadTooClose {
+                        x: p.x,
+                        y: p.y,
+                        distance: 0.0,
+                    });
+                }
+            }
+        }
+        None
+    }
+
+    /// A point where `span` crosses a contour, other than the lead's end on contour `r`
+    /// (the end at t = 1 of a lead-in, t = 0 of a lead-out).
+    fn crossing(&self, r: ContourRef, span: &Span, lead_in: bool) -> Option<Point> {
+        let bbox = span.bounding_box();
+        for other in self.nest.contour_refs() {
+            let c = self.nest.contour(other)?;
+            if !c.bounding_box().intersects(&bbox) {
+                continue;
+            }
+            for s in c.spans() {
+                for x in span.intersections(&s) {
+                    let at_own_end = other == r
+                        && if lead_in {
+                            x.t_self > 1.0 - 1e-9
+                        } else {
+                            x.t_self < 1e-9
+                        };
+                    if !at_own_end {
+                        return Some(x.point);
+                    }
+                }
+            }
+        }
+        None
+    }
+
+    /// The nest of *pierce curves*: every contour replaced by its offset at kerf/2 plus the
+    /// lead-in's reach (at least d₁), on the scrap side — where the pierce points M of
+    /// unobstructed leads lie. A solver of idealised routes run on it places M and orders the
+    /// contours with the leads' idle legs priced; [`LeadFitter::project`] and
+    /// [`LeadFitter::attach`] then bring its route back to this nest. Contours whose curve
+    /// does not exist, or would change which contour holds which, keep their own shape, so
+    /// the precedence of the curve nest is that of the nest.
+    pub fn pierce_curve_nest(&self) -> Nest {
+        let reach = (self.settings.kerf / 2.0 + self.settings.lead_in.reach())
+            .max(self.settings.pierce_clearance);
+        let mut curves = self.nest.clone();
+        for part in &mut curves.parts {
+            for contour in &mut part.contours {
+                if let Ok(curve) = equidistant(contour, reach) {
+                    *contour = curve;
+                }
+            }
+        }
+        // Undo the curves that change the containment forest (a part near the wall of the
+        // hole it sits in), until none does.
+        loop {
+            let forest = curves.containment_forest();
+            let changed: Vec<ContourRef> = self
+                .nest
+                .contour_refs()
+                .filter(|&r| forest.parent(r) != self.forest.parent(r))
+                .collect();
+            if changed.is_empty() {
+                return curves;
+            }
+            let mut undone = 0;
+            for r in changed {
+                for c in [Some(r), self.forest.parent(r)].into_iter().flatten() {
+                    let original = &self.nest.parts[c.part].contours[c.contour];
+                    let slot = &mut curves.parts[c.part].contours[c.contour];
+                    if slot != original {
+                        *slot = original.clone();
+                        undone += 1;
+                    }
+                }
+            }
+            if undone == 0 {
+                return self.nest.clone();
+            }
+        }
+    }
+
+    /// `route` (over [`LeadFitter::pierce_curve_nest`] or any nest of the same contours) with
+    /// every pierce point moved to the nearest point of its own contour in this nest.
+    pub fn project(&self, route: &Route) -> Route {
+        let mut projected = route.clone();
+        for step in &mut projected.steps {
+            if let Some(p) = self
+                .nest
+                .contour(step.contour)
+                .and_then(|c| c.nearest_point(step.pierce_point))
+            {
+                step.pierce_point = p.point;
+            }
+        }
+        projected
+    }
+
+    /// The leads of one step: fitted with the entry as near as the rules allow to the step's
+    /// pierce point, which then moves to the contour point under the entry.
+    pub fn attach_to_step(&self, step: &CutStep) -> Result<CutStep, LeadError> {
+        let leads = self.fit(step.contour, step.pierce_point)?;
+        let contour = self
+            .nest
+            .contour(step.contour)
+            .ok_or(LeadError::UnknownContour {
+                contour: step.contour,
+            })?;
+        let on_contour = contour
+            .nearest_point(leads.entry)
+            .map_or(step.pierce_point, |p| p.point);
+        Ok(CutStep {
+            pierce_point: on_contour,
+            leads: Some(leads),
+            ..step.clone()
+        })
+    }
+
+    /// `route` with leads attached to every pierced step ("solve, then attach leads"); steps
+    /// entered by a tool-on link keep none. Every contour where no lead fits is reported.
+    pub fn attach(&self, route: &Route) -> Result<Route, Vec<LeadError>> {
+        let mut errors = Vec::new();
+        let mut steps = Vec::with_capacity(route.steps.len());
+        for step in &route.steps {
+            if !step.is_pierced() {
+                steps.push(step.clone());
+                continue;
+            }
+            match self.attach_to_step(step) {
+                Ok(s) => steps.push(s),
+                Err(e) => errors.push(e),
+            }
+        }
+        if errors.is_empty() {
+            Ok(Route {
+                steps,
+                ..route.clone()
+            })
+        } else {
+            Err(errors)
+        }
+    }
+
+    /// Moves the leads of every pierced step of `route` (a route with leads) along its
+    /// equidistant to shorten the idle legs around it, `passes` sweeps over the route: each
+    /// step tries `positions` entries evenly spread round its equidistant, keeping the one
+    /// with the least |previous M* → M| + |M* → next M| among those whose leads fit. The
+    /// order is kept; leads stay valid.
+    pub fn relax(&self, route: &Route, passes: usize, positions: usize) -> Route {
+        let mut route = route.clone();
+        let n = route.steps.len();
+        for _ in 0..passes {
+            for i in 0..n {
+                let step = &route.steps[i];
+                let (Some(current), true) = (&step.leads, step.is_pierced()) else {
+                    continue;
+                };
+                let Ok(eq) = self.equidistant(step.contour) else {
+                    continue;
+                };
+                let before = if i == 0 {
+                    route.start
+                } else {
+                    route.steps[i - 1].switch_off_point()
+                };
+                let after = match route.steps.get(i + 1) {
+                    Some(next) if next.is_pierced() => Some(next.switch_on_point()),
+                    Some(_) => None,
+                    None => route.finish,
+                };
+                let legs = |l: &StepLeads| {
+                    before.distance(l.pierce) + after.map_or(0.0, |a| l.switch_off.distance(a))
+                };
+                let perimeter = eq.perimeter();
+                let mut best = (legs(current), None);
+                for k in 0..positions {
+                    let s = perimeter * k as f64 / positions as f64;
+                    if let Ok(leads) = self.fit_at(step.contour, &eq, s) {
+                        let value = legs(&leads);
+                        if value < best.0 - 1e-9 {
+                            best = (value, Some(leads));
+                        }
+                    }
+                }
+                if let Some(leads) = best.1 {
+                    let contour = self.nest.contour(step.contour).expect("fitted contour");
+                    let step = &mut route.steps[i];
+                    if let Some(p) = contour.nearest_point(leads.entry) {
+                        step.pierce_point = p.point;
+                    }
+                    step.leads = Some(leads);
+                }
+            }
+        }
+        route
+    }
+
+    /// Every rule that `leads` breaks as the leads of contour `r` (the checker used by
+    /// [`crate::Route::problems`]): M ∈ G_M, M* ∈ G_M*, the leads clear of every contour by
+    /// kerf/2, the entry and exit on the equidistant, the chains joined to their points.
+    pub fn problems(&self, r: ContourRef, leads: &StepLeads) -> Vec<LeadProblem> {
+        let mut problems = Vec::new();
+        let joined = leads.lead_in.first().map(|v| v.point) == Some(leads.pierce)
+            && leads.lead_in.last().map(|v| v.point) == Some(leads.entry)
+            && leads.lead_out.last().map(|v| v.point) == Some(leads.switch_off);
+        if !joined {
+            problems.push(LeadProblem::Disjoint);
+        }
+        match self.equidistant(r) {
+            Ok(eq) => {
+                for p in [leads.entry, leads.exit()] {
+                    let distance = eq.distance_to(p);
+                    if !(distance <= 1e-6) {
+                        problems.push(LeadProblem::EntryOffEquidistant {
+                            x: p.x,
+                            y: p.y,
+                            distance,
+                        });
+                    }
+                }
+            }
+            Err(_) => problems.push(LeadProblem::EntryOffEquidistant {
+                x: leads.entry.x,
+                y: leads.entry.y,
+                distance: f64::NAN,
+            }),
+        }
+        problems.extend(self.chain_problem(r, &leads.lead_in, true));
+        problems.extend(self.chain_problem(r, &leads.lead_out, false));
+        problems
+    }
+}
+
+fn vertex(p: Point) -> Vertex {
+    Vertex::arc(p.x, p.y, 0.0)
+}
+
+/// The point at arc length `s` of `eq` and the unit tangent there (cut direction).
+fn frame_at(eq: &Contour, s: f64) -> (Point, Point) {
+    let Some(position) = eq.position_at_length(s) else {
+        return (Point::new(f64::NAN, f64::NAN), Point::new(1.0, 0.0));
+    };
+    let span = eq.span(position.span).expect("position on the contour");
+    (span.point_at(position.t), span.tangent_at(position.t))
+}
+
+/// The lead-in chain from M to `entry`, where the cut leaves in direction `tangent`; the
+/// scrap side is the left of the tangent.
+fn lead_in_chain(spec: LeadSpec, entry: Point, tangent: Point) -> Vec<Vertex> {
+    let normal = tangent.rotated_quarter();
+    match spec.shape {
+        LeadShape::None => vec![vertex(entry)],
+        LeadShape::Line => {
+            let a = spec.angle.to_radians();
+            let m = entry + (normal * a.cos() - tangent * a.sin()) * spec.length;
+            vec![vertex(m), vertex(entry)]
+        }
+        LeadShape::Arc | LeadShape::LineArc => {
+            // The arc ends at the entry moving along the tangent, its centre on the scrap side,
+            // so it turns counter-clockwise; it starts `sweep` before the entry.
+            let (radius, sweep) = spec.arc();
+            let centre = entry + normal * radius;
+            let start = centre + (entry - centre).rotated(-sweep);
+            let bulge = (sweep / 4.0).tan();
+            let mut chain = vec![Vertex::arc(start.x, start.y, bulge), vertex(entry)];
+            if spec.shape == LeadShape::LineArc && spec.length > 0.0 {
+                // The line runs into the arc along the arc's tangent at its start.
+                let arc_tangent = (start - centre).rotated_quarter().normalized();
+                let m = start - arc_tangent * spec.length;
+                chain.insert(0, vertex(m));
+            }
+            chain
+        }
+    }
+}
+
+/// The lead-out chain from `exit`, where the cut arrives in direction `tangent`, to M*.
+fn lead_out_chain(spec: LeadSpec, exit: Point, tangent: Point) -> Vec<Vertex> {
+    let normal = tangent.rotated_quarter();
+    match spec.shape {
+        LeadShape::None => vec![vertex(exit)],
+        LeadShape::Line => {
+            let a = spec.angle.to_radians();
+            let m = exit + (normal * a.cos() + tangent * a.sin()) * spec.length;
+            vec![vertex(exit), vertex(m)]
+        }
+        LeadShape::Arc | LeadShape::LineArc => {
+            let (radius, sweep) = spec.arc();
+            let centre = exit + normal * radius;
+            let end = centre + (exit - centre).rotated(sweep);
+            let bulge = (sweep / 4.0).tan();
+            let mut chain = vec![Vertex::arc(exit.x, exit.y, bulge), vertex(end)];
+            if spec.shape == LeadShape::LineArc && spec.length > 0.0 {
+                let arc_tangent = (end - centre).rotated_quarter().normalized();
+                chain.push(vertex(end + arc_tangent * spec.length));
+            }
+            chain
+        }
+    }
+}
