@@ -543,3 +543,25 @@ fn containment(inner: &Placed, outer: &Placed, tolerance: f64) -> Containment {
         Containment::Outside
     }
 }
+
+/// The curve and joining settings DXF and SVG import share, checked once for both: the
+/// approximation tolerance at least 1e-6 mm, the join tolerance positive, a span budget.
+pub(crate) fn check_curve_options(
+    approximation_tolerance: f64,
+    join_tolerance: f64,
+    max_spans: usize,
+) -> Result<(), String> {
+    let ok = |t: f64| t.is_finite() && t > 0.0;
+    if !ok(approximation_tolerance) || approximation_tolerance < 1e-6 {
+        return Err(format!(
+            "approximation tolerance {approximation_tolerance} must be at least 1e-6 mm"
+        ));
+    }
+    if !ok(join_tolerance) || join_tolerance < 1e-9 {
+        return Err(format!("join tolerance {join_tolerance} must be positive"));
+    }
+    if max_spans == 0 {
+        return Err("max_spans must be positive".into());
+    }
+    Ok(())
+}

@@ -306,26 +306,14 @@ pub fn read_svg(bytes: &[u8], options: &SvgOptions) -> Result<SvgImport, SvgErro
 }
 
 fn check_options(options: &SvgOptions) -> Result<(), SvgError> {
-    let ok = |t: f64| t.is_finite() && t > 0.0;
-    if !ok(options.approximation_tolerance) || options.approximation_tolerance < 1e-6 {
-        return Err(SvgError::InvalidOptions(format!(
-            "approximation tolerance {} must be at least 1e-6 mm",
-            options.approximation_tolerance
-        )));
-    }
-    if !ok(options.join_tolerance) || options.join_tolerance < 1e-9 {
-        return Err(SvgError::InvalidOptions(format!(
-            "join tolerance {} must be positive",
-            options.join_tolerance
-        )));
-    }
-    if options.max_spans == 0 {
-        return Err(SvgError::InvalidOptions(
-            "max_spans must be positive".into(),
-        ));
-    }
+    crate::assemble::check_curve_options(
+        options.approximation_tolerance,
+        options.join_tolerance,
+        options.max_spans,
+    )
+    .map_err(SvgError::InvalidOptions)?;
     if let Some(mm) = options.user_unit_mm {
-        if !ok(mm) || mm > 1e6 {
+        if !(mm.is_finite() && mm > 0.0) || mm > 1e6 {
             return Err(SvgError::InvalidOptions(format!(
                 "user unit {mm} mm must be positive and at most 1e6"
             )));

@@ -246,23 +246,10 @@ pub fn read_dxf(bytes: &[u8], options: &DxfOptions) -> Result<DxfImport, DxfErro
 }
 
 fn check_options(options: &DxfOptions) -> Result<(), DxfError> {
-    let ok = |t: f64| t.is_finite() && t > 0.0;
-    if !ok(options.approximation_tolerance) || options.approximation_tolerance < 1e-6 {
-        return Err(DxfError::InvalidOptions(format!(
-            "approximation tolerance {} must be at least 1e-6 mm",
-            options.approximation_tolerance
-        )));
-    }
-    if !ok(options.join_tolerance) || options.join_tolerance < 1e-9 {
-        return Err(DxfError::InvalidOptions(format!(
-            "join tolerance {} must be positive",
-            options.join_tolerance
-        )));
-    }
-    if options.max_spans == 0 {
-        return Err(DxfError::InvalidOptions(
-            "max_spans must be positive".into(),
-        ));
-    }
-    Ok(())
+    crate::assemble::check_curve_options(
+        options.approximation_tolerance,
+        options.join_tolerance,
+        options.max_spans,
+    )
+    .map_err(DxfError::InvalidOptions)
 }
