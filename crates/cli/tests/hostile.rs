@@ -170,6 +170,7 @@ fn check_result(args: &[&str], input: &Path, stdout: &str) {
                         Some(corners) => Entry::Link(corners.iter().map(point).collect()),
                         None => Entry::Pierce,
                     },
+                    leads: None,
                 })
                 .collect();
             let route = Route {
