@@ -64,6 +64,11 @@ use crate::CcpError;
 /// never lift it above the true value; relative to the nest's size.
 const COST_MARGIN: f64 = 1e-9;
 
+/// Most entries of a relaxation's dense cost matrix (2²⁴ f64, 128 MiB): beyond it a stage is
+/// not built and the bound keeps what it has, so a sheet of 100,000 contours cannot ask for a
+/// 137 GB matrix (it did, and aborted the process) and the browser's worker stays in memory.
+pub const MAX_RELAXATION_ENTRIES: usize = 1 << 24;
+
 /// Settings of [`CcpLowerBound`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct LowerBoundOptions {
@@ -384,7 +389,13 @@ impl CcpLowerBound {
         }
         loop {
             match self.stage.take() {
-                None => self.stage = Some(Stage::Building(self.start_building())),
+                None => {
+                    let n = 1 + self.pieces.iter().map(Vec::len).sum::<usize>();
+                    if n.saturating_mul(n) > MAX_RELAXATION_ENTRIES {
+                        return false;
+                    }
+                    self.stage = Some(Stage::Building(self.start_building()));
+                }
                 Some(Stage::Building(mut b)) => {
                     if self.build_rows(&mut b, deadline) {
                         match self.start_solving(b) {

@@ -87,7 +87,7 @@ mod route;
 mod search;
 mod solver;
 
-pub use bound::{CcpLowerBound, LowerBoundOptions};
+pub use bound::{CcpLowerBound, LowerBoundOptions, MAX_RELAXATION_ENTRIES};
 pub use discrete::{
     build_pcgtsp, DiscreteInstance, DiscreteNode, DiscretisationOptions, MAX_DISCRETE_NODES,
 };

@@ -271,3 +271,16 @@ fn a_nest_without_contours_has_nothing_to_bound() {
     );
     assert!(refused.is_err());
 }
+
+/// A sheet too large for a dense relaxation (40,000 generated contours: far more pieces than
+/// `MAX_RELAXATION_ENTRIES` allows) gives up at once with the trivial bound 0, instead of
+/// asking for a matrix of tens of gigabytes.
+#[test]
+fn a_sheet_too_large_for_the_relaxation_keeps_the_trivial_bound() {
+    let nest = cutroute_geometry::generate_nest(40_000, 1);
+    let mut bound = CcpLowerBound::new(&nest, LowerBoundOptions::default()).unwrap();
+    let started = std::time::Instant::now();
+    assert!(!bound.step(Duration::from_millis(40)), "nothing to do");
+    assert!(started.elapsed() < std::time::Duration::from_secs(5));
+    assert_eq!(bound.lower_bound(), 0.0);
+}
