@@ -426,29 +426,17 @@ pub fn direction_arrows(nest: &Nest, size: f64) -> String {
     out
 }
 
-/// Candidate pierce points of the discrete solvers: every `step` mm of arc length along each
-/// contour from its first vertex, and the vertices. Drawn as zero-length subpaths with round
-/// caps (dots that keep their size when zooming).
+/// Candidate pierce points of the discrete solvers (`Contour::candidate_points` with the
+/// vertices, as the engine's discretisation takes them). Drawn as zero-length subpaths with
+/// round caps (dots that keep their size when zooming).
 pub fn candidate_dots(nest: &Nest, step: f64) -> String {
     let mut out = String::new();
     if !(step > 0.0 && step.is_finite()) {
         return out;
     }
-    let mut dot = |p: Point| {
-        let _ = write!(out, "M{:.3} {:.3}l0 0", p.x, p.y);
-    };
     for contour in nest.parts.iter().flat_map(|p| p.contours.iter()) {
-        contour.vertices.iter().for_each(|v| dot(v.point));
-        let perimeter = contour.perimeter();
-        if !(perimeter.is_finite()) {
-            continue;
-        }
-        let mut s = 0.0;
-        while s < perimeter {
-            if let Some(p) = contour.point_at_length(s) {
-                dot(p);
-            }
-            s += step;
+        for p in contour.candidate_points(step, true) {
+            let _ = write!(out, "M{:.3} {:.3}l0 0", p.x, p.y);
         }
     }
     out
@@ -602,9 +590,10 @@ mod tests {
     #[test]
     fn candidates_every_step_and_at_vertices() {
         let (nest, _) = square_nest();
-        let dots = candidate_dots(&nest, 5.0);
-        // 4 vertices + 8 points every 5 mm round a 40 mm perimeter.
-        assert_eq!(dots.matches('M').count(), 12);
+        // Round a 40 mm square: every 5 mm gives 8 points, its vertices among them (drawn once).
+        assert_eq!(candidate_dots(&nest, 5.0).matches('M').count(), 8);
+        // Every 3 mm gives 14 points (0 to 39 mm); the vertices at 10 and 20 mm fall between them.
+        assert_eq!(candidate_dots(&nest, 3.0).matches('M').count(), 16);
         assert!(candidate_dots(&nest, 0.0).is_empty());
     }
 

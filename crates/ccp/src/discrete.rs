@@ -4,7 +4,7 @@
 use cutroute_geometry::{ContourRef, CutStep, Nest, Point, Route};
 use cutroute_pcgtsp::Instance;
 
-use crate::geom::{Shape, V};
+use crate::geom::V;
 use crate::problem::Problem;
 use crate::CcpError;
 
@@ -64,31 +64,6 @@ pub struct DiscreteInstance {
     pub finish: Option<Point>,
 }
 
-/// Candidate points every `step` mm of arc length along a contour, plus vertices if asked.
-fn candidates(shape: &Shape, step: f64, vertices: bool) -> Vec<V> {
-    let mut out = Vec::new();
-    let mut next_at = 0.0;
-    let mut walked = 0.0;
-    for span in &shape.spans {
-        let len = span.length();
-        if vertices && !out.last().is_some_and(|p: &V| p.dist(span.a()) < 1e-9) {
-            out.push(span.a());
-        }
-        while next_at <= walked + len && len > 0.0 {
-            let x = span.point_at((next_at - walked) / len);
-            if !out.last().is_some_and(|p: &V| p.dist(x) < 1e-9) {
-                out.push(x);
-            }
-            next_at += step;
-        }
-        walked += len;
-    }
-    if out.is_empty() {
-        out.push(shape.spans[0].a());
-    }
-    out
-}
-
 /// Most nodes (candidate points + depot) of a discretisation: its dense cost matrix is n² f64,
 /// 3.2 GB at this size.
 pub const MAX_DISCRETE_NODES: usize = 20_000;
@@ -136,9 +111,14 @@ pub fn build_pcgtsp(
     let mut points = vec![start];
     let mut clusters = vec![vec![0usize]];
     let mut node_cluster = vec![0usize];
-    for (i, shape) in prob.shapes.iter().enumerate() {
+    for (i, contour_ref) in prob.refs.iter().enumerate() {
+        let contour = &nest.parts[contour_ref.part].contours[contour_ref.contour];
         let mut cl = Vec::new();
-        for x in candidates(shape, options.step, options.include_vertices) {
+        for x in contour
+            .candidate_points(options.step, options.include_vertices)
+            .into_iter()
+            .map(V::from)
+        {
             cl.push(points.len());
             node_cluster.push(i + 1);
             points.push(x);

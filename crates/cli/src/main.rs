@@ -1,7 +1,7 @@
 //! `cutroute`: inspect, convert and route cutting plans and PCGTSP instances from the shell.
 //!
 //! ```text
-//! cutroute inspect FILE [--json] [--sheet N]              # lists a project's sheets
+//! cutroute inspect FILE [--json] [--sheet N] [--step MM]  # lists a project's sheets
 //! cutroute convert IN OUT [--to dbs|json|svg|gcode|html]   # default: by OUT's extension
 //!                  [--sheet N] [--profile FILE.json] [--preset NAME]
 //!                  [--solver nearest|ccp|heuristic|discrete] [--time-limit S] [--seed N] [--step MM]
@@ -75,6 +75,10 @@ enum Command {
         json: bool,
         #[command(flatten)]
         sheet: inputs::SheetArg,
+        /// Also count the candidate pierce points of the discrete solvers at this spacing, mm
+        /// (`candidate_points`: every STEP mm along each contour, and its vertices).
+        #[arg(long, value_name = "MM", value_parser = step_mm)]
+        step: Option<f64>,
     },
     /// Convert a nest between formats (.dbs, .json, .svg), or route it and write the route as
     /// G-code (.nc, .gcode, .ngc, .tap) or a standalone HTML page (.html).
@@ -239,9 +243,12 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     install_stop_handler();
     let outcome = match cli.command {
-        Command::Inspect { file, json, sheet } => {
-            inspect(&file, sheet.index(), json).map_err(Failure::Error)
-        }
+        Command::Inspect {
+            file,
+            json,
+            sheet,
+            step,
+        } => inspect(&file, sheet.index(), json, step).map_err(Failure::Error),
         Command::Convert {
             input,
             output,
@@ -610,7 +617,7 @@ fn open((path, sheet): (&Path, usize)) -> Result<Document, String> {
     open_sheet(&name, &bytes, sheet).map_err(|e| e.to_string())
 }
 
-fn inspect(path: &Path, sheet: usize, as_json: bool) -> Result<(), String> {
+fn inspect(path: &Path, sheet: usize, as_json: bool, step: Option<f64>) -> Result<(), String> {
     let document = open((path, sheet))?;
     let summary = match &document.problem {
         Problem::Nest { nest, .. } => {
@@ -624,6 +631,15 @@ fn inspect(path: &Path, sheet: usize, as_json: bool) -> Result<(), String> {
                 fields.insert("route_pierces".into(), json!(route.pierce_count()));
                 fields.insert("route_cut_length".into(), json!(route.cut_length()));
                 fields.insert("route_idle_length".into(), json!(route.idle_length()));
+            }
+            if let (Some(step), Value::Object(fields)) = (step, &mut summary) {
+                let candidates: usize = nest
+                    .parts
+                    .iter()
+                    .flat_map(|part| &part.contours)
+                    .map(|contour| contour.candidate_points(step, true).len())
+                    .sum();
+                fields.insert("candidate_points".into(), json!(candidates));
             }
             summary
         }

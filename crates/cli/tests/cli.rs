@@ -304,6 +304,50 @@ fn convert_refuses_unknown_formats_and_solvers() {
     assert!(!ok && stderr.contains("unknown output format"), "{stderr}");
 }
 
+/// `inspect --step` counts the candidate pierce points the discrete solvers weigh: the nodes of
+/// the discretised instance but its depot (the app's candidate dots are checked against it).
+#[test]
+fn inspect_counts_the_discrete_candidates() {
+    for (file, step) in [
+        ("nests/dbs/nested.dbs", 25.0),
+        ("nests/dbs-json/E1X_6_01.dbs.json", 10.0),
+        ("nests/dbs/seven.dbs", 3.5),
+    ] {
+        let path = data(file);
+        let v = json(&[
+            "inspect",
+            path.to_str().unwrap(),
+            "--json",
+            "--step",
+            &step.to_string(),
+        ]);
+        let Problem::Nest { nest, .. } = open_document(file, &std::fs::read(&path).unwrap())
+            .unwrap()
+            .problem
+        else {
+            panic!("{file} is a nest");
+        };
+        let options = cutroute_ccp::DiscretisationOptions {
+            step,
+            ..Default::default()
+        };
+        let instance = cutroute_ccp::build_pcgtsp(&nest, &options)
+            .unwrap()
+            .instance;
+        assert_eq!(
+            v["candidate_points"].as_u64(),
+            Some(instance.node_count as u64 - 1),
+            "{file} at {step} mm"
+        );
+    }
+    let without = json(&[
+        "inspect",
+        data("nests/dbs/nested.dbs").to_str().unwrap(),
+        "--json",
+    ]);
+    assert_eq!(without.get("candidate_points"), None);
+}
+
 #[test]
 fn generate_writes_a_seeded_nest() {
     let out = scratch("generated.json");

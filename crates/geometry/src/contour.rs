@@ -385,6 +385,47 @@ impl Contour {
         self.position_at_length(s).and_then(|p| self.point_at(p))
     }
 
+    /// The candidate pierce points of the discrete solvers: a point every `step` of arc length
+    /// from vertex 0 in the contour's direction, and (with `with_vertices`) every vertex, in the
+    /// order met; a point within 1e-9 of the one before (or, for the last, of the first) is not
+    /// repeated. Never empty for a contour with vertices (vertex 0 at least). The discretisation
+    /// (`cutroute-ccp`), the view's candidate dots and `cutroute inspect --step` all count these
+    /// same points.
+    pub fn candidate_points(&self, step: f64, with_vertices: bool) -> Vec<Point> {
+        let mut out: Vec<Point> = Vec::new();
+        let Some(first) = self.vertices.first() else {
+            return out;
+        };
+        let push = |p: Point, out: &mut Vec<Point>| {
+            if !out.last().is_some_and(|q| q.distance(p) < 1e-9) {
+                out.push(p);
+            }
+        };
+        if step > 0.0 && step.is_finite() {
+            let mut next_at = 0.0;
+            let mut walked = 0.0;
+            for span in self.spans() {
+                let length = span.length();
+                if with_vertices {
+                    push(span.start, &mut out);
+                }
+                while length > 0.0 && next_at <= walked + length {
+                    push(span.point_at((next_at - walked) / length), &mut out);
+                    next_at += step;
+                }
+                walked += length;
+            }
+            // The grid point at exactly the perimeter is vertex 0 again.
+            if out.len() > 1 && out[0].distance(out[out.len() - 1]) < 1e-9 {
+                out.pop();
+            }
+        }
+        if out.is_empty() {
+            out.push(first.point);
+        }
+        out
+    }
+
     /// Every point where the segment `a → b` meets the contour, ordered along the segment
     /// (CCP step 4 takes the last one). A meeting at a vertex is reported once.
     pub fn segment_crossings(&self, a: Point, b: Point) -> Vec<ContourCrossing> {

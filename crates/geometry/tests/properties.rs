@@ -311,3 +311,34 @@ proptest! {
         prop_assert!(c.point_at_length(length).unwrap().distance(c.point_at(pos).unwrap()) < 1e-12);
     }
 }
+
+proptest! {
+    /// Candidate pierce points lie on the contour, walk it in order (their arc lengths never
+    /// decrease), are `step` apart where no vertex falls between, and number exactly the points
+    /// of the grid plus the vertices that are not on it.
+    #[test]
+    fn candidate_points_walk_the_contour_every_step(c in contour(), step in 0.5f64..40.0) {
+        let perimeter = c.perimeter();
+        prop_assume!(perimeter > 1e-3);
+        let without = c.candidate_points(step, false);
+        let with = c.candidate_points(step, true);
+        for p in with.iter() {
+            prop_assert!(c.distance_to(*p) < 1e-6 * (1.0 + perimeter), "{p:?} off the contour");
+        }
+        // The grid alone: points at 0, step, 2 step, … up to the perimeter (the last one may
+        // fall on vertex 0 again at exactly the perimeter).
+        let grid = (perimeter / step).floor() as usize + 1;
+        prop_assert!(without.len() == grid || without.len() + 1 == grid,
+            "{} grid points for {grid}", without.len());
+        for (k, p) in without.iter().enumerate() {
+            let expected = c.point_at_length(k as f64 * step).unwrap();
+            prop_assert!(p.distance(expected) < 1e-6 * (1.0 + perimeter));
+        }
+        // With the vertices: each vertex is among the points (once).
+        for v in &c.vertices {
+            prop_assert!(with.iter().any(|p| p.distance(v.point) < 1e-6 * (1.0 + perimeter)));
+        }
+        prop_assert!(with.len() <= without.len() + c.vertices.len());
+        prop_assert!(with.len() >= without.len());
+    }
+}
