@@ -4,7 +4,8 @@
 //! cutroute inspect FILE [--json] [--sheet N] [--step MM]  # lists a project's sheets
 //! cutroute convert IN OUT [--to dbs|json|svg|gcode|html]   # default: by OUT's extension
 //!                  [--sheet N] [--profile FILE.json] [--preset NAME]
-//!                  [--solver nearest|ccp|heuristic|discrete] [--time-limit S] [--seed N] [--step MM]
+//!                  [--solver NAME] [--time-limit S] [--seed N] [--step MM]   # as solve
+//!                  [--cost …] [--speeds …] [--task …] [--objective …]         # as solve
 //!                  [--incremental] [--arcs ij|r|lines] [--decimals N] [--line-numbers]
 //!                  [--feed MM_PER_MIN] [--dwell S] [--torch-on CODE] [--torch-off CODE]
 //! cutroute generate --contours N [--seed S] --out FILE   # synthetic nest as geometry JSON
@@ -12,7 +13,7 @@
 //!                     [--time-limit S] [--seed N] [--ub N] [--step MM] [--cost C_off,C_on,C_pt]
 //!                     [--speeds V_off,V_on,t_pt] [--task TASK.json] [--objective time|cost]
 //!                     [--thermal-sigma MM] [--thermal-tau S] [--thermal-weight W]
-//!                     [--rules part,sheet,islands] [--rules-hard] [--json]
+//!                     [--rules part,sheet,islands] [--rules-hard] [--json] [--out FILE]
 //!                     [--kerf MM] [--pierce-clearance MM] [--switch-off-clearance MM]
 //!                     [--lead-in arc|line|line-arc|none] [--lead-in-length MM]
 //!                     [--lead-out arc|line|line-arc|none] [--lead-out-length MM]
@@ -36,6 +37,9 @@
 //! carries `pierce` (M), `entry`, `lead_in`, `lead_out` and `switch_off`.
 //! `--sheet`, `--profile` and `--preset` are described in `inputs.rs` (profile < task <
 //! flags; `--preset` < the G-code flags).
+//! `-` as a file name is standard input (FILE, IN) or standard output (OUT, `--out`); files are
+//! written whole or not at all, and on a terminal a live line shows UB, LB and the gap
+//! (`stdio.rs`).
 //! Errors go to stderr with the reader's location, and the exit code is 1.
 
 use std::path::{Path, PathBuf};
@@ -51,6 +55,7 @@ use serde_json::{json, Value};
 
 mod inputs;
 mod kerf;
+mod stdio;
 mod thermal;
 
 #[derive(Parser)]
@@ -68,7 +73,7 @@ struct Cli {
 enum Command {
     /// Summarise a nest or PCGTSP file (format detected from content).
     Inspect {
-        /// The file to read.
+        /// The file to read (`-`: standard input).
         file: PathBuf,
         /// Print one JSON object instead of text.
         #[arg(long)]
@@ -83,12 +88,12 @@ enum Command {
     /// Convert a nest between formats (.dbs, .json, .svg), or route it and write the route as
     /// G-code (.nc, .gcode, .ngc, .tap) or a standalone HTML page (.html).
     Convert {
-        /// The file to read (any supported nest format).
+        /// The file to read (any supported nest format; `-`: standard input).
         input: PathBuf,
-        /// The file to write.
+        /// The file to write (`-`: standard output, with --to).
         output: PathBuf,
-        /// Output format: dbs, json, svg, gcode or html (default: from the output's extension).
-        #[arg(long)]
+        /// Output format (default: from the output's extension).
+        #[arg(long, value_parser = ["dbs", "json", "svg", "gcode", "html"])]
         to: Option<String>,
         /// Solver of the route for gcode/html: nearest, ccp, heuristic or discrete (default: the
         /// route the file holds, else ccp).
@@ -106,6 +111,8 @@ enum Command {
         #[arg(long, default_value = "50", value_parser = step_mm)]
         step: f64,
         #[command(flatten)]
+        machine: MachineArgs,
+        #[command(flatten)]
         gcode: GcodeArgs,
         #[command(flatten)]
         kerf: kerf::KerfArgs,
@@ -122,13 +129,13 @@ enum Command {
         /// Seed of the generator.
         #[arg(long, default_value_t = 1)]
         seed: u64,
-        /// The file to write.
+        /// The file to write (`-`: standard output).
         #[arg(long)]
         out: PathBuf,
     },
     /// Route a nest or solve a PCGTSP instance.
     Solve {
-        /// A nest file or a PCGTSP instance.
+        /// A nest file or a PCGTSP instance (`-`: standard input).
         file: PathBuf,
         /// nearest, ccp, heuristic, exact, discrete (= heuristic on a discretised nest),
         /// chain (ccp, then chain cutting), aoe (common edges cut once along AOE-chains),
@@ -150,22 +157,14 @@ enum Command {
         /// at least the nest's perimeter / 20,000, see the error).
         #[arg(long, default_value = "50", value_parser = step_mm)]
         step: f64,
-        /// Prices: idle travel per metre, cut per metre, one pierce (C_off,C_on,C_pt).
-        #[arg(long, value_name = "C_off,C_on,C_pt")]
-        cost: Option<String>,
-        /// Idle speed and cutting speed (mm/s) and pierce time (s): V_off,V_on,t_pt.
-        #[arg(long, value_name = "V_off,V_on,t_pt")]
-        speeds: Option<String>,
-        /// A RouteManager task JSON whose speeds and pierce time are the defaults.
-        #[arg(long)]
-        task: Option<PathBuf>,
-        /// What gsccp minimises when it picks an ensemble, and the unit of the path-route
-        /// solvers' (sccp, gsccp, aoe) bounds: time or cost.
-        #[arg(long, default_value = "time", value_parser = ["time", "cost"])]
-        objective: String,
+        #[command(flatten)]
+        machine: MachineArgs,
         /// Print one JSON object instead of text.
         #[arg(long)]
         json: bool,
+        /// Write the report to this file instead of standard output (whole or not at all).
+        #[arg(long, value_name = "FILE")]
+        out: Option<PathBuf>,
         #[command(flatten)]
         thermal: thermal::ThermalArgs,
         #[command(flatten)]
@@ -175,6 +174,41 @@ enum Command {
         #[command(flatten)]
         profile: inputs::ProfileArg,
     },
+}
+
+/// The machine's time and cost model and the objective, the same for `solve` and `convert`.
+#[derive(clap::Args)]
+struct MachineArgs {
+    /// Prices: idle travel per metre, cut per metre, one pierce (C_off,C_on,C_pt).
+    #[arg(long, value_name = "C_off,C_on,C_pt")]
+    cost: Option<String>,
+    /// Idle speed and cutting speed (mm/s) and pierce time (s): V_off,V_on,t_pt.
+    #[arg(long, value_name = "V_off,V_on,t_pt")]
+    speeds: Option<String>,
+    /// A RouteManager task JSON whose speeds and pierce time are the defaults.
+    #[arg(long)]
+    task: Option<PathBuf>,
+    /// What gsccp minimises when it picks an ensemble, and the unit of the path-route
+    /// solvers' (sccp, gsccp, aoe) bounds: time or cost.
+    #[arg(long, default_value = "time", value_parser = ["time", "cost"])]
+    objective: String,
+}
+
+impl MachineArgs {
+    /// The time and cost model on top of `base` (defaults or the profile), and the objective.
+    fn parse(&self, base: MachineParameters) -> Result<(MachineParameters, Objective), String> {
+        let machine = machine_parameters(
+            base,
+            self.cost.as_deref(),
+            self.speeds.as_deref(),
+            self.task.as_deref(),
+        )?;
+        let objective = match self.objective.as_str() {
+            "cost" => Objective::Cost,
+            _ => Objective::Time,
+        };
+        Ok((machine, objective))
+    }
 }
 
 /// The `--solver` names of `solve`.
@@ -257,6 +291,7 @@ fn main() -> ExitCode {
             time_limit,
             seed,
             step,
+            machine,
             gcode,
             kerf,
             sheet,
@@ -265,13 +300,14 @@ fn main() -> ExitCode {
             .load()
             .and_then(|profile| {
                 let kerf = kerf.parse()?;
+                let (machine, objective) = machine.parse(inputs::base_machine(profile.as_ref()))?;
                 let params = SolverParams {
                     time_limit_s: time_limit,
                     seed,
                     discretisation_step_mm: step,
                     initial_upper_bound: None,
-                    machine: inputs::base_machine(profile.as_ref()),
-                    objective: Default::default(),
+                    machine,
+                    objective,
                 };
                 let gcode = gcode.options(profile.as_ref(), &params.machine)?;
                 convert(
@@ -297,11 +333,9 @@ fn main() -> ExitCode {
             seed,
             ub,
             step,
-            cost,
-            speeds,
-            task,
-            objective,
+            machine,
             json,
+            out,
             thermal,
             kerf,
             sheet,
@@ -309,18 +343,8 @@ fn main() -> ExitCode {
         } => (|| {
             let kerf = kerf.parse()?;
             let base = inputs::base_machine(profile.load()?.as_ref());
-            let machine =
-                machine_parameters(base, cost.as_deref(), speeds.as_deref(), task.as_deref())?;
+            let (machine, objective) = machine.parse(base)?;
             let thermal = thermal.parse()?;
-            let objective = match objective.as_str() {
-                "time" => Objective::Time,
-                "cost" => Objective::Cost,
-                other => {
-                    return Err(Failure::Error(format!(
-                        "--objective {other:?}: expected time or cost"
-                    )))
-                }
-            };
             let params = SolverParams {
                 time_limit_s: time_limit,
                 seed,
@@ -330,13 +354,14 @@ fn main() -> ExitCode {
                 objective,
             };
             let input = (file.as_path(), sheet.index());
-            match solver.as_str() {
+            let report = match solver.as_str() {
                 "sccp" | "gsccp" | "aoe" if kerf.is_on() => Err(Failure::Error(format!(
                     "--solver {solver} does not cut with kerf and leads yet"
                 ))),
                 "sccp" | "gsccp" | "aoe" => Ok(solve_path(input, &solver, params, json, &thermal)?),
                 _ => solve(input, &solver, params, json, &thermal, &kerf),
-            }
+            }?;
+            Ok(write_report(&report, json, out.as_deref())?)
         })(),
     };
     match outcome {
@@ -488,14 +513,17 @@ fn bounded_job_run(
     make_job: impl FnOnce(&JobRequest) -> Result<Option<Box<dyn Job>>, String> + Send + 'static,
 ) -> Result<JobRun, Failure> {
     let time_limit_s = request.params.time_limit_s;
+    let display = stdio::ProgressDisplay::new(as_json);
+    let mut shown = display.clone();
     let outcome = run_bounded(time_limit_s, move |watch| {
         let mut job = match make_job(&request).map_err(Failure::Error)? {
             Some(job) => job,
             None => start_job(&request)
                 .map_err(|e| Failure::Error(format!("--solver {}: {e}", request.solver.name())))?,
         };
-        Ok(run_job(job.as_mut(), watch, &mut progress_printer(as_json)))
+        Ok(run_job(job.as_mut(), watch, &mut |p| shown.show(p)))
     })?;
+    drop(display);
     let mut run = outcome.unwrap_or_else(|snapshot| snapshot);
     run.time_limit_s = time_limit_s;
     Ok(run)
@@ -612,8 +640,7 @@ fn machine_parameters(
 
 /// Opens sheet `sheet` (from 0) of the file; every file has sheet 0.
 fn open((path, sheet): (&Path, usize)) -> Result<Document, String> {
-    let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let name = path.display().to_string();
+    let (name, bytes) = stdio::read_input(path)?;
     open_sheet(&name, &bytes, sheet).map_err(|e| e.to_string())
 }
 
@@ -703,7 +730,7 @@ struct GcodeArgs {
     incremental: bool,
     /// Arcs as G02/G03 with I/J ("ij"), with R ("r"), or as G01 chords ("lines")
     /// [default: the preset's, ij].
-    #[arg(long)]
+    #[arg(long, value_parser = ["ij", "r", "lines"])]
     arcs: Option<String>,
     /// Largest chord deviation of --arcs lines, mm.
     #[arg(long, default_value_t = 0.01)]
@@ -790,6 +817,9 @@ fn convert(
         ));
     };
     let name = output.to_string_lossy().to_lowercase();
+    if stdio::is_standard(output) && to.is_none() {
+        return Err("writing to standard output (-) needs --to dbs|json|svg|gcode|html".into());
+    }
     let format = match to {
         Some(format) => format.to_string(),
         None => [
@@ -883,7 +913,7 @@ fn convert(
             ))
         }
     };
-    std::fs::write(output, bytes).map_err(|e| format!("{}: {e}", output.display()))
+    stdio::write_output(output, &bytes)
 }
 
 /// What a G-code or HTML output draws: a route of whole contours, or tool-on paths (segment
@@ -950,7 +980,7 @@ fn solver_kind(name: &str) -> Result<SolverKind, String> {
 fn generate(contours: usize, seed: u64, out: &Path) -> Result<(), String> {
     let nest = cutroute_geometry::generate_nest(contours, seed);
     let text = cutroute_formats::write_geometry_json(&nest).map_err(|e| e.to_string())?;
-    std::fs::write(out, text).map_err(|e| format!("{}: {e}", out.display()))
+    stdio::write_output(out, text.as_bytes())
 }
 
 /// With leads on, the solver ran over the pierce curves: its routes (the last and the earlier
@@ -976,7 +1006,7 @@ fn solve(
     as_json: bool,
     thermal: &thermal::Thermal,
     kerf: &kerf::Kerf,
-) -> Result<(), Failure> {
+) -> Result<Value, Failure> {
     let document = open(input)?;
     let solver = solver_kind(solver_name)?;
     let (machine, objective) = (params.machine, params.objective);
@@ -1018,21 +1048,23 @@ fn solve(
             report
         }
     };
-    print_report(&report, as_json);
-    Ok(())
+    Ok(report)
 }
 
-/// A solve report: one JSON object, or its keys one per line without the route or tour.
-fn print_report(report: &Value, as_json: bool) {
+/// A solve report, to standard output or `out`: one JSON object, or its keys one per line
+/// without the route or tour.
+fn write_report(report: &Value, as_json: bool, out: Option<&Path>) -> Result<(), String> {
+    let mut text = String::new();
     if as_json {
-        println!("{report}");
+        text = format!("{report}\n");
     } else {
         for (key, value) in report.as_object().into_iter().flatten() {
             if key != "route" && key != "tour" {
-                println!("{key:>18}: {value}");
+                text.push_str(&format!("{key:>18}: {value}\n"));
             }
         }
     }
+    stdio::write_output(out.unwrap_or(Path::new("-")), text.as_bytes())
 }
 
 fn machine_json(machine: &MachineParameters) -> Value {
@@ -1044,12 +1076,6 @@ fn machine_json(machine: &MachineParameters) -> Value {
         "cut_price_per_metre": machine.cut_price_per_metre,
         "pierce_price": machine.pierce_price,
     })
-}
-
-fn fmt(value: Option<f64>) -> String {
-    value
-        .map(|v| format!("{v:.1}"))
-        .unwrap_or_else(|| "—".into())
 }
 
 /// The PCGTSP report: tour as 1-based node ids of the instance, starting at the depot, and
@@ -1142,23 +1168,6 @@ fn nest_scale(nest: &Nest) -> f64 {
     ((b.max.x - b.min.x).abs() + (b.max.y - b.min.y).abs()).max(1.0)
 }
 
-/// Prints a progress line to stderr about once a second (text mode only).
-fn progress_printer(as_json: bool) -> impl FnMut(&Progress) {
-    let mut last_report = -1.0;
-    move |progress: &Progress| {
-        if !as_json && progress.elapsed_s - last_report >= 1.0 {
-            last_report = progress.elapsed_s;
-            eprintln!(
-                "{:8.2} s  ub {:>12}  lb {:>12}  {}",
-                progress.elapsed_s,
-                fmt(progress.upper_bound),
-                fmt(progress.lower_bound),
-                progress.phase
-            );
-        }
-    }
-}
-
 /// `--solver sccp|gsccp|aoe`: the engine's path-route jobs (the app's code path), stepped to
 /// their end. sccp solves the multi-contour chain ensemble alone, gsccp every ensemble,
 /// keeping the best by `--objective`; aoe cuts common edges once along AOE-chains. The
@@ -1171,7 +1180,7 @@ fn solve_path(
     params: SolverParams,
     as_json: bool,
     thermal: &thermal::Thermal,
-) -> Result<(), String> {
+) -> Result<Value, String> {
     let document = open(input)?;
     let Problem::Nest { nest, .. } = &document.problem else {
         return Err(format!(
@@ -1189,8 +1198,10 @@ fn solve_path(
         params,
     };
     let started = std::time::Instant::now();
+    let display = stdio::ProgressDisplay::new(as_json);
+    let mut shown = display.clone();
     let outcome = run_bounded(time_limit_s, move |watch| {
-        let mut on_progress = progress_printer(as_json);
+        let mut on_progress = |p: &Progress| shown.show(p);
         let mut extra = serde_json::Map::new();
         let progress = if solver == SolverKind::Aoe {
             let mut job =
@@ -1254,6 +1265,7 @@ fn solve_path(
     .map_err(|f| match f {
         Failure::Error(m) | Failure::Infeasible(m) => m,
     })?;
+    drop(display);
     // Stopped in a long step: the latest published state, without the job's own extras.
     let (progress, extra, stopped) = match outcome {
         Ok((progress, extra)) => (progress, extra, None),
@@ -1306,8 +1318,7 @@ fn solve_path(
         fields.extend(extra);
     }
     thermal.report_paths(&mut report, route, &machine);
-    print_report(&report, as_json);
-    Ok(())
+    Ok(report)
 }
 
 /// A number for JSON: `null` when not finite (an ensemble that gave no route).
