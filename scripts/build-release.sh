@@ -6,4 +6,6 @@ cd "$(dirname "$0")/.."
 scripts/setup.sh
 source scripts/wasm-env.sh
 trunk build --release --public-url ./ "$@"
+# The service worker caches every file of this build (offline after the first visit).
+scripts/precache.py dist
 ls -l dist/*.wasm | awk '{print "[build] " $5 " bytes  " $9}' >&2
