@@ -8,4 +8,6 @@ source scripts/wasm-env.sh
 trunk build --release --public-url ./ "$@"
 # The service worker caches every file of this build (offline after the first visit).
 scripts/precache.py dist
+# dist/cutroute.html: the same app in one file, for a double-click (file://) or a USB stick.
+scripts/single-file.py dist
 ls -l dist/*.wasm | awk '{print "[build] " $5 " bytes  " $9}' >&2

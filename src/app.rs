@@ -863,6 +863,9 @@ async fn read_file(file: &web_sys::File) -> Result<Vec<u8>, String> {
 }
 
 async fn fetch_bytes(url: &str) -> Result<Vec<u8>, String> {
+    if let Some(bytes) = crate::embedded::file(url) {
+        return Ok(bytes);
+    }
     let response = gloo_net::http::Request::get(url)
         .send()
         .await

@@ -6,6 +6,7 @@ mod app;
 mod chart;
 mod compare;
 mod drawing;
+mod embedded;
 mod export;
 mod pan_zoom;
 mod settings;

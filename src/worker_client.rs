@@ -24,10 +24,13 @@ impl gloo_worker::Worker for SolverWorker {
     }
 }
 
-/// Spawn the worker next to the page (relative URL: works from any sub-path of a static host).
+/// Spawn the worker next to the page (relative URL: works from any sub-path of a static host),
+/// or from the loader the single-file page carries (`crate::embedded`).
 pub fn spawn(on_message: impl Fn(FromWorker) + 'static) -> WorkerBridge<SolverWorker> {
-    SolverWorker::spawner()
-        .callback(on_message)
-        .as_module(false)
-        .spawn("./worker.js")
+    let mut spawner = SolverWorker::spawner();
+    spawner.callback(on_message).as_module(false);
+    match crate::embedded::worker_loader() {
+        Some(loader) => spawner.with_loader(true).spawn(&loader),
+        None => spawner.spawn("./worker.js"),
+    }
 }
