@@ -5,6 +5,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
 source scripts/wasm-env.sh
+# binaryen's wasm-opt from tools/ (npm): trunk takes it from the PATH when its version is the pinned one.
+export PATH="$PWD/tools/node_modules/.bin:$PATH"
 trunk build --release --public-url ./ "$@"
 # The service worker caches every file of this build (offline after the first visit).
 scripts/precache.py dist

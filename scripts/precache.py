@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Fills in the service worker of a release build: the list of files it caches at install
-(every file of the build but the worker script itself) and a version made of their contents,
+(every file of the build but the worker script itself and the single-file page) and a version made of their contents,
 so a new build replaces the old cache. Usage: scripts/precache.py dist"""
 import hashlib
 import json
@@ -9,7 +9,9 @@ import sys
 
 dist = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else "dist")
 sw = dist / "sw.js"
-files = sorted(p for p in dist.rglob("*") if p.is_file() and p != sw)
+# cutroute.html is the same app in one file, a download for file:// use; the hosted app never
+# loads it (scripts/single-file.py writes it after this script anyway).
+files = sorted(p for p in dist.rglob("*") if p.is_file() and p != sw and p.name != "cutroute.html")
 digest = hashlib.sha256()
 for p in files:
     digest.update(p.relative_to(dist).as_posix().encode())

@@ -6,6 +6,7 @@
 #   - the wasm32 standard library: rustup's if it can be had, else Debian's rustc-web toolchain
 #     with std sources, from which std is built for wasm32 on the fly (see scripts/wasm-env.sh);
 #   - trunk and wasm-bindgen-cli at the exact versions the project pins;
+#   - wasm-opt (binaryen from npm, run by Node; the version Trunk.toml pins) for the release build;
 #   - playwright-core (npm; it drives the system Chromium, it never downloads a browser).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -57,6 +58,11 @@ if [ "$(wasm-bindgen --version 2>/dev/null)" != "wasm-bindgen $WASM_BINDGEN_VERS
   log "cargo install wasm-bindgen-cli $WASM_BINDGEN_VERSION"
   # Not --locked: one locked dependency of this release is missing from the registry mirror.
   cargo install wasm-bindgen-cli --version "$WASM_BINDGEN_VERSION" --quiet
+fi
+
+if [ ! -x tools/node_modules/.bin/wasm-opt ]; then
+  log "npm ci (tools: binaryen's wasm-opt)"
+  (cd tools && npm ci --no-audit --no-fund --silent)
 fi
 
 if [ ! -d tests/e2e/node_modules/playwright-core ]; then
