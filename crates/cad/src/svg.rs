@@ -48,12 +48,11 @@
 //! assert!(part.contours[0].bounding_box().max.y <= -5.0 + 1e-9);
 //! ```
 
-use cutroute_geometry::{Nest, Point, Transform};
+use cutroute_geometry::{Nest, Point, Span, Transform};
 use roxmltree::{Document, Node};
 
 use crate::assemble::{assemble, AssembleLimits, EntityRef, OpenChain, Piece};
 use crate::curves::{approximate, elliptic_spans, ApproxFailure, EllipticArc, Nurbs};
-use crate::shape::Span;
 
 /// Deepest nesting of elements followed; deeper content is refused (hostile input).
 const MAX_DEPTH: usize = 256;

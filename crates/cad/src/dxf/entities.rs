@@ -2,13 +2,14 @@
 
 use std::collections::HashMap;
 
-use cutroute_geometry::Point;
+use cutroute_geometry::{Point, Span};
 
 use super::groups::{decode_text, Codepage, Group};
 use super::{DxfError, DxfOptions, DxfWarning};
 use crate::assemble::{Piece, SourceRef};
-use crate::curves::{approximate, approximate_elliptic, ApproxFailure, EllipticArc, Nurbs};
-use crate::shape::{dist, Span};
+use crate::curves::{
+    approximate, approximate_elliptic, ApproxFailure, EllipticArc, Nurbs, STRAIGHT_BULGE,
+};
 
 /// Deepest chain of blocks inserting blocks; real drawings use 3–5 levels.
 const MAX_BLOCK_DEPTH: usize = 16;
@@ -509,7 +510,7 @@ impl Expander<'_, '_> {
             "LINE" => {
                 let a = record.point(10, "start point")?;
                 let b = record.point(11, "end point")?;
-                if dist(a, b) == 0.0 {
+                if a == b {
                     self.warn(record.line, "zero-length LINE skipped");
                     return Ok(());
                 }
@@ -664,12 +665,8 @@ impl Expander<'_, '_> {
         for i in 0..count {
             let (a, bulge) = vertices[i];
             let (b, _) = vertices[(i + 1) % n];
-            if dist(a, b) > 0.0 {
-                spans.push(Span {
-                    start: a,
-                    end: b,
-                    bulge,
-                });
+            if a != b {
+                spans.push(Span::new(a, b, bulge));
             }
         }
         if spans.is_empty() {
@@ -697,20 +694,21 @@ impl Expander<'_, '_> {
             let start = to_world.apply(s.start);
             let end = to_world.apply(s.end);
             if s.bulge == 0.0 || similar {
-                out.push(Span {
-                    start,
-                    end,
-                    bulge: if flip { -s.bulge } else { s.bulge },
-                });
-            } else if let Some((center, radius)) = s.arc_center() {
-                // An unevenly scaled arc is an elliptic arc: approximate it.
+                out.push(Span::new(start, end, if flip { -s.bulge } else { s.bulge }));
+            } else if let Some(center) = s
+                .centre()
+                .filter(|_| s.bulge.abs() >= STRAIGHT_BULGE && s.chord_length() >= 1e-15)
+            {
+                // An unevenly scaled arc is an elliptic arc: approximate it. A nearly straight
+                // or vanishing one stays a line: its centre would be meaningless.
+                let radius = s.radius();
                 let t0 = (s.start.y - center.y).atan2(s.start.x - center.x);
                 let arc = EllipticArc {
                     center,
                     u: Point::new(radius, 0.0),
                     v: Point::new(0.0, radius),
                     t0,
-                    t1: t0 + 4.0 * s.bulge.atan(),
+                    t1: t0 + s.sweep(),
                 };
                 out.extend(self.approximate_elliptic(&arc, to_world)?);
             } else {
@@ -817,7 +815,7 @@ impl Expander<'_, '_> {
             );
             let spans: Vec<Span> = fit
                 .windows(2)
-                .filter(|w| dist(w[0], w[1]) > 0.0)
+                .filter(|w| w[0] != w[1])
                 .map(|w| Span::line(w[0], w[1]))
                 .collect();
             return self.path(spans, flags & 1 == 1, to_world, source);
@@ -837,10 +835,7 @@ impl Expander<'_, '_> {
         .map_err(|ApproxFailure::BudgetExceeded| DxfError::TooComplex {
             limit: self.options.max_spans,
         })?;
-        let spans: Vec<Span> = spans
-            .into_iter()
-            .filter(|s| dist(s.start, s.end) > 0.0)
-            .collect();
+        let spans: Vec<Span> = spans.into_iter().filter(|s| s.start != s.end).collect();
         if spans.is_empty() {
             self.warn(record.line, "SPLINE without extent skipped");
             return Ok(());
