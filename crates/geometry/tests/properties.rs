@@ -2,7 +2,7 @@
 
 use proptest::prelude::*;
 
-use cutroute_geometry::{Contour, Point, Span, Transform, Vertex};
+use cutroute_geometry::{Contour, Part, Point, Span, Transform, Vertex};
 
 fn point() -> impl Strategy<Value = Point> {
     (-100.0..100.0f64, -100.0..100.0f64).prop_map(|(x, y)| Point::new(x, y))
@@ -179,6 +179,23 @@ proptest! {
     }
 
     #[test]
+    fn halves_are_the_split_at_the_middle(s in span()) {
+        let (a, b) = s.halved();
+        let (x, y) = s.split_at(0.5);
+        let scale = s.length().max(1.0);
+        prop_assert_eq!(a.start, s.start);
+        prop_assert_eq!(b.end, s.end);
+        prop_assert_eq!(a.end, b.start);
+        prop_assert!(a.end.distance(x.end) < 1e-9 * scale);
+        prop_assert!((a.bulge - x.bulge).abs() <= 1e-12 * (1.0 + x.bulge.abs()));
+        prop_assert!((b.bulge - y.bulge).abs() <= 1e-12 * (1.0 + y.bulge.abs()));
+        prop_assert!((a.length() - 0.5 * s.length()).abs() < 1e-9 * scale);
+        prop_assert!((b.length() - 0.5 * s.length()).abs() < 1e-9 * scale);
+        // Each half turns less than half a circle, whatever the span turns.
+        prop_assert!(a.bulge.abs() < 1.0 && b.bulge.abs() < 1.0);
+    }
+
+    #[test]
     fn arc_through_its_own_point(s in span(), t in 0.05..0.95f64) {
         let via = s.point_at(t);
         if let Some(r) = Span::through_points(s.start, via, s.end) {
@@ -247,6 +264,26 @@ proptest! {
         let per = polyline_length(&closed);
         prop_assert!((c.perimeter() - per).abs() <= 1e-5 * per);
         prop_assert_eq!(c.is_clockwise(), area < 0.0);
+    }
+
+    #[test]
+    fn part_area_is_material_whatever_the_hole_orientation(c in contour(), hole_reversed: bool) {
+        // The outer contour twice the size of the hole; both star-shaped about the origin.
+        let outer = c.transformed(&Transform::scaling(2.0));
+        let hole = if hole_reversed { c.reversed() } else { c.clone() };
+        let part = Part { name: "P".into(), contours: vec![outer.clone(), hole.clone()] };
+        let (outer_poly, hole_poly) = (dense(&outer, 800), dense(&hole, 800));
+        let material = shoelace(&outer_poly).abs() - shoelace(&hole_poly).abs();
+        let tolerance = 1e-3 * outer.perimeter() * outer.perimeter() / 800.0;
+        prop_assert!((part.area() - material).abs() <= tolerance, "{} vs {}", part.area(), material);
+        let mut cut = 0.0;
+        for poly in [outer_poly, hole_poly] {
+            let mut closed = poly.clone();
+            closed.push(poly[0]);
+            cut += polyline_length(&closed);
+        }
+        prop_assert!((part.perimeter() - cut).abs() <= 1e-5 * cut);
+        prop_assert_eq!(Part::default().area(), 0.0);
     }
 
     #[test]
