@@ -509,7 +509,7 @@ fn checked_route(
     nest: &Nest,
     forest: &ContainmentForest,
 ) -> Result<(Route, Option<String>), String> {
-    let tolerance = 1e-6 * nest_scale(nest);
+    let tolerance = nest.check_tolerance();
     let first_problem = |route: &Route| route.problems(nest, forest, tolerance).into_iter().next();
     let no_route = || match run.stopped {
         Some(why) => format!(
@@ -1137,11 +1137,6 @@ fn route_report(
     }))
 }
 
-fn nest_scale(nest: &Nest) -> f64 {
-    let b = nest.bounding_box();
-    ((b.max.x - b.min.x).abs() + (b.max.y - b.min.y).abs()).max(1.0)
-}
-
 /// Prints a progress line to stderr about once a second (text mode only).
 fn progress_printer(as_json: bool) -> impl FnMut(&Progress) {
     let mut last_report = -1.0;
@@ -1271,7 +1266,7 @@ fn solve_path(
         .as_ref()
         .ok_or_else(|| format!("the solver found no route ({})", progress.phase))?;
     // Checked again here, as every route the CLI prints.
-    let tolerance = 1e-6 * nest_scale(nest);
+    let tolerance = nest.check_tolerance();
     let problems = route.problems(nest, tolerance);
     if let Some(other) = problems
         .iter()
