@@ -321,6 +321,31 @@ proptest! {
     }
 
     #[test]
+    fn similarities_are_recognised(
+        angle in -7.0..7.0f64, scale in 0.01..100.0f64, mirror: bool, dx in -1e3..1e3f64,
+        stretch in 1.001..10.0f64, c in contour(),
+    ) {
+        let mut t = Transform::rotation(angle).then(&Transform::scaling(scale));
+        if mirror { t = t.then(&Transform::mirror_x()); }
+        let t = t.then(&Transform::translation(dx, -dx));
+        prop_assert!(t.is_similarity());
+        // A similarity maps an arc onto the arc of the mapped ends and bulge: the image of the
+        // span's midpoint is the mapped span's midpoint.
+        for s in c.spans() {
+            let image = s.transformed(&t);
+            let expected = t.apply(s.point_at(0.5));
+            prop_assert!(image.point_at(0.5).distance(expected) < 1e-9 * scale * 100.0);
+        }
+        let uneven = Transform { matrix: [[stretch, 0.0], [0.0, 1.0]], offset: Point::ORIGIN };
+        prop_assert!(!uneven.then(&t).is_similarity());
+        prop_assert!(!t.then(&uneven).is_similarity());
+        let sheared = Transform { matrix: [[1.0, stretch - 1.0], [0.0, 1.0]], offset: Point::ORIGIN };
+        prop_assert!(!sheared.then(&t).is_similarity());
+        let singular = Transform { matrix: [[0.0; 2]; 2], offset: Point::ORIGIN };
+        prop_assert!(!singular.is_similarity());
+    }
+
+    #[test]
     fn transform_then_inverse_is_identity(
         c in contour(), angle in -7.0..7.0f64, scale in 0.5..2.0f64, mirror: bool, dx in -1e3..1e3f64, dy in -1e3..1e3f64
     ) {
