@@ -10,7 +10,7 @@
 
 use std::collections::HashMap;
 
-use cutroute_geometry::{BoundingBox, Contour, Part, Point, Span, Vertex};
+use cutroute_geometry::{BoundingBox, Contour, Part, Point, Span, Transform, Vertex};
 
 /// Where a piece of geometry came from in the file.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -550,4 +550,13 @@ pub(crate) fn check_curve_options(
         return Err("max_spans must be positive".into());
     }
     Ok(())
+}
+
+/// Whether scales stay within 1e6 and offsets within 1e12 mm: with input coordinates bounded
+/// by 1e9, every transformed point is then finite with room to spare, so nested inserts (DXF)
+/// and nested transforms (SVG) cannot overflow to infinity or NaN.
+pub(crate) fn is_bounded(t: &Transform) -> bool {
+    t.matrix.iter().flatten().all(|v| v.abs() <= 1e6)
+        && t.offset.x.abs() <= 1e12
+        && t.offset.y.abs() <= 1e12
 }
