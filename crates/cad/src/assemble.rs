@@ -10,12 +10,7 @@
 
 use std::collections::HashMap;
 
-use cutroute_geometry::{Contour, Part, Point, Vertex};
-
-use crate::shape::{
-    contour_bounds, dist, distance_to_polygon, flatten, point_in_polygon, reversed, signed_area,
-    Span,
-};
+use cutroute_geometry::{BoundingBox, Contour, Part, Point, Span, Transform, Vertex};
 
 /// Where a piece of geometry came from in the file.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -142,7 +137,7 @@ impl EndGrid {
                     }
                     i += 1;
                     examined += 1;
-                    let d = dist(p, ends[id as usize]);
+                    let d = p.distance(ends[id as usize]);
                     if d <= tolerance && best.is_none_or(|(_, bd)| d < bd) {
                         best = Some((id, d));
                     }
@@ -252,7 +247,7 @@ pub(crate) fn assemble(pieces: Vec<Piece>, limits: &AssembleLimits) -> Assembled
                 let (head, tail) = chain_ends(&chain, &ends);
                 let (from, to_close) = if forward { (tail, head) } else { (head, tail) };
                 let candidate = grid.nearest(from, tolerance, &ends, &used);
-                let closing = dist(from, to_close);
+                let closing = from.distance(to_close);
                 if closing <= tolerance && candidate.is_none_or(|(_, d)| closing <= d) {
                     // A chain of one straight span cannot close on itself.
                     closed = chain.len() > 1
@@ -284,7 +279,7 @@ pub(crate) fn assemble(pieces: Vec<Piece>, limits: &AssembleLimits) -> Assembled
             ));
         } else {
             let spans: Vec<Span> = chain_spans(&links, &pieces).collect();
-            let length = spans.iter().map(span_length).sum();
+            let length = spans.iter().map(Span::length).sum();
             open_chains.push(OpenChain {
                 start: spans[0].start,
                 end: spans[spans.len() - 1].end,
@@ -342,19 +337,13 @@ fn chain_contour(links: &[(usize, bool)], pieces: &[Piece]) -> Contour {
     )
 }
 
-fn span_length(s: &Span) -> f64 {
-    match s.arc_center() {
-        None => dist(s.start, s.end),
-        Some((_, r)) => r * (4.0 * s.bulge.atan()).abs(),
-    }
-}
-
 struct Placed {
     contour: Contour,
     source: SourceRef,
     area: f64,
-    lo: Point,
-    hi: Point,
+    bbox: BoundingBox,
+    /// The contour flattened within the flattening tolerance: where containment samples it
+    /// when this contour is the inner one.
     polygon: Vec<Point>,
 }
 
@@ -366,7 +355,7 @@ fn group_into_parts(
     let tolerance = limits.join_tolerance;
     let mut placed: Vec<Placed> = Vec::with_capacity(contours.len());
     for (contour, source) in contours {
-        let area = signed_area(&contour);
+        let area = contour.signed_area();
         if area.abs() <= tolerance * tolerance {
             dropped.push(Dropped {
                 line: source.line,
@@ -377,14 +366,13 @@ fn group_into_parts(
             });
             continue;
         }
-        let (lo, hi) = contour_bounds(&contour);
-        let polygon = flatten(&contour, limits.flatten_tolerance.min(tolerance));
+        let bbox = contour.bounding_box();
+        let polygon = contour.flatten(limits.flatten_tolerance.min(tolerance));
         placed.push(Placed {
             contour,
             source,
             area,
-            lo,
-            hi,
+            bbox,
             polygon,
         });
     }
@@ -402,18 +390,19 @@ fn group_into_parts(
             .enumerate()
             .map(|(j, p)| {
                 rstar::primitives::GeomWithData::new(
-                    rstar::primitives::Rectangle::from_corners([p.lo.x, p.lo.y], [p.hi.x, p.hi.y]),
+                    rstar::primitives::Rectangle::from_corners(
+                        [p.bbox.min.x, p.bbox.min.y],
+                        [p.bbox.max.x, p.bbox.max.y],
+                    ),
                     j,
                 )
             })
             .collect(),
     );
     for i in 0..placed.len() {
-        let (lo, hi) = (placed[i].lo, placed[i].hi);
-        let query = rstar::AABB::from_corners(
-            [lo.x - tolerance, lo.y - tolerance],
-            [hi.x + tolerance, hi.y + tolerance],
-        );
+        let reach = placed[i].bbox.expanded(tolerance);
+        let query =
+            rstar::AABB::from_corners([reach.min.x, reach.min.y], [reach.max.x, reach.max.y]);
         // Same order as the scan they replace: the nearest larger contour first.
         let mut candidates: Vec<usize> = boxes
             .locate_in_envelope_intersecting(&query)
@@ -426,11 +415,7 @@ fn group_into_parts(
                 continue;
             }
             let (inner, outer) = (&placed[i], &placed[j]);
-            if inner.lo.x < outer.lo.x - tolerance
-                || inner.lo.y < outer.lo.y - tolerance
-                || inner.hi.x > outer.hi.x + tolerance
-                || inner.hi.y > outer.hi.y + tolerance
-            {
+            if !outer.bbox.expanded(tolerance).contains_box(&inner.bbox) {
                 continue;
             }
             match containment(inner, outer, tolerance) {
@@ -475,7 +460,7 @@ fn group_into_parts(
         .map(|(k, &i)| {
             let p = &placed[i];
             let contour = if p.area > 0.0 {
-                reversed(&p.contour)
+                p.contour.reversed()
             } else {
                 p.contour.clone()
             };
@@ -491,7 +476,7 @@ fn group_into_parts(
             continue;
         };
         let contour = if p.area < 0.0 {
-            reversed(&p.contour)
+            p.contour.reversed()
         } else {
             p.contour.clone()
         };
@@ -507,7 +492,8 @@ enum Containment {
     Same,
 }
 
-/// Votes over the inner contour's vertices and span midpoints, ignoring samples on the outer
+/// Votes over samples of the inner contour (its flattened outline's vertices and chord
+/// midpoints), tested against the outer contour's true arcs and ignoring samples on the outer
 /// boundary: contours that touch stay decidable, identical ones are recognised.
 fn containment(inner: &Placed, outer: &Placed, tolerance: f64) -> Containment {
     let n = inner.polygon.len();
@@ -517,11 +503,11 @@ fn containment(inner: &Placed, outer: &Placed, tolerance: f64) -> Containment {
     while k < n {
         let a = inner.polygon[k];
         let b = inner.polygon[(k + 1) % n];
-        for p in [a, Point::new((a.x + b.x) / 2.0, (a.y + b.y) / 2.0)] {
-            if distance_to_polygon(p, &outer.polygon) <= tolerance {
+        for p in [a, a.midpoint(b)] {
+            if outer.contour.distance_to(p) <= tolerance {
                 continue;
             }
-            if point_in_polygon(p, &outer.polygon) {
+            if outer.contour.contains(p) {
                 inside += 1;
             } else {
                 outside += 1;
@@ -564,4 +550,13 @@ pub(crate) fn check_curve_options(
         return Err("max_spans must be positive".into());
     }
     Ok(())
+}
+
+/// Whether scales stay within 1e6 and offsets within 1e12 mm: with input coordinates bounded
+/// by 1e9, every transformed point is then finite with room to spare, so nested inserts (DXF)
+/// and nested transforms (SVG) cannot overflow to infinity or NaN.
+pub(crate) fn is_bounded(t: &Transform) -> bool {
+    t.matrix.iter().flatten().all(|v| v.abs() <= 1e6)
+        && t.offset.x.abs() <= 1e12
+        && t.offset.y.abs() <= 1e12
 }

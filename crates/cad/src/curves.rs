@@ -7,9 +7,7 @@
 //! of arcs (straight spans where the three points are collinear); far fewer spans than chords
 //! would need for the same tolerance, which keeps the route optimizer's input small.
 
-use cutroute_geometry::Point;
-
-use crate::shape::{angle_in_sweep, dist, distance_to_segment, Span};
+use cutroute_geometry::{Point, Span};
 
 /// Highest spline degree accepted (AutoCAD allows up to 11); each evaluation costs degree².
 pub(crate) const MAX_SPLINE_DEGREE: usize = 11;
@@ -178,58 +176,24 @@ impl EllipticArc {
                 .map(|i| {
                     let ta = self.t0 + (self.t1 - self.t0) * i as f64 / pieces as f64;
                     let tb = self.t0 + (self.t1 - self.t0) * (i + 1) as f64 / pieces as f64;
-                    Span {
-                        start: self.point_at(ta),
-                        end: self.point_at(tb),
-                        bulge,
-                    }
+                    Span::new(self.point_at(ta), self.point_at(tb), bulge)
                 })
                 .collect(),
         )
     }
 }
 
-/// The circular arc through `a`, `m`, `b` (in that order) as a span from `a` to `b`.
-pub(crate) fn arc_through(a: Point, m: Point, b: Point) -> Span {
-    let cross = (b.x - a.x) * (m.y - a.y) - (b.y - a.y) * (m.x - a.x);
-    let ma = Point::new(a.x - m.x, a.y - m.y);
-    let mb = Point::new(b.x - m.x, b.y - m.y);
-    let la = ma.x.hypot(ma.y);
-    let lb = mb.x.hypot(mb.y);
-    if la == 0.0 || lb == 0.0 {
-        return Span::line(a, b);
-    }
-    let cos_amb = ((ma.x * mb.x + ma.y * mb.y) / (la * lb)).clamp(-1.0, 1.0);
-    // The inscribed angle at m is π − φ/2, so φ/4 = (π − ∠amb)/2.
-    let quarter = (std::f64::consts::PI - cos_amb.acos()) / 2.0;
-    let magnitude = quarter.tan();
-    // m to the right of a→b means the arc turns counter-clockwise.
-    let bulge = if cross < 0.0 { magnitude } else { -magnitude };
-    if !bulge.is_finite() || magnitude < 1e-12 {
-        return Span::line(a, b);
-    }
-    Span {
-        start: a,
-        end: b,
-        bulge,
-    }
-}
+/// Below this |bulge| a span is taken as straight: the arc through three points of a spline's
+/// straight stretch stays a line (no G2/G3 of astronomic radius, no bulge of rounding noise),
+/// and a DXF arc this flat is not turned into an ellipse around its far-away centre.
+pub(crate) const STRAIGHT_BULGE: f64 = 1e-12;
 
-/// Distance from `p` to the span (segment or arc).
-pub(crate) fn distance_to_span(p: Point, span: &Span) -> f64 {
-    match span.arc_center() {
-        None => distance_to_segment(p, span.start, span.end),
-        Some((c, r)) => {
-            let a0 = (span.start.y - c.y).atan2(span.start.x - c.x);
-            let sweep = 4.0 * span.bulge.atan();
-            let a = (p.y - c.y).atan2(p.x - c.x);
-            if angle_in_sweep(a, a0, sweep) {
-                (dist(p, c) - r).abs()
-            } else {
-                dist(p, span.start).min(dist(p, span.end))
-            }
-        }
-    }
+/// The circular arc through `a`, `m`, `b` (in that order) as a span from `a` to `b`; a straight
+/// span when the three points are (nearly) collinear or `m` repeats an end.
+pub(crate) fn arc_through(a: Point, m: Point, b: Point) -> Span {
+    Span::through_points(a, m, b)
+        .filter(|s| s.bulge.abs() >= STRAIGHT_BULGE)
+        .unwrap_or(Span::line(a, b))
 }
 
 /// Approximates `curve` on `[t0, t1]` by arcs within `tolerance`, splitting first at `breaks`.
@@ -261,7 +225,7 @@ pub(crate) fn approximate(
             let fits = depth >= MAX_DEPTH
                 || (1..CHECK_SAMPLES).all(|k| {
                     let t = a + (b - a) * k as f64 / CHECK_SAMPLES as f64;
-                    distance_to_span(curve(t), &span) <= tolerance
+                    span.distance_to(curve(t)) <= tolerance
                 });
             if fits {
                 if *budget == 0 {
@@ -398,7 +362,7 @@ mod tests {
             let p = e.point_at(t);
             let d = spans
                 .iter()
-                .map(|s| distance_to_span(p, s))
+                .map(|s| s.distance_to(p))
                 .fold(f64::INFINITY, f64::min);
             assert!(d <= tol * 1.01, "deviation {d} at t = {t}");
         }

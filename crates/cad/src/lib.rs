@@ -39,7 +39,6 @@
 mod assemble;
 mod curves;
 pub mod dxf;
-mod shape;
 pub mod svg;
 pub mod tflex;
 

@@ -48,12 +48,11 @@
 //! assert!(part.contours[0].bounding_box().max.y <= -5.0 + 1e-9);
 //! ```
 
-use cutroute_geometry::{Nest, Point, Transform};
+use cutroute_geometry::{Nest, Point, Span, Transform};
 use roxmltree::{Document, Node};
 
-use crate::assemble::{assemble, AssembleLimits, EntityRef, OpenChain, Piece};
+use crate::assemble::{assemble, is_bounded, AssembleLimits, EntityRef, OpenChain, Piece};
 use crate::curves::{approximate, elliptic_spans, ApproxFailure, EllipticArc, Nurbs};
-use crate::shape::Span;
 
 /// Deepest nesting of elements followed; deeper content is refused (hostile input).
 const MAX_DEPTH: usize = 256;
@@ -740,13 +739,6 @@ impl<'a, 'input> Reader<'a, 'input, '_> {
         }
         Ok(())
     }
-}
-
-/// Whether the map keeps every accepted coordinate finite with room to spare.
-fn is_bounded(t: &Transform) -> bool {
-    t.matrix.iter().flatten().all(|v| v.abs() <= 1e6)
-        && t.offset.x.abs() <= 1e12
-        && t.offset.y.abs() <= 1e12
 }
 
 fn polyline(points: &[Point]) -> Subpath {

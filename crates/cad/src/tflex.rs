@@ -30,8 +30,6 @@ use std::collections::HashMap;
 use cutroute_geometry::{Contour, Nest, Part, Point, Vertex};
 use roxmltree::{Document, Node};
 
-use crate::shape::{dist, reversed, signed_area};
-
 const XSI: &str = "http://www.w3.org/2001/XMLSchema-instance";
 /// Largest accepted coordinate magnitude (mm): far beyond any sheet, far below overflow.
 const MAX_MAGNITUDE: f64 = cutroute_geometry::MAX_COORDINATE;
@@ -360,7 +358,7 @@ fn place(contours: &[Contour], placement: &Placement) -> Vec<Contour> {
 /// Largest contour first and clockwise, the others counter-clockwise.
 fn orient(contours: Vec<Contour>) -> Vec<Contour> {
     let mut with_area: Vec<(f64, Contour)> =
-        contours.into_iter().map(|c| (signed_area(&c), c)).collect();
+        contours.into_iter().map(|c| (c.signed_area(), c)).collect();
     let outer = with_area
         .iter()
         .enumerate()
@@ -376,7 +374,7 @@ fn orient(contours: Vec<Contour>) -> Vec<Contour> {
         .map(|(k, (area, c))| {
             let want_ccw = k > 0;
             if (area > 0.0) != want_ccw {
-                reversed(&c)
+                c.reversed()
             } else {
                 c
             }
@@ -579,12 +577,12 @@ impl<'d, 'i> Reader<'d, 'i> {
             let begin = self.point(self.child(object, "Begin")?)?;
             let end = self.point(self.child(object, "End")?)?;
             if let Some((prev, prev_node)) = previous_end {
-                if dist(prev, begin) > CONTINUITY_TOLERANCE {
+                if prev.distance(begin) > CONTINUITY_TOLERANCE {
                     return Err(self.invalid(
                         object,
                         format!(
                             "begins {:.4} mm away from where {} ends",
-                            dist(prev, begin),
+                            prev.distance(begin),
                             self.path(prev_node)
                         ),
                     ));
@@ -605,7 +603,7 @@ impl<'d, 'i> Reader<'d, 'i> {
                             format!("arc angle {sweep} rad is not in (0, 2π]"),
                         ));
                     }
-                    if dist(center, begin) == 0.0 {
+                    if center == begin {
                         return Err(self.invalid(object, "arc of zero radius"));
                     }
                     if sweep.abs() > std::f64::consts::PI {
@@ -638,13 +636,14 @@ impl<'d, 'i> Reader<'d, 'i> {
             return Err(self.invalid(objects, "the contour has no objects"));
         };
         if let Some((last, last_node)) = previous_end {
-            if dist(last, first.point) > CONTINUITY_TOLERANCE {
+            if last.distance(first.point) > CONTINUITY_TOLERANCE {
                 return Err(self.invalid(last_node, "the contour does not close"));
             }
         }
-        if signed_area(&Contour::new(vertices.clone())).abs() == 0.0 {
+        let contour = Contour::new(vertices);
+        if contour.signed_area() == 0.0 {
             return Err(self.invalid(node, "the contour encloses no area"));
         }
-        Ok(Contour::new(vertices))
+        Ok(contour)
     }
 }

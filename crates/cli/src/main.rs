@@ -537,7 +537,7 @@ fn checked_route(
     nest: &Nest,
     forest: &ContainmentForest,
 ) -> Result<(Route, Option<String>), String> {
-    let tolerance = 1e-6 * nest_scale(nest);
+    let tolerance = nest.check_tolerance();
     let first_problem = |route: &Route| route.problems(nest, forest, tolerance).into_iter().next();
     let no_route = || match run.stopped {
         Some(why) => format!(
@@ -1163,11 +1163,6 @@ fn route_report(
     }))
 }
 
-fn nest_scale(nest: &Nest) -> f64 {
-    let b = nest.bounding_box();
-    ((b.max.x - b.min.x).abs() + (b.max.y - b.min.y).abs()).max(1.0)
-}
-
 /// `--solver sccp|gsccp|aoe`: the engine's path-route jobs (the app's code path), stepped to
 /// their end. sccp solves the multi-contour chain ensemble alone, gsccp every ensemble,
 /// keeping the best by `--objective`; aoe cuts common edges once along AOE-chains. The
@@ -1283,7 +1278,7 @@ fn solve_path(
         .as_ref()
         .ok_or_else(|| format!("the solver found no route ({})", progress.phase))?;
     // Checked again here, as every route the CLI prints.
-    let tolerance = 1e-6 * nest_scale(nest);
+    let tolerance = nest.check_tolerance();
     let problems = route.problems(nest, tolerance);
     if let Some(other) = problems
         .iter()

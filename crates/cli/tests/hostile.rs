@@ -143,8 +143,7 @@ fn check_result(args: &[&str], input: &Path, stdout: &str) {
                 .unwrap_or_else(|e| panic!("{args:?}: exit 0 with a bad tour: {e}"));
         }
         Problem::Nest { nest, start, .. } => {
-            let b = nest.bounding_box();
-            let tolerance = 1e-6 * ((b.max.x - b.min.x).abs() + (b.max.y - b.min.y).abs()).max(1.0);
+            let tolerance = nest.check_tolerance();
             if report.get("objective").is_some() {
                 let route: PathRoute = serde_json::from_value(report["route"].clone()).unwrap();
                 let problems = route.problems(nest, tolerance);

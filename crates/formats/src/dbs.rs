@@ -24,7 +24,6 @@ use std::collections::{HashMap, HashSet};
 use cutroute_geometry::{Contour, Nest, Part, Point, Vertex};
 
 use crate::contour_check::{self, ContourProblem, DEFAULT_CLOSURE_TOLERANCE};
-use crate::geom;
 
 /// Record type: contour geometry.
 const TYPE_GEOMETRY: i16 = 1;
@@ -897,8 +896,8 @@ pub fn write_dbs_with(nest: &Nest, options: &DbsWriteOptions) -> Result<Vec<u8>,
         put_header(&mut out, 8, TYPE_NAME, part_id);
         out.extend_from_slice(&name);
         put_header(&mut out, 8, TYPE_DIMENSIONS, part_id);
-        let area = (geom::part_area(&as_stored) * 1e-4) as f32 + 0.0;
-        let perimeter = (geom::part_perimeter(&as_stored) * 1e-2) as f32 + 0.0;
+        let area = (as_stored.area() * 1e-4) as f32 + 0.0;
+        let perimeter = (as_stored.perimeter() * 1e-2) as f32 + 0.0;
         if !area.is_finite() || !perimeter.is_finite() {
             return Err(DbsWriteError::DimensionsNotRepresentable { part: index });
         }

@@ -44,7 +44,6 @@
 mod contour_check;
 mod dbs;
 mod detect;
-mod geom;
 mod geometry_json;
 mod html_export;
 mod json;
@@ -77,16 +76,16 @@ pub use task_json::{
     read_task_json, write_task_json, FlatTaskContour, PiercePoint, RmTask, TaskContour, TaskData,
 };
 
-/// Area (mm², outer contour minus holes) of a part, as DBS record 27 stores it (in dm²).
-///
-/// A stop-gap until `cutroute-geometry` provides area maths; then this delegates.
+/// Area (mm², outer contour minus holes) of a part, as DBS record 27 stores it (in dm²):
+/// [`Part::area`](cutroute_geometry::Part::area).
 pub fn part_area(part: &cutroute_geometry::Part) -> f64 {
-    geom::part_area(part)
+    part.area()
 }
 
-/// Perimeter (mm, all contours) of a part, as DBS record 27 stores it (in dm).
+/// Perimeter (mm, all contours) of a part, as DBS record 27 stores it (in dm):
+/// [`Part::perimeter`](cutroute_geometry::Part::perimeter).
 pub fn part_perimeter(part: &cutroute_geometry::Part) -> f64 {
-    geom::part_perimeter(part)
+    part.perimeter()
 }
 
 /// Renders a nest with a route over it (convenience over [`route_moves`] + [`nest_svg`]).

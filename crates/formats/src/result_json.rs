@@ -11,11 +11,12 @@
 //! Chain cutting's tool-on links (see [`cutroute_geometry::Entry::Link`]) are written as `cut`
 //! moves without a `part.id` (the torch is on, no contour is being cut) and read back as links.
 
-use cutroute_geometry::{ContourRef, CutStep, Entry, Nest, Part, Point, Route};
+use cutroute_geometry::{
+    opened_at, Contour, ContourRef, CutStep, Entry, Nest, Part, Point, Route, Span, Vertex,
+};
 use serde::{Deserialize, Serialize};
 
 use crate::contour_check::{self, DEFAULT_CLOSURE_TOLERANCE};
-use crate::geom;
 use crate::json::{self, JsonError, JsonWriteError};
 
 /// A cutting result.
@@ -217,10 +218,48 @@ pub fn write_result_json(result: &RmResult) -> Result<String, JsonWriteError> {
     json::to_pretty(result)
 }
 
-fn stored_degrees(contour: &cutroute_geometry::Contour) -> Vec<[f64; 3]> {
+/// Arc angle in degrees (signed, CCW positive) of a span with bulge `b`: how result JSON stores
+/// a bulge.
+fn bulge_to_degrees(b: f64) -> f64 {
+    4.0 * b.atan().to_degrees()
+}
+
+/// Bulge of a span whose swept angle is `deg` degrees (result JSON's angle read back).
+fn degrees_to_bulge(deg: f64) -> f64 {
+    (deg.to_radians() / 4.0).tan()
+}
+
+/// The vertices of the full cut of `contour` from the point nearest to `pierce` round to it
+/// again, as the tool path lists them: the first vertex is the pierce point and the list
+/// repeats it at the end with bulge 0. Pieces without length (a pierce point on a vertex, a
+/// repeated vertex) are left out. `None` for a contour without vertices.
+fn cut_from(contour: &Contour, pierce: Point) -> Option<Vec<Vertex>> {
+    let start = contour.nearest_point(pierce)?.point;
+    let mut out: Vec<Vertex> = opened_at(contour, pierce, 0.0)
+        .into_iter()
+        .map(|s| Vertex {
+            point: s.start,
+            bulge: s.bulge,
+        })
+        .collect();
+    if out.is_empty() {
+        // Every span has zero length: the cut is the pierce point alone.
+        out.push(Vertex {
+            point: start,
+            bulge: 0.0,
+        });
+    }
+    out.push(Vertex {
+        point: start,
+        bulge: 0.0,
+    });
+    Some(out)
+}
+
+fn stored_degrees(contour: &Contour) -> Vec<[f64; 3]> {
     contour_check::stored_points(contour)
         .into_iter()
-        .map(|[x, y, b]| [x, y, geom::bulge_to_degrees(b)])
+        .map(|[x, y, b]| [x, y, bulge_to_degrees(b)])
         .collect()
 }
 
@@ -285,11 +324,7 @@ fn link_pieces(from: Point, corners: &[Point], to: Point) -> Vec<(Point, Point)>
     points.windows(2).map(|w| (w[0], w[1])).collect()
 }
 
-fn cut_vertices(
-    nest: &Nest,
-    step: usize,
-    cut: &CutStep,
-) -> Result<Vec<cutroute_geometry::Vertex>, RouteError> {
+fn cut_vertices(nest: &Nest, step: usize, cut: &CutStep) -> Result<Vec<Vertex>, RouteError> {
     let ContourRef { part, contour } = cut.contour;
     let c = nest
         .parts
@@ -300,7 +335,7 @@ fn cut_vertices(
             part,
             contour,
         })?;
-    geom::cut_from(c, cut.pierce_point).ok_or(RouteError::EmptyContour { step })
+    cut_from(c, cut.pierce_point).ok_or(RouteError::EmptyContour { step })
 }
 
 impl RmResult {
@@ -348,19 +383,19 @@ impl RmResult {
         for (step, cut) in route.steps.iter().enumerate() {
             let vertices = cut_vertices(nest, step, cut)?;
             match &cut.entry {
-                Entry::Pierce => idle += geom::dist(at, vertices[0].point),
+                Entry::Pierce => idle += at.distance(vertices[0].point),
                 Entry::Link(corners) => {
                     for (from, to) in link_pieces(at, corners, vertices[0].point) {
-                        cut_len += geom::dist(from, to);
+                        cut_len += from.distance(to);
                     }
                 }
             }
             for w in vertices.windows(2) {
-                cut_len += geom::span(w[0].point, w[1].point, w[0].bulge).length();
+                cut_len += Span::new(w[0].point, w[1].point, w[0].bulge).length();
                 push(
                     MoveKind::Cut,
                     w[0].point,
-                    geom::bulge_to_degrees(w[0].bulge),
+                    bulge_to_degrees(w[0].bulge),
                     Some(cut.contour),
                 );
             }
@@ -377,7 +412,7 @@ impl RmResult {
             }
         }
         if let Some(finish) = route.finish {
-            idle += geom::dist(at, finish);
+            idle += at.distance(finish);
             push(MoveKind::Air, finish, 0.0, None);
         }
         Ok(RmResult {
@@ -420,7 +455,7 @@ impl RmResult {
                     kind: w[0].mode,
                     from: Point::new(x, y),
                     to: Point::new(w[1].point[0], w[1].point[1]),
-                    bulge: geom::degrees_to_bulge(angle),
+                    bulge: degrees_to_bulge(angle),
                     contour,
                 }
             })
@@ -433,7 +468,7 @@ impl RmResult {
         let closed = |points: &[[f64; 3]], path: String| {
             let pts: Vec<[f64; 3]> = points
                 .iter()
-                .map(|&[x, y, a]| [x, y, geom::degrees_to_bulge(a)])
+                .map(|&[x, y, a]| [x, y, degrees_to_bulge(a)])
                 .collect();
             contour_check::closed_contour(&pts, DEFAULT_CLOSURE_TOLERANCE, false)
                 .map_err(|problem| JsonError::BadContour { path, problem })
@@ -551,4 +586,64 @@ fn bounding_rectangle(nest: &Nest) -> Vec<[f64; 3]> {
         [b[2], b[1], 0.0],
         [b[0], b[1], 0.0],
     ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn circle(r: f64, bulge: f64) -> Contour {
+        Contour::new(vec![
+            Vertex::arc(0.0, r, bulge),
+            Vertex::arc(0.0, -r, bulge),
+        ])
+    }
+
+    #[test]
+    fn angle_conversion_round_trips() {
+        assert!((bulge_to_degrees(1.0) - 180.0).abs() < 1e-12);
+        assert!((degrees_to_bulge(90.0) - (2f64.sqrt() - 1.0)).abs() < 1e-12);
+        assert!((degrees_to_bulge(bulge_to_degrees(-0.3)) + 0.3).abs() < 1e-12);
+    }
+
+    fn cut_length(cut: &[Vertex]) -> f64 {
+        cut.windows(2)
+            .map(|w| Span::new(w[0].point, w[1].point, w[0].bulge).length())
+            .sum()
+    }
+
+    #[test]
+    fn cut_from_mid_arc_keeps_the_length() {
+        let c = circle(5.0, -1.0);
+        let pierce = Point::new(5.0, 0.0);
+        let cut = cut_from(&c, pierce).unwrap();
+        assert_eq!(cut.first().unwrap().point, cut.last().unwrap().point);
+        assert!(cut[0].point.distance(pierce) < 1e-9);
+        assert_eq!(cut.len(), 4);
+        assert!((cut_length(&cut) - c.perimeter()).abs() < 1e-9);
+    }
+
+    #[test]
+    fn cut_from_a_vertex_adds_no_sliver() {
+        let square = Contour::new(vec![
+            Vertex::line(0.0, 0.0),
+            Vertex::line(0.0, 10.0),
+            Vertex::line(10.0, 10.0),
+            Vertex::line(10.0, 0.0),
+        ]);
+        let cut = cut_from(&square, Point::new(10.0, 10.0)).unwrap();
+        let points: Vec<Point> = cut.iter().map(|v| v.point).collect();
+        assert_eq!(
+            points,
+            [
+                (10.0, 10.0),
+                (10.0, 0.0),
+                (0.0, 0.0),
+                (0.0, 10.0),
+                (10.0, 10.0)
+            ]
+            .map(|(x, y)| Point::new(x, y))
+        );
+        assert!((cut_length(&cut) - 40.0).abs() < 1e-12);
+    }
 }

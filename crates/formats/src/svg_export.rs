@@ -7,12 +7,11 @@
 //! `cut`, `link` (chain cutting's tool-on links between contours), `lead` (lead-in/out),
 //! `pierce`, `start`, `finish`.
 
-use cutroute_geometry::{Contour, Nest, Part, Point};
+use cutroute_geometry::{Contour, Nest, Part, Point, Span};
 use svg::node::element::path::Data;
 use svg::node::element::{Circle, Group, Path, Style, Title};
 use svg::Document;
 
-use crate::geom;
 use crate::result_json::{MoveKind, ToolMove};
 
 /// The default theme embedded when [`SvgOptions::embed_style`] is on.
@@ -125,15 +124,19 @@ fn span_data(data: Data, a: Point, z: Point, b: f64) -> Data {
     }
     if b.abs() >= 1.0 {
         // ≥ 180°: halve at the zenith so each piece is below 180° and needs no large-arc flag.
-        let m = geom::span(a, z, b).midpoint();
-        let h = geom::half_bulge(b);
-        return arc(arc(data, a, m, h), m, z, h);
+        let (first, second) = Span::new(a, z, b).halved();
+        return arc(
+            arc(data, a, first.end, first.bulge),
+            first.end,
+            z,
+            second.bulge,
+        );
     }
     arc(data, a, z, b)
 }
 
 fn arc(data: Data, a: Point, z: Point, b: f64) -> Data {
-    let r = geom::span(a, z, b).radius();
+    let r = Span::new(a, z, b).radius();
     // Inside the y-flipped group a counter-clockwise arc (b > 0) has sweep flag 1.
     let sweep = if b > 0.0 { 1 } else { 0 };
     data.elliptical_arc_to((r, r, 0, 0, sweep, z.x, z.y))

@@ -673,6 +673,21 @@ fn arc_pieces(s: &Span, tolerance: f64) -> usize {
 }
 
 impl Part {
+    /// Material area (mm²): the outer contour's enclosed area minus each hole's, whatever
+    /// their stored orientation (real files store holes clockwise too). The contours after the
+    /// first are taken as holes of it, as the model defines a part; 0 for a part without
+    /// contours.
+    pub fn area(&self) -> f64 {
+        let mut contours = self.contours.iter();
+        let outer = contours.next().map_or(0.0, Contour::area);
+        outer - contours.map(Contour::area).sum::<f64>()
+    }
+
+    /// Total cut length (mm): the sum of every contour's perimeter.
+    pub fn perimeter(&self) -> f64 {
+        self.contours.iter().map(Contour::perimeter).sum()
+    }
+
     /// Bounding box of the part (its outer contour's, plus any stray hole).
     pub fn bounding_box(&self) -> BoundingBox {
         self.contours

@@ -390,6 +390,18 @@ impl Span {
         (first, second)
     }
 
+    /// The two halves `start → midpoint()` and `midpoint() → end`, each with bulge
+    /// `β / (1 + √(1 + β²))` = `tan(φ/8)` (Appendix Б): [`split_at`](Self::split_at)`(0.5)`
+    /// without trigonometry. Halves of an arc of 180° or more are below 180° each, so they can
+    /// be written where an arc must be less than a half turn (an SVG `A` without the large-arc
+    /// flag).
+    pub fn halved(&self) -> (Span, Span) {
+        let b = self.bulge;
+        let half = b / (1.0 + (1.0 + b * b).sqrt());
+        let m = self.midpoint();
+        (Span::new(self.start, m, half), Span::new(m, self.end, half))
+    }
+
     /// The sub-span between arc-length fractions `t0` and `t1` (`t0 ≤ t1` not required: a
     /// reversed range gives the reversed piece).
     pub fn sub_span(&self, t0: f64, t1: f64) -> Span {

@@ -99,6 +99,18 @@ impl Transform {
         self.determinant() < 0.0
     }
 
+    /// True when the map keeps circles circles (a rotation, reflection or uniform scale, with
+    /// any translation): the matrix's columns are orthogonal and of equal length, within 10⁻⁹
+    /// of their squared length. A singular map is not a similarity.
+    pub fn is_similarity(&self) -> bool {
+        let m = &self.matrix;
+        let col1 = m[0][0] * m[0][0] + m[1][0] * m[1][0];
+        let col2 = m[0][1] * m[0][1] + m[1][1] * m[1][1];
+        let dot = m[0][0] * m[0][1] + m[1][0] * m[1][1];
+        let scale = col1.max(col2);
+        scale > 0.0 && (col1 - col2).abs() <= 1e-9 * scale && dot.abs() <= 1e-9 * scale
+    }
+
     /// The image of a point.
     pub fn apply(&self, p: Point) -> Point {
         self.apply_vector(p) + self.offset

@@ -3,7 +3,7 @@
 use std::f64::consts::PI;
 
 use cutroute_geometry::{
-    ClosureError, Contour, ContourError, ContourPosition, Point, Transform, Vertex,
+    ClosureError, Contour, ContourError, ContourPosition, Part, Point, Transform, Vertex,
 };
 
 fn p(x: f64, y: f64) -> Point {
@@ -398,4 +398,22 @@ fn closed_vertices_lose_repeats() {
         Contour::from_closed_vertices(&[Vertex::line(1.0, 1.0), Vertex::line(1.0, 1.0)], 0.0),
         Err(ClosureError::TooFewPoints { count: 1 })
     ));
+}
+
+#[test]
+fn part_area_subtracts_holes_in_either_orientation() {
+    let circle = |r: f64, bulge: f64| {
+        Contour::new(vec![
+            Vertex::arc(0.0, r, bulge),
+            Vertex::arc(0.0, -r, bulge),
+        ])
+    };
+    let ring = |hole_bulge| Part {
+        name: "R".into(),
+        contours: vec![circle(2.0, -1.0), circle(1.0, hole_bulge)],
+    };
+    let expected = PI * 3.0;
+    assert!((ring(1.0).area() - expected).abs() < 1e-9);
+    assert!((ring(-1.0).area() - expected).abs() < 1e-9);
+    assert!((ring(1.0).perimeter() - 6.0 * PI).abs() < 1e-9);
 }

@@ -2,7 +2,7 @@
 
 use proptest::prelude::*;
 
-use cutroute_geometry::{Contour, Point, Span, Transform, Vertex};
+use cutroute_geometry::{Contour, Part, Point, Span, Transform, Vertex};
 
 fn point() -> impl Strategy<Value = Point> {
     (-100.0..100.0f64, -100.0..100.0f64).prop_map(|(x, y)| Point::new(x, y))
@@ -179,6 +179,23 @@ proptest! {
     }
 
     #[test]
+    fn halves_are_the_split_at_the_middle(s in span()) {
+        let (a, b) = s.halved();
+        let (x, y) = s.split_at(0.5);
+        let scale = s.length().max(1.0);
+        prop_assert_eq!(a.start, s.start);
+        prop_assert_eq!(b.end, s.end);
+        prop_assert_eq!(a.end, b.start);
+        prop_assert!(a.end.distance(x.end) < 1e-9 * scale);
+        prop_assert!((a.bulge - x.bulge).abs() <= 1e-12 * (1.0 + x.bulge.abs()));
+        prop_assert!((b.bulge - y.bulge).abs() <= 1e-12 * (1.0 + y.bulge.abs()));
+        prop_assert!((a.length() - 0.5 * s.length()).abs() < 1e-9 * scale);
+        prop_assert!((b.length() - 0.5 * s.length()).abs() < 1e-9 * scale);
+        // Each half turns less than half a circle, whatever the span turns.
+        prop_assert!(a.bulge.abs() < 1.0 && b.bulge.abs() < 1.0);
+    }
+
+    #[test]
     fn arc_through_its_own_point(s in span(), t in 0.05..0.95f64) {
         let via = s.point_at(t);
         if let Some(r) = Span::through_points(s.start, via, s.end) {
@@ -250,6 +267,26 @@ proptest! {
     }
 
     #[test]
+    fn part_area_is_material_whatever_the_hole_orientation(c in contour(), hole_reversed: bool) {
+        // The outer contour twice the size of the hole; both star-shaped about the origin.
+        let outer = c.transformed(&Transform::scaling(2.0));
+        let hole = if hole_reversed { c.reversed() } else { c.clone() };
+        let part = Part { name: "P".into(), contours: vec![outer.clone(), hole.clone()] };
+        let (outer_poly, hole_poly) = (dense(&outer, 800), dense(&hole, 800));
+        let material = shoelace(&outer_poly).abs() - shoelace(&hole_poly).abs();
+        let tolerance = 1e-3 * outer.perimeter() * outer.perimeter() / 800.0;
+        prop_assert!((part.area() - material).abs() <= tolerance, "{} vs {}", part.area(), material);
+        let mut cut = 0.0;
+        for poly in [outer_poly, hole_poly] {
+            let mut closed = poly.clone();
+            closed.push(poly[0]);
+            cut += polyline_length(&closed);
+        }
+        prop_assert!((part.perimeter() - cut).abs() <= 1e-5 * cut);
+        prop_assert_eq!(Part::default().area(), 0.0);
+    }
+
+    #[test]
     fn point_in_contour_matches_dense_winding(c in contour(), q in (-60.0..60.0f64, -60.0..60.0f64)) {
         let q = Point::new(q.0, q.1);
         prop_assume!(c.distance_to(q) > 1e-2);
@@ -281,6 +318,31 @@ proptest! {
         for p in dense(&r, 5) {
             prop_assert!(c.distance_to(p) < 1e-9);
         }
+    }
+
+    #[test]
+    fn similarities_are_recognised(
+        angle in -7.0..7.0f64, scale in 0.01..100.0f64, mirror: bool, dx in -1e3..1e3f64,
+        stretch in 1.001..10.0f64, c in contour(),
+    ) {
+        let mut t = Transform::rotation(angle).then(&Transform::scaling(scale));
+        if mirror { t = t.then(&Transform::mirror_x()); }
+        let t = t.then(&Transform::translation(dx, -dx));
+        prop_assert!(t.is_similarity());
+        // A similarity maps an arc onto the arc of the mapped ends and bulge: the image of the
+        // span's midpoint is the mapped span's midpoint.
+        for s in c.spans() {
+            let image = s.transformed(&t);
+            let expected = t.apply(s.point_at(0.5));
+            prop_assert!(image.point_at(0.5).distance(expected) < 1e-9 * scale * 100.0);
+        }
+        let uneven = Transform { matrix: [[stretch, 0.0], [0.0, 1.0]], offset: Point::ORIGIN };
+        prop_assert!(!uneven.then(&t).is_similarity());
+        prop_assert!(!t.then(&uneven).is_similarity());
+        let sheared = Transform { matrix: [[1.0, stretch - 1.0], [0.0, 1.0]], offset: Point::ORIGIN };
+        prop_assert!(!sheared.then(&t).is_similarity());
+        let singular = Transform { matrix: [[0.0; 2]; 2], offset: Point::ORIGIN };
+        prop_assert!(!singular.is_similarity());
     }
 
     #[test]

@@ -246,3 +246,12 @@ fn every_point_of_an_arc_maps_to_its_own_parameter_even_at_the_ends() {
         }
     }
 }
+
+#[test]
+fn half_bulges_recombine() {
+    let b = 0.7;
+    let (first, second) = Span::new(p(0.0, 0.0), p(3.0, 1.0), b).halved();
+    for h in [first.bulge, second.bulge] {
+        assert!((2.0 * h / (1.0 - h * h) - b).abs() < 1e-12);
+    }
+}

@@ -2,13 +2,14 @@
 
 use std::collections::HashMap;
 
-use cutroute_geometry::Point;
+use cutroute_geometry::{Point, Span, Transform};
 
 use super::groups::{decode_text, Codepage, Group};
 use super::{DxfError, DxfOptions, DxfWarning};
-use crate::assemble::{Piece, SourceRef};
-use crate::curves::{approximate, approximate_elliptic, ApproxFailure, EllipticArc, Nurbs};
-use crate::shape::{dist, Span};
+use crate::assemble::{is_bounded, Piece, SourceRef};
+use crate::curves::{
+    approximate, approximate_elliptic, ApproxFailure, EllipticArc, Nurbs, STRAIGHT_BULGE,
+};
 
 /// Deepest chain of blocks inserting blocks; real drawings use 3–5 levels.
 const MAX_BLOCK_DEPTH: usize = 16;
@@ -101,7 +102,7 @@ impl<'a> Record<'a> {
     /// The object coordinate system of 2D entities, as a map into world coordinates: identity
     /// for the usual +Z extrusion, a mirror for −Z (mirrored geometry in many CAD exports),
     /// `None` for a tilted plane, which has no faithful flat image.
-    fn ocs(&self) -> Result<Option<Affine>, DxfError> {
+    fn ocs(&self) -> Result<Option<Transform>, DxfError> {
         let nx = self.real_or(210, 0.0)?;
         let ny = self.real_or(220, 0.0)?;
         let nz = self.real_or(230, 1.0)?;
@@ -110,105 +111,30 @@ impl<'a> Record<'a> {
             return Ok(None);
         }
         Ok(Some(if nz > 0.0 {
-            Affine::IDENTITY
+            Transform::IDENTITY
         } else {
-            Affine::MIRROR_X
+            // The arbitrary-axis algorithm's OCS for extrusion (0, 0, −1): x ↦ −x.
+            Transform::mirror_y()
         }))
     }
 }
 
-/// A 2D affine map `p ↦ L·p + t` with `L = [[a, b], [c, d]]`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct Affine {
-    a: f64,
-    b: f64,
-    c: f64,
-    d: f64,
-    tx: f64,
-    ty: f64,
-}
-
-impl Affine {
-    const IDENTITY: Self = Self {
-        a: 1.0,
-        b: 0.0,
-        c: 0.0,
-        d: 1.0,
-        tx: 0.0,
-        ty: 0.0,
-    };
-    /// The arbitrary-axis algorithm's OCS for extrusion (0, 0, −1): x ↦ −x.
-    const MIRROR_X: Self = Self {
-        a: -1.0,
-        b: 0.0,
-        c: 0.0,
-        d: 1.0,
-        tx: 0.0,
-        ty: 0.0,
-    };
-
-    fn apply(&self, p: Point) -> Point {
-        Point::new(
-            self.a * p.x + self.b * p.y + self.tx,
-            self.c * p.x + self.d * p.y + self.ty,
-        )
-    }
-
-    fn apply_vector(&self, v: Point) -> Point {
-        Point::new(self.a * v.x + self.b * v.y, self.c * v.x + self.d * v.y)
-    }
-
-    /// `self ∘ inner`: first `inner`, then `self`.
-    fn then_after(&self, inner: &Affine) -> Affine {
-        Affine {
-            a: self.a * inner.a + self.b * inner.c,
-            b: self.a * inner.b + self.b * inner.d,
-            c: self.c * inner.a + self.d * inner.c,
-            d: self.c * inner.b + self.d * inner.d,
-            tx: self.a * inner.tx + self.b * inner.ty + self.tx,
-            ty: self.c * inner.tx + self.d * inner.ty + self.ty,
-        }
-    }
-
-    /// Whether scales stay within 1e6 and offsets within 1e12 mm: with input coordinates
-    /// bounded by 1e9, every transformed point is then finite with room to spare, so nested
-    /// inserts cannot overflow to infinity or NaN.
-    fn is_bounded(&self) -> bool {
-        [self.a, self.b, self.c, self.d]
-            .iter()
-            .all(|v| v.abs() <= 1e6)
-            && self.tx.abs() <= 1e12
-            && self.ty.abs() <= 1e12
-    }
-
-    fn determinant(&self) -> f64 {
-        self.a * self.d - self.b * self.c
-    }
-
-    /// Whether circles stay circles (rotation, uniform scale, mirror).
-    fn is_similarity(&self) -> bool {
-        let col1 = self.a * self.a + self.c * self.c;
-        let col2 = self.b * self.b + self.d * self.d;
-        let dot = self.a * self.b + self.c * self.d;
-        let scale = col1.max(col2);
-        scale > 0.0 && (col1 - col2).abs() <= 1e-9 * scale && dot.abs() <= 1e-9 * scale
-    }
-
-    /// Insert placement: `p ↦ at + R(rotation)·(S·(p − base) + offset)`.
-    fn placement(at: Point, scale: Point, rotation_deg: f64, base: Point, offset: Point) -> Self {
-        let (s, c) = rotation_deg.to_radians().sin_cos();
-        let (sx, sy) = (scale.x, scale.y);
-        // Local: q = (sx·(x − bx) + ox, sy·(y − by) + oy); world = at + R·q.
-        let qx_t = -sx * base.x + offset.x;
-        let qy_t = -sy * base.y + offset.y;
-        Affine {
-            a: c * sx,
-            b: -s * sy,
-            c: s * sx,
-            d: c * sy,
-            tx: at.x + c * qx_t - s * qy_t,
-            ty: at.y + s * qx_t + c * qy_t,
-        }
+/// The placement of a block insert: `p ↦ at + R(rotation)·(S·(p − base) + offset)`.
+fn insert_placement(
+    at: Point,
+    scale: Point,
+    rotation_deg: f64,
+    base: Point,
+    offset: Point,
+) -> Transform {
+    let (s, c) = rotation_deg.to_radians().sin_cos();
+    let (sx, sy) = (scale.x, scale.y);
+    // Local: q = (sx·(x − bx) + ox, sy·(y − by) + oy); world = at + R·q.
+    let qx_t = -sx * base.x + offset.x;
+    let qy_t = -sy * base.y + offset.y;
+    Transform {
+        matrix: [[c * sx, -s * sy], [s * sx, c * sy]],
+        offset: Point::new(at.x + c * qx_t - s * qy_t, at.y + s * qx_t + c * qy_t),
     }
 }
 
@@ -288,14 +214,7 @@ pub(crate) fn collect_pieces(
         warnings: std::mem::take(warnings),
         unknown: HashMap::new(),
     };
-    let world = Affine {
-        a: unit_scale,
-        b: 0.0,
-        c: 0.0,
-        d: unit_scale,
-        tx: 0.0,
-        ty: 0.0,
-    };
+    let world = Transform::scaling(unit_scale);
     for record in &entities {
         if record.in_paper_space()? {
             continue;
@@ -491,7 +410,7 @@ impl Expander<'_, '_> {
     fn entity(
         &mut self,
         record: &Record<'_>,
-        to_world: &Affine,
+        to_world: &Transform,
         depth: usize,
         inherited_layer: &str,
     ) -> Result<(), DxfError> {
@@ -509,7 +428,7 @@ impl Expander<'_, '_> {
             "LINE" => {
                 let a = record.point(10, "start point")?;
                 let b = record.point(11, "end point")?;
-                if dist(a, b) == 0.0 {
+                if a == b {
                     self.warn(record.line, "zero-length LINE skipped");
                     return Ok(());
                 }
@@ -545,7 +464,7 @@ impl Expander<'_, '_> {
                     t0,
                     t1,
                 };
-                self.elliptic(arc, closed, &to_world.then_after(&ocs), source)
+                self.elliptic(arc, closed, &ocs.then(to_world), source)
             }
             "ELLIPSE" => {
                 let center = record.point(10, "centre")?;
@@ -599,13 +518,7 @@ impl Expander<'_, '_> {
                         _ => {}
                     }
                 }
-                self.polyline(
-                    record,
-                    &vertices,
-                    closed,
-                    &to_world.then_after(&ocs),
-                    source,
-                )
+                self.polyline(record, &vertices, closed, &ocs.then(to_world), source)
             }
             "POLYLINE" => {
                 let flags = record.int_or(70, 0)?;
@@ -615,7 +528,7 @@ impl Expander<'_, '_> {
                 }
                 let is_3d = flags & 8 != 0;
                 let ocs = if is_3d {
-                    Some(Affine::IDENTITY)
+                    Some(Transform::IDENTITY)
                 } else {
                     record.ocs()?
                 };
@@ -637,7 +550,7 @@ impl Expander<'_, '_> {
                     record,
                     &vertices,
                     flags & 1 == 1,
-                    &to_world.then_after(&ocs),
+                    &ocs.then(to_world),
                     source,
                 )
             }
@@ -655,7 +568,7 @@ impl Expander<'_, '_> {
         record: &Record<'_>,
         vertices: &[(Point, f64)],
         closed: bool,
-        to_world: &Affine,
+        to_world: &Transform,
         source: SourceRef,
     ) -> Result<(), DxfError> {
         let mut spans = Vec::with_capacity(vertices.len());
@@ -664,12 +577,8 @@ impl Expander<'_, '_> {
         for i in 0..count {
             let (a, bulge) = vertices[i];
             let (b, _) = vertices[(i + 1) % n];
-            if dist(a, b) > 0.0 {
-                spans.push(Span {
-                    start: a,
-                    end: b,
-                    bulge,
-                });
+            if a != b {
+                spans.push(Span::new(a, b, bulge));
             }
         }
         if spans.is_empty() {
@@ -687,30 +596,31 @@ impl Expander<'_, '_> {
         &mut self,
         spans: Vec<Span>,
         closed: bool,
-        to_world: &Affine,
+        to_world: &Transform,
         source: SourceRef,
     ) -> Result<(), DxfError> {
         let mut out = Vec::with_capacity(spans.len());
         let similar = to_world.is_similarity();
-        let flip = to_world.determinant() < 0.0;
+        let flip = to_world.is_reflection();
         for s in spans {
             let start = to_world.apply(s.start);
             let end = to_world.apply(s.end);
             if s.bulge == 0.0 || similar {
-                out.push(Span {
-                    start,
-                    end,
-                    bulge: if flip { -s.bulge } else { s.bulge },
-                });
-            } else if let Some((center, radius)) = s.arc_center() {
-                // An unevenly scaled arc is an elliptic arc: approximate it.
+                out.push(Span::new(start, end, if flip { -s.bulge } else { s.bulge }));
+            } else if let Some(center) = s
+                .centre()
+                .filter(|_| s.bulge.abs() >= STRAIGHT_BULGE && s.chord_length() >= 1e-15)
+            {
+                // An unevenly scaled arc is an elliptic arc: approximate it. A nearly straight
+                // or vanishing one stays a line: its centre would be meaningless.
+                let radius = s.radius();
                 let t0 = (s.start.y - center.y).atan2(s.start.x - center.x);
                 let arc = EllipticArc {
                     center,
                     u: Point::new(radius, 0.0),
                     v: Point::new(0.0, radius),
                     t0,
-                    t1: t0 + 4.0 * s.bulge.atan(),
+                    t1: t0 + s.sweep(),
                 };
                 out.extend(self.approximate_elliptic(&arc, to_world)?);
             } else {
@@ -724,7 +634,7 @@ impl Expander<'_, '_> {
         &mut self,
         arc: EllipticArc,
         closed: bool,
-        to_world: &Affine,
+        to_world: &Transform,
         source: SourceRef,
     ) -> Result<(), DxfError> {
         let world = EllipticArc {
@@ -744,7 +654,7 @@ impl Expander<'_, '_> {
     fn approximate_elliptic(
         &mut self,
         arc: &EllipticArc,
-        to_world: &Affine,
+        to_world: &Transform,
     ) -> Result<Vec<Span>, DxfError> {
         let world = EllipticArc {
             center: to_world.apply(arc.center),
@@ -766,7 +676,7 @@ impl Expander<'_, '_> {
     fn spline(
         &mut self,
         record: &Record<'_>,
-        to_world: &Affine,
+        to_world: &Transform,
         source: SourceRef,
     ) -> Result<(), DxfError> {
         let flags = record.int_or(70, 0)?;
@@ -817,7 +727,7 @@ impl Expander<'_, '_> {
             );
             let spans: Vec<Span> = fit
                 .windows(2)
-                .filter(|w| dist(w[0], w[1]) > 0.0)
+                .filter(|w| w[0] != w[1])
                 .map(|w| Span::line(w[0], w[1]))
                 .collect();
             return self.path(spans, flags & 1 == 1, to_world, source);
@@ -837,10 +747,7 @@ impl Expander<'_, '_> {
         .map_err(|ApproxFailure::BudgetExceeded| DxfError::TooComplex {
             limit: self.options.max_spans,
         })?;
-        let spans: Vec<Span> = spans
-            .into_iter()
-            .filter(|s| dist(s.start, s.end) > 0.0)
-            .collect();
+        let spans: Vec<Span> = spans.into_iter().filter(|s| s.start != s.end).collect();
         if spans.is_empty() {
             self.warn(record.line, "SPLINE without extent skipped");
             return Ok(());
@@ -852,7 +759,7 @@ impl Expander<'_, '_> {
     fn insert(
         &mut self,
         record: &Record<'_>,
-        to_world: &Affine,
+        to_world: &Transform,
         depth: usize,
         layer: &str,
     ) -> Result<(), DxfError> {
@@ -909,9 +816,9 @@ impl Expander<'_, '_> {
                     });
                 }
                 let offset = Point::new(column as f64 * column_spacing, row as f64 * row_spacing);
-                let local = Affine::placement(at, scale, rotation, base, offset);
-                let inner = to_world.then_after(&ocs.then_after(&local));
-                if !inner.is_bounded() {
+                let local = insert_placement(at, scale, rotation, base, offset);
+                let inner = local.then(&ocs).then(to_world);
+                if !is_bounded(&inner) {
                     return Err(record
                         .invalid("nested insert scales and offsets grow beyond 1e6× / 1e12 mm"));
                 }
@@ -956,7 +863,7 @@ mod tests {
 
     #[test]
     fn placement_rotates_scales_and_moves() {
-        let m = Affine::placement(
+        let m = insert_placement(
             Point::new(10.0, 0.0),
             Point::new(2.0, 2.0),
             90.0,
@@ -966,7 +873,7 @@ mod tests {
         let p = m.apply(Point::new(2.0, 0.0));
         assert!((p.x - 10.0).abs() < 1e-12 && (p.y - 2.0).abs() < 1e-12);
         assert!(m.is_similarity());
-        let uneven = Affine::placement(
+        let uneven = insert_placement(
             Point::new(0.0, 0.0),
             Point::new(1.0, 3.0),
             0.0,
@@ -974,6 +881,6 @@ mod tests {
             Point::new(0.0, 0.0),
         );
         assert!(!uneven.is_similarity());
-        assert!(Affine::MIRROR_X.determinant() < 0.0);
+        assert!(Transform::mirror_y().determinant() < 0.0);
     }
 }
