@@ -183,6 +183,30 @@ test('a worker that dies during a job is restarted with a message; the best rout
   await context.close();
 });
 
+test('a panic in the worker (a wasm trap) restarts it the same way', async () => {
+  const { page, errors, context } = await freshPage();
+  await page.selectOption('#sample', 'seven.dbs');
+  await fileShown(page, 'seven');
+  await start(page, 'ccp', 30);
+  await page.waitForFunction(() => document.querySelector('#upper-bound')?.textContent !== '—', null, { timeout: 30000 });
+  const [worker] = page.workers();
+  // Bytes gloo-worker cannot decode: its registrar panics in Rust (`expect`), which traps the
+  // wasm; the trap leaves the worker's message handler as an uncaught RuntimeError.
+  await worker.evaluate(() => {
+    setTimeout(() => self.onmessage(new MessageEvent('message', { data: new Uint8Array([9, 9, 9, 9, 9]) })), 0);
+  });
+  await page.locator('#worker-notice').waitFor({ timeout: 10000 });
+  assert.match(await page.textContent('#worker-notice'),
+    /^The solver stopped unexpectedly \(.*(unreachable|RuntimeError).*\) and was restarted; the best route received before is kept/);
+  assert.equal(await page.textContent('#job-status'), 'failed: the solver stopped unexpectedly');
+  assert.notEqual(await page.textContent('#upper-bound'), '—');
+  await start(page, 'nearest', 1);
+  await status(page, /^finished$/);
+  // The worker's own report of its panic (its console) is expected; nothing else.
+  assert.deepEqual(errors.filter((e) => !/panicked|unreachable|deserialize|RuntimeError/.test(e)), []);
+  await context.close();
+});
+
 test('a worker that stops answering is restarted after the silence limit', async () => {
   const { page, errors, context } = await freshPage();
   await start(page, 'ccp', 120);
