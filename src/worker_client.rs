@@ -45,11 +45,12 @@ enum WireToWorker<'a> {
     Destroy,
 }
 
-/// gloo-worker 0.6's message from a worker (`gloo_worker::actor::messages::FromWorker`).
+/// gloo-worker 0.6's message from a worker (`gloo_worker::actor::messages::FromWorker`). A box
+/// decodes as its content does.
 #[derive(Deserialize)]
 enum WireFromWorker {
     WorkerLoaded,
-    ProcessOutput(usize, FromWorker),
+    ProcessOutput(usize, Box<FromWorker>),
 }
 
 /// The one handler id this page uses on each worker.
@@ -139,7 +140,7 @@ impl Shared {
             Ok(WireFromWorker::ProcessOutput(handler, message)) => {
                 if handler == HANDLER {
                     self.answered(&message);
-                    (self.on_message)(message);
+                    (self.on_message)(*message);
                 }
             }
             Err(error) => self.die(format!("it sent a message the page cannot read ({error})")),
