@@ -207,6 +207,27 @@ test('a panic in the worker (a wasm trap) restarts it the same way', async () =>
   await context.close();
 });
 
+test('a worker that dies while opening a file: the open fails naming the file, the document stays', async () => {
+  const { page, errors, context } = await freshPage();
+  const [worker] = page.workers();
+  // The next message never reaches gloo's handler: the worker's `onmessage` is replaced by one
+  // that throws, so the open dies unanswered.
+  await worker.evaluate(() => {
+    self.onmessage = () => { throw new Error('died opening'); };
+  });
+  await page.setInputFiles('#file-input', nest('dbs/nested.dbs'));
+  await page.locator('.error[role=alert]').waitFor({ timeout: 10000 });
+  assert.match(await alertText(page),
+    /^nested\.dbs: the solver stopped unexpectedly while opening this \(.*died opening.*\); it was restarted and the document shown before is still open$/);
+  assert.match(await page.textContent('#worker-notice'), /^The solver stopped unexpectedly \(.*died opening.*\) and was restarted; nothing was lost\.$/);
+  assert.match(await page.textContent('#file-name'), /^E1X_6_01/, 'the document shown before stays');
+  // The fresh worker opens the same file.
+  await page.setInputFiles('#file-input', nest('dbs/nested.dbs'));
+  await fileShown(page, 'nested.dbs (DBS binary)');
+  assert.deepEqual(errors.filter((e) => !/died opening/.test(e)), []);
+  await context.close();
+});
+
 test('a worker that stops answering is restarted after the silence limit', async () => {
   const { page, errors, context } = await freshPage();
   await start(page, 'ccp', 120);
