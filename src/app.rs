@@ -5,7 +5,6 @@ use cutroute_geometry::{MachineParameters, Nest, Objective, PathRoute, Point, Ro
 use cutroute_protocol::{
     Document, FromWorker, JobId, JobRequest, Problem, Progress, SolverKind, SolverParams, ToWorker,
 };
-use gloo_worker::WorkerBridge;
 use leptos::prelude::*;
 use wasm_bindgen::JsCast;
 
@@ -20,7 +19,7 @@ use crate::export::ExportMenu;
 use crate::pan_zoom::PanZoom;
 use crate::settings::{objective_from_name, Layer, Settings};
 use crate::stats::{AlternativesTable, StatsPanel};
-use crate::worker_client::{spawn, SolverWorker};
+use crate::worker_client::{spawn, SolverWorker, WorkerDeath};
 
 /// Bundled sample nests (files under `assets/samples/`), the first is opened on start.
 pub const SAMPLES: [(&str, &str); 4] = [
@@ -183,8 +182,9 @@ pub fn App() -> impl IntoView {
                 if job_state.get_untracked() == JobState::Running(last.job_id) {
                     let last = merged(last);
                     record(&last);
+                    let missing = missing_tour(&last, document, solver);
                     progress.set(Some(last));
-                    job_state.set(JobState::Finished);
+                    job_state.set(missing.map_or(JobState::Finished, JobState::Failed));
                 }
             }
             FromWorker::Cancelled(last) => {
@@ -199,12 +199,28 @@ pub fn App() -> impl IntoView {
                 }
             }
         }));
+    // What to do when the worker dies: set below, once the worker it replaces exists.
+    let on_death: StoredValue<std::rc::Rc<dyn Fn(WorkerDeath)>, LocalStorage> =
+        StoredValue::new_local(std::rc::Rc::new(|_| {}));
     let spawn_worker = move || {
         let on_message = on_message.get_value();
-        spawn(move |message| on_message(message))
+        spawn(
+            move |message| on_message(message),
+            move |death| on_death.get_value()(death),
+        )
     };
-    let bridge: StoredValue<WorkerBridge<SolverWorker>, LocalStorage> =
-        StoredValue::new_local(spawn_worker());
+    let bridge: StoredValue<SolverWorker, LocalStorage> = StoredValue::new_local(spawn_worker());
+    let worker_notice = RwSignal::new(None::<String>);
+    on_death.set_value(std::rc::Rc::new(move |death: WorkerDeath| {
+        bridge.set_value(spawn_worker());
+        after_worker_death(&death, job_state, open_error, worker_notice);
+    }));
+    // The notice stays until the next job starts.
+    Effect::new(move |_| {
+        if matches!(job_state.get(), JobState::Running(_)) {
+            worker_notice.set(None);
+        }
+    });
 
     let shown_nest = Memo::new(move |_| {
         document.with(|d| match d.as_ref().map(|d| &d.problem) {
@@ -647,6 +663,7 @@ pub fn App() -> impl IntoView {
                 }
             >
                 {move || open_error.get().map(|e| view! { <p class="error" role="alert">{e}</p> })}
+                {move || worker_notice.get().map(|n| view! { <p id="worker-notice" class="error" role="status">{n}</p> })}
                 // What the reader left out or approximated, and what was checked on opening.
                 {move || {
                     let notes = document.with(|d| d.as_ref().map(|d| d.warnings.clone()).unwrap_or_default());
@@ -734,6 +751,58 @@ pub fn App() -> impl IntoView {
             </aside>
         </main>
     }
+}
+
+/// A PCGTSP job that ended without a tour failed: proved infeasible, or none found (the CLI's
+/// words, exit 3 there).
+fn missing_tour(
+    last: &Progress,
+    document: RwSignal<Option<Document>>,
+    solver: RwSignal<SolverKind>,
+) -> Option<String> {
+    let instance = document.with_untracked(|d| {
+        d.as_ref()
+            .is_some_and(|d| matches!(d.problem, Problem::PcgtspText { .. }))
+    });
+    if !instance {
+        return None;
+    }
+    last.missing_tour(solver.get_untracked().name(), false)
+}
+
+/// After the worker died and a fresh one took over (`src/worker_client.rs`): what was lost is
+/// said, and nothing else changes. The document stays open (every job request carries its
+/// problem, so the fresh worker needs nothing re-sent) and so does the best route received
+/// from the job, which Continue can start from. An open in flight is not retried: the file
+/// may be what killed the worker.
+fn after_worker_death(
+    death: &WorkerDeath,
+    job_state: RwSignal<JobState>,
+    open_error: RwSignal<Option<String>>,
+    worker_notice: RwSignal<Option<String>>,
+) {
+    let job_lost =
+        matches!(job_state.get_untracked(), JobState::Running(id) if death.jobs.contains(&id));
+    if job_lost {
+        job_state.set(JobState::Failed("the solver stopped unexpectedly".into()));
+    }
+    if !death.opening.is_empty() {
+        open_error.set(Some(format!(
+            "{}: the solver stopped unexpectedly while opening this ({}); it was restarted and \
+             the document shown before is still open",
+            death.opening.join(" + "),
+            death.reason
+        )));
+    }
+    worker_notice.set(Some(format!(
+        "The solver stopped unexpectedly ({}) and was restarted; {}",
+        death.reason,
+        if job_lost {
+            "the best route received before is kept: Start or Continue runs the job again."
+        } else {
+            "nothing was lost."
+        }
+    )));
 }
 
 /// Hues the tool-on paths of a path route take in turn (`.hue-0` … `.hue-5` in `style/`).

@@ -4,7 +4,7 @@ import http from 'node:http';
 import fs from 'node:fs';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
-import { execFileSync } from 'node:child_process';
+import { execFileSync, spawnSync } from 'node:child_process';
 import { chromium } from 'playwright-core';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
@@ -113,15 +113,32 @@ export async function screenshot(page, name) {
  * and returns its JSON report. e2e tests compare what the page shows with it.
  */
 export function cli(...args) {
-  const binary = path.join(projectRoot, 'target', 'debug', 'cutroute');
+  const out = execFileSync(cliBinary(), args, { cwd: projectRoot, encoding: 'utf8', maxBuffer: 64 << 20 });
+  return JSON.parse(out);
+}
+let cliBuilt = false;
+
+function cliBinary() {
   if (!cliBuilt) {
     execFileSync('cargo', ['build', '--quiet', '-p', 'cutroute-cli'], { cwd: projectRoot, stdio: 'inherit' });
     cliBuilt = true;
   }
-  const out = execFileSync(binary, args, { cwd: projectRoot, encoding: 'utf8', maxBuffer: 64 << 20 });
-  return JSON.parse(out);
+  return path.join(projectRoot, 'target', 'debug', 'cutroute');
 }
-let cliBuilt = false;
+
+/**
+ * The oracle for a refusal: runs the CLI with `args`, which must fail, and returns its exit
+ * status and its error (the last line of stderr) without the `cutroute: ` prefix. The engine names a file as it was
+ * given; `file` (a path among `args`) is replaced by its base name, as the page names it.
+ */
+export function cliError(file, ...args) {
+  const run = spawnSync(cliBinary(), args, { cwd: projectRoot, encoding: 'utf8', maxBuffer: 64 << 20 });
+  if (run.status === 0) throw new Error(`cutroute ${args.join(' ')} succeeded; a refusal was expected`);
+  // Text mode prints progress lines first; the error is the last line.
+  const last = run.stderr.trim().split('\n').at(-1);
+  const message = last.replace(/^cutroute: /, '').split(file).join(path.basename(file));
+  return { status: run.status, message };
+}
 
 /**
  * Display rounding of the page's figures: `shown` (the page's text, `decimals` places) must be

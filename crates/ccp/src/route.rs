@@ -5,7 +5,7 @@ use cutroute_geometry::{ContourRef, CutStep, MachineParameters, Nest, Point, Rou
 use serde::{Deserialize, Serialize};
 
 use crate::geom::{on_segment, BBox, Shape, Span, V};
-use crate::problem::Grid;
+use crate::problem::{Grid, Problem};
 use crate::search::Search;
 use crate::CcpError;
 
@@ -162,53 +162,89 @@ pub(crate) fn assemble_route(s: &Search, order: &[u32], pts: &[V]) -> Route {
         }
         leftovers = (0..prob.shapes.len()).filter(|&c| late[c]).collect();
     }
-    let mut steps = Vec::with_capacity(prob.shapes.len());
+    // The route as (contour, pierce point), in the order the air path meets them.
+    let mut seq: Vec<(usize, V)> = Vec::with_capacity(prob.shapes.len());
     for t in 0..poly.len() {
         if let Some(c) = poly_step[t] {
-            steps.push(CutStep {
-                contour: prob.refs[c],
-                pierce_point: poly[t].into(),
-                entry: Default::default(),
-                leads: None,
-            });
+            seq.push((c, poly[t]));
         }
         if t < moves {
             let list = &mut inserted[t];
             list.sort_by(|a, b| a.0.total_cmp(&b.0));
-            for &(_, c, x) in list.iter() {
-                steps.push(CutStep {
-                    contour: prob.refs[c],
-                    pierce_point: x.into(),
-                    entry: Default::default(),
-                    leads: None,
-                });
-            }
+            seq.extend(list.iter().map(|&(_, c, x)| (c, x)));
         }
     }
+    let (mut seq, deferred) = inner_first(prob, seq);
+    leftovers.extend(deferred);
     // Cut them last, innermost (smallest) first, each from the nearest point: precedence holds at
-    // the price of extra idle length.
+    // the price of extra idle length (a contour of the forest is larger than the ones inside it).
     leftovers.sort_by(|a, b| {
         prob.shapes[*a]
             .area
             .abs()
             .total_cmp(&prob.shapes[*b].area.abs())
     });
-    let mut cur = steps.last().map_or(s.start, |st| V::from(st.pierce_point));
+    let mut cur = seq.last().map_or(s.start, |&(_, x)| x);
     for c in leftovers {
         let x = prob.shapes[c].nearest(cur);
-        steps.push(CutStep {
+        seq.push((c, x));
+        cur = x;
+    }
+    let steps = seq
+        .into_iter()
+        .map(|(c, x)| CutStep {
             contour: prob.refs[c],
             pierce_point: x.into(),
             entry: Default::default(),
             leads: None,
-        });
-        cur = x;
-    }
+        })
+        .collect();
     Route {
         start: s.start.into(),
         steps,
         finish: s.finish.map(Into::into),
     }
+}
+
+/// The containment forest's precedence imposed on a sequence of cuts: a contour met before
+/// every contour inside it is cut waits until the last of them is cut, and is then cut from
+/// its point nearest that one. Returns the sequence and the contours still waiting at its end
+/// (those with a child missing from it).
+///
+/// Crossings place a removed contour where the air path leaves it, which is after the
+/// contours inside it only when the route's geometry agrees with the forest. A nest whose
+/// contours cross (a vertex moved into a spike through a neighbour) breaks that: the path can
+/// leave an outer contour before visiting a contour the forest puts inside it, and the checker
+/// (`Route::problems`, on the same forest) rejects the route. The forest is the one authority
+/// on "inside"; crossings only choose where, among the places it allows.
+fn inner_first(prob: &Problem, seq: Vec<(usize, V)>) -> (Vec<(usize, V)>, Vec<usize>) {
+    let mut uncut_children = vec![0_usize; prob.shapes.len()];
+    for p in prob.parent.iter().flatten() {
+        uncut_children[*p] += 1;
+    }
+    let mut waiting = vec![false; prob.shapes.len()];
+    let mut out = Vec::with_capacity(seq.len());
+    for (c, x) in seq {
+        if uncut_children[c] > 0 {
+            waiting[c] = true;
+            continue;
+        }
+        out.push((c, x));
+        // Cutting `c` may release its parent, then the parent's parent.
+        let mut done = c;
+        while let Some(p) = prob.parent[done] {
+            uncut_children[p] -= 1;
+            if uncut_children[p] > 0 || !waiting[p] {
+                break;
+            }
+            waiting[p] = false;
+            let from = out.last().map_or(x, |&(_, at)| at);
+            out.push((p, prob.shapes[p].nearest(from)));
+            done = p;
+        }
+    }
+    let still: Vec<usize> = (0..prob.shapes.len()).filter(|&c| waiting[c]).collect();
+    (out, still)
 }
 
 /// Idle (air) length of a route: start → pierce points in order → finish.

@@ -668,6 +668,17 @@ fn inspect(path: &Path, sheet: usize, as_json: bool, step: Option<f64>) -> Resul
                     .sum();
                 fields.insert("candidate_points".into(), json!(candidates));
             }
+            // The file's own route of whole contours, through the independent checker: what
+            // tests use to check a route saved elsewhere (the app's result JSON).
+            if let (Some(route), Value::Object(fields)) = (&document.route, &mut summary) {
+                let tolerance = nest.check_tolerance();
+                let problems: Vec<String> = route
+                    .problems(nest, &nest.containment_forest(), tolerance)
+                    .iter()
+                    .map(ToString::to_string)
+                    .collect();
+                fields.insert("route_problems".into(), json!(problems));
+            }
             summary
         }
         Problem::PcgtspText { text } => {
@@ -1090,16 +1101,8 @@ fn tour_report(solver: &str, text: &str, run: &JobRun) -> Result<Value, Failure>
         )));
     };
     let Some(tour) = &result.tour else {
-        return Err(Failure::Infeasible(
-            if result.proven_optimal && run.stopped.is_none() {
-                format!("the {solver} solver proved that the instance has no feasible tour")
-            } else {
-                format!(
-                "the {solver} solver found no feasible tour in {:.1} s (not a proof that none exists)",
-                result.elapsed_s
-            )
-            },
-        ));
+        let why = result.missing_tour(solver, run.stopped.is_some());
+        return Err(Failure::Infeasible(why.unwrap_or_default()));
     };
     let cost = cutroute_pcgtsp::check_tour(&instance, tour)
         .map_err(|e| format!("the {solver} solver's tour fails the checker: {e}"))?;

@@ -505,10 +505,10 @@ fn ctrl_c_stops_an_unlimited_run_and_keeps_its_best_route() {
     check_result(&["solve", "--json"], &nest, &stdout);
 }
 
-/// Item 13: on `ccp_chain_invalid_route_spike.dbs` (a vertex of nested.dbs moved into a
-/// spike) ccp's and chain's final routes cut a hole after its outer contour; the CLI reports the
-/// newest earlier route that passes the checker instead (`final_route_rejected` says why), and
-/// exits 0 only with a checked route.
+/// Item 13, the safety net: should a final route fail the checker, the CLI reports the newest
+/// earlier route that passes it instead (`final_route_rejected` says why), and exits 0 only
+/// with a checked route. (On `ccp_chain_invalid_route_spike.dbs` ccp's and chain's final routes
+/// once cut a hole after its outer contour; the test below holds them to never doing so.)
 #[test]
 fn a_final_route_that_fails_the_checker_gives_way_to_a_valid_earlier_one() {
     let spike = data("hostile/ccp_chain_invalid_route_spike.dbs");
@@ -529,5 +529,45 @@ fn a_final_route_that_fails_the_checker_gives_way_to_a_valid_earlier_one() {
         if let Some(why) = report["final_route_rejected"].as_str() {
             assert!(why.starts_with("invalid route"), "{why}");
         }
+    }
+}
+
+/// Item 13 at its root: on the spike file (a vertex of nested.dbs moved into a spike, so
+/// contours cross) ccp placed outer contours where its air path left them, which came before
+/// a hole the containment forest puts inside; the checker, on the same forest, rejected the
+/// route. Now the forest orders the cuts, so the final route passes at the limits and seeds
+/// that failed (ccp 5 s seeds 2 and 3, chain 2 s seed 2 and 5 s seeds 1–3), with no fallback.
+#[test]
+fn ccp_and_chain_build_only_routes_the_checker_accepts_on_the_spike_file() {
+    let spike = data("hostile/ccp_chain_invalid_route_spike.dbs");
+    let cases = [
+        ("ccp", "2", "1"),
+        ("ccp", "5", "2"),
+        ("ccp", "5", "3"),
+        ("chain", "2", "2"),
+        ("chain", "5", "1"),
+        ("chain", "5", "3"),
+    ];
+    for (solver, limit, seed) in cases {
+        let args = [
+            "solve",
+            spike.to_str().unwrap(),
+            "--solver",
+            solver,
+            "--time-limit",
+            limit,
+            "--seed",
+            seed,
+            "--json",
+        ];
+        let out = run(&args);
+        assert_eq!(out.code, 0, "{args:?}: {}", out.stderr);
+        check_result(&args, &spike, &out.stdout);
+        let report: Value = serde_json::from_str(&out.stdout).unwrap();
+        assert!(
+            report["final_route_rejected"].is_null(),
+            "{args:?}: the final route failed the checker: {}",
+            report["final_route_rejected"]
+        );
     }
 }

@@ -354,6 +354,24 @@ impl Progress {
             _ => None,
         }
     }
+
+    /// Why a PCGTSP job that ended holds no tour, in the words the CLI and the page both use;
+    /// `None` when it holds one. Only a search that ran to its end (`stopped_early` false)
+    /// and proved its result proves infeasibility; otherwise nothing is proved.
+    /// `solver` is the solver's name ([`SolverKind::name`]).
+    pub fn missing_tour(&self, solver: &str, stopped_early: bool) -> Option<String> {
+        if self.tour.is_some() {
+            return None;
+        }
+        Some(if self.proven_optimal && !stopped_early {
+            format!("the {solver} solver proved that the instance has no feasible tour")
+        } else {
+            format!(
+                "the {solver} solver found no feasible tour in {:.1} s (not a proof that none exists)",
+                self.elapsed_s
+            )
+        })
+    }
 }
 
 #[cfg(test)]
@@ -501,6 +519,34 @@ mod tests {
         };
         assert_eq!(p.gap(), Some(0.25));
         assert_eq!(Progress::default().gap(), None);
+    }
+
+    #[test]
+    fn a_missing_tour_is_proved_infeasible_only_by_a_finished_proof() {
+        let with_tour = Progress {
+            tour: Some(vec![0, 1]),
+            proven_optimal: true,
+            ..Progress::default()
+        };
+        assert_eq!(with_tour.missing_tour("exact", false), None);
+        let proved = Progress {
+            proven_optimal: true,
+            ..Progress::default()
+        };
+        assert_eq!(
+            proved.missing_tour("exact", false).as_deref(),
+            Some("the exact solver proved that the instance has no feasible tour")
+        );
+        let stopped = proved.missing_tour("exact", true).unwrap();
+        assert!(stopped.contains("not a proof"), "{stopped}");
+        let heuristic = Progress {
+            elapsed_s: 1.04,
+            ..Progress::default()
+        };
+        assert_eq!(
+            heuristic.missing_tour("heuristic", false).as_deref(),
+            Some("the heuristic solver found no feasible tour in 1.0 s (not a proof that none exists)")
+        );
     }
 
     #[test]
