@@ -265,6 +265,7 @@ fn main() -> ExitCode {
                     initial_upper_bound: None,
                     machine: inputs::base_machine(profile.as_ref()),
                     objective: Default::default(),
+                    thermal: Default::default(),
                 };
                 let gcode = gcode.options(profile.as_ref(), &params.machine)?;
                 convert(
@@ -321,6 +322,7 @@ fn main() -> ExitCode {
                 initial_upper_bound: ub,
                 machine,
                 objective,
+                thermal: thermal.engine_settings(),
             };
             let input = (file.as_path(), sheet.index());
             match solver.as_str() {
@@ -974,8 +976,8 @@ fn solve(
     // curves; its routes are projected back, see `project_routes`).
     let forest = forest_in_background(&document.problem);
     let request = kerf.request(request, solver_name)?;
-    let heated = thermal.clone();
-    let mut run = bounded_job_run(request, as_json, move |r| heated.heated_job(r))?;
+    thermal.warn_unpriced(solver);
+    let mut run = bounded_job_run(request, as_json, |_| Ok(None))?;
     let report = match &document.problem {
         Problem::PcgtspText { text } => tour_report(solver_name, text, &run)?,
         Problem::Nest { nest, .. } => {
@@ -1166,6 +1168,7 @@ fn solve_path(
     let machine = params.machine;
     let time_limit_s = params.time_limit_s;
     let objective = params.objective;
+    thermal.warn_unpriced(solver);
     let request = JobRequest {
         job_id: 1,
         problem: document.problem.clone(),

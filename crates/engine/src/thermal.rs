@@ -1,0 +1,286 @@
+//! Thermal rules in every nest job (issue #19): the heat-penalised jobs (nearest, ccp, chain),
+//! the hard-rule repair of a finished route, and H with the rule violations in every
+//! [`Progress`].
+//!
+//! What each solver honours (README "Thermal rules" has the table):
+//! - nearest, ccp, chain: the heat penalty (objective + W·H) in their search, then the repair;
+//! - heuristic, exact: the hard-rule repair of their final route (H is dynamic — it depends on
+//!   the times of every earlier pierce — so no static arc cost carries it; their bounds stay
+//!   those of the problem without rules, which remain sound lower bounds for it);
+//! - sccp, gsccp, aoe: H is reported (one source per tool-on path); the rules are defined on
+//!   routes of whole contours, so they are neither checked nor enforced.
+
+use std::cell::RefCell;
+
+use cutroute_ccp::HeatPenalty;
+use cutroute_geometry::{MachineParameters, Nest, Objective, PathRoute, Route};
+use cutroute_protocol::{Progress, ThermalSettings};
+use cutroute_thermal::{
+    admissible_pierce_points, check_rules, enforce_rules, path_route_pierces, relax_pierce_points,
+    route_pierces, HeatModel, RuleCounts, RuleParams, Violation,
+};
+use web_time::{Duration, Instant};
+
+use crate::{Job, JobStatus};
+
+/// Passes of the heat-aware pierce relaxation after a repair (as the CLI always did).
+const RELAX_PASSES: usize = 3;
+
+/// A rule check on a route that is not the final one runs only when at least this many times
+/// its own last duration has passed since it ran: the island check replays the route on a
+/// raster, which on a large sheet would otherwise eat the solver's slices.
+const RULE_CHECK_SPACING: u32 = 10;
+
+/// The route repaired until `settings.rules` hold (whole parts reordered, pierce points moved;
+/// what is left is what [`check_rules`] then reports), then, with a heat weight, its pierce
+/// points relaxed on idle + W·H among those the part rule admits. A route already obeying the
+/// rules comes back with its order unchanged.
+pub fn enforce_thermal_rules(
+    nest: &Nest,
+    route: Route,
+    settings: &ThermalSettings,
+    machine: &MachineParameters,
+    objective: Objective,
+) -> Result<Route, String> {
+    let model = settings.model().map_err(|e| e.to_string())?;
+    let params = RuleParams::default();
+    let route = enforce_rules(nest, &route, settings.rules, &params)
+        .map_err(|e| e.to_string())?
+        .route;
+    if !settings.penalised() {
+        return Ok(route);
+    }
+    let candidates = if settings.rules.part {
+        Some(admissible_pierce_points(nest, &route, &params).map_err(|e| e.to_string())?)
+    } else {
+        None
+    };
+    let weight_mm = heat_penalty(settings, objective).weight_mm(machine);
+    relax_pierce_points(
+        nest,
+        &route,
+        machine,
+        &model,
+        weight_mm,
+        RELAX_PASSES,
+        candidates.as_deref(),
+    )
+    .map_err(|e| e.to_string())
+}
+
+/// CCP-Relax's penalty for the settings and objective.
+pub fn heat_penalty(settings: &ThermalSettings, objective: Objective) -> HeatPenalty {
+    HeatPenalty {
+        model: HeatModel {
+            sigma_mm: settings.sigma_mm,
+            tau_s: settings.tau_s,
+        },
+        weight: settings.weight,
+        objective,
+    }
+}
+
+/// What the thermal model says about one route.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ThermalMeasure {
+    /// H on the route's machine clock.
+    pub heat: f64,
+    /// Violations per checked group (`None` when no rule is selected).
+    pub counts: Option<RuleCounts>,
+    /// Every violation.
+    pub violations: Vec<Violation>,
+}
+
+/// H and the selected rules' violations of a contour route.
+pub fn measure_route(
+    nest: &Nest,
+    route: &Route,
+    settings: &ThermalSettings,
+    machine: &MachineParameters,
+) -> Result<ThermalMeasure, String> {
+    let heat = measure_heat(nest, route, settings, machine)?;
+    let (counts, violations) = if settings.rules.any() {
+        let report = check_rules(nest, route, settings.rules, &RuleParams::default())
+            .map_err(|e| e.to_string())?;
+        (Some(report.counts()), report.violations)
+    } else {
+        (None, Vec::new())
+    };
+    Ok(ThermalMeasure {
+        heat,
+        counts,
+        violations,
+    })
+}
+
+fn measure_heat(
+    nest: &Nest,
+    route: &Route,
+    settings: &ThermalSettings,
+    machine: &MachineParameters,
+) -> Result<f64, String> {
+    let model = settings.model().map_err(|e| e.to_string())?;
+    let pierces = route_pierces(route, nest, machine).map_err(|e| e.to_string())?;
+    Ok(model.load(&pierces))
+}
+
+/// H of a route of tool-on paths (one source per path, at its pierce).
+pub fn measure_path_route(
+    route: &PathRoute,
+    settings: &ThermalSettings,
+    machine: &MachineParameters,
+) -> Result<f64, String> {
+    let model = settings.model().map_err(|e| e.to_string())?;
+    Ok(model.load(&path_route_pierces(route, machine)))
+}
+
+/// The last measured route, so a progress report of an unchanged route costs a comparison.
+#[derive(Default)]
+struct Measured {
+    route: Option<Route>,
+    path_route: Option<PathRoute>,
+    heat: Option<f64>,
+    rules: Option<(Option<RuleCounts>, Vec<Violation>)>,
+    /// When the rules were last checked, and how long that took.
+    rules_checked: Option<(Instant, Duration)>,
+}
+
+/// Any nest job with the thermal settings applied around it: H and the rule violations in
+/// every [`Progress`], and with `hard` the final route repaired by
+/// [`enforce_thermal_rules`] (contour routes only).
+pub struct ThermalJob {
+    inner: Box<dyn Job>,
+    nest: Nest,
+    machine: MachineParameters,
+    objective: Objective,
+    settings: ThermalSettings,
+    done: bool,
+    /// The repaired final route, or why the repair failed (the solver's route is then kept).
+    repaired: Option<Result<Route, String>>,
+    measured: RefCell<Measured>,
+}
+
+impl ThermalJob {
+    /// Wraps `inner`, a job on `nest`.
+    pub fn new(
+        inner: Box<dyn Job>,
+        nest: Nest,
+        machine: MachineParameters,
+        objective: Objective,
+        settings: ThermalSettings,
+    ) -> Self {
+        ThermalJob {
+            inner,
+            nest,
+            machine,
+            objective,
+            settings,
+            done: false,
+            repaired: None,
+            measured: RefCell::default(),
+        }
+    }
+
+    fn repair(&mut self) {
+        if !(self.settings.hard && self.settings.rules.any()) {
+            return;
+        }
+        let Some(route) = self.inner.progress().route else {
+            return;
+        };
+        self.repaired = Some(enforce_thermal_rules(
+            &self.nest,
+            route,
+            &self.settings,
+            &self.machine,
+            self.objective,
+        ));
+    }
+
+    /// Fills `progress`'s thermal fields from its route, measuring only what changed.
+    fn measure(&self, progress: &mut Progress) {
+        let mut measured = self.measured.borrow_mut();
+        if let Some(route) = &progress.route {
+            if measured.route.as_ref() != Some(route) {
+                *measured = Measured {
+                    heat: measure_heat(&self.nest, route, &self.settings, &self.machine).ok(),
+                    route: Some(route.clone()),
+                    rules_checked: measured.rules_checked,
+                    ..Measured::default()
+                };
+            }
+            let due = match measured.rules_checked {
+                None => true,
+                Some((at, took)) => self.done || at.elapsed() >= took * RULE_CHECK_SPACING,
+            };
+            if self.settings.rules.any() && measured.rules.is_none() && due {
+                let started = Instant::now();
+                if let Ok(report) = check_rules(
+                    &self.nest,
+                    route,
+                    self.settings.rules,
+                    &RuleParams::default(),
+                ) {
+                    measured.rules = Some((Some(report.counts()), report.violations));
+                }
+                measured.rules_checked = Some((started, started.elapsed()));
+            }
+            progress.heat = measured.heat;
+            if let Some((counts, violations)) = &measured.rules {
+                progress.rule_counts = *counts;
+                progress.violations = violations.clone();
+            }
+        } else if let Some(path_route) = &progress.path_route {
+            if measured.path_route.as_ref() != Some(path_route) {
+                *measured = Measured {
+                    heat: measure_path_route(path_route, &self.settings, &self.machine).ok(),
+                    path_route: Some(path_route.clone()),
+                    ..Measured::default()
+                };
+            }
+            progress.heat = measured.heat;
+        }
+    }
+}
+
+impl Job for ThermalJob {
+    fn step(&mut self, budget: Duration) -> JobStatus {
+        if self.done {
+            return JobStatus::Done;
+        }
+        if self.inner.step(budget) == JobStatus::Running {
+            return JobStatus::Running;
+        }
+        self.repair();
+        self.done = true;
+        JobStatus::Done
+    }
+
+    fn progress(&self) -> Progress {
+        let mut progress = self.inner.progress();
+        match &self.repaired {
+            Some(Ok(route)) if progress.route.as_ref() != Some(route) => {
+                // The solver's bounds are those of the problem without rules: its lower bound
+                // stays a sound bound (the rules only remove routes), its optimality proof and
+                // its tour do not describe the repaired route.
+                progress.upper_bound = Some(route.idle_length());
+                progress.proven_optimal = false;
+                progress.tour = None;
+                if !progress.certified.is_empty() {
+                    progress.certified = cutroute_ccp::route_certificates(&self.nest, route)
+                        .map(|c| c.iter().map(|c| c.condition1).collect())
+                        .unwrap_or_default();
+                }
+                progress.phase = format!("{} · rules enforced", progress.phase);
+                progress.route = Some(route.clone());
+            }
+            Some(Err(e)) => {
+                progress.phase =
+                    format!("{} · rule repair failed ({e}); route kept", progress.phase)
+            }
+            _ => {}
+        }
+        self.measure(&mut progress);
+        progress
+    }
+}
