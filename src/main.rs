@@ -11,6 +11,7 @@ mod pan_zoom;
 mod settings;
 mod stats;
 mod theme;
+mod thermal;
 mod worker_client;
 
 fn main() {
