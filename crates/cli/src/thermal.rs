@@ -82,16 +82,21 @@ impl Thermal {
 
     /// Says on stderr when a heat weight is given to a solver that does not price H.
     pub fn warn_unpriced(&self, solver: SolverKind) {
-        if self.weight > 0.0
-            && !matches!(
-                solver,
-                SolverKind::Ccp | SolverKind::Chain | SolverKind::NearestNeighbour
-            )
-        {
-            eprintln!(
-                "cutroute: --thermal-weight is honoured by nearest, ccp and chain; {} only reports H",
+        if self.weight <= 0.0 {
+            return;
+        }
+        match solver {
+            SolverKind::Ccp | SolverKind::Chain | SolverKind::NearestNeighbour => {}
+            SolverKind::Heuristic | SolverKind::Exact => eprintln!(
+                "cutroute: {}'s order search does not price H; --thermal-weight relaxes its final \
+                 pierce points on objective + W·H (and drops the discrete lb)",
                 solver.name()
-            );
+            ),
+            _ => eprintln!(
+                "cutroute: --thermal-weight is honoured by nearest, ccp and chain (and heuristic/exact's \
+                 final pierce points); {} only reports H",
+                solver.name()
+            ),
         }
     }
 

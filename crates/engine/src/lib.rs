@@ -104,7 +104,8 @@ pub enum EngineError {
 /// Build the job a request asks for. On a nest, the job runs inside a [`ThermalJob`]: its
 /// progress carries H and the rule violations of [`SolverParams::thermal`], and with `hard`
 /// its final route is repaired until the rules hold; with a positive heat weight, nearest, ccp
-/// and chain price H in their search (see the module `thermal` for what each solver honours).
+/// and chain price H in their search, and heuristic/exact relax their final pierce points on
+/// idle + W·H (see the module `thermal` for what each solver honours).
 ///
 /// [`SolverParams::thermal`]: cutroute_protocol::SolverParams::thermal
 pub fn start_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
@@ -125,6 +126,7 @@ pub fn start_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
     };
     Ok(Box::new(ThermalJob::new(
         inner,
+        request.solver,
         nest.clone(),
         params.machine,
         params.objective,

@@ -4,9 +4,11 @@
 //!
 //! What each solver honours (README "Thermal rules" has the table):
 //! - nearest, ccp, chain: the heat penalty (objective + W·H) in their search, then the repair;
-//! - heuristic, exact: the hard-rule repair of their final route (H is dynamic — it depends on
-//!   the times of every earlier pierce — so no static arc cost carries it; their bounds stay
-//!   those of the problem without rules, which remain sound lower bounds for it);
+//! - heuristic, exact: the order is not priced (H is dynamic — it depends on the times of every
+//!   earlier pierce — so no static arc cost of the PCGTSP carries it); with a heat weight the
+//!   final route's pierce points are relaxed on idle + W·H along their contours, and with hard
+//!   rules the route is repaired first. A changed route leaves the candidate points the
+//!   discrete lower bound is about, so that bound is then not reported;
 //! - sccp, gsccp, aoe: H is reported (one source per tool-on path); the rules are defined on
 //!   routes of whole contours, so they are neither checked nor enforced.
 
@@ -14,7 +16,7 @@ use std::cell::RefCell;
 
 use cutroute_ccp::HeatPenalty;
 use cutroute_geometry::{MachineParameters, Nest, Objective, PathRoute, Route};
-use cutroute_protocol::{Progress, ThermalSettings};
+use cutroute_protocol::{Progress, SolverKind, ThermalSettings};
 use cutroute_thermal::{
     admissible_pierce_points, check_rules, enforce_rules, path_route_pierces, relax_pierce_points,
     route_pierces, HeatModel, RuleCounts, RuleParams, Violation,
@@ -150,6 +152,7 @@ struct Measured {
 /// [`enforce_thermal_rules`] (contour routes only).
 pub struct ThermalJob {
     inner: Box<dyn Job>,
+    solver: SolverKind,
     nest: Nest,
     machine: MachineParameters,
     objective: Objective,
@@ -161,9 +164,10 @@ pub struct ThermalJob {
 }
 
 impl ThermalJob {
-    /// Wraps `inner`, a job on `nest`.
+    /// Wraps `inner`, a job of `solver` on `nest`.
     pub fn new(
         inner: Box<dyn Job>,
+        solver: SolverKind,
         nest: Nest,
         machine: MachineParameters,
         objective: Objective,
@@ -171,6 +175,7 @@ impl ThermalJob {
     ) -> Self {
         ThermalJob {
             inner,
+            solver,
             nest,
             machine,
             objective,
@@ -181,20 +186,47 @@ impl ThermalJob {
         }
     }
 
+    /// The discrete solvers, whose order search does not price H.
+    fn discrete(&self) -> bool {
+        matches!(self.solver, SolverKind::Heuristic | SolverKind::Exact)
+    }
+
     fn repair(&mut self) {
-        if !(self.settings.hard && self.settings.rules.any()) {
+        let hard = self.settings.hard && self.settings.rules.any();
+        let relax = self.settings.penalised() && self.discrete();
+        if !(hard || relax) {
             return;
         }
         let Some(route) = self.inner.progress().route else {
             return;
         };
-        self.repaired = Some(enforce_thermal_rules(
-            &self.nest,
-            route,
-            &self.settings,
-            &self.machine,
-            self.objective,
-        ));
+        self.repaired = Some(if hard {
+            enforce_thermal_rules(
+                &self.nest,
+                route,
+                &self.settings,
+                &self.machine,
+                self.objective,
+            )
+        } else {
+            self.settings
+                .model()
+                .map_err(|e| e.to_string())
+                .and_then(|model| {
+                    let weight_mm =
+                        heat_penalty(&self.settings, self.objective).weight_mm(&self.machine);
+                    relax_pierce_points(
+                        &self.nest,
+                        &route,
+                        &self.machine,
+                        &model,
+                        weight_mm,
+                        RELAX_PASSES,
+                        None,
+                    )
+                    .map_err(|e| e.to_string())
+                })
+        });
     }
 
     /// Fills `progress`'s thermal fields from its route, measuring only what changed.
@@ -260,10 +292,14 @@ impl Job for ThermalJob {
         let mut progress = self.inner.progress();
         match &self.repaired {
             Some(Ok(route)) if progress.route.as_ref() != Some(route) => {
-                // The solver's bounds are those of the problem without rules: its lower bound
-                // stays a sound bound (the rules only remove routes), its optimality proof and
-                // its tour do not describe the repaired route.
+                // The solver's bounds are those of the problem without rules: a lower bound on
+                // every route stays sound (the rules only remove routes); the discrete one is
+                // about routes through its candidate points, which the changed route leaves.
+                // The optimality proof and the tour do not describe the changed route.
                 progress.upper_bound = Some(route.idle_length());
+                if self.discrete() {
+                    progress.lower_bound = None;
+                }
                 progress.proven_optimal = false;
                 progress.tour = None;
                 if !progress.certified.is_empty() {
@@ -271,7 +307,11 @@ impl Job for ThermalJob {
                         .map(|c| c.iter().map(|c| c.condition1).collect())
                         .unwrap_or_default();
                 }
-                progress.phase = format!("{} · rules enforced", progress.phase);
+                progress.phase = if self.settings.hard {
+                    format!("{} · rules enforced", progress.phase)
+                } else {
+                    format!("{} · pierce points relaxed on idle + W·H", progress.phase)
+                };
                 progress.route = Some(route.clone());
             }
             Some(Err(e)) => {

@@ -182,6 +182,30 @@ fn the_heat_weight_lowers_h_where_a_solver_prices_it() {
 }
 
 #[test]
+fn discrete_solvers_relax_their_pierce_points_on_the_heat_weight() {
+    let problem = nest_problem("nests/dbs-json/test0.dbs.json");
+    let plain = ThermalSettings::default();
+    let heated = ThermalSettings {
+        weight: 100.0,
+        ..plain
+    };
+    for solver in [SolverKind::Heuristic, SolverKind::Exact] {
+        let a = solve(&problem, solver, plain);
+        let b = solve(&problem, solver, heated);
+        let route = b.route.as_ref().unwrap();
+        route.validate(nest_of(&problem), 1e-3).unwrap();
+        let h = heat_by_definition(&problem, &b, &heated);
+        assert!((b.heat.unwrap() - h).abs() <= 1e-6 * h.max(1e-12));
+        let (ha, hb) = (a.heat.unwrap(), b.heat.unwrap());
+        assert!(hb < ha, "{solver:?}: H {ha} → {hb}");
+        // The relaxed route left the candidate points: no discrete bound is claimed for it.
+        assert_eq!(b.lower_bound, None, "{solver:?}");
+        assert!(!b.proven_optimal);
+        assert!((b.upper_bound.unwrap() - route.idle_length()).abs() <= 1e-6 * route.idle_length());
+    }
+}
+
+#[test]
 fn path_route_solvers_report_h_and_no_rules() {
     let problem = nest_problem("nests/dbs-json/E1X_6_01.dbs.json");
     let settings = ThermalSettings {
