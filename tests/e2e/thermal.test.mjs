@@ -95,7 +95,7 @@ test('ccp with the heat penalty: H and the violations match the CLI, the heat ma
   await page.waitForFunction(() => Number(document.querySelector('#heat-map')?.getAttribute('data-time')) > 5,
     null, { timeout: 20000 });
   await page.click('#anim-play');
-  await screenshot(page, 'thermal-heat-map');
+  await screenshot(page, 'thermal-heat-map.png');
 
   // The comparison view: time, cost and H side by side.
   await page.click('#keep-result');
