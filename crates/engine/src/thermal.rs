@@ -28,10 +28,18 @@ use crate::{Job, JobStatus};
 /// Passes of the heat-aware pierce relaxation after a repair (as the CLI always did).
 const RELAX_PASSES: usize = 3;
 
-/// A rule check on a route that is not the final one runs only when at least this many times
-/// its own last duration has passed since it ran: the island check replays the route on a
-/// raster, which on a large sheet would otherwise eat the solver's slices.
-const RULE_CHECK_SPACING: u32 = 10;
+/// Rules are checked on routes that are not the final one only on nests of at most this many
+/// contours: the check took 0.7 s on 1,000 generated contours, 15 s on 10,000 and 47 s on
+/// 30,000 (`thermal_measure` example, BENCHMARKS.md), and a slice that long would keep Stop
+/// from reaching the job. The final route is always checked.
+const LIVE_RULES_MAX_CONTOURS: usize = 1_000;
+
+/// A measure (H, or the rule check) of a route that is not the final one runs only when at
+/// least this many times its own last duration has passed since it ran: the island check
+/// replays the route on a raster, and H lays out the route on the machine clock, which on a
+/// large nest improving every slice would otherwise eat the solver's slices. Until then the
+/// progress carries `None` for it rather than a figure of an earlier route.
+const MEASURE_SPACING: u32 = 10;
 
 /// The route repaired until `settings.rules` hold (whole parts reordered, pierce points moved;
 /// what is left is what [`check_rules`] then reports), then, with a heat weight, its pierce
@@ -143,8 +151,18 @@ struct Measured {
     path_route: Option<PathRoute>,
     heat: Option<f64>,
     rules: Option<(Option<RuleCounts>, Vec<Violation>)>,
+    /// When H was last measured, and how long that took.
+    heat_measured: Option<(Instant, Duration)>,
     /// When the rules were last checked, and how long that took.
     rules_checked: Option<(Instant, Duration)>,
+}
+
+/// Whether a measure last run at `last` (start, duration) may run again.
+fn due(last: Option<(Instant, Duration)>, done: bool) -> bool {
+    match last {
+        None => true,
+        Some((at, took)) => done || at.elapsed() >= took * MEASURE_SPACING,
+    }
 }
 
 /// Any nest job with the thermal settings applied around it: H and the rule violations in
@@ -154,6 +172,8 @@ pub struct ThermalJob {
     inner: Box<dyn Job>,
     solver: SolverKind,
     nest: Nest,
+    /// Contours of the nest.
+    contours: usize,
     machine: MachineParameters,
     objective: Objective,
     settings: ThermalSettings,
@@ -176,6 +196,7 @@ impl ThermalJob {
         ThermalJob {
             inner,
             solver,
+            contours: nest.parts.iter().map(|p| p.contours.len()).sum(),
             nest,
             machine,
             objective,
@@ -235,17 +256,22 @@ impl ThermalJob {
         if let Some(route) = &progress.route {
             if measured.route.as_ref() != Some(route) {
                 *measured = Measured {
-                    heat: measure_heat(&self.nest, route, &self.settings, &self.machine).ok(),
                     route: Some(route.clone()),
+                    heat_measured: measured.heat_measured,
                     rules_checked: measured.rules_checked,
                     ..Measured::default()
                 };
             }
-            let due = match measured.rules_checked {
-                None => true,
-                Some((at, took)) => self.done || at.elapsed() >= took * RULE_CHECK_SPACING,
-            };
-            if self.settings.rules.any() && measured.rules.is_none() && due {
+            if measured.heat.is_none() && due(measured.heat_measured, self.done) {
+                let started = Instant::now();
+                measured.heat = measure_heat(&self.nest, route, &self.settings, &self.machine).ok();
+                measured.heat_measured = Some((started, started.elapsed()));
+            }
+            let live = self.contours <= LIVE_RULES_MAX_CONTOURS;
+            if self.settings.rules.any()
+                && measured.rules.is_none()
+                && (self.done || (live && due(measured.rules_checked, false)))
+            {
                 let started = Instant::now();
                 if let Ok(report) = check_rules(
                     &self.nest,
