@@ -30,7 +30,8 @@
 //! objective's unit, and (sccp, gsccp) each ensemble's numbers.
 //! Every nest report adds the heat load `heat` (σ = 50 mm, τ = 60 s unless given), the rule
 //! violations and each step's machine time `t` (`cutroute-thermal`); `--thermal-weight` makes
-//! nearest, ccp and chain minimise objective + W·H, `--rules-hard` repairs the route until the rules hold.
+//! nearest, ccp and chain minimise objective + W·H (heuristic and exact relax their final pierce
+//! points on it), `--rules-hard` repairs the route until the rules hold.
 //! With `--kerf`/leads on (`kerf.rs`), nearest, ccp, heuristic and discrete optimise the full
 //! route (pierce points off the contours, leads, cut on the equidistants) and each route step
 //! carries `pierce` (M), `entry`, `lead_in`, `lead_out` and `switch_off`.

@@ -18,7 +18,7 @@ pub struct ThermalArgs {
     #[arg(long, value_name = "S", default_value_t = 60.0)]
     thermal_tau: f64,
     /// nearest, ccp and chain minimise their objective + W·H (W in objective units per unit of H;
-    /// 0: plain CCP-Relax).
+    /// 0: plain CCP-Relax); heuristic and exact relax their final pierce points on it.
     #[arg(long, value_name = "W", default_value_t = 0.0)]
     thermal_weight: f64,
     /// The rules checked and reported (and enforced with --rules-hard): a list of
