@@ -111,3 +111,33 @@ test('ccp with the heat penalty: H and the violations match the CLI, the heat ma
   assert.deepEqual(errors, []);
   await context.close();
 });
+
+test('hard rules: the page repairs the route as the CLI does, and lists nothing left', async () => {
+  const context = await app.browser.newContext({ viewport: { width: 1280, height: 800 } });
+  const page = await context.newPage();
+  const errors = watchErrors(page);
+  // The settings from a link, as a shared link would carry them.
+  await page.goto(`${app.baseUrl}?solver=ccp&time=3&seed=1&sigma=50&tau=60&heat_weight=100&rules=part,sheet,islands&hard=1`);
+  await page.setInputFiles('#file-input', nest);
+  await page.waitForFunction(() => (document.querySelector('#file-name')?.textContent ?? '').includes('Nest01'),
+    null, { timeout: 20000 });
+  await page.click('details.thermal summary');
+  assert.equal(await page.isChecked('#rules-hard'), true, 'hard mode from the link');
+  assert.equal(await page.inputValue('#thermal-weight'), '100');
+  await runSolver(page, 'ccp', 3);
+  const oracle = cli('solve', 'data/nests/tflex/Nest01.tfnesting', '--solver', 'ccp', '--time-limit', '3',
+    '--seed', '1', '--thermal-sigma', '50', '--thermal-tau', '60', '--thermal-weight', '100',
+    '--rules-hard', '--json');
+  assert.deepEqual(oracle.rule_violations, { part: 0, sheet: 0, islands: 0 }, 'the CLI repairs every rule here');
+  assertRounded(await page.getAttribute('#idle-length', 'data-mm'), oracle.idle_length, 3, 'idle length');
+  assertRounded(await page.textContent('#heat'), oracle.heat, 4, 'H');
+  const counts = await page.evaluate(() => {
+    const dd = document.querySelector('#rule-counts');
+    return { part: Number(dd.dataset.part), sheet: Number(dd.dataset.sheet), islands: Number(dd.dataset.islands) };
+  });
+  assert.deepEqual(counts, oracle.rule_violations);
+  assert.equal(await page.locator('#violations li').count(), 0);
+  assert.equal(await page.locator('#nest-view .violations .violation').count(), 0);
+  assert.deepEqual(errors, []);
+  await context.close();
+});
