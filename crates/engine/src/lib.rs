@@ -50,8 +50,8 @@ pub use open_files::{
 };
 pub use path_jobs::{AoeJob, PlanBound, SegmentJob};
 pub use thermal::{
-    enforce_thermal_rules, heat_penalty, measure_path_route, measure_route, ThermalJob,
-    ThermalMeasure,
+    enforce_thermal_rules, heat_penalty, measure_path_route, measure_route, price_consecutive_heat,
+    ThermalJob, ThermalMeasure,
 };
 
 /// How long one [`Job::step`] may run before it returns, so cancel requests are seen quickly.
@@ -296,8 +296,20 @@ fn start_solver_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
                 step: params.discretisation_step_mm,
                 ..cutroute_ccp::DiscretisationOptions::default()
             };
-            let discrete =
+            let mut discrete =
                 cutroute_ccp::build_pcgtsp(nest, &options).map_err(|e| refused(e.to_string()))?;
+            if params.thermal.penalised() {
+                let model = params.thermal.model().map_err(|e| refused(e.to_string()))?;
+                let weight_mm = thermal::heat_penalty(&params.thermal, params.objective)
+                    .weight_mm(&params.machine);
+                thermal::price_consecutive_heat(
+                    &mut discrete,
+                    nest,
+                    &model,
+                    weight_mm,
+                    &params.machine,
+                );
+            }
             let instance = discrete.instance.clone();
             discrete_job(
                 instance,

@@ -4,11 +4,14 @@
 //!
 //! What each solver honours (README "Thermal rules" has the table):
 //! - nearest, ccp, chain: the heat penalty (objective + W·H) in their search, then the repair;
-//! - heuristic, exact: the order is not priced (H is dynamic — it depends on the times of every
-//!   earlier pierce — so no static arc cost of the PCGTSP carries it); with a heat weight the
-//!   final route's pierce points are relaxed on idle + W·H along their contours, and with hard
-//!   rules the route is repaired first. A changed route leaves the candidate points the
-//!   discrete lower bound is about, so that bound is then not reported;
+//! - heuristic, exact: H is dynamic (it depends on the times of every earlier pierce), but its
+//!   terms between *consecutive* pierces are static: from pierce u to the next pierce v the
+//!   machine spends the pierce, the cut of u's contour and the idle move u → v, all known per
+//!   arc. With a heat weight those terms are priced on the PCGTSP's arcs
+//!   ([`price_consecutive_heat`]), then the final route's pierce points are relaxed on
+//!   idle + W·H (all terms) along their contours; with hard rules the route is repaired first.
+//!   The reported upper bound is the final route's idle length, and the discrete lower bound
+//!   (about penalised arcs through candidate points) is not reported then;
 //! - sccp, gsccp, aoe: H is reported (one source per tool-on path); the rules are defined on
 //!   routes of whole contours, so they are neither checked nor enforced.
 
@@ -76,6 +79,45 @@ pub fn enforce_thermal_rules(
         candidates.as_deref(),
     )
     .map_err(|e| e.to_string())
+}
+
+/// Adds to every arc between two candidate pierce points of `discrete` the heat term H would
+/// get from that pair being consecutive, `weight_mm · exp(−d²/(2σ²) − Δt/τ)`, with d the
+/// points' distance and Δt = pierce time + the first contour's cut + the idle move (the arc's
+/// own cost, mm) under `machine`. Arcs from the depot and forbidden arcs are left alone.
+pub fn price_consecutive_heat(
+    discrete: &mut cutroute_ccp::DiscreteInstance,
+    nest: &Nest,
+    model: &HeatModel,
+    weight_mm: f64,
+    machine: &MachineParameters,
+) {
+    use cutroute_ccp::DiscreteNode;
+    let n = discrete.instance.node_count;
+    let pierce_of = |v: usize| match discrete.nodes.get(v) {
+        Some(DiscreteNode::Pierce { contour, point }) => Some((*contour, *point)),
+        _ => None,
+    };
+    let nodes: Vec<_> = (0..n)
+        .map(|v| {
+            pierce_of(v).map(|(contour, point)| {
+                let cut = nest.contour(contour).map_or(0.0, |c| c.perimeter());
+                (point, machine.pierce_time + cut / machine.cut_speed)
+            })
+        })
+        .collect();
+    for (u, from) in nodes.iter().enumerate() {
+        let Some((pu, busy)) = from else { continue };
+        for (v, to) in nodes.iter().enumerate() {
+            let Some((pv, _)) = to else { continue };
+            let cost = &mut discrete.instance.cost[u * n + v];
+            if u == v || !cost.is_finite() {
+                continue;
+            }
+            let dt = busy + *cost / machine.idle_speed;
+            *cost += weight_mm * model.kernel((*pu - *pv).norm_squared(), dt);
+        }
+    }
 }
 
 /// CCP-Relax's penalty for the settings and objective.
@@ -339,6 +381,15 @@ impl Job for ThermalJob {
                     format!("{} · pierce points relaxed on idle + W·H", progress.phase)
                 };
                 progress.route = Some(route.clone());
+            }
+            _ if self.discrete() && self.settings.penalised() => {
+                // The tour's cost includes the arcs' heat terms: report the route's idle
+                // length, and no discrete bound (it bounds the penalised arcs).
+                if let Some(route) = &progress.route {
+                    progress.upper_bound = Some(route.idle_length());
+                }
+                progress.lower_bound = None;
+                progress.proven_optimal = false;
             }
             Some(Err(e)) => {
                 progress.phase =

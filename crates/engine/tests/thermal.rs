@@ -243,3 +243,71 @@ fn invalid_thermal_settings_are_refused() {
     };
     assert!(start_job(&request).is_err());
 }
+
+#[test]
+fn the_discrete_arcs_carry_exactly_the_consecutive_terms_of_h() {
+    use cutroute_ccp::{build_pcgtsp, DiscretisationOptions};
+    let problem = nest_problem("nests/dbs-json/E1X_6_01.dbs.json");
+    let Problem::Nest {
+        nest,
+        start,
+        finish,
+    } = &problem
+    else {
+        panic!("a nest")
+    };
+    let options = DiscretisationOptions {
+        start: *start,
+        finish: *finish,
+        step: 50.0,
+        ..DiscretisationOptions::default()
+    };
+    let plain = build_pcgtsp(nest, &options).unwrap();
+    let mut priced = plain.clone();
+    let machine = MachineParameters::default();
+    let model = cutroute_thermal::HeatModel::new(50.0, 60.0).unwrap();
+    let weight_mm = 7.0;
+    cutroute_engine::price_consecutive_heat(&mut priced, nest, &model, weight_mm, &machine);
+    // A feasible tour: the nearest neighbour's contour order, each contour's first candidate.
+    let order = solve(
+        &problem,
+        SolverKind::NearestNeighbour,
+        ThermalSettings::default(),
+    )
+    .route
+    .unwrap();
+    let cluster_of = |c: cutroute_geometry::ContourRef| {
+        1 + nest.parts[..c.part]
+            .iter()
+            .map(|p| p.contours.len())
+            .sum::<usize>()
+            + c.contour
+    };
+    let mut tour = vec![plain.instance.clusters[plain.instance.depot][0]];
+    tour.extend(
+        order
+            .steps
+            .iter()
+            .map(|s| plain.instance.clusters[cluster_of(s.contour)][0]),
+    );
+    let plain_cost = cutroute_pcgtsp::check_tour(&plain.instance, &tour).unwrap();
+    let priced_cost = cutroute_pcgtsp::check_tour(&priced.instance, &tour).unwrap();
+    let route = plain.tour_to_route(&tour).unwrap();
+    let pierces = route_pierces(&route, nest, &machine).unwrap();
+    let consecutive: f64 = pierces
+        .windows(2)
+        .map(|w| {
+            model.kernel(
+                (w[1].point - w[0].point).norm_squared(),
+                w[1].time - w[0].time,
+            )
+        })
+        .sum();
+    assert!(consecutive > 0.0);
+    let added = priced_cost - plain_cost;
+    assert!(
+        (added - weight_mm * consecutive).abs() <= 1e-9 * added.max(1e-12),
+        "arcs add {added}, H's consecutive terms × W are {}",
+        weight_mm * consecutive
+    );
+}
