@@ -19,6 +19,7 @@ use crate::export::ExportMenu;
 use crate::pan_zoom::PanZoom;
 use crate::settings::{objective_from_name, Layer, Settings};
 use crate::stats::{AlternativesTable, StatsPanel};
+use crate::thermal::{HeatMapLayer, ThermalPanel, ThermalStats, ThermalView, ViolationMarks};
 use crate::worker_client::{spawn, SolverWorker, WorkerDeath};
 
 /// Bundled sample nests (files under `assets/samples/`), the first is opened on start.
@@ -112,6 +113,7 @@ pub fn App() -> impl IntoView {
     let kept = RwSignal::new(Vec::<Kept>::new());
     let machine = RwSignal::new(MachineParameters::default());
     let objective = RwSignal::new(objective_from_name(&initial.objective).unwrap_or_default());
+    let thermal_settings = RwSignal::new(initial.thermal);
     // The tool-on paths a G-code file holds when they are not whole contours.
     let file_paths = RwSignal::new(None::<PathRoute>);
     let presentation = RwSignal::new(false);
@@ -127,6 +129,7 @@ pub fn App() -> impl IntoView {
             step_mm: step_mm.get(),
             hidden_layers: hidden_layers.get(),
             objective: objective.get().name().to_string(),
+            thermal: thermal_settings.get(),
         }
         .save();
     });
@@ -285,6 +288,14 @@ pub fn App() -> impl IntoView {
     let certified = Memo::new(move |_| {
         progress.with(|p| p.as_ref().map(|p| p.certified.clone()).unwrap_or_default())
     });
+    let thermal_view = ThermalView::new(
+        thermal_settings,
+        shown_nest,
+        shown_route,
+        shown_paths,
+        machine,
+        progress,
+    );
     let animation = Animation::new(
         shown_toolpath,
         machine,
@@ -372,6 +383,7 @@ pub fn App() -> impl IntoView {
             // The stats panel's speeds and prices: chain cutting decides by this cost model.
             machine: machine.get_untracked(),
             objective: objective.get_untracked(),
+            thermal: thermal_settings.get_untracked(),
         };
         if from.is_none() {
             progress.set(None);
@@ -469,6 +481,7 @@ pub fn App() -> impl IntoView {
             seed: seed.get(),
             step_mm: step_mm.get(),
             objective: objective.get().name().to_string(),
+            thermal: thermal_settings.get(),
             ..Settings::default()
         };
         let base = web_sys::window()
@@ -480,19 +493,24 @@ pub fn App() -> impl IntoView {
         format!("{base}{}", settings.query())
     };
 
+    // H of the shown route under the panel's σ and τ, for the comparison table.
+    let shown_heat = move || {
+        let model = thermal_settings.with_untracked(|s| s.model().ok())?;
+        Some(thermal_view.sources.with_untracked(|s| model.load(s)))
+    };
     let keep = move |_| {
         let label = progress
             .with_untracked(|p| p.as_ref().map(|_| solver.get_untracked().label()))
             .unwrap_or("from the file");
         let entry = if let Some(paths) = shown_paths.get_untracked() {
-            machine.with_untracked(|m| Kept::of_paths(&paths, m, label))
+            machine.with_untracked(|m| Kept::of_paths(&paths, m, label, shown_heat()))
         } else {
             let (Some(nest), Some(route)) =
                 (shown_nest.get_untracked(), shown_route.get_untracked())
             else {
                 return;
             };
-            machine.with_untracked(|m| Kept::new(&nest, &route, m, label))
+            machine.with_untracked(|m| Kept::new(&nest, &route, m, label, shown_heat()))
         };
         kept.update(|k| {
             let id = k.iter().map(|e| e.id).max().unwrap_or(0) + 1;
@@ -701,6 +719,7 @@ pub fn App() -> impl IntoView {
                     })
                     kept=kept
                     animation=animation
+                    thermal=thermal_view
                 />
                 <AnimationControls animation=animation />
             </section>
@@ -739,6 +758,8 @@ pub fn App() -> impl IntoView {
                     </dd>
                 </dl>
                 <StatsPanel nest=shown_nest route=shown_route paths=shown_paths machine=machine />
+                <ThermalPanel settings=thermal_settings />
+                <ThermalStats progress=progress />
                 <AlternativesTable alternatives=alternatives />
                 <BoundsChart samples=samples log_time=log_time unit=bound_unit />
                 <LayerPanel hidden=hidden_layers />
@@ -956,6 +977,7 @@ fn NestView(
     candidates_step: Signal<Option<f64>>,
     kept: RwSignal<Vec<Kept>>,
     animation: Animation,
+    thermal: ThermalView,
 ) -> impl IntoView {
     // The nest's box; for a nest with nothing to draw (a G-code program of open paths), the
     // box of the head's moves.
@@ -1273,6 +1295,7 @@ fn NestView(
             <g transform="scale(1,-1)">
                 <path class="sheet" d=sheet />
                 <g class="parts">{parts}</g>
+                <HeatMapLayer thermal=thermal nest=nest hidden=hidden_layers animation=animation />
                 <path class="arrows" d=arrows />
                 <path class="candidates" d=candidates />
                 {move || {
@@ -1295,6 +1318,9 @@ fn NestView(
                     <g class="ends">{ends}</g>
                 </g>
                 <g class="compared">{compared}</g>
+                <g class="violations">
+                    <ViolationMarks thermal=thermal nest=nest route=route extent=extent />
+                </g>
             </g>
             <g class="order" font-size=move || view_width.get() / 70.0>{order_labels}</g>
         </svg>

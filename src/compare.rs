@@ -26,6 +26,8 @@ pub struct Kept {
     pub time_s: f64,
     /// Cost.
     pub cost: f64,
+    /// Thermal load H under the panel's σ and τ when kept (`None`: the settings were invalid).
+    pub heat: Option<f64>,
     /// Path data of the route's idle moves (what an overlay draws).
     pub idle_d: String,
     /// Drawn over the current route.
@@ -37,6 +39,7 @@ impl Kept {
         (idle_length, cut_length, pierces, time_s, cost): Figures,
         idle_d: String,
         label: &'static str,
+        heat: Option<f64>,
     ) -> Kept {
         Kept {
             id: 0,
@@ -46,27 +49,40 @@ impl Kept {
             pierces,
             time_s,
             cost,
+            heat,
             idle_d,
             overlay: false,
         }
     }
 
-    /// The figures of `route` under `machine`.
+    /// The figures of `route` under `machine`, with its H.
     pub fn new(
         nest: &Nest,
         route: &Route,
         machine: &MachineParameters,
         label: &'static str,
+        heat: Option<f64>,
     ) -> Kept {
-        Kept::from_figures(route_figures(nest, route, machine), idle_path(route), label)
+        Kept::from_figures(
+            route_figures(nest, route, machine),
+            idle_path(route),
+            label,
+            heat,
+        )
     }
 
-    /// The figures of a route of tool-on paths under `machine`.
-    pub fn of_paths(route: &PathRoute, machine: &MachineParameters, label: &'static str) -> Kept {
+    /// The figures of a route of tool-on paths under `machine`, with its H.
+    pub fn of_paths(
+        route: &PathRoute,
+        machine: &MachineParameters,
+        label: &'static str,
+        heat: Option<f64>,
+    ) -> Kept {
         Kept::from_figures(
             path_route_figures(route, machine),
             path_route_idle_path(route),
             label,
+            heat,
         )
     }
 
@@ -122,6 +138,7 @@ pub fn ComparePanel(
                         <th scope="col" id="compare-by">{move || format!("vs best ({})", objective.get().name())}</th>
                         <th scope="col">"Time, s"</th>
                         <th scope="col">"Cost"</th>
+                        <th scope="col" title="Thermal load H under the heat panel's σ and τ">"H"</th>
                         <th scope="col">"Pierces"</th>
                         <th scope="col">"Overlay"</th>
                     </tr>
@@ -151,8 +168,9 @@ pub fn ComparePanel(
                                     <td>{e.label}</td>
                                     <td class="kept-idle">{format!("{:.1}", e.idle_length)}</td>
                                     <td>{excess}</td>
-                                    <td>{format!("{:.1}", e.time_s)}</td>
+                                    <td class="kept-time">{format!("{:.1}", e.time_s)}</td>
                                     <td class="kept-cost">{format!("{:.2}", e.cost)}</td>
+                                    <td class="kept-heat">{e.heat.map_or_else(|| "—".into(), |h| format!("{h:.4}"))}</td>
                                     <td class="kept-pierces">{e.pierces}</td>
                                     <td>
                                         <input

@@ -732,3 +732,98 @@ mod tests {
         assert_eq!(toolpath_bounds(&Toolpath::default()), None);
     }
 }
+
+/// The heat map's colour scale: a cell whose temperature is at least `HEAT_LEVELS[k]` (and
+/// below the next level) is drawn in class `heat-k`, whose colour each theme defines; cooler
+/// cells are not drawn. Temperatures are in units of H: 1 is one source at its own point the
+/// moment it switches on, so the scale means the same on every nest and at every time.
+pub const HEAT_LEVELS: [f64; 8] = [0.02, 0.05, 0.1, 0.2, 0.35, 0.5, 0.7, 1.0];
+
+/// One frame of the heat map: per colour level, the path data of its cells and their number,
+/// and what the frame shows in numbers (the tests' handle on the drawn temperatures).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct HeatFrame {
+    /// `(level, path data, cells)` for every level with at least one cell.
+    pub levels: Vec<(usize, String, usize)>,
+    /// The hottest cell's temperature.
+    pub max: f64,
+    /// The sum of every cell's temperature.
+    pub sum: f64,
+}
+
+/// The temperature field of `sources` (in time order) at machine time `t`, sampled at the
+/// centres of square cells over `bounds` (`[min_x, min_y, max_x, max_y]`), `cells_across` along
+/// its longer side.
+pub fn heat_frame(
+    model: &cutroute_thermal::HeatModel,
+    sources: &[cutroute_thermal::Pierce],
+    bounds: [f64; 4],
+    t: f64,
+    cells_across: usize,
+) -> HeatFrame {
+    let [x0, y0, x1, y1] = bounds;
+    let side = (x1 - x0).max(y1 - y0) / cells_across.max(1) as f64;
+    if !(side > 0.0 && side.is_finite()) {
+        return HeatFrame::default();
+    }
+    let (nx, ny) = (
+        ((x1 - x0) / side).ceil().max(1.0) as usize,
+        ((y1 - y0) / side).ceil().max(1.0) as usize,
+    );
+    let mut paths = vec![(String::new(), 0_usize); HEAT_LEVELS.len()];
+    let mut frame = HeatFrame::default();
+    for j in 0..ny {
+        for i in 0..nx {
+            let (x, y) = (x0 + i as f64 * side, y0 + j as f64 * side);
+            let centre = Point::new(x + side / 2.0, y + side / 2.0);
+            let temperature = model.temperature_at(sources, centre, t);
+            frame.sum += temperature;
+            frame.max = frame.max.max(temperature);
+            let Some(level) = HEAT_LEVELS.iter().rposition(|l| temperature >= *l) else {
+                continue;
+            };
+            let (d, count) = &mut paths[level];
+            let _ = write!(d, "M{x:.2} {y:.2}h{side:.2}v{side:.2}h{:.2}z", -side);
+            *count += 1;
+        }
+    }
+    frame.levels = paths
+        .into_iter()
+        .enumerate()
+        .filter(|(_, (_, count))| *count > 0)
+        .map(|(level, (d, count))| (level, d, count))
+        .collect();
+    frame
+}
+
+#[cfg(test)]
+mod heat_tests {
+    use super::*;
+    use cutroute_thermal::{HeatModel, Pierce};
+
+    #[test]
+    fn the_heat_map_warms_where_and_when_the_torch_went_on_and_cools_after() {
+        let model = HeatModel::new(10.0, 60.0).unwrap();
+        let sources = [Pierce {
+            point: Point::new(5.0, 5.0),
+            time: 10.0,
+        }];
+        let bounds = [0.0, 0.0, 100.0, 50.0];
+        let before = heat_frame(&model, &sources, bounds, 5.0, 20);
+        assert_eq!(before.sum, 0.0, "nothing switched on yet");
+        assert!(before.levels.is_empty());
+        let at = heat_frame(&model, &sources, bounds, 10.0, 20);
+        let later = heat_frame(&model, &sources, bounds, 70.0, 20);
+        // The cell centred on (2.5, 2.5) is 3.54 mm from the source: exp(−12.5/200) ≈ 0.939.
+        assert!((at.max - (-12.5f64 / 200.0).exp()).abs() < 1e-12);
+        assert!(
+            (later.max - at.max * (-1.0f64).exp()).abs() < 1e-12,
+            "one τ later"
+        );
+        assert!(later.sum < at.sum);
+        let hottest = at.levels.last().unwrap();
+        assert_eq!(hottest.0, 6, "0.939 is in the level from 0.7");
+        let cells: usize = at.levels.iter().map(|l| l.2).sum();
+        assert!(cells > 0 && cells < 20 * 10);
+    }
+}

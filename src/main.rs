@@ -12,6 +12,7 @@ mod pan_zoom;
 mod settings;
 mod stats;
 mod theme;
+mod thermal;
 mod worker_client;
 
 fn main() {

@@ -3,6 +3,7 @@
 //! key (see `theme`).
 
 use cutroute_geometry::Objective;
+use cutroute_protocol::{RuleSet, ThermalSettings};
 use serde::{Deserialize, Serialize};
 
 /// Local-storage key of [`Settings`].
@@ -29,11 +30,15 @@ pub enum Layer {
     Ends,
     /// CCP's per-contour optimality certificates.
     Certificates,
+    /// The temperature field of the heat model at the animation's clock time.
+    Heat,
+    /// The shop rules' violations.
+    Violations,
 }
 
 impl Layer {
     /// Every layer, in the order the panel lists them.
-    pub const ALL: [Layer; 9] = [
+    pub const ALL: [Layer; 11] = [
         Layer::Hatch,
         Layer::Arrows,
         Layer::Candidates,
@@ -43,6 +48,8 @@ impl Layer {
         Layer::Order,
         Layer::Ends,
         Layer::Certificates,
+        Layer::Heat,
+        Layer::Violations,
     ];
 
     /// Stable short name (element ids, CSS classes).
@@ -57,6 +64,8 @@ impl Layer {
             Layer::Order => "order",
             Layer::Ends => "ends",
             Layer::Certificates => "certificates",
+            Layer::Heat => "heat",
+            Layer::Violations => "violations",
         }
     }
 
@@ -72,6 +81,8 @@ impl Layer {
             Layer::Order => "Cutting order",
             Layer::Ends => "Start and finish",
             Layer::Certificates => "Optimality certificates",
+            Layer::Heat => "Heat map",
+            Layer::Violations => "Rule violations",
         }
     }
 }
@@ -97,6 +108,8 @@ pub struct Settings {
     /// What routes are compared by and what the solvers that weigh routes minimise:
     /// `Objective::name`, "time" or "cost".
     pub objective: String,
+    /// The material's heat model, heat weight and shop rules (off by default).
+    pub thermal: ThermalSettings,
 }
 
 impl Default for Settings {
@@ -111,8 +124,10 @@ impl Default for Settings {
             time_limit_s: params.time_limit_s,
             seed: params.seed,
             step_mm: params.discretisation_step_mm,
-            hidden_layers: Vec::new(),
+            // The heat map costs a field per animation frame: shown when asked for.
+            hidden_layers: vec![Layer::Heat],
             objective: params.objective.name().to_string(),
+            thermal: params.thermal,
         }
     }
 }
@@ -148,18 +163,65 @@ impl Settings {
                         self.seed = v;
                     }
                 }
+                "sigma" => {
+                    if let Some(v) = positive(&value) {
+                        self.thermal.sigma_mm = v;
+                    }
+                }
+                "tau" => {
+                    if let Some(v) = positive(&value) {
+                        self.thermal.tau_s = v;
+                    }
+                }
+                "heat_weight" => {
+                    if let Some(v) = value
+                        .parse::<f64>()
+                        .ok()
+                        .filter(|v| *v >= 0.0 && v.is_finite())
+                    {
+                        self.thermal.weight = v;
+                    }
+                }
+                "rules" => {
+                    if let Ok(rules) = RuleSet::parse(&value) {
+                        self.thermal.rules = rules;
+                    }
+                }
+                "hard" => self.thermal.hard = value == "1",
                 _ => {}
             }
         }
         self
     }
 
-    /// The query of a link that reopens this sample with these solver settings.
+    /// The query of a link that reopens this sample with these solver settings; the thermal
+    /// ones only when they differ from the defaults (old links stay short and the same).
     pub fn query(&self) -> String {
-        format!(
+        let mut query = format!(
             "?sample={}&solver={}&time={}&seed={}&step={}&objective={}",
             self.sample, self.solver, self.time_limit_s, self.seed, self.step_mm, self.objective
-        )
+        );
+        let t = &self.thermal;
+        if *t != ThermalSettings::default() {
+            let rules = [
+                ("part", t.rules.part),
+                ("sheet", t.rules.sheet),
+                ("islands", t.rules.islands),
+            ]
+            .into_iter()
+            .filter(|(_, on)| *on)
+            .map(|(name, _)| name)
+            .collect::<Vec<_>>()
+            .join(",");
+            query.push_str(&format!(
+                "&sigma={}&tau={}&heat_weight={}&rules={rules}&hard={}",
+                t.sigma_mm,
+                t.tau_s,
+                t.weight,
+                u8::from(t.hard)
+            ));
+        }
+        query
     }
 
     /// The remembered settings (defaults when nothing or something unreadable is stored).
@@ -248,5 +310,33 @@ mod tests {
         let nonsense = Settings::default().with_query("?objective=speed");
         assert_eq!(nonsense.objective, "time", "unknown objectives are ignored");
         assert_eq!(objective_from_name("cost"), Some(Objective::Cost));
+    }
+
+    #[test]
+    fn thermal_settings_ride_the_link_and_old_links_leave_them_off() {
+        let s = Settings {
+            sample: "seven.dbs".into(),
+            solver: "ccp".into(),
+            thermal: ThermalSettings {
+                sigma_mm: 40.0,
+                tau_s: 90.0,
+                weight: 100.0,
+                rules: RuleSet {
+                    part: true,
+                    sheet: false,
+                    islands: true,
+                },
+                hard: true,
+            },
+            ..Settings::default()
+        };
+        assert_eq!(Settings::default().with_query(&s.query()), s);
+        assert!(!Settings::default().query().contains("sigma"));
+        let old = Settings::default().with_query("?sample=seven.dbs&solver=ccp&time=3");
+        assert_eq!(old.thermal, ThermalSettings::default());
+        let stored: Settings = serde_json::from_str(r#"{"solver":"ccp"}"#).unwrap();
+        assert_eq!(stored.thermal, ThermalSettings::default());
+        let nonsense = Settings::default().with_query("?sigma=-3&heat_weight=x&rules=heat");
+        assert_eq!(nonsense.thermal, ThermalSettings::default());
     }
 }

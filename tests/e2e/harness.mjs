@@ -151,3 +151,48 @@ export function assertRounded(shown, exact, decimals, what) {
     throw new Error(`${what}: the page shows ${shown}, the oracle ${exact} (±${half})`);
   }
 }
+
+/**
+ * Selects `solver`, sets the time limit and runs the job to its end in the page; fails with the
+ * job's status unless it finishes.
+ */
+export async function runSolver(page, solver, seconds) {
+  await page.selectOption('#solver', solver);
+  await page.fill('#time-limit', String(seconds));
+  await page.dispatchEvent('#time-limit', 'change');
+  await page.click('#start');
+  await page.waitForFunction(() => /^(finished|failed)/.test(document.querySelector('#job-status')?.textContent ?? ''),
+    null, { timeout: 120000 });
+  const status = await page.textContent('#job-status');
+  if (status !== 'finished') throw new Error(`${solver}: the job ended ${status}`);
+}
+
+/**
+ * Sets a number field of the page (an `<input type=number>` read on change) to `value`.
+ */
+export async function setNumber(page, selector, value) {
+  await page.fill(selector, String(value));
+  await page.dispatchEvent(selector, 'change');
+}
+
+/**
+ * Moves the animation to machine time `t` (the scrub slider) and returns what the heat-map
+ * layer draws then: its time, hottest and summed cell temperatures, and the cells per colour
+ * level. Fails when the layer is missing.
+ */
+export async function heatMapAt(page, t) {
+  await page.locator('#anim-scrub').fill(String(t));
+  await page.waitForFunction((want) => {
+    const g = document.querySelector('#heat-map');
+    return g && Math.abs(Number(g.getAttribute('data-time')) - want) < 1e-2;
+  }, t, { timeout: 10000 });
+  return page.evaluate(() => {
+    const g = document.querySelector('#heat-map');
+    return {
+      time: Number(g.getAttribute('data-time')),
+      max: Number(g.getAttribute('data-max')),
+      sum: Number(g.getAttribute('data-sum')),
+      levels: [...g.querySelectorAll('path.heat')].map((p) => [p.getAttribute('class'), Number(p.getAttribute('data-cells'))]),
+    };
+  });
+}

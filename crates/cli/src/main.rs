@@ -31,7 +31,8 @@
 //! objective's unit, and (sccp, gsccp) each ensemble's numbers.
 //! Every nest report adds the heat load `heat` (σ = 50 mm, τ = 60 s unless given), the rule
 //! violations and each step's machine time `t` (`cutroute-thermal`); `--thermal-weight` makes
-//! nearest, ccp and chain minimise objective + W·H, `--rules-hard` repairs the route until the rules hold.
+//! nearest, ccp and chain minimise objective + W·H (heuristic and exact relax their final pierce
+//! points on it), `--rules-hard` repairs the route until the rules hold.
 //! With `--kerf`/leads on (`kerf.rs`), nearest, ccp, heuristic and discrete optimise the full
 //! route (pierce points off the contours, leads, cut on the equidistants) and each route step
 //! carries `pierce` (M), `entry`, `lead_in`, `lead_out` and `switch_off`.
@@ -308,6 +309,7 @@ fn main() -> ExitCode {
                     initial_upper_bound: None,
                     machine,
                     objective,
+                    thermal: Default::default(),
                 };
                 let gcode = gcode.options(profile.as_ref(), &params.machine)?;
                 convert(
@@ -352,6 +354,7 @@ fn main() -> ExitCode {
                 initial_upper_bound: ub,
                 machine,
                 objective,
+                thermal: thermal.engine_settings(),
             };
             let input = (file.as_path(), sheet.index());
             let report = match solver.as_str() {
@@ -1031,8 +1034,8 @@ fn solve(
     // curves; its routes are projected back, see `project_routes`).
     let forest = forest_in_background(&document.problem);
     let request = kerf.request(request, solver_name)?;
-    let heated = thermal.clone();
-    let mut run = bounded_job_run(request, as_json, move |r| heated.heated_job(r))?;
+    thermal.warn_unpriced(solver);
+    let mut run = bounded_job_run(request, as_json, |_| Ok(None))?;
     let report = match &document.problem {
         Problem::PcgtspText { text } => tour_report(solver_name, text, &run)?,
         Problem::Nest { nest, .. } => {
@@ -1189,6 +1192,7 @@ fn solve_path(
     let machine = params.machine;
     let time_limit_s = params.time_limit_s;
     let objective = params.objective;
+    thermal.warn_unpriced(solver);
     let request = JobRequest {
         job_id: 1,
         problem: document.problem.clone(),

@@ -2,14 +2,10 @@
 //! rules as a check or as a hard repair, and the report's `heat`, `rule_violations` and
 //! per-step `t`.
 
-use cutroute_ccp::{CcpSolver, HeatPenalty};
-use cutroute_engine::{ccp_options, CcpJob, ChainJob, Job, NearestNeighbourJob};
+use cutroute_engine::enforce_thermal_rules;
 use cutroute_geometry::{MachineParameters, Nest, Objective, Route};
-use cutroute_protocol::{JobRequest, Problem, SolverKind};
-use cutroute_thermal::{
-    admissible_pierce_points, check_rules, enforce_rules, relax_pierce_points, route_pierces,
-    HeatModel, RuleParams, RuleSet,
-};
+use cutroute_protocol::{SolverKind, ThermalSettings};
+use cutroute_thermal::{check_rules, route_pierces, HeatModel, RuleParams, RuleSet};
 use serde_json::{json, Value};
 
 /// The thermal flags of `solve`.
@@ -22,7 +18,7 @@ pub struct ThermalArgs {
     #[arg(long, value_name = "S", default_value_t = 60.0)]
     thermal_tau: f64,
     /// nearest, ccp and chain minimise their objective + W·H (W in objective units per unit of H;
-    /// 0: plain CCP-Relax).
+    /// 0: plain CCP-Relax); heuristic and exact relax their final pierce points on it.
     #[arg(long, value_name = "W", default_value_t = 0.0)]
     thermal_weight: f64,
     /// The rules checked and reported (and enforced with --rules-hard): a list of
@@ -70,65 +66,44 @@ impl ThermalArgs {
 }
 
 impl Thermal {
-    /// A nearest, ccp or chain job with the heat penalty, when the weight is positive (else
-    /// `None`: the engine's own job, unchanged).
-    pub fn heated_job(&self, request: &JobRequest) -> Result<Option<Box<dyn Job>>, String> {
-        let Problem::Nest {
-            nest,
-            start,
-            finish,
-        } = &request.problem
-        else {
-            return Ok(None);
-        };
-        if self.weight <= 0.0 {
-            return Ok(None);
-        }
-        if !matches!(
-            request.solver,
-            SolverKind::Ccp | SolverKind::Chain | SolverKind::NearestNeighbour
-        ) {
-            eprintln!(
-                "cutroute: --thermal-weight is honoured by nearest, ccp and chain; {} only reports H",
-                request.solver.name()
-            );
-            return Ok(None);
-        }
-        let params = &request.params;
-        let penalty = HeatPenalty {
-            model: self.model,
+    /// The settings the engine runs the job with: σ, τ and the weight (nearest, ccp and chain
+    /// price H in their search). Rules and their repair stay with the CLI, which applies them
+    /// after bringing a kerf route back onto the real contours ([`Thermal::enforce`]), and
+    /// checks them once, on the route it prints ([`Thermal::report`]).
+    pub fn engine_settings(&self) -> ThermalSettings {
+        ThermalSettings {
+            sigma_mm: self.model.sigma_mm,
+            tau_s: self.model.tau_s,
             weight: self.weight,
-            objective: params.objective,
-        };
-        if request.solver == SolverKind::NearestNeighbour {
-            let job = NearestNeighbourJob::new(request.job_id, nest.clone(), *start, *finish)
-                .map_err(|e| e.to_string())?
-                .with_heat(
-                    self.model,
-                    penalty.weight_mm(&params.machine),
-                    params.machine,
-                );
-            return Ok(Some(Box::new(job)));
+            rules: RuleSet::NONE,
+            hard: false,
         }
-        let time_limit = std::time::Duration::from_secs_f64(params.time_limit_s.clamp(0.0, 1.0e7));
-        let mut options = ccp_options(*start, *finish, time_limit, params.seed, params.machine);
-        options.heat = Some(penalty);
-        let ccp = CcpSolver::new(nest, options).map_err(|e| e.to_string())?;
-        Ok(Some(if request.solver == SolverKind::Chain {
-            Box::new(ChainJob::new(
-                request.job_id,
-                ccp,
-                nest.clone(),
-                params.machine,
-            ))
-        } else {
-            Box::new(CcpJob::new(request.job_id, ccp))
-        }))
+    }
+
+    /// Says on stderr when a heat weight is given to a solver that does not price H.
+    pub fn warn_unpriced(&self, solver: SolverKind) {
+        if self.weight <= 0.0 {
+            return;
+        }
+        match solver {
+            SolverKind::Ccp | SolverKind::Chain | SolverKind::NearestNeighbour => {}
+            SolverKind::Heuristic | SolverKind::Exact => eprintln!(
+                "cutroute: {}'s order search does not price H; --thermal-weight relaxes its final \
+                 pierce points on objective + W·H (and drops the discrete lb)",
+                solver.name()
+            ),
+            _ => eprintln!(
+                "cutroute: --thermal-weight is honoured by nearest, ccp and chain (and heuristic/exact's \
+                 final pierce points); {} only reports H",
+                solver.name()
+            ),
+        }
     }
 
     /// With `--rules-hard`, the route repaired until the rules hold (what is left is reported
     /// by [`Thermal::report`]), then, with a heat weight, its pierce points relaxed on
-    /// objective + W·H among those the part rule admits; else the route as it is.
+    /// objective + W·H among those the part rule admits (the engine's
+    /// `enforce_thermal_rules`, as the app's hard mode); else the route as it is.
     pub fn enforce(
         &self,
         nest: &Nest,
@@ -139,34 +114,12 @@ impl Thermal {
         if !self.hard {
             return Ok(route);
         }
-        let params = RuleParams::default();
-        let route = enforce_rules(nest, &route, self.rules, &params)
-            .map_err(|e| e.to_string())?
-            .route;
-        if self.weight <= 0.0 {
-            return Ok(route);
-        }
-        let candidates = if self.rules.part {
-            Some(admissible_pierce_points(nest, &route, &params).map_err(|e| e.to_string())?)
-        } else {
-            None
+        let settings = ThermalSettings {
+            rules: self.rules,
+            hard: true,
+            ..self.engine_settings()
         };
-        let weight_mm = HeatPenalty {
-            model: self.model,
-            weight: self.weight,
-            objective,
-        }
-        .weight_mm(machine);
-        relax_pierce_points(
-            nest,
-            &route,
-            machine,
-            &self.model,
-            weight_mm,
-            3,
-            candidates.as_deref(),
-        )
-        .map_err(|e| e.to_string())
+        enforce_thermal_rules(nest, route, &settings, machine, objective)
     }
 
     /// Adds `heat` (one source per tool-on path) and each path's `t` to a path-route report;

@@ -141,6 +141,7 @@ impl Job for CcpJob {
             certified,
             path_route: None,
             alternatives: Vec::new(),
+            ..Progress::default()
         }
     }
 }
@@ -299,6 +300,7 @@ impl Job for DiscreteJob {
             certified: Vec::new(),
             path_route: None,
             alternatives: Vec::new(),
+            ..Progress::default()
         }
     }
 }

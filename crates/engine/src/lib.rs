@@ -36,6 +36,7 @@ mod nearest;
 mod open;
 mod open_files;
 mod path_jobs;
+mod thermal;
 
 use cutroute_protocol::{JobRequest, Problem, Progress, SolverKind};
 use web_time::Duration;
@@ -48,6 +49,10 @@ pub use open_files::{
     POINT_TOLERANCE_MM,
 };
 pub use path_jobs::{AoeJob, PlanBound, SegmentJob};
+pub use thermal::{
+    enforce_thermal_rules, heat_penalty, measure_path_route, measure_route, price_consecutive_heat,
+    ThermalJob, ThermalMeasure,
+};
 
 /// How long one [`Job::step`] may run before it returns, so cancel requests are seen quickly.
 pub const DEFAULT_SLICE: Duration = Duration::from_millis(40);
@@ -96,8 +101,95 @@ pub enum EngineError {
     },
 }
 
-/// Build the job a request asks for.
+/// Build the job a request asks for. On a nest, the job runs inside a [`ThermalJob`]: its
+/// progress carries H and the rule violations of [`SolverParams::thermal`], and with `hard`
+/// its final route is repaired until the rules hold; with a positive heat weight, nearest, ccp
+/// and chain price H in their search, and heuristic/exact relax their final pierce points on
+/// idle + W·H (see the module `thermal` for what each solver honours).
+///
+/// [`SolverParams::thermal`]: cutroute_protocol::SolverParams::thermal
 pub fn start_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
+    let params = &request.params;
+    let Problem::Nest { nest, .. } = &request.problem else {
+        return start_solver_job(request);
+    };
+    params
+        .thermal
+        .validate()
+        .map_err(|message| EngineError::SolverRefused {
+            solver: request.solver.name(),
+            message,
+        })?;
+    let inner = match heated_job(request)? {
+        Some(job) => job,
+        None => start_solver_job(request)?,
+    };
+    Ok(Box::new(ThermalJob::new(
+        inner,
+        request.solver,
+        nest.clone(),
+        params.machine,
+        params.objective,
+        params.thermal,
+    )))
+}
+
+/// The nearest, ccp or chain job that prices heat, when the request's heat weight is positive
+/// (else `None`). The ccp job has no lower bound: its search minimises idle + W·H, and the
+/// bound's share of each slice would change the routes a weight gives.
+fn heated_job(request: &JobRequest) -> Result<Option<Box<dyn Job>>, EngineError> {
+    let params = &request.params;
+    let Problem::Nest {
+        nest,
+        start,
+        finish,
+    } = &request.problem
+    else {
+        return Ok(None);
+    };
+    let solver = request.solver;
+    if !params.thermal.penalised()
+        || !matches!(
+            solver,
+            SolverKind::Ccp | SolverKind::Chain | SolverKind::NearestNeighbour
+        )
+    {
+        return Ok(None);
+    }
+    let refused = |message: String| EngineError::SolverRefused {
+        solver: solver.name(),
+        message,
+    };
+    let model = params.thermal.model().map_err(|e| refused(e.to_string()))?;
+    let penalty = thermal::heat_penalty(&params.thermal, params.objective);
+    if solver == SolverKind::NearestNeighbour {
+        let job = NearestNeighbourJob::new(request.job_id, nest.clone(), *start, *finish)?
+            .with_heat(model, penalty.weight_mm(&params.machine), params.machine);
+        return Ok(Some(Box::new(job)));
+    }
+    let time_limit = Duration::from_secs_f64(params.time_limit_s.clamp(0.0, 1.0e7));
+    let ccp_limit = if solver == SolverKind::Chain {
+        time_limit.mul_f64(CHAIN_CCP_SHARE)
+    } else {
+        time_limit
+    };
+    let mut options = jobs::ccp_options(*start, *finish, ccp_limit, params.seed, params.machine);
+    options.heat = Some(penalty);
+    let ccp = cutroute_ccp::CcpSolver::new(nest, options).map_err(|e| refused(e.to_string()))?;
+    Ok(Some(if solver == SolverKind::Chain {
+        Box::new(ChainJob::new(
+            request.job_id,
+            ccp,
+            nest.clone(),
+            params.machine,
+        ))
+    } else {
+        Box::new(CcpJob::new(request.job_id, ccp))
+    }))
+}
+
+/// The solver's own job, without thermal settings.
+fn start_solver_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
     let params = &request.params;
     let time_limit = Duration::from_secs_f64(params.time_limit_s.clamp(0.0, 1.0e7));
     // Building the problem (a discretisation's dense matrix) counts against the limit.
@@ -204,8 +296,20 @@ pub fn start_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
                 step: params.discretisation_step_mm,
                 ..cutroute_ccp::DiscretisationOptions::default()
             };
-            let discrete =
+            let mut discrete =
                 cutroute_ccp::build_pcgtsp(nest, &options).map_err(|e| refused(e.to_string()))?;
+            if params.thermal.penalised() {
+                let model = params.thermal.model().map_err(|e| refused(e.to_string()))?;
+                let weight_mm = thermal::heat_penalty(&params.thermal, params.objective)
+                    .weight_mm(&params.machine);
+                thermal::price_consecutive_heat(
+                    &mut discrete,
+                    nest,
+                    &model,
+                    weight_mm,
+                    &params.machine,
+                );
+            }
             let instance = discrete.instance.clone();
             discrete_job(
                 instance,

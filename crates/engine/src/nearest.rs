@@ -275,6 +275,7 @@ impl Job for NearestNeighbourJob {
             certified: Vec::new(),
             path_route: None,
             alternatives: Vec::new(),
+            ..Progress::default()
         }
     }
 }

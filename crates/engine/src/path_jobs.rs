@@ -274,6 +274,7 @@ impl Job for SegmentJob {
             certified: Vec::new(),
             path_route: best.map(|c| c.route.clone()),
             alternatives,
+            ..Progress::default()
         }
     }
 }
@@ -380,6 +381,7 @@ impl Job for AoeJob {
                     vec![s]
                 })
                 .unwrap_or_default(),
+            ..Progress::default()
         }
     }
 }

@@ -27,13 +27,20 @@ use cutroute_geometry::{MachineParameters, Nest, Objective, PathRoute, Point, Ro
 use serde::{Deserialize, Serialize};
 
 mod profile;
+mod thermal;
 
 pub use profile::{MachineProfile, ProfileError};
+pub use thermal::ThermalSettings;
+// The thermal types a `Progress` carries, so the UI needs no second import path.
+pub use cutroute_thermal::{HeatModel, RuleCounts, RuleSet, Violation};
 
 /// Identifies one job for the lifetime of a worker; chosen by the sender, echoed in every answer.
 pub type JobId = u64;
 
 /// A message to the solver worker.
+// `Start` is large (a request carries every setting) but one message is built per job, never
+// in bulk: boxing it would change every sender for nothing measurable.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub enum ToWorker {
     /// Start a job. A job already running keeps running: jobs are independent.
@@ -256,6 +263,10 @@ pub struct SolverParams {
     /// UI compares routes by.
     #[serde(default)]
     pub objective: Objective,
+    /// The material's heat model, the heat weight and the shop rules (issue #19); off by
+    /// default (weight 0, no rules), so requests without it run as before.
+    #[serde(default)]
+    pub thermal: ThermalSettings,
 }
 
 impl Default for SolverParams {
@@ -267,6 +278,7 @@ impl Default for SolverParams {
             initial_upper_bound: None,
             machine: MachineParameters::default(),
             objective: Objective::default(),
+            thermal: ThermalSettings::default(),
         }
     }
 }
@@ -322,6 +334,18 @@ pub struct Progress {
     /// them), with their numbers under the machine's model; empty for other solvers.
     #[serde(default)]
     pub alternatives: Vec<RouteSummary>,
+    /// The thermal load H of the best route (or path route) under
+    /// [`SolverParams::thermal`]'s σ and τ, on the route's machine clock
+    /// (`cutroute_thermal::HeatModel::load`); `None` without a route.
+    #[serde(default)]
+    pub heat: Option<f64>,
+    /// Violations per rule group of the rules [`SolverParams::thermal`] selects (`None` for a
+    /// group not checked, and for path routes: the rules are defined on contour routes).
+    #[serde(default)]
+    pub rule_counts: Option<RuleCounts>,
+    /// Every violation behind `rule_counts`, by rule group then step.
+    #[serde(default)]
+    pub violations: Vec<Violation>,
 }
 
 /// One candidate route a solver weighed, in numbers (lengths in mm, time in s).
@@ -455,6 +479,19 @@ mod tests {
                 cost: 4.0,
                 chosen: true,
                 failure: None,
+            }],
+            heat: Some(0.75),
+            rule_counts: Some(RuleCounts {
+                part: Some(1),
+                sheet: None,
+                islands: Some(0),
+            }),
+            violations: vec![Violation::Island {
+                step: 0,
+                part: ContourRef {
+                    part: 0,
+                    contour: 0,
+                },
             }],
         });
         let bytes = bincode::serialize(&progress).unwrap();

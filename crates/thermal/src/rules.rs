@@ -154,6 +154,18 @@ pub struct RuleSet {
 }
 
 impl RuleSet {
+    /// No rule.
+    pub const NONE: RuleSet = RuleSet {
+        part: false,
+        sheet: false,
+        islands: false,
+    };
+
+    /// Whether any rule is selected.
+    pub fn any(&self) -> bool {
+        self.part || self.sheet || self.islands
+    }
+
     /// Every rule.
     pub const ALL: RuleSet = RuleSet {
         part: true,
@@ -163,11 +175,7 @@ impl RuleSet {
 
     /// Parses a comma-separated list of `part`, `sheet`, `islands` (the CLI's `--rules`).
     pub fn parse(text: &str) -> Result<RuleSet, ThermalError> {
-        let mut set = RuleSet {
-            part: false,
-            sheet: false,
-            islands: false,
-        };
+        let mut set = RuleSet::NONE;
         for name in text.split(',').map(str::trim).filter(|n| !n.is_empty()) {
             match name {
                 "part" => set.part = true,

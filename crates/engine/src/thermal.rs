@@ -1,0 +1,403 @@
+//! Thermal rules in every nest job (issue #19): the heat-penalised jobs (nearest, ccp, chain),
+//! the hard-rule repair of a finished route, and H with the rule violations in every
+//! [`Progress`].
+//!
+//! What each solver honours (README "Thermal rules" has the table):
+//! - nearest, ccp, chain: the heat penalty (objective + W·H) in their search, then the repair;
+//! - heuristic, exact: H is dynamic (it depends on the times of every earlier pierce), but its
+//!   terms between *consecutive* pierces are static: from pierce u to the next pierce v the
+//!   machine spends the pierce, the cut of u's contour and the idle move u → v, all known per
+//!   arc. With a heat weight those terms are priced on the PCGTSP's arcs
+//!   ([`price_consecutive_heat`]), then the final route's pierce points are relaxed on
+//!   idle + W·H (all terms) along their contours; with hard rules the route is repaired first.
+//!   The reported upper bound is the final route's idle length, and the discrete lower bound
+//!   (about penalised arcs through candidate points) is not reported then;
+//! - sccp, gsccp, aoe: H is reported (one source per tool-on path); the rules are defined on
+//!   routes of whole contours, so they are neither checked nor enforced.
+
+use std::cell::RefCell;
+
+use cutroute_ccp::HeatPenalty;
+use cutroute_geometry::{MachineParameters, Nest, Objective, PathRoute, Route};
+use cutroute_protocol::{Progress, SolverKind, ThermalSettings};
+use cutroute_thermal::{
+    admissible_pierce_points, check_rules, enforce_rules, path_route_pierces, relax_pierce_points,
+    route_pierces, HeatModel, RuleCounts, RuleParams, Violation,
+};
+use web_time::{Duration, Instant};
+
+use crate::{Job, JobStatus};
+
+/// Passes of the heat-aware pierce relaxation after a repair (as the CLI always did).
+const RELAX_PASSES: usize = 3;
+
+/// Rules are checked on routes that are not the final one only on nests of at most this many
+/// contours: the check took 0.7 s on 1,000 generated contours, 15 s on 10,000 and 47 s on
+/// 30,000 (`thermal_measure` example, BENCHMARKS.md), and a slice that long would keep Stop
+/// from reaching the job. The final route is always checked.
+const LIVE_RULES_MAX_CONTOURS: usize = 1_000;
+
+/// A measure (H, or the rule check) of a route that is not the final one runs only when at
+/// least this many times its own last duration has passed since it ran: the island check
+/// replays the route on a raster, and H lays out the route on the machine clock, which on a
+/// large nest improving every slice would otherwise eat the solver's slices. Until then the
+/// progress carries `None` for it rather than a figure of an earlier route.
+const MEASURE_SPACING: u32 = 10;
+
+/// The route repaired until `settings.rules` hold (whole parts reordered, pierce points moved;
+/// what is left is what [`check_rules`] then reports), then, with a heat weight, its pierce
+/// points relaxed on idle + W·H among those the part rule admits. A route already obeying the
+/// rules comes back with its order unchanged.
+pub fn enforce_thermal_rules(
+    nest: &Nest,
+    route: Route,
+    settings: &ThermalSettings,
+    machine: &MachineParameters,
+    objective: Objective,
+) -> Result<Route, String> {
+    let model = settings.model().map_err(|e| e.to_string())?;
+    let params = RuleParams::default();
+    let route = enforce_rules(nest, &route, settings.rules, &params)
+        .map_err(|e| e.to_string())?
+        .route;
+    if !settings.penalised() {
+        return Ok(route);
+    }
+    let candidates = if settings.rules.part {
+        Some(admissible_pierce_points(nest, &route, &params).map_err(|e| e.to_string())?)
+    } else {
+        None
+    };
+    let weight_mm = heat_penalty(settings, objective).weight_mm(machine);
+    relax_pierce_points(
+        nest,
+        &route,
+        machine,
+        &model,
+        weight_mm,
+        RELAX_PASSES,
+        candidates.as_deref(),
+    )
+    .map_err(|e| e.to_string())
+}
+
+/// Adds to every arc between two candidate pierce points of `discrete` the heat term H would
+/// get from that pair being consecutive, `weight_mm · exp(−d²/(2σ²) − Δt/τ)`, with d the
+/// points' distance and Δt = pierce time + the first contour's cut + the idle move (the arc's
+/// own cost, mm) under `machine`. Arcs from the depot and forbidden arcs are left alone.
+pub fn price_consecutive_heat(
+    discrete: &mut cutroute_ccp::DiscreteInstance,
+    nest: &Nest,
+    model: &HeatModel,
+    weight_mm: f64,
+    machine: &MachineParameters,
+) {
+    use cutroute_ccp::DiscreteNode;
+    let n = discrete.instance.node_count;
+    let pierce_of = |v: usize| match discrete.nodes.get(v) {
+        Some(DiscreteNode::Pierce { contour, point }) => Some((*contour, *point)),
+        _ => None,
+    };
+    let nodes: Vec<_> = (0..n)
+        .map(|v| {
+            pierce_of(v).map(|(contour, point)| {
+                let cut = nest.contour(contour).map_or(0.0, |c| c.perimeter());
+                (point, machine.pierce_time + cut / machine.cut_speed)
+            })
+        })
+        .collect();
+    for (u, from) in nodes.iter().enumerate() {
+        let Some((pu, busy)) = from else { continue };
+        for (v, to) in nodes.iter().enumerate() {
+            let Some((pv, _)) = to else { continue };
+            let cost = &mut discrete.instance.cost[u * n + v];
+            if u == v || !cost.is_finite() {
+                continue;
+            }
+            let dt = busy + *cost / machine.idle_speed;
+            *cost += weight_mm * model.kernel((*pu - *pv).norm_squared(), dt);
+        }
+    }
+}
+
+/// CCP-Relax's penalty for the settings and objective.
+pub fn heat_penalty(settings: &ThermalSettings, objective: Objective) -> HeatPenalty {
+    HeatPenalty {
+        model: HeatModel {
+            sigma_mm: settings.sigma_mm,
+            tau_s: settings.tau_s,
+        },
+        weight: settings.weight,
+        objective,
+    }
+}
+
+/// What the thermal model says about one route.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ThermalMeasure {
+    /// H on the route's machine clock.
+    pub heat: f64,
+    /// Violations per checked group (`None` when no rule is selected).
+    pub counts: Option<RuleCounts>,
+    /// Every violation.
+    pub violations: Vec<Violation>,
+}
+
+/// H and the selected rules' violations of a contour route.
+pub fn measure_route(
+    nest: &Nest,
+    route: &Route,
+    settings: &ThermalSettings,
+    machine: &MachineParameters,
+) -> Result<ThermalMeasure, String> {
+    let heat = measure_heat(nest, route, settings, machine)?;
+    let (counts, violations) = if settings.rules.any() {
+        let report = check_rules(nest, route, settings.rules, &RuleParams::default())
+            .map_err(|e| e.to_string())?;
+        (Some(report.counts()), report.violations)
+    } else {
+        (None, Vec::new())
+    };
+    Ok(ThermalMeasure {
+        heat,
+        counts,
+        violations,
+    })
+}
+
+fn measure_heat(
+    nest: &Nest,
+    route: &Route,
+    settings: &ThermalSettings,
+    machine: &MachineParameters,
+) -> Result<f64, String> {
+    let model = settings.model().map_err(|e| e.to_string())?;
+    let pierces = route_pierces(route, nest, machine).map_err(|e| e.to_string())?;
+    Ok(model.load(&pierces))
+}
+
+/// H of a route of tool-on paths (one source per path, at its pierce).
+pub fn measure_path_route(
+    route: &PathRoute,
+    settings: &ThermalSettings,
+    machine: &MachineParameters,
+) -> Result<f64, String> {
+    let model = settings.model().map_err(|e| e.to_string())?;
+    Ok(model.load(&path_route_pierces(route, machine)))
+}
+
+/// The last measured route, so a progress report of an unchanged route costs a comparison.
+#[derive(Default)]
+struct Measured {
+    route: Option<Route>,
+    path_route: Option<PathRoute>,
+    heat: Option<f64>,
+    rules: Option<(Option<RuleCounts>, Vec<Violation>)>,
+    /// When H was last measured, and how long that took.
+    heat_measured: Option<(Instant, Duration)>,
+    /// When the rules were last checked, and how long that took.
+    rules_checked: Option<(Instant, Duration)>,
+}
+
+/// Whether a measure last run at `last` (start, duration) may run again.
+fn due(last: Option<(Instant, Duration)>, done: bool) -> bool {
+    match last {
+        None => true,
+        Some((at, took)) => done || at.elapsed() >= took * MEASURE_SPACING,
+    }
+}
+
+/// Any nest job with the thermal settings applied around it: H and the rule violations in
+/// every [`Progress`], and with `hard` the final route repaired by
+/// [`enforce_thermal_rules`] (contour routes only).
+pub struct ThermalJob {
+    inner: Box<dyn Job>,
+    solver: SolverKind,
+    nest: Nest,
+    /// Contours of the nest.
+    contours: usize,
+    machine: MachineParameters,
+    objective: Objective,
+    settings: ThermalSettings,
+    done: bool,
+    /// The repaired final route, or why the repair failed (the solver's route is then kept).
+    repaired: Option<Result<Route, String>>,
+    measured: RefCell<Measured>,
+}
+
+impl ThermalJob {
+    /// Wraps `inner`, a job of `solver` on `nest`.
+    pub fn new(
+        inner: Box<dyn Job>,
+        solver: SolverKind,
+        nest: Nest,
+        machine: MachineParameters,
+        objective: Objective,
+        settings: ThermalSettings,
+    ) -> Self {
+        ThermalJob {
+            inner,
+            solver,
+            contours: nest.parts.iter().map(|p| p.contours.len()).sum(),
+            nest,
+            machine,
+            objective,
+            settings,
+            done: false,
+            repaired: None,
+            measured: RefCell::default(),
+        }
+    }
+
+    /// The discrete solvers, whose order search does not price H.
+    fn discrete(&self) -> bool {
+        matches!(self.solver, SolverKind::Heuristic | SolverKind::Exact)
+    }
+
+    fn repair(&mut self) {
+        let hard = self.settings.hard && self.settings.rules.any();
+        let relax = self.settings.penalised() && self.discrete();
+        if !(hard || relax) {
+            return;
+        }
+        let Some(route) = self.inner.progress().route else {
+            return;
+        };
+        self.repaired = Some(if hard {
+            enforce_thermal_rules(
+                &self.nest,
+                route,
+                &self.settings,
+                &self.machine,
+                self.objective,
+            )
+        } else {
+            self.settings
+                .model()
+                .map_err(|e| e.to_string())
+                .and_then(|model| {
+                    let weight_mm =
+                        heat_penalty(&self.settings, self.objective).weight_mm(&self.machine);
+                    relax_pierce_points(
+                        &self.nest,
+                        &route,
+                        &self.machine,
+                        &model,
+                        weight_mm,
+                        RELAX_PASSES,
+                        None,
+                    )
+                    .map_err(|e| e.to_string())
+                })
+        });
+    }
+
+    /// Fills `progress`'s thermal fields from its route, measuring only what changed.
+    fn measure(&self, progress: &mut Progress) {
+        let mut measured = self.measured.borrow_mut();
+        if let Some(route) = &progress.route {
+            if measured.route.as_ref() != Some(route) {
+                *measured = Measured {
+                    route: Some(route.clone()),
+                    heat_measured: measured.heat_measured,
+                    rules_checked: measured.rules_checked,
+                    ..Measured::default()
+                };
+            }
+            if measured.heat.is_none() && due(measured.heat_measured, self.done) {
+                let started = Instant::now();
+                measured.heat = measure_heat(&self.nest, route, &self.settings, &self.machine).ok();
+                measured.heat_measured = Some((started, started.elapsed()));
+            }
+            let live = self.contours <= LIVE_RULES_MAX_CONTOURS;
+            if self.settings.rules.any()
+                && measured.rules.is_none()
+                && (self.done || (live && due(measured.rules_checked, false)))
+            {
+                let started = Instant::now();
+                if let Ok(report) = check_rules(
+                    &self.nest,
+                    route,
+                    self.settings.rules,
+                    &RuleParams::default(),
+                ) {
+                    measured.rules = Some((Some(report.counts()), report.violations));
+                }
+                measured.rules_checked = Some((started, started.elapsed()));
+            }
+            progress.heat = measured.heat;
+            if let Some((counts, violations)) = &measured.rules {
+                progress.rule_counts = *counts;
+                progress.violations = violations.clone();
+            }
+        } else if let Some(path_route) = &progress.path_route {
+            if measured.path_route.as_ref() != Some(path_route) {
+                *measured = Measured {
+                    heat: measure_path_route(path_route, &self.settings, &self.machine).ok(),
+                    path_route: Some(path_route.clone()),
+                    ..Measured::default()
+                };
+            }
+            progress.heat = measured.heat;
+        }
+    }
+}
+
+impl Job for ThermalJob {
+    fn step(&mut self, budget: Duration) -> JobStatus {
+        if self.done {
+            return JobStatus::Done;
+        }
+        if self.inner.step(budget) == JobStatus::Running {
+            return JobStatus::Running;
+        }
+        self.repair();
+        self.done = true;
+        JobStatus::Done
+    }
+
+    fn progress(&self) -> Progress {
+        let mut progress = self.inner.progress();
+        match &self.repaired {
+            Some(Ok(route)) if progress.route.as_ref() != Some(route) => {
+                // The solver's bounds are those of the problem without rules: a lower bound on
+                // every route stays sound (the rules only remove routes); the discrete one is
+                // about routes through its candidate points, which the changed route leaves.
+                // The optimality proof and the tour do not describe the changed route.
+                progress.upper_bound = Some(route.idle_length());
+                if self.discrete() {
+                    progress.lower_bound = None;
+                }
+                progress.proven_optimal = false;
+                progress.tour = None;
+                if !progress.certified.is_empty() {
+                    progress.certified = cutroute_ccp::route_certificates(&self.nest, route)
+                        .map(|c| c.iter().map(|c| c.condition1).collect())
+                        .unwrap_or_default();
+                }
+                progress.phase = if self.settings.hard {
+                    format!("{} · rules enforced", progress.phase)
+                } else {
+                    format!("{} · pierce points relaxed on idle + W·H", progress.phase)
+                };
+                progress.route = Some(route.clone());
+            }
+            _ if self.discrete() && self.settings.penalised() => {
+                // The tour's cost includes the arcs' heat terms: report the route's idle
+                // length, and no discrete bound (it bounds the penalised arcs).
+                if let Some(route) = &progress.route {
+                    progress.upper_bound = Some(route.idle_length());
+                }
+                progress.lower_bound = None;
+                progress.proven_optimal = false;
+            }
+            Some(Err(e)) => {
+                progress.phase =
+                    format!("{} · rule repair failed ({e}); route kept", progress.phase)
+            }
+            _ => {}
+        }
+        self.measure(&mut progress);
+        progress
+    }
+}
