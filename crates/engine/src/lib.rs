@@ -207,11 +207,41 @@ pub fn start_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
             let discrete =
                 cutroute_ccp::build_pcgtsp(nest, &options).map_err(|e| refused(e.to_string()))?;
             let instance = discrete.instance.clone();
-            discrete_job(
-                instance,
-                Some(discrete),
-                discrete_mode.unwrap_or(DiscreteMode::Heuristic),
-            )
+            let mode = discrete_mode.unwrap_or(DiscreteMode::Heuristic);
+            if mode == DiscreteMode::Exact && !options.round_costs {
+                // The exact search's own bounds relax "a pierce point is entered and left at
+                // one node" on nests of more than ~20 contours; the continuous bound of the
+                // same nest, start and finish (below the discrete optimum) keeps it.
+                let bound = cutroute_ccp::CcpLowerBound::new(
+                    nest,
+                    cutroute_ccp::LowerBoundOptions {
+                        start: *start,
+                        finish: *finish,
+                        budget_seconds: time_limit.as_secs_f64() / 2.0,
+                        first_stage: (time_limit / 20).clamp(
+                            web_time::Duration::from_millis(250),
+                            web_time::Duration::from_secs(3),
+                        ),
+                        ..Default::default()
+                    },
+                )
+                .map_err(|e| refused(e.to_string()))?;
+                let job = DiscreteJob::new(
+                    request.job_id,
+                    instance,
+                    Some(discrete),
+                    mode,
+                    time_limit
+                        .saturating_sub(started.elapsed())
+                        .max(time_limit / 10),
+                    params.seed,
+                    params.initial_upper_bound,
+                )
+                .map_err(refused)?
+                .with_lower_bound(bound);
+                return Ok(Box::new(job));
+            }
+            discrete_job(instance, Some(discrete), mode)
         }
         (Problem::PcgtspText { text }, _) => {
             let Some(mode) = discrete_mode else {

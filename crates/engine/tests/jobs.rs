@@ -224,3 +224,92 @@ fn the_chain_job_chains_in_short_slices_and_reports_the_phase() {
     assert!(result.phase.starts_with("chained:"), "{}", result.phase);
     check_route(&document.problem, &result);
 }
+
+/// The exact job on a discretised nest adds the continuous bound of the nest (`CcpLowerBound`):
+/// never above the discrete optimum, proven here by the exact solver alone on small random
+/// nests (5–7 contours, coarse steps), with and without a finish point.
+#[test]
+fn discrete_exact_job_bound_never_exceeds_the_discrete_optimum() {
+    use cutroute_geometry::{generate_nest, Point};
+    for seed in 1..=6u64 {
+        let nest = generate_nest(5 + (seed as usize % 3), seed);
+        let b = nest.bounding_box();
+        let start = Point::new(b.min.x - 10.0, b.min.y - 5.0);
+        let finish = (seed % 2 == 0).then(|| Point::new(b.max.x + 3.0, b.min.y));
+        let step = (b.max.x - b.min.x).max(b.max.y - b.min.y) / 6.0;
+        let params = SolverParams {
+            time_limit_s: 3.0,
+            discretisation_step_mm: step,
+            ..SolverParams::default()
+        };
+        let request = JobRequest {
+            job_id: 3,
+            problem: Problem::Nest {
+                nest: nest.clone(),
+                start,
+                finish,
+            },
+            solver: SolverKind::Exact,
+            params,
+        };
+        let mut job = start_job(&request).expect("starts");
+        let result = run_to_end(job.as_mut(), &mut |_| {});
+        let discrete = cutroute_ccp::build_pcgtsp(
+            &nest,
+            &cutroute_ccp::DiscretisationOptions {
+                start,
+                finish,
+                step,
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        let alone = cutroute_pcgtsp::solve(
+            &discrete.instance,
+            cutroute_pcgtsp::ExactOptions {
+                time_limit: None,
+                ..Default::default()
+            },
+            &mut |_| {},
+        )
+        .unwrap();
+        assert!(alone.proven_optimal(), "seed {seed}: not proven");
+        let optimum = alone.progress.upper_bound;
+        let lb = result.lower_bound.expect("a lower bound");
+        assert!(
+            lb <= optimum * (1.0 + 1e-9) + 1e-9,
+            "seed {seed}: job bound {lb} above the discrete optimum {optimum}"
+        );
+        let ub = result.upper_bound.expect("a tour");
+        assert!(ub >= optimum - 1e-6 * optimum.max(1.0), "seed {seed}");
+        // A bound offered above the optimum would end the search with a worse tour "proven".
+        if result.proven_optimal {
+            assert!(
+                (ub - optimum).abs() <= 1e-6 * optimum.max(1.0),
+                "seed {seed}: proven {ub} vs optimum {optimum}"
+            );
+        }
+    }
+}
+
+/// On seven.dbs (50 contours) the job's bound stays below its own route.
+#[test]
+fn discrete_exact_job_on_seven_reports_a_bound_below_its_route() {
+    let (name, bytes) = data("nests/dbs/seven.dbs");
+    let document = open_document(&name, &bytes).expect("opens");
+    let request = JobRequest {
+        job_id: 4,
+        problem: document.problem.clone(),
+        solver: SolverKind::Exact,
+        params: SolverParams {
+            time_limit_s: 3.0,
+            discretisation_step_mm: 25.0,
+            ..SolverParams::default()
+        },
+    };
+    let mut job = start_job(&request).expect("starts");
+    let result = run_to_end(job.as_mut(), &mut |_| {});
+    let idle = check_route(&document.problem, &result);
+    let lb = result.lower_bound.expect("a lower bound");
+    assert!(lb > 0.0 && lb <= idle, "bound {lb} vs route {idle}");
+}
