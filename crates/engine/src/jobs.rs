@@ -161,8 +161,9 @@ pub enum DiscreteMode {
 /// On a discretised nest the exact search may run beside the continuous bound of the same nest
 /// (`with_lower_bound`): every discrete tour is a continuous route with the same idle length,
 /// so the continuous optimum, and any lower bound of it, is below the discrete optimum. The
-/// exact search and the bound then share the exact search's part of each slice, and the bound
-/// is offered to the exact search as a proven lower bound.
+/// bound then gets the exact search's part of each slice until it ends or half the limit has
+/// passed, and shares it half and half after that; its value is offered to the exact search
+/// as a proven lower bound, and the job ends at its wall-clock limit.
 pub struct DiscreteJob {
     job_id: JobId,
     instance: Instance,
@@ -301,11 +302,26 @@ impl Job for DiscreteJob {
                 }
             }
         }
+        if self.bound.is_some() && self.started.elapsed() >= self.time_limit {
+            // The exact search counts only its share of the slices: the limit is wall time.
+            self.exact_done.get_or_insert(false);
+            return JobStatus::Done;
+        }
         let mut exact_share = budget - budget / 4;
         if self.bound_running && self.exact_done.is_none() {
-            let bound_share = exact_share / 2;
+            // The bound first (its stage at fixed candidates ends in seconds), for at most
+            // half of the limit; then the two share. The exact search's bound preparation on
+            // these orders is long and weaker than the continuous bound.
+            let bound_share = if self.started.elapsed() < self.time_limit / 2 {
+                exact_share
+            } else {
+                exact_share / 2
+            };
             exact_share -= bound_share;
             self.step_bound(bound_share);
+            if exact_share.is_zero() {
+                return JobStatus::Running;
+            }
         }
         let Some(exact) = self.exact.as_mut() else {
             return JobStatus::Done;
