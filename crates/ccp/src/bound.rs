@@ -23,6 +23,12 @@
 //!    for the continuous problem. Each arc cost is lowered by a tiny margin so that rounding
 //!    in the distance computations cannot lift it above the true set distance.
 //!
+//! **Fixed candidates** ([`CcpLowerBound::for_candidates`]): for routes that pierce only at
+//! given points (a discretised nest's candidates), each piece is a tiny arc around one
+//! candidate instead, so the relaxed PCGTSP is the discrete instance restricted to the kept
+//! contours (with the tail above) and there is nothing to refine: one stage, solved until
+//! it ends. Its optimum lies between the continuous relaxation's and the discrete optimum.
+//!
 //! **Refinement.** A stage builds the instance (row by row, in slices), then runs the exact
 //! solver for a doubling time share. Then the pieces holding the best route's pierce points and
 //! the pieces of the relaxed tour are halved, and the next stage starts. Finer pieces only raise
@@ -236,6 +242,8 @@ pub struct CcpLowerBound {
     incumbent_length: f64,
     incumbent_offered: bool,
     elapsed: Duration,
+    /// Pieces are fixed candidates (no refinement; one stage).
+    fixed: bool,
 }
 
 impl CcpLowerBound {
@@ -321,7 +329,48 @@ impl CcpLowerBound {
             incumbent_length: f64::INFINITY,
             incumbent_offered: false,
             elapsed: Duration::ZERO,
+            fixed: false,
         })
+    }
+
+    /// The bound for routes that pierce each contour only at one of `candidates` (contour,
+    /// point on it): the discrete model's bound. `None` when a kept contour has no candidate
+    /// or the candidates exceed `options.max_nodes`.
+    pub fn for_candidates(
+        nest: &Nest,
+        options: LowerBoundOptions,
+        candidates: &[(ContourRef, Point)],
+    ) -> Result<Option<CcpLowerBound>, CcpError> {
+        let mut bound = CcpLowerBound::new(nest, options)?;
+        let mut at: Vec<Vec<f64>> = vec![Vec::new(); bound.leaves.len()];
+        for &(r, p) in candidates {
+            if let Some(&leaf) = bound.by_ref.get(&r) {
+                at[leaf].push(bound.leaves[leaf].length_of(p));
+            }
+        }
+        let total: usize = at.iter().map(Vec::len).sum();
+        if at.iter().any(Vec::is_empty) || total + 1 > bound.options.max_nodes {
+            return Ok(None);
+        }
+        for (leaf, lengths) in at.iter_mut().enumerate() {
+            let perimeter = bound.leaves[leaf].perimeter();
+            // Half-width of each piece: the arc around a candidate absorbs the rounding of its
+            // arc length (a wider piece only lowers the distances, so any width is sound).
+            let half = 1e-7 * (1.0 + perimeter);
+            lengths.sort_by(f64::total_cmp);
+            lengths.dedup_by(|a, b| *a - *b <= half);
+            bound.pieces[leaf] = lengths
+                .iter()
+                .map(|&s| ((s - half).max(0.0), (s + half).min(perimeter)))
+                .collect();
+        }
+        bound.fixed = true;
+        Ok(Some(bound))
+    }
+
+    /// Contours the relaxation keeps (the innermost ones: its clusters).
+    pub fn kept_contours(&self) -> usize {
+        self.leaves.len()
     }
 
     /// The best certified lower bound so far (mm of idle travel; 0 before the first stage).
@@ -428,6 +477,11 @@ impl CcpLowerBound {
                             self.incumbent_length
                         )
                     });
+                    if self.fixed {
+                        // Nothing to refine: the stage ran until its exact search ended.
+                        self.stage = None;
+                        return false;
+                    }
                     let tour = progress.best_tour;
                     // With no piece left to split, the next stage reruns the same pieces
                     // with twice the time.
@@ -528,10 +582,19 @@ impl CcpLowerBound {
             precedence: Vec::new(),
             depot: 0,
         };
-        let share = self.options.first_stage * (1u32 << self.stages_done.min(16));
+        let share = if self.fixed {
+            // One stage: it runs until the exact search ends or the caller stops.
+            Duration::from_secs(1 << 40)
+        } else {
+            self.options.first_stage * (1u32 << self.stages_done.min(16))
+        };
         let options = ExactOptions {
             time_limit: Some(share),
-            budget_seconds: Some(self.options.budget_seconds.max(share.as_secs_f64())),
+            budget_seconds: Some(if self.fixed {
+                self.options.budget_seconds
+            } else {
+                self.options.budget_seconds.max(share.as_secs_f64())
+            }),
             memory_limit_bytes: self.options.memory_limit_bytes,
             heuristic: false,
             penalty_iterations: 0,
@@ -564,10 +627,19 @@ impl CcpLowerBound {
         let mut tour = vec![0];
         for &(leaf, s) in &self.incumbent {
             let pieces = &self.pieces[leaf];
+            // The piece holding the pierce point, else (fixed candidates, which need not
+            // cover the contour) the nearest one.
             let k = pieces
                 .iter()
                 .position(|&(a, b)| a <= s && s <= b)
-                .unwrap_or(pieces.len() - 1);
+                .unwrap_or_else(|| {
+                    (0..pieces.len())
+                        .min_by(|&i, &j| {
+                            let d = |k: usize| (0.5 * (pieces[k].0 + pieces[k].1) - s).abs();
+                            d(i).total_cmp(&d(j))
+                        })
+                        .unwrap_or(0)
+                });
             tour.push(first_node[leaf] + k);
         }
         Some(tour)

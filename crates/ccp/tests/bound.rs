@@ -284,3 +284,74 @@ fn a_sheet_too_large_for_the_relaxation_keeps_the_trivial_bound() {
     assert!(started.elapsed() < std::time::Duration::from_secs(5));
     assert_eq!(bound.lower_bound(), 0.0);
 }
+
+/// The bound at fixed candidates (a discretisation's pierce points) is never above the discrete
+/// optimum (proven by the exact solver alone), and where every contour is kept (no holes, so
+/// nothing is relaxed but the pieces' micrometre widths) it equals that optimum.
+#[test]
+fn at_fixed_candidates_never_above_the_discrete_optimum_and_exact_without_holes() {
+    use cutroute_ccp::{build_pcgtsp, DiscreteNode, DiscretisationOptions};
+    let mut without_holes = 0;
+    for seed in 1..=12u64 {
+        let nest = random_nest(seed);
+        let start = Point::new(-30.0, -10.0);
+        let finish = (seed % 3 == 0).then_some(Point::new(150.0, -20.0));
+        let discrete = build_pcgtsp(
+            &nest,
+            &DiscretisationOptions {
+                start,
+                finish,
+                step: 9.0,
+                ..DiscretisationOptions::default()
+            },
+        )
+        .unwrap();
+        let optimum = cutroute_pcgtsp::solve(
+            &discrete.instance,
+            cutroute_pcgtsp::ExactOptions {
+                time_limit: None,
+                ..Default::default()
+            },
+            &mut |_| {},
+        )
+        .unwrap();
+        assert!(optimum.proven_optimal(), "seed {seed}");
+        let optimum = optimum.progress.upper_bound;
+        let candidates: Vec<(ContourRef, Point)> = discrete
+            .nodes
+            .iter()
+            .filter_map(|n| match *n {
+                DiscreteNode::Pierce { contour, point } => Some((contour, point)),
+                DiscreteNode::Depot(_) => None,
+            })
+            .collect();
+        let options = LowerBoundOptions {
+            start,
+            finish,
+            budget_seconds: 2.0,
+            ..LowerBoundOptions::default()
+        };
+        let mut bound = CcpLowerBound::for_candidates(&nest, options, &candidates)
+            .unwrap()
+            .expect("every kept contour has candidates");
+        while bound.step(Duration::from_millis(50)) {}
+        assert_eq!(
+            bound.stages(),
+            1,
+            "seed {seed}: one stage, nothing to refine"
+        );
+        let lb = bound.lower_bound();
+        assert!(
+            lb <= optimum + 1e-9,
+            "seed {seed}: bound {lb} above the discrete optimum {optimum}"
+        );
+        if bound.kept_contours() == nest.contour_count() {
+            without_holes += 1;
+            assert!(
+                lb >= optimum - 1e-4,
+                "seed {seed}: bound {lb} vs discrete optimum {optimum} with every contour kept"
+            );
+        }
+    }
+    assert!(without_holes > 0, "no nest without holes was tried");
+}

@@ -455,7 +455,15 @@ fn run_job(job: &mut dyn Job, watch: &Watch, on_progress: &mut dyn FnMut(&Progre
             if stop {
                 seen.stopped = *watch.reason.lock().unwrap_or_else(|e| e.into_inner());
             }
-            return std::mem::take(&mut *seen);
+            // A copy, not `take`: the job is dropped after this returns, and dropping a large
+            // one (the exact search's states) can outlast the grace, when the main thread
+            // reports what was published; taken, that was nothing ("found no route").
+            return JobRun {
+                last: seen.last.clone(),
+                earlier_routes: seen.earlier_routes.clone(),
+                stopped: seen.stopped,
+                time_limit_s: seen.time_limit_s,
+            };
         }
     }
 }

@@ -158,6 +158,13 @@ pub enum DiscreteMode {
 /// A PCGTSP job: ALNS alone, or ALNS and the exact solver sharing the time (the heuristic gets
 /// a quarter of each slice while the exact search runs, and every improvement it finds is
 /// offered to the exact search as an incumbent).
+///
+/// On a discretised nest the exact search may run beside the continuous bound of the same nest
+/// (`with_lower_bound`): every discrete tour is a continuous route with the same idle length,
+/// so the continuous optimum, and any lower bound of it, is below the discrete optimum. The
+/// bound then gets the exact search's part of each slice until it ends or half the limit has
+/// passed, and shares it half and half after that; its value is offered to the exact search
+/// as a proven lower bound, and the job ends at its wall-clock limit.
 pub struct DiscreteJob {
     job_id: JobId,
     instance: Instance,
@@ -167,6 +174,11 @@ pub struct DiscreteJob {
     exact: Option<ExactSolver>,
     exact_done: Option<bool>,
     offered_cost: f64,
+    /// The continuous bound of the nest the instance discretises, while it may still improve.
+    bound: Option<CcpLowerBound>,
+    bound_running: bool,
+    offered_route_cost: f64,
+    time_limit: Duration,
     started: Instant,
 }
 
@@ -191,8 +203,12 @@ impl DiscreteJob {
         let exact = match mode {
             DiscreteMode::Heuristic => None,
             DiscreteMode::Exact => {
+                // ALNS supplies the incumbents here, so the exact solver's own beam search
+                // (which ate the whole budget on nests of 50-90 contours, leaving only the
+                // root assignment bound) is switched off: the time goes to the bounds.
                 let options = ExactOptions {
                     time_limit: Some(time_limit),
+                    heuristic: false,
                     ..ExactOptions::default()
                 };
                 let _ = initial_upper_bound;
@@ -208,8 +224,47 @@ impl DiscreteJob {
             exact,
             exact_done: None,
             offered_cost: f64::INFINITY,
+            bound: None,
+            bound_running: false,
+            offered_route_cost: f64::INFINITY,
+            time_limit,
             started: Instant::now(),
         })
+    }
+
+    /// Adds the continuous lower bound (`CcpLowerBound`) of the nest this job's instance
+    /// discretises, with the same start and finish and unrounded costs (the caller vouches for
+    /// that: the bound is then below the discrete optimum). Only for the exact mode.
+    pub fn with_lower_bound(mut self, bound: CcpLowerBound) -> Self {
+        if self.exact.is_some() && self.discrete.is_some() {
+            self.bound = Some(bound);
+            self.bound_running = true;
+        }
+        self
+    }
+
+    /// Runs the continuous bound for `slice` and hands its value to the exact search.
+    fn step_bound(&mut self, slice: Duration) {
+        let (Some(bound), Some(exact)) = (self.bound.as_mut(), self.exact.as_mut()) else {
+            return;
+        };
+        if !self.bound_running {
+            return;
+        }
+        if let (Some(discrete), Some((tour, cost))) = (&self.discrete, self.alns.best()) {
+            if cost < self.offered_route_cost {
+                if let Ok(route) = discrete.tour_to_route(tour) {
+                    self.offered_route_cost = cost;
+                    bound.offer_route(&route);
+                }
+            }
+        }
+        let left = self.time_limit.saturating_sub(self.started.elapsed());
+        self.bound_running = !left.is_zero() && bound.step(slice.min(left));
+        let lb = bound.lower_bound();
+        if lb > 0.0 {
+            exact.offer_lower_bound(lb);
+        }
     }
 
     fn best_tour(&self) -> Option<(Vec<usize>, f64)> {
@@ -248,8 +303,32 @@ impl Job for DiscreteJob {
                 }
             }
         }
+        if self.bound.is_some() && self.started.elapsed() >= self.time_limit {
+            // The exact search counts only its share of the slices: the limit is wall time.
+            self.exact_done.get_or_insert(false);
+            return JobStatus::Done;
+        }
+        let mut exact_share = budget - budget / 4;
+        if self.bound_running && self.exact_done.is_none() {
+            // The bound first (its stage at fixed candidates ends in seconds), for at most
+            // half of the limit; then the two share. The exact search's bound preparation on
+            // these orders is long and weaker than the continuous bound.
+            let bound_share = if self.started.elapsed() < self.time_limit / 2 {
+                exact_share
+            } else {
+                exact_share / 2
+            };
+            exact_share -= bound_share;
+            self.step_bound(bound_share);
+            if exact_share.is_zero() {
+                return JobStatus::Running;
+            }
+        }
+        let Some(exact) = self.exact.as_mut() else {
+            return JobStatus::Done;
+        };
         if self.exact_done.is_none() {
-            match exact.step(budget - budget / 4) {
+            match exact.step(exact_share) {
                 cutroute_pcgtsp::SolverStatus::Running => {}
                 cutroute_pcgtsp::SolverStatus::Finished { proven_optimal } => {
                     self.exact_done = Some(proven_optimal)

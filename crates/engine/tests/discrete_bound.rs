@@ -1,0 +1,146 @@
+//! The exact job on a discretised nest with the interval bound of the nest beside it. Its own
+//! test binary: these runs are CPU-heavy, and beside the timed checks of `jobs.rs` (a bound
+//! within a 1 s CCP run) they would compete for the same cores.
+
+use std::path::PathBuf;
+
+use cutroute_engine::{open_document, run_to_end, start_job};
+use cutroute_protocol::{JobRequest, Problem, Progress, SolverKind, SolverParams};
+use web_time::Duration;
+
+fn data(relative: &str) -> (String, Vec<u8>) {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../data")
+        .join(relative);
+    let bytes = std::fs::read(&path)
+        .unwrap_or_else(|e| panic!("missing test file {}: {e}", path.display()));
+    (relative.to_string(), bytes)
+}
+
+fn check_route(problem: &Problem, result: &Progress) -> f64 {
+    let Problem::Nest { nest, .. } = problem else {
+        panic!("a nest")
+    };
+    let route = result.route.as_ref().expect("a route");
+    route
+        .validate(nest, 1e-3)
+        .expect("the route passes the independent checker");
+    let idle = route.idle_length();
+    let reported = result.upper_bound.expect("an upper bound");
+    assert!(
+        (idle - reported).abs() <= 1e-6 * idle.max(1.0),
+        "reported {reported} vs recomputed {idle}"
+    );
+    idle
+}
+
+/// The exact job with the interval bound of the nest beside it (`DiscreteJob::with_lower_bound`,
+/// as `start_job` builds it for nests above 35 contours): never above the discrete optimum,
+/// proven here by the exact solver alone on small random nests (5–7 contours, coarse steps),
+/// with and without a finish point, for both the refined continuous bound and the bound at the
+/// discretisation's candidates.
+#[test]
+fn discrete_exact_job_bound_never_exceeds_the_discrete_optimum() {
+    use cutroute_ccp::{CcpLowerBound, DiscreteNode, LowerBoundOptions};
+    use cutroute_engine::{DiscreteJob, DiscreteMode};
+    use cutroute_geometry::{generate_nest, Point};
+    for seed in 1..=6u64 {
+        let nest = generate_nest(5 + (seed as usize % 3), seed);
+        let b = nest.bounding_box();
+        let start = Point::new(b.min.x - 10.0, b.min.y - 5.0);
+        let finish = (seed % 2 == 0).then(|| Point::new(b.max.x + 3.0, b.min.y));
+        let step = (b.max.x - b.min.x).max(b.max.y - b.min.y) / 6.0;
+        let discrete = cutroute_ccp::build_pcgtsp(
+            &nest,
+            &cutroute_ccp::DiscretisationOptions {
+                start,
+                finish,
+                step,
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        let alone = cutroute_pcgtsp::solve(
+            &discrete.instance,
+            cutroute_pcgtsp::ExactOptions {
+                time_limit: None,
+                ..Default::default()
+            },
+            &mut |_| {},
+        )
+        .unwrap();
+        assert!(alone.proven_optimal(), "seed {seed}: not proven");
+        let optimum = alone.progress.upper_bound;
+        let candidates: Vec<_> = discrete
+            .nodes
+            .iter()
+            .filter_map(|n| match *n {
+                DiscreteNode::Pierce { contour, point } => Some((contour, point)),
+                DiscreteNode::Depot(_) => None,
+            })
+            .collect();
+        for at_candidates in [false, true] {
+            let options = LowerBoundOptions {
+                start,
+                finish,
+                budget_seconds: 1.0,
+                ..Default::default()
+            };
+            let bound = if at_candidates {
+                CcpLowerBound::for_candidates(&nest, options, &candidates)
+                    .unwrap()
+                    .expect("candidates on every kept contour")
+            } else {
+                CcpLowerBound::new(&nest, options).unwrap()
+            };
+            let mut job = DiscreteJob::new(
+                3,
+                discrete.instance.clone(),
+                Some(discrete.clone()),
+                DiscreteMode::Exact,
+                Duration::from_secs(2),
+                seed,
+                None,
+            )
+            .unwrap()
+            .with_lower_bound(bound);
+            let result = run_to_end(&mut job, &mut |_| {});
+            let lb = result.lower_bound.expect("a lower bound");
+            assert!(
+                lb <= optimum * (1.0 + 1e-9) + 1e-9,
+                "seed {seed} ({at_candidates}): job bound {lb} above the discrete optimum {optimum}"
+            );
+            let ub = result.upper_bound.expect("a tour");
+            assert!(ub >= optimum - 1e-6 * optimum.max(1.0), "seed {seed}");
+            // A bound offered above the optimum would end the search with a worse tour "proven".
+            if result.proven_optimal {
+                assert!(
+                    (ub - optimum).abs() <= 1e-6 * optimum.max(1.0),
+                    "seed {seed}: proven {ub} vs optimum {optimum}"
+                );
+            }
+        }
+    }
+}
+
+/// On seven.dbs (50 contours) the job's bound stays below its own route.
+#[test]
+fn discrete_exact_job_on_seven_reports_a_bound_below_its_route() {
+    let (name, bytes) = data("nests/dbs/seven.dbs");
+    let document = open_document(&name, &bytes).expect("opens");
+    let request = JobRequest {
+        job_id: 4,
+        problem: document.problem.clone(),
+        solver: SolverKind::Exact,
+        params: SolverParams {
+            time_limit_s: 3.0,
+            discretisation_step_mm: 25.0,
+            ..SolverParams::default()
+        },
+    };
+    let mut job = start_job(&request).expect("starts");
+    let result = run_to_end(job.as_mut(), &mut |_| {});
+    let idle = check_route(&document.problem, &result);
+    let lb = result.lower_bound.expect("a lower bound");
+    assert!(lb > 0.0 && lb <= idle, "bound {lb} vs route {idle}");
+}
