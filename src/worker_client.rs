@@ -316,7 +316,8 @@ pub fn spawn(
 fn create_worker(path: &str) -> web_sys::Worker {
     // The single-file page carries the worker's script and wasm behind a loader of its own.
     if let Some(loader) = crate::embedded::worker_loader() {
-        return web_sys::Worker::new(&loader).expect_throw("the solver worker could not be started");
+        return web_sys::Worker::new(&loader)
+            .expect_throw("the solver worker could not be started");
     }
     let href = web_sys::window()
         .and_then(|w| w.location().href().ok())
