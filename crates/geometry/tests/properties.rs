@@ -221,9 +221,10 @@ proptest! {
             prop_assert!(s.point_at(x.t_self).distance(x.point) < 1e-6);
             prop_assert!(o.point_at(x.t_other).distance(x.point) < 1e-6);
         }
-        // Every crossing of the dense polylines is near a reported intersection, unless all
-        // possible intersections were found already (at near-tangent crossings a polyline's
-        // crossing can drift far from the true one).
+        // Every transversal crossing of the dense polylines is near a reported intersection,
+        // unless all possible intersections were found already. Near-tangent crossings are left
+        // out: there the chords of two arcs can cross where the arcs themselves pass each other
+        // at a tiny gap (bulges −20 and 5 did), or a true crossing's polyline image drifts far.
         let most = if s.is_line() && o.is_line() { 1 } else { 2 };
         prop_assume!(found.len() < most);
         let (ps, po) = (samples(&s, 600), samples(&o, 600));
@@ -232,7 +233,7 @@ proptest! {
             for b in po.windows(2) {
                 let (r, q) = (a[1] - a[0], b[1] - b[0]);
                 let den = r.cross(q);
-                if den.abs() < 1e-12 { continue; }
+                if den.abs() < 1e-12 || den.abs() < 0.05 * r.norm() * q.norm() { continue; }
                 let w = b[0] - a[0];
                 let (t, u) = (w.cross(q) / den, w.cross(r) / den);
                 if (0.0..=1.0).contains(&t) && (0.0..=1.0).contains(&u) {
