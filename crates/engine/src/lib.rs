@@ -112,18 +112,15 @@ pub fn start_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
         SolverKind::Exact => Some(DiscreteMode::Exact),
         _ => None,
     };
-    let discrete_job = |instance, discrete, mode| -> Result<Box<dyn Job>, EngineError> {
+    let discrete_job = |instance, mode| -> Result<Box<dyn Job>, EngineError> {
         let job = DiscreteJob::new(
             request.job_id,
             instance,
-            discrete,
+            None,
             mode,
-            // At least a tenth of the limit, for a first tour after a long build.
-            time_limit
-                .saturating_sub(started.elapsed())
-                .max(time_limit / 10),
+            time_limit,
+            started,
             params.seed,
-            params.initial_upper_bound,
         )
         .map_err(refused)?;
         Ok(Box::new(job))
@@ -161,12 +158,10 @@ pub fn start_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
             let ccp =
                 cutroute_ccp::CcpSolver::new(nest, options).map_err(|e| refused(e.to_string()))?;
             if solver == SolverKind::Chain {
-                return Ok(Box::new(ChainJob::new(
-                    request.job_id,
-                    ccp,
-                    nest.clone(),
-                    params.machine,
-                )));
+                return Ok(Box::new(
+                    ChainJob::new(request.job_id, ccp, nest.clone(), params.machine)
+                        .with_time_limit(started, time_limit),
+                ));
             }
             let bound = cutroute_ccp::CcpLowerBound::new(
                 nest,
@@ -204,14 +199,17 @@ pub fn start_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
                 step: params.discretisation_step_mm,
                 ..cutroute_ccp::DiscretisationOptions::default()
             };
-            let discrete =
-                cutroute_ccp::build_pcgtsp(nest, &options).map_err(|e| refused(e.to_string()))?;
-            let instance = discrete.instance.clone();
-            discrete_job(
-                instance,
-                Some(discrete),
+            // The matrix is filled in the job's first steps (seconds on big nests).
+            let builder = cutroute_ccp::PcgtspBuilder::new(nest, &options)
+                .map_err(|e| refused(e.to_string()))?;
+            Ok(Box::new(DiscreteJob::building(
+                request.job_id,
+                builder,
                 discrete_mode.unwrap_or(DiscreteMode::Heuristic),
-            )
+                time_limit,
+                started,
+                params.seed,
+            )))
         }
         (Problem::PcgtspText { text }, _) => {
             let Some(mode) = discrete_mode else {
@@ -222,7 +220,7 @@ pub fn start_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
             };
             let instance =
                 cutroute_pcgtsp::Instance::parse(text).map_err(|e| refused(e.to_string()))?;
-            discrete_job(instance, None, mode)
+            discrete_job(instance, mode)
         }
     }
 }

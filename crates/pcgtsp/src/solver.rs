@@ -721,8 +721,12 @@ impl ExactSolver {
                         for r in (0..self.runs.len()).filter(|_| self.runs[0].preparation.is_none())
                         {
                             if let Some(mut tour) = heuristic::greedy(&self.runs[r].model) {
-                                let cost =
-                                    heuristic::improve(&self.runs[r].model, &mut tour, 20_000);
+                                let cost = heuristic::improve(
+                                    &self.runs[r].model,
+                                    &mut tour,
+                                    20_000,
+                                    began + deadline,
+                                );
                                 if cost < self.incumbent.upper_bound {
                                     if let Ok(checked) = check_tour(&self.instance, &tour) {
                                         self.incumbent.upper_bound = checked;
@@ -785,7 +789,7 @@ impl ExactSolver {
                         });
                         *engine = None;
                         *beam += 1;
-                        self.polish_incumbent();
+                        self.polish_incumbent(began + deadline);
                         debug_log(|| {
                             format!(
                                 "polished at {:?}: UB {}",
@@ -887,8 +891,8 @@ impl ExactSolver {
         SolverStatus::Stopped
     }
 
-    /// Local search on the incumbent (for the start node it begins with).
-    fn polish_incumbent(&mut self) {
+    /// Local search on the incumbent (for the start node it begins with), until `deadline`.
+    fn polish_incumbent(&mut self, deadline: Instant) {
         let Some(tour) = self.incumbent.tour.clone() else {
             return;
         };
@@ -896,7 +900,7 @@ impl ExactSolver {
             return;
         };
         let mut improved = tour;
-        let cost = heuristic::improve(&run.model, &mut improved, 200_000);
+        let cost = heuristic::improve(&run.model, &mut improved, 200_000, deadline);
         if cost < self.incumbent.upper_bound {
             if let Ok(checked) = check_tour(&self.instance, &improved) {
                 self.incumbent.upper_bound = checked;
