@@ -4,7 +4,7 @@
 //! `params.objective`), a lower bound in the same unit, and the candidates weighed as
 //! `alternatives`.
 
-use cutroute_aoe::{AoeSolution, AoeSolveOptions, PlanGraph, PlanOptions};
+use cutroute_aoe::{AoeSolution, AoeSolveOptions, AoeSolving, PlanGraph, PlanOptions};
 use cutroute_geometry::{MachineParameters, Nest, Objective, PathRoute, Point};
 use cutroute_protocol::{JobId, JobRequest, Problem, Progress, RouteSummary, SolverKind};
 use cutroute_segments::{
@@ -278,10 +278,10 @@ impl Job for SegmentJob {
     }
 }
 
-/// Common-edge routes along AOE-chains (`cutroute-aoe`'s `solve_nest`): linear-time chains per
-/// component and a short ordering of the components, done in one step (the longest on the
-/// real nests is in `BENCHMARKS.md`). Its lower bound: the plan's length cut once and the
-/// trail pierce bound.
+/// Common-edge routes along AOE-chains (`cutroute-aoe`'s [`AoeSolving`]): the plan graph and
+/// linear-time chains per component in the first step, the ordering of the components in
+/// slices (a round of moves per piece), the plan bound in a step of its own. Its lower bound:
+/// the plan's length cut once and the trail pierce bound.
 pub struct AoeJob {
     job_id: JobId,
     nest: Nest,
@@ -289,6 +289,10 @@ pub struct AoeJob {
     finish_bound: (Point, Option<Point>),
     machine: MachineParameters,
     objective: Objective,
+    /// The ordering under way (after the first step).
+    solving: Option<Box<AoeSolving>>,
+    /// The route, before its plan bound is measured.
+    solved: Option<AoeSolution>,
     outcome: Option<Result<(AoeSolution, Option<PlanBound>), String>>,
     started: Instant,
 }
@@ -311,6 +315,8 @@ impl AoeJob {
             finish_bound: (start, finish),
             machine: request.params.machine,
             objective: request.params.objective,
+            solving: None,
+            solved: None,
             outcome: None,
             started: Instant::now(),
         })
@@ -323,18 +329,45 @@ impl AoeJob {
 }
 
 impl Job for AoeJob {
-    fn step(&mut self, _budget: Duration) -> JobStatus {
-        if self.outcome.is_none() {
-            let solved =
-                cutroute_aoe::solve_nest(&self.nest, &self.options).map_err(|e| e.to_string());
-            self.outcome = Some(solved.map(|solution| {
-                let (start, finish) = self.finish_bound;
-                let bound =
-                    PlanBound::new(&self.nest, start, finish, self.options.plan.tolerance).ok();
-                (solution, bound)
-            }));
+    fn step(&mut self, budget: Duration) -> JobStatus {
+        if self.outcome.is_some() {
+            return JobStatus::Done;
         }
-        JobStatus::Done
+        if let Some(solution) = self.solved.take() {
+            // The plan bound builds the plan graph again: a step of its own.
+            let (start, finish) = self.finish_bound;
+            let bound = PlanBound::new(&self.nest, start, finish, self.options.plan.tolerance).ok();
+            self.outcome = Some(Ok((solution, bound)));
+            return JobStatus::Done;
+        }
+        let Some(solving) = self.solving.as_mut() else {
+            match AoeSolving::new(&self.nest, &self.options) {
+                Ok(solving) => {
+                    self.solving = Some(Box::new(solving));
+                    return JobStatus::Running;
+                }
+                Err(e) => {
+                    self.outcome = Some(Err(e.to_string()));
+                    return JobStatus::Done;
+                }
+            }
+        };
+        let slice_end = Instant::now().checked_add(budget);
+        match solving.advance(&self.nest, &self.options, &|| {
+            slice_end.is_some_and(|end| Instant::now() >= end)
+        }) {
+            None => JobStatus::Running,
+            Some(Ok(solution)) => {
+                self.solving = None;
+                self.solved = Some(solution);
+                JobStatus::Running
+            }
+            Some(Err(e)) => {
+                self.solving = None;
+                self.outcome = Some(Err(e.to_string()));
+                JobStatus::Done
+            }
+        }
     }
 
     fn progress(&self) -> Progress {
@@ -343,6 +376,8 @@ impl Job for AoeJob {
             _ => None,
         };
         let phase = match &self.outcome {
+            None if self.solved.is_some() => "common-edge routes: measuring the plan bound".into(),
+            None if self.solving.is_some() => "common-edge routes: ordering the components".into(),
             None => "common-edge routes: building the plan graph".to_string(),
             Some(Ok((solution, _))) => format!(
                 "common-edge routes: {} chains in {} components",
