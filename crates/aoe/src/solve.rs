@@ -292,6 +292,23 @@ impl AoeSolving {
         Some(self.route(nest, options))
     }
 
+    /// Ends the ordering now (a time limit): the route of the best ordering so far (the plain
+    /// inner-first area order at worst), checked as [`AoeSolving::advance`]'s is.
+    pub fn finish_now(
+        &mut self,
+        nest: &Nest,
+        options: &AoeSolveOptions,
+    ) -> Result<AoeSolution, AoeSolveError> {
+        if let Some((placed, order, _)) = self.ordering.take() {
+            let idle = idle_length(&placed, &order, options.start, options.finish);
+            if idle < self.best.0 {
+                self.best = (idle, placed, order);
+            }
+        }
+        self.starts.clear();
+        self.route(nest, options)
+    }
+
     /// The route of the best ordering, checked by the plan's and the nest's checkers.
     fn route(
         &mut self,

@@ -293,6 +293,8 @@ pub struct AoeJob {
     solving: Option<Box<AoeSolving>>,
     /// The route, before its plan bound is measured.
     solved: Option<AoeSolution>,
+    /// The job's wall-clock end: the ordering stops there with its best so far.
+    deadline: Option<Instant>,
     outcome: Option<Result<(AoeSolution, Option<PlanBound>), String>>,
     started: Instant,
 }
@@ -317,6 +319,9 @@ impl AoeJob {
             objective: request.params.objective,
             solving: None,
             solved: None,
+            deadline: Instant::now().checked_add(Duration::from_secs_f64(
+                request.params.time_limit_s.clamp(0.0, 1.0e7),
+            )),
             outcome: None,
             started: Instant::now(),
         })
@@ -353,9 +358,14 @@ impl Job for AoeJob {
             }
         };
         let slice_end = Instant::now().checked_add(budget);
-        match solving.advance(&self.nest, &self.options, &|| {
-            slice_end.is_some_and(|end| Instant::now() >= end)
-        }) {
+        let advanced = if self.deadline.is_some_and(|end| Instant::now() >= end) {
+            Some(solving.finish_now(&self.nest, &self.options))
+        } else {
+            solving.advance(&self.nest, &self.options, &|| {
+                slice_end.is_some_and(|end| Instant::now() >= end)
+            })
+        };
+        match advanced {
             None => JobStatus::Running,
             Some(Ok(solution)) => {
                 self.solving = None;
