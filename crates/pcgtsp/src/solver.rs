@@ -507,6 +507,12 @@ enum Phase {
     Done(SolverStatus),
 }
 
+/// The least time the or-opt polish of a tour gets in a step, whatever the slice: on small
+/// instances 20,000 evaluations take about 0.1 s and the tour they give shortens the proof; on
+/// a discretised nest of 5,000 nodes they took 21 s, so the polish stops here (a step may
+/// overrun a shorter slice by this much).
+const POLISH_SLICE: Duration = Duration::from_millis(150);
+
 /// The anytime exact solver: construct, then call [`ExactSolver::step`] until it stops
 /// returning [`SolverStatus::Running`]; read [`ExactSolver::progress`] at any time; feed
 /// tours found elsewhere with [`ExactSolver::offer_incumbent`].
@@ -725,7 +731,7 @@ impl ExactSolver {
                                     &self.runs[r].model,
                                     &mut tour,
                                     20_000,
-                                    began + deadline,
+                                    began + deadline.max(POLISH_SLICE),
                                 );
                                 if cost < self.incumbent.upper_bound {
                                     if let Ok(checked) = check_tour(&self.instance, &tour) {
@@ -789,7 +795,7 @@ impl ExactSolver {
                         });
                         *engine = None;
                         *beam += 1;
-                        self.polish_incumbent(began + deadline);
+                        self.polish_incumbent(began + deadline.max(POLISH_SLICE));
                         debug_log(|| {
                             format!(
                                 "polished at {:?}: UB {}",
