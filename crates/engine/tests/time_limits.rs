@@ -13,9 +13,14 @@ use web_time::{Duration, Instant};
 
 const SLICE: Duration = Duration::from_millis(40);
 
-/// A step may overrun its slice by this much (the machine is shared; the promise is "Stop
-/// within 200 ms").
-const LONGEST_STEP_S: f64 = 0.25;
+/// The longest step allowed. The promise is "Stop within 200 ms" in the release build; this
+/// test build is unoptimised (opt-level 1) and CI machines are shared (steps of 0.17 s in
+/// release measured 0.34 s here under a load average of 15), hence the margin.
+/// `cargo run --release -p cutroute-bench --bin time_limits` measures the release steps.
+const LONGEST_STEP_S: f64 = 0.5;
+
+/// The two tests run one at a time: in parallel they would slow each other's steps.
+static ONE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
 
 /// (solver, input, what) whose steps are known to run longer than [`LONGEST_STEP_S`]: single
 /// pieces of work not yet split (measured in BENCHMARKS.md, "Time limits in the engine").
@@ -105,6 +110,7 @@ fn run(problem: &Problem, solver: SolverKind, limit_s: f64) -> Run {
 }
 
 fn assert_promises_kept(name: &str, problem: &Problem, limit_s: f64) {
+    let _alone = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let Problem::Nest { nest, .. } = problem else {
         panic!("a nest")
     };
