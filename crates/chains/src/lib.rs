@@ -713,17 +713,8 @@ impl Context<'_> {
                             0.0
                         })
                 };
-                // Symmetric corners tie on straight cost; which of them are tried must not be
-                // decided by the last bits of the float maths (wasm32's libm and the native one
-                // differ there, and the page's links differed from the CLI's by 1.5 mm): costs
-                // are compared rounded to 1e-9 of the nest's size, ties kept in contour order.
-                let quantum = 1e-9 * self.scale.max(1.0);
-                let mut keyed: Vec<(f64, Point)> = chain[k]
-                    .spans()
-                    .map(|s| ((straight_cost(s.start) / quantum).round(), s.start))
-                    .collect();
-                keyed.sort_by(|a, b| a.0.total_cmp(&b.0));
-                let mut candidates: Vec<Point> = keyed.into_iter().map(|(_, p)| p).collect();
+                let mut candidates: Vec<Point> = chain[k].spans().map(|s| s.start).collect();
+                candidates.sort_by(|a, b| straight_cost(*a).total_cmp(&straight_cost(*b)));
                 candidates.truncate(REFINEMENT_CANDIDATES);
                 // Links are never shorter than straight: a candidate whose straight-line cost
                 // is no better than the best true cost so far cannot win.
