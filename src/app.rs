@@ -402,14 +402,28 @@ pub fn App() -> impl IntoView {
     let stop = move |_| {
         if let JobState::Running(job_id) = job_state.get_untracked() {
             bridge.with_value(|b| b.send(ToWorker::Cancel { job_id }));
-            // The worker answers between solver steps; a step that runs long (a big chain
-            // group, a bound build) would hold Stop up. After 150 ms the job is dropped with
-            // the best result already received and a fresh worker takes over (the old one is
-            // told to close, and its late messages name a job that is no longer running), so
-            // Stop takes effect within the promised 200 ms, page updates included.
+            // The worker answers between solver steps, which the jobs keep short (their long
+            // phases run in slices), so the job stops itself. A step that still runs long (the
+            // few single pieces listed in BENCHMARKS.md, "Time limits in the engine") would
+            // hold Stop up: as a safety net, after 150 ms the job is dropped with the best
+            // result already received and a fresh worker takes over (the old one is told to
+            // close, and its late messages name a job that is no longer running), so Stop
+            // takes effect within the promised 200 ms, page updates included. The net firing
+            // is logged and marked on the page (`data-stop-fallback` = the job's id), so tests
+            // can tell a job that stopped itself from one that was replaced.
             set_timeout(
                 move || {
                     if job_state.get_untracked() == JobState::Running(job_id) {
+                        leptos::logging::warn!(
+                            "Stop: job {job_id} did not stop itself within 150 ms; its worker \
+                             was replaced"
+                        );
+                        if let Some(root) = web_sys::window()
+                            .and_then(|w| w.document())
+                            .and_then(|d| d.document_element())
+                        {
+                            let _ = root.set_attribute("data-stop-fallback", &job_id.to_string());
+                        }
                         bridge.set_value(spawn_worker());
                         job_state.set(JobState::Cancelled);
                     }

@@ -2,7 +2,8 @@
 // sample, runs a solver job in the Web Worker, draws the route, and cancels a running job.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { watchErrors, useApp, screenshot, cli, assertRounded } from './harness.mjs';
+import path from 'node:path';
+import { watchErrors, useApp, screenshot, cli, assertRounded, projectRoot } from './harness.mjs';
 
 const app = useApp(before, after);
 
@@ -62,6 +63,39 @@ test('opens the default sample, solves in the worker, draws the route, cancels',
     document.querySelector('#stop').click();
   }));
   assert.ok(cancelMs <= 200, `Stop took effect in ${cancelMs.toFixed(1)} ms (promise: 200 ms)`);
+  // By the job's own cooperation: the page's safety net (a fresh worker after 150 ms) did not fire.
+  assert.equal(await page.getAttribute('html', 'data-stop-fallback'), null, 'the job stopped itself');
   await screenshot(page, 'shell-cancelled.png');
+  assert.deepEqual(errors, [], 'no errors in the page');
+});
+
+test('Stop reaches an exact job while it builds its model (nested.dbs at 25 mm)', async () => {
+  const page = await app.browser.newPage({ viewport: { width: 1280, height: 800 } });
+  const errors = watchErrors(page);
+  await page.goto(app.baseUrl);
+  await page.waitForFunction(() => document.querySelector('#file-name')?.textContent.includes('E1X_6_01'),
+    null, { timeout: 20000 });
+  await page.setInputFiles('#file-input', path.resolve(projectRoot, 'data', 'nests', 'dbs', 'nested.dbs'));
+  await page.waitForFunction(() => document.querySelector('#file-name')?.textContent.includes('nested.dbs'),
+    null, { timeout: 20000 });
+  await page.selectOption('#solver', 'exact');
+  for (const [id, value] of [['#step', '25'], ['#time-limit', '60']]) {
+    await page.fill(id, value);
+    await page.dispatchEvent(id, 'change');
+  }
+  await page.click('#start');
+  // The job's first report names the build (the cost matrix is filled row by row in steps).
+  await page.waitForFunction(() => document.querySelector('#job-status')?.textContent === 'running'
+    && (document.querySelector('#phase')?.textContent ?? '').startsWith('building the model'), null, { timeout: 20000 });
+  const cancelMs = await page.evaluate(() => new Promise((resolve) => {
+    const status = document.querySelector('#job-status');
+    const clicked = performance.now();
+    new MutationObserver((_, observer) => {
+      if (status.textContent === 'cancelled') { observer.disconnect(); resolve(performance.now() - clicked); }
+    }).observe(status, { childList: true, characterData: true, subtree: true });
+    document.querySelector('#stop').click();
+  }));
+  assert.ok(cancelMs <= 200, `Stop took effect in ${cancelMs.toFixed(1)} ms (promise: 200 ms)`);
+  assert.equal(await page.getAttribute('html', 'data-stop-fallback'), null, 'the job stopped itself');
   assert.deepEqual(errors, [], 'no errors in the page');
 });

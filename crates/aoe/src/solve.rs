@@ -115,151 +115,253 @@ struct Opening {
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub fn solve_nest(nest: &Nest, options: &AoeSolveOptions) -> Result<AoeSolution, AoeSolveError> {
-    let plan = PlanGraph::from_nest(nest, &options.plan)?;
-    let components = plan.components()?;
-    let forest = nest.containment_forest();
-    let mut visits = Vec::with_capacity(components.len());
-    let mut pierce_lower_bound = 0;
-    let mut contours_of = Vec::with_capacity(components.len());
-    for component in &components {
-        pierce_lower_bound += crate::pierce_lower_bound(component.embedding.graph());
-        let chains = plan.component_chains(component);
-        let entry = chains
-            .first()
-            .and_then(|c| c.spans.first())
-            .map_or(options.start, |s| s.start);
-        let exit = chains
-            .last()
-            .and_then(|c| c.spans.last())
-            .map_or(entry, |s| s.end);
-        let inner_idle = chains
-            .windows(2)
-            .filter_map(|w| Some(w[0].spans.last()?.end.distance(w[1].spans.first()?.start)))
-            .sum();
-        let simple_cycle = chains.len() == 1
-            && (0..component.embedding.graph().vertex_count())
-                .all(|v| component.embedding.graph().degree(v) == 2);
-        visits.push(Visit {
-            chains,
-            entry,
-            exit,
-            inner_idle,
-            opening: simple_cycle.then_some(Opening { span: 0, t: 0.0 }),
-        });
-        let mut contours: Vec<_> = component
-            .edges
-            .iter()
-            .flat_map(|&e| plan.edge_contours(e).iter().copied())
-            .collect();
-        contours.sort();
-        contours.dedup();
-        contours_of.push(contours);
-    }
-    // before[b] lists the components that must be cut before b: those holding a contour that
-    // lies inside one of b's contours (and is not itself b's).
-    let n = components.len();
-    let mut before: Vec<Vec<usize>> = vec![Vec::new(); n];
-    let mut owner = std::collections::HashMap::new();
-    for (c, contours) in contours_of.iter().enumerate() {
-        for &r in contours {
-            owner.entry(r).or_insert_with(Vec::new).push(c);
+    let mut solving = AoeSolving::new(nest, options)?;
+    loop {
+        if let Some(result) = solving.advance(nest, options, &|| false) {
+            return result;
         }
     }
-    for (a, contours) in contours_of.iter().enumerate() {
-        for &r in contours {
-            for outer in forest.ancestors(r) {
-                for &b in owner.get(&outer).map_or(&[][..], |v| &v[..]) {
-                    if b != a && !before[b].contains(&a) {
-                        before[b].push(a);
+}
+
+/// [`solve_nest`] in resumable pieces, for callers that must stay responsive (the app's worker
+/// answers Stop between slices): [`AoeSolving::new`] builds the plan graph and the components'
+/// chains, [`AoeSolving::advance`] orders them — one start of the nearest-ready order or one
+/// round of moves per piece, `stop` asked after each — and checks the route. On 1,000
+/// components the ordering alone took seconds, a single step of the worker before. The result
+/// does not depend on where `stop` falls. Pass the same nest and options to every call.
+pub struct AoeSolving {
+    plan: PlanGraph,
+    n: usize,
+    visits: Vec<Visit>,
+    before: Vec<Vec<usize>>,
+    after: Vec<Vec<usize>>,
+    pierce_lower_bound: usize,
+    unordered_idle_length: f64,
+    /// The shortest ordering so far: idle length, visits (closed curves placed), order.
+    best: (f64, Vec<Visit>, Vec<usize>),
+    /// The starts of the ordering still to try (`choose_points` of each), next last.
+    starts: Vec<bool>,
+    /// The start under way: its visits, order and rounds done.
+    ordering: Option<(Vec<Visit>, Vec<usize>, usize)>,
+}
+
+impl AoeSolving {
+    /// Builds the plan graph, its components and their chains, and the precedence between
+    /// components.
+    pub fn new(nest: &Nest, options: &AoeSolveOptions) -> Result<Self, AoeSolveError> {
+        let plan = PlanGraph::from_nest(nest, &options.plan)?;
+        let components = plan.components()?;
+        let forest = nest.containment_forest();
+        let mut visits = Vec::with_capacity(components.len());
+        let mut pierce_lower_bound = 0;
+        let mut contours_of = Vec::with_capacity(components.len());
+        for component in &components {
+            pierce_lower_bound += crate::pierce_lower_bound(component.embedding.graph());
+            let chains = plan.component_chains(component);
+            let entry = chains
+                .first()
+                .and_then(|c| c.spans.first())
+                .map_or(options.start, |s| s.start);
+            let exit = chains
+                .last()
+                .and_then(|c| c.spans.last())
+                .map_or(entry, |s| s.end);
+            let inner_idle = chains
+                .windows(2)
+                .filter_map(|w| Some(w[0].spans.last()?.end.distance(w[1].spans.first()?.start)))
+                .sum();
+            let simple_cycle = chains.len() == 1
+                && (0..component.embedding.graph().vertex_count())
+                    .all(|v| component.embedding.graph().degree(v) == 2);
+            visits.push(Visit {
+                chains,
+                entry,
+                exit,
+                inner_idle,
+                opening: simple_cycle.then_some(Opening { span: 0, t: 0.0 }),
+            });
+            let mut contours: Vec<_> = component
+                .edges
+                .iter()
+                .flat_map(|&e| plan.edge_contours(e).iter().copied())
+                .collect();
+            contours.sort();
+            contours.dedup();
+            contours_of.push(contours);
+        }
+        // before[b] lists the components that must be cut before b: those holding a contour
+        // that lies inside one of b's contours (and is not itself b's).
+        let n = components.len();
+        let mut before: Vec<Vec<usize>> = vec![Vec::new(); n];
+        let mut owner = std::collections::HashMap::new();
+        for (c, contours) in contours_of.iter().enumerate() {
+            for &r in contours {
+                owner.entry(r).or_insert_with(Vec::new).push(c);
+            }
+        }
+        for (a, contours) in contours_of.iter().enumerate() {
+            for &r in contours {
+                for outer in forest.ancestors(r) {
+                    for &b in owner.get(&outer).map_or(&[][..], |v| &v[..]) {
+                        if b != a && !before[b].contains(&a) {
+                            before[b].push(a);
+                        }
                     }
                 }
             }
         }
-    }
-    let area_order = {
-        let enclosed: Vec<f64> = components.iter().map(|c| plan.enclosed_area(c)).collect();
-        let mut order: Vec<usize> = (0..n).collect();
-        order.sort_by(|&a, &b| enclosed[a].total_cmp(&enclosed[b]));
-        order
-    };
-    let (start, finish) = (options.start, options.finish);
-    let unordered_idle_length = idle_length(&visits, &area_order, start, finish);
-    let mut after: Vec<Vec<usize>> = vec![Vec::new(); n];
-    for (b, list) in before.iter().enumerate() {
-        for &a in list {
-            after[a].push(b);
-        }
-    }
-    // Nearest ready component (closed curves entered at their nearest point), then rounds of
-    // single-component moves and relaxation of the closed curves' points, while they gain.
-    // Two starts — closed curves entered at their nearest point, or at their chain's start —
-    // each improved; the shorter wins, and the plain area order if both are longer.
-    let mut best = (unordered_idle_length, visits.clone(), area_order.clone());
-    for choose_points in [true, false] {
-        let mut placed = visits.clone();
-        // A containment cycle cannot come from a valid nest; the area order stays then.
-        let Some(mut order) =
-            nearest_ready_order(&mut placed, &before, &after, start, choose_points)
-        else {
-            continue;
+        let area_order = {
+            let enclosed: Vec<f64> = components.iter().map(|c| plan.enclosed_area(c)).collect();
+            let mut order: Vec<usize> = (0..n).collect();
+            order.sort_by(|&a, &b| enclosed[a].total_cmp(&enclosed[b]));
+            order
         };
-        for _ in 0..ORDER_ROUNDS {
-            order = improve_by_moves(order, &before, &after, &placed, start, finish);
-            if relax_openings(&mut placed, &order, start, finish) < 1e-6 {
-                break;
+        let unordered_idle_length =
+            idle_length(&visits, &area_order, options.start, options.finish);
+        let mut after: Vec<Vec<usize>> = vec![Vec::new(); n];
+        for (b, list) in before.iter().enumerate() {
+            for &a in list {
+                after[a].push(b);
             }
         }
-        let idle = idle_length(&placed, &order, start, finish);
-        if idle < best.0 {
-            best = (idle, placed, order);
-        }
+        Ok(AoeSolving {
+            plan,
+            n,
+            best: (unordered_idle_length, visits.clone(), area_order),
+            visits,
+            before,
+            after,
+            pierce_lower_bound,
+            unordered_idle_length,
+            // Tried in the order true, then false.
+            starts: vec![false, true],
+            ordering: None,
+        })
     }
-    let (_, visits, order) = best;
 
-    let chains: Vec<CutChain> = order
-        .iter()
-        .flat_map(|&c| visits[c].chains.iter().cloned())
-        .collect();
-    plan.check_route(&chains)?;
-    let mut paths = Vec::with_capacity(chains.len());
-    for &c in &order {
-        let visit = &visits[c];
-        match visit.opening {
-            Some(opening) => {
-                let spans = &visit.chains[0].spans;
-                paths.push(ToolOnPath {
-                    pierce: visit.entry,
-                    spans: opened(spans, opening, visit.entry),
-                });
+    /// Works on the ordering piece by piece until `stop()` says so (`None`: call again) or the
+    /// route is made and checked.
+    pub fn advance(
+        &mut self,
+        nest: &Nest,
+        options: &AoeSolveOptions,
+        stop: &dyn Fn() -> bool,
+    ) -> Option<Result<AoeSolution, AoeSolveError>> {
+        let (start, finish) = (options.start, options.finish);
+        // Nearest ready component (closed curves entered at their nearest point), then rounds
+        // of single-component moves and relaxation of the closed curves' points, while they
+        // gain. Two starts — closed curves entered at their nearest point, or at their chain's
+        // start — each improved; the shorter wins, and the plain area order if both are longer.
+        loop {
+            match self.ordering.take() {
+                None => {
+                    let Some(choose_points) = self.starts.pop() else {
+                        break;
+                    };
+                    let mut placed = self.visits.clone();
+                    // A containment cycle cannot come from a valid nest; the area order stays
+                    // then.
+                    if let Some(order) = nearest_ready_order(
+                        &mut placed,
+                        &self.before,
+                        &self.after,
+                        start,
+                        choose_points,
+                    ) {
+                        self.ordering = Some((placed, order, 0));
+                    }
+                }
+                Some((mut placed, order, rounds)) => {
+                    let order =
+                        improve_by_moves(order, &self.before, &self.after, &placed, start, finish);
+                    let settled = relax_openings(&mut placed, &order, start, finish) < 1e-6;
+                    if settled || rounds + 1 >= ORDER_ROUNDS {
+                        let idle = idle_length(&placed, &order, start, finish);
+                        if idle < self.best.0 {
+                            self.best = (idle, placed, order);
+                        }
+                    } else {
+                        self.ordering = Some((placed, order, rounds + 1));
+                    }
+                }
             }
-            None => paths.extend(
-                visit
-                    .chains
-                    .iter()
-                    .filter(|c| !c.spans.is_empty())
-                    .map(|c| ToolOnPath {
+            if stop() {
+                return None;
+            }
+        }
+        Some(self.route(nest, options))
+    }
+
+    /// Ends the ordering now (a time limit): the route of the best ordering so far (the plain
+    /// inner-first area order at worst), checked as [`AoeSolving::advance`]'s is.
+    pub fn finish_now(
+        &mut self,
+        nest: &Nest,
+        options: &AoeSolveOptions,
+    ) -> Result<AoeSolution, AoeSolveError> {
+        if let Some((placed, order, _)) = self.ordering.take() {
+            let idle = idle_length(&placed, &order, options.start, options.finish);
+            if idle < self.best.0 {
+                self.best = (idle, placed, order);
+            }
+        }
+        self.starts.clear();
+        self.route(nest, options)
+    }
+
+    /// The route of the best ordering, checked by the plan's and the nest's checkers.
+    fn route(
+        &mut self,
+        nest: &Nest,
+        options: &AoeSolveOptions,
+    ) -> Result<AoeSolution, AoeSolveError> {
+        let (start, finish) = (options.start, options.finish);
+        let (_, visits, order) = std::mem::take(&mut self.best);
+        let plan = &self.plan;
+        let n = self.n;
+        let pierce_lower_bound = self.pierce_lower_bound;
+        let unordered_idle_length = self.unordered_idle_length;
+        let chains: Vec<CutChain> = order
+            .iter()
+            .flat_map(|&c| visits[c].chains.iter().cloned())
+            .collect();
+        plan.check_route(&chains)?;
+        let mut paths = Vec::with_capacity(chains.len());
+        for &c in &order {
+            let visit = &visits[c];
+            match visit.opening {
+                Some(opening) => {
+                    let spans = &visit.chains[0].spans;
+                    paths.push(ToolOnPath {
+                        pierce: visit.entry,
+                        spans: opened(spans, opening, visit.entry),
+                    });
+                }
+                None => paths.extend(visit.chains.iter().filter(|c| !c.spans.is_empty()).map(
+                    |c| ToolOnPath {
                         pierce: c.spans[0].start,
                         spans: c.spans.clone(),
-                    }),
-            ),
+                    },
+                )),
+            }
         }
+        let route = PathRoute {
+            start,
+            paths,
+            finish,
+        };
+        let tolerance = (options.plan.tolerance * 10.0).max(1e-6);
+        if let Some(problem) = route.problems(nest, tolerance).into_iter().next() {
+            return Err(AoeSolveError::Route(problem));
+        }
+        Ok(AoeSolution {
+            route,
+            chains,
+            components: n,
+            pierce_lower_bound,
+            unordered_idle_length,
+        })
     }
-    let route = PathRoute {
-        start,
-        paths,
-        finish,
-    };
-    let tolerance = (options.plan.tolerance * 10.0).max(1e-6);
-    if let Some(problem) = route.problems(nest, tolerance).into_iter().next() {
-        return Err(AoeSolveError::Route(problem));
-    }
-    Ok(AoeSolution {
-        route,
-        chains,
-        components: n,
-        pierce_lower_bound,
-        unordered_idle_length,
-    })
 }
 
 /// Idle length of visiting the components in `order`: start → entry, exit → next entry, …,

@@ -446,7 +446,9 @@ impl CcpLowerBound {
                     self.stage = Some(Stage::Building(self.start_building()));
                 }
                 Some(Stage::Building(mut b)) => {
-                    if self.build_rows(&mut b, deadline) {
+                    // A complete matrix waits for the next slice when this one is used up:
+                    // making the stage's solver is a long piece of work of its own.
+                    if self.build_rows(&mut b, deadline) && Instant::now() < deadline {
                         match self.start_solving(b) {
                             Some(s) => self.stage = Some(Stage::Solving(Box::new(s))),
                             None => return false,

@@ -76,99 +76,172 @@ pub fn build_pcgtsp(
     nest: &Nest,
     options: &DiscretisationOptions,
 ) -> Result<DiscreteInstance, CcpError> {
-    if !(options.step > 0.0 && options.step.is_finite()) {
-        return Err(CcpError::InvalidOption("step must be positive".into()));
-    }
-    let start = V::from(options.start);
-    let finish = options.finish.map(V::from);
-    let prob = Problem::new(nest, start, finish);
-    // Sized before anything is allocated: a contour gives at most one point per step of its
-    // perimeter, one more, and (with vertices) one per span.
-    let perimeter: f64 = prob
-        .shapes
-        .iter()
-        .flat_map(|shape| shape.spans.iter().map(|span| span.length()))
-        .sum();
-    let fixed: usize = prob.shapes.iter().map(|shape| shape.spans.len() + 2).sum();
-    let bound = perimeter / options.step + fixed as f64 + 1.0;
-    if fixed + 1 >= MAX_DISCRETE_NODES {
-        return Err(CcpError::InvalidOption(format!(
-            "{} contours of {} spans need more than the {MAX_DISCRETE_NODES} candidate points \
-             of a dense cost matrix at any step",
-            prob.shapes.len(),
-            fixed - 2 * prob.shapes.len()
-        )));
-    }
-    if bound.is_nan() || bound > MAX_DISCRETE_NODES as f64 {
-        let smallest = perimeter / (MAX_DISCRETE_NODES - fixed - 1) as f64;
-        return Err(CcpError::InvalidOption(format!(
-            "step {} mm gives up to {bound:.0} candidate points, above the {MAX_DISCRETE_NODES} \
-             of a dense cost matrix; use a step of at least {smallest:.3} mm for this nest",
-            options.step
-        )));
-    }
-    let mut nodes = vec![DiscreteNode::Depot(options.start)];
-    let mut points = vec![start];
-    let mut clusters = vec![vec![0usize]];
-    let mut node_cluster = vec![0usize];
-    for (i, contour_ref) in prob.refs.iter().enumerate() {
-        let contour = &nest.parts[contour_ref.part].contours[contour_ref.contour];
-        let mut cl = Vec::new();
-        for x in contour
-            .candidate_points(options.step, options.include_vertices)
-            .into_iter()
-            .map(V::from)
-        {
-            cl.push(points.len());
-            node_cluster.push(i + 1);
-            points.push(x);
-            nodes.push(DiscreteNode::Pierce {
-                contour: prob.refs[i],
-                point: x.into(),
-            });
+    let mut builder = PcgtspBuilder::new(nest, options)?;
+    loop {
+        if let Some(instance) = builder.advance(&|| false) {
+            return Ok(instance);
         }
-        clusters.push(cl);
     }
-    let n = points.len();
-    if n > MAX_DISCRETE_NODES {
-        return Err(CcpError::InvalidOption(format!(
-            "{n} candidate points: the dense cost matrix is too large"
-        )));
-    }
-    let mut cost = vec![f64::INFINITY; n * n];
-    for a in 0..n {
-        for b in 0..n {
-            if node_cluster[a] == node_cluster[b] {
-                continue;
+}
+
+/// [`build_pcgtsp`] in slices: [`PcgtspBuilder::new`] sizes the instance and places the
+/// candidate points (cheap), [`PcgtspBuilder::advance`] fills the dense cost matrix row by row
+/// until its `stop` says so. The matrix of a big nest takes seconds (Nest02 at 50 mm: 6,835
+/// rows, 0.7 s), and a worker that must answer Stop within 200 ms cannot wait for it.
+pub struct PcgtspBuilder {
+    nodes: Vec<DiscreteNode>,
+    points: Vec<V>,
+    clusters: Vec<Vec<usize>>,
+    node_cluster: Vec<usize>,
+    precedence: Vec<(usize, usize)>,
+    finish: Option<V>,
+    round_costs: bool,
+    start_point: Point,
+    finish_point: Option<Point>,
+    /// The rows filled so far (row `a` is the costs from node `a`).
+    cost: Vec<f64>,
+}
+
+impl PcgtspBuilder {
+    /// Checks the step, sizes the matrix (refusing more than [`MAX_DISCRETE_NODES`] nodes) and
+    /// places the candidate points; the matrix is not allocated yet.
+    pub fn new(nest: &Nest, options: &DiscretisationOptions) -> Result<Self, CcpError> {
+        if !(options.step > 0.0 && options.step.is_finite()) {
+            return Err(CcpError::InvalidOption("step must be positive".into()));
+        }
+        let start = V::from(options.start);
+        let finish = options.finish.map(V::from);
+        let prob = Problem::new(nest, start, finish);
+        // Sized before anything is allocated: a contour gives at most one point per step of its
+        // perimeter, one more, and (with vertices) one per span.
+        let perimeter: f64 = prob
+            .shapes
+            .iter()
+            .flat_map(|shape| shape.spans.iter().map(|span| span.length()))
+            .sum();
+        let fixed: usize = prob.shapes.iter().map(|shape| shape.spans.len() + 2).sum();
+        let bound = perimeter / options.step + fixed as f64 + 1.0;
+        if fixed + 1 >= MAX_DISCRETE_NODES {
+            return Err(CcpError::InvalidOption(format!(
+                "{} contours of {} spans need more than the {MAX_DISCRETE_NODES} candidate points \
+                 of a dense cost matrix at any step",
+                prob.shapes.len(),
+                fixed - 2 * prob.shapes.len()
+            )));
+        }
+        if bound.is_nan() || bound > MAX_DISCRETE_NODES as f64 {
+            let smallest = perimeter / (MAX_DISCRETE_NODES - fixed - 1) as f64;
+            return Err(CcpError::InvalidOption(format!(
+                "step {} mm gives up to {bound:.0} candidate points, above the {MAX_DISCRETE_NODES} \
+                 of a dense cost matrix; use a step of at least {smallest:.3} mm for this nest",
+                options.step
+            )));
+        }
+        let mut nodes = vec![DiscreteNode::Depot(options.start)];
+        let mut points = vec![start];
+        let mut clusters = vec![vec![0usize]];
+        let mut node_cluster = vec![0usize];
+        for (i, contour_ref) in prob.refs.iter().enumerate() {
+            let contour = &nest.parts[contour_ref.part].contours[contour_ref.contour];
+            let mut cl = Vec::new();
+            for x in contour
+                .candidate_points(options.step, options.include_vertices)
+                .into_iter()
+                .map(V::from)
+            {
+                cl.push(points.len());
+                node_cluster.push(i + 1);
+                points.push(x);
+                nodes.push(DiscreteNode::Pierce {
+                    contour: prob.refs[i],
+                    point: x.into(),
+                });
             }
-            let d = if b == 0 {
-                finish.map_or(0.0, |f| points[a].dist(f))
-            } else {
-                points[a].dist(points[b])
-            };
-            cost[a * n + b] = if options.round_costs { d.round() } else { d };
+            clusters.push(cl);
         }
+        let n = points.len();
+        if n > MAX_DISCRETE_NODES {
+            return Err(CcpError::InvalidOption(format!(
+                "{n} candidate points: the dense cost matrix is too large"
+            )));
+        }
+        let precedence = prob
+            .precedence_pairs()
+            .into_iter()
+            .map(|(inner, outer)| (inner + 1, outer + 1))
+            .collect();
+        Ok(PcgtspBuilder {
+            nodes,
+            points,
+            clusters,
+            node_cluster,
+            precedence,
+            finish,
+            round_costs: options.round_costs,
+            start_point: options.start,
+            finish_point: options.finish,
+            cost: Vec::new(),
+        })
     }
-    let precedence = prob
-        .precedence_pairs()
-        .into_iter()
-        .map(|(inner, outer)| (inner + 1, outer + 1))
-        .collect();
-    let instance = Instance {
-        name: "ccp-discretised".into(),
-        node_count: n,
-        cost,
-        clusters,
-        node_cluster,
-        precedence,
-        depot: 0,
-    };
-    Ok(DiscreteInstance {
-        instance,
-        nodes,
-        start: options.start,
-        finish: options.finish,
-    })
+
+    /// Nodes of the instance (candidate points and the depot).
+    pub fn node_count(&self) -> usize {
+        self.points.len()
+    }
+
+    /// What each node stands for (placed by [`PcgtspBuilder::new`], before any row is filled).
+    pub fn nodes(&self) -> &[DiscreteNode] {
+        &self.nodes
+    }
+
+    /// Rows of the cost matrix filled so far.
+    pub fn rows_done(&self) -> usize {
+        self.cost.len() / self.points.len().max(1)
+    }
+
+    /// Fills rows of the cost matrix, asking `stop` after each row; returns the instance once
+    /// every row is filled (`None`: call again).
+    pub fn advance(&mut self, stop: &dyn Fn() -> bool) -> Option<DiscreteInstance> {
+        let n = self.points.len();
+        if self.cost.capacity() < n * n {
+            self.cost.reserve_exact(n * n - self.cost.len());
+        }
+        while self.rows_done() < n {
+            let a = self.rows_done();
+            for b in 0..n {
+                let d = if self.node_cluster[a] == self.node_cluster[b] {
+                    f64::INFINITY
+                } else if b == 0 {
+                    self.finish.map_or(0.0, |f| self.points[a].dist(f))
+                } else {
+                    self.points[a].dist(self.points[b])
+                };
+                self.cost.push(if self.round_costs && d.is_finite() {
+                    d.round()
+                } else {
+                    d
+                });
+            }
+            if self.rows_done() < n && stop() {
+                return None;
+            }
+        }
+        let instance = Instance {
+            name: "ccp-discretised".into(),
+            node_count: n,
+            cost: std::mem::take(&mut self.cost),
+            clusters: std::mem::take(&mut self.clusters),
+            node_cluster: std::mem::take(&mut self.node_cluster),
+            precedence: std::mem::take(&mut self.precedence),
+            depot: 0,
+        };
+        Some(DiscreteInstance {
+            instance,
+            nodes: std::mem::take(&mut self.nodes),
+            start: self.start_point,
+            finish: self.finish_point,
+        })
+    }
 }
 
 impl DiscreteInstance {

@@ -89,7 +89,8 @@ mod solver;
 
 pub use bound::{CcpLowerBound, LowerBoundOptions, MAX_RELAXATION_ENTRIES};
 pub use discrete::{
-    build_pcgtsp, DiscreteInstance, DiscreteNode, DiscretisationOptions, MAX_DISCRETE_NODES,
+    build_pcgtsp, DiscreteInstance, DiscreteNode, DiscretisationOptions, PcgtspBuilder,
+    MAX_DISCRETE_NODES,
 };
 pub use route::{idle_length, route_certificates, route_metrics, ContourCertificate, RouteMetrics};
 pub use solver::{

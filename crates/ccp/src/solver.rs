@@ -427,7 +427,6 @@ impl CcpSolver {
 
     /// Runs the queue-driven VND; true when the queue emptied, false when time ran out.
     fn descend(&mut self, t0: Instant, budget: Duration) -> bool {
-        let mut count = 0u32;
         while let Some(c) = self.search.pop() {
             for nb in 0..Search::NEIGHBOURHOODS {
                 if self.search.explore(nb, c) {
@@ -435,8 +434,9 @@ impl CcpSolver {
                     break;
                 }
             }
-            count += 1;
-            if count.is_multiple_of(32) && self.out_of_time(t0, budget) {
+            // After every contour: on 460 contours 32 explorations took up to 1.7 s, far
+            // past a 40 ms slice, and a clock read is nothing beside one exploration.
+            if self.out_of_time(t0, budget) {
                 return false;
             }
         }

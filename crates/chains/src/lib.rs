@@ -285,6 +285,21 @@ impl Chaining {
     /// Tries groups of close contours until all are done (`true`) or `stop()` says so after a
     /// group (`false`: call again).
     pub fn step(&mut self, nest: &Nest, options: &ChainOptions, stop: &dyn Fn() -> bool) -> bool {
+        self.step_within(nest, options, stop, &|| false)
+    }
+
+    /// [`Chaining::step`] that also gives up when `abort()` says so, inside a group too (between
+    /// its contours): the group under way is left as it was, chaining ends (`true`) and the
+    /// route keeps every group done before. One group of a big scrap region can take seconds
+    /// (seven.dbs: 20 s), so a caller with a time limit passes its end here; groups are never
+    /// cut short by `stop`, so where slices end does not change the route.
+    pub fn step_within(
+        &mut self,
+        nest: &Nest,
+        options: &ChainOptions,
+        stop: &dyn Fn() -> bool,
+        abort: &dyn Fn() -> bool,
+    ) -> bool {
         let m = &options.machine;
         let context = Context {
             nest,
@@ -323,7 +338,11 @@ impl Chaining {
                 options.clearance_mm,
                 1e-9 * self.scale,
             );
-            let candidate = context.chain_group(&self.current, &group, &region);
+            let Some(candidate) = context.chain_group(&self.current, &group, &region, abort) else {
+                self.region = self.regions.len();
+                self.groups = None;
+                return true;
+            };
             let cost = candidate.cost(nest, m);
             if cost < self.current_cost - 1e-12 * self.current_cost.abs().max(1.0) {
                 self.current = candidate;
@@ -498,8 +517,15 @@ impl Context<'_> {
         reach.min(straight + 2.0 * self.scale)
     }
 
-    /// `current` with `group` cut as one chain where its last member stood.
-    fn chain_group(&self, current: &Route, group: &[ContourRef], region: &Region) -> Route {
+    /// `current` with `group` cut as one chain where its last member stood; `None` when
+    /// `abort()` said so on the way.
+    fn chain_group(
+        &self,
+        current: &Route,
+        group: &[ContourRef],
+        region: &Region,
+        abort: &dyn Fn() -> bool,
+    ) -> Option<Route> {
         let is_member = |c: ContourRef| group.contains(&c);
         let last = current
             .steps
@@ -552,17 +578,17 @@ impl Context<'_> {
             if best.is_some() && k == paper_at {
                 continue;
             }
-            let route = self.chain_at(current, group, &rest, k, region);
+            let route = self.chain_at(current, group, &rest, k, region, abort)?;
             let cost = route.cost(self.nest, self.machine);
             if best.as_ref().is_none_or(|(c, _)| cost < *c) {
                 best = Some((cost, route));
             }
         }
-        best.map_or_else(|| current.clone(), |(_, r)| r)
+        Some(best.map_or_else(|| current.clone(), |(_, r)| r))
     }
 
     /// `current` with `group` cut as one chain, inserted into `rest` (the other steps) at
-    /// `insert_at`.
+    /// `insert_at`; `None` when `abort()` said so (asked per contour of the group).
     fn chain_at(
         &self,
         current: &Route,
@@ -570,7 +596,8 @@ impl Context<'_> {
         rest: &[CutStep],
         insert_at: usize,
         region: &Region,
-    ) -> Route {
+        abort: &dyn Fn() -> bool,
+    ) -> Option<Route> {
         let rest = rest.to_vec();
         let before = if insert_at > 0 {
             rest[insert_at - 1].pierce_point
@@ -601,6 +628,9 @@ impl Context<'_> {
         let boxes: Vec<BoundingBox> = contours.iter().map(|c| c.bounding_box()).collect();
         let mut between = vec![vec![0.0; n]; n];
         for i in 0..n {
+            if abort() {
+                return None;
+            }
             for j in i + 1..n {
                 let near = box_distance(&boxes[i], &boxes[j]);
                 let d = if near < self.threshold {
@@ -657,6 +687,9 @@ impl Context<'_> {
         };
         for _ in 0..self.options.refinement_rounds {
             for k in 0..n {
+                if abort() {
+                    return None;
+                }
                 let entering = |x: Point| {
                     if k == 0 {
                         off * before.distance(x)
@@ -722,6 +755,9 @@ impl Context<'_> {
         // Links that pay, on obstacle-avoiding paths; elsewhere the chain is cut.
         let mut steps = Vec::with_capacity(n);
         for k in 0..n {
+            if abort() {
+                return None;
+            }
             let contour = group[order[k]];
             let entry = if k == 0 {
                 Entry::Pierce
@@ -744,10 +780,10 @@ impl Context<'_> {
         }
         let mut new_steps = rest;
         new_steps.splice(insert_at..insert_at, steps);
-        Route {
+        Some(Route {
             steps: new_steps,
             ..current.clone()
-        }
+        })
     }
 }
 

@@ -159,17 +159,30 @@ pub enum DiscreteMode {
 /// a quarter of each slice while the exact search runs, and every improvement it finds is
 /// offered to the exact search as an incumbent).
 ///
+/// The model is built in steps of its own, so no step runs long and the build counts against
+/// the limit: the discretisation's cost matrix row by row ([`cutroute_ccp::PcgtspBuilder`]),
+/// then the ALNS, then the exact solver (each solver gets the limit's rest when it is made).
+///
 /// On a discretised nest the exact search may run beside the continuous bound of the same nest
 /// (`with_lower_bound`): every discrete tour is a continuous route with the same idle length,
 /// so the continuous optimum, and any lower bound of it, is below the discrete optimum. The
 /// bound then gets the exact search's part of each slice until it ends or half the limit has
 /// passed, and shares it half and half after that; its value is offered to the exact search
-/// as a proven lower bound, and the job ends at its wall-clock limit.
+/// as a proven lower bound.
 pub struct DiscreteJob {
     job_id: JobId,
-    instance: Instance,
+    mode: DiscreteMode,
+    seed: u64,
+    /// The wall-clock end of the job (its limit counted from the request).
+    deadline: Instant,
+    /// A first tour is worth this much time even when the build used up the limit.
+    first_tour_allowance: Duration,
+    /// The discretisation under way (nest problems only).
+    builder: Option<Box<cutroute_ccp::PcgtspBuilder>>,
+    /// The instance of a PCGTSP problem (a nest's is in `discrete`).
+    instance: Option<Instance>,
     discrete: Option<DiscreteInstance>,
-    alns: AlnsSolver,
+    alns: Option<AlnsSolver>,
     alns_done: bool,
     exact: Option<ExactSolver>,
     exact_done: Option<bool>,
@@ -178,65 +191,86 @@ pub struct DiscreteJob {
     bound: Option<CcpLowerBound>,
     bound_running: bool,
     offered_route_cost: f64,
-    time_limit: Duration,
     started: Instant,
+    /// Why the job ended without a search (a solver refused the instance).
+    failure: Option<String>,
 }
 
 impl DiscreteJob {
-    /// Prepare the solvers; `discrete` maps nodes back to pierce points when the instance was
-    /// built from a nest.
+    /// A job on an instance, ended `time_limit` after `started` (the request's arrival: what
+    /// was spent before counts). `discrete` maps nodes back to pierce points when the instance
+    /// was built from a nest. The solvers are made here, so one that refuses the instance
+    /// (infeasible, too large) is an error now.
     pub fn new(
         job_id: JobId,
         instance: Instance,
         discrete: Option<DiscreteInstance>,
         mode: DiscreteMode,
         time_limit: Duration,
+        started: Instant,
         seed: u64,
-        initial_upper_bound: Option<f64>,
     ) -> Result<Self, String> {
-        let alns_options = AlnsOptions {
-            seed,
-            time_limit: Some(time_limit),
-            ..AlnsOptions::default()
-        };
-        let alns = AlnsSolver::new(&instance, alns_options).map_err(|e| e.to_string())?;
-        let exact = match mode {
-            DiscreteMode::Heuristic => None,
-            DiscreteMode::Exact => {
-                // ALNS supplies the incumbents here, so the exact solver's own beam search
-                // (which ate the whole budget on nests of 50-90 contours, leaving only the
-                // root assignment bound) is switched off: the time goes to the bounds.
-                let options = ExactOptions {
-                    time_limit: Some(time_limit),
-                    heuristic: false,
-                    ..ExactOptions::default()
-                };
-                let _ = initial_upper_bound;
-                Some(ExactSolver::new(&instance, options).map_err(|e| e.to_string())?)
+        let mut job = Self::pending(job_id, mode, time_limit, started, seed);
+        job.instance = Some(instance);
+        job.discrete = discrete;
+        while !job.build(Duration::MAX) {
+            if let Some(failure) = job.failure.take() {
+                return Err(failure);
             }
-        };
-        Ok(Self {
+        }
+        Ok(job)
+    }
+
+    /// A job on the discretisation `builder` is building (one step fills rows of its matrix).
+    pub fn building(
+        job_id: JobId,
+        builder: cutroute_ccp::PcgtspBuilder,
+        mode: DiscreteMode,
+        time_limit: Duration,
+        started: Instant,
+        seed: u64,
+    ) -> Self {
+        let mut job = Self::pending(job_id, mode, time_limit, started, seed);
+        job.builder = Some(Box::new(builder));
+        job
+    }
+
+    fn pending(
+        job_id: JobId,
+        mode: DiscreteMode,
+        time_limit: Duration,
+        started: Instant,
+        seed: u64,
+    ) -> Self {
+        Self {
             job_id,
-            instance,
-            discrete,
-            alns,
+            mode,
+            seed,
+            deadline: started + time_limit,
+            // A tenth of the limit, at most half a second: a run whose build used up the
+            // limit still gets a first tour, within the limit + 1 s promise.
+            first_tour_allowance: (time_limit / 10).min(Duration::from_millis(500)),
+            builder: None,
+            instance: None,
+            discrete: None,
+            alns: None,
             alns_done: false,
-            exact,
+            exact: None,
             exact_done: None,
             offered_cost: f64::INFINITY,
             bound: None,
             bound_running: false,
             offered_route_cost: f64::INFINITY,
-            time_limit,
-            started: Instant::now(),
-        })
+            started,
+            failure: None,
+        }
     }
 
     /// Adds the continuous lower bound (`CcpLowerBound`) of the nest this job's instance
     /// discretises, with the same start and finish and unrounded costs (the caller vouches for
     /// that: the bound is then below the discrete optimum). Only for the exact mode.
     pub fn with_lower_bound(mut self, bound: CcpLowerBound) -> Self {
-        if self.exact.is_some() && self.discrete.is_some() {
+        if self.mode == DiscreteMode::Exact {
             self.bound = Some(bound);
             self.bound_running = true;
         }
@@ -251,7 +285,8 @@ impl DiscreteJob {
         if !self.bound_running {
             return;
         }
-        if let (Some(discrete), Some((tour, cost))) = (&self.discrete, self.alns.best()) {
+        let best = self.alns.as_ref().and_then(|a| a.best());
+        if let (Some(discrete), Some((tour, cost))) = (&self.discrete, best) {
             if cost < self.offered_route_cost {
                 if let Ok(route) = discrete.tour_to_route(tour) {
                     self.offered_route_cost = cost;
@@ -259,7 +294,7 @@ impl DiscreteJob {
                 }
             }
         }
-        let left = self.time_limit.saturating_sub(self.started.elapsed());
+        let left = self.deadline.saturating_duration_since(Instant::now());
         self.bound_running = !left.is_zero() && bound.step(slice.min(left));
         let lb = bound.lower_bound();
         if lb > 0.0 {
@@ -267,8 +302,68 @@ impl DiscreteJob {
         }
     }
 
+    /// The time a solver made now may run.
+    fn time_left(&self) -> Duration {
+        self.deadline
+            .saturating_duration_since(Instant::now())
+            .max(self.first_tour_allowance)
+    }
+
+    /// Builds what is missing, one piece per call; true when everything is built.
+    fn build(&mut self, budget: Duration) -> bool {
+        if let Some(builder) = self.builder.as_mut() {
+            let slice_end = Instant::now().checked_add(budget);
+            if let Some(discrete) =
+                builder.advance(&|| slice_end.is_some_and(|end| Instant::now() >= end))
+            {
+                // Kept once, inside `discrete`: the dense matrix of a big nest is hundreds of MB.
+                self.discrete = Some(discrete);
+                self.builder = None;
+            }
+            return false;
+        }
+        let Some(instance) = self
+            .instance
+            .as_ref()
+            .or(self.discrete.as_ref().map(|d| &d.instance))
+        else {
+            return false;
+        };
+        if self.alns.is_none() {
+            let options = AlnsOptions {
+                seed: self.seed,
+                time_limit: Some(self.time_left()),
+                ..AlnsOptions::default()
+            };
+            match AlnsSolver::new(instance, options) {
+                Ok(alns) => self.alns = Some(alns),
+                Err(e) => self.failure = Some(e.to_string()),
+            }
+            return false;
+        }
+        if self.mode == DiscreteMode::Exact && self.exact.is_none() {
+            // ALNS supplies the incumbents here, so the exact solver's own beam search (which
+            // ate the whole budget on nests of 50-90 contours, leaving only the root assignment
+            // bound) is switched off: the time goes to the bounds.
+            let options = ExactOptions {
+                time_limit: Some(self.time_left()),
+                heuristic: false,
+                ..ExactOptions::default()
+            };
+            match ExactSolver::new(instance, options) {
+                Ok(exact) => self.exact = Some(exact),
+                Err(e) => self.failure = Some(e.to_string()),
+            }
+            return false;
+        }
+        true
+    }
+
     fn best_tour(&self) -> Option<(Vec<usize>, f64)> {
-        let heuristic = self.alns.best().map(|(tour, cost)| (tour.to_vec(), cost));
+        let heuristic = self
+            .alns
+            .as_ref()
+            .and_then(|a| a.best().map(|(tour, cost)| (tour.to_vec(), cost)));
         let exact = self.exact.as_ref().and_then(|e| {
             let p = e.progress();
             p.best_tour.map(|t| (t, p.upper_bound))
@@ -282,8 +377,33 @@ impl DiscreteJob {
 
 impl Job for DiscreteJob {
     fn step(&mut self, budget: Duration) -> JobStatus {
+        if self.failure.is_some() {
+            return JobStatus::Done;
+        }
+        if !self.build(budget) {
+            // A build past the limit ends the job (no solver yet: no tour to keep).
+            let over = Instant::now() >= self.deadline + self.first_tour_allowance;
+            return if self.failure.is_some() || (over && self.alns.is_none()) {
+                if self.failure.is_none() {
+                    self.failure = Some("the time limit passed while the model was built".into());
+                }
+                JobStatus::Done
+            } else {
+                JobStatus::Running
+            };
+        }
+        if Instant::now() >= self.deadline && self.best_tour().is_some() {
+            // The solvers count only their own shares of the slices (and were made after the
+            // build): the job's limit is wall time from the request, so it ends here.
+            if self.exact.is_some() && self.exact_done.is_none() {
+                self.exact_done = Some(false);
+            }
+            self.alns_done = true;
+            return JobStatus::Done;
+        }
+        let alns = self.alns.as_mut().expect("built");
         let Some(exact) = self.exact.as_mut() else {
-            if self.alns_done || self.alns.step(budget) == cutroute_alns::SolverStatus::Finished {
+            if self.alns_done || alns.step(budget) == cutroute_alns::SolverStatus::Finished {
                 self.alns_done = true;
                 return JobStatus::Done;
             }
@@ -295,25 +415,21 @@ impl Job for DiscreteJob {
             } else {
                 budget / 4
             };
-            self.alns_done = self.alns.step(share) == cutroute_alns::SolverStatus::Finished;
-            if let Some((tour, cost)) = self.alns.best() {
+            self.alns_done = alns.step(share) == cutroute_alns::SolverStatus::Finished;
+            if let Some((tour, cost)) = alns.best() {
                 if cost < self.offered_cost {
                     self.offered_cost = cost;
                     exact.offer_incumbent(tour, cost);
                 }
             }
         }
-        if self.bound.is_some() && self.started.elapsed() >= self.time_limit {
-            // The exact search counts only its share of the slices: the limit is wall time.
-            self.exact_done.get_or_insert(false);
-            return JobStatus::Done;
-        }
         let mut exact_share = budget - budget / 4;
         if self.bound_running && self.exact_done.is_none() {
             // The bound first (its stage at fixed candidates ends in seconds), for at most
             // half of the limit; then the two share. The exact search's bound preparation on
             // these orders is long and weaker than the continuous bound.
-            let bound_share = if self.started.elapsed() < self.time_limit / 2 {
+            let half_limit = self.started + (self.deadline - self.started) / 2;
+            let bound_share = if Instant::now() < half_limit {
                 exact_share
             } else {
                 exact_share / 2
@@ -324,9 +440,7 @@ impl Job for DiscreteJob {
                 return JobStatus::Running;
             }
         }
-        let Some(exact) = self.exact.as_mut() else {
-            return JobStatus::Done;
-        };
+        let exact = self.exact.as_mut().expect("built");
         if self.exact_done.is_none() {
             match exact.step(exact_share) {
                 cutroute_pcgtsp::SolverStatus::Running => {}
@@ -352,16 +466,31 @@ impl Job for DiscreteJob {
         };
         let proven_optimal = self.exact_done == Some(true);
         let phase = match (&exact, self.exact_done) {
+            _ if self.failure.is_some() => {
+                format!("stopped: {}", self.failure.as_deref().unwrap_or_default())
+            }
             (_, Some(true)) => "proven optimal".to_string(),
             (_, Some(false)) => "stopped".to_string(),
             (Some(p), None) => format!("layer {} · {} states", p.layer, p.live_states),
-            (None, _) => format!("ALNS · {} iterations", self.alns.progress().iterations),
+            (None, _) => match (&self.builder, &self.alns) {
+                (Some(b), _) => format!(
+                    "building the model: {} of {} rows of the cost matrix",
+                    b.rows_done(),
+                    b.node_count()
+                ),
+                (None, None) => "building the model: the heuristic".to_string(),
+                (None, Some(_)) if self.mode == DiscreteMode::Exact => {
+                    "building the model: the exact search".to_string()
+                }
+                (None, Some(alns)) => {
+                    format!("ALNS · {} iterations", alns.progress().iterations)
+                }
+            },
         };
         let lower_bound = exact
             .as_ref()
             .map(|p| p.lower_bound)
             .filter(|lb| lb.is_finite());
-        let _ = &self.instance;
         Progress {
             job_id: self.job_id,
             elapsed_s: self.started.elapsed().as_secs_f64(),
@@ -413,6 +542,8 @@ pub struct ChainJob {
     chained: Option<Chained>,
     failure: Option<String>,
     started: Instant,
+    /// The job's wall-clock end: chain cutting gives up the group under way there.
+    deadline: Option<Instant>,
 }
 
 impl ChainJob {
@@ -429,7 +560,15 @@ impl ChainJob {
             chained: None,
             failure: None,
             started: Instant::now(),
+            deadline: None,
         }
+    }
+
+    /// Ends the job `time_limit` after `started` (CCP has its own share of it): a chain group
+    /// still under way then is dropped and the route keeps the groups done before.
+    pub fn with_time_limit(mut self, started: Instant, time_limit: Duration) -> Self {
+        self.deadline = Some(started + time_limit);
+        self
     }
 }
 
@@ -456,7 +595,13 @@ impl Job for ChainJob {
             }
         }
         let chaining = self.chaining.as_mut().expect("set above");
-        if !chaining.step(&self.nest, &self.options, &|| Instant::now() >= deadline) {
+        let job_end = self.deadline;
+        if !chaining.step_within(
+            &self.nest,
+            &self.options,
+            &|| Instant::now() >= deadline,
+            &|| job_end.is_some_and(|end| Instant::now() >= end),
+        ) {
             return JobStatus::Running;
         }
         let chaining = self.chaining.take().expect("set above");

@@ -109,6 +109,19 @@ const DISCRETE_BOUND_MAX_KEPT: usize = 22;
 /// bound (the exact search's own bounds prove such nests: test0, test1, E1X_6_01 in seconds).
 const DISCRETE_EXACT_ALONE_CONTOURS: usize = 35;
 
+/// The candidate pierce points of a discretisation (its nodes but the depot).
+fn pierce_candidates(
+    nodes: &[cutroute_ccp::DiscreteNode],
+) -> Vec<(cutroute_geometry::ContourRef, cutroute_geometry::Point)> {
+    nodes
+        .iter()
+        .filter_map(|n| match *n {
+            cutroute_ccp::DiscreteNode::Pierce { contour, point } => Some((contour, point)),
+            cutroute_ccp::DiscreteNode::Depot(_) => None,
+        })
+        .collect()
+}
+
 /// Build the job a request asks for. On a nest, the job runs inside a [`ThermalJob`]: its
 /// progress carries H and the rule violations of [`SolverParams::thermal`], and with `hard`
 /// its final route is repaired until the rules hold; with a positive heat weight, nearest, ccp
@@ -212,18 +225,15 @@ fn start_solver_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
         SolverKind::Exact => Some(DiscreteMode::Exact),
         _ => None,
     };
-    let discrete_job = |instance, discrete, mode| -> Result<Box<dyn Job>, EngineError> {
+    let discrete_job = |instance, mode| -> Result<Box<dyn Job>, EngineError> {
         let job = DiscreteJob::new(
             request.job_id,
             instance,
-            discrete,
+            None,
             mode,
-            // At least a tenth of the limit, for a first tour after a long build.
-            time_limit
-                .saturating_sub(started.elapsed())
-                .max(time_limit / 10),
+            time_limit,
+            started,
             params.seed,
-            params.initial_upper_bound,
         )
         .map_err(refused)?;
         Ok(Box::new(job))
@@ -261,12 +271,10 @@ fn start_solver_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
             let ccp =
                 cutroute_ccp::CcpSolver::new(nest, options).map_err(|e| refused(e.to_string()))?;
             if solver == SolverKind::Chain {
-                return Ok(Box::new(ChainJob::new(
-                    request.job_id,
-                    ccp,
-                    nest.clone(),
-                    params.machine,
-                )));
+                return Ok(Box::new(
+                    ChainJob::new(request.job_id, ccp, nest.clone(), params.machine)
+                        .with_time_limit(started, time_limit),
+                ));
             }
             let bound = cutroute_ccp::CcpLowerBound::new(
                 nest,
@@ -304,9 +312,13 @@ fn start_solver_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
                 step: params.discretisation_step_mm,
                 ..cutroute_ccp::DiscretisationOptions::default()
             };
-            let mut discrete =
-                cutroute_ccp::build_pcgtsp(nest, &options).map_err(|e| refused(e.to_string()))?;
-            if params.thermal.penalised() {
+            let mode = discrete_mode.unwrap_or(DiscreteMode::Heuristic);
+            // With a heat weight the arcs are priced once the matrix is there: built here, in
+            // one piece. Otherwise the matrix is filled in the job's first steps (seconds on
+            // big nests), so no step runs long.
+            let (job, candidates) = if params.thermal.penalised() {
+                let mut discrete = cutroute_ccp::build_pcgtsp(nest, &options)
+                    .map_err(|e| refused(e.to_string()))?;
                 let model = params.thermal.model().map_err(|e| refused(e.to_string()))?;
                 let weight_mm = thermal::heat_penalty(&params.thermal, params.objective)
                     .weight_mm(&params.machine);
@@ -317,74 +329,75 @@ fn start_solver_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
                     weight_mm,
                     &params.machine,
                 );
-            }
-            let instance = discrete.instance.clone();
-            let mode = discrete_mode.unwrap_or(DiscreteMode::Heuristic);
-            // On nests of up to ~35 contours (the industrial set's size) the exact search
-            // builds its lattice bound and proves the discrete optimum itself: the continuous
-            // bound, below that optimum, would only take its time. (Counting the order's
-            // ideals to decide took 10 s on seven.dbs.)
-            let exact_alone = nest.contour_count() <= DISCRETE_EXACT_ALONE_CONTOURS;
-            if mode == DiscreteMode::Exact && !options.round_costs && !exact_alone {
-                // The exact search's own bounds relax "a pierce point is entered and left at
-                // one node" on nests of more than ~20 contours; the continuous bound of the
-                // same nest, start and finish (below the discrete optimum) keeps it.
-                let bound_options = cutroute_ccp::LowerBoundOptions {
-                    start: *start,
-                    finish: *finish,
-                    budget_seconds: time_limit.as_secs_f64() / 2.0,
-                    first_stage: (time_limit / 20).clamp(
-                        web_time::Duration::from_millis(250),
-                        web_time::Duration::from_secs(3),
-                    ),
-                    ..Default::default()
-                };
-                let bound = cutroute_ccp::CcpLowerBound::new(nest, bound_options.clone())
-                    .map_err(|e| refused(e.to_string()))?;
-                // Where the relaxed instance is solved exactly (the lattice of its ideals,
-                // 2^kept without precedence, is built up to a few million), the bound at the
-                // discretisation's own candidates is tighter than the continuous one and needs
-                // no refinement.
-                let bound = if bound.kept_contours() <= DISCRETE_BOUND_MAX_KEPT {
-                    let candidates: Vec<_> = discrete
-                        .nodes
-                        .iter()
-                        .filter_map(|n| match *n {
-                            cutroute_ccp::DiscreteNode::Pierce { contour, point } => {
-                                Some((contour, point))
-                            }
-                            cutroute_ccp::DiscreteNode::Depot(_) => None,
-                        })
-                        .collect();
-                    cutroute_ccp::CcpLowerBound::for_candidates(
-                        nest,
-                        cutroute_ccp::LowerBoundOptions {
-                            max_nodes: 4000,
-                            ..bound_options
-                        },
-                        &candidates,
-                    )
-                    .map_err(|e| refused(e.to_string()))?
-                    .unwrap_or(bound)
-                } else {
-                    bound
-                };
+                let candidates = pierce_candidates(&discrete.nodes);
+                let instance = discrete.instance.clone();
                 let job = DiscreteJob::new(
                     request.job_id,
                     instance,
                     Some(discrete),
                     mode,
-                    time_limit
-                        .saturating_sub(started.elapsed())
-                        .max(time_limit / 10),
+                    time_limit,
+                    started,
                     params.seed,
-                    params.initial_upper_bound,
                 )
-                .map_err(refused)?
-                .with_lower_bound(bound);
+                .map_err(refused)?;
+                (job, candidates)
+            } else {
+                let builder = cutroute_ccp::PcgtspBuilder::new(nest, &options)
+                    .map_err(|e| refused(e.to_string()))?;
+                let candidates = pierce_candidates(builder.nodes());
+                let job = DiscreteJob::building(
+                    request.job_id,
+                    builder,
+                    mode,
+                    time_limit,
+                    started,
+                    params.seed,
+                );
+                (job, candidates)
+            };
+            // On nests of up to ~35 contours (the industrial set's size) the exact search
+            // builds its lattice bound and proves the discrete optimum itself: the continuous
+            // bound, below that optimum, would only take its time. (Counting the order's
+            // ideals to decide took 10 s on seven.dbs.)
+            let exact_alone = nest.contour_count() <= DISCRETE_EXACT_ALONE_CONTOURS;
+            if mode != DiscreteMode::Exact || options.round_costs || exact_alone {
                 return Ok(Box::new(job));
             }
-            discrete_job(instance, Some(discrete), mode)
+            // The exact search's own bounds relax "a pierce point is entered and left at one
+            // node" on nests of more than ~20 contours; the continuous bound of the same nest,
+            // start and finish (below the discrete optimum) keeps it.
+            let bound_options = cutroute_ccp::LowerBoundOptions {
+                start: *start,
+                finish: *finish,
+                budget_seconds: time_limit.as_secs_f64() / 2.0,
+                first_stage: (time_limit / 20).clamp(
+                    web_time::Duration::from_millis(250),
+                    web_time::Duration::from_secs(3),
+                ),
+                ..Default::default()
+            };
+            let bound = cutroute_ccp::CcpLowerBound::new(nest, bound_options.clone())
+                .map_err(|e| refused(e.to_string()))?;
+            // Where the relaxed instance is solved exactly (the lattice of its ideals, 2^kept
+            // without precedence, is built up to a few million), the bound at the
+            // discretisation's own candidates is tighter than the continuous one and needs no
+            // refinement.
+            let bound = if bound.kept_contours() <= DISCRETE_BOUND_MAX_KEPT {
+                cutroute_ccp::CcpLowerBound::for_candidates(
+                    nest,
+                    cutroute_ccp::LowerBoundOptions {
+                        max_nodes: 4000,
+                        ..bound_options
+                    },
+                    &candidates,
+                )
+                .map_err(|e| refused(e.to_string()))?
+                .unwrap_or(bound)
+            } else {
+                bound
+            };
+            Ok(Box::new(job.with_lower_bound(bound)))
         }
         (Problem::PcgtspText { text }, _) => {
             let Some(mode) = discrete_mode else {
@@ -395,7 +408,7 @@ fn start_solver_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
             };
             let instance =
                 cutroute_pcgtsp::Instance::parse(text).map_err(|e| refused(e.to_string()))?;
-            discrete_job(instance, None, mode)
+            discrete_job(instance, mode)
         }
     }
 }

@@ -4,7 +4,7 @@
 //! `params.objective`), a lower bound in the same unit, and the candidates weighed as
 //! `alternatives`.
 
-use cutroute_aoe::{AoeSolution, AoeSolveOptions, PlanGraph, PlanOptions};
+use cutroute_aoe::{AoeSolution, AoeSolveOptions, AoeSolving, PlanGraph, PlanOptions};
 use cutroute_geometry::{MachineParameters, Nest, Objective, PathRoute, Point};
 use cutroute_protocol::{JobId, JobRequest, Problem, Progress, RouteSummary, SolverKind};
 use cutroute_segments::{
@@ -279,10 +279,10 @@ impl Job for SegmentJob {
     }
 }
 
-/// Common-edge routes along AOE-chains (`cutroute-aoe`'s `solve_nest`): linear-time chains per
-/// component and a short ordering of the components, done in one step (the longest on the
-/// real nests is in `BENCHMARKS.md`). Its lower bound: the plan's length cut once and the
-/// trail pierce bound.
+/// Common-edge routes along AOE-chains (`cutroute-aoe`'s [`AoeSolving`]): the plan graph and
+/// linear-time chains per component in the first step, the ordering of the components in
+/// slices (a round of moves per piece), the plan bound in a step of its own. Its lower bound:
+/// the plan's length cut once and the trail pierce bound.
 pub struct AoeJob {
     job_id: JobId,
     nest: Nest,
@@ -290,6 +290,12 @@ pub struct AoeJob {
     finish_bound: (Point, Option<Point>),
     machine: MachineParameters,
     objective: Objective,
+    /// The ordering under way (after the first step).
+    solving: Option<Box<AoeSolving>>,
+    /// The route, before its plan bound is measured.
+    solved: Option<AoeSolution>,
+    /// The job's wall-clock end: the ordering stops there with its best so far.
+    deadline: Option<Instant>,
     outcome: Option<Result<(AoeSolution, Option<PlanBound>), String>>,
     started: Instant,
 }
@@ -312,6 +318,11 @@ impl AoeJob {
             finish_bound: (start, finish),
             machine: request.params.machine,
             objective: request.params.objective,
+            solving: None,
+            solved: None,
+            deadline: Instant::now().checked_add(Duration::from_secs_f64(
+                request.params.time_limit_s.clamp(0.0, 1.0e7),
+            )),
             outcome: None,
             started: Instant::now(),
         })
@@ -324,18 +335,50 @@ impl AoeJob {
 }
 
 impl Job for AoeJob {
-    fn step(&mut self, _budget: Duration) -> JobStatus {
-        if self.outcome.is_none() {
-            let solved =
-                cutroute_aoe::solve_nest(&self.nest, &self.options).map_err(|e| e.to_string());
-            self.outcome = Some(solved.map(|solution| {
-                let (start, finish) = self.finish_bound;
-                let bound =
-                    PlanBound::new(&self.nest, start, finish, self.options.plan.tolerance).ok();
-                (solution, bound)
-            }));
+    fn step(&mut self, budget: Duration) -> JobStatus {
+        if self.outcome.is_some() {
+            return JobStatus::Done;
         }
-        JobStatus::Done
+        if let Some(solution) = self.solved.take() {
+            // The plan bound builds the plan graph again: a step of its own.
+            let (start, finish) = self.finish_bound;
+            let bound = PlanBound::new(&self.nest, start, finish, self.options.plan.tolerance).ok();
+            self.outcome = Some(Ok((solution, bound)));
+            return JobStatus::Done;
+        }
+        let Some(solving) = self.solving.as_mut() else {
+            match AoeSolving::new(&self.nest, &self.options) {
+                Ok(solving) => {
+                    self.solving = Some(Box::new(solving));
+                    return JobStatus::Running;
+                }
+                Err(e) => {
+                    self.outcome = Some(Err(e.to_string()));
+                    return JobStatus::Done;
+                }
+            }
+        };
+        let slice_end = Instant::now().checked_add(budget);
+        let advanced = if self.deadline.is_some_and(|end| Instant::now() >= end) {
+            Some(solving.finish_now(&self.nest, &self.options))
+        } else {
+            solving.advance(&self.nest, &self.options, &|| {
+                slice_end.is_some_and(|end| Instant::now() >= end)
+            })
+        };
+        match advanced {
+            None => JobStatus::Running,
+            Some(Ok(solution)) => {
+                self.solving = None;
+                self.solved = Some(solution);
+                JobStatus::Running
+            }
+            Some(Err(e)) => {
+                self.solving = None;
+                self.outcome = Some(Err(e.to_string()));
+                JobStatus::Done
+            }
+        }
     }
 
     fn progress(&self) -> Progress {
@@ -344,6 +387,8 @@ impl Job for AoeJob {
             _ => None,
         };
         let phase = match &self.outcome {
+            None if self.solved.is_some() => "common-edge routes: measuring the plan bound".into(),
+            None if self.solving.is_some() => "common-edge routes: ordering the components".into(),
             None => "common-edge routes: building the plan graph".to_string(),
             Some(Ok((solution, _))) => format!(
                 "common-edge routes: {} chains in {} components",

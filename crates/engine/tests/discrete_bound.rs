@@ -99,8 +99,8 @@ fn discrete_exact_job_bound_never_exceeds_the_discrete_optimum() {
                 Some(discrete.clone()),
                 DiscreteMode::Exact,
                 Duration::from_secs(2),
+                web_time::Instant::now(),
                 seed,
-                None,
             )
             .unwrap()
             .with_lower_bound(bound);

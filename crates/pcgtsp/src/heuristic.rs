@@ -3,6 +3,7 @@
 //! clusters or short cluster chains to better precedence-feasible positions (or-opt).
 
 use crate::bounds::Model;
+use web_time::Instant;
 
 const INF: f64 = f64::INFINITY;
 
@@ -56,8 +57,16 @@ pub(crate) fn best_nodes(model: &Model, clusters: &[usize]) -> (Vec<usize>, f64)
 }
 
 /// Improves a feasible node tour in place by or-opt cluster-chain moves (with node re-selection
-/// after every accepted move) until no move helps or `budget_moves` evaluations are used.
-pub(crate) fn improve(model: &Model, tour: &mut Vec<usize>, budget_moves: usize) -> f64 {
+/// after every accepted move) until no move helps, `budget_moves` evaluations are used or the
+/// clock passes `deadline` (each evaluation is a DP over every cluster's nodes: on a
+/// discretised nest of 5,000 nodes 20,000 of them take 20 s, so the caller's slice must bound
+/// them too). The tour is the best found either way.
+pub(crate) fn improve(
+    model: &Model,
+    tour: &mut Vec<usize>,
+    budget_moves: usize,
+    deadline: Instant,
+) -> f64 {
     let m = tour.len();
     let mut clusters: Vec<usize> = tour.iter().map(|&v| model.node_cluster[v]).collect();
     let (mut nodes, mut cost) = best_nodes(model, &clusters);
@@ -66,7 +75,7 @@ pub(crate) fn improve(model: &Model, tour: &mut Vec<usize>, budget_moves: usize)
     }
     let mut evaluations = 0usize;
     let mut improved = true;
-    while improved && evaluations < budget_moves {
+    while improved && evaluations < budget_moves && Instant::now() < deadline {
         improved = false;
         'moves: for len in 1..=3usize {
             for i in 1..m {
@@ -91,7 +100,7 @@ pub(crate) fn improve(model: &Model, tour: &mut Vec<usize>, budget_moves: usize)
                         improved = true;
                         break 'moves;
                     }
-                    if evaluations >= budget_moves {
+                    if evaluations >= budget_moves || Instant::now() >= deadline {
                         break 'moves;
                     }
                 }

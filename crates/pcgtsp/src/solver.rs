@@ -507,6 +507,12 @@ enum Phase {
     Done(SolverStatus),
 }
 
+/// The least time the or-opt polish of a tour gets in a step, whatever the slice: on small
+/// instances 20,000 evaluations take about 0.1 s and the tour they give shortens the proof; on
+/// a discretised nest of 5,000 nodes they took 21 s, so the polish stops here (a step may
+/// overrun a shorter slice by this much).
+const POLISH_SLICE: Duration = Duration::from_millis(150);
+
 /// The anytime exact solver: construct, then call [`ExactSolver::step`] until it stops
 /// returning [`SolverStatus::Running`]; read [`ExactSolver::progress`] at any time; feed
 /// tours found elsewhere with [`ExactSolver::offer_incumbent`].
@@ -721,8 +727,12 @@ impl ExactSolver {
                         for r in (0..self.runs.len()).filter(|_| self.runs[0].preparation.is_none())
                         {
                             if let Some(mut tour) = heuristic::greedy(&self.runs[r].model) {
-                                let cost =
-                                    heuristic::improve(&self.runs[r].model, &mut tour, 20_000);
+                                let cost = heuristic::improve(
+                                    &self.runs[r].model,
+                                    &mut tour,
+                                    20_000,
+                                    began + deadline.max(POLISH_SLICE),
+                                );
                                 if cost < self.incumbent.upper_bound {
                                     if let Ok(checked) = check_tour(&self.instance, &tour) {
                                         self.incumbent.upper_bound = checked;
@@ -785,7 +795,7 @@ impl ExactSolver {
                         });
                         *engine = None;
                         *beam += 1;
-                        self.polish_incumbent();
+                        self.polish_incumbent(began + deadline.max(POLISH_SLICE));
                         debug_log(|| {
                             format!(
                                 "polished at {:?}: UB {}",
@@ -887,8 +897,8 @@ impl ExactSolver {
         SolverStatus::Stopped
     }
 
-    /// Local search on the incumbent (for the start node it begins with).
-    fn polish_incumbent(&mut self) {
+    /// Local search on the incumbent (for the start node it begins with), until `deadline`.
+    fn polish_incumbent(&mut self, deadline: Instant) {
         let Some(tour) = self.incumbent.tour.clone() else {
             return;
         };
@@ -896,7 +906,7 @@ impl ExactSolver {
             return;
         };
         let mut improved = tour;
-        let cost = heuristic::improve(&run.model, &mut improved, 200_000);
+        let cost = heuristic::improve(&run.model, &mut improved, 200_000, deadline);
         if cost < self.incumbent.upper_bound {
             if let Ok(checked) = check_tour(&self.instance, &improved) {
                 self.incumbent.upper_bound = checked;

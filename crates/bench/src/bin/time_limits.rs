@@ -1,0 +1,232 @@
+//! Benchmark: time limits and step lengths of every solver, driven through the engine exactly
+//! as the web worker drives it (`start_job`, then `step(40 ms)` until done).
+//!
+//! `cargo run --release -p cutroute-bench --bin time_limits -- [--time-limit 5] [--slice-ms 40]
+//! [--step 50] [--solvers ccp,exact,…] [--filter NAME[,NAME…]] [--set nests|pcgtsp|all]
+//! [--generated 1000,10000] [--data DIR] [--trace]`
+//!
+//! `--trace` prints every call longer than its slice + 50 ms to stderr, with the job's phase
+//! before and after it.
+//!
+//! Inputs: every real nest of `data/nests` (dbs, dbs-json, dxf, svg, tflex), every PCGTSP
+//! instance of `data/pcgtsp` (industrial, pcgtsplib) and generated nests of the given sizes
+//! (`generate_nest(n, 1)`; their discretisations are the 1,000-cluster PCGTSP instances).
+//!
+//! Prints a Markdown table: solver, input, limit, wall (start + steps), `start_job`'s own time
+//! (the model is built there), the longest `step` call, the number of steps, and what ended the
+//! job: "limit" when the wall reached the limit, "finished" when the solver ended before it.
+//! A row is marked **over** when the wall exceeds limit + 1 s or one call (start or step)
+//! exceeds its slice by more than 50 ms. A job still running at limit + 60 s is abandoned
+//! ("abandoned").
+
+use cutroute_engine::{open_document, start_job, JobStatus};
+use cutroute_protocol::{JobRequest, Problem, SolverKind, SolverParams};
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+struct Input {
+    name: String,
+    problem: Problem,
+}
+
+fn nest_inputs(data: &std::path::Path, generated: &[usize]) -> Vec<Input> {
+    let mut inputs = Vec::new();
+    for dir in ["dbs", "dbs-json", "dxf", "svg", "tflex"] {
+        let Ok(entries) = std::fs::read_dir(data.join("nests").join(dir)) else {
+            continue;
+        };
+        let mut paths: Vec<PathBuf> = entries.filter_map(|e| e.ok().map(|e| e.path())).collect();
+        paths.sort();
+        for path in paths {
+            let name = path.file_name().unwrap().to_string_lossy().to_string();
+            let bytes = std::fs::read(&path).expect("readable");
+            match open_document(&name, &bytes) {
+                Ok(document) if matches!(document.problem, Problem::Nest { .. }) => {
+                    inputs.push(Input {
+                        name,
+                        problem: document.problem,
+                    })
+                }
+                Ok(_) => {}
+                Err(e) => eprintln!("{name}: not opened ({e})"),
+            }
+        }
+    }
+    for &n in generated {
+        inputs.push(Input {
+            name: format!("generated-{n}"),
+            problem: Problem::Nest {
+                nest: cutroute_geometry::generate_nest(n, 1),
+                start: cutroute_geometry::Point::new(0.0, 0.0),
+                finish: None,
+            },
+        });
+    }
+    inputs
+}
+
+fn pcgtsp_inputs(data: &std::path::Path) -> Vec<Input> {
+    let mut inputs = Vec::new();
+    for set in ["industrial", "pcgtsplib"] {
+        let Ok(entries) = std::fs::read_dir(data.join("pcgtsp").join(set)) else {
+            continue;
+        };
+        let mut paths: Vec<PathBuf> = entries.filter_map(|e| e.ok().map(|e| e.path())).collect();
+        paths.sort();
+        for path in paths {
+            inputs.push(Input {
+                name: path.file_name().unwrap().to_string_lossy().to_string(),
+                problem: Problem::PcgtspText {
+                    text: std::fs::read_to_string(&path).expect("readable"),
+                },
+            });
+        }
+    }
+    inputs
+}
+
+pub fn main() {
+    let mut limit = 5.0f64;
+    let mut slice = Duration::from_millis(40);
+    let mut step_mm = SolverParams::default().discretisation_step_mm;
+    let mut solvers: Vec<SolverKind> = SolverKind::ALL.to_vec();
+    let mut filter: Option<Vec<String>> = None;
+    let mut set = "all".to_string();
+    let mut generated: Vec<usize> = vec![1000];
+    let mut data = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../data");
+    let mut trace = false;
+    let mut args = std::env::args().skip(1);
+    while let Some(arg) = args.next() {
+        let mut value = || args.next().unwrap_or_else(|| panic!("{arg} needs a value"));
+        match arg.as_str() {
+            "--time-limit" => limit = value().parse().expect("--time-limit SECONDS"),
+            "--slice-ms" => {
+                slice = Duration::from_millis(value().parse().expect("--slice-ms MILLISECONDS"))
+            }
+            "--step" => step_mm = value().parse().expect("--step MM"),
+            "--solvers" => {
+                let names = value();
+                solvers = names
+                    .split(',')
+                    .map(|n| {
+                        *SolverKind::ALL
+                            .iter()
+                            .find(|k| k.name() == n)
+                            .unwrap_or_else(|| panic!("unknown solver {n}"))
+                    })
+                    .collect()
+            }
+            "--filter" => filter = Some(value().split(',').map(str::to_string).collect()),
+            "--set" => set = value(),
+            "--generated" => {
+                let sizes = value();
+                generated = if sizes.is_empty() {
+                    Vec::new()
+                } else {
+                    sizes
+                        .split(',')
+                        .map(|s| s.parse().expect("--generated N[,N…]"))
+                        .collect()
+                }
+            }
+            "--data" => data = PathBuf::from(value()),
+            "--trace" => trace = true,
+            other => panic!("unknown option {other}"),
+        }
+    }
+    let mut inputs = Vec::new();
+    if set == "all" || set == "nests" {
+        inputs.extend(nest_inputs(&data, &generated));
+    }
+    if set == "all" || set == "pcgtsp" {
+        inputs.extend(pcgtsp_inputs(&data));
+    }
+    if let Some(names) = &filter {
+        inputs.retain(|i| names.iter().any(|n| i.name.contains(n.as_str())));
+    }
+    println!(
+        "| solver | input | limit s | wall s | start s | longest step s | steps | ended by | |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|");
+    let mut worst_step = 0.0f64;
+    let mut worst_over = 0.0f64;
+    let mut overs = 0;
+    for input in &inputs {
+        for &solver in &solvers {
+            let is_pcgtsp = matches!(input.problem, Problem::PcgtspText { .. });
+            if is_pcgtsp && !matches!(solver, SolverKind::Heuristic | SolverKind::Exact) {
+                continue;
+            }
+            let request = JobRequest {
+                job_id: 1,
+                problem: input.problem.clone(),
+                solver,
+                params: SolverParams {
+                    time_limit_s: limit,
+                    discretisation_step_mm: step_mm,
+                    ..SolverParams::default()
+                },
+            };
+            let started = Instant::now();
+            let job = start_job(&request);
+            let start_s = started.elapsed().as_secs_f64();
+            let mut longest = 0.0f64;
+            let mut steps = 0usize;
+            let ended_by = match job {
+                Err(e) => format!("refused: {e}"),
+                Ok(mut job) => loop {
+                    let phase = if trace {
+                        job.progress().phase
+                    } else {
+                        String::new()
+                    };
+                    let t = Instant::now();
+                    let status = job.step(slice);
+                    let took = t.elapsed().as_secs_f64();
+                    longest = longest.max(took);
+                    if trace && took > slice.as_secs_f64() + 0.05 {
+                        eprintln!(
+                            "{} {}: step {steps} took {took:.3} s from phase \"{phase}\" to \"{}\"",
+                            solver.name(),
+                            input.name,
+                            job.progress().phase
+                        );
+                    }
+                    steps += 1;
+                    let wall = started.elapsed().as_secs_f64();
+                    if status == JobStatus::Done {
+                        break if wall >= limit - 0.05 {
+                            "limit"
+                        } else {
+                            "finished"
+                        }
+                        .to_string();
+                    }
+                    if wall > limit + 60.0 {
+                        break "abandoned".to_string();
+                    }
+                },
+            };
+            let wall = started.elapsed().as_secs_f64();
+            let call = longest.max(start_s);
+            worst_step = worst_step.max(call);
+            let over = wall > limit + 1.0 || call > slice.as_secs_f64() + 0.05;
+            if over {
+                overs += 1;
+                worst_over = worst_over.max(wall - limit);
+            }
+            println!(
+                "| {} | {} | {limit} | {wall:.2} | {start_s:.3} | {longest:.3} | {steps} | {ended_by} | {} |",
+                solver.name(),
+                input.name,
+                if over { "**over**" } else { "" }
+            );
+        }
+    }
+    println!();
+    println!(
+        "{} rows; longest single call (start or step) {worst_step:.3} s; {overs} rows over \
+         (wall > limit + 1 s or a call > slice + 50 ms); worst wall over the limit {worst_over:.2} s",
+        inputs.len()
+    );
+}

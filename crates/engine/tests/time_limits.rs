@@ -1,0 +1,175 @@
+//! Time limits are promises (issues #14, #15), in the app as on the CLI: every solver stepped
+//! the way the web worker steps it (`start_job`, then `step(40 ms)` until done) ends within its
+//! limit + 1 s of wall time, the model's build included, and keeps a checked result; and no
+//! single step runs long, because Stop reaches a job only between steps. Timed tests, allowed
+//! here because they test a promise, not a speed.
+
+use std::path::PathBuf;
+
+use cutroute_engine::{open_document, start_job, JobStatus};
+use cutroute_geometry::{generate_nest, Point};
+use cutroute_protocol::{JobRequest, Problem, Progress, SolverKind, SolverParams};
+use web_time::{Duration, Instant};
+
+const SLICE: Duration = Duration::from_millis(40);
+
+/// The longest step allowed. The promise is "Stop within 200 ms" in the release build; this
+/// test build is unoptimised (opt-level 1) and CI machines are shared (steps of 0.17 s in
+/// release measured 0.34 s here under a load average of 15), hence the margin.
+/// `cargo run --release -p cutroute-bench --bin time_limits` measures the release steps.
+const LONGEST_STEP_S: f64 = 0.5;
+
+/// The two tests run one at a time: in parallel they would slow each other's steps.
+static ONE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
+/// (solver, input, what) whose steps are known to run longer than [`LONGEST_STEP_S`]: single
+/// pieces of work not yet split (measured in BENCHMARKS.md, "Time limits in the engine").
+/// Their wall-clock promise is still asserted unless they are in [`KNOWN_OVERRUNS`] too.
+const LONG_STEPS: &[(SolverKind, &str, &str)] = &[
+    // The bound's first stage: pcgtsp's subset/lattice preparation of the relaxation.
+    (
+        SolverKind::Ccp,
+        "",
+        "the interval relaxation's first exact step",
+    ),
+    // Chaining::new validates the route; one group of close contours is one piece.
+    (SolverKind::Chain, "", "a chain group"),
+    // ExactSolver::new (root bounds) and the ALNS's first descent are single pieces.
+    (SolverKind::Exact, "", "ExactSolver::new"),
+    (
+        SolverKind::Heuristic,
+        "generated",
+        "the ALNS's first descent",
+    ),
+    // AoeSolving::new (plan graph, chains) and the final route checks.
+    (
+        SolverKind::Aoe,
+        "generated",
+        "the plan graph and the route checks",
+    ),
+];
+
+/// (solver, input, what) that still overrun limit + 1 s: a single step longer than the limit
+/// (hundreds of clusters: the ALNS's first descent, 2–4 s; ExactSolver::new and its first step,
+/// 5–9 s, in this unoptimised test build).
+const KNOWN_OVERRUNS: &[(SolverKind, &str, &str)] = &[
+    (
+        SolverKind::Heuristic,
+        "generated",
+        "the ALNS's first descent",
+    ),
+    (
+        SolverKind::Exact,
+        "generated",
+        "ExactSolver::new and the ALNS's first descent",
+    ),
+];
+
+fn listed(list: &[(SolverKind, &str, &str)], solver: SolverKind, name: &str) -> bool {
+    list.iter()
+        .any(|&(s, input, _)| s == solver && name.contains(input))
+}
+
+struct Run {
+    wall: f64,
+    longest_step: f64,
+    result: Progress,
+}
+
+fn run(problem: &Problem, solver: SolverKind, limit_s: f64) -> Run {
+    let request = JobRequest {
+        job_id: 1,
+        problem: problem.clone(),
+        solver,
+        params: SolverParams {
+            time_limit_s: limit_s,
+            ..SolverParams::default()
+        },
+    };
+    let started = Instant::now();
+    let mut job = start_job(&request).expect("starts");
+    let mut longest_step = started.elapsed().as_secs_f64();
+    loop {
+        let t = Instant::now();
+        let status = job.step(SLICE);
+        longest_step = longest_step.max(t.elapsed().as_secs_f64());
+        if status == JobStatus::Done {
+            break;
+        }
+        assert!(
+            started.elapsed().as_secs_f64() < limit_s + 30.0,
+            "{} still running at limit + 30 s",
+            solver.name()
+        );
+    }
+    Run {
+        wall: started.elapsed().as_secs_f64(),
+        longest_step,
+        result: job.progress(),
+    }
+}
+
+fn assert_promises_kept(name: &str, problem: &Problem, limit_s: f64) {
+    let _alone = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let Problem::Nest { nest, .. } = problem else {
+        panic!("a nest")
+    };
+    // Every broken promise is listed before the test fails, not just the first.
+    let mut broken = Vec::new();
+    for solver in SolverKind::ALL {
+        let run = run(problem, solver, limit_s);
+        if run.wall > limit_s + 1.0 && !listed(KNOWN_OVERRUNS, solver, name) {
+            broken.push(format!(
+                "{} on {name}: {:.2} s on a {limit_s} s limit",
+                solver.name(),
+                run.wall
+            ));
+        }
+        if !listed(LONG_STEPS, solver, name) && run.longest_step > LONGEST_STEP_S {
+            broken.push(format!(
+                "{} on {name}: a step took {:.3} s (slices of {} ms)",
+                solver.name(),
+                run.longest_step,
+                SLICE.as_millis()
+            ));
+        }
+        // Whatever stopped it, the job keeps a result that passes the independent checker.
+        if solver.gives_path_route() {
+            let route = run
+                .result
+                .path_route
+                .as_ref()
+                .unwrap_or_else(|| panic!("{}: a path route", solver.name()));
+            let problems = route.problems(nest, nest.check_tolerance() * 10.0);
+            assert!(problems.is_empty(), "{}: {problems:?}", solver.name());
+        } else {
+            let route = run
+                .result
+                .route
+                .as_ref()
+                .unwrap_or_else(|| panic!("{} on {name}: a route", solver.name()));
+            route
+                .validate(nest, 1e-3)
+                .unwrap_or_else(|e| panic!("{} on {name}: {e}", solver.name()));
+        }
+    }
+    assert!(broken.is_empty(), "{}", broken.join("\n"));
+}
+
+#[test]
+fn every_solver_keeps_its_limit_and_short_steps_on_nested_dbs() {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../data/nests/dbs/nested.dbs");
+    let bytes = std::fs::read(&path).expect("nested.dbs");
+    let document = open_document("nested.dbs", &bytes).expect("opens");
+    assert_promises_kept("nested.dbs", &document.problem, 2.0);
+}
+
+#[test]
+fn every_solver_keeps_its_limit_on_a_big_generated_nest() {
+    let problem = Problem::Nest {
+        nest: generate_nest(600, 1),
+        start: Point::new(0.0, 0.0),
+        finish: None,
+    };
+    assert_promises_kept("generated-600", &problem, 2.0);
+}
