@@ -1,5 +1,6 @@
 //! The resumable ALNS driver: operator selection, acceptance, restarts and bookkeeping.
 
+use cutroute_geometry::float::Libm;
 use std::time::Duration;
 
 use cutroute_pcgtsp::Instance;
@@ -298,7 +299,7 @@ impl AlnsSolver {
         let start = params.start_temperature * reference * scale;
         let end = (params.end_temperature * reference).min(start);
         let frac = self.epoch_iteration as f64 / self.epoch_length as f64;
-        start * (end / start).powf(frac.min(1.0))
+        start * (end / start).powf_libm(frac.min(1.0))
     }
 
     /// One destroy–repair–improve–accept iteration; returns whether the best tour improved.
@@ -348,8 +349,8 @@ impl AlnsSolver {
         let eps = eps(&self.problem);
         let delta = cost - self.current_cost;
         let temperature = self.temperature();
-        let accepted =
-            delta <= 0.0 || (temperature > 0.0 && self.rng.unit() < (-delta / temperature).exp());
+        let accepted = delta <= 0.0
+            || (temperature > 0.0 && self.rng.unit() < (-delta / temperature).exp_libm());
         let mut score = 0.0;
         let mut new_best = false;
         if cost < self.best_cost - eps {

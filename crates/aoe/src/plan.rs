@@ -8,6 +8,7 @@
 //! leaving it (taken a little way along each curve), exact ties broken by curvature. Vertices of degree 2 (corners of a
 //! contour that touch nothing) are dissolved by default, so an edge is a chain of spans.
 
+use cutroute_geometry::float::Libm;
 use std::collections::HashMap;
 
 use cutroute_geometry::{Contour, ContourRef, Nest, Point, Span, Vertex};
@@ -786,7 +787,7 @@ fn assemble(points: Vec<Point>, pieces: Vec<Piece>, dissolve: bool) -> PlanGraph
                 let span = oriented(pd);
                 let q = span.point_at((0.25 * shortest / span.length()).min(0.5));
                 let d = q - centre;
-                (d.y.atan2(d.x), span.curvature(), pd)
+                (d.y.atan2_libm(d.x), span.curvature(), pd)
             })
             .collect();
         order_around(&mut around);

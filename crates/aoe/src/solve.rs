@@ -8,6 +8,7 @@
 //! the only rule is containment: a component holding a contour that lies inside a contour of
 //! another component is cut first (the part it frees would otherwise fall with uncut edges).
 
+use cutroute_geometry::float::Libm;
 use cutroute_geometry::{BoundingBox, Nest, PathRoute, PathRouteError, Point, Span, ToolOnPath};
 use thiserror::Error;
 
@@ -677,7 +678,7 @@ fn best_point(
 fn box_distance(b: &BoundingBox, p: Point) -> f64 {
     let dx = (b.min.x - p.x).max(p.x - b.max.x).max(0.0);
     let dy = (b.min.y - p.y).max(p.y - b.max.y).max(0.0);
-    dx.hypot(dy)
+    dx.hypot_libm(dy)
 }
 
 /// A closed chain of spans opened at `point` (on span `opening.span` at `opening.t`): the rest

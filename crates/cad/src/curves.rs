@@ -7,6 +7,7 @@
 //! of arcs (straight spans where the three points are collinear); far fewer spans than chords
 //! would need for the same tolerance, which keeps the route optimizer's input small.
 
+use cutroute_geometry::float::Libm;
 use cutroute_geometry::{Point, Span};
 
 /// Highest spline degree accepted (AutoCAD allows up to 11); each evaluation costs degree².
@@ -149,7 +150,7 @@ pub(crate) struct EllipticArc {
 
 impl EllipticArc {
     pub fn point_at(&self, t: f64) -> Point {
-        let (s, c) = t.sin_cos();
+        let (s, c) = t.sin_cos_libm();
         Point::new(
             self.center.x + self.u.x * c + self.v.x * s,
             self.center.y + self.u.y * c + self.v.y * s,
@@ -158,8 +159,8 @@ impl EllipticArc {
 
     /// The arc as exact circular spans when it is circular, `None` otherwise.
     pub fn as_circular_spans(&self) -> Option<Vec<Span>> {
-        let ru = self.u.x.hypot(self.u.y);
-        let rv = self.v.x.hypot(self.v.y);
+        let ru = self.u.x.hypot_libm(self.u.y);
+        let rv = self.v.x.hypot_libm(self.v.y);
         let dot = self.u.x * self.v.x + self.u.y * self.v.y;
         let scale = ru.max(rv);
         if scale == 0.0 || (ru - rv).abs() > 1e-9 * scale || dot.abs() > 1e-9 * scale * scale {
@@ -170,7 +171,7 @@ impl EllipticArc {
         let sweep = (self.t1 - self.t0) * orientation;
         // At most a half turn per span keeps |bulge| ≤ 1, far from the ill-conditioned ∞.
         let pieces = ((sweep.abs() / std::f64::consts::PI).ceil() as usize).max(1);
-        let bulge = (sweep / pieces as f64 / 4.0).tan();
+        let bulge = (sweep / pieces as f64 / 4.0).tan_libm();
         Some(
             (0..pieces)
                 .map(|i| {
@@ -330,7 +331,7 @@ mod tests {
         let n = Nurbs::new(2, vec![0.0, 0.0, 0.0, 1.0, 1.0, 1.0], &pts, &[1.0, w, 1.0]).unwrap();
         for k in 0..=10 {
             let p = n.point_at(k as f64 / 10.0);
-            assert!((p.x.hypot(p.y) - 1.0).abs() < 1e-12);
+            assert!((p.x.hypot_libm(p.y) - 1.0).abs() < 1e-12);
         }
     }
 

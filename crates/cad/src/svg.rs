@@ -48,6 +48,7 @@
 //! assert!(part.contours[0].bounding_box().max.y <= -5.0 + 1e-9);
 //! ```
 
+use cutroute_geometry::float::Libm;
 use cutroute_geometry::{Nest, Point, Span, Transform};
 use roxmltree::{Document, Node};
 
@@ -921,11 +922,11 @@ fn parse_transform(text: &str) -> Result<Transform, String> {
                 .then(&Transform::rotation(a.to_radians()))
                 .then(&Transform::translation(cx, cy)),
             ("skewX", &[a]) => Transform {
-                matrix: [[1.0, a.to_radians().tan()], [0.0, 1.0]],
+                matrix: [[1.0, a.to_radians().tan_libm()], [0.0, 1.0]],
                 offset: Point::ORIGIN,
             },
             ("skewY", &[a]) => Transform {
-                matrix: [[1.0, 0.0], [a.to_radians().tan(), 1.0]],
+                matrix: [[1.0, 0.0], [a.to_radians().tan_libm(), 1.0]],
                 offset: Point::ORIGIN,
             },
             _ => {
@@ -1199,7 +1200,7 @@ fn endpoint_arc(
     if rx == 0.0 || ry == 0.0 {
         return Segment::Line(from, to);
     }
-    let (sin, cos) = rotation_deg.to_radians().sin_cos();
+    let (sin, cos) = rotation_deg.to_radians().sin_cos_libm();
     let dx = (from.x - to.x) / 2.0;
     let dy = (from.y - to.y) / 2.0;
     let x1 = cos * dx + sin * dy;
@@ -1231,7 +1232,7 @@ fn endpoint_arc(
         cos * cx1 - sin * cy1 + (from.x + to.x) / 2.0,
         sin * cx1 + cos * cy1 + (from.y + to.y) / 2.0,
     );
-    let angle = |ux: f64, uy: f64| uy.atan2(ux);
+    let angle = |ux: f64, uy: f64| uy.atan2_libm(ux);
     let t0 = angle((x1 - cx1) / rx, (y1 - cy1) / ry);
     let t_end = angle((-x1 - cx1) / rx, (-y1 - cy1) / ry);
     let mut delta = t_end - t0;

@@ -25,6 +25,7 @@
 //! Contours are re-oriented after placement (a mirror reverses them): the outer contour (the
 //! largest) clockwise, the holes counter-clockwise.
 
+use cutroute_geometry::float::Libm;
 use std::collections::HashMap;
 
 use cutroute_geometry::{Contour, Nest, Part, Point, Vertex};
@@ -327,7 +328,7 @@ fn end_position(text: &str) -> (u32, u32) {
 
 /// Applies a placement to a part definition's contours and re-orients them.
 fn place(contours: &[Contour], placement: &Placement) -> Vec<Contour> {
-    let (s, c) = placement.angle_deg.to_radians().sin_cos();
+    let (s, c) = placement.angle_deg.to_radians().sin_cos_libm();
     let mirror = if placement.mirrored { -1.0 } else { 1.0 };
     let moved = contours
         .iter()
@@ -608,11 +609,11 @@ impl<'d, 'i> Reader<'d, 'i> {
                     }
                     if sweep.abs() > std::f64::consts::PI {
                         // Split large arcs: a single span's bulge tends to infinity at 2π.
-                        let (s, c) = (sweep / 2.0).sin_cos();
+                        let (s, c) = (sweep / 2.0).sin_cos_libm();
                         let (dx, dy) = (begin.x - center.x, begin.y - center.y);
                         let middle =
                             Point::new(center.x + c * dx - s * dy, center.y + s * dx + c * dy);
-                        let bulge = (sweep / 8.0).tan();
+                        let bulge = (sweep / 8.0).tan_libm();
                         vertices.push(Vertex {
                             point: begin,
                             bulge,
@@ -624,7 +625,7 @@ impl<'d, 'i> Reader<'d, 'i> {
                     } else {
                         vertices.push(Vertex {
                             point: begin,
-                            bulge: (sweep / 4.0).tan(),
+                            bulge: (sweep / 4.0).tan_libm(),
                         });
                     }
                 }

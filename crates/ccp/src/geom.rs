@@ -8,6 +8,7 @@
 //! crate's too (see `problem.rs`). The evaluators kept here work on the cached data and are
 //! tested against the geometry crate's own.
 
+use cutroute_geometry::float::Libm;
 use cutroute_geometry::{BoundingBox, Contour, Point, Span as GeoSpan};
 
 /// Tolerance for "lies on" decisions, in millimetres.
@@ -188,7 +189,7 @@ impl Span {
                     b,
                     center,
                     radius: span.radius(),
-                    start: (a.y - center.y).atan2(a.x - center.x),
+                    start: (a.y - center.y).atan2_libm(a.x - center.x),
                     sweep: span.sweep(),
                 }
             }
@@ -200,7 +201,7 @@ impl Span {
     pub fn to_geometry(self) -> GeoSpan {
         let bulge = match self {
             Span::Seg { .. } => 0.0,
-            Span::Arc { sweep, .. } => (sweep / 4.0).tan(),
+            Span::Arc { sweep, .. } => (sweep / 4.0).tan_libm(),
         };
         GeoSpan::new(self.a().into(), self.b().into(), bulge)
     }
@@ -239,7 +240,7 @@ impl Span {
                     return b;
                 }
                 let th = start + sweep * t;
-                center + V::new(th.cos(), th.sin()) * radius
+                center + V::new(th.cos_libm(), th.sin_libm()) * radius
             }
         }
     }
@@ -254,7 +255,7 @@ impl Span {
                 ..
             } => {
                 let th = start + sweep * t;
-                V::new(-th.sin(), th.cos()) * (radius * sweep)
+                V::new(-th.sin_libm(), th.cos_libm()) * (radius * sweep)
             }
         }
     }
@@ -297,7 +298,7 @@ impl Span {
             } => {
                 let d = p - center;
                 if d.norm() > 0.0 {
-                    let th = d.y.atan2(d.x);
+                    let th = d.y.atan2_libm(d.x);
                     if let Some(t) = Self::arc_param(start, sweep, th) {
                         return (t, self.point_at(t));
                     }
@@ -348,7 +349,7 @@ impl Span {
                 for lam in [(-bq - sq) / (2.0 * ww), (-bq + sq) / (2.0 * ww)] {
                     if (-EPS..=1.0 + EPS).contains(&lam) {
                         let x = p + w * lam - center;
-                        if let Some(t) = Self::arc_param(start, sweep, x.y.atan2(x.x)) {
+                        if let Some(t) = Self::arc_param(start, sweep, x.y.atan2_libm(x.x)) {
                             out.push((lam.clamp(0.0, 1.0), t));
                         }
                     }
@@ -372,7 +373,8 @@ impl Span {
         {
             // The arc's extreme point in direction −n.
             let dir = n.unit() * -1.0;
-            if dir.norm() > 0.0 && Self::arc_param(start, sweep, dir.y.atan2(dir.x)).is_some() {
+            if dir.norm() > 0.0 && Self::arc_param(start, sweep, dir.y.atan2_libm(dir.x)).is_some()
+            {
                 best = best.min(n.dot(center + dir * radius - m));
             }
         }

@@ -6,6 +6,7 @@
 //! local minimum that bisection refines, and the endpoints are candidates too.
 
 use crate::geom::{Shape, Span, V};
+use cutroute_geometry::float::Libm;
 
 /// `|P X| + |X Q|`, or `|P X|` at an open end.
 #[inline]
@@ -73,7 +74,7 @@ pub(crate) fn best_on_span(span: &Span, p: V, q: Option<V>) -> (f64, V) {
             };
             let n = ((sweep.abs() / (std::f64::consts::PI / 10.0)).ceil() as usize).max(2);
             let step = sweep / n as f64;
-            let (sd, cd) = step.sin_cos();
+            let (sd, cd) = step.sin_cos_libm();
             let rot = |u: V| V::new(u.x * cd - u.y * sd, u.x * sd + u.y * cd);
             let u0 = (a - center) * (1.0 / radius);
             let mut u_prev = u0;

@@ -60,6 +60,7 @@
 mod order;
 mod region;
 
+use cutroute_geometry::float::Libm;
 use cutroute_geometry::{
     is_scrap_region, BoundingBox, ContainmentForest, Contour, ContourRef, CutStep, Entry,
     MachineParameters, Nest, Point, Route, RouteError,
@@ -452,7 +453,7 @@ fn close_groups(nest: &Nest, members: &[ContourRef], threshold: f64) -> Vec<Vec<
 fn box_distance(a: &BoundingBox, b: &BoundingBox) -> f64 {
     let dx = (a.min.x - b.max.x).max(b.min.x - a.max.x).max(0.0);
     let dy = (a.min.y - b.max.y).max(b.min.y - a.max.y).max(0.0);
-    dx.hypot(dy)
+    dx.hypot_libm(dy)
 }
 
 /// Distance between two disjoint contours: from every vertex and span middle of each to the
@@ -482,7 +483,7 @@ fn contour_distance(a: &Contour, b: &Contour) -> f64 {
 fn point_box_distance(p: Point, b: &BoundingBox) -> f64 {
     let dx = (b.min.x - p.x).max(p.x - b.max.x).max(0.0);
     let dy = (b.min.y - p.y).max(p.y - b.max.y).max(0.0);
-    dx.hypot(dy)
+    dx.hypot_libm(dy)
 }
 
 /// What every group needs.

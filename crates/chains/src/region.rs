@@ -1,6 +1,7 @@
 //! A scrap region as an obstacle field: the contours a link inside it must not cross, and the
 //! shortest link between two points of its boundary that crosses none of them.
 
+use cutroute_geometry::float::Libm;
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
@@ -150,7 +151,7 @@ impl<'a> Region<'a> {
                     // Outside the circle, the tangent polygon's corners at radius
                     // (r + c)/cos(half step) keep every chord clear; inside, the arc bows away.
                     for x in [
-                        centre + out * ((radius + self.clearance) / half.cos()),
+                        centre + out * ((radius + self.clearance) / half.cos_libm()),
                         centre + out * (radius - self.clearance).max(0.0),
                     ] {
                         if in_ellipse(x) && Self::contains(local, x) {

@@ -1,5 +1,6 @@
 //! The nearest-neighbour route: the baseline every real solver must beat.
 
+use cutroute_geometry::float::Libm;
 use std::collections::HashMap;
 
 use cutroute_geometry::{ContourRef, CutStep, MachineParameters, Nest, Point, Route};
@@ -246,7 +247,7 @@ impl NearestNeighbourJob {
 type ReadyVertex = GeomWithData<[f64; 2], (ContourRef, usize)>;
 
 fn distance(a: Point, b: Point) -> f64 {
-    (a.x - b.x).hypot(a.y - b.y)
+    (a.x - b.x).hypot_libm(a.y - b.y)
 }
 
 impl Job for NearestNeighbourJob {

@@ -5,6 +5,7 @@
 //! `alternatives`.
 
 use cutroute_aoe::{AoeSolution, AoeSolveOptions, AoeSolving, PlanGraph, PlanOptions};
+use cutroute_geometry::float::Libm;
 use cutroute_geometry::{MachineParameters, Nest, Objective, PathRoute, Point};
 use cutroute_protocol::{JobId, JobRequest, Problem, Progress, RouteSummary, SolverKind};
 use cutroute_segments::{
@@ -66,7 +67,7 @@ impl PlanBound {
         let to_box = |p: Point| {
             let dx = (b.min.x - p.x).max(p.x - b.max.x).max(0.0);
             let dy = (b.min.y - p.y).max(p.y - b.max.y).max(0.0);
-            dx.hypot(dy)
+            dx.hypot_libm(dy)
         };
         Ok(PlanBound {
             // Merged copies of a common edge agree within the tolerance at their ends.

@@ -2,6 +2,7 @@
 //! reader applies to it. The readers wrap a [`ContourProblem`] into their own error type together
 //! with the location (byte offset or JSON path).
 
+use cutroute_geometry::float::Libm;
 use cutroute_geometry::{domain, Contour, DomainError, Vertex};
 
 /// How far apart (mm) the first and last stored points may be for the contour to count as closed.
@@ -69,7 +70,7 @@ pub(crate) fn closed_contour(
             })
         }
     };
-    let gap = (first[0] - last[0]).hypot(first[1] - last[1]);
+    let gap = (first[0] - last[0]).hypot_libm(first[1] - last[1]);
     // A NaN gap (from overflowing coordinates) must be rejected too, hence not `gap > tolerance`.
     if gap.is_nan() || gap > tolerance {
         return Err(ContourProblem::Unclosed { gap });

@@ -11,6 +11,7 @@
 //! Chain cutting's tool-on links (see [`cutroute_geometry::Entry::Link`]) are written as `cut`
 //! moves without a `part.id` (the torch is on, no contour is being cut) and read back as links.
 
+use cutroute_geometry::float::Libm;
 use cutroute_geometry::{
     opened_at, Contour, ContourRef, CutStep, Entry, Nest, Part, Point, Route, Span, Vertex,
 };
@@ -221,12 +222,12 @@ pub fn write_result_json(result: &RmResult) -> Result<String, JsonWriteError> {
 /// Arc angle in degrees (signed, CCW positive) of a span with bulge `b`: how result JSON stores
 /// a bulge.
 fn bulge_to_degrees(b: f64) -> f64 {
-    4.0 * b.atan().to_degrees()
+    4.0 * b.atan_libm().to_degrees()
 }
 
 /// Bulge of a span whose swept angle is `deg` degrees (result JSON's angle read back).
 fn degrees_to_bulge(deg: f64) -> f64 {
-    (deg.to_radians() / 4.0).tan()
+    (deg.to_radians() / 4.0).tan_libm()
 }
 
 /// The vertices of the full cut of `contour` from the point nearest to `pierce` round to it

@@ -10,6 +10,7 @@
 //! the motion (other planes, canned cycles, homing, …) are refused with their location. Z and the
 //! rotary axes are ignored: the motion is the head's path in the sheet's plane.
 
+use cutroute_geometry::float::Libm;
 use std::f64::consts::{PI, TAU};
 
 use cutroute_geometry::{PathRoute, Point, Span, ToolMove, ToolOnPath, Toolpath};
@@ -768,7 +769,7 @@ impl State<'_> {
             });
         }
         let (a, b) = (self.at - centre, to - centre);
-        let turn = b.y.atan2(b.x) - a.y.atan2(a.x);
+        let turn = b.y.atan2_libm(b.x) - a.y.atan2_libm(a.x);
         let sweep = if self.at.distance(to) <= SAME_POINT {
             TAU
         } else if ccw {
@@ -800,7 +801,7 @@ impl State<'_> {
                 half_chord,
             });
         }
-        let short = 2.0 * (half_chord / r.abs()).min(1.0).asin();
+        let short = 2.0 * (half_chord / r.abs()).min(1.0).asin_libm();
         let sweep = if r < 0.0 { TAU - short } else { short };
         Ok(if ccw { sweep } else { -sweep })
     }
@@ -810,16 +811,16 @@ impl State<'_> {
     fn arc(&mut self, to: Point, sweep: f64, centre: Option<Point>, line: usize) {
         let from = self.at;
         if sweep.abs() <= PI {
-            self.feed_span(Span::new(from, to, (sweep / 4.0).tan()), line);
+            self.feed_span(Span::new(from, to, (sweep / 4.0).tan_libm()), line);
             return;
         }
         let middle = match centre {
             // Turning about the centre also works for a full circle, whose ends coincide.
             Some(c) => c + (from - c).rotated(0.5 * sweep),
             // An R arc: the midpoint is the zenith of the whole span.
-            None => Span::new(from, to, (sweep / 4.0).tan()).midpoint(),
+            None => Span::new(from, to, (sweep / 4.0).tan_libm()).midpoint(),
         };
-        let half_bulge = (sweep / 8.0).tan();
+        let half_bulge = (sweep / 8.0).tan_libm();
         self.feed_span(Span::new(from, middle, half_bulge), line);
         self.feed_span(Span::new(middle, to, half_bulge), line);
     }

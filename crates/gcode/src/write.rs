@@ -1,5 +1,6 @@
 //! The post-processor: a [`Toolpath`] as a G-code program.
 
+use cutroute_geometry::float::Libm;
 use std::f64::consts::PI;
 use std::fmt::Write as _;
 
@@ -506,7 +507,7 @@ impl<'a> Writer<'a> {
             return self.straight("G01", span.end, true);
         }
         let sweep = span.sweep().abs();
-        let sagitta = 0.5 * span.chord_length() * (sweep / 4.0).tan().abs();
+        let sagitta = 0.5 * span.chord_length() * (sweep / 4.0).tan_libm().abs();
         if sweep < PI && sagitta * self.scale < FLAT_ARC_QUANTA {
             return self.straight("G01", span.end, true);
         }
@@ -534,7 +535,7 @@ impl<'a> Writer<'a> {
             ArcOutput::Lines { tolerance_mm } => {
                 let r = span.radius();
                 let step = if tolerance_mm < r {
-                    2.0 * (1.0 - tolerance_mm / r).acos()
+                    2.0 * (1.0 - tolerance_mm / r).acos_libm()
                 } else {
                     2.0 * PI / 3.0
                 };

@@ -1,5 +1,6 @@
 //! Axis-aligned bounding boxes.
 
+use crate::float::Libm;
 use serde::{Deserialize, Serialize};
 
 use crate::Point;
@@ -121,7 +122,7 @@ impl BoundingBox {
         let dy = (other.min.y - self.max.y)
             .max(self.min.y - other.max.y)
             .max(0.0);
-        dx.hypot(dy)
+        dx.hypot_libm(dy)
     }
 
     /// The closed boxes share at least one point.

@@ -1,6 +1,7 @@
 //! Whole-contour geometry: orientation, area, perimeter, point-in-contour with true arcs,
 //! nearest point, length parameterisation, self-intersection and flattening.
 
+use crate::float::Libm;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
@@ -571,7 +572,7 @@ fn span_crossings(s: &Span, p: Point) -> i32 {
     let curve = Some((b > 0.0, inside_circle));
     // Cut at the points with a horizontal tangent: θ_d − φ/2 + tφ ≡ 0 (mod π).
     let phi = s.sweep();
-    let theta = d.y.atan2(d.x);
+    let theta = d.y.atan2_libm(d.x);
     let pi = std::f64::consts::PI;
     let mut cuts = [0.0f64; 5];
     let mut count = 1;
@@ -664,7 +665,7 @@ fn arc_pieces(s: &Span, tolerance: f64) -> usize {
         // A tiny arc: its sagitta (≤ R) is already within tolerance, but keep its shape.
         return if phi > std::f64::consts::PI { 2 } else { 1 };
     }
-    let max_half_angle = (1.0 - tolerance / radius).acos();
+    let max_half_angle = (1.0 - tolerance / radius).acos_libm();
     let pieces = (phi / (2.0 * max_half_angle)).ceil();
     if pieces.is_nan() {
         return 1;

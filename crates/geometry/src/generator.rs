@@ -5,6 +5,7 @@
 //! square grid of 100 mm cells, so they never overlap. Outer contours run clockwise, holes
 //! counter-clockwise, as in real files.
 
+use crate::float::Libm;
 use std::f64::consts::{FRAC_PI_8, PI, TAU};
 
 use crate::{Contour, Nest, Part, Point, SplitMix64, Transform, Vertex};
@@ -24,7 +25,7 @@ fn rounded_rectangle(width: f64, height: f64, r: f64) -> Contour {
             Vertex::line(x0, y1),
         ]);
     }
-    let q = FRAC_PI_8.tan();
+    let q = FRAC_PI_8.tan_libm();
     Contour::new(vec![
         Vertex::line(x0 + r, y0),
         Vertex::arc(x1 - r, y0, q),
@@ -68,8 +69,8 @@ fn random_part(rng: &mut SplitMix64, budget: usize, serial: usize) -> Vec<Part> 
             let r_centre = rng.range(0.2, 0.4) * r_outer;
             let bolts = (3 + rng.below(6) as usize).min(budget - 2);
             let pitch = 0.5 * (r_outer + r_centre);
-            let max_bolt =
-                (0.5 * (r_outer - r_centre) - 1.0).min(pitch * (PI / bolts as f64).sin() - 1.0);
+            let max_bolt = (0.5 * (r_outer - r_centre) - 1.0)
+                .min(pitch * (PI / bolts as f64).sin_libm() - 1.0);
             let r_bolt = rng.range(0.4, 0.9) * max_bolt;
             let phase = rng.range(0.0, TAU);
             let mut contours = vec![
@@ -78,7 +79,11 @@ fn random_part(rng: &mut SplitMix64, budget: usize, serial: usize) -> Vec<Part> 
             ];
             contours.extend((0..bolts).map(|k| {
                 let a = phase + TAU * k as f64 / bolts as f64;
-                Contour::circle(Point::new(pitch * a.cos(), pitch * a.sin()), r_bolt, false)
+                Contour::circle(
+                    Point::new(pitch * a.cos_libm(), pitch * a.sin_libm()),
+                    r_bolt,
+                    false,
+                )
             }));
             vec![part("flange", contours)]
         }

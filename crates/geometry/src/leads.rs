@@ -39,6 +39,7 @@
 //! assert!(fitter.problems(r, &leads).is_empty());
 //! ```
 
+use crate::float::Libm;
 use std::borrow::Cow;
 
 use serde::{Deserialize, Serialize};
@@ -102,8 +103,8 @@ impl LeadSpec {
         let (radius, sweep) = self.arc();
         match self.shape {
             LeadShape::None => 0.0,
-            LeadShape::Line => self.length * self.angle.to_radians().cos().max(0.0),
-            LeadShape::Arc => radius * (1.0 - sweep.cos()),
+            LeadShape::Line => self.length * self.angle.to_radians().cos_libm().max(0.0),
+            LeadShape::Arc => radius * (1.0 - sweep.cos_libm()),
             LeadShape::LineArc => radius + self.length,
         }
     }
@@ -114,8 +115,8 @@ impl LeadSpec {
         let (radius, sweep) = self.arc();
         match self.shape {
             LeadShape::None => 0.0,
-            LeadShape::Line => self.length * self.angle.to_radians().sin(),
-            LeadShape::Arc => radius * sweep.sin(),
+            LeadShape::Line => self.length * self.angle.to_radians().sin_libm(),
+            LeadShape::Arc => radius * sweep.sin_libm(),
             LeadShape::LineArc => radius,
         }
     }
@@ -857,7 +858,7 @@ fn lead_in_chain(spec: LeadSpec, entry: Point, tangent: Point) -> Vec<Vertex> {
         LeadShape::None => vec![vertex(entry)],
         LeadShape::Line => {
             let a = spec.angle.to_radians();
-            let m = entry + (normal * a.cos() - tangent * a.sin()) * spec.length;
+            let m = entry + (normal * a.cos_libm() - tangent * a.sin_libm()) * spec.length;
             vec![vertex(m), vertex(entry)]
         }
         LeadShape::Arc | LeadShape::LineArc => {
@@ -866,7 +867,7 @@ fn lead_in_chain(spec: LeadSpec, entry: Point, tangent: Point) -> Vec<Vertex> {
             let (radius, sweep) = spec.arc();
             let centre = entry + normal * radius;
             let start = centre + (entry - centre).rotated(-sweep);
-            let bulge = (sweep / 4.0).tan();
+            let bulge = (sweep / 4.0).tan_libm();
             let mut chain = vec![Vertex::arc(start.x, start.y, bulge), vertex(entry)];
             if spec.shape == LeadShape::LineArc && spec.length > 0.0 {
                 // The line runs into the arc along the arc's tangent at its start.
@@ -886,14 +887,14 @@ fn lead_out_chain(spec: LeadSpec, exit: Point, tangent: Point) -> Vec<Vertex> {
         LeadShape::None => vec![vertex(exit)],
         LeadShape::Line => {
             let a = spec.angle.to_radians();
-            let m = exit + (normal * a.cos() + tangent * a.sin()) * spec.length;
+            let m = exit + (normal * a.cos_libm() + tangent * a.sin_libm()) * spec.length;
             vec![vertex(exit), vertex(m)]
         }
         LeadShape::Arc | LeadShape::LineArc => {
             let (radius, sweep) = spec.arc();
             let centre = exit + normal * radius;
             let end = centre + (exit - centre).rotated(sweep);
-            let bulge = (sweep / 4.0).tan();
+            let bulge = (sweep / 4.0).tan_libm();
             let mut chain = vec![Vertex::arc(exit.x, exit.y, bulge), vertex(end)];
             if spec.shape == LeadShape::LineArc && spec.length > 0.0 {
                 let arc_tangent = (end - centre).rotated_quarter().normalized();

@@ -75,6 +75,7 @@
 mod bbox;
 mod contour;
 pub mod domain;
+pub mod float;
 mod forest;
 mod generator;
 mod kerf;

@@ -1,6 +1,7 @@
 //! Vector arithmetic on [`Point`]: the plane is treated as ℝ² (and, in the arc formulas of
 //! Appendix Б, as the complex plane, where `rotated_quarter` is multiplication by `i`).
 
+use crate::float::Libm;
 use std::ops::{Add, AddAssign, Mul, Neg, Sub, SubAssign};
 
 use crate::Point;
@@ -21,7 +22,7 @@ impl Point {
 
     /// Euclidean length of the vector.
     pub fn norm(self) -> f64 {
-        self.x.hypot(self.y)
+        self.x.hypot_libm(self.y)
     }
 
     /// Squared Euclidean length of the vector.
@@ -51,7 +52,7 @@ impl Point {
 
     /// The vector turned by `angle` radians counter-clockwise.
     pub fn rotated(self, angle: f64) -> Point {
-        let (sin, cos) = angle.sin_cos();
+        let (sin, cos) = angle.sin_cos_libm();
         Point::new(self.x * cos - self.y * sin, self.x * sin + self.y * cos)
     }
 

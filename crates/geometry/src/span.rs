@@ -9,6 +9,7 @@
 //! Points on a span are addressed by `t ∈ [0, 1]`, proportional to arc length (not the τ of
 //! formula Б.2, whose speed varies along the arc).
 
+use crate::float::Libm;
 use serde::{Deserialize, Serialize};
 
 use crate::{BoundingBox, Point, Transform};
@@ -58,7 +59,7 @@ pub struct SpanIntersection {
 ///
 /// Returns `None` for `z = 0` and for the negative real axis, where the result is infinite.
 pub fn tan_half_arg(re: f64, im: f64) -> Option<f64> {
-    let r = re.hypot(im);
+    let r = re.hypot_libm(im);
     let value = if re < 0.0 {
         if im == 0.0 {
             return None;
@@ -79,7 +80,7 @@ fn sin_ratio(t: f64, x: f64) -> f64 {
         // sin(tx)/sin(x) = t·(1 + (1 − t²)·x²/6 + O(x⁴))
         t * (1.0 + (1.0 - t * t) * x * x / 6.0)
     } else {
-        (t * x).sin() / x.sin()
+        (t * x).sin_libm() / x.sin_libm()
     }
 }
 
@@ -90,7 +91,7 @@ fn atan_over(beta: f64) -> f64 {
         // 1 − β²/3 + β⁴/5 − β⁶/7 + β⁸/9 − …; the next term is below 1e-20.
         1.0 - b2 * (1.0 / 3.0 - b2 * (1.0 / 5.0 - b2 * (1.0 / 7.0 - b2 / 9.0)))
     } else {
-        beta.atan() / beta
+        beta.atan_libm() / beta
     }
 }
 
@@ -103,7 +104,7 @@ fn segment_area_factor(beta: f64) -> f64 {
         beta * (1.0 / 3.0
             + b2 * (1.0 / 15.0 - b2 * (1.0 / 105.0 - b2 * (1.0 / 315.0 - b2 / 693.0))))
     } else {
-        ((1.0 + b2) * (1.0 + b2) * beta.atan() - (1.0 - b2) * beta) / (8.0 * b2)
+        ((1.0 + b2) * (1.0 + b2) * beta.atan_libm() - (1.0 - b2) * beta) / (8.0 * b2)
     }
 }
 
@@ -230,7 +231,7 @@ impl Span {
 
     /// Signed swept angle φ = 4·atan(β), in `(−2π, 2π)`; positive counter-clockwise.
     pub fn sweep(&self) -> f64 {
-        4.0 * self.bulge.atan()
+        4.0 * self.bulge.atan_libm()
     }
 
     /// Radius `L·(1 + β²)/(4|β|)`; infinite for a segment.
@@ -350,7 +351,7 @@ impl Span {
         if d.norm_squared() == 0.0 || !phi.is_finite() {
             return bbox;
         }
-        let theta = d.y.atan2(d.x);
+        let theta = d.y.atan2_libm(d.x);
         let tau = std::f64::consts::TAU;
         // The outward radius at fraction t points at θ + (2t − 1)φ/2 ∓ π/2 (− for CCW arcs,
         // whose centre is on the left); it points along axis direction α when
@@ -385,8 +386,8 @@ impl Span {
             return (Span::line(self.start, p), Span::line(p, self.end));
         }
         let phi = self.sweep();
-        let first = Span::new(self.start, p, (0.25 * t * phi).tan());
-        let second = Span::new(p, self.end, (0.25 * (1.0 - t) * phi).tan());
+        let first = Span::new(self.start, p, (0.25 * t * phi).tan_libm());
+        let second = Span::new(p, self.end, (0.25 * (1.0 - t) * phi).tan_libm());
         (first, second)
     }
 
@@ -410,7 +411,7 @@ impl Span {
         if self.is_line() {
             return Span::line(a, b);
         }
-        Span::new(a, b, (0.25 * (t1 - t0) * self.sweep()).tan())
+        Span::new(a, b, (0.25 * (t1 - t0) * self.sweep()).tan_libm())
     }
 
     /// Merges `self` with the following span `next` into one span when they are pieces of the
@@ -428,7 +429,7 @@ impl Span {
         let merged = if self.is_line() && next.is_line() {
             Span::line(self.start, next.end)
         } else {
-            Span::new(self.start, next.end, (0.25 * total).tan())
+            Span::new(self.start, next.end, (0.25 * total).tan_libm())
         };
         // Both pieces must lie on the merged span: test each one's midpoint.
         let on = |s: &Span| merged.nearest_point(s.midpoint()).distance <= tolerance;
@@ -453,8 +454,8 @@ impl Span {
         if phi.abs() < 1.0 {
             // Chord ratio: |P − A| = L·sin(tφ/2)/sin(φ/2), monotone here. Going through the
             // angle instead would multiply its rounding error by 2/φ.
-            let ratio = (v.norm() / l2.sqrt() * (0.5 * phi.abs()).sin()).min(1.0);
-            let t = 2.0 * ratio.asin() / phi.abs();
+            let ratio = (v.norm() / l2.sqrt() * (0.5 * phi.abs()).sin_libm()).min(1.0);
+            let t = 2.0 * ratio.asin_libm() / phi.abs();
             return if tangent.dot(v) < 0.0 { -t } else { t };
         }
         if let Some(c) = self.centre() {
@@ -463,15 +464,15 @@ impl Span {
             // just past A, it lives in P's offset across the tangent (second order in the
             // distance), which rounding of P's coordinates erases.
             let (u, w) = (self.start - c, p - c);
-            let angle = u.cross(w).atan2(u.dot(w));
+            let angle = u.cross(w).atan2_libm(u.dot(w));
             // Take the turn of that angle nearest the arc's middle (φ/2), so a point a rounding
             // error before A (or past Z) maps just outside [0, 1], not a full turn away.
             let from_middle = angle - 0.5 * phi;
-            let from_middle = from_middle.sin().atan2(from_middle.cos());
+            let from_middle = from_middle.sin_libm().atan2_libm(from_middle.cos_libm());
             return (0.5 * phi + from_middle) / phi;
         }
         // Tangent–chord angle: the chord A→P makes half of its arc's angle with the start tangent.
-        let psi = tangent.cross(v).atan2(tangent.dot(v));
+        let psi = tangent.cross(v).atan2_libm(tangent.dot(v));
         let psi = if phi > 0.0 && psi < 0.0 {
             psi + std::f64::consts::TAU
         } else if phi < 0.0 && psi > 0.0 {

@@ -1,5 +1,6 @@
 //! Affine maps of the plane: rotation, reflection, scaling and translation of parts.
 
+use crate::float::Libm;
 use serde::{Deserialize, Serialize};
 
 use crate::Point;
@@ -41,7 +42,7 @@ impl Transform {
 
     /// Rotation by `angle` radians counter-clockwise about the origin.
     pub fn rotation(angle: f64) -> Self {
-        let (s, c) = angle.sin_cos();
+        let (s, c) = angle.sin_cos_libm();
         Transform {
             matrix: [[c, -s], [s, c]],
             offset: Point::ORIGIN,

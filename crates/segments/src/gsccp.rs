@@ -1,5 +1,6 @@
 //! GSCCP: several ensembles of one nest, each solved as an SCCP, the best kept by time or cost.
 
+use cutroute_geometry::float::Libm;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
@@ -591,7 +592,7 @@ pub fn recut_length(problems: &[PathRouteError], tolerance: f64) -> f64 {
         else {
             continue;
         };
-        let near = |a: f64, b: f64, c: f64, d: f64| (a - c).hypot(b - d) <= tolerance;
+        let near = |a: f64, b: f64, c: f64, d: f64| (a - c).hypot_libm(b - d) <= tolerance;
         let repeated = seen.iter().any(|&(sx, sy, tx, ty)| {
             (near(x, y, sx, sy) && near(to_x, to_y, tx, ty))
                 || (near(x, y, tx, ty) && near(to_x, to_y, sx, sy))

@@ -14,6 +14,7 @@
 //! until `max_non_improving_shakes` shakes in a row fail, the time is up or the cancel flag is
 //! raised.
 
+use cutroute_geometry::float::Libm;
 use std::collections::{BinaryHeap, HashMap};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
@@ -109,7 +110,7 @@ fn entry_point(segment: &Segment, place: Place) -> Point {
 fn box_distance(p: Point, min: Point, max: Point) -> f64 {
     let dx = (min.x - p.x).max(p.x - max.x).max(0.0);
     let dy = (min.y - p.y).max(p.y - max.y).max(0.0);
-    dx.hypot(dy)
+    dx.hypot_libm(dy)
 }
 
 /// The point of a closed segment minimising `|a M| + |M b|` (or `|a M|` without `b`), starting

@@ -12,6 +12,7 @@
 //! a pierce close in space and time to earlier ones scores close to 1 per neighbour; a pierce far
 //! away (≫ σ) or late (≫ τ) scores nothing.
 
+use cutroute_geometry::float::Libm;
 use cutroute_geometry::{
     MachineParameters, Nest, PathRoute, Point, Route, ToolClock, ToolMove, Toolpath,
 };
@@ -77,7 +78,7 @@ impl HeatModel {
     /// seconds before, contributes.
     #[inline]
     pub fn kernel(&self, distance_squared: f64, dt: f64) -> f64 {
-        (-distance_squared / (2.0 * self.sigma_mm * self.sigma_mm) - dt / self.tau_s).exp()
+        (-distance_squared / (2.0 * self.sigma_mm * self.sigma_mm) - dt / self.tau_s).exp_libm()
     }
 
     /// The thermal load H of sources in time order (times non-decreasing; pairs more than 40 τ
@@ -110,7 +111,7 @@ impl HeatModel {
             }
             let exponent = (p - b.point).norm_squared() * space + dt;
             if exponent <= max_exponent {
-                total += (-exponent).exp();
+                total += (-exponent).exp_libm();
             }
         }
         total

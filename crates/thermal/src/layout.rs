@@ -2,6 +2,7 @@
 //! cutting — a part's outer contour (a root of the containment forest) with everything inside
 //! it. Cutting a unit's root frees the part: from that step on its area is cut out of the sheet.
 
+use cutroute_geometry::float::Libm;
 use cutroute_geometry::{BoundingBox, ContainmentForest, Contour, ContourRef, Nest, Point, Route};
 
 /// A root contour and its subtree.
@@ -126,7 +127,7 @@ pub(crate) fn along(p: Point, axis: usize) -> f64 {
 pub(crate) fn box_distance(b: &BoundingBox, p: Point) -> f64 {
     let dx = (b.min.x - p.x).max(p.x - b.max.x).max(0.0);
     let dy = (b.min.y - p.y).max(p.y - b.max.y).max(0.0);
-    dx.hypot(dy)
+    dx.hypot_libm(dy)
 }
 
 /// Candidate points of a contour: every ≤ 5 mm of arc length (at least 16, at most 400) and its

@@ -8,6 +8,7 @@
 //! with the steps near it in time, and keeps the result only if the route's whole objective
 //! (idle + weight · H, recomputed) fell.
 
+use cutroute_geometry::float::Libm;
 use cutroute_geometry::{Entry, MachineParameters, Nest, Point, Route};
 
 use crate::layout::samples;
@@ -81,7 +82,7 @@ pub fn relax_pierce_points(
                 for p in near {
                     let exponent = (x - p.point).norm_squared() * space + (p.time - t).abs() * time;
                     if exponent <= MAX_EXPONENT {
-                        heat += (-exponent).exp();
+                        heat += (-exponent).exp_libm();
                     }
                 }
                 idle + weight_mm * heat

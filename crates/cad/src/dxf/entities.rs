@@ -1,5 +1,6 @@
 //! DXF sections and entities → loose pieces (chains of spans) in world coordinates.
 
+use cutroute_geometry::float::Libm;
 use std::collections::HashMap;
 
 use cutroute_geometry::{Point, Span, Transform};
@@ -127,7 +128,7 @@ fn insert_placement(
     base: Point,
     offset: Point,
 ) -> Transform {
-    let (s, c) = rotation_deg.to_radians().sin_cos();
+    let (s, c) = rotation_deg.to_radians().sin_cos_libm();
     let (sx, sy) = (scale.x, scale.y);
     // Local: q = (sx·(x − bx) + ox, sy·(y − by) + oy); world = at + R·q.
     let qx_t = -sx * base.x + offset.x;
@@ -614,7 +615,7 @@ impl Expander<'_, '_> {
                 // An unevenly scaled arc is an elliptic arc: approximate it. A nearly straight
                 // or vanishing one stays a line: its centre would be meaningless.
                 let radius = s.radius();
-                let t0 = (s.start.y - center.y).atan2(s.start.x - center.x);
+                let t0 = (s.start.y - center.y).atan2_libm(s.start.x - center.x);
                 let arc = EllipticArc {
                     center,
                     u: Point::new(radius, 0.0),
