@@ -180,6 +180,42 @@ export async function setNumber(page, selector, value) {
  * layer draws then: its time, hottest and summed cell temperatures, and the cells per colour
  * level. Fails when the layer is missing.
  */
+/**
+ * The heat field an oracle expects where the page drew `frame` (from `heatMapAt`): the model of
+ * issue #19 recomputed from a CLI report's pierce points and machine times (`route[].pierce`,
+ * `route[].t`): T(p, t) = Σ over sources switched on by t of exp(−|p − M|²/2σ² − (t − t_M)/τ),
+ * kernels below exp(−40) left out as the model does; sampled at the cell centres of the page's
+ * grid. Returns the sum, the maximum and the cells per colour level.
+ */
+export function expectedHeatField(report, frame, sigma, tau) {
+  const [x0, y0, x1, y1, across] = frame.grid;
+  const side = Math.max(x1 - x0, y1 - y0) / across;
+  const [nx, ny] = [Math.max(1, Math.ceil((x1 - x0) / side)), Math.max(1, Math.ceil((y1 - y0) / side))];
+  const sources = report.route.filter((s) => s.t <= frame.time);
+  const cells = new Array(frame.thresholds.length).fill(0);
+  let sum = 0;
+  let max = 0;
+  for (let j = 0; j < ny; j++) {
+    for (let i = 0; i < nx; i++) {
+      const [cx, cy] = [x0 + i * side + side / 2, y0 + j * side + side / 2];
+      let temperature = 0;
+      for (let k = sources.length - 1; k >= 0; k--) {
+        const dt = (frame.time - sources[k].t) / tau;
+        if (dt > 40) break;
+        const [dx, dy] = [cx - sources[k].pierce[0], cy - sources[k].pierce[1]];
+        const exponent = (dx * dx + dy * dy) * (0.5 / (sigma * sigma)) + dt;
+        if (exponent <= 40) temperature += Math.exp(-exponent);
+      }
+      sum += temperature;
+      max = Math.max(max, temperature);
+      let level = -1;
+      frame.thresholds.forEach((l, k) => { if (temperature >= l) level = k; });
+      if (level >= 0) cells[level] += 1;
+    }
+  }
+  return { sum, max, cells };
+}
+
 export async function heatMapAt(page, t) {
   await page.locator('#anim-scrub').fill(String(t));
   await page.waitForFunction((want) => {
@@ -190,6 +226,8 @@ export async function heatMapAt(page, t) {
     const g = document.querySelector('#heat-map');
     return {
       time: Number(g.getAttribute('data-time')),
+      grid: g.getAttribute('data-grid').split(' ').map(Number),
+      thresholds: g.getAttribute('data-levels').split(' ').map(Number),
       max: Number(g.getAttribute('data-max')),
       sum: Number(g.getAttribute('data-sum')),
       levels: [...g.querySelectorAll('path.heat')].map((p) => [p.getAttribute('class'), Number(p.getAttribute('data-cells'))]),
