@@ -2,37 +2,12 @@
 //! test binary: these runs are CPU-heavy, and beside the timed checks of `jobs.rs` (a bound
 //! within a 1 s CCP run) they would compete for the same cores.
 
-use std::path::PathBuf;
+mod common;
 
+use common::{check_route, data};
 use cutroute_engine::{open_document, run_to_end, start_job};
-use cutroute_protocol::{JobRequest, Problem, Progress, SolverKind, SolverParams};
+use cutroute_protocol::{JobRequest, SolverKind, SolverParams};
 use web_time::Duration;
-
-fn data(relative: &str) -> (String, Vec<u8>) {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../data")
-        .join(relative);
-    let bytes = std::fs::read(&path)
-        .unwrap_or_else(|e| panic!("missing test file {}: {e}", path.display()));
-    (relative.to_string(), bytes)
-}
-
-fn check_route(problem: &Problem, result: &Progress) -> f64 {
-    let Problem::Nest { nest, .. } = problem else {
-        panic!("a nest")
-    };
-    let route = result.route.as_ref().expect("a route");
-    route
-        .validate(nest, 1e-3)
-        .expect("the route passes the independent checker");
-    let idle = route.idle_length();
-    let reported = result.upper_bound.expect("an upper bound");
-    assert!(
-        (idle - reported).abs() <= 1e-6 * idle.max(1.0),
-        "reported {reported} vs recomputed {idle}"
-    );
-    idle
-}
 
 /// The exact job with the interval bound of the nest beside it (`DiscreteJob::with_lower_bound`,
 /// as `start_job` builds it for nests above 35 contours): never above the discrete optimum,

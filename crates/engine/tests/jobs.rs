@@ -1,19 +1,11 @@
 //! Every solver through the engine on real files, with every answer checked independently.
 
-use std::path::PathBuf;
+mod common;
 
+use common::{check_route, data};
 use cutroute_engine::{open_document, run_to_end, start_job, EngineError, Job, JobStatus};
 use cutroute_protocol::{JobRequest, Problem, Progress, SolverKind, SolverParams};
 use web_time::Duration;
-
-fn data(relative: &str) -> (String, Vec<u8>) {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../data")
-        .join(relative);
-    let bytes = std::fs::read(&path)
-        .unwrap_or_else(|e| panic!("missing test file {}: {e}", path.display()));
-    (relative.to_string(), bytes)
-}
 
 fn run(relative: &str, solver: SolverKind, time_limit_s: f64) -> (Problem, Progress) {
     let (name, bytes) = data(relative);
@@ -35,23 +27,6 @@ fn run(relative: &str, solver: SolverKind, time_limit_s: f64) -> (Problem, Progr
         reports += 1;
     });
     (document.problem, result)
-}
-
-fn check_route(problem: &Problem, result: &Progress) -> f64 {
-    let Problem::Nest { nest, .. } = problem else {
-        panic!("a nest")
-    };
-    let route = result.route.as_ref().expect("a route");
-    route
-        .validate(nest, 1e-3)
-        .expect("the route passes the independent checker");
-    let idle = route.idle_length();
-    let reported = result.upper_bound.expect("an upper bound");
-    assert!(
-        (idle - reported).abs() <= 1e-6 * idle.max(1.0),
-        "reported {reported} vs recomputed {idle}"
-    );
-    idle
 }
 
 #[test]
