@@ -86,6 +86,7 @@ fn continued(from: &Progress, update: Progress) -> Progress {
 /// The whole page.
 #[component]
 pub fn App() -> impl IntoView {
+    provide_context(crate::i18n::Language::new());
     let query = web_sys::window()
         .and_then(|w| w.location().search().ok())
         .unwrap_or_default();
@@ -575,6 +576,7 @@ pub fn App() -> impl IntoView {
                 />
             </label>
             <crate::theme::ThemePicker />
+            <crate::i18n::LanguagePicker />
             <button
                 id="present"
                 aria-pressed=move || presentation.get().to_string()

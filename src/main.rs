@@ -8,6 +8,7 @@ mod compare;
 mod drawing;
 mod embedded;
 mod export;
+mod i18n;
 mod pan_zoom;
 mod settings;
 mod stats;

@@ -3,12 +3,14 @@
 
 use leptos::prelude::*;
 
-/// The themes, as (value of `data-theme`, label).
-pub const THEMES: [(&str, &str); 4] = [
-    ("light", "Light"),
-    ("dark", "Dark"),
-    ("high-contrast", "High contrast"),
-    ("print", "Print"),
+use crate::i18n::tr;
+
+/// The themes, as (value of `data-theme`, English label, Russian label).
+pub const THEMES: [(&str, &str, &str); 4] = [
+    ("light", "Light", "Светлая"),
+    ("dark", "Dark", "Тёмная"),
+    ("high-contrast", "High contrast", "Контрастная"),
+    ("print", "Print", "Для печати"),
 ];
 
 const STORAGE_KEY: &str = "cutroute.theme";
@@ -21,7 +23,7 @@ fn storage() -> Option<web_sys::Storage> {
 pub fn remembered() -> String {
     storage()
         .and_then(|s| s.get_item(STORAGE_KEY).ok().flatten())
-        .filter(|t| THEMES.iter().any(|(value, _)| value == t))
+        .filter(|t| THEMES.iter().any(|(value, ..)| value == t))
         .unwrap_or_else(|| THEMES[0].0.to_string())
 }
 
@@ -45,16 +47,16 @@ pub fn ThemePicker() -> impl IntoView {
     Effect::new(move |_| apply(&theme.get()));
     view! {
         <label>
-            "Theme "
+            {tr("Theme ", "Тема ")}
             <select
                 id="theme"
-                aria-label="Colour theme"
+                aria-label=tr("Colour theme", "Цветовая тема")
                 prop:value=move || theme.get()
                 on:change=move |ev| theme.set(event_target_value(&ev))
             >
                 {THEMES
                     .iter()
-                    .map(|(value, label)| view! { <option value=*value>{*label}</option> })
+                    .map(|(value, en, ru)| view! { <option value=*value>{tr(en, ru)}</option> })
                     .collect_view()}
             </select>
         </label>
