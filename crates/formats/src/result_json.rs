@@ -13,7 +13,8 @@
 
 use cutroute_geometry::float::Libm;
 use cutroute_geometry::{
-    opened_at, Contour, ContourRef, CutStep, Entry, Nest, Part, Point, Route, Span, Vertex,
+    chain_spans, opened_at, Contour, ContourRef, CutStep, Entry, Nest, Part, Point, Route, Span,
+    StepLeads, Vertex,
 };
 use serde::{Deserialize, Serialize};
 
@@ -193,6 +194,15 @@ pub enum RouteError {
         /// Index of the step.
         step: usize,
     },
+    /// A step with leads names an offset its contour has no equidistant at.
+    #[error("route step {step}: no equidistant for its kerf ({problem})")]
+    NoEquidistant {
+        /// Index of the step.
+        step: usize,
+        /// Why the offset failed.
+        #[source]
+        problem: cutroute_geometry::OffsetError,
+    },
 }
 
 /// Reads a result file and checks the schema's minimum lengths.
@@ -267,42 +277,67 @@ fn stored_degrees(contour: &Contour) -> Vec<[f64; 3]> {
 /// The moves of a route over a nest: idle to each pierce point (or the tool-on link of a chained
 /// step, as `Cut` moves without a contour), the full contour from there (split where the pierce
 /// point falls inside a span), and idle to the finish.
+///
+/// A step cut with leads (see [`StepLeads`]) is idle to its pierce point M, `cut.in` along the
+/// lead-in to the entry, `cut` round the equidistant from the entry (and the overcut), `cut.out`
+/// along the lead-out to the switch-off point M*, where the next idle move starts. The lead
+/// moves name the step's contour, so a reader knows whose they are.
 pub fn route_moves(nest: &Nest, route: &Route) -> Result<Vec<ToolMove>, RouteError> {
     let mut moves = Vec::new();
     let mut at = route.start;
     for (step, cut) in route.steps.iter().enumerate() {
-        let vertices = cut_vertices(nest, step, cut)?;
-        let pierce = vertices[0].point;
+        let contour = step_contour(nest, step, cut)?;
+        let on = Some(cut.contour);
+        let mut push = |kind, span: Span, contour| {
+            moves.push(ToolMove {
+                kind,
+                from: span.start,
+                to: span.end,
+                bulge: span.bulge,
+                contour,
+            })
+        };
+        let switch_on = match &cut.leads {
+            Some(leads) => leads.pierce,
+            None => {
+                cut_from(contour, cut.pierce_point).ok_or(RouteError::EmptyContour { step })?[0]
+                    .point
+            }
+        };
         match &cut.entry {
-            Entry::Pierce => moves.push(ToolMove {
-                kind: MoveKind::Air,
-                from: at,
-                to: pierce,
-                bulge: 0.0,
-                contour: None,
-            }),
+            Entry::Pierce => push(MoveKind::Air, Span::line(at, switch_on), None),
             Entry::Link(corners) => {
-                for (from, to) in link_pieces(at, corners, pierce) {
-                    moves.push(ToolMove {
-                        kind: MoveKind::Cut,
-                        from,
-                        to,
-                        bulge: 0.0,
-                        contour: None,
-                    });
+                for (from, to) in link_pieces(at, corners, switch_on) {
+                    push(MoveKind::Cut, Span::line(from, to), None);
                 }
             }
         }
-        for w in vertices.windows(2) {
-            moves.push(ToolMove {
-                kind: MoveKind::Cut,
-                from: w[0].point,
-                to: w[1].point,
-                bulge: w[0].bulge,
-                contour: Some(cut.contour),
-            });
+        match &cut.leads {
+            None => {
+                let vertices =
+                    cut_from(contour, cut.pierce_point).ok_or(RouteError::EmptyContour { step })?;
+                for w in vertices.windows(2) {
+                    push(
+                        MoveKind::Cut,
+                        Span::new(w[0].point, w[1].point, w[0].bulge),
+                        on,
+                    );
+                }
+            }
+            Some(leads) => {
+                chain_spans(&leads.lead_in).for_each(|s| push(MoveKind::CutIn, s, on));
+                let equidistant = cutroute_geometry::equidistant(contour, leads.offset)
+                    .map_err(|problem| RouteError::NoEquidistant { step, problem })?;
+                for span in leads.equidistant_cut(&equidistant, 0.0) {
+                    push(MoveKind::Cut, span, on);
+                }
+                chain_spans(&leads.lead_out).for_each(|s| push(MoveKind::CutOut, s, on));
+            }
         }
-        at = pierce;
+        at = match &cut.leads {
+            Some(leads) => leads.switch_off,
+            None => switch_on,
+        };
     }
     if let Some(finish) = route.finish {
         moves.push(ToolMove {
@@ -325,7 +360,7 @@ fn link_pieces(from: Point, corners: &[Point], to: Point) -> Vec<(Point, Point)>
     points.windows(2).map(|w| (w[0], w[1])).collect()
 }
 
-fn cut_vertices(nest: &Nest, step: usize, cut: &CutStep) -> Result<Vec<Vertex>, RouteError> {
+fn step_contour<'a>(nest: &'a Nest, step: usize, cut: &CutStep) -> Result<&'a Contour, RouteError> {
     let ContourRef { part, contour } = cut.contour;
     let c = nest
         .parts
@@ -336,7 +371,17 @@ fn cut_vertices(nest: &Nest, step: usize, cut: &CutStep) -> Result<Vec<Vertex>, 
             part,
             contour,
         })?;
-    cut_from(c, cut.pierce_point).ok_or(RouteError::EmptyContour { step })
+    if c.vertices.is_empty() {
+        return Err(RouteError::EmptyContour { step });
+    }
+    Ok(c)
+}
+
+impl ToolMove {
+    /// Length of the move, mm.
+    pub fn length(&self) -> f64 {
+        Span::new(self.from, self.to, self.bulge).length()
+    }
 }
 
 impl RmResult {
@@ -378,44 +423,20 @@ impl RmResult {
                 point: [point.x, point.y, angle],
             });
         };
-        push(MoveKind::Air, route.start, 0.0, None);
+        // Each vertex carries the mode, contour and arc angle of the move that leaves it; the
+        // last one ends the path as an idle vertex.
+        let moves = route_moves(nest, route)?;
         let (mut idle, mut cut_len) = (0.0, 0.0);
-        let mut at = route.start;
-        for (step, cut) in route.steps.iter().enumerate() {
-            let vertices = cut_vertices(nest, step, cut)?;
-            match &cut.entry {
-                Entry::Pierce => idle += at.distance(vertices[0].point),
-                Entry::Link(corners) => {
-                    for (from, to) in link_pieces(at, corners, vertices[0].point) {
-                        cut_len += from.distance(to);
-                    }
-                }
+        for m in &moves {
+            let length = m.length();
+            match m.kind {
+                MoveKind::Air => idle += length,
+                _ => cut_len += length,
             }
-            for w in vertices.windows(2) {
-                cut_len += Span::new(w[0].point, w[1].point, w[0].bulge).length();
-                push(
-                    MoveKind::Cut,
-                    w[0].point,
-                    bulge_to_degrees(w[0].bulge),
-                    Some(cut.contour),
-                );
-            }
-            at = vertices[0].point;
-            // The vertex's mode is that of the move leaving it: the next step's link, or idle.
-            match route.steps.get(step + 1).map(|next| &next.entry) {
-                Some(Entry::Link(corners)) => {
-                    push(MoveKind::Cut, at, 0.0, None);
-                    for &corner in corners {
-                        push(MoveKind::Cut, corner, 0.0, None);
-                    }
-                }
-                _ => push(MoveKind::Air, at, 0.0, None),
-            }
+            push(m.kind, m.from, bulge_to_degrees(m.bulge), m.contour);
         }
-        if let Some(finish) = route.finish {
-            idle += at.distance(finish);
-            push(MoveKind::Air, finish, 0.0, None);
-        }
+        let end = moves.last().map_or(route.start, |m| m.to);
+        push(MoveKind::Air, end, 0.0, None);
         Ok(RmResult {
             job: Job {
                 paths_count: paths.len() as i64,
@@ -506,16 +527,38 @@ impl RmResult {
     /// where cutting of the contour begins, after any lead-in) and the final point as finish.
     /// A contour reached from the previous one by `cut` moves without a contour (torch on, no
     /// idle move, no lead) is a chained step: its entry is a link through those moves' corners.
+    ///
+    /// A step with `cut.in`/`cut.out` moves, or whose cut runs off its contour (on the kerf's
+    /// equidistant), gets its [`StepLeads`] back: M where the lead-in starts, the entry where
+    /// the cut starts, M* where the lead-out ends. The offset is the entry's distance from the
+    /// contour and the overcut the cut's length beyond the equidistant's perimeter; the
+    /// clearances d₁ and d₂ are not in the file and read as 0.
     pub fn route(&self) -> Route {
         let moves = self.tool_moves();
+        let nest = self.nest().ok();
         let start = moves.first().map(|m| m.from).unwrap_or_default();
         let mut steps: Vec<CutStep> = Vec::new();
         // The contour being cut, and the ends of the link moves since it (torch still on).
         let mut current: Option<ContourRef> = None;
         let mut link_ends: Option<Vec<Point>> = None;
+        // Lead-in moves since the last idle move, and the step being cut with what it had.
+        let mut lead_in: Vec<ToolMove> = Vec::new();
+        let mut open: Option<ReadLeads> = None;
+        let close = |open: &mut Option<ReadLeads>, steps: &mut Vec<CutStep>| {
+            if let (Some(read), Some(nest)) = (open.take(), nest.as_ref()) {
+                read.attach(nest, steps);
+            }
+        };
         for m in &moves {
             match (m.kind, m.contour) {
+                (MoveKind::CutIn, _) => {
+                    close(&mut open, &mut steps);
+                    lead_in.push(*m);
+                    current = None;
+                    link_ends = None;
+                }
                 (MoveKind::Cut, Some(contour)) if current != Some(contour) => {
+                    close(&mut open, &mut steps);
                     let entry = match (current, link_ends.take()) {
                         (Some(_), Some(mut ends)) => {
                             ends.pop(); // the last end is this step's pierce point
@@ -529,18 +572,39 @@ impl RmResult {
                         entry,
                         leads: None,
                     });
+                    open = Some(ReadLeads {
+                        step: steps.len() - 1,
+                        lead_in: std::mem::take(&mut lead_in),
+                        entry: m.from,
+                        cut_length: m.length(),
+                        exit: m.to,
+                        lead_out: Vec::new(),
+                    });
                     current = Some(contour);
                 }
-                (MoveKind::Cut, Some(_)) => {}
+                (MoveKind::Cut, Some(_)) => {
+                    if let Some(read) = open.as_mut() {
+                        read.cut_length += m.length();
+                        read.exit = m.to;
+                    }
+                }
+                (MoveKind::CutOut, _) => {
+                    if let Some(read) = open.as_mut() {
+                        read.lead_out.push(*m);
+                    }
+                }
                 (MoveKind::Cut, None) if current.is_some() => {
                     link_ends.get_or_insert_with(Vec::new).push(m.to);
                 }
                 _ => {
+                    close(&mut open, &mut steps);
+                    lead_in.clear();
                     current = None;
                     link_ends = None;
                 }
             }
         }
+        close(&mut open, &mut steps);
         let finish = match moves.last() {
             Some(m) if m.kind == MoveKind::Air => Some(m.to),
             _ => None,
@@ -550,6 +614,67 @@ impl RmResult {
             steps,
             finish,
         }
+    }
+}
+
+/// What the tool path says about one step's full-route elements, while it is read.
+struct ReadLeads {
+    step: usize,
+    lead_in: Vec<ToolMove>,
+    entry: Point,
+    cut_length: f64,
+    exit: Point,
+    lead_out: Vec<ToolMove>,
+}
+
+/// Entries closer to their contour than this are on it: the idealised model.
+const ON_CONTOUR: f64 = 1e-9;
+
+impl ReadLeads {
+    /// Gives the step its leads, unless it was cut on its contour without any.
+    fn attach(self, nest: &Nest, steps: &mut [CutStep]) {
+        let Some(step) = steps.get_mut(self.step) else {
+            return;
+        };
+        let Some(contour) = nest.contour(step.contour) else {
+            return;
+        };
+        let Some(nearest) = contour.nearest_point(self.entry) else {
+            return;
+        };
+        let offset = nearest.point.distance(self.entry);
+        if self.lead_in.is_empty() && self.lead_out.is_empty() && offset < ON_CONTOUR {
+            return;
+        }
+        let chain = |moves: &[ToolMove], end: Point| -> Vec<Vertex> {
+            moves
+                .iter()
+                .map(|m| Vertex {
+                    point: m.from,
+                    bulge: m.bulge,
+                })
+                .chain(std::iter::once(Vertex {
+                    point: moves.last().map_or(end, |m| m.to),
+                    bulge: 0.0,
+                }))
+                .collect()
+        };
+        let lead_in = chain(&self.lead_in, self.entry);
+        let lead_out = chain(&self.lead_out, self.exit);
+        let perimeter = cutroute_geometry::equidistant(contour, offset)
+            .map_or(contour.perimeter(), |eq| eq.perimeter());
+        step.pierce_point = nearest.point;
+        step.leads = Some(StepLeads {
+            pierce: lead_in[0].point,
+            entry: self.entry,
+            switch_off: lead_out[lead_out.len() - 1].point,
+            lead_in,
+            lead_out,
+            offset,
+            overcut: (self.cut_length - perimeter).max(0.0),
+            pierce_clearance: 0.0,
+            switch_off_clearance: 0.0,
+        });
     }
 }
 
