@@ -7,7 +7,8 @@
 #     with std sources, from which std is built for wasm32 on the fly (see scripts/wasm-env.sh);
 #   - trunk and wasm-bindgen-cli at the exact versions the project pins;
 #   - wasm-opt (binaryen from npm, run by Node; the version Trunk.toml pins) for the release build;
-#   - playwright-core (npm; it drives the system Chromium, it never downloads a browser).
+#   - Firefox ESR (Debian) for the single-file page's test in a second browser;
+#   - playwright-core and ws (npm; they drive the system browsers, they never download one).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -21,6 +22,8 @@ log() { printf '[setup] %s\n' "$*" >&2; }
 apt_packages=()
 command -v chromium >/dev/null 2>&1 || apt_packages+=(chromium)
 command -v chromedriver >/dev/null 2>&1 || apt_packages+=(chromium-driver)
+# The single-file page is also tested in Firefox (over WebDriver BiDi, tests/e2e/firefox.mjs).
+command -v firefox-esr >/dev/null 2>&1 || apt_packages+=(firefox-esr)
 
 wasm_std_installed() {
   [ -d "$(rustc --print sysroot)/lib/rustlib/wasm32-unknown-unknown/lib" ]
@@ -65,7 +68,7 @@ if [ ! -x tools/node_modules/.bin/wasm-opt ]; then
   (cd tools && npm ci --no-audit --no-fund --silent)
 fi
 
-if [ ! -d tests/e2e/node_modules/playwright-core ]; then
+if [ ! -d tests/e2e/node_modules/playwright-core ] || [ ! -d tests/e2e/node_modules/ws ]; then
   log "npm ci (tests/e2e)"
   (cd tests/e2e && PLAYWRIGHT_SKIP_BROWSER_DOWNLOAD=1 npm ci --no-audit --no-fund --silent)
 fi
