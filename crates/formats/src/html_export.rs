@@ -11,8 +11,13 @@
 use std::fmt::Write as _;
 
 use cutroute_geometry::{
-    MachineParameters, Nest, Point, Route, RouteError, Span, ToolClock, ToolMove, Toolpath,
+    MachineParameters, Nest, Point, Route, RouteError, ToolClock, ToolMove, Toolpath,
 };
+use svg::node::element::path::Data;
+use svg::node::element::{Circle, Group, Path, Title};
+use svg::Document;
+
+use crate::svg_export::span_data;
 
 /// Options of [`route_html`].
 #[derive(Clone, Debug, PartialEq)]
@@ -235,78 +240,9 @@ pub fn toolpath_html(
     out.push_str("<button id=\"fit\" type=\"button\">Fit</button>\n</div>\n</header>\n");
     let _ = writeln!(
         out,
-        "<svg id=\"view\" viewBox=\"{view_box}\" data-playback-s=\"{}\" role=\"img\" aria-label=\"{title}\">",
-        num(options.playback_s.max(0.1))
+        "{}",
+        drawing(nest, toolpath, step_labels, options, view_box, marker)
     );
-    out.push_str("<g transform=\"scale(1,-1)\">\n<g class=\"nest\">\n");
-    for (part, class) in nest
-        .sheet
-        .iter()
-        .map(|p| (p, "sheet"))
-        .chain(nest.parts.iter().map(|p| (p, "part")))
-    {
-        let mut d = String::new();
-        for contour in &part.contours {
-            let mut spans = contour.spans().peekable();
-            if let Some(first) = spans.peek() {
-                let _ = write!(d, "M{} {}", num(first.start.x), num(first.start.y));
-            }
-            for span in spans {
-                span_data(&mut d, &span);
-            }
-            d.push('Z');
-        }
-        let _ = writeln!(
-            out,
-            "<path class=\"{class}\" d=\"{d}\"><title>{}</title></path>",
-            escape(&part.name)
-        );
-    }
-    out.push_str("</g>\n<g class=\"route\">\n");
-    route_paths(&mut out, toolpath);
-    for m in &toolpath.moves {
-        if let ToolMove::Pierce { at, step } = m {
-            let label = step_labels
-                .get(*step)
-                .cloned()
-                .unwrap_or_else(|| format!("Step {}", step + 1));
-            let _ = writeln!(
-                out,
-                "<circle class=\"pierce\" data-step=\"{}\" cx=\"{}\" cy=\"{}\" r=\"{}\"><title>{}</title></circle>",
-                step + 1,
-                num(at.x),
-                num(at.y),
-                num(marker),
-                escape(&label)
-            );
-        }
-    }
-    let start = toolpath.start;
-    let _ = writeln!(
-        out,
-        "<circle class=\"start\" cx=\"{}\" cy=\"{}\" r=\"{}\"><title>Start</title></circle>",
-        num(start.x),
-        num(start.y),
-        num(1.5 * marker)
-    );
-    if matches!(toolpath.moves.last(), Some(ToolMove::Idle { .. })) {
-        let end = toolpath.end();
-        let _ = writeln!(
-            out,
-            "<circle class=\"finish\" cx=\"{}\" cy=\"{}\" r=\"{}\"><title>Finish</title></circle>",
-            num(end.x),
-            num(end.y),
-            num(1.5 * marker)
-        );
-    }
-    let _ = writeln!(
-        out,
-        "<circle id=\"tool-head\" cx=\"{}\" cy=\"{}\" r=\"{}\" data-machine-time=\"0\"/>",
-        num(start.x),
-        num(start.y),
-        num(2.0 * marker)
-    );
-    out.push_str("</g>\n</g>\n</svg>\n");
     let _ = writeln!(
         out,
         "<script type=\"application/json\" id=\"route-data\">{}</script>",
@@ -319,68 +255,148 @@ pub fn toolpath_html(
     out
 }
 
-/// Consecutive moves of one kind form one `<path>`, so a contour's cut is a single element.
-fn route_paths(out: &mut String, toolpath: &Toolpath) {
-    let mut idle = String::new();
-    let mut cut = String::new();
-    let mut cut_step = None;
-    let flush = |out: &mut String, cut: &mut String, step: Option<usize>| {
-        if !cut.is_empty() {
-            let _ = writeln!(
-                out,
-                "<path class=\"cut\" data-step=\"{}\" d=\"{cut}\"/>",
-                step.map_or(0, |s| s + 1)
-            );
-            cut.clear();
+/// The SVG drawing of the page (built with the `svg` crate, like every SVG the project writes):
+/// the nest, then the route in a y-flipped group, with the head the script moves.
+fn drawing(
+    nest: &Nest,
+    toolpath: &Toolpath,
+    step_labels: &[String],
+    options: &HtmlOptions,
+    view_box: String,
+    marker: f64,
+) -> Document {
+    let mut doc = Document::new()
+        .set("id", "view")
+        .set("viewBox", view_box)
+        .set("data-playback-s", rounded(options.playback_s.max(0.1)))
+        .set("role", "img")
+        .set("aria-label", options.title.as_str());
+    // Inline SVG in HTML needs no namespace, and the page names no URL at all.
+    doc.get_attributes_mut().remove("xmlns");
+    let mut parts = Group::new().set("class", "nest");
+    for (part, class) in nest
+        .sheet
+        .iter()
+        .map(|p| (p, "sheet"))
+        .chain(nest.parts.iter().map(|p| (p, "part")))
+    {
+        let mut data = Data::new();
+        for contour in &part.contours {
+            let mut spans = contour.spans().peekable();
+            if let Some(first) = spans.peek() {
+                data = data.move_to(xy(first.start));
+            }
+            for span in spans {
+                data = span_data(data, at(span.start), at(span.end), span.bulge);
+            }
+            data = data.close();
         }
+        parts = parts.add(
+            Path::new()
+                .set("class", class)
+                .set("d", data)
+                .add(Title::new(part.name.as_str())),
+        );
+    }
+    let mut route = route_paths(Group::new().set("class", "route"), toolpath);
+    let circle = |class: &str, p: Point, r: f64| {
+        Circle::new()
+            .set("class", class)
+            .set("cx", rounded(p.x))
+            .set("cy", rounded(p.y))
+            .set("r", rounded(r))
+    };
+    for m in &toolpath.moves {
+        if let ToolMove::Pierce { at, step } = m {
+            let label = step_labels
+                .get(*step)
+                .cloned()
+                .unwrap_or_else(|| format!("Step {}", step + 1));
+            route = route.add(
+                circle("pierce", *at, marker)
+                    .set("data-step", step + 1)
+                    .add(Title::new(label)),
+            );
+        }
+    }
+    let start = toolpath.start;
+    route = route.add(circle("start", start, 1.5 * marker).add(Title::new("Start")));
+    if matches!(toolpath.moves.last(), Some(ToolMove::Idle { .. })) {
+        route = route.add(circle("finish", toolpath.end(), 1.5 * marker).add(Title::new("Finish")));
+    }
+    let head = Circle::new()
+        .set("id", "tool-head")
+        .set("cx", rounded(start.x))
+        .set("cy", rounded(start.y))
+        .set("r", rounded(2.0 * marker))
+        .set("data-machine-time", 0);
+    doc.add(
+        Group::new()
+            .set("transform", "scale(1,-1)")
+            .add(parts)
+            .add(route.add(head)),
+    )
+}
+
+/// Consecutive moves of one kind form one `<path>`, so a contour's cut is a single element.
+fn route_paths(mut group: Group, toolpath: &Toolpath) -> Group {
+    let mut idle = Data::new();
+    let mut cut: Option<(usize, Data)> = None;
+    let finish = |group: Group, cut: Option<(usize, Data)>| match cut {
+        Some((step, data)) => group.add(
+            Path::new()
+                .set("class", "cut")
+                .set("data-step", step + 1)
+                .set("d", data),
+        ),
+        None => group,
     };
     for m in &toolpath.moves {
         match *m {
-            ToolMove::Idle { from, to } => {
-                let _ = write!(
-                    idle,
-                    "M{} {}L{} {}",
-                    num(from.x),
-                    num(from.y),
-                    num(to.x),
-                    num(to.y)
-                );
-            }
+            ToolMove::Idle { from, to } => idle = idle.move_to(xy(from)).line_to(xy(to)),
             ToolMove::Pierce { .. } => {}
             ToolMove::Cut { step, span, .. } => {
-                if cut_step != Some(step) {
-                    flush(out, &mut cut, cut_step);
-                    cut_step = Some(step);
-                    let _ = write!(cut, "M{} {}", num(span.start.x), num(span.start.y));
-                }
-                span_data(&mut cut, &span);
+                let data = match cut.take() {
+                    Some((s, data)) if s == step => data,
+                    other => {
+                        group = finish(group, other);
+                        Data::new().move_to(xy(span.start))
+                    }
+                };
+                cut = Some((
+                    step,
+                    span_data(data, at(span.start), at(span.end), span.bulge),
+                ));
             }
         }
     }
-    flush(out, &mut cut, cut_step);
+    group = finish(group, cut);
     if !idle.is_empty() {
-        let _ = writeln!(out, "<path class=\"idle\" d=\"{idle}\"/>");
+        group = group.add(Path::new().set("class", "idle").set("d", idle));
+    }
+    group
+}
+
+/// A coordinate to a micrometre, as the page draws it (its text stays small); non-finite values
+/// (never in a valid nest) as 0 so the document stays well-formed.
+fn rounded(v: f64) -> f64 {
+    if !v.is_finite() {
+        return 0.0;
+    }
+    let r = (v * 1000.0).round() / 1000.0;
+    if r == 0.0 {
+        0.0
+    } else {
+        r
     }
 }
 
-/// Appends a span's end as `L` or `A` path data.
-fn span_data(d: &mut String, span: &Span) {
-    let (z, r) = (span.end, span.radius());
-    if span.is_line() || !r.is_finite() || span.start == span.end {
-        let _ = write!(d, "L{} {}", num(z.x), num(z.y));
-        return;
-    }
-    let large = u8::from(span.sweep().abs() > std::f64::consts::PI);
-    // Inside the y-flipped group a counter-clockwise arc (bulge > 0) has sweep flag 1.
-    let sweep = u8::from(span.bulge > 0.0);
-    let _ = write!(
-        d,
-        "A{} {} 0 {large} {sweep} {} {}",
-        num(r),
-        num(r),
-        num(z.x),
-        num(z.y)
-    );
+fn at(p: Point) -> Point {
+    Point::new(rounded(p.x), rounded(p.y))
+}
+
+fn xy(p: Point) -> (f64, f64) {
+    (rounded(p.x), rounded(p.y))
 }
 
 /// The head's positions over machine time as `[[t, x, y], …]`: move ends, with arcs sampled

@@ -112,7 +112,7 @@ fn contour_data(mut data: Data, contour: &Contour) -> Data {
 }
 
 /// Appends one span; `V`/`H`/`L` for straight spans, one or two `A` for arcs.
-fn span_data(data: Data, a: Point, z: Point, b: f64) -> Data {
+pub(crate) fn span_data(data: Data, a: Point, z: Point, b: f64) -> Data {
     if b == 0.0 || a == z {
         return if a.x == z.x {
             data.vertical_line_to(z.y)
