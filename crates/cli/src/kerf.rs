@@ -1,5 +1,5 @@
 //! `cutroute solve` and `convert`'s full-route options (issue #17): kerf, the pierce and
-//! switch-off clearances d₁ and d₂, lead-ins, lead-outs and overcut. The defaults are the
+//! switch-off clearances d₁ and d₂, lead-ins, lead-outs, overcut and micro-joints (tabs). The defaults are the
 //! idealised model, under which nothing here changes a route or a report.
 //!
 //! With leads on, the contour solvers (nearest, ccp, heuristic, discrete) optimise the full
@@ -10,7 +10,8 @@
 //! idealised route and attaches leads to it (the comparison of the benchmark).
 
 use cutroute_geometry::{
-    KerfSettings, LeadError, LeadFitter, LeadShape, LeadSpec, Nest, Route, StepLeads, Vertex,
+    KerfSettings, LeadError, LeadFitter, LeadShape, LeadSpec, Nest, Route, StepLeads, TabSpec,
+    Vertex,
 };
 use cutroute_protocol::{JobRequest, Problem};
 use serde_json::{json, Value};
@@ -42,6 +43,10 @@ pub struct KerfArgs {
     /// How far the cut runs on past the entry before the lead-out, mm.
     #[arg(long, value_name = "MM", default_value_t = 0.0)]
     overcut: f64,
+    /// Micro-joints: N uncut gaps of WIDTH mm in the outer contour of every part, away from
+    /// corners (the torch switches off over each gap and pierces after it).
+    #[arg(long, value_name = "N:WIDTH")]
+    tabs: Option<String>,
     /// Solve the idealised route, then attach leads (instead of optimising with them).
     #[arg(long)]
     leads_after: bool,
@@ -63,6 +68,21 @@ fn shape(flag: &str, text: &str) -> Result<LeadShape, String> {
             "--{flag} {other:?}: expected arc, line, line-arc or none"
         )),
     }
+}
+
+fn tabs(text: Option<&str>) -> Result<TabSpec, String> {
+    let Some(text) = text else {
+        return Ok(TabSpec::default());
+    };
+    let bad =
+        || format!("--tabs {text:?}: expected N:WIDTH, e.g. 3:1.5 (N gaps of WIDTH mm per part)");
+    let (count, width) = text.split_once(':').ok_or_else(bad)?;
+    let count: usize = count.trim().parse().map_err(|_| bad())?;
+    let width: f64 = width.trim().parse().map_err(|_| bad())?;
+    if !(width.is_finite() && width > 0.0) || count > 1000 {
+        return Err(bad());
+    }
+    Ok(TabSpec { count, width })
 }
 
 fn length(flag: &str, value: f64) -> Result<f64, String> {
@@ -88,6 +108,7 @@ impl KerfArgs {
                 length("lead-out-length", self.lead_out_length)?,
             ),
             overcut: length("overcut", self.overcut)?,
+            tabs: tabs(self.tabs.as_deref())?,
         };
         Ok(Kerf {
             settings,
@@ -171,6 +192,7 @@ impl Kerf {
             "pierce_clearance": s.pierce_clearance,
             "switch_off_clearance": s.switch_off_clearance,
             "overcut": s.overcut,
+            "tabs": { "per_part": s.tabs.count, "width": s.tabs.width },
             "optimised_with_leads": !self.after,
         });
         let leads = || route.steps.iter().filter_map(|s| s.leads.as_ref());
@@ -193,6 +215,14 @@ impl Kerf {
             step["lead_in"] = json!(triples(&l.lead_in));
             step["lead_out"] = json!(triples(&l.lead_out));
             step["switch_off"] = json!([l.switch_off.x, l.switch_off.y]);
+            if !l.tabs.is_empty() {
+                // Each gap: where the torch stops and where it pierces again.
+                step["tabs"] = json!(l
+                    .tabs
+                    .iter()
+                    .map(|t| json!({ "from": [t.from.x, t.from.y], "to": [t.to.x, t.to.y] }))
+                    .collect::<Vec<_>>());
+            }
         }
     }
 }

@@ -149,3 +149,87 @@ fn every_real_nest_routes_with_plasma_leads_or_names_the_contour_without_room() 
         }
     }
 }
+
+/// `--tabs N:WIDTH`: each part's outer contour gets up to N gaps (holes none); each gap is a
+/// torch-off crossing and one more pierce, in the report and in the G-code read back.
+#[test]
+fn tabs_add_a_pierce_and_an_idle_crossing_per_gap() {
+    let file = data("nests/dbs-json/E1X_6_01.dbs.json");
+    let solve = |extra: &[&str]| {
+        let mut args = vec![
+            "solve",
+            &file,
+            "--solver",
+            "ccp",
+            "--time-limit",
+            "1",
+            "--json",
+        ];
+        args.extend(PLASMA);
+        args.extend(extra);
+        json(&args)
+    };
+    let report = solve(&["--tabs", "2:1.5"]);
+    let steps = report["route"].as_array().unwrap();
+    let mut gaps = 0;
+    let mut crossing = 0.0;
+    for step in steps {
+        if let Some(tabs) = step.get("tabs").and_then(Value::as_array) {
+            assert!(tabs.len() <= 2);
+            for tab in tabs {
+                let (a, b) = (point(&tab["from"]), point(&tab["to"]));
+                crossing += (b.0 - a.0).hypot(b.1 - a.1);
+                gaps += 1;
+            }
+        }
+    }
+    assert!(gaps > 0, "{report}");
+    assert_eq!(
+        report["pierces"].as_u64().unwrap() as usize,
+        steps.len() + gaps
+    );
+    // idle = the legs between steps plus the crossings of the gaps.
+    let mut at = point(&report["start"]);
+    let mut legs = 0.0;
+    for step in steps {
+        let m = point(&step["pierce"]);
+        legs += (m.0 - at.0).hypot(m.1 - at.1);
+        at = point(&step["switch_off"]);
+    }
+    if let Some(finish) = report.get("finish").filter(|f| !f.is_null()) {
+        let f = point(finish);
+        legs += (f.0 - at.0).hypot(f.1 - at.1);
+    }
+    let idle = report["idle_length"].as_f64().unwrap();
+    assert!(
+        (legs + crossing - idle).abs() < 1e-6,
+        "{legs} + {crossing} vs {idle}"
+    );
+    // The program written with tabs reads back with the same pierces and cut.
+    let out = std::env::temp_dir().join(format!("cutroute-tabs-{}.nc", std::process::id()));
+    let out_s = out.to_string_lossy().into_owned();
+    let mut args = vec![
+        "convert",
+        &file,
+        &out_s,
+        "--solver",
+        "ccp",
+        "--time-limit",
+        "1",
+        "--tabs",
+        "2:1.5",
+    ];
+    args.extend(PLASMA);
+    let (ok, _, err) = cutroute(&args);
+    assert!(ok, "{err}");
+    let read = json(&["inspect", &out_s, "--json"]);
+    let _ = std::fs::remove_file(&out);
+    let pierces = read["route_pierces"].as_u64().unwrap() as usize;
+    let contours = steps.len();
+    assert!(
+        pierces > contours,
+        "the gaps' pierces are in the program: {pierces}"
+    );
+    let (ok, _, err) = cutroute(&["solve", &file, "--tabs", "two:1"]);
+    assert!(!ok && err.contains("--tabs"), "{err}");
+}

@@ -14,7 +14,7 @@
 use cutroute_geometry::float::Libm;
 use cutroute_geometry::{
     chain_spans, opened_at, Contour, ContourRef, CutStep, Entry, Nest, Part, Point, Route, Span,
-    StepLeads, Vertex,
+    StepLeads, Tab, Vertex,
 };
 use serde::{Deserialize, Serialize};
 
@@ -328,8 +328,15 @@ pub fn route_moves(nest: &Nest, route: &Route) -> Result<Vec<ToolMove>, RouteErr
                 chain_spans(&leads.lead_in).for_each(|s| push(MoveKind::CutIn, s, on));
                 let equidistant = cutroute_geometry::equidistant(contour, leads.offset)
                     .map_err(|problem| RouteError::NoEquidistant { step, problem })?;
-                for span in leads.equidistant_cut(&equidistant, 0.0) {
-                    push(MoveKind::Cut, span, on);
+                // A tab's gap is an idle move that names the contour, between cut pieces.
+                let pieces = leads.equidistant_pieces(&equidistant, 0.0);
+                for (k, piece) in pieces.into_iter().enumerate() {
+                    if let Some(tab) = k.checked_sub(1).and_then(|t| leads.tabs.get(t)) {
+                        push(MoveKind::Air, Span::line(tab.from, tab.to), on);
+                    }
+                    for span in piece {
+                        push(MoveKind::Cut, span, on);
+                    }
                 }
                 chain_spans(&leads.lead_out).for_each(|s| push(MoveKind::CutOut, s, on));
             }
@@ -579,6 +586,7 @@ impl RmResult {
                         cut_length: m.length(),
                         exit: m.to,
                         lead_out: Vec::new(),
+                        tabs: Vec::new(),
                     });
                     current = Some(contour);
                 }
@@ -591,6 +599,11 @@ impl RmResult {
                 (MoveKind::CutOut, _) => {
                     if let Some(read) = open.as_mut() {
                         read.lead_out.push(*m);
+                    }
+                }
+                (MoveKind::Air, Some(contour)) if current == Some(contour) => {
+                    if let Some(read) = open.as_mut() {
+                        read.tabs.push((read.cut_length, m.from, m.to));
                     }
                 }
                 (MoveKind::Cut, None) if current.is_some() => {
@@ -625,6 +638,8 @@ struct ReadLeads {
     cut_length: f64,
     exit: Point,
     lead_out: Vec<ToolMove>,
+    /// Tab gaps: the cut length before each, where the torch stops and where it starts again.
+    tabs: Vec<(f64, Point, Point)>,
 }
 
 /// Entries closer to their contour than this are on it: the idealised model.
@@ -643,7 +658,11 @@ impl ReadLeads {
             return;
         };
         let offset = nearest.point.distance(self.entry);
-        if self.lead_in.is_empty() && self.lead_out.is_empty() && offset < ON_CONTOUR {
+        if self.lead_in.is_empty()
+            && self.lead_out.is_empty()
+            && self.tabs.is_empty()
+            && offset < ON_CONTOUR
+        {
             return;
         }
         let chain = |moves: &[ToolMove], end: Point| -> Vec<Vertex> {
@@ -661,8 +680,32 @@ impl ReadLeads {
         };
         let lead_in = chain(&self.lead_in, self.entry);
         let lead_out = chain(&self.lead_out, self.exit);
-        let perimeter = cutroute_geometry::equidistant(contour, offset)
-            .map_or(contour.perimeter(), |eq| eq.perimeter());
+        let equidistant =
+            cutroute_geometry::equidistant(contour, offset).unwrap_or_else(|_| contour.clone());
+        let perimeter = equidistant.perimeter();
+        let along = |p: Point| {
+            equidistant
+                .nearest_point(p)
+                .map_or(0.0, |q| equidistant.length_at(q.position))
+        };
+        // Each gap's width is its length along the equidistant; its start counts the cut
+        // before it and the gaps before it.
+        let mut gaps = 0.0;
+        let tabs: Vec<Tab> = self
+            .tabs
+            .iter()
+            .map(|&(cut, from, to)| {
+                let width = (along(to) - along(from)).rem_euclid(perimeter.max(f64::MIN_POSITIVE));
+                let start = cut + gaps;
+                gaps += width;
+                Tab {
+                    start,
+                    end: start + width,
+                    from,
+                    to,
+                }
+            })
+            .collect();
         step.pierce_point = nearest.point;
         step.leads = Some(StepLeads {
             pierce: lead_in[0].point,
@@ -671,9 +714,10 @@ impl ReadLeads {
             lead_in,
             lead_out,
             offset,
-            overcut: (self.cut_length - perimeter).max(0.0),
+            overcut: (self.cut_length + gaps - perimeter).max(0.0),
             pierce_clearance: 0.0,
             switch_off_clearance: 0.0,
+            tabs,
         });
     }
 }

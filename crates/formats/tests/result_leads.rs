@@ -6,7 +6,7 @@ use cutroute_formats::ResultExportOptions;
 use cutroute_formats::{read_result_json, route_moves, write_result_json, MoveKind, RmResult};
 use cutroute_geometry::{
     generate_nest, ContourRef, CutStep, KerfSettings, LeadFitter, LeadShape, LeadSpec, Nest, Point,
-    Route,
+    Route, TabSpec,
 };
 
 fn route_with_leads(nest: &Nest, settings: KerfSettings) -> Route {
@@ -34,6 +34,7 @@ fn plasma() -> KerfSettings {
         lead_in: LeadSpec::new(LeadShape::Arc, 4.0),
         lead_out: LeadSpec::new(LeadShape::Line, 2.0),
         overcut: 0.5,
+        ..KerfSettings::default()
     }
 }
 
@@ -46,6 +47,16 @@ fn leads_round_trip_through_the_result_format() {
             KerfSettings {
                 lead_out: LeadSpec::new(LeadShape::None, 0.0),
                 overcut: 0.0,
+                ..plasma()
+            },
+        ),
+        (
+            13,
+            KerfSettings {
+                tabs: TabSpec {
+                    count: 3,
+                    width: 1.5,
+                },
                 ..plasma()
             },
         ),
@@ -100,11 +111,17 @@ fn leads_round_trip_through_the_result_format() {
             );
             assert!((r.lead_in_length() - w.lead_in_length()).abs() < 1e-6);
             assert!((r.lead_out_length() - w.lead_out_length()).abs() < 1e-6);
+            assert_eq!(r.tabs.len(), w.tabs.len());
+            for (a, b) in r.tabs.iter().zip(&w.tabs) {
+                assert!((a.start - b.start).abs() < 1e-6 && (a.end - b.end).abs() < 1e-6);
+                assert!(close(a.from, b.from) && close(a.to, b.to));
+            }
         }
         // The route read back is a full route the checker accepts, with the same lengths.
         back.validate(&nest, 1e-6).unwrap();
         assert!((back.idle_length() - idle).abs() < 1e-6);
         assert!((back.cut_length(&nest) - route.cut_length(&nest)).abs() < 1e-6);
+        assert_eq!(back.pierce_count(), route.pierce_count());
         // The drawn moves are the route's: idle ends at pierce points M, not on the contours.
         let moves = route_moves(&nest, &route).unwrap();
         let pierces: Vec<Point> = moves

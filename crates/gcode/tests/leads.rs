@@ -4,7 +4,7 @@
 use cutroute_gcode::{read_gcode, route_gcode, ArcOutput, DistanceMode, GcodeOptions, ReadOptions};
 use cutroute_geometry::{
     generate_nest, ContourRef, CutStep, KerfSettings, LeadFitter, LeadShape, LeadSpec, Point,
-    Route, Toolpath,
+    Route, TabSpec, Toolpath,
 };
 
 #[test]
@@ -28,6 +28,7 @@ fn a_route_with_leads_reads_back_with_the_same_lengths_and_pierces() {
         lead_in: LeadSpec::new(LeadShape::Arc, 4.0),
         lead_out: LeadSpec::new(LeadShape::Line, 2.0),
         overcut: 0.5,
+        ..KerfSettings::default()
     };
     let route = LeadFitter::new(&nest, settings).attach(&route).unwrap();
     route.validate(&nest, 1e-6).unwrap();
@@ -63,4 +64,47 @@ fn a_route_with_leads_reads_back_with_the_same_lengths_and_pierces() {
             }
         }
     }
+}
+
+#[test]
+fn tabs_read_back_as_pierces_and_idle_gaps() {
+    let nest = generate_nest(40, 7);
+    let forest = nest.containment_forest();
+    let mut refs: Vec<ContourRef> = nest.contour_refs().collect();
+    refs.sort_by_key(|&r| std::cmp::Reverse(forest.depth(r)));
+    let route = Route {
+        start: Point::new(0.0, 0.0),
+        steps: refs
+            .into_iter()
+            .map(|r| CutStep::pierced(r, nest.contour(r).unwrap().vertices[0].point))
+            .collect(),
+        finish: Some(Point::new(0.0, 0.0)),
+    };
+    let settings = KerfSettings {
+        kerf: 2.0,
+        pierce_clearance: 2.0,
+        switch_off_clearance: 1.0,
+        lead_in: LeadSpec::new(LeadShape::Arc, 4.0),
+        lead_out: LeadSpec::new(LeadShape::Line, 2.0),
+        tabs: TabSpec {
+            count: 3,
+            width: 1.5,
+        },
+        ..KerfSettings::default()
+    };
+    let route = LeadFitter::new(&nest, settings).attach(&route).unwrap();
+    route.validate(&nest, 1e-6).unwrap();
+    let tabs: usize = route.steps.iter().map(|s| s.tabs().len()).sum();
+    assert!(tabs > 0);
+    let options = GcodeOptions {
+        decimals: 6,
+        ..GcodeOptions::default()
+    };
+    let text = route_gcode(&nest, &route, &options).unwrap();
+    let program = read_gcode(&text, &ReadOptions::default()).unwrap();
+    // The torch goes on once per step and once after every gap; the gaps are crossed idle.
+    assert_eq!(program.pierce_count(), route.steps.len() + tabs);
+    assert_eq!(program.pierce_count(), route.pierce_count());
+    assert!((program.cut_length() - route.cut_length(&nest)).abs() < 1e-3);
+    assert!((program.idle_length() - route.idle_length()).abs() < 1e-3);
 }

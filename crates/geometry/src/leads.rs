@@ -29,6 +29,7 @@
 //!     lead_in: LeadSpec::new(LeadShape::Arc, 10.0),
 //!     lead_out: LeadSpec::new(LeadShape::Line, 3.0),
 //!     overcut: 0.0,
+//!     tabs: Default::default(),
 //! };
 //! let fitter = LeadFitter::new(&nest, settings);
 //! let r = ContourRef { part: 0, contour: 0 };
@@ -137,6 +138,128 @@ impl LeadSpec {
     }
 }
 
+/// Micro-joints (tabs, bridges): `count` uncut gaps of `width` mm in the outer contour of every
+/// part, which hold the part in the sheet until it is broken out. The torch switches off at
+/// each gap, crosses it and pierces again after it. Holes get none: they fall out as scrap.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct TabSpec {
+    /// Gaps per part (0: none).
+    pub count: usize,
+    /// Width of each gap along the cut, mm.
+    pub width: f64,
+}
+
+/// One micro-joint of a step: the cut stops at arc length `start` of the step's cut (measured
+/// from the entry round the equidistant) and starts again at `end`; the head crosses the gap
+/// from `from` to `to` with the torch off and pierces at `to`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Tab {
+    /// Where the gap begins, mm of the cut from the entry.
+    pub start: f64,
+    /// Where it ends, mm of the cut from the entry.
+    pub end: f64,
+    /// The point of the equidistant at `start`: the torch switches off here.
+    pub from: Point,
+    /// The point at `end`: the torch pierces again here.
+    pub to: Point,
+}
+
+impl Tab {
+    /// Width of the gap along the cut, mm.
+    pub fn width(&self) -> f64 {
+        self.end - self.start
+    }
+}
+
+/// A corner of an equidistant: where its direction turns by more than this, degrees. A tab over
+/// a corner would leave a notch where the part breaks out badly.
+const CORNER_DEG: f64 = 20.0;
+
+/// Places `spec.count` tabs on `eq`, the equidistant at `offset` from its contour, for a cut
+/// that starts at arc length `entry` of `eq` and runs on `overcut` past it: spread evenly round
+/// the cut, each at least its width (and 1 mm) away from every corner and from the cut's start
+/// and end (where the lead-in, overcut and lead-out are). A corner is a turn of more than 20°
+/// between spans, or an arc of radius at most `offset` (how an outward offset rounds a corner
+/// of its contour). A tab that finds no such place within half the spacing of its even
+/// position is left out; the step then has fewer tabs.
+pub fn place_tabs(eq: &Contour, offset: f64, entry: f64, overcut: f64, spec: TabSpec) -> Vec<Tab> {
+    let perimeter = eq.perimeter();
+    let width = spec.width;
+    if spec.count == 0 || !(width > 0.0) || !(perimeter > 0.0) || !width.is_finite() {
+        return Vec::new();
+    }
+    let margin = width.max(1.0);
+    let corners = corner_intervals(eq, offset, entry);
+    let mut tabs: Vec<Tab> = Vec::with_capacity(spec.count);
+    let fits = |a: f64, tabs: &[Tab]| {
+        a >= overcut + margin
+            && a + width <= perimeter - margin
+            && corners
+                .iter()
+                .all(|&(c0, c1)| c1 < a - margin || c0 > a + width + margin)
+            && tabs
+                .iter()
+                .all(|t| a + width + margin < t.start || a > t.end + margin)
+    };
+    let spacing = perimeter / spec.count as f64;
+    const TRIES: usize = 200;
+    for k in 0..spec.count {
+        let even = spacing * (k as f64 + 0.5) - width / 2.0;
+        let found = (0..=TRIES)
+            .flat_map(|j| {
+                let d = 0.5 * spacing * j as f64 / TRIES as f64;
+                [even + d, even - d]
+            })
+            .find(|&a| fits(a, &tabs));
+        if let Some(a) = found {
+            let at = |s: f64| frame_at(eq, (entry + s).rem_euclid(perimeter)).0;
+            tabs.push(Tab {
+                start: a,
+                end: a + width,
+                from: at(a),
+                to: at(a + width),
+            });
+        }
+    }
+    tabs.sort_by(|a, b| a.start.total_cmp(&b.start));
+    tabs
+}
+
+/// The corners of `eq` (see [`place_tabs`]) as arc-length intervals measured from `entry` in
+/// the cut direction; a sharp turn is an interval of no length. An interval that wraps past
+/// the entry is split in two.
+fn corner_intervals(eq: &Contour, offset: f64, entry: f64) -> Vec<(f64, f64)> {
+    let perimeter = eq.perimeter();
+    let spans: Vec<Span> = eq.spans().collect();
+    let n = spans.len();
+    let mut at = 0.0;
+    let mut out = Vec::new();
+    let mut push = |from: f64, to: f64| {
+        let a = (from - entry).rem_euclid(perimeter);
+        let b = a + (to - from);
+        if b > perimeter {
+            out.push((a, perimeter));
+            out.push((0.0, b - perimeter));
+        } else {
+            out.push((a, b));
+        }
+    };
+    for k in 0..n {
+        let before = spans[(k + n - 1) % n].tangent_at(1.0);
+        let after = spans[k].tangent_at(0.0);
+        let turn = before.cross(after).atan2_libm(before.dot(after)).abs();
+        if turn > CORNER_DEG.to_radians() {
+            push(at, at);
+        }
+        let length = spans[k].length();
+        if !spans[k].is_line() && spans[k].radius() <= offset * (1.0 + 1e-9) + 1e-12 {
+            push(at, at + length);
+        }
+        at += length;
+    }
+    out
+}
+
 /// Machine and material settings of the full cutting route. The default is the idealised
 /// model (kerf 0, no leads, no clearances, no overcut), under which a route is cut on the
 /// contours themselves.
@@ -154,6 +277,9 @@ pub struct KerfSettings {
     pub lead_out: LeadSpec,
     /// How far the cut runs on past the entry before the lead-out, mm.
     pub overcut: f64,
+    /// Micro-joints in the outer contour of every part.
+    #[serde(default)]
+    pub tabs: TabSpec,
 }
 
 impl KerfSettings {
@@ -165,6 +291,7 @@ impl KerfSettings {
             && self.lead_in.shape == LeadShape::None
             && self.lead_out.shape == LeadShape::None
             && self.overcut == 0.0
+            && self.tabs.count == 0
     }
 }
 
@@ -196,6 +323,9 @@ pub struct StepLeads {
     /// d₂ the switch-off point was placed under, mm.
     #[serde(default)]
     pub switch_off_clearance: f64,
+    /// Micro-joints of the cut, in cut order.
+    #[serde(default)]
+    pub tabs: Vec<Tab>,
 }
 
 /// Spans of a vertex chain (each vertex's bulge shapes the span to the next; the last vertex
@@ -220,9 +350,56 @@ impl StepLeads {
     }
 
     /// Length of the tool-on path of the step: lead-in, the equidistant's perimeter, the
-    /// overcut and the lead-out, mm.
+    /// overcut and the lead-out, less the gaps of the tabs, mm.
     pub fn cut_length(&self, equidistant: &Contour) -> f64 {
         self.lead_in_length() + equidistant.perimeter() + self.overcut + self.lead_out_length()
+            - self.tab_width()
+    }
+
+    /// Total width of the tabs' gaps, mm.
+    pub fn tab_width(&self) -> f64 {
+        self.tabs.iter().map(Tab::width).sum()
+    }
+
+    /// The cut of `equidistant` ([`StepLeads::equidistant_cut`]) split at the tabs: the pieces
+    /// the torch cuts between the entry, the gaps and the exit, in order (one piece without
+    /// tabs). Pieces shorter than `min_piece` are dropped.
+    pub fn equidistant_pieces(&self, equidistant: &Contour, min_piece: f64) -> Vec<Vec<Span>> {
+        let cut = self.equidistant_cut(equidistant, 0.0);
+        let mut pieces = vec![Vec::new()];
+        // Cut intervals [from, to] of arc length between the tabs.
+        let mut bounds = vec![0.0];
+        for tab in &self.tabs {
+            bounds.push(tab.start);
+            bounds.push(tab.end);
+        }
+        bounds.push(f64::INFINITY);
+        let intervals: Vec<(f64, f64)> = bounds.chunks(2).map(|w| (w[0], w[1])).collect();
+        let mut at = 0.0;
+        let mut current = 0;
+        for span in cut {
+            let length = span.length();
+            let (begin, end) = (at, at + length);
+            at = end;
+            while current < intervals.len() {
+                let (from, to) = intervals[current];
+                let (a, b) = (begin.max(from), end.min(to));
+                if b > a && length > 0.0 {
+                    let piece = span.sub_span((a - begin) / length, (b - begin) / length);
+                    if piece.length() > min_piece {
+                        pieces[current].push(piece);
+                    }
+                }
+                if to <= end {
+                    current += 1;
+                    pieces.push(Vec::new());
+                } else {
+                    break;
+                }
+            }
+        }
+        pieces.truncate(intervals.len());
+        pieces
     }
 
     /// Length of the lead-in, mm.
@@ -372,6 +549,15 @@ pub enum LeadProblem {
     /// The lead chain does not run from M to the entry, or from the exit to M*.
     #[error("a lead does not join its end points")]
     Disjoint,
+    /// A tab lies outside the cut, out of order, off the equidistant, over a corner, or in a
+    /// hole (holes get no tabs).
+    #[error("the tab at ({x}, {y}) is misplaced")]
+    TabMisplaced {
+        /// Where its gap begins, x.
+        x: f64,
+        /// Where its gap begins, y.
+        y: f64,
+    },
 }
 
 /// Relative tolerance of the checks, times the nest's scale (1 mm).
@@ -481,6 +667,17 @@ impl<'a> LeadFitter<'a> {
             self.variants(self.settings.lead_out)
                 .map(|spec| lead_out_chain(spec, exit, exit_tangent)),
         )?;
+        let tabs = if self.is_hole(r) {
+            Vec::new()
+        } else {
+            place_tabs(
+                eq,
+                self.settings.kerf / 2.0,
+                s,
+                self.settings.overcut,
+                self.settings.tabs,
+            )
+        };
         Ok(StepLeads {
             pierce: lead_in[0].point,
             entry,
@@ -491,6 +688,7 @@ impl<'a> LeadFitter<'a> {
             overcut: self.settings.overcut,
             pierce_clearance: self.settings.pierce_clearance,
             switch_off_clearance: self.settings.switch_off_clearance,
+            tabs,
         })
     }
 
@@ -560,6 +758,7 @@ impl<'a> LeadFitter<'a> {
             overcut: 0.0,
             pierce_clearance: self.settings.pierce_clearance,
             switch_off_clearance: self.settings.switch_off_clearance,
+            tabs: Vec::new(),
         })
     }
 
@@ -833,6 +1032,44 @@ impl<'a> LeadFitter<'a> {
         }
         problems.extend(self.chain_problem(r, &leads.lead_in, true));
         problems.extend(self.chain_problem(r, &leads.lead_out, false));
+        if !leads.tabs.is_empty() {
+            problems.extend(self.tab_problems(r, leads));
+        }
+        problems
+    }
+
+    /// The tabs of `leads` on contour `r`: only in a part's outer contour, in cut order within
+    /// the cut, their ends on the equidistant where their arc lengths say, and no corner inside
+    /// a gap.
+    fn tab_problems(&self, r: ContourRef, leads: &StepLeads) -> Vec<LeadProblem> {
+        let misplaced = |p: Point| LeadProblem::TabMisplaced { x: p.x, y: p.y };
+        if self.is_hole(r) {
+            return leads.tabs.iter().map(|t| misplaced(t.from)).collect();
+        }
+        let Ok(eq) = self.equidistant(r) else {
+            return Vec::new(); // reported as the entry off the equidistant
+        };
+        let perimeter = eq.perimeter();
+        let entry = eq
+            .nearest_point(leads.entry)
+            .map_or(0.0, |p| eq.length_at(p.position));
+        let corners = corner_intervals(&eq, leads.offset, entry);
+        let tolerance = 1e-6;
+        let mut problems = Vec::new();
+        let mut previous_end = 0.0;
+        for tab in &leads.tabs {
+            let at = |s: f64| frame_at(&eq, (entry + s).rem_euclid(perimeter)).0;
+            let ordered = previous_end <= tab.start && tab.start < tab.end && tab.end <= perimeter;
+            let on_equidistant = at(tab.start).distance(tab.from) <= tolerance
+                && at(tab.end).distance(tab.to) <= tolerance;
+            let clear = corners
+                .iter()
+                .all(|&(c0, c1)| c1 <= tab.start || c0 >= tab.end);
+            if !(ordered && on_equidistant && clear) {
+                problems.push(misplaced(tab.from));
+            }
+            previous_end = tab.end;
+        }
         problems
     }
 }

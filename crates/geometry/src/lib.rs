@@ -98,8 +98,8 @@ pub use forest::ContainmentForest;
 pub use generator::generate_nest;
 pub use kerf::{clearance, equidistant, in_clear_scrap, OffsetError};
 pub use leads::{
-    chain_spans, opened_at, KerfSettings, LeadError, LeadFitter, LeadProblem, LeadShape, LeadSpec,
-    StepLeads,
+    chain_spans, opened_at, place_tabs, KerfSettings, LeadError, LeadFitter, LeadProblem,
+    LeadShape, LeadSpec, StepLeads, Tab, TabSpec,
 };
 pub use path_route::{PathRoute, PathRouteError, ToolOnPath};
 pub use rng::{SplitMix64, Xoshiro256};

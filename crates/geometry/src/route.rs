@@ -83,6 +83,11 @@ impl CutStep {
             .map_or(self.pierce_point, |l| l.switch_off)
     }
 
+    /// The micro-joints of this step (none in the idealised model).
+    pub fn tabs(&self) -> &[crate::Tab] {
+        self.leads.as_ref().map_or(&[], |l| l.tabs.as_slice())
+    }
+
     /// Tool-on length of this step on `contour` (its own contour): the perimeter, or with
     /// leads the lead-in, the equidistant, the overcut and the lead-out.
     pub fn cut_length_on(&self, contour: &Contour) -> f64 {
@@ -312,6 +317,8 @@ impl Route {
             if s.is_pierced() {
                 moves.push((at, s.switch_on_point()));
             }
+            // The head crosses each tab's gap with the torch off.
+            moves.extend(s.tabs().iter().map(|tab| (tab.from, tab.to)));
             at = s.switch_off_point();
         }
         if let Some(finish) = self.finish {
@@ -349,9 +356,10 @@ impl Route {
             .sum()
     }
 
-    /// Number of pierces: one per step not entered by a link.
+    /// Number of pierces: one per step not entered by a link, and one after every tab.
     pub fn pierce_count(&self) -> usize {
         self.steps.iter().filter(|s| s.is_pierced()).count()
+            + self.steps.iter().map(|s| s.tabs().len()).sum::<usize>()
     }
 
     /// Total cut length: the perimeters of the contours cut (with leads: the equidistants,

@@ -143,7 +143,7 @@ impl Toolpath {
                 }
             }
             at = cut.switch_off_point();
-            let mut push = |span: Span| {
+            let push = |moves: &mut Vec<ToolMove>, span: Span| {
                 if span.length() > MIN_PIECE_LENGTH {
                     moves.push(ToolMove::Cut {
                         step,
@@ -155,19 +155,27 @@ impl Toolpath {
             match &cut.leads {
                 None => opened_at(contour, cut.pierce_point, MIN_PIECE_LENGTH)
                     .into_iter()
-                    .for_each(&mut push),
+                    .for_each(|span| push(&mut moves, span)),
                 Some(leads) => {
                     // The lead-in, the equidistant from the entry round (and the overcut),
                     // the lead-out; an equidistant that does not exist is reported by the
                     // checker, and the step then cuts its leads only.
-                    chain_spans(&leads.lead_in).for_each(&mut push);
+                    chain_spans(&leads.lead_in).for_each(|span| push(&mut moves, span));
                     if let Ok(eq) = crate::equidistant(contour, leads.offset) {
-                        leads
-                            .equidistant_cut(&eq, MIN_PIECE_LENGTH)
-                            .into_iter()
-                            .for_each(&mut push);
+                        // Between the pieces, the tabs: torch off across the gap, pierce again.
+                        let pieces = leads.equidistant_pieces(&eq, MIN_PIECE_LENGTH);
+                        for (k, piece) in pieces.into_iter().enumerate() {
+                            if let Some(tab) = k.checked_sub(1).and_then(|t| leads.tabs.get(t)) {
+                                moves.push(ToolMove::Idle {
+                                    from: tab.from,
+                                    to: tab.to,
+                                });
+                                moves.push(ToolMove::Pierce { at: tab.to, step });
+                            }
+                            piece.into_iter().for_each(|span| push(&mut moves, span));
+                        }
                     }
-                    chain_spans(&leads.lead_out).for_each(&mut push);
+                    chain_spans(&leads.lead_out).for_each(|span| push(&mut moves, span));
                 }
             }
         }

@@ -72,6 +72,7 @@ fn plasma() -> KerfSettings {
         lead_in: LeadSpec::new(LeadShape::Arc, 8.0),
         lead_out: LeadSpec::new(LeadShape::Line, 2.0),
         overcut: 1.0,
+        ..KerfSettings::default()
     }
 }
 

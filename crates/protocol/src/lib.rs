@@ -521,6 +521,12 @@ mod tests {
             overcut: 0.5,
             pierce_clearance: 5.0,
             switch_off_clearance: 1.0,
+            tabs: vec![cutroute_geometry::Tab {
+                start: 3.0,
+                end: 4.5,
+                from: Point::new(0.0, 3.0),
+                to: Point::new(0.0, 4.5),
+            }],
         });
         let route = Route {
             start: Point::default(),
