@@ -25,6 +25,24 @@ const PLASMA: [&str; 12] = [
     "line",
 ];
 
+/// Laser settings of the issue: kerf 0.2, d₁ 1, d₂ 0.5, arc lead-ins of 3 mm.
+const LASER: [&str; 14] = [
+    "--kerf",
+    "0.2",
+    "--pierce-clearance",
+    "1",
+    "--switch-off-clearance",
+    "0.5",
+    "--lead-in",
+    "arc",
+    "--lead-in-length",
+    "3",
+    "--lead-out",
+    "line",
+    "--lead-out-length",
+    "1",
+];
+
 fn point(v: &Value) -> (f64, f64) {
     (v[0].as_f64().unwrap(), v[1].as_f64().unwrap())
 }
@@ -124,7 +142,7 @@ fn convert_writes_gcode_with_leads_that_reads_back() {
 }
 
 /// The issue's target: on every real nest the routes with kerf 2, d₁ 5, d₂ 1 and arc
-/// lead-ins pass the checker (the CLI checks every route before printing it); a nest with no
+/// lead-ins (and the laser's kerf 0.2, d₁ 1) pass the checker (the CLI checks every route before printing it); a nest with no
 /// room for the kerf (`ring.dbs`, a 4 mm ring) names the contour instead.
 #[test]
 fn every_real_nest_routes_with_plasma_leads_or_names_the_contour_without_room() {
@@ -146,6 +164,11 @@ fn every_real_nest_routes_with_plasma_leads_or_names_the_contour_without_room() 
             } else {
                 assert!(ok, "{file} {solver}: {err}");
             }
+            // Laser: a 0.2 mm kerf and d₁ 1 leave room on every nest, the 4 mm ring included.
+            let mut args = vec!["solve", &file, "--solver", solver, "--time-limit", "0.3"];
+            args.extend(LASER);
+            let (ok, _, err) = cutroute(&args);
+            assert!(ok, "{file} {solver} (laser): {err}");
         }
     }
 }
