@@ -775,6 +775,12 @@ struct GcodeArgs {
     /// Torch-off line [default: the preset's, M05].
     #[arg(long)]
     torch_off: Option<String>,
+    /// Who offsets the tool by half the kerf: the program ("program": the tool centre on the
+    /// equidistants), or the controller, the program running on the contours with
+    /// "g41.1" (G41.1 D<kerf>, LinuxCNC) or "g41:N" (G41 D<N>, the kerf in tool-table entry N).
+    /// The controller's needs straight leads (--lead-in line --lead-out line) and no tabs.
+    #[arg(long, value_name = "WHO", default_value = "program")]
+    kerf_compensation: String,
 }
 
 impl GcodeArgs {
@@ -784,7 +790,7 @@ impl GcodeArgs {
         profile: Option<&cutroute_protocol::MachineProfile>,
         machine: &MachineParameters,
     ) -> Result<cutroute_gcode::GcodeOptions, String> {
-        use cutroute_gcode::{ArcOutput, DistanceMode};
+        use cutroute_gcode::{ArcOutput, DistanceMode, KerfCompensation};
         let mut options = inputs::preset_options(self.preset, profile, machine)?;
         match self.arcs.as_deref() {
             None => {}
@@ -818,6 +824,18 @@ impl GcodeArgs {
         if let Some(code) = &self.torch_off {
             options.torch_off = code.clone();
         }
+        options.kerf_compensation = match self.kerf_compensation.as_str() {
+            "program" => KerfCompensation::InProgram,
+            "g41.1" => KerfCompensation::ControllerDiameter,
+            other => match other.strip_prefix("g41:").map(str::parse::<u32>) {
+                Some(Ok(n)) => KerfCompensation::ControllerRegister(n),
+                _ => {
+                    return Err(format!(
+                        "--kerf-compensation {other:?}: expected program, g41.1 or g41:N"
+                    ))
+                }
+            },
+        };
         Ok(options)
     }
 }

@@ -256,3 +256,65 @@ fn tabs_add_a_pierce_and_an_idle_crossing_per_gap() {
     let (ok, _, err) = cutroute(&["solve", &file, "--tabs", "two:1"]);
     assert!(!ok && err.contains("--tabs"), "{err}");
 }
+
+/// `--kerf-compensation g41.1`: the program runs on the contours and the controller offsets
+/// it; read back (the reader offsets it too) it has the route's pierces and cut.
+#[test]
+fn controller_compensation_writes_a_program_that_reads_back_as_the_route() {
+    let file = data("nests/dbs-json/E1X_6_01.dbs.json");
+    let line_leads = [
+        "--kerf",
+        "2",
+        "--pierce-clearance",
+        "3",
+        "--lead-in",
+        "line",
+        "--lead-out",
+        "line",
+        "--overcut",
+        "1",
+    ];
+    let out = std::env::temp_dir().join(format!("cutroute-g41-{}.nc", std::process::id()));
+    let out_s = out.to_string_lossy().into_owned();
+    let mut args = vec![
+        "convert",
+        &file,
+        &out_s,
+        "--solver",
+        "nearest",
+        "--kerf-compensation",
+        "g41.1",
+    ];
+    args.extend(line_leads);
+    let (ok, _, err) = cutroute(&args);
+    assert!(ok, "{err}");
+    let program = std::fs::read_to_string(&out).unwrap();
+    let read = json(&["inspect", &out_s, "--json"]);
+    let _ = std::fs::remove_file(&out);
+    let mut solve = vec!["solve", &file, "--solver", "nearest", "--json"];
+    solve.extend(line_leads);
+    let solved = json(&solve);
+    let steps = solved["route"].as_array().unwrap().len();
+    assert_eq!(program.matches("G41.1 D2.000").count(), steps);
+    assert_eq!(read["route_pierces"], solved["pierces"]);
+    let (cut, expected) = (
+        read["route_cut_length"].as_f64().unwrap(),
+        solved["cut_length"].as_f64().unwrap(),
+    );
+    assert!((cut - expected).abs() < 1e-2, "{cut} vs {expected}");
+    // Arc leads cannot be the controller's start-up move.
+    let mut args = vec![
+        "convert",
+        &file,
+        &out_s,
+        "--solver",
+        "nearest",
+        "--kerf-compensation",
+        "g41.1",
+    ];
+    args.extend(PLASMA);
+    let (ok, _, err) = cutroute(&args);
+    assert!(!ok && err.contains("straight lead"), "{err}");
+    let (ok, _, err) = cutroute(&["convert", &file, &out_s, "--kerf-compensation", "g42"]);
+    assert!(!ok && err.contains("--kerf-compensation"), "{err}");
+}

@@ -57,5 +57,5 @@ pub use preset::{GcodePreset, UnknownPreset};
 pub use read::{read_gcode, GcodeReadError, Motion, Program, ReadOptions};
 pub use write::{
     path_route_gcode, route_gcode, write_gcode, ArcOutput, DistanceMode, DwellFormat, GcodeError,
-    GcodeOptions,
+    GcodeOptions, KerfCompensation,
 };

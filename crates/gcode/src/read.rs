@@ -5,15 +5,24 @@
 //! dwell (`P` or `X` seconds), `G20`/`G21` (inches are converted to mm), `G90`/`G91`,
 //! `G90.1`/`G91.1` (absolute or incremental arc centres), `N` line numbers, `( )` and `;`
 //! comments, `%` tape marks, block delete `/` (the block is executed), modal motion (a line of
-//! bare coordinates continues the last motion). Harmless modal codes (`G17`, `G40`, `G49`,
+//! bare coordinates continues the last motion). Harmless modal codes (`G17`, `G49`,
 //! `G54`–`G59`, `G61`, `G64`, `G80`, `G94`) are accepted; codes that would change the meaning of
 //! the motion (other planes, canned cycles, homing, …) are refused with their location. Z and the
 //! rotary axes are ignored: the motion is the head's path in the sheet's plane.
+//!
+//! Cutter (kerf) compensation is followed as the post-processor writes it: `G41`/`G42` (radius
+//! from [`ReadOptions::compensation_radius`]) or `G41.1`/`G42.1 D<diameter>`, then a straight
+//! start-up move onto a closed contour, the contour (and any overcut), `G40` and a straight
+//! cancel move. The head's path is that contour's offset to the side by the radius (exact for
+//! lines and arcs), entered from where the head stood and left to the cancel move's end.
+//! Compensation on open paths, rapids or torch switches under it are refused with their line.
 
 use cutroute_geometry::float::Libm;
 use std::f64::consts::{PI, TAU};
 
-use cutroute_geometry::{PathRoute, Point, Span, ToolMove, ToolOnPath, Toolpath};
+use cutroute_geometry::{
+    equidistant, opened_at, Contour, PathRoute, Point, Span, ToolMove, ToolOnPath, Toolpath, Vertex,
+};
 use thiserror::Error;
 
 /// Settings of [`read_gcode`].
@@ -31,6 +40,9 @@ pub struct ReadOptions {
     /// `G04 P` counts milliseconds (Fanuc-style controllers), not seconds; `G04 X` stays
     /// seconds.
     pub dwell_p_milliseconds: bool,
+    /// Half the kerf, mm, for `G41 D<n>`/`G42 D<n>` (the controller's tool table holds it;
+    /// `G41.1 D<kerf>` carries it in the program).
+    pub compensation_radius: Option<f64>,
 }
 
 impl Default for ReadOptions {
@@ -42,6 +54,7 @@ impl Default for ReadOptions {
             torch_off: vec![5],
             arc_tolerance_mm: 0.01,
             dwell_p_milliseconds: false,
+            compensation_radius: None,
         }
     }
 }
@@ -370,6 +383,16 @@ pub enum GcodeReadError {
         /// Column.
         column: usize,
     },
+    /// Cutter (kerf) compensation that this reader cannot follow.
+    #[error("line {line}, column {column}: cutter compensation: {problem}")]
+    Compensation {
+        /// Line.
+        line: usize,
+        /// Column.
+        column: usize,
+        /// What is wrong.
+        problem: &'static str,
+    },
 }
 
 impl GcodeReadError {
@@ -389,7 +412,8 @@ impl GcodeReadError {
             | ArcRadiusMismatch { line, column, .. }
             | ArcRadiusTooSmall { line, column, .. }
             | ZeroLengthRadiusArc { line, column }
-            | InvalidDwell { line, column } => (line, column),
+            | InvalidDwell { line, column }
+            | Compensation { line, column, .. } => (line, column),
         }
     }
 }
@@ -418,10 +442,20 @@ pub fn read_gcode(text: &str, options: &ReadOptions) -> Result<Program, GcodeRea
         tool_on: false,
         feed: None,
         motions: Vec::new(),
+        compensation: None,
     };
+    let mut lines = 0;
     for (index, raw) in text.lines().enumerate() {
         let words = tokenize(raw, index + 1)?;
         state.block(&words, index + 1)?;
+        lines = index + 1;
+    }
+    if state.compensation.is_some() {
+        return Err(GcodeReadError::Compensation {
+            line: lines,
+            column: 1,
+            problem: "the program ends with compensation on (no G40 and cancel move)",
+        });
     }
     Ok(Program {
         start: options.start,
@@ -516,11 +550,102 @@ struct State<'a> {
     tool_on: bool,
     feed: Option<f64>,
     motions: Vec<Motion>,
+    /// Cutter compensation under way, between its start-up and cancel moves.
+    compensation: Option<Compensated>,
+}
+
+/// Which side of the programmed path the controller keeps the tool on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Side {
+    Left,
+    Right,
+}
+
+/// A stretch of program under cutter compensation (`G41`/`G42` … `G40`), gathered whole: the
+/// tool path is the programmed closed contour offset to the side by the radius, entered by the
+/// start-up move and left by the cancel move, and can only be known once the stretch ends.
+struct Compensated {
+    side: Side,
+    radius: f64,
+    /// Where the head stood before the start-up move (not compensated), with its line.
+    from: Option<(Point, usize)>,
+    /// Where the start-up move's programmed end is: the first point of the contour.
+    entry: Option<Point>,
+    /// The programmed moves after the start-up move, with their lines.
+    section: Vec<(Span, usize)>,
+    /// `G40` was read: the next move is the cancel move.
+    cancelling: bool,
+}
+
+impl Compensated {
+    /// The tool path of the stretch, ended by the cancel move to `to` (on `line`): the start-up
+    /// move from where the head stood to the contour's offset, the offset contour once round,
+    /// on along it as far as the programmed overcut goes, and the cancel move. `None` when the
+    /// programmed moves do not close a contour or it has no offset.
+    fn tool_path(self, to: Point, line: usize) -> Option<Vec<(Span, usize)>> {
+        let ((start, start_line), first) = (self.from?, self.entry?);
+        let spans = &self.section;
+        let k = spans
+            .iter()
+            .position(|(span, _)| span.end.distance(first) <= CLOSED)?;
+        let (round, overcut) = (&spans[..=k], &spans[k + 1..]);
+        let contour = Contour::new(
+            round
+                .iter()
+                .map(|(s, _)| Vertex::arc(s.start.x, s.start.y, s.bulge))
+                .collect(),
+        );
+        let r = self.radius;
+        let offset = match self.side {
+            Side::Left => equidistant(&contour, r).ok()?,
+            Side::Right => equidistant(&contour.reversed(), r).ok()?.reversed(),
+        };
+        let normal = |t: Point| match self.side {
+            Side::Left => t.rotated_quarter(),
+            Side::Right => -t.rotated_quarter(),
+        };
+        let on_offset = |p: Point| offset.nearest_point(p);
+        let entry = on_offset(first + normal(spans[0].0.tangent_at(0.0)) * r)?;
+        let cut = opened_at(&offset, entry.point, 1e-9);
+        let round_line = spans[0].1;
+        let mut path = vec![(Span::line(start, entry.point), start_line)];
+        path.extend(cut.iter().map(|&span| (span, round_line)));
+        let exit = match overcut.last() {
+            None => entry.point,
+            Some((last, last_line)) => {
+                let exit = on_offset(last.end + normal(last.tangent_at(1.0)) * r)?;
+                let mut left = (offset.length_at(exit.position) - offset.length_at(entry.position))
+                    .rem_euclid(offset.perimeter());
+                for span in cut {
+                    let l = span.length();
+                    if left <= 1e-9 || l <= 0.0 {
+                        break;
+                    }
+                    path.push((span.sub_span(0.0, (left / l).min(1.0)), *last_line));
+                    left -= l;
+                }
+                exit.point
+            }
+        };
+        path.push((Span::line(exit, to), line));
+        Some(path)
+    }
+}
+
+/// Programmed points closer than this (mm) are one point: where a compensated contour closes.
+const CLOSED: f64 = 1e-6;
+
+/// The compensation code of a block: on to a side (with `.1`: the diameter in `D`), or off.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum CompensationCode {
+    Off,
+    On { side: Side, dynamic: bool },
 }
 
 /// The G codes of one block, sorted by what they change.
 #[derive(Default)]
 struct Codes {
+    compensation: Option<(CompensationCode, usize, String)>,
     motion: Option<(MotionMode, usize, String)>,
     dwell: Option<usize>,
     distance: Option<(bool, usize, String)>,
@@ -588,6 +713,15 @@ impl State<'_> {
                 continue;
             }
             let number = number as u32;
+            let switches = (self.options.torch_off.contains(&number) && self.tool_on)
+                || (self.options.torch_on.contains(&number) && !self.tool_on);
+            if switches && self.compensation.is_some() {
+                return Err(GcodeReadError::Compensation {
+                    line,
+                    column: 1,
+                    problem: "the torch switches while compensation is on",
+                });
+            }
             if self.options.torch_off.contains(&number) && self.tool_on {
                 self.tool_on = false;
                 self.motions.push(Motion::TorchOff { at: self.at, line });
@@ -630,6 +764,9 @@ impl State<'_> {
         if let Some((mode, _, _)) = codes.motion {
             self.motion = Some(mode);
         }
+        if let Some((code, column, _)) = codes.compensation {
+            self.compensation_code(code, get('D'), unit, line, column)?;
+        }
         let arc_words = ['I', 'J', 'R'].into_iter().filter_map(get).next();
         let Some(first) = axis.or(arc_words) else {
             return Ok(());
@@ -647,6 +784,13 @@ impl State<'_> {
         };
         let to = Point::new(coordinate('X', self.at.x), coordinate('Y', self.at.y));
         let column = codes.motion.as_ref().map_or(first.column, |m| m.1);
+        if let Some(c) = &self.compensation {
+            // The start-up move, a rapid and the cancel move are the stretch's own; its
+            // programmed feed moves are gathered by `feed_span` below.
+            if c.entry.is_none() || c.cancelling || mode == MotionMode::Rapid {
+                return self.compensated_move(mode, to, line, column);
+            }
+        }
         match mode {
             MotionMode::Rapid => {
                 self.motions.push(Motion::Rapid {
@@ -722,9 +866,31 @@ impl State<'_> {
             910 => set(&mut codes.distance, true, word, name, line),
             901 => set(&mut codes.centres, false, word, name, line),
             911 => set(&mut codes.centres, true, word, name, line),
-            // Plane XY, cutter compensation off, tool length off, work offsets, path control,
-            // canned cycle off, feed per minute: nothing changes for the head's XY path.
-            170 | 400 | 490 | 540..=590 | 610 | 640 | 800 | 940 => Ok(()),
+            400 => set(
+                &mut codes.compensation,
+                CompensationCode::Off,
+                word,
+                name,
+                line,
+            ),
+            410 | 411 | 420 | 421 => {
+                let side = if tenths as i64 / 10 == 41 {
+                    Side::Left
+                } else {
+                    Side::Right
+                };
+                let dynamic = tenths as i64 % 10 == 1;
+                set(
+                    &mut codes.compensation,
+                    CompensationCode::On { side, dynamic },
+                    word,
+                    name,
+                    line,
+                )
+            }
+            // Plane XY, tool length off, work offsets, path control, canned cycle off, feed
+            // per minute: nothing changes for the head's XY path.
+            170 | 490 | 540..=590 | 610 | 640 | 800 | 940 => Ok(()),
             _ => Err(GcodeReadError::UnsupportedCode {
                 line,
                 column: word.column,
@@ -734,12 +900,113 @@ impl State<'_> {
     }
 
     fn feed_span(&mut self, span: Span, line: usize) {
+        if let Some(c) = self.compensation.as_mut() {
+            c.section.push((span, line));
+            return;
+        }
         self.motions.push(Motion::Feed {
             span,
             tool_on: self.tool_on,
             feed: self.feed,
             line,
         });
+    }
+
+    /// `G40`, `G41`/`G42` (radius from the options) or `G41.1`/`G42.1` (diameter in `D`).
+    fn compensation_code(
+        &mut self,
+        code: CompensationCode,
+        d: Option<Word>,
+        unit: f64,
+        line: usize,
+        column: usize,
+    ) -> Result<(), GcodeReadError> {
+        let problem = |problem| GcodeReadError::Compensation {
+            line,
+            column,
+            problem,
+        };
+        match code {
+            CompensationCode::Off => match self.compensation.as_mut() {
+                Some(c) if c.entry.is_some() => c.cancelling = true,
+                Some(_) => return Err(problem("G40 before the start-up move")),
+                None => {} // already off: harmless
+            },
+            CompensationCode::On { side, dynamic } => {
+                if self.compensation.is_some() {
+                    return Err(problem("compensation switched on twice without G40"));
+                }
+                let radius = if dynamic {
+                    d.map(|w| 0.5 * w.value * unit)
+                        .ok_or_else(|| problem("G41.1/G42.1 without the diameter D"))?
+                } else {
+                    self.options.compensation_radius.ok_or_else(|| {
+                        problem(
+                            "G41/G42 take the kerf from the tool table: give the reader the radius",
+                        )
+                    })?
+                };
+                if !(radius.is_finite() && radius >= 0.0) {
+                    return Err(problem("negative compensation"));
+                }
+                self.compensation = Some(Compensated {
+                    side,
+                    radius,
+                    from: None,
+                    entry: None,
+                    section: Vec::new(),
+                    cancelling: false,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// A move under compensation: the start-up move, a programmed move of the stretch, or the
+    /// cancel move, which ends the stretch and emits its tool path.
+    fn compensated_move(
+        &mut self,
+        mode: MotionMode,
+        to: Point,
+        line: usize,
+        column: usize,
+    ) -> Result<(), GcodeReadError> {
+        let problem = |problem| GcodeReadError::Compensation {
+            line,
+            column,
+            problem,
+        };
+        let straight = matches!(mode, MotionMode::Linear | MotionMode::Rapid);
+        let c = self.compensation.as_mut().expect("compensation on");
+        if c.entry.is_none() {
+            if !straight {
+                return Err(problem("the start-up move must be straight"));
+            }
+            c.from = Some((self.at, line));
+            c.entry = Some(to);
+            self.at = to;
+            return Ok(());
+        }
+        if !c.cancelling {
+            return Err(problem("a rapid move while compensation is on"));
+        }
+        if !straight {
+            return Err(problem("the cancel move must be straight"));
+        }
+        let c = self.compensation.take().expect("compensation on");
+        let path = c.tool_path(to, line).ok_or_else(|| {
+            problem("the compensated moves do not close a contour that can be offset")
+        })?;
+        for (span, line) in path {
+            self.motions.push(Motion::Feed {
+                span,
+                tool_on: self.tool_on,
+                feed: self.feed,
+                line,
+            });
+        }
+        self.at = to;
+        Ok(())
     }
 
     /// Signed sweep of the arc to `to` about `centre`.

@@ -55,6 +55,21 @@ pub enum DwellFormat {
     Omitted,
 }
 
+/// Who moves the tool off the contour by half the kerf, for routes cut with kerf.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum KerfCompensation {
+    /// The program runs the tool centre on the equidistants: any controller.
+    #[default]
+    InProgram,
+    /// The program runs on the contours and the controller keeps the tool left of the cut (on
+    /// the scrap side) by half the kerf: `G41.1 D<kerf>` switches it on with the kerf written
+    /// in the program (LinuxCNC), `G40` off. The operator can then trim the kerf at the machine.
+    ControllerDiameter,
+    /// As [`KerfCompensation::ControllerDiameter`] with `G41 D<n>`: the kerf is entry `n` of the
+    /// controller's tool table (Fanuc-style, Mach3).
+    ControllerRegister(u32),
+}
+
 /// Settings of the post-processor. The defaults suit a LinuxCNC/Mach3-style plasma or laser
 /// controller with the machine parameters of [`MachineParameters::default`].
 ///
@@ -101,6 +116,9 @@ pub struct GcodeOptions {
     pub footer: Vec<String>,
     /// Write comments: a summary at the top and the part/contour of every pierce.
     pub comments: bool,
+    /// Kerf compensation in the program or by the controller (`G41`/`G40`); the controller's
+    /// needs straight lead-ins and lead-outs (its start-up and cancel moves) and no tabs.
+    pub kerf_compensation: KerfCompensation,
 }
 
 impl GcodeOptions {
@@ -129,6 +147,7 @@ impl GcodeOptions {
             header: Vec::new(),
             footer: vec!["M30".into()],
             comments: true,
+            kerf_compensation: KerfCompensation::InProgram,
         }
     }
 }
@@ -199,11 +218,18 @@ pub enum GcodeError {
     /// The route does not fit the nest.
     #[error("the route does not fit the nest: {0}")]
     Route(#[from] RouteError),
+    /// Kerf compensation by the controller switches on and off on straight moves only, and a
+    /// torch that stops at a tab would leave it on across the gap.
+    #[error("route step {step}: kerf compensation by the controller needs straight lead-ins and lead-outs (its start-up and cancel moves) and no tabs")]
+    CompensationNeedsLineLeads {
+        /// Index of the route step.
+        step: usize,
+    },
 }
 
 /// Writes `toolpath` as a G-code program.
 pub fn write_gcode(toolpath: &Toolpath, options: &GcodeOptions) -> Result<String, GcodeError> {
-    write_labelled(toolpath, &|_| None, options)
+    write_labelled(toolpath, &|_| None, &[], options)
 }
 
 /// Writes the route's toolpath over `nest`, with a comment naming the part and contour before
@@ -213,7 +239,6 @@ pub fn route_gcode(
     route: &Route,
     options: &GcodeOptions,
 ) -> Result<String, GcodeError> {
-    let toolpath = Toolpath::new(route, nest)?;
     let label = |step: usize| {
         let contour = route.steps.get(step)?.contour;
         let part = nest.parts.get(contour.part)?;
@@ -222,7 +247,114 @@ pub fn route_gcode(
             contour.part, part.name, contour.contour
         ))
     };
-    write_labelled(&toolpath, &label, options)
+    match options.kerf_compensation {
+        KerfCompensation::InProgram => {
+            write_labelled(&Toolpath::new(route, nest)?, &label, &[], options)
+        }
+        code => {
+            let (toolpath, codes) = compensated_toolpath(nest, route, code, options.decimals)?;
+            // Controllers compensate arcs of up to half a turn (full circles are split).
+            let options = GcodeOptions {
+                max_arc_sweep_deg: options.max_arc_sweep_deg.min(180.0),
+                ..options.clone()
+            };
+            write_labelled(&toolpath, &label, &codes, &options)
+        }
+    }
+}
+
+/// The programmed path of a route whose kerf the controller compensates: each step with kerf
+/// runs on its contour, from the contour point under its entry round and on to the point under
+/// its exit (the overcut); the straight lead-in from M to the contour is the controller's
+/// start-up move (`G41…` before it) and the straight lead-out to M* its cancel move (`G40`
+/// before it). The controller's offset to the left by kerf/2 turns this back into the route's
+/// equidistant cut. Also returns the code lines, each with the move it goes before.
+fn compensated_toolpath(
+    nest: &Nest,
+    route: &Route,
+    code: KerfCompensation,
+    decimals: usize,
+) -> Result<(Toolpath, Vec<(usize, String)>), GcodeError> {
+    let actual = Toolpath::new(route, nest)?;
+    let mut moves = Vec::with_capacity(actual.moves.len());
+    let mut codes = Vec::new();
+    let mut replaced = vec![false; route.steps.len()];
+    for m in &actual.moves {
+        let step = match *m {
+            ToolMove::Cut {
+                step, link: false, ..
+            } => step,
+            _ => {
+                moves.push(*m);
+                continue;
+            }
+        };
+        let cut = &route.steps[step];
+        let Some(leads) = cut.leads.as_ref().filter(|l| l.offset > 0.0) else {
+            moves.push(*m);
+            continue;
+        };
+        if std::mem::replace(&mut replaced[step], true) {
+            continue; // the step's programmed moves are already in
+        }
+        let straight = |chain: &[cutroute_geometry::Vertex]| {
+            chain.len() == 2 && chain[0].bulge == 0.0 && chain[0].point != chain[1].point
+        };
+        if !(straight(&leads.lead_in) && straight(&leads.lead_out) && leads.tabs.is_empty()) {
+            return Err(GcodeError::CompensationNeedsLineLeads { step });
+        }
+        let contour = nest
+            .contour(cut.contour)
+            .ok_or(RouteError::UnknownContour {
+                step,
+                contour: cut.contour,
+            })?;
+        let on_contour = |p: Point| contour.nearest_point(p).map_or(p, |q| q.point);
+        let (start, exit) = (on_contour(leads.entry), on_contour(leads.exit()));
+        let push = |moves: &mut Vec<ToolMove>, span: Span| {
+            if span.length() > 1e-9 {
+                moves.push(ToolMove::Cut {
+                    step,
+                    span,
+                    link: false,
+                });
+            }
+        };
+        let on = match code {
+            KerfCompensation::ControllerRegister(n) => format!("G41 D{n}"),
+            _ => format!("G41.1 D{:.*}", decimals, 2.0 * leads.offset),
+        };
+        codes.push((moves.len(), on));
+        push(&mut moves, Span::line(leads.pierce, start));
+        let round = cutroute_geometry::opened_at(contour, start, 1e-9);
+        round.iter().for_each(|&span| push(&mut moves, span));
+        if leads.overcut > 0.0 {
+            // On along the contour to the point under the exit.
+            let along = |p: Point| {
+                contour
+                    .nearest_point(p)
+                    .map_or(0.0, |q| contour.length_at(q.position))
+            };
+            let mut left = (along(exit) - along(start)).rem_euclid(contour.perimeter());
+            for span in round {
+                let l = span.length();
+                if left <= 1e-9 || l <= 0.0 {
+                    break;
+                }
+                push(&mut moves, span.sub_span(0.0, (left / l).min(1.0)));
+                left -= l;
+            }
+        }
+        codes.push((moves.len(), "G40".into()));
+        push(&mut moves, Span::line(exit, leads.switch_off));
+    }
+    Ok((
+        Toolpath {
+            start: actual.start,
+            moves,
+        },
+        codes,
+    ))
 }
 
 /// Writes a route of tool-on paths (segment cutting, AOE-chains), with a comment numbering
@@ -239,7 +371,7 @@ pub fn path_route_gcode(route: &PathRoute, options: &GcodeOptions) -> Result<Str
             path.length()
         ))
     };
-    write_labelled(&toolpath, &label, options)
+    write_labelled(&toolpath, &label, &[], options)
 }
 
 /// Arcs whose sagitta is below this many quanta (units of the last written digit) are written
@@ -253,9 +385,11 @@ const LONGEST_RADIUS_ARC_DEG: f64 = 150.0;
 /// No arc longer than this is written in one move (see [`GcodeOptions::max_arc_sweep_deg`]).
 const LONGEST_ARC_DEG: f64 = 350.0;
 
+/// Writes the moves; `codes` are extra lines, each before the move of its index (in order).
 fn write_labelled(
     toolpath: &Toolpath,
     label: &dyn Fn(usize) -> Option<String>,
+    codes: &[(usize, String)],
     options: &GcodeOptions,
 ) -> Result<String, GcodeError> {
     check(options)?;
@@ -277,8 +411,12 @@ fn write_labelled(
     for line in &options.header {
         w.line(line.clone());
     }
+    let mut codes = codes.iter().peekable();
     for (index, m) in toolpath.moves.iter().enumerate() {
         w.move_index = index;
+        while let Some((_, code)) = codes.next_if(|(at, _)| *at == index) {
+            w.line(code.clone());
+        }
         match *m {
             ToolMove::Idle { to, .. } => {
                 w.torch_off();

@@ -108,3 +108,100 @@ fn tabs_read_back_as_pierces_and_idle_gaps() {
     assert!((program.cut_length() - route.cut_length(&nest)).abs() < 1e-3);
     assert!((program.idle_length() - route.idle_length()).abs() < 1e-3);
 }
+
+/// Kerf compensation by the controller: the program runs on the contours with `G41.1 D<kerf>`
+/// (or `G41 D<n>` and the tool table's radius) and straight leads as its start-up and cancel
+/// moves; the reader offsets it back and finds the route's own tool path.
+#[test]
+fn controller_compensation_reads_back_as_the_route() {
+    use cutroute_gcode::KerfCompensation;
+    let nest = generate_nest(30, 4);
+    let forest = nest.containment_forest();
+    let mut refs: Vec<ContourRef> = nest.contour_refs().collect();
+    refs.sort_by_key(|&r| std::cmp::Reverse(forest.depth(r)));
+    let route = Route {
+        start: Point::new(0.0, 0.0),
+        steps: refs
+            .into_iter()
+            .map(|r| CutStep::pierced(r, nest.contour(r).unwrap().vertices[0].point))
+            .collect(),
+        finish: Some(Point::new(0.0, 0.0)),
+    };
+    let settings = KerfSettings {
+        kerf: 2.0,
+        pierce_clearance: 3.0,
+        switch_off_clearance: 1.0,
+        lead_in: LeadSpec::new(LeadShape::Line, 4.0),
+        lead_out: LeadSpec::new(LeadShape::Line, 2.0),
+        overcut: 1.0,
+        ..KerfSettings::default()
+    };
+    let route = LeadFitter::new(&nest, settings).attach(&route).unwrap();
+    route.validate(&nest, 1e-6).unwrap();
+    for (compensation, read) in [
+        (KerfCompensation::ControllerDiameter, ReadOptions::default()),
+        (
+            KerfCompensation::ControllerRegister(1),
+            ReadOptions {
+                compensation_radius: Some(1.0),
+                ..ReadOptions::default()
+            },
+        ),
+    ] {
+        let options = GcodeOptions {
+            decimals: 6,
+            kerf_compensation: compensation,
+            ..GcodeOptions::default()
+        };
+        let text = route_gcode(&nest, &route, &options).unwrap();
+        let on = match compensation {
+            KerfCompensation::ControllerRegister(_) => "G41 D1",
+            _ => "G41.1 D2.000000",
+        };
+        assert_eq!(
+            text.matches(on).count(),
+            route.steps.len(),
+            "{compensation:?}"
+        );
+        assert_eq!(text.matches("G40").count(), route.steps.len());
+        // The programmed cut is the contours' (shorter outside, longer in the holes) …
+        let programmed = read_gcode(&text, &ReadOptions::default());
+        assert!(
+            programmed.is_err() == matches!(compensation, KerfCompensation::ControllerRegister(_))
+        );
+        // … and the compensated read-back is the route's tool path.
+        let program = read_gcode(&text, &read).unwrap();
+        let what = format!("{compensation:?}");
+        assert_eq!(program.pierce_count(), route.pierce_count(), "{what}");
+        assert!(
+            (program.cut_length() - route.cut_length(&nest)).abs() < 1e-3,
+            "{what}: {} vs {}",
+            program.cut_length(),
+            route.cut_length(&nest)
+        );
+        assert!(
+            (program.idle_length() - route.idle_length()).abs() < 1e-3,
+            "{what}"
+        );
+        for (read, step) in program.pierce_points().iter().zip(&route.steps) {
+            assert!(
+                read.distance(step.leads.as_ref().unwrap().pierce) < 1e-4,
+                "{what}"
+            );
+        }
+    }
+    // Arc lead-ins cannot be a controller's start-up move: refused, naming the step.
+    let arcs = KerfSettings {
+        lead_in: LeadSpec::new(LeadShape::Arc, 4.0),
+        ..settings
+    };
+    let with_arcs = LeadFitter::new(&nest, arcs).attach(&route).unwrap();
+    let options = GcodeOptions {
+        kerf_compensation: KerfCompensation::ControllerDiameter,
+        ..GcodeOptions::default()
+    };
+    assert!(matches!(
+        route_gcode(&nest, &with_arcs, &options),
+        Err(cutroute_gcode::GcodeError::CompensationNeedsLineLeads { .. })
+    ));
+}
