@@ -595,6 +595,9 @@ impl Compensated {
                 .map(|(s, _)| Vertex::arc(s.start.x, s.start.y, s.bulge))
                 .collect(),
         );
+        // Only a simple closed contour has an offset; anything else is refused before the
+        // offset library sees it (it must never panic in the browser's worker).
+        contour.validate().ok()?;
         let r = self.radius;
         let offset = match self.side {
             Side::Left => equidistant(&contour, r).ok()?,
