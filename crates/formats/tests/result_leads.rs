@@ -5,22 +5,13 @@
 use cutroute_formats::ResultExportOptions;
 use cutroute_formats::{read_result_json, route_moves, write_result_json, MoveKind, RmResult};
 use cutroute_geometry::{
-    generate_nest, ContourRef, CutStep, KerfSettings, LeadFitter, LeadShape, LeadSpec, Nest, Point,
-    Route, TabSpec,
+    generate_nest, CutStep, KerfSettings, LeadFitter, LeadShape, LeadSpec, Nest, Point, Route,
+    TabSpec,
 };
 
 fn route_with_leads(nest: &Nest, settings: KerfSettings) -> Route {
-    let forest = nest.containment_forest();
-    let mut refs: Vec<ContourRef> = nest.contour_refs().collect();
-    refs.sort_by_key(|&r| std::cmp::Reverse(forest.depth(r)));
-    let route = Route {
-        start: Point::new(0.0, 0.0),
-        steps: refs
-            .into_iter()
-            .map(|r| CutStep::pierced(r, nest.contour(r).unwrap().vertices[0].point))
-            .collect(),
-        finish: Some(Point::new(0.0, 0.0)),
-    };
+    let origin = Point::new(0.0, 0.0);
+    let route = Route::innermost_first(nest, origin, Some(origin));
     let route = LeadFitter::new(nest, settings).attach(&route).unwrap();
     route.validate(nest, 1e-6).unwrap();
     route

@@ -3,24 +3,14 @@
 
 use cutroute_gcode::{read_gcode, route_gcode, ArcOutput, DistanceMode, GcodeOptions, ReadOptions};
 use cutroute_geometry::{
-    generate_nest, ContourRef, CutStep, KerfSettings, LeadFitter, LeadShape, LeadSpec, Point,
-    Route, TabSpec, Toolpath,
+    generate_nest, KerfSettings, LeadFitter, LeadShape, LeadSpec, Point, Route, TabSpec, Toolpath,
 };
 
 #[test]
 fn a_route_with_leads_reads_back_with_the_same_lengths_and_pierces() {
     let nest = generate_nest(40, 11);
-    let forest = nest.containment_forest();
-    let mut refs: Vec<ContourRef> = nest.contour_refs().collect();
-    refs.sort_by_key(|&r| std::cmp::Reverse(forest.depth(r)));
-    let route = Route {
-        start: Point::new(0.0, 0.0),
-        steps: refs
-            .into_iter()
-            .map(|r| CutStep::pierced(r, nest.contour(r).unwrap().vertices[0].point))
-            .collect(),
-        finish: Some(Point::new(0.0, 0.0)),
-    };
+    let origin = Point::new(0.0, 0.0);
+    let route = Route::innermost_first(&nest, origin, Some(origin));
     let settings = KerfSettings {
         kerf: 2.0,
         pierce_clearance: 2.0,
@@ -69,17 +59,8 @@ fn a_route_with_leads_reads_back_with_the_same_lengths_and_pierces() {
 #[test]
 fn tabs_read_back_as_pierces_and_idle_gaps() {
     let nest = generate_nest(40, 7);
-    let forest = nest.containment_forest();
-    let mut refs: Vec<ContourRef> = nest.contour_refs().collect();
-    refs.sort_by_key(|&r| std::cmp::Reverse(forest.depth(r)));
-    let route = Route {
-        start: Point::new(0.0, 0.0),
-        steps: refs
-            .into_iter()
-            .map(|r| CutStep::pierced(r, nest.contour(r).unwrap().vertices[0].point))
-            .collect(),
-        finish: Some(Point::new(0.0, 0.0)),
-    };
+    let origin = Point::new(0.0, 0.0);
+    let route = Route::innermost_first(&nest, origin, Some(origin));
     let settings = KerfSettings {
         kerf: 2.0,
         pierce_clearance: 2.0,
@@ -116,17 +97,8 @@ fn tabs_read_back_as_pierces_and_idle_gaps() {
 fn controller_compensation_reads_back_as_the_route() {
     use cutroute_gcode::KerfCompensation;
     let nest = generate_nest(30, 4);
-    let forest = nest.containment_forest();
-    let mut refs: Vec<ContourRef> = nest.contour_refs().collect();
-    refs.sort_by_key(|&r| std::cmp::Reverse(forest.depth(r)));
-    let route = Route {
-        start: Point::new(0.0, 0.0),
-        steps: refs
-            .into_iter()
-            .map(|r| CutStep::pierced(r, nest.contour(r).unwrap().vertices[0].point))
-            .collect(),
-        finish: Some(Point::new(0.0, 0.0)),
-    };
+    let origin = Point::new(0.0, 0.0);
+    let route = Route::innermost_first(&nest, origin, Some(origin));
     let settings = KerfSettings {
         kerf: 2.0,
         pierce_clearance: 3.0,

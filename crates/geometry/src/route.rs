@@ -299,6 +299,26 @@ pub enum RouteError {
 }
 
 impl Route {
+    /// A feasible route that needs no solver: every contour pierced at its first vertex, the
+    /// deepest contours first (so every hole before the part around it, every part in a hole
+    /// before that hole). A baseline for comparisons and a starting point for tests.
+    pub fn innermost_first(nest: &Nest, start: Point, finish: Option<Point>) -> Route {
+        let forest = nest.containment_forest();
+        let mut refs: Vec<ContourRef> = nest.contour_refs().collect();
+        refs.sort_by_key(|&r| std::cmp::Reverse(forest.depth(r)));
+        Route {
+            start,
+            steps: refs
+                .into_iter()
+                .filter_map(|r| {
+                    let first = nest.contour(r)?.vertices.first()?.point;
+                    Some(CutStep::pierced(r, first))
+                })
+                .collect(),
+            finish,
+        }
+    }
+
     /// The points the head passes between contours: start, every step's pierce point (where
     /// its cut starts), finish (if any). Consecutive points are joined by idle moves except
     /// where a step is entered by a link (see [`Route::idle_moves`]).

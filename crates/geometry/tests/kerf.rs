@@ -1,7 +1,7 @@
 //! Equidistants and leads, checked by their defining properties.
 
 use cutroute_geometry::{
-    chain_spans, equidistant, generate_nest, Contour, ContourRef, CutStep, KerfSettings, LeadError,
+    chain_spans, equidistant, generate_nest, Contour, ContourRef, KerfSettings, LeadError,
     LeadFitter, LeadProblem, LeadShape, LeadSpec, MachineParameters, Nest, OffsetError, Part,
     Point, Route, RouteError, Toolpath, Vertex,
 };
@@ -235,17 +235,7 @@ fn leads_read_and_write_as_vertex_triples() {
 
 /// A valid idealised route over `nest`: holes (deeper contours) first.
 fn idealised_route(nest: &Nest) -> Route {
-    let forest = nest.containment_forest();
-    let mut refs: Vec<ContourRef> = nest.contour_refs().collect();
-    refs.sort_by_key(|&r| std::cmp::Reverse(forest.depth(r)));
-    Route {
-        start: Point::new(0.0, 0.0),
-        steps: refs
-            .into_iter()
-            .map(|r| CutStep::pierced(r, nest.contour(r).unwrap().vertices[0].point))
-            .collect(),
-        finish: None,
-    }
+    Route::innermost_first(nest, Point::new(0.0, 0.0), None)
 }
 
 #[test]

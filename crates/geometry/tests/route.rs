@@ -156,22 +156,8 @@ fn inner_first_route_on_a_generated_nest_is_valid() {
     let n = generate_nest(300, 3);
     let forest = n.containment_forest();
     // Cut deepest first: sorting by decreasing depth respects every precedence pair.
-    let mut refs: Vec<ContourRef> = n.contour_refs().collect();
-    refs.sort_by_key(|&c| std::cmp::Reverse(forest.depth(c)));
-    let steps = refs
-        .iter()
-        .map(|&c| CutStep {
-            contour: c,
-            pierce_point: n.contour(c).unwrap().vertices[0].point,
-            entry: Default::default(),
-            leads: None,
-        })
-        .collect();
-    let route = Route {
-        start: Point::ORIGIN,
-        steps,
-        finish: Some(Point::ORIGIN),
-    };
+    let route = Route::innermost_first(&n, Point::ORIGIN, Some(Point::ORIGIN));
+    assert_eq!(route.steps.len(), n.contour_refs().count());
     assert!(route.problems(&n, &forest, 1e-9).is_empty());
     let mut backwards = route.clone();
     backwards.steps.reverse();

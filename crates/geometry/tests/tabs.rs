@@ -22,17 +22,8 @@ fn settings(count: usize, width: f64) -> KerfSettings {
 }
 
 fn idealised_route(nest: &Nest) -> Route {
-    let forest = nest.containment_forest();
-    let mut refs: Vec<ContourRef> = nest.contour_refs().collect();
-    refs.sort_by_key(|&r| std::cmp::Reverse(forest.depth(r)));
-    Route {
-        start: Point::new(0.0, 0.0),
-        steps: refs
-            .into_iter()
-            .map(|r| CutStep::pierced(r, nest.contour(r).unwrap().vertices[0].point))
-            .collect(),
-        finish: Some(Point::new(0.0, 0.0)),
-    }
+    let origin = Point::new(0.0, 0.0);
+    Route::innermost_first(nest, origin, Some(origin))
 }
 
 /// The corners of `eq` as arc-length intervals from `entry`: turns of more than `deg` degrees
