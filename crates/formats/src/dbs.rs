@@ -21,7 +21,7 @@
 
 use std::collections::{HashMap, HashSet};
 
-use cutroute_geometry::{Contour, Nest, Part, Point, Vertex};
+use cutroute_geometry::{Contour, Nest, Part, Transform, Vertex};
 
 use crate::contour_check::{self, ContourProblem, DEFAULT_CLOSURE_TOLERANCE};
 
@@ -314,31 +314,13 @@ pub fn read_dbs(bytes: &[u8]) -> Result<DbsFile, DbsError> {
     read_dbs_with(bytes, &DbsReadOptions::default())
 }
 
-/// The affine map of a contour record: `x' = m0·x + m2·y + m4`, `y' = m1·x + m3·y + m5`.
-type Matrix = [f64; 6];
-
-const IDENTITY: Matrix = [1.0, 0.0, 0.0, 1.0, 0.0, 0.0];
-
-/// `outer ∘ inner`: apply `inner` first.
-fn compose(outer: &Matrix, inner: &Matrix) -> Matrix {
-    let [a0, a1, a2, a3, a4, a5] = *outer;
-    let [b0, b1, b2, b3, b4, b5] = *inner;
-    [
-        a0 * b0 + a2 * b1,
-        a1 * b0 + a3 * b1,
-        a0 * b2 + a2 * b3,
-        a1 * b2 + a3 * b3,
-        a0 * b4 + a2 * b5 + a4,
-        a1 * b4 + a3 * b5 + a5,
-    ]
-}
-
 /// A type-1 or type-2 record as read.
 struct ContourRecord {
     offset: usize,
     original: i16,
     reversed: bool,
-    matrix: Matrix,
+    /// The record's map, formula В.1 (`Transform::from_dbs`).
+    matrix: Transform,
     /// Type 1 only: the stored contour (closing point dropped, untransformed).
     geometry: Option<Contour>,
 }
@@ -347,7 +329,7 @@ struct ContourRecord {
 #[derive(Clone, Copy)]
 struct Resolved {
     base: i16,
-    matrix: Matrix,
+    matrix: Transform,
     reversed: bool,
 }
 
@@ -469,11 +451,12 @@ pub fn read_dbs_with(bytes: &[u8], options: &DbsReadOptions) -> Result<DbsFile, 
                 }
                 let original = cur.i16(pos + 32);
                 let reversed = cur.i16(pos + 36) != 0;
-                let mut matrix = [0.0; 6];
-                for (k, m) in matrix.iter_mut().enumerate() {
+                let mut m = [0.0; 6];
+                for (k, m) in m.iter_mut().enumerate() {
                     *m = cur.finite(pos + 40 + 4 * k, "transformation matrix")?;
                 }
-                if matrix[0] * matrix[3] - matrix[1] * matrix[2] == 0.0 {
+                let matrix = Transform::from_dbs(m[0], m[1], m[2], m[3], m[4], m[5]);
+                if matrix.determinant() == 0.0 {
                     return Err(DbsError::SingularMatrix { offset: pos });
                 }
                 let geometry = if record_type == TYPE_GEOMETRY {
@@ -700,7 +683,7 @@ fn copy_map(
         if record.geometry.is_some() {
             break Resolved {
                 base: current,
-                matrix: IDENTITY,
+                matrix: Transform::IDENTITY,
                 reversed: false,
             };
         }
@@ -725,7 +708,8 @@ fn copy_map(
         let rec = &contours[&cid];
         acc = Resolved {
             base: acc.base,
-            matrix: compose(&rec.matrix, &acc.matrix),
+            // The original's map first, then the copy's own.
+            matrix: acc.matrix.then(&rec.matrix),
             reversed: acc.reversed ^ rec.reversed,
         };
         memo.insert(cid, acc);
@@ -736,23 +720,12 @@ fn copy_map(
 /// Applies a resolved map to stored geometry: transform points, flip bulges under a mirror,
 /// then reverse the direction if asked (the reference reader's order).
 fn transform(base: &Contour, r: &Resolved) -> Contour {
-    let m = &r.matrix;
-    let mirror = m[0] * m[3] - m[1] * m[2] < 0.0;
-    let mut vertices: Vec<Vertex> = base
-        .vertices
-        .iter()
-        .map(|v| Vertex {
-            point: Point::new(
-                m[0] * v.point.x + m[2] * v.point.y + m[4],
-                m[1] * v.point.x + m[3] * v.point.y + m[5],
-            ),
-            bulge: if mirror { -v.bulge } else { v.bulge },
-        })
-        .collect();
+    let mapped = base.transformed(&r.matrix);
     if r.reversed {
-        vertices = reversed(&vertices);
+        Contour::new(reversed(&mapped.vertices))
+    } else {
+        mapped
     }
-    Contour::new(vertices)
 }
 
 /// The same closed contour traversed backwards: the span that entered a vertex now leaves it,
