@@ -28,7 +28,7 @@
 use cutroute_geometry::float::Libm;
 use std::collections::HashMap;
 
-use cutroute_geometry::{Contour, Nest, Part, Point, Vertex};
+use cutroute_geometry::{Contour, Nest, Part, Point, Transform, Vertex};
 use roxmltree::{Document, Node};
 
 const XSI: &str = "http://www.w3.org/2001/XMLSchema-instance";
@@ -326,34 +326,21 @@ fn end_position(text: &str) -> (u32, u32) {
     )
 }
 
-/// Applies a placement to a part definition's contours and re-orients them.
+/// Applies a placement to a part definition's contours and re-orients them: mirrored in the
+/// y axis if asked, turned by the angle, moved to the position.
 fn place(contours: &[Contour], placement: &Placement) -> Vec<Contour> {
-    let (s, c) = placement.angle_deg.to_radians().sin_cos_libm();
-    let mirror = if placement.mirrored { -1.0 } else { 1.0 };
-    let moved = contours
-        .iter()
-        .map(|contour| {
-            Contour::new(
-                contour
-                    .vertices
-                    .iter()
-                    .map(|v| {
-                        let x = v.point.x * mirror;
-                        let y = v.point.y;
-                        Vertex {
-                            point: Point::new(
-                                placement.position.x + c * x - s * y,
-                                placement.position.y + s * x + c * y,
-                            ),
-                            // A mirror turns counter-clockwise arcs into clockwise ones.
-                            bulge: v.bulge * mirror,
-                        }
-                    })
-                    .collect(),
-            )
-        })
-        .collect();
-    orient(moved)
+    let mirror = if placement.mirrored {
+        Transform::mirror_y()
+    } else {
+        Transform::IDENTITY
+    };
+    let map = mirror
+        .then(&Transform::rotation(placement.angle_deg.to_radians()))
+        .then(&Transform::translation(
+            placement.position.x,
+            placement.position.y,
+        ));
+    orient(contours.iter().map(|c| c.transformed(&map)).collect())
 }
 
 /// Largest contour first and clockwise, the others counter-clockwise.
