@@ -748,7 +748,7 @@ pub fn App() -> impl IntoView {
                     <dt>"Job"</dt>
                     <dd id="job-status">{move || job_state.get().label()}</dd>
                     <dt>"Phase"</dt>
-                    <dd id="phase">{move || progress.get().map(|p| p.phase).unwrap_or_default()}</dd>
+                    <dd id="phase">{move || progress.get().map(|p| p.phase.to_string()).unwrap_or_default()}</dd>
                     <dt>"Upper bound"</dt>
                     <dd id="upper-bound" data-unit=move || bound_unit.get()>{move || format_bound(progress.get().and_then(|p| p.upper_bound))}</dd>
                     <dt>"Lower bound"</dt>
