@@ -26,10 +26,12 @@
 use cutroute_geometry::{MachineParameters, Nest, Objective, PathRoute, Point, Route};
 use serde::{Deserialize, Serialize};
 
+mod open_error;
 mod phase;
 mod profile;
 mod thermal;
 
+pub use open_error::{OpenError, OpenErrorKind, SourceLocation};
 pub use phase::{CcpStage, Ensemble, Phase, ThermalNote};
 pub use profile::{MachineProfile, ProfileError};
 pub use thermal::ThermalSettings;
@@ -137,8 +139,8 @@ pub enum FromWorker {
     OpenFailed {
         /// The `request_id` of the `Open` message.
         request_id: u64,
-        /// What is wrong and where, in plain words.
-        message: String,
+        /// What is wrong and where.
+        error: OpenError,
     },
     /// The job could not run.
     Failed {

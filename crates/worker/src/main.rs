@@ -24,7 +24,7 @@ mod web {
             },
             Err(error) => FromWorker::OpenFailed {
                 request_id,
-                message: error.to_string(),
+                error: error.report(),
             },
         }
     }
