@@ -22,11 +22,12 @@ after(async () => {
 });
 
 // Latin words the Russian UI may show: proper names (the program, formats, solvers, their
-// algorithms, RouteManager), G-code words, the language's own name in the switch, file names.
+// algorithms, RouteManager), solver ids, the language's own name in the switch, and `exp` in
+// the formula of H. File names, part names «…» and G-code words are taken out before.
 const ALLOWED = new Set([
   'cutroute', 'English', 'CCP', 'Relax', 'ALNS', 'SCCP', 'GSCCP', 'AOE', 'VNS', 'PCGTSP',
   'PCGLNS', 'PCGTSPLIB', 'DBS', 'JSON', 'SVG', 'HTML', 'DXF', 'RouteManager', 'nearest', 'ccp',
-  'chain', 'heuristic', 'exact',
+  'chain', 'heuristic', 'exact', 'exp',
 ]);
 
 /** Every Latin word of the page's text nodes and title/aria-label/placeholder attributes that

@@ -16,7 +16,11 @@ fn data(relative: &str) -> Vec<u8> {
 fn refused(name: &str, bytes: &[u8]) -> cutroute_protocol::OpenError {
     let error = open_document(name, bytes).expect_err("the file is refused");
     let report = error.report();
-    assert_eq!(report.message, error.to_string(), "the CLI's words ride along");
+    assert_eq!(
+        report.message,
+        error.to_string(),
+        "the CLI's words ride along"
+    );
     assert_eq!(report.file_name, name);
     report
 }
@@ -32,7 +36,11 @@ fn a_truncated_dbs_is_located_by_byte() {
         }
     );
     assert_eq!(report.location, Some(SourceLocation::Byte { offset: 696 }));
-    assert!(report.detail.starts_with("DBS truncated at byte 696"), "{}", report.detail);
+    assert!(
+        report.detail.starts_with("DBS truncated at byte 696"),
+        "{}",
+        report.detail
+    );
 }
 
 #[test]
@@ -40,12 +48,24 @@ fn malformed_json_is_located_by_line_and_column() {
     let report = refused("broken.json", b"{\n  \"a\": [1, 2,\n");
     assert_eq!(report.kind, OpenErrorKind::MalformedJson);
     assert!(
-        matches!(report.location, Some(SourceLocation::Line { line: 3, column: Some(_) })),
+        matches!(
+            report.location,
+            Some(SourceLocation::Line {
+                line: 3,
+                column: Some(_)
+            })
+        ),
         "{:?}",
         report.location
     );
-    assert!(report.detail.starts_with("malformed JSON: "), "{}", report.detail);
-    assert!(report.message.starts_with("broken.json (JSON): line 3 column "));
+    assert!(
+        report.detail.starts_with("malformed JSON: "),
+        "{}",
+        report.detail
+    );
+    assert!(report
+        .message
+        .starts_with("broken.json (JSON): line 3 column "));
 }
 
 #[test]
@@ -61,7 +81,10 @@ fn xml_json_path_and_text_readers_give_their_places() {
             column: Some(10)
         })
     );
-    let json = refused("g.dbs.json", &data("hostile/huge_coords_null_lengths.dbs.json"));
+    let json = refused(
+        "g.dbs.json",
+        &data("hostile/huge_coords_null_lengths.dbs.json"),
+    );
     assert_eq!(
         json.location,
         Some(SourceLocation::JsonPath {
@@ -82,14 +105,20 @@ fn xml_json_path_and_text_readers_give_their_places() {
     let gcode = refused("p.nc", b"G90\nG01 X1 Y1 Q\n");
     assert_eq!(gcode.kind, OpenErrorKind::Gcode);
     assert!(
-        matches!(gcode.location, Some(SourceLocation::Line { line: 2, column: Some(_) })),
+        matches!(
+            gcode.location,
+            Some(SourceLocation::Line {
+                line: 2,
+                column: Some(_)
+            })
+        ),
         "{gcode:?}"
     );
 }
 
 #[test]
 fn errors_without_a_place_have_none() {
-    let report = refused("notes.txt", b"nothing to see here");
+    let report = refused("notes.txt", b"just some words");
     assert_eq!(report.kind, OpenErrorKind::UnknownFormat);
     assert_eq!(report.location, None);
     assert!(report.detail.is_empty());
