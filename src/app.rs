@@ -543,13 +543,14 @@ pub fn App() -> impl IntoView {
         Some(thermal_view.sources.with_untracked(|s| model.load(s)))
     };
     let keep = move |_| {
-        let lang = language.get_untracked();
         let label = progress
             .with_untracked(|p| {
-                p.as_ref()
-                    .map(|_| solver_label(lang, solver.get_untracked()))
+                p.as_ref().map(|_| {
+                    let kind = solver.get_untracked();
+                    (solver_label(Lang::En, kind), solver_label(Lang::Ru, kind))
+                })
             })
-            .unwrap_or(lang.pick("from the file", "из файла"));
+            .unwrap_or(("from the file", "из файла"));
         let entry = if let Some(paths) = shown_paths.get_untracked() {
             machine.with_untracked(|m| Kept::of_paths(&paths, m, label, shown_heat()))
         } else {
@@ -1423,7 +1424,7 @@ fn NestView(
                 .map(|(e, class)| {
                     view! {
                         <path class=format!("compare {class}") d=e.idle_d.clone()>
-                            <title>{format!("{} #{}: {}", language.pick("kept result", "сохранённый результат"), e.id, e.label)}</title>
+                            <title>{format!("{} #{}: {}", language.pick("kept result", "сохранённый результат"), e.id, language.pick(e.label.0, e.label.1))}</title>
                         </path>
                     }
                 })

@@ -15,8 +15,8 @@ use crate::stats::{path_route_figures, route_figures, Figures};
 pub struct Kept {
     /// Number shown in the list (1, 2, …).
     pub id: usize,
-    /// Which solver (or "from the file").
-    pub label: &'static str,
+    /// Which solver (or "from the file"), in English and Russian.
+    pub label: (&'static str, &'static str),
     /// Idle length, mm.
     pub idle_length: f64,
     /// Cut length, mm.
@@ -39,7 +39,7 @@ impl Kept {
     fn from_figures(
         (idle_length, cut_length, pierces, time_s, cost): Figures,
         idle_d: String,
-        label: &'static str,
+        label: (&'static str, &'static str),
         heat: Option<f64>,
     ) -> Kept {
         Kept {
@@ -61,7 +61,7 @@ impl Kept {
         nest: &Nest,
         route: &Route,
         machine: &MachineParameters,
-        label: &'static str,
+        label: (&'static str, &'static str),
         heat: Option<f64>,
     ) -> Kept {
         Kept::from_figures(
@@ -76,7 +76,7 @@ impl Kept {
     pub fn of_paths(
         route: &PathRoute,
         machine: &MachineParameters,
-        label: &'static str,
+        label: (&'static str, &'static str),
         heat: Option<f64>,
     ) -> Kept {
         Kept::from_figures(
@@ -179,7 +179,7 @@ pub fn ComparePanel(
                             view! {
                                 <tr class="kept" data-id=id>
                                     <td>{id}</td>
-                                    <td>{e.label}</td>
+                                    <td>{tr(e.label.0, e.label.1)}</td>
                                     <td class="kept-idle">{format!("{:.1}", e.idle_length)}</td>
                                     <td>{excess}</td>
                                     <td class="kept-time">{format!("{:.1}", e.time_s)}</td>

@@ -64,6 +64,9 @@ fn phase_ru(phase: &Phase) -> String {
         Phase::Alns { iterations } => format!("ALNS · итераций {iterations}"),
         Phase::ExactLayer { layer, states } => format!("слой {layer} · состояний {states}"),
         Phase::ProvenOptimal => "оптимальность доказана".into(),
+        Phase::BuildTimedOut => {
+            "остановлено: лимит времени истёк во время построения модели".into()
+        }
         Phase::Stopped { reason: None } => "остановлено".into(),
         Phase::Stopped {
             reason: Some(reason),

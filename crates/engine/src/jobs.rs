@@ -375,6 +375,10 @@ impl DiscreteJob {
     }
 }
 
+/// Why a discrete job ends when its limit passes before the model is built (the phase says
+/// it as [`Phase::BuildTimedOut`]).
+const BUILD_TIMED_OUT: &str = "the time limit passed while the model was built";
+
 impl Job for DiscreteJob {
     fn step(&mut self, budget: Duration) -> JobStatus {
         if self.failure.is_some() {
@@ -385,7 +389,7 @@ impl Job for DiscreteJob {
             let over = Instant::now() >= self.deadline + self.first_tour_allowance;
             return if self.failure.is_some() || (over && self.alns.is_none()) {
                 if self.failure.is_none() {
-                    self.failure = Some("the time limit passed while the model was built".into());
+                    self.failure = Some(BUILD_TIMED_OUT.into());
                 }
                 JobStatus::Done
             } else {
@@ -466,6 +470,7 @@ impl Job for DiscreteJob {
         };
         let proven_optimal = self.exact_done == Some(true);
         let phase = match (&exact, self.exact_done) {
+            _ if self.failure.as_deref() == Some(BUILD_TIMED_OUT) => Phase::BuildTimedOut,
             _ if self.failure.is_some() => Phase::Stopped {
                 reason: self.failure.clone(),
             },

@@ -130,6 +130,8 @@ pub enum Phase {
     },
     /// The exact search proved the best tour optimal.
     ProvenOptimal,
+    /// The time limit passed while the model was built: no tour.
+    BuildTimedOut,
     /// The search stopped, for this reason if any.
     Stopped {
         /// Why, in English.
@@ -235,6 +237,12 @@ impl fmt::Display for Phase {
             Phase::Alns { iterations } => write!(f, "ALNS · {iterations} iterations"),
             Phase::ExactLayer { layer, states } => write!(f, "layer {layer} · {states} states"),
             Phase::ProvenOptimal => write!(f, "proven optimal"),
+            Phase::BuildTimedOut => {
+                write!(
+                    f,
+                    "stopped: the time limit passed while the model was built"
+                )
+            }
             Phase::Stopped { reason: None } => write!(f, "stopped"),
             Phase::Stopped {
                 reason: Some(reason),
