@@ -24,6 +24,7 @@ use cutroute_geometry::{BoundingBox, MachineParameters, ToolClock, ToolMove, Too
 use leptos::prelude::*;
 
 use crate::drawing::{travel_chunks, ChunkLimits, Travel};
+use crate::i18n::{tr, use_language, Lang};
 
 /// Speed factors offered: machine seconds per real second.
 pub const SPEEDS: [u32; 7] = [1, 2, 5, 10, 20, 50, 100];
@@ -304,56 +305,79 @@ pub fn AnimationControls(animation: Animation) -> impl IntoView {
             animation.seek(target);
         }
     };
+    let language = use_language();
+    // The piece ("contour" or "path") in the page's language; both are masculine in Russian.
+    let piece_word = move || match (language.get(), piece.get()) {
+        (Lang::En, p) => p,
+        (Lang::Ru, "path") => "путь",
+        (Lang::Ru, _) => "контур",
+    };
     let contour_text = move || {
         let t = time.get()?;
+        let of = language.pick("of", "из");
         timeline.with(|tl| {
             tl.as_ref().map(|tl| {
                 format!(
-                    "{} {} of {}",
-                    piece.get(),
+                    "{} {} {of} {}",
+                    piece_word(),
                     tl.contours_begun(t),
                     tl.pierces.len()
                 )
             })
         })
     };
+    let previous = move || match language.get() {
+        Lang::En => format!("Previous {}", piece.get()),
+        Lang::Ru => format!("Предыдущий {}", piece_word()),
+    };
+    let next = move || match language.get() {
+        Lang::En => format!("Next {}", piece.get()),
+        Lang::Ru => format!("Следующий {}", piece_word()),
+    };
+    let play_pause = move || {
+        if playing.get() {
+            language.pick("Pause", "Пауза")
+        } else {
+            language.pick("Play", "Пуск анимации")
+        }
+    };
     view! {
-        <div class="animation" role="group" aria-label="Animation of the route">
+        <div class="animation" role="group" aria-label=tr("Animation of the route", "Анимация маршрута")>
             <button
                 id="anim-prev"
-                title=move || format!("Previous {}", piece.get())
-                aria-label=move || format!("Previous {}", piece.get())
+                title=previous
+                aria-label=previous
                 disabled=absent
                 on:click=move |_| step(false)
             >
-                "‹ Prev"
+                {tr("‹ Prev", "‹ Назад")}
             </button>
             <button
                 id="anim-play"
-                aria-label=move || if playing.get() { "Pause" } else { "Play" }
-                title=move || if playing.get() { "Pause" } else { "Play" }
+                aria-label=play_pause
+                title=play_pause
                 disabled=absent
                 on:click=move |_| animation.toggle()
             >
-                {move || if playing.get() { "Pause" } else { "Play" }}
+                {play_pause}
             </button>
             <button
                 id="anim-next"
-                title=move || format!("Next {}", piece.get())
-                aria-label=move || format!("Next {}", piece.get())
+                title=next
+                aria-label=next
                 disabled=absent
                 on:click=move |_| step(true)
             >
-                "Next ›"
+                {tr("Next ›", "Вперёд ›")}
             </button>
             <label class="scrub">
-                <span class="visually-hidden">"Machine time"</span>
+                <span class="visually-hidden">{tr("Machine time", "Время работы станка")}</span>
                 <input
                     id="anim-scrub"
                     type="range"
                     min="0"
                     step="any"
-                    aria-label="Machine time"
+                    aria-label=tr("Machine time", "Время работы станка")
                     disabled=absent
                     max=move || total().to_string()
                     prop:value=move || shown().to_string()
@@ -365,10 +389,10 @@ pub fn AnimationControls(animation: Animation) -> impl IntoView {
                 />
             </label>
             <label>
-                "Speed "
+                {tr("Speed ", "Скорость ")}
                 <select
                     id="anim-speed"
-                    aria-label="Animation speed (machine time)"
+                    aria-label=tr("Animation speed (machine time)", "Скорость анимации (по времени станка)")
                     prop:value=move || speed.get().to_string()
                     on:change=move |ev| {
                         if let Ok(v) = event_target_value(&ev).parse::<u32>() {
@@ -390,7 +414,7 @@ pub fn AnimationControls(animation: Animation) -> impl IntoView {
             </label>
             <output
                 id="anim-clock"
-                aria-label="Machine time"
+                aria-label=tr("Machine time", "Время работы станка")
                 data-time=move || format!("{:.3}", shown())
                 data-total=move || format!("{:.3}", total())
             >

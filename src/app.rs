@@ -16,18 +16,37 @@ use crate::drawing::{
     link_path, nest_bounds, path_route_idle_path, path_route_toolpath, toolpath_bounds,
 };
 use crate::export::ExportMenu;
+use crate::i18n::{tr, use_language, Lang};
 use crate::pan_zoom::PanZoom;
 use crate::settings::{objective_from_name, Layer, Settings};
 use crate::stats::{AlternativesTable, StatsPanel};
 use crate::thermal::{HeatMapLayer, ThermalPanel, ThermalStats, ThermalView, ViolationMarks};
-use crate::worker_client::{spawn, SolverWorker, WorkerDeath};
+use crate::words::{format_text, phase_text, solver_label, JobFailure, PageError};
+use crate::worker_client::{spawn, DeathReason, SolverWorker, WorkerDeath};
 
-/// Bundled sample nests (files under `assets/samples/`), the first is opened on start.
-pub const SAMPLES: [(&str, &str); 4] = [
-    ("E1X_6_01.dbs.json", "E1X_6_01 — 9 parts with arcs"),
-    ("test1.dbs.json", "test1 — 40 contours"),
-    ("nested.dbs", "nested — parts inside holes"),
-    ("seven.dbs", "seven — 29 parts, 5,000 points"),
+/// Bundled sample nests (files under `assets/samples/`, English and Russian label), the first
+/// is opened on start.
+pub const SAMPLES: [(&str, &str, &str); 4] = [
+    (
+        "E1X_6_01.dbs.json",
+        "E1X_6_01 — 9 parts with arcs",
+        "E1X_6_01 — 9 деталей с дугами",
+    ),
+    (
+        "test1.dbs.json",
+        "test1 — 40 contours",
+        "test1 — 40 контуров",
+    ),
+    (
+        "nested.dbs",
+        "nested — parts inside holes",
+        "nested — детали в отверстиях",
+    ),
+    (
+        "seven.dbs",
+        "seven — 29 parts, 5,000 points",
+        "seven — 29 деталей, 5 000 точек",
+    ),
 ];
 
 /// What the page shows about the current job.
@@ -37,17 +56,22 @@ enum JobState {
     Running(JobId),
     Finished,
     Cancelled,
-    Failed(String),
+    Failed(JobFailure),
 }
 
 impl JobState {
-    fn label(&self) -> String {
-        match self {
-            JobState::Idle => "idle".into(),
-            JobState::Running(_) => "running".into(),
-            JobState::Finished => "finished".into(),
-            JobState::Cancelled => "cancelled".into(),
-            JobState::Failed(message) => format!("failed: {message}"),
+    fn label(&self, lang: Lang) -> String {
+        match (self, lang) {
+            (JobState::Idle, Lang::En) => "idle".into(),
+            (JobState::Idle, Lang::Ru) => "ожидание".into(),
+            (JobState::Running(_), Lang::En) => "running".into(),
+            (JobState::Running(_), Lang::Ru) => "выполняется".into(),
+            (JobState::Finished, Lang::En) => "finished".into(),
+            (JobState::Finished, Lang::Ru) => "завершено".into(),
+            (JobState::Cancelled, Lang::En) => "cancelled".into(),
+            (JobState::Cancelled, Lang::Ru) => "отменено".into(),
+            (JobState::Failed(failure), Lang::En) => format!("failed: {}", failure.text(lang)),
+            (JobState::Failed(failure), Lang::Ru) => format!("ошибка: {}", failure.text(lang)),
         }
     }
 }
@@ -87,13 +111,14 @@ fn continued(from: &Progress, update: Progress) -> Progress {
 #[component]
 pub fn App() -> impl IntoView {
     provide_context(crate::i18n::Language::new());
+    let language = use_language();
     let query = web_sys::window()
         .and_then(|w| w.location().search().ok())
         .unwrap_or_default();
     let initial = Settings::load().with_query(&query);
 
     let document = RwSignal::new(None::<Document>);
-    let open_error = RwSignal::new(None::<String>);
+    let open_error = RwSignal::new(None::<PageError>);
     let progress = RwSignal::new(None::<Progress>);
     let samples = RwSignal::new(Vec::<BoundSample>::new());
     let log_time = RwSignal::new(false);
@@ -174,7 +199,7 @@ pub fn App() -> impl IntoView {
                 file_paths.set(opened.paths.take());
                 document.set(Some(opened));
             }
-            FromWorker::OpenFailed { message, .. } => open_error.set(Some(message)),
+            FromWorker::OpenFailed { error, .. } => open_error.set(Some(PageError::Open(error))),
             FromWorker::Progress(update) => {
                 if job_state.get_untracked() == JobState::Running(update.job_id) {
                     let update = merged(update);
@@ -199,7 +224,7 @@ pub fn App() -> impl IntoView {
             }
             FromWorker::Failed { job_id, message } => {
                 if job_state.get_untracked() == JobState::Running(job_id) {
-                    job_state.set(JobState::Failed(message));
+                    job_state.set(JobState::Failed(JobFailure::Engine(message)));
                 }
             }
         }));
@@ -214,7 +239,7 @@ pub fn App() -> impl IntoView {
         )
     };
     let bridge: StoredValue<SolverWorker, LocalStorage> = StoredValue::new_local(spawn_worker());
-    let worker_notice = RwSignal::new(None::<String>);
+    let worker_notice = RwSignal::new(None::<WorkerNotice>);
     on_death.set_value(std::rc::Rc::new(move |death: WorkerDeath| {
         bridge.set_value(spawn_worker());
         after_worker_death(&death, job_state, open_error, worker_notice);
@@ -278,12 +303,13 @@ pub fn App() -> impl IntoView {
             d.as_ref()
                 .is_some_and(|d| matches!(d.problem, Problem::PcgtspText { .. }))
         });
+        let lang = language.get();
         if instance {
-            "tour cost"
+            lang.pick("tour cost", "стоимость обхода")
         } else if solver.get().gives_path_route() {
-            objective_unit(objective.get())
+            objective_unit(objective.get(), lang)
         } else {
-            "mm idle"
+            lang.pick("mm idle", "мм холостого хода")
         }
     });
     let certified = Memo::new(move |_| {
@@ -329,7 +355,7 @@ pub fn App() -> impl IntoView {
                         files: vec![(file_name, bytes)],
                     })
                 }),
-                Err(message) => open_error.set(Some(format!("{url}: {message}"))),
+                Err(message) => open_error.set(Some(PageError::Fetch { url, message })),
             }
         });
     };
@@ -345,7 +371,10 @@ pub fn App() -> impl IntoView {
             for file in files {
                 match read_file(&file).await {
                     Ok(bytes) => batch.push((file.name(), bytes)),
-                    Err(message) => open_error.set(Some(format!("{}: {message}", file.name()))),
+                    Err(message) => open_error.set(Some(PageError::Read {
+                        file_name: file.name(),
+                        message,
+                    })),
                 }
             }
             if batch.is_empty() {
@@ -515,8 +544,13 @@ pub fn App() -> impl IntoView {
     };
     let keep = move |_| {
         let label = progress
-            .with_untracked(|p| p.as_ref().map(|_| solver.get_untracked().label()))
-            .unwrap_or("from the file");
+            .with_untracked(|p| {
+                p.as_ref().map(|_| {
+                    let kind = solver.get_untracked();
+                    (solver_label(Lang::En, kind), solver_label(Lang::Ru, kind))
+                })
+            })
+            .unwrap_or(("from the file", "из файла"));
         let entry = if let Some(paths) = shown_paths.get_untracked() {
             machine.with_untracked(|m| Kept::of_paths(&paths, m, label, shown_heat()))
         } else {
@@ -537,10 +571,10 @@ pub fn App() -> impl IntoView {
         <header class="toolbar">
             <h1>"cutroute"</h1>
             <label>
-                "Sample "
+                {tr("Sample ", "Пример ")}
                 <select
                     id="sample"
-                    aria-label="Sample nest"
+                    aria-label=tr("Sample nest", "Пример раскроя")
                     prop:value=move || sample.get()
                     on:change=move |ev| {
                         last_file.set(None);
@@ -549,10 +583,10 @@ pub fn App() -> impl IntoView {
                 >
                     {SAMPLES
                         .iter()
-                        .map(|(file, label)| {
+                        .map(|(file, en, ru)| {
                             view! {
                                 <option value=*file selected=*file == initial.sample>
-                                    {*label}
+                                    {tr(en, ru)}
                                 </option>
                             }
                         })
@@ -560,12 +594,12 @@ pub fn App() -> impl IntoView {
                 </select>
             </label>
             <label class="file-button">
-                "Open files… "
+                {tr("Open files… ", "Открыть файлы… ")}
                 <input
                     id="file-input"
                     type="file"
                     multiple
-                    aria-label="Open nest or instance files"
+                    aria-label=tr("Open nest or instance files", "Открыть файлы раскроя или задачи")
                     on:change=move |ev| {
                         let input: web_sys::HtmlInputElement = event_target(&ev);
                         if let Some(files) = input.files() {
@@ -580,10 +614,13 @@ pub fn App() -> impl IntoView {
             <button
                 id="present"
                 aria-pressed=move || presentation.get().to_string()
-                title="Presentation mode: large fonts, full screen (key F)"
+                title=tr(
+                    "Presentation mode: large fonts, full screen (key F)",
+                    "Режим показа: крупный шрифт, полный экран (клавиша F)",
+                )
                 on:click=move |_| presentation.update(|p| *p = !*p)
             >
-                "Present"
+                {tr("Present", "Показ")}
             </button>
             <ExportMenu
                 file_name=file_name
@@ -594,12 +631,12 @@ pub fn App() -> impl IntoView {
                 machine=machine
             />
         </header>
-        <section class="solver-panel" aria-label="Solver">
-            <label title="Which algorithm routes the tool">
-                "Solver "
+        <section class="solver-panel" aria-label=tr("Solver", "Решатель")>
+            <label title=tr("Which algorithm routes the tool", "Какой алгоритм строит маршрут инструмента")>
+                {tr("Solver ", "Решатель ")}
                 <select
                     id="solver"
-                    aria-label="Solver"
+                    aria-label=tr("Solver", "Решатель")
                     prop:value=move || solver.get().name()
                     on:change=move |ev| {
                         if let Some(kind) = SolverKind::from_name(&event_target_value(&ev)) {
@@ -612,18 +649,21 @@ pub fn App() -> impl IntoView {
                         .map(|kind| {
                             view! {
                                 <option value=kind.name() selected=kind.name() == initial.solver>
-                                    {kind.label()}
+                                    {move || solver_label(language.get(), *kind)}
                                 </option>
                             }
                         })
                         .collect_view()}
                 </select>
             </label>
-            <label title="What routes are compared by, and what GSCCP picks its ensemble by (machine parameters in the stats panel)">
-                "Objective "
+            <label title=tr(
+                "What routes are compared by, and what GSCCP picks its ensemble by (machine parameters in the stats panel)",
+                "По какому критерию сравниваются маршруты и GSCCP выбирает ансамбль (параметры станка — в панели показателей)",
+            )>
+                {tr("Objective ", "Критерий ")}
                 <select
                     id="objective"
-                    aria-label="Objective"
+                    aria-label=tr("Objective", "Критерий")
                     prop:value=move || objective.get().name()
                     on:change=move |ev| {
                         if let Some(o) = objective_from_name(&event_target_value(&ev)) {
@@ -631,19 +671,25 @@ pub fn App() -> impl IntoView {
                         }
                     }
                 >
-                    <option value="time" selected=initial.objective == "time">"machine time"</option>
-                    <option value="cost" selected=initial.objective == "cost">"cost"</option>
+                    <option value="time" selected=initial.objective == "time">{tr("machine time", "время работы станка")}</option>
+                    <option value="cost" selected=initial.objective == "cost">{tr("cost", "стоимость")}</option>
                 </select>
             </label>
             <NumberField
                 id="time-limit"
-                label="Time limit, s"
-                tip="Wall-clock time the solver may run; it stops earlier when it proves optimality"
+                label=("Time limit, s", "Лимит времени, с")
+                tip=(
+                    "Wall-clock time the solver may run; it stops earlier when it proves optimality",
+                    "Сколько времени может работать решатель; он останавливается раньше, если доказал оптимальность",
+                )
                 min="0.1"
                 value=time_limit
             />
-            <label title="Seed of the solver's random choices: the same seed repeats a run">
-                "Seed "
+            <label title=tr(
+                "Seed of the solver's random choices: the same seed repeats a run",
+                "Зерно случайного выбора решателя: с тем же зерном запуск повторяется",
+            )>
+                {tr("Seed ", "Зерно ")}
                 <input
                     id="seed"
                     type="number"
@@ -659,35 +705,44 @@ pub fn App() -> impl IntoView {
             </label>
             <NumberField
                 id="step"
-                label="Pierce step, mm"
-                tip="Discrete solvers: spacing of candidate pierce points along each contour (smaller = finer, slower)"
+                label=("Pierce step, mm", "Шаг точек врезки, мм")
+                tip=(
+                    "Discrete solvers: spacing of candidate pierce points along each contour (smaller = finer, slower)",
+                    "Дискретные решатели: шаг точек врезки-кандидатов вдоль каждого контура (меньше — точнее, но дольше)",
+                )
                 min="0.1"
                 value=step_mm
             />
             <button id="start" on:click=move |_| launch(None) disabled=move || running() || document.get().is_none()>
-                "Start"
+                {tr("Start", "Пуск")}
             </button>
             <button id="stop" on:click=stop disabled=move || !running()>
-                "Stop"
+                {tr("Stop", "Стоп")}
             </button>
             <button
                 id="continue"
-                title="Run again from the best result so far (another seed, pruned by its cost)"
+                title=tr(
+                    "Run again from the best result so far (another seed, pruned by its cost)",
+                    "Запустить снова от лучшего результата (другое зерно, отсечение по его стоимости)",
+                )
                 disabled=move || !can_continue()
                 on:click=move |_| launch(progress.get_untracked())
             >
-                "Continue"
+                {tr("Continue", "Продолжить")}
             </button>
-            <label class="share" title="A link that opens this sample with these solver settings">
-                "Link "
+            <label class="share" title=tr(
+                "A link that opens this sample with these solver settings",
+                "Ссылка, открывающая этот пример с этими настройками решателя",
+            )>
+                {tr("Link ", "Ссылка ")}
                 <input id="share-link" type="text" readonly prop:value=share_link />
             </label>
-            <p id="solver-uses" class="note">{move || solver_uses(solver.get())}</p>
+            <p id="solver-uses" class="note">{move || solver_uses(solver.get(), language.get())}</p>
         </section>
         <main class="workspace">
             <section
                 class="view"
-                aria-label="Cutting plan"
+                aria-label=tr("Cutting plan", "Карта раскроя")
                 on:dragover=move |ev: web_sys::DragEvent| ev.prevent_default()
                 on:drop=move |ev: web_sys::DragEvent| {
                     ev.prevent_default();
@@ -696,14 +751,14 @@ pub fn App() -> impl IntoView {
                     }
                 }
             >
-                {move || open_error.get().map(|e| view! { <p class="error" role="alert">{e}</p> })}
-                {move || worker_notice.get().map(|n| view! { <p id="worker-notice" class="error" role="status">{n}</p> })}
+                {move || open_error.get().map(|e| view! { <p class="error" role="alert">{e.text(language.get())}</p> })}
+                {move || worker_notice.get().map(|n| view! { <p id="worker-notice" class="error" role="status">{n.text(language.get())}</p> })}
                 // What the reader left out or approximated, and what was checked on opening.
                 {move || {
                     let notes = document.with(|d| d.as_ref().map(|d| d.warnings.clone()).unwrap_or_default());
                     (!notes.is_empty()).then(|| {
                         view! {
-                            <ul id="open-notes" class="note" aria-label="Notes on the open file">
+                            <ul id="open-notes" class="note" aria-label=tr("Notes on the open file", "Замечания к открытому файлу")>
                                 {notes.into_iter().map(|n| view! { <li>{n}</li> }).collect_view()}
                             </ul>
                         }
@@ -717,8 +772,11 @@ pub fn App() -> impl IntoView {
                         .map(|f| {
                             view! {
                                 <p id="last-file" class="note">
-                                    "Last time " <strong>{f}</strong>
-                                    " was open: choose it again with Open files… (the sample is shown meanwhile)"
+                                    {tr("Last time ", "В прошлый раз был открыт ")} <strong>{f}</strong>
+                                    {tr(
+                                        " was open: choose it again with Open files… (the sample is shown meanwhile)",
+                                        ": выберите его снова через «Открыть файлы…» (пока показан пример)",
+                                    )}
                                 </p>
                             }
                         })
@@ -739,36 +797,52 @@ pub fn App() -> impl IntoView {
                 />
                 <AnimationControls animation=animation />
             </section>
-            <aside class="stats" aria-label="Job status">
+            <aside class="stats" aria-label=tr("Job status", "Состояние задачи")>
                 <dl>
-                    <dt>"File"</dt>
+                    <dt>{tr("File", "Файл")}</dt>
                     <dd id="file-name">
-                        {move || document.get().map(|d| format!("{} ({})", d.file_name, d.format)).unwrap_or_default()}
+                        {move || document.get().map(|d| format!("{} ({})", d.file_name, format_text(language.get(), &d.format))).unwrap_or_default()}
                     </dd>
-                    <dt>"Job"</dt>
-                    <dd id="job-status">{move || job_state.get().label()}</dd>
-                    <dt>"Phase"</dt>
-                    <dd id="phase">{move || progress.get().map(|p| p.phase).unwrap_or_default()}</dd>
-                    <dt>"Upper bound"</dt>
+                    <dt>{tr("Job", "Задача")}</dt>
+                    <dd id="job-status">{move || job_state.get().label(language.get())}</dd>
+                    <dt>{tr("Phase", "Этап")}</dt>
+                    <dd id="phase">
+                        {move || progress.with(|p| p.as_ref().map(|p| phase_text(language.get(), &p.phase))).unwrap_or_default()}
+                        // Phases that count towards a total (the exact model's matrix rows)
+                        // show how far they are.
+                        {move || progress.with(|p| p.as_ref().and_then(|p| p.phase.fraction())).map(|(done, total)| {
+                            view! {
+                                <progress
+                                    id="phase-progress"
+                                    max=total.max(1)
+                                    value=done
+                                    aria-label=tr("Phase progress", "Ход этапа")
+                                ></progress>
+                            }
+                        })}
+                    </dd>
+                    <dt>{tr("Upper bound", "Верхняя оценка")}</dt>
                     <dd id="upper-bound" data-unit=move || bound_unit.get()>{move || format_bound(progress.get().and_then(|p| p.upper_bound))}</dd>
-                    <dt>"Lower bound"</dt>
+                    <dt>{tr("Lower bound", "Нижняя оценка")}</dt>
                     <dd id="lower-bound">{move || format_bound(progress.get().and_then(|p| p.lower_bound))}</dd>
-                    <dt>"Gap"</dt>
+                    <dt>{tr("Gap", "Разрыв")}</dt>
                     <dd id="gap">
                         {move || progress.get().and_then(|p| {
                             let gap = format!("{:.2} %", p.gap()? * 100.0);
-                            Some(if p.proven_optimal { format!("{gap} · proven optimal") } else { gap })
+                            let proven = language.pick("proven optimal", "оптимальность доказана");
+                            Some(if p.proven_optimal { format!("{gap} · {proven}") } else { gap })
                         }).unwrap_or_else(|| "—".into())}
                     </dd>
-                    <dt>"Elapsed"</dt>
-                    <dd id="elapsed">{move || progress.get().map(|p| format!("{:.2} s", p.elapsed_s)).unwrap_or_default()}</dd>
-                    <dt>"Certified"</dt>
+                    <dt>{tr("Elapsed", "Прошло")}</dt>
+                    <dd id="elapsed">{move || progress.get().map(|p| format!("{:.2} {}", p.elapsed_s, language.pick("s", "с"))).unwrap_or_default()}</dd>
+                    <dt>{tr("Certified", "Подтверждено")}</dt>
                     <dd id="certified-count">
                         {move || certified.with(|c| {
                             if c.is_empty() {
                                 "—".to_string()
                             } else {
-                                format!("{} of {}", c.iter().filter(|x| **x).count(), c.len())
+                                let of = language.pick("of", "из");
+                                format!("{} {of} {}", c.iter().filter(|x| **x).count(), c.len())
                             }
                         })}
                     </dd>
@@ -796,7 +870,7 @@ fn missing_tour(
     last: &Progress,
     document: RwSignal<Option<Document>>,
     solver: RwSignal<SolverKind>,
-) -> Option<String> {
+) -> Option<JobFailure> {
     let instance = document.with_untracked(|d| {
         d.as_ref()
             .is_some_and(|d| matches!(d.problem, Problem::PcgtspText { .. }))
@@ -804,7 +878,50 @@ fn missing_tour(
     if !instance {
         return None;
     }
-    last.missing_tour(solver.get_untracked().name(), false)
+    // `Progress::missing_tour`'s cases (the CLI's words), as data the page words itself.
+    let solver = solver.get_untracked().name();
+    if last.tour.is_some() {
+        None
+    } else if last.proven_optimal {
+        Some(JobFailure::NoTourExists { solver })
+    } else {
+        Some(JobFailure::NoTourFound {
+            solver,
+            seconds: last.elapsed_s,
+        })
+    }
+}
+
+/// The notice after the worker died and was restarted.
+#[derive(Clone, Debug, PartialEq)]
+struct WorkerNotice {
+    reason: DeathReason,
+    job_lost: bool,
+}
+
+impl WorkerNotice {
+    fn text(&self, lang: Lang) -> String {
+        let reason = self.reason.text(lang);
+        match (lang, self.job_lost) {
+            (Lang::En, lost) => format!(
+                "The solver stopped unexpectedly ({reason}) and was restarted; {}",
+                if lost {
+                    "the best route received before is kept: Start or Continue runs the job again."
+                } else {
+                    "nothing was lost."
+                }
+            ),
+            (Lang::Ru, lost) => format!(
+                "Решатель неожиданно остановился ({reason}) и перезапущен; {}",
+                if lost {
+                    "полученный ранее лучший маршрут сохранён: «Пуск» или «Продолжить» \
+                     запускают задачу снова."
+                } else {
+                    "ничего не потеряно."
+                }
+            ),
+        }
+    }
 }
 
 /// After the worker died and a fresh one took over (`src/worker_client.rs`): what was lost is
@@ -815,48 +932,41 @@ fn missing_tour(
 fn after_worker_death(
     death: &WorkerDeath,
     job_state: RwSignal<JobState>,
-    open_error: RwSignal<Option<String>>,
-    worker_notice: RwSignal<Option<String>>,
+    open_error: RwSignal<Option<PageError>>,
+    worker_notice: RwSignal<Option<WorkerNotice>>,
 ) {
     let job_lost =
         matches!(job_state.get_untracked(), JobState::Running(id) if death.jobs.contains(&id));
     if job_lost {
-        job_state.set(JobState::Failed("the solver stopped unexpectedly".into()));
+        job_state.set(JobState::Failed(JobFailure::WorkerStopped));
     }
     if !death.opening.is_empty() {
-        open_error.set(Some(format!(
-            "{}: the solver stopped unexpectedly while opening this ({}); it was restarted and \
-             the document shown before is still open",
-            death.opening.join(" + "),
-            death.reason
-        )));
+        open_error.set(Some(PageError::WorkerDiedOpening {
+            files: death.opening.join(" + "),
+            reason: death.reason.clone(),
+        }));
     }
-    worker_notice.set(Some(format!(
-        "The solver stopped unexpectedly ({}) and was restarted; {}",
-        death.reason,
-        if job_lost {
-            "the best route received before is kept: Start or Continue runs the job again."
-        } else {
-            "nothing was lost."
-        }
-    )));
+    worker_notice.set(Some(WorkerNotice {
+        reason: death.reason.clone(),
+        job_lost,
+    }));
 }
 
 /// Hues the tool-on paths of a path route take in turn (`.hue-0` … `.hue-5` in `style/`).
 const PATH_HUES: usize = 6;
 
-/// A labelled positive number input with a tooltip.
+/// A labelled positive number input with a tooltip (label and tip in English and Russian).
 #[component]
 fn NumberField(
     id: &'static str,
-    label: &'static str,
-    tip: &'static str,
+    label: (&'static str, &'static str),
+    tip: (&'static str, &'static str),
     min: &'static str,
     value: RwSignal<f64>,
 ) -> impl IntoView {
     view! {
-        <label title=tip>
-            {label} " "
+        <label title=tr(tip.0, tip.1)>
+            {tr(label.0, label.1)} " "
             <input
                 id=id
                 type="number"
@@ -878,9 +988,10 @@ fn NumberField(
 /// A checkbox per drawing layer.
 #[component]
 fn LayerPanel(hidden: RwSignal<Vec<Layer>>) -> impl IntoView {
+    let language = use_language();
     view! {
         <fieldset class="layers">
-            <legend>"Layers"</legend>
+            <legend>{tr("Layers", "Слои")}</legend>
             {Layer::ALL
                 .into_iter()
                 .map(|layer| {
@@ -901,7 +1012,7 @@ fn LayerPanel(hidden: RwSignal<Vec<Layer>>) -> impl IntoView {
                                 }
                             />
                             " "
-                            {layer.label()}
+                            {move || layer.label(language.get())}
                         </label>
                     }
                 })
@@ -911,15 +1022,27 @@ fn LayerPanel(hidden: RwSignal<Vec<Layer>>) -> impl IntoView {
 }
 
 /// The unit of an objective's values, as the chart and bounds show it.
-fn objective_unit(objective: Objective) -> &'static str {
+fn objective_unit(objective: Objective, lang: Lang) -> &'static str {
     match objective {
-        Objective::Time => "s (machine time)",
-        Objective::Cost => "cost",
+        Objective::Time => lang.pick("s (machine time)", "с (время работы станка)"),
+        Objective::Cost => lang.pick("cost", "стоимость"),
     }
 }
 
 /// Which of the panel's parameters a solver uses, in words.
-fn solver_uses(kind: SolverKind) -> &'static str {
+fn solver_uses(kind: SolverKind, lang: Lang) -> &'static str {
+    if lang == Lang::Ru {
+        return match kind {
+            SolverKind::NearestNeighbour => "Использует: только раскрой (жадный алгоритм, один проход); оценка — длина холостого хода, мм.",
+            SolverKind::Ccp => "Использует: лимит времени, зерно; оценка — длина холостого хода, мм.",
+            SolverKind::Heuristic => "Использует: лимит времени, зерно, шаг точек врезки; оценка — длина холостого хода, мм.",
+            SolverKind::Exact => "Использует: лимит времени, зерно, шаг точек врезки; оценки — длина холостого хода, мм.",
+            SolverKind::Chain => "Использует: лимит времени, зерно, цены станка (переход с включённым инструментом заменяет врезку, если дешевле); оценка — длина холостого хода, мм.",
+            SolverKind::Sccp => "Использует: лимит времени, зерно, критерий, скорости и цены станка; оценка — значение критерия.",
+            SolverKind::Gsccp => "Использует: лимит времени, зерно, критерий (по нему выбирается лучший ансамбль), скорости и цены станка; оценка — значение критерия.",
+            SolverKind::Aoe => "Использует: критерий, скорости и цены станка (общие кромки режутся один раз); оценка — значение критерия.",
+        };
+    }
     match kind {
         SolverKind::NearestNeighbour => "Uses: the nest only (greedy, one pass); bound = idle length, mm.",
         SolverKind::Ccp => "Uses: time limit, seed; bound = idle length, mm.",
@@ -995,6 +1118,7 @@ fn NestView(
     animation: Animation,
     thermal: ThermalView,
 ) -> impl IntoView {
+    let language = use_language();
     // The nest's box; for a nest with nothing to draw (a G-code program of open paths), the
     // box of the head's moves.
     let fit = Memo::new(move |_| {
@@ -1062,13 +1186,18 @@ fn NestView(
                     .map(|(i, part)| {
                         let mut d = String::new();
                         part.contours.iter().for_each(|c| contour_path(c, &mut d));
-                        let title = format!(
-                            "part {} “{}”, {} contour{}",
-                            i + 1,
-                            part.name,
-                            part.contours.len(),
-                            if part.contours.len() == 1 { "" } else { "s" }
-                        );
+                        let count = part.contours.len();
+                        let title = match language.get() {
+                            Lang::En => format!(
+                                "part {} “{}”, {count} contour{}",
+                                i + 1,
+                                part.name,
+                                if count == 1 { "" } else { "s" }
+                            ),
+                            Lang::Ru => {
+                                format!("деталь {} «{}», контуров: {count}", i + 1, part.name)
+                            }
+                        };
                         view! { <path class="part" d=d><title>{title}</title></path> }
                     })
                     .collect_view()
@@ -1169,14 +1298,24 @@ fn NestView(
                 .iter()
                 .enumerate()
                 .map(|(k, p)| {
-                    let title = format!(
-                        "path {} of {total}: pierce at ({:.2}, {:.2}), {:.1} mm tool-on, {} spans",
-                        k + 1,
-                        p.pierce.x,
-                        p.pierce.y,
-                        p.length(),
-                        p.spans.len()
-                    );
+                    let title = match language.get() {
+                        Lang::En => format!(
+                            "path {} of {total}: pierce at ({:.2}, {:.2}), {:.1} mm tool-on, {} spans",
+                            k + 1,
+                            p.pierce.x,
+                            p.pierce.y,
+                            p.length(),
+                            p.spans.len()
+                        ),
+                        Lang::Ru => format!(
+                            "путь {} из {total}: врезка в ({:.2}, {:.2}), {:.1} мм резки, участков: {}",
+                            k + 1,
+                            p.pierce.x,
+                            p.pierce.y,
+                            p.length(),
+                            p.spans.len()
+                        ),
+                    };
                     view! {
                         <circle class="pierce" cx=p.pierce.x cy=p.pierce.y r=r>
                             <title>{title}</title>
@@ -1199,16 +1338,27 @@ fn NestView(
                     .enumerate()
                     .map(|(k, s)| {
                         let part = n.parts.get(s.contour.part);
-                        let title = format!(
-                            "cut {} of {total}: part {} “{}”, contour {}{} — pierce at ({:.2}, {:.2})",
-                            k + 1,
-                            s.contour.part + 1,
-                            part.map_or("", |p| p.name.as_str()),
-                            s.contour.contour,
-                            if s.contour.contour == 0 { " (outer)" } else { "" },
-                            s.pierce_point.x,
-                            s.pierce_point.y
-                        );
+                        let name = part.map_or("", |p| p.name.as_str());
+                        let title = match language.get() {
+                            Lang::En => format!(
+                                "cut {} of {total}: part {} “{name}”, contour {}{} — pierce at ({:.2}, {:.2})",
+                                k + 1,
+                                s.contour.part + 1,
+                                s.contour.contour,
+                                if s.contour.contour == 0 { " (outer)" } else { "" },
+                                s.pierce_point.x,
+                                s.pierce_point.y
+                            ),
+                            Lang::Ru => format!(
+                                "рез {} из {total}: деталь {} «{name}», контур {}{} — врезка в ({:.2}, {:.2})",
+                                k + 1,
+                                s.contour.part + 1,
+                                s.contour.contour,
+                                if s.contour.contour == 0 { " (внешний)" } else { "" },
+                                s.pierce_point.x,
+                                s.pierce_point.y
+                            ),
+                        };
                         view! {
                             <circle class="pierce" cx=s.pierce_point.x cy=s.pierce_point.y r=r>
                                 <title>{title}</title>
@@ -1224,6 +1374,7 @@ fn NestView(
             .with(|r| r.as_ref().map(|r| (r.start, r.finish)))
             .or_else(|| paths.with(|p| p.as_ref().map(|p| (p.start, p.finish))))?;
         let r = extent.get() / 100.0;
+        let lang = language.get();
         let marker = move |p: Point, class: &'static str, name: &'static str| {
             view! {
                 <rect class=class x=p.x - r y=p.y - r width=2.0 * r height=2.0 * r>
@@ -1232,8 +1383,8 @@ fn NestView(
             }
         };
         Some(view! {
-            {marker(start, "start-marker", "start")}
-            {finish.map(|f| marker(f, "finish-marker", "finish"))}
+            {marker(start, "start-marker", lang.pick("start", "старт"))}
+            {finish.map(|f| marker(f, "finish-marker", lang.pick("finish", "финиш")))}
         })
     };
     // Order numbers live outside the flipped group (text must not be mirrored): (x, −y).
@@ -1273,7 +1424,7 @@ fn NestView(
                 .map(|(e, class)| {
                     view! {
                         <path class=format!("compare {class}") d=e.idle_d.clone()>
-                            <title>{format!("kept result #{}: {}", e.id, e.label)}</title>
+                            <title>{format!("{} #{}: {}", language.pick("kept result", "сохранённый результат"), e.id, language.pick(e.label.0, e.label.1))}</title>
                         </path>
                     }
                 })
@@ -1299,7 +1450,10 @@ fn NestView(
             preserveAspectRatio="xMidYMid meet"
             tabindex="0"
             role="img"
-            aria-label="Nest and route; drag to pan, wheel or + and − to zoom, 0 to fit"
+            aria-label=tr(
+                "Nest and route; drag to pan, wheel or + and − to zoom, 0 to fit",
+                "Раскрой и маршрут; перетаскивание — сдвиг, колесо или + и − — масштаб, 0 — вписать",
+            )
             on:wheel=move |ev| pan_zoom.on_wheel(ev)
             on:pointerdown=move |ev| pan_zoom.on_pointer_down(ev)
             on:pointermove=move |ev| pan_zoom.on_pointer_move(ev)

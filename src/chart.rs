@@ -2,6 +2,8 @@
 
 use leptos::prelude::*;
 
+use crate::i18n::{tr, use_language, Lang};
+
 /// One sample of a job's bounds.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BoundSample {
@@ -54,6 +56,7 @@ pub fn BoundsChart(
     log_time: RwSignal<bool>,
     unit: Signal<&'static str>,
 ) -> impl IntoView {
+    let language = use_language();
     let paths = move || {
         samples.with(|samples| {
             let values: Vec<f64> = samples
@@ -80,7 +83,10 @@ pub fn BoundsChart(
                 PAD + f * (WIDTH - 2.0 * PAD)
             };
             let vy = move |v: f64| HEIGHT - PAD - (v - lo) / span * (HEIGHT - 2.0 * PAD);
-            let label = format!("{lo:.1} – {hi:.1} {} over {t_max:.2} s", unit.get());
+            let label = match language.get() {
+                Lang::En => format!("{lo:.1} – {hi:.1} {} over {t_max:.2} s", unit.get()),
+                Lang::Ru => format!("{lo:.1} – {hi:.1} {} за {t_max:.2} с", unit.get()),
+            };
             (
                 step_path(samples, |s| s.upper_bound, tx, vy),
                 step_path(samples, |s| s.lower_bound, tx, vy),
@@ -90,21 +96,21 @@ pub fn BoundsChart(
     };
     view! {
         <figure class="chart">
-            <svg id="bounds-chart" viewBox=format!("0 0 {WIDTH} {HEIGHT}") role="img" aria-label="Upper and lower bound over time">
+            <svg id="bounds-chart" viewBox=format!("0 0 {WIDTH} {HEIGHT}") role="img" aria-label=tr("Upper and lower bound over time", "Верхняя и нижняя оценки во времени")>
                 <rect class="chart-frame" x="0" y="0" width=WIDTH height=HEIGHT />
                 <path class="chart-ub" d=move || paths().0 />
                 <path class="chart-lb" d=move || paths().1 />
                 <text id="chart-y-label" class="chart-axis" x=PAD y=PAD + 10.0>{move || unit.get()}</text>
             </svg>
             <figcaption>
-                <span class="legend-ub">"upper bound"</span>
+                <span class="legend-ub">{tr("upper bound", "верхняя оценка")}</span>
                 " · "
-                <span class="legend-lb">"lower bound"</span>
+                <span class="legend-lb">{tr("lower bound", "нижняя оценка")}</span>
                 " · "
                 <span id="chart-range">{move || paths().2}</span>
                 <label>
                     <input type="checkbox" id="log-time" prop:checked=move || log_time.get() on:change=move |ev| log_time.set(event_target_checked(&ev)) />
-                    " log time"
+                    {tr(" log time", " логарифмическая шкала времени")}
                 </label>
             </figcaption>
         </figure>

@@ -7,6 +7,7 @@ use cutroute_geometry::{MachineParameters, Nest, Objective, PathRoute, Route};
 use leptos::prelude::*;
 
 use crate::drawing::{idle_path, path_route_idle_path};
+use crate::i18n::{tr, use_language, Lang};
 use crate::stats::{path_route_figures, route_figures, Figures};
 
 /// A kept result.
@@ -14,8 +15,8 @@ use crate::stats::{path_route_figures, route_figures, Figures};
 pub struct Kept {
     /// Number shown in the list (1, 2, …).
     pub id: usize,
-    /// Which solver (or "from the file").
-    pub label: &'static str,
+    /// Which solver (or "from the file"), in English and Russian.
+    pub label: (&'static str, &'static str),
     /// Idle length, mm.
     pub idle_length: f64,
     /// Cut length, mm.
@@ -38,7 +39,7 @@ impl Kept {
     fn from_figures(
         (idle_length, cut_length, pierces, time_s, cost): Figures,
         idle_d: String,
-        label: &'static str,
+        label: (&'static str, &'static str),
         heat: Option<f64>,
     ) -> Kept {
         Kept {
@@ -60,7 +61,7 @@ impl Kept {
         nest: &Nest,
         route: &Route,
         machine: &MachineParameters,
-        label: &'static str,
+        label: (&'static str, &'static str),
         heat: Option<f64>,
     ) -> Kept {
         Kept::from_figures(
@@ -75,7 +76,7 @@ impl Kept {
     pub fn of_paths(
         route: &PathRoute,
         machine: &MachineParameters,
-        label: &'static str,
+        label: (&'static str, &'static str),
         heat: Option<f64>,
     ) -> Kept {
         Kept::from_figures(
@@ -103,6 +104,7 @@ pub fn ComparePanel(
     can_keep: Signal<bool>,
     objective: Signal<Objective>,
 ) -> impl IntoView {
+    let language = use_language();
     let best = move || {
         let objective = objective.get();
         kept.with(|k| {
@@ -112,35 +114,47 @@ pub fn ComparePanel(
         })
     };
     view! {
-        <section class="compare" aria-label="Compare results">
-            <h2>"Compare"</h2>
+        <section class="compare" aria-label=tr("Compare results", "Сравнение результатов")>
+            <h2>{tr("Compare", "Сравнение")}</h2>
             <button
                 id="keep-result"
-                title="Keep the route shown to compare it with later ones"
+                title=tr(
+                    "Keep the route shown to compare it with later ones",
+                    "Сохранить показанный маршрут, чтобы сравнить его с последующими",
+                )
                 disabled=move || !can_keep.get()
                 on:click=keep
             >
-                "Keep this result"
+                {tr("Keep this result", "Сохранить результат")}
             </button>
             <button
                 id="clear-kept"
                 disabled=move || kept.with(Vec::is_empty)
                 on:click=move |_| kept.set(Vec::new())
             >
-                "Clear"
+                {tr("Clear", "Очистить")}
             </button>
             <table id="compare-table">
                 <thead>
                     <tr>
                         <th scope="col">"#"</th>
-                        <th scope="col">"Solver"</th>
-                        <th scope="col">"Idle, mm"</th>
-                        <th scope="col" id="compare-by">{move || format!("vs best ({})", objective.get().name())}</th>
-                        <th scope="col">"Time, s"</th>
-                        <th scope="col">"Cost"</th>
-                        <th scope="col" title="Thermal load H under the heat panel's σ and τ">"H"</th>
-                        <th scope="col">"Pierces"</th>
-                        <th scope="col">"Overlay"</th>
+                        <th scope="col">{tr("Solver", "Решатель")}</th>
+                        <th scope="col">{tr("Idle, mm", "Хол. ход, мм")}</th>
+                        <th scope="col" id="compare-by">{move || match language.get() {
+                            Lang::En => format!("vs best ({})", objective.get().name()),
+                            Lang::Ru => format!(
+                                "к лучшему ({})",
+                                match objective.get() {
+                                    Objective::Time => "время",
+                                    Objective::Cost => "стоимость",
+                                }
+                            ),
+                        }}</th>
+                        <th scope="col">{tr("Time, s", "Время, с")}</th>
+                        <th scope="col">{tr("Cost", "Стоимость")}</th>
+                        <th scope="col" title=tr("Thermal load H under the heat panel's σ and τ", "Тепловая нагрузка H при σ и τ из тепловой панели")>"H"</th>
+                        <th scope="col">{tr("Pierces", "Врезки")}</th>
+                        <th scope="col">{tr("Overlay", "Наложить")}</th>
                     </tr>
                 </thead>
                 <tbody>
@@ -165,7 +179,7 @@ pub fn ComparePanel(
                             view! {
                                 <tr class="kept" data-id=id>
                                     <td>{id}</td>
-                                    <td>{e.label}</td>
+                                    <td>{tr(e.label.0, e.label.1)}</td>
                                     <td class="kept-idle">{format!("{:.1}", e.idle_length)}</td>
                                     <td>{excess}</td>
                                     <td class="kept-time">{format!("{:.1}", e.time_s)}</td>
@@ -176,7 +190,10 @@ pub fn ComparePanel(
                                         <input
                                             type="checkbox"
                                             class="kept-overlay"
-                                            aria-label=format!("Overlay result {id} on the drawing")
+                                            aria-label=move || match language.get() {
+                                                Lang::En => format!("Overlay result {id} on the drawing"),
+                                                Lang::Ru => format!("Наложить результат {id} на чертёж"),
+                                            }
                                             prop:checked=e.overlay
                                             on:change=move |ev| {
                                                 let on = event_target_checked(&ev);

@@ -21,6 +21,8 @@ use cutroute_geometry::{MachineParameters, Nest, PathRoute, Route, Toolpath};
 use leptos::prelude::*;
 use wasm_bindgen::JsCast;
 
+use crate::i18n::{tr, use_language, Lang};
+
 /// Styles inlined into an exported SVG so it looks like the view without the page's CSS.
 const SVG_STYLE: &str = ".sheet{fill:#e9e6df;stroke:#6b6b70}.part{fill:#c9d6e8;fill-rule:evenodd;stroke:#2b4a73}\
 .idle{fill:none;stroke:#d55e00;stroke-dasharray:6 4}.cut{fill:none;stroke:#0072b2}\
@@ -148,6 +150,8 @@ pub fn standalone_html_of_paths(
 
 /// Why the result JSON export is off for routes of tool-on paths.
 pub const RESULT_JSON_CANNOT_HOLD_PATHS: &str = "Result JSON is off for this route: RouteManager's format cuts each contour whole from one pierce and cannot hold tool-on paths that cut common edges once or parts of contours. Use G-code or the standalone HTML page.";
+/// [`RESULT_JSON_CANNOT_HOLD_PATHS`] in Russian.
+pub const RESULT_JSON_CANNOT_HOLD_PATHS_RU: &str = "JSON результата недоступен для этого маршрута: в формате RouteManager каждый контур вырезается целиком от одной врезки, и пути, режущие общие кромки один раз или части контуров, в нём не записать. Используйте G-код или отдельную HTML-страницу.";
 
 /// What the G-code panel lets the user choose.
 #[derive(Clone, Debug, PartialEq)]
@@ -260,6 +264,9 @@ pub fn save(download: &Download) -> Result<(), String> {
     Ok(())
 }
 
+/// A saved file's name, or why the export failed (in English: the writers' words).
+type ExportOutcome = Result<String, String>;
+
 /// The export menu for the nest and route shown.
 #[component]
 pub fn ExportMenu(
@@ -270,7 +277,8 @@ pub fn ExportMenu(
     toolpath: Signal<Option<Toolpath>>,
     machine: RwSignal<MachineParameters>,
 ) -> impl IntoView {
-    let message = RwSignal::new(None::<String>);
+    let language = use_language();
+    let message = RwSignal::new(None::<ExportOutcome>);
     let run = move |make: Exporter| {
         let Some(nest) = nest.get_untracked() else {
             return;
@@ -281,10 +289,7 @@ pub fn ExportMenu(
             save(&d)?;
             Ok(d.name)
         });
-        message.set(Some(match outcome {
-            Ok(name) => format!("saved {name}"),
-            Err(e) => format!("export failed: {e}"),
-        }));
+        message.set(Some(outcome));
     };
     let no_nest = move || nest.with(Option::is_none);
     let no_route = move || route.with(Option::is_none) && paths.with(Option::is_none);
@@ -318,19 +323,25 @@ pub fn ExportMenu(
                 .collect::<Vec<_>>()
                 .join("\n"),
         ),
-        Err(e) => preview.set(format!("no G-code: {e}")),
+        Err(e) => preview.set(format!(
+            "{}: {e}",
+            language.get_untracked().pick("no G-code", "G-кода нет")
+        )),
     };
     view! {
         <details class="export">
-            <summary>"Export"</summary>
-            <div class="export-buttons" role="group" aria-label="Export">
+            <summary>{tr("Export", "Экспорт")}</summary>
+            <div class="export-buttons" role="group" aria-label=tr("Export", "Экспорт")>
                 <button
                     id="export-result"
                     title=move || {
                         if is_paths() {
-                            RESULT_JSON_CANNOT_HOLD_PATHS
+                            language.pick(RESULT_JSON_CANNOT_HOLD_PATHS, RESULT_JSON_CANNOT_HOLD_PATHS_RU)
                         } else {
-                            "The route in RouteManager's result format (rm-result.json)"
+                            language.pick(
+                                "The route in RouteManager's result format (rm-result.json)",
+                                "Маршрут в формате результата RouteManager (rm-result.json)",
+                            )
                         }
                     }
                     disabled=move || route.with(Option::is_none)
@@ -341,19 +352,19 @@ pub fn ExportMenu(
                         })
                     }
                 >
-                    "Result JSON"
+                    {tr("Result JSON", "JSON результата")}
                 </button>
                 <button
                     id="export-geometry"
-                    title="The nest as geometry JSON (dbs.json)"
+                    title=tr("The nest as geometry JSON (dbs.json)", "Раскрой в JSON геометрии (dbs.json)")
                     disabled=no_nest
                     on:click=move |_| run(&|stem, nest, _| geometry_json(stem, nest))
                 >
-                    "Geometry JSON"
+                    {tr("Geometry JSON", "JSON геометрии")}
                 </button>
                 <button
                     id="export-dbs"
-                    title="The nest as binary DBS"
+                    title=tr("The nest as binary DBS", "Раскрой в двоичном формате DBS")
                     disabled=no_nest
                     on:click=move |_| run(&|stem, nest, _| dbs(stem, nest))
                 >
@@ -361,15 +372,18 @@ pub fn ExportMenu(
                 </button>
                 <button
                     id="export-svg"
-                    title="The drawing as shown (current zoom and layers)"
+                    title=tr("The drawing as shown (current zoom and layers)", "Чертёж как на экране (текущий масштаб и слои)")
                     disabled=no_nest
                     on:click=move |_| run(&|stem, _, _| current_view_svg(stem, "nest-view"))
                 >
-                    "SVG of the view"
+                    {tr("SVG of the view", "SVG вида")}
                 </button>
                 <button
                     id="export-html"
-                    title="A single HTML file that shows and animates the route, no server needed"
+                    title=tr(
+                        "A single HTML file that shows and animates the route, no server needed",
+                        "Один HTML-файл, который показывает и анимирует маршрут, без сервера",
+                    )
                     disabled=no_route
                     on:click=move |_| {
                         run(&|stem, nest, route| {
@@ -381,17 +395,20 @@ pub fn ExportMenu(
                         })
                     }
                 >
-                    "Standalone HTML"
+                    {tr("Standalone HTML", "Отдельная HTML-страница")}
                 </button>
             </div>
             {move || {
                 is_paths()
-                    .then(|| view! { <p id="export-result-note" class="note">{RESULT_JSON_CANNOT_HOLD_PATHS}</p> })
+                    .then(|| view! { <p id="export-result-note" class="note">{tr(RESULT_JSON_CANNOT_HOLD_PATHS, RESULT_JSON_CANNOT_HOLD_PATHS_RU)}</p> })
             }}
             <fieldset class="gcode">
-                <legend>"G-code"</legend>
-                <label title="G90: positions; G91: increments from the previous point">
-                    "Coordinates "
+                <legend>{tr("G-code", "G-код")}</legend>
+                <label title=tr(
+                    "G90: positions; G91: increments from the previous point",
+                    "G90: абсолютные координаты; G91: приращения от предыдущей точки",
+                )>
+                    {tr("Coordinates ", "Координаты ")}
                     <select
                         id="gcode-distance"
                         on:change=move |ev| {
@@ -399,12 +416,12 @@ pub fn ExportMenu(
                             choice.update(|c| c.incremental = incremental);
                         }
                     >
-                        <option value="absolute">"absolute (G90)"</option>
-                        <option value="incremental">"incremental (G91)"</option>
+                        <option value="absolute">{tr("absolute (G90)", "абсолютные (G90)")}</option>
+                        <option value="incremental">{tr("incremental (G91)", "в приращениях (G91)")}</option>
                     </select>
                 </label>
-                <label title="How arcs are written">
-                    "Arcs "
+                <label title=tr("How arcs are written", "Как записываются дуги")>
+                    {tr("Arcs ", "Дуги ")}
                     <select
                         id="gcode-arcs"
                         on:change=move |ev| {
@@ -412,13 +429,13 @@ pub fn ExportMenu(
                             choice.update(|c| c.arcs = arcs);
                         }
                     >
-                        <option value="ij">"G02/G03 with I, J"</option>
-                        <option value="r">"G02/G03 with R"</option>
-                        <option value="lines">"G01 chords only"</option>
+                        <option value="ij">{tr("G02/G03 with I, J", "G02/G03 с I, J")}</option>
+                        <option value="r">{tr("G02/G03 with R", "G02/G03 с R")}</option>
+                        <option value="lines">{tr("G01 chords only", "только хорды G01")}</option>
                     </select>
                 </label>
-                <label title="Line that switches the torch on">
-                    "Torch on "
+                <label title=tr("Line that switches the torch on", "Строка включения резака")>
+                    {tr("Torch on ", "Включение резака ")}
                     <input
                         id="gcode-torch-on"
                         type="text"
@@ -430,8 +447,8 @@ pub fn ExportMenu(
                         }
                     />
                 </label>
-                <label title="Line that switches the torch off">
-                    "Torch off "
+                <label title=tr("Line that switches the torch off", "Строка выключения резака")>
+                    {tr("Torch off ", "Выключение резака ")}
                     <input
                         id="gcode-torch-off"
                         type="text"
@@ -443,8 +460,11 @@ pub fn ExportMenu(
                         }
                     />
                 </label>
-                <label title="Dwell after the torch is switched on (G04), seconds">
-                    "Pierce dwell, s "
+                <label title=tr(
+                    "Dwell after the torch is switched on (G04), seconds",
+                    "Выдержка после включения резака (G04), секунды",
+                )>
+                    {tr("Pierce dwell, s ", "Выдержка на врезку, с ")}
                     <input
                         id="gcode-dwell"
                         type="number"
@@ -461,7 +481,7 @@ pub fn ExportMenu(
                     />
                 </label>
                 <button id="gcode-preview-button" disabled=no_route on:click=move |_| show_preview()>
-                    "Preview"
+                    {tr("Preview", "Просмотр")}
                 </button>
                 <button
                     id="export-gcode"
@@ -472,17 +492,21 @@ pub fn ExportMenu(
                             save(&d)?;
                             Ok(d.name)
                         });
-                        message.set(Some(match outcome {
-                            Ok(name) => format!("saved {name}"),
-                            Err(e) => format!("export failed: {e}"),
-                        }));
+                        message.set(Some(outcome));
                     }
                 >
-                    "G-code"
+                    {tr("G-code", "G-код")}
                 </button>
-                <pre id="gcode-preview" aria-label="First lines of the G-code">{move || preview.get()}</pre>
+                <pre id="gcode-preview" aria-label=tr("First lines of the G-code", "Первые строки G-кода")>{move || preview.get()}</pre>
             </fieldset>
-            <p id="export-status" class="muted" aria-live="polite">{move || message.get()}</p>
+            <p id="export-status" class="muted" aria-live="polite">
+                {move || message.get().map(|outcome| match (outcome, language.get()) {
+                    (Ok(name), Lang::En) => format!("saved {name}"),
+                    (Ok(name), Lang::Ru) => format!("сохранено: {name}"),
+                    (Err(e), Lang::En) => format!("export failed: {e}"),
+                    (Err(e), Lang::Ru) => format!("экспорт не удался: {e}"),
+                })}
+            </p>
         </details>
     }
 }

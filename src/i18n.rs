@@ -64,17 +64,21 @@ impl Lang {
 pub struct Language(RwSignal<Lang>);
 
 impl Language {
-    /// The language at start; keeps `<html lang>` in step with the choice.
+    /// The language at start; keeps `<html lang>` and the page title in step with the choice.
     pub fn new() -> Self {
         let language = Language(RwSignal::new(Lang::initial()));
         Effect::new(move |_| {
             let lang = language.get();
-            if let Some(root) = web_sys::window()
-                .and_then(|w| w.document())
-                .and_then(|d| d.document_element())
-            {
+            let Some(document) = web_sys::window().and_then(|w| w.document()) else {
+                return;
+            };
+            if let Some(root) = document.document_element() {
                 let _ = root.set_attribute("lang", lang.code());
             }
+            document.set_title(lang.pick(
+                "cutroute — tool paths for CNC sheet cutting",
+                "cutroute — маршруты резки листа на станках с ЧПУ",
+            ));
         });
         language
     }
@@ -82,6 +86,11 @@ impl Language {
     /// The current language (tracked).
     pub fn get(self) -> Lang {
         self.0.get()
+    }
+
+    /// The current language, not tracked (event handlers).
+    pub fn get_untracked(self) -> Lang {
+        self.0.get_untracked()
     }
 
     /// Switch and remember the choice.

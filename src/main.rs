@@ -14,6 +14,7 @@ mod settings;
 mod stats;
 mod theme;
 mod thermal;
+mod words;
 mod worker_client;
 
 fn main() {

@@ -70,20 +70,21 @@ impl Layer {
     }
 
     /// What the layer panel shows.
-    pub fn label(self) -> &'static str {
-        match self {
-            Layer::Hatch => "Hatched parts",
-            Layer::Arrows => "Contour direction",
-            Layer::Candidates => "Candidate pierce points",
-            Layer::Pierces => "Pierce points",
-            Layer::Cuts => "Cut moves",
-            Layer::Idle => "Idle moves",
-            Layer::Order => "Cutting order",
-            Layer::Ends => "Start and finish",
-            Layer::Certificates => "Optimality certificates",
-            Layer::Heat => "Heat map",
-            Layer::Violations => "Rule violations",
-        }
+    pub fn label(self, lang: crate::i18n::Lang) -> &'static str {
+        let (en, ru) = match self {
+            Layer::Hatch => ("Hatched parts", "Штриховка деталей"),
+            Layer::Arrows => ("Contour direction", "Направление обхода контуров"),
+            Layer::Candidates => ("Candidate pierce points", "Точки врезки-кандидаты"),
+            Layer::Pierces => ("Pierce points", "Точки врезки"),
+            Layer::Cuts => ("Cut moves", "Рабочий ход (резка)"),
+            Layer::Idle => ("Idle moves", "Холостой ход"),
+            Layer::Order => ("Cutting order", "Порядок резки"),
+            Layer::Ends => ("Start and finish", "Старт и финиш"),
+            Layer::Certificates => ("Optimality certificates", "Сертификаты оптимальности"),
+            Layer::Heat => ("Heat map", "Тепловая карта"),
+            Layer::Violations => ("Rule violations", "Нарушения правил"),
+        };
+        lang.pick(en, ru)
     }
 }
 
@@ -140,7 +141,7 @@ impl Settings {
             let (key, value) = pair.split_once('=').unwrap_or((pair, ""));
             let value = js_decode(value);
             match key {
-                "sample" if crate::app::SAMPLES.iter().any(|(f, _)| *f == value) => {
+                "sample" if crate::app::SAMPLES.iter().any(|(f, ..)| *f == value) => {
                     self.sample = value;
                     self.last_file = None;
                 }

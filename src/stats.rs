@@ -6,11 +6,14 @@ use cutroute_geometry::{MachineParameters, Nest, PathRoute, Route};
 use cutroute_protocol::RouteSummary;
 use leptos::prelude::*;
 
-/// One editable machine parameter: (id, label, unit, getter, setter).
+use crate::i18n::{tr, use_language, Lang};
+
+/// One editable machine parameter: (id, (label, Russian label), (unit, Russian unit), getter,
+/// setter).
 type Field = (
     &'static str,
-    &'static str,
-    &'static str,
+    (&'static str, &'static str),
+    (&'static str, &'static str),
     fn(&MachineParameters) -> f64,
     fn(&mut MachineParameters, f64),
 );
@@ -18,43 +21,43 @@ type Field = (
 const FIELDS: [Field; 6] = [
     (
         "idle-speed",
-        "Idle speed",
-        "mm/s",
+        ("Idle speed", "Скорость холостого хода"),
+        ("mm/s", "мм/с"),
         |m| m.idle_speed,
         |m, v| m.idle_speed = v,
     ),
     (
         "cut-speed",
-        "Cut speed",
-        "mm/s",
+        ("Cut speed", "Скорость резки"),
+        ("mm/s", "мм/с"),
         |m| m.cut_speed,
         |m, v| m.cut_speed = v,
     ),
     (
         "pierce-time",
-        "Pierce time",
-        "s",
+        ("Pierce time", "Время врезки"),
+        ("s", "с"),
         |m| m.pierce_time,
         |m, v| m.pierce_time = v,
     ),
     (
         "idle-price",
-        "Idle price",
-        "per m",
+        ("Idle price", "Цена холостого хода"),
+        ("per m", "за м"),
         |m| m.idle_price_per_metre,
         |m, v| m.idle_price_per_metre = v,
     ),
     (
         "cut-price",
-        "Cut price",
-        "per m",
+        ("Cut price", "Цена резки"),
+        ("per m", "за м"),
         |m| m.cut_price_per_metre,
         |m, v| m.cut_price_per_metre = v,
     ),
     (
         "pierce-price",
-        "Pierce price",
-        "each",
+        ("Pierce price", "Цена врезки"),
+        ("each", "за врезку"),
         |m| m.pierce_price,
         |m, v| m.pierce_price = v,
     ),
@@ -108,33 +111,41 @@ pub fn StatsPanel(
     let cell = move |pick: fn(Figures) -> String| {
         move || figures().map(pick).unwrap_or_else(|| "—".into())
     };
+    let language = use_language();
+    let mm = move |pick: fn(Figures) -> f64| {
+        move || {
+            figures()
+                .map(|f| format!("{:.1} {}", pick(f), language.pick("mm", "мм")))
+                .unwrap_or_else(|| "—".into())
+        }
+    };
     view! {
         <dl class="route-stats">
-            <dt>"Idle length"</dt>
+            <dt>{tr("Idle length", "Длина холостого хода")}</dt>
             // The shown figures are rounded; `data-mm` keeps 0.001 mm for checks by tools.
             <dd id="idle-length" data-mm=cell(|f| format!("{:.3}", f.0))>
-                {cell(|f| format!("{:.1} mm", f.0))}
+                {mm(|f| f.0)}
             </dd>
-            <dt>"Cut length"</dt>
+            <dt>{tr("Cut length", "Длина резки")}</dt>
             <dd id="cut-length" data-mm=cell(|f| format!("{:.3}", f.1))>
-                {cell(|f| format!("{:.1} mm", f.1))}
+                {mm(|f| f.1)}
             </dd>
-            <dt>"Pierces"</dt>
+            <dt>{tr("Pierces", "Врезки")}</dt>
             <dd id="pierces">{cell(|f| f.2.to_string())}</dd>
-            <dt>"Machine time"</dt>
+            <dt>{tr("Machine time", "Время работы станка")}</dt>
             // `data-s` / `data-value` keep the unrounded figures for checks by tools.
             <dd id="machine-time" data-s=cell(|f| format!("{:.3}", f.3))>{cell(|f| format_duration(f.3))}</dd>
-            <dt>"Cost"</dt>
+            <dt>{tr("Cost", "Стоимость")}</dt>
             <dd id="route-cost" data-value=cell(|f| format!("{:.3}", f.4))>{cell(|f| format!("{:.2}", f.4))}</dd>
         </dl>
         <details class="machine">
-            <summary>"Machine parameters"</summary>
+            <summary>{tr("Machine parameters", "Параметры станка")}</summary>
             {FIELDS
                 .into_iter()
                 .map(|(id, label, unit, get, set)| {
                     view! {
                         <label class="param">
-                            <span>{label}</span>
+                            <span>{tr(label.0, label.1)}</span>
                             <input
                                 id=id
                                 type="number"
@@ -149,7 +160,7 @@ pub fn StatsPanel(
                                     }
                                 }
                             />
-                            <span class="unit">{unit}</span>
+                            <span class="unit">{tr(unit.0, unit.1)}</span>
                         </label>
                     }
                 })
@@ -162,22 +173,24 @@ pub fn StatsPanel(
 /// them), the one it returned marked; nothing when the solver weighed none.
 #[component]
 pub fn AlternativesTable(alternatives: Signal<Vec<RouteSummary>>) -> impl IntoView {
+    let language = use_language();
     move || {
+        let lang = language.get();
         let rows = alternatives.get();
         (!rows.is_empty()).then(|| {
             view! {
                 // Scrolls sideways in the narrow panel rather than clipping columns.
                 <div class="table-scroll">
-                <table id="alternatives" aria-label="Candidates the solver weighed">
-                    <caption>"Candidates weighed"</caption>
+                <table id="alternatives" aria-label=lang.pick("Candidates the solver weighed", "Варианты, рассмотренные решателем")>
+                    <caption>{lang.pick("Candidates weighed", "Рассмотренные варианты")}</caption>
                     <thead>
                         <tr>
-                            <th scope="col">"Route"</th>
-                            <th scope="col" title="Pierces">"Pierc."</th>
-                            <th scope="col" title="Idle length, mm">"Idle"</th>
-                            <th scope="col" title="Cut length, mm">"Cut"</th>
-                            <th scope="col" title="Machine time, s">"Time"</th>
-                            <th scope="col">"Cost"</th>
+                            <th scope="col">{lang.pick("Route", "Маршрут")}</th>
+                            <th scope="col" title=lang.pick("Pierces", "Врезки")>{lang.pick("Pierc.", "Врез.")}</th>
+                            <th scope="col" title=lang.pick("Idle length, mm", "Длина холостого хода, мм")>{lang.pick("Idle", "Хол.")}</th>
+                            <th scope="col" title=lang.pick("Cut length, mm", "Длина резки, мм")>{lang.pick("Cut", "Рез")}</th>
+                            <th scope="col" title=lang.pick("Machine time, s", "Время работы станка, с")>{lang.pick("Time", "Время")}</th>
+                            <th scope="col">{lang.pick("Cost", "Стоим.")}</th>
                         </tr>
                     </thead>
                     <tbody>
@@ -186,13 +199,13 @@ pub fn AlternativesTable(alternatives: Signal<Vec<RouteSummary>>) -> impl IntoVi
                             .map(|r| {
                                 let class = if r.chosen { "alternative chosen" } else { "alternative" };
                                 let mark = r.chosen.then_some("✓ ");
-                                let said = r.chosen.then(|| view! { <span class="visually-hidden">" (chosen)"</span> });
-                                let name = view! { {mark} {r.name.clone()} {said} };
+                                let said = r.chosen.then(|| view! { <span class="visually-hidden">{lang.pick(" (chosen)", " (выбран)")}</span> });
+                                let name = view! { {mark} {candidate_name(&r.name, lang)} {said} };
                                 match r.failure {
                                     Some(why) => view! {
                                         <tr class=class data-name=r.name.clone() data-chosen=r.chosen.to_string()>
                                             <td>{name}</td>
-                                            <td colspan="5" class="failure">{format!("no route: {why}")}</td>
+                                            <td colspan="5" class="failure">{format!("{}: {why}", lang.pick("no route", "нет маршрута"))}</td>
                                         </tr>
                                     }
                                     .into_any(),
@@ -215,6 +228,16 @@ pub fn AlternativesTable(alternatives: Signal<Vec<RouteSummary>>) -> impl IntoVi
                 </div>
             }
         })
+    }
+}
+
+/// A candidate's name (a segment ensemble, or `ccp`, a solver id) in the page's language.
+fn candidate_name(name: &str, lang: Lang) -> String {
+    match (lang, name) {
+        (Lang::Ru, "standard") => "стандартный".into(),
+        (Lang::Ru, "chains") => "цепочки".into(),
+        (Lang::Ru, "junctions") => "стыки".into(),
+        _ => name.to_string(),
     }
 }
 

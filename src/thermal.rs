@@ -14,6 +14,7 @@ use leptos::prelude::*;
 
 use crate::animation::Animation;
 use crate::drawing::{contour_path, heat_frame, nest_bounds};
+use crate::i18n::{tr, use_language, Lang};
 use crate::settings::Layer;
 
 /// Cells of the heat map along the drawing's longer side: fine enough to show each source's
@@ -66,16 +67,18 @@ impl ThermalView {
 /// The material's heat model and the shop rules, beside the machine parameters.
 #[component]
 pub fn ThermalPanel(settings: RwSignal<ThermalSettings>) -> impl IntoView {
+    // Labels, units and tips as (English, Russian).
+    type Words = (&'static str, &'static str);
     let number = move |id: &'static str,
-                       label: &'static str,
-                       unit: &'static str,
-                       tip: &'static str,
+                       label: Words,
+                       unit: Words,
+                       tip: Words,
                        get: fn(&ThermalSettings) -> f64,
                        set: fn(&mut ThermalSettings, f64),
                        min_exclusive: bool| {
         view! {
-            <label class="param" title=tip>
-                <span>{label}</span>
+            <label class="param" title=tr(tip.0, tip.1)>
+                <span>{tr(label.0, label.1)}</span>
                 <input
                     id=id
                     type="number"
@@ -90,17 +93,17 @@ pub fn ThermalPanel(settings: RwSignal<ThermalSettings>) -> impl IntoView {
                         }
                     }
                 />
-                <span class="unit">{unit}</span>
+                <span class="unit">{tr(unit.0, unit.1)}</span>
             </label>
         }
     };
     let rule = move |id: &'static str,
-                     label: &'static str,
-                     tip: &'static str,
+                     label: Words,
+                     tip: Words,
                      get: fn(&ThermalSettings) -> bool,
                      set: fn(&mut ThermalSettings, bool)| {
         view! {
-            <label class="rule" title=tip>
+            <label class="rule" title=tr(tip.0, tip.1)>
                 <input
                     id=id
                     type="checkbox"
@@ -110,20 +113,20 @@ pub fn ThermalPanel(settings: RwSignal<ThermalSettings>) -> impl IntoView {
                         settings.update(|s| set(s, on));
                     }
                 />
-                {label}
+                {tr(label.0, label.1)}
             </label>
         }
     };
     view! {
         <details class="machine thermal">
-            <summary>"Heat and shop rules"</summary>
-            {number("thermal-sigma", "Heat radius σ", "mm", "Heat-affected radius of one pierce (material)", |s| s.sigma_mm, |s, v| s.sigma_mm = v, true)}
-            {number("thermal-tau", "Cooling time τ", "s", "Time for the sheet to cool by a factor e (material)", |s| s.tau_s, |s, v| s.tau_s = v, true)}
-            {number("thermal-weight", "Heat weight", "per H", "Objective units (s or cost) per unit of H that nearest, ccp and chain add to their objective; 0: ignore heat", |s| s.weight, |s, v| s.weight = v, false)}
-            {rule("rule-part", "Part rigidity", "Pierce each part next to the free edge (sheet border or parts cut before)", |s| s.rules.part, |s, v| s.rules.part = v)}
-            {rule("rule-sheet", "Sheet rigidity", "Long parts at a narrow border first; start on the side of the large scrap's opposite, else of the most heat", |s| s.rules.sheet, |s, v| s.rules.sheet = v)}
-            {rule("rule-islands", "No islands", "Never leave uncut parts held by less than a 20 mm strip", |s| s.rules.islands, |s, v| s.rules.islands = v)}
-            {rule("rules-hard", "Enforce (hard)", "Repair the final route until the checked rules hold (nearest, ccp, heuristic, exact, chain)", |s| s.hard, |s, v| s.hard = v)}
+            <summary>{tr("Heat and shop rules", "Нагрев и технологические правила")}</summary>
+            {number("thermal-sigma", ("Heat radius σ", "Радиус нагрева σ"), ("mm", "мм"), ("Heat-affected radius of one pierce (material)", "Радиус зоны нагрева одной врезки (материал)"), |s| s.sigma_mm, |s, v| s.sigma_mm = v, true)}
+            {number("thermal-tau", ("Cooling time τ", "Время остывания τ"), ("s", "с"), ("Time for the sheet to cool by a factor e (material)", "Время, за которое лист остывает в e раз (материал)"), |s| s.tau_s, |s, v| s.tau_s = v, true)}
+            {number("thermal-weight", ("Heat weight", "Вес нагрева"), ("per H", "на ед. H"), ("Objective units (s or cost) per unit of H that nearest, ccp and chain add to their objective; 0: ignore heat", "Единицы критерия (с или стоимость) на единицу H, которые nearest, ccp и chain добавляют к критерию; 0 — нагрев не учитывается"), |s| s.weight, |s, v| s.weight = v, false)}
+            {rule("rule-part", ("Part rigidity", "Жёсткость детали"), ("Pierce each part next to the free edge (sheet border or parts cut before)", "Врезка в каждую деталь у свободного края (кромка листа или уже вырезанные детали)"), |s| s.rules.part, |s, v| s.rules.part = v)}
+            {rule("rule-sheet", ("Sheet rigidity", "Жёсткость листа"), ("Long parts at a narrow border first; start on the side of the large scrap's opposite, else of the most heat", "Длинные детали у узкой кромки — первыми; начинать со стороны, противоположной крупному отходу, иначе — со стороны наибольшего нагрева"), |s| s.rules.sheet, |s, v| s.rules.sheet = v)}
+            {rule("rule-islands", ("No islands", "Без островов"), ("Never leave uncut parts held by less than a 20 mm strip", "Не оставлять невырезанные детали на перемычке уже 20 мм"), |s| s.rules.islands, |s, v| s.rules.islands = v)}
+            {rule("rules-hard", ("Enforce (hard)", "Соблюдать строго"), ("Repair the final route until the checked rules hold (nearest, ccp, heuristic, exact, chain)", "Исправлять итоговый маршрут, пока проверяемые правила не выполнены (nearest, ccp, heuristic, exact, chain)"), |s| s.hard, |s, v| s.hard = v)}
         </details>
     }
 }
@@ -147,26 +150,53 @@ fn violation_place(v: &Violation) -> (usize, cutroute_geometry::ContourRef) {
     }
 }
 
-fn violation_text(v: &Violation) -> String {
-    match v {
-        Violation::PartRigidity { excess_mm, .. } => {
+fn violation_text(v: &Violation, lang: Lang) -> String {
+    match (v, lang) {
+        (Violation::PartRigidity { excess_mm, .. }, Lang::En) => {
             format!("pierced {excess_mm:.1} mm farther from the free edge than allowed")
         }
-        Violation::LongPartLate { .. } => "long part at a narrow border cut late".into(),
-        Violation::WrongStartSide { required, rule, .. } => format!(
+        (Violation::PartRigidity { excess_mm, .. }, Lang::Ru) => {
+            format!("врезка на {excess_mm:.1} мм дальше от свободного края, чем допустимо")
+        }
+        (Violation::LongPartLate { .. }, Lang::En) => {
+            "long part at a narrow border cut late".into()
+        }
+        (Violation::LongPartLate { .. }, Lang::Ru) => {
+            "длинная деталь у узкой кромки вырезана поздно".into()
+        }
+        (Violation::WrongStartSide { required, rule, .. }, Lang::En) => format!(
             "start on the wrong side (rule {rule}: the {} side)",
             match required {
                 cutroute_thermal::Side::Low => "low",
                 cutroute_thermal::Side::High => "high",
             }
         ),
-        Violation::Island { .. } => "left as an island by this cut".into(),
+        (Violation::WrongStartSide { required, rule, .. }, Lang::Ru) => format!(
+            "начало не с той стороны (правило {rule}: со стороны {})",
+            match required {
+                cutroute_thermal::Side::Low => "меньших координат",
+                cutroute_thermal::Side::High => "больших координат",
+            }
+        ),
+        (Violation::Island { .. }, Lang::En) => "left as an island by this cut".into(),
+        (Violation::Island { .. }, Lang::Ru) => "после этого реза остаётся островом".into(),
+    }
+}
+
+/// A rule group's name (`part`, `sheet`, `islands`) in the page's language.
+fn kind_word(kind: &'static str, lang: Lang) -> &'static str {
+    match (lang, kind) {
+        (Lang::Ru, "part") => "деталь",
+        (Lang::Ru, "sheet") => "лист",
+        (Lang::Ru, "islands") => "острова",
+        _ => kind,
     }
 }
 
 /// H and the rule violations of the job's route.
 #[component]
 pub fn ThermalStats(progress: RwSignal<Option<Progress>>) -> impl IntoView {
+    let language = use_language();
     let heat = move || progress.with(|p| p.as_ref().and_then(|p| p.heat));
     let counts = move || progress.with(|p| p.as_ref().and_then(|p| p.rule_counts));
     let count = move |pick: fn(&cutroute_protocol::RuleCounts) -> Option<usize>| {
@@ -179,12 +209,15 @@ pub fn ThermalStats(progress: RwSignal<Option<Progress>>) -> impl IntoView {
     };
     view! {
         <dl class="thermal-stats">
-            <dt title="Thermal load: Σ over pairs of pierces of exp(−d²/2σ²)·exp(−Δt/τ) on the machine clock">"Heat H"</dt>
+            <dt title=tr(
+                "Thermal load: Σ over pairs of pierces of exp(−d²/2σ²)·exp(−Δt/τ) on the machine clock",
+                "Тепловая нагрузка: Σ по парам врезок exp(−d²/2σ²)·exp(−Δt/τ) по часам станка",
+            )>{tr("Heat H", "Нагрев H")}</dt>
             // `data-value` keeps the unrounded H for checks by tools.
             <dd id="heat" data-value=move || heat().map(|h| format!("{h:e}")).unwrap_or_default()>
                 {move || heat().map(|h| format!("{h:.4}")).unwrap_or_else(|| "—".into())}
             </dd>
-            <dt>"Rule violations"</dt>
+            <dt>{tr("Rule violations", "Нарушения правил")}</dt>
             <dd
                 id="rule-counts"
                 data-part=count(|c| c.part)
@@ -192,16 +225,16 @@ pub fn ThermalStats(progress: RwSignal<Option<Progress>>) -> impl IntoView {
                 data-islands=count(|c| c.islands)
             >
                 {move || match counts() {
-                    None => "— (no rule checked)".to_string(),
+                    None => language.pick("— (no rule checked)", "— (правила не проверялись)").to_string(),
                     Some(c) => [("part", c.part), ("sheet", c.sheet), ("islands", c.islands)]
                         .into_iter()
-                        .filter_map(|(name, n)| n.map(|n| format!("{name} {n}")))
+                        .filter_map(|(name, n)| n.map(|n| format!("{} {n}", kind_word(name, language.get()))))
                         .collect::<Vec<_>>()
                         .join(" · "),
                 }}
             </dd>
         </dl>
-        <ol id="violations" class="violations" aria-label="Rule violations">
+        <ol id="violations" class="violations" aria-label=tr("Rule violations", "Нарушения правил")>
             {move || {
                 progress.with(|p| {
                     p.as_ref()
@@ -219,13 +252,23 @@ pub fn ThermalStats(progress: RwSignal<Option<Progress>>) -> impl IntoView {
                                             data-part=contour.part
                                             data-contour=contour.contour
                                         >
-                                            {format!(
-                                                "{kind}: cut {}, part {} contour {} — {}",
-                                                step + 1,
-                                                contour.part + 1,
-                                                contour.contour,
-                                                violation_text(v)
-                                            )}
+                                            {match language.get() {
+                                                Lang::En => format!(
+                                                    "{kind}: cut {}, part {} contour {} — {}",
+                                                    step + 1,
+                                                    contour.part + 1,
+                                                    contour.contour,
+                                                    violation_text(v, Lang::En)
+                                                ),
+                                                Lang::Ru => format!(
+                                                    "{}: рез {}, деталь {} контур {} — {}",
+                                                    kind_word(kind, Lang::Ru),
+                                                    step + 1,
+                                                    contour.part + 1,
+                                                    contour.contour,
+                                                    violation_text(v, Lang::Ru)
+                                                ),
+                                            }}
                                         </li>
                                     }
                                 })
@@ -294,7 +337,9 @@ pub fn ViolationMarks(
     route: Signal<Option<Route>>,
     extent: Memo<f64>,
 ) -> impl IntoView {
+    let language = use_language();
     move || {
+        let lang = language.get();
         let violations = thermal.violations.get();
         if violations.is_empty() {
             return None;
@@ -309,7 +354,17 @@ pub fn ViolationMarks(
                     .filter_map(|v| {
                         let (step, contour) = violation_place(v);
                         let kind = violation_kind(v);
-                        let title = format!("{kind}: cut {} — {}", step + 1, violation_text(v));
+                        let title = match lang {
+                            Lang::En => {
+                                format!("{kind}: cut {} — {}", step + 1, violation_text(v, lang))
+                            }
+                            Lang::Ru => format!(
+                                "{}: рез {} — {}",
+                                kind_word(kind, lang),
+                                step + 1,
+                                violation_text(v, lang)
+                            ),
+                        };
                         if let Violation::PartRigidity { .. } = v {
                             let p = route.steps.get(step)?.pierce_point;
                             Some(

@@ -56,11 +56,48 @@ enum WireFromWorker {
 /// The one handler id this page uses on each worker.
 const HANDLER: usize = 0;
 
+/// Why a worker was given up.
+#[derive(Clone, Debug, PartialEq)]
+pub enum DeathReason {
+    /// It sent a message the page cannot read (the decoder's words).
+    Unreadable(String),
+    /// It did not answer for this many seconds.
+    Silent(u64),
+    /// Its error event's message (the browser's or the wasm's words).
+    Error(String),
+    /// A message could not be read (`messageerror`).
+    MessageError,
+    /// An error event without a message: it could not start or failed.
+    Failed,
+}
+
+impl DeathReason {
+    /// The reason in the page's language (messages from the browser stay as they are).
+    pub fn text(&self, lang: crate::i18n::Lang) -> String {
+        use crate::i18n::Lang;
+        match (self, lang) {
+            (DeathReason::Unreadable(e), Lang::En) => {
+                format!("it sent a message the page cannot read ({e})")
+            }
+            (DeathReason::Unreadable(e), Lang::Ru) => {
+                format!("он прислал сообщение, которое страница не может прочитать ({e})")
+            }
+            (DeathReason::Silent(s), Lang::En) => format!("it did not answer for {s} s"),
+            (DeathReason::Silent(s), Lang::Ru) => format!("он не отвечал {s} с"),
+            (DeathReason::Error(message), _) => message.clone(),
+            (DeathReason::MessageError, Lang::En) => "a message could not be read".into(),
+            (DeathReason::MessageError, Lang::Ru) => "сообщение не удалось прочитать".into(),
+            (DeathReason::Failed, Lang::En) => "it could not start or failed".into(),
+            (DeathReason::Failed, Lang::Ru) => "он не запустился или завершился с ошибкой".into(),
+        }
+    }
+}
+
 /// What was lost when a worker died.
 #[derive(Clone, Debug)]
 pub struct WorkerDeath {
-    /// What happened, in words (the worker's error message, or the silence).
-    pub reason: String,
+    /// What happened (the worker's error message, or the silence).
+    pub reason: DeathReason,
     /// Names of the files of opens that had not been answered.
     pub opening: Vec<String>,
     /// Jobs that were running.
@@ -143,7 +180,7 @@ impl Shared {
                     (self.on_message)(*message);
                 }
             }
-            Err(error) => self.die(format!("it sent a message the page cannot read ({error})")),
+            Err(error) => self.die(DeathReason::Unreadable(error.to_string())),
         }
     }
 
@@ -167,7 +204,7 @@ impl Shared {
     /// Terminates the worker and reports what it was doing, once. The report comes from a
     /// fresh task: the page replaces (drops) this worker in it, which must not happen inside
     /// one of the worker's own event handlers.
-    fn die(&self, reason: String) {
+    fn die(&self, reason: DeathReason) {
         if self.dead.replace(true) {
             return;
         }
@@ -189,10 +226,7 @@ impl Shared {
         }
         let silent_ms = now_ms() - self.last_heard_ms.get();
         if silent_ms > SILENCE_LIMIT.as_secs_f64() * 1000.0 {
-            self.die(format!(
-                "it did not answer for {} s",
-                SILENCE_LIMIT.as_secs()
-            ));
+            self.die(DeathReason::Silent(SILENCE_LIMIT.as_secs()));
         }
     }
 }
@@ -275,9 +309,9 @@ pub fn spawn(
             .and_then(|m| m.as_string())
             .filter(|m| !m.is_empty());
         let reason = match message {
-            Some(message) => message,
-            None if event.type_() == "messageerror" => "a message could not be read".to_string(),
-            None => "it could not start or failed".to_string(),
+            Some(message) => DeathReason::Error(message),
+            None if event.type_() == "messageerror" => DeathReason::MessageError,
+            None => DeathReason::Failed,
         };
         shared.die(reason);
     });

@@ -40,13 +40,18 @@ export async function startServer() {
   return { server, baseUrl: `http://127.0.0.1:${port}${SUB_PATH}` };
 }
 
-/** The Debian Chromium, headless, with the flags this closed network needs. */
-export async function launchBrowser() {
+/**
+ * The Debian Chromium, headless, with the flags this closed network needs. The browser's
+ * language is English unless `lang` says otherwise: the page follows the browser's language
+ * (src/i18n.rs) and the tests assert English texts, whatever the machine's locale.
+ */
+export async function launchBrowser({ lang = 'en-US' } = {}) {
   return chromium.launch({
     executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium',
     headless: true,
     args: ['--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
-      '--disable-background-networking', '--disable-component-update', '--disable-sync'],
+      '--disable-background-networking', '--disable-component-update', '--disable-sync',
+      `--lang=${lang}`, `--accept-lang=${lang}`],
   });
 }
 

@@ -65,18 +65,30 @@ const truncatedDbs = () => {
   return file;
 };
 const REFUSED = [
-  ['truncated result JSON', () => hostile('result_json_truncated_no_location.result.json'), /\(JSON\): line 1 column 5693: /],
-  ['result JSON with NaN', () => hostile('result_json_nan_no_location.result.json'), /\(JSON\): line 1 column 116: /],
-  ['truncated DBS', truncatedDbs, /\(DBS binary\): DBS truncated at byte 696: /],
-  ['DXF whose only entity is rejected', () => hostile('dxf_only_entity_rejected_nothing_drawn.dxf'), /\(DXF\): .*line 5: closed chain/],
-  ['DXF arc of radius 0', () => hostile('dxf_zero_radius_arc_nothing_drawn.dxf'), /\(DXF\): .*line 5: ARC with radius 0/],
-  ['T-FLEX missing its last byte', () => hostile('tflex_truncated_location_1_1.tfnesting'), /\(T-FLEX nesting\): 349:10: /],
-  ['coordinates of 1e308', () => hostile('huge_coords_null_lengths.dbs.json'), /\(geometry JSON\): JSON contour at \[1\]\.paths\[0\]: contour vertex 0: coordinate 1e308/],
-  ['a bulge of 1e300', () => hostile('huge_bulge_gcode_8000km_arcs.dbs.json'), /\(geometry JSON\): JSON contour at \[1\]\.paths\[0\]: contour vertex 0: bulge 1e300/],
-  ['a part at 1e200', () => hostile('panic_ccp_far_part_1e200.dbs.json'), /JSON contour at \[2\]\.paths\[0\]: contour vertex 0: coordinate 1e200/],
-  ['a zero-size contour', () => hostile('zero_size_contour_accepted.dbs.json'), /JSON contour at \[1\]\.paths\[0\]: contour spans 0e0 mm/],
-  ['a 1e-6 mm contour', () => hostile('path_solvers_drop_tiny_contour.dbs.json'), /JSON contour at \[1\]\.paths\[0\]: contour spans 9\.99/],
-  ['PCGTSP weights near f64::MAX', () => hostile('pcgtsp_weights_1e308_bad_tour.pcglns'), /\(PCGTSP instance\): line 8: /],
+  ['truncated result JSON', () => hostile('result_json_truncated_no_location.result.json'), /\(JSON\): line 1 column 5693: /,
+    /\(JSON\): ошибка в JSON: строка 1, столбец 5693: /],
+  ['result JSON with NaN', () => hostile('result_json_nan_no_location.result.json'), /\(JSON\): line 1 column 116: /,
+    /\(JSON\): ошибка в JSON: строка 1, столбец 116: /],
+  ['truncated DBS', truncatedDbs, /\(DBS binary\): DBS truncated at byte 696: /,
+    /\(DBS, двоичный\): файл не читается: байт 696: DBS truncated/],
+  ['DXF whose only entity is rejected', () => hostile('dxf_only_entity_rejected_nothing_drawn.dxf'), /\(DXF\): .*line 5: closed chain/,
+    /\(DXF\): файл не читается: .*line 5: closed chain/],
+  ['DXF arc of radius 0', () => hostile('dxf_zero_radius_arc_nothing_drawn.dxf'), /\(DXF\): .*line 5: ARC with radius 0/,
+    /\(DXF\): файл не читается: .*line 5: ARC with radius 0/],
+  ['T-FLEX missing its last byte', () => hostile('tflex_truncated_location_1_1.tfnesting'), /\(T-FLEX nesting\): 349:10: /,
+    /\(раскрой T-FLEX\): файл не читается: строка 349, столбец 10: /],
+  ['coordinates of 1e308', () => hostile('huge_coords_null_lengths.dbs.json'), /\(geometry JSON\): JSON contour at \[1\]\.paths\[0\]: contour vertex 0: coordinate 1e308/,
+    /\(JSON геометрии\): файл не читается: элемент JSON \[1\]\.paths\[0\]: /],
+  ['a bulge of 1e300', () => hostile('huge_bulge_gcode_8000km_arcs.dbs.json'), /\(geometry JSON\): JSON contour at \[1\]\.paths\[0\]: contour vertex 0: bulge 1e300/,
+    /\(JSON геометрии\): файл не читается: элемент JSON \[1\]\.paths\[0\]: /],
+  ['a part at 1e200', () => hostile('panic_ccp_far_part_1e200.dbs.json'), /JSON contour at \[2\]\.paths\[0\]: contour vertex 0: coordinate 1e200/,
+    /файл не читается: элемент JSON \[2\]\.paths\[0\]: /],
+  ['a zero-size contour', () => hostile('zero_size_contour_accepted.dbs.json'), /JSON contour at \[1\]\.paths\[0\]: contour spans 0e0 mm/,
+    /файл не читается: элемент JSON \[1\]\.paths\[0\]: /],
+  ['a 1e-6 mm contour', () => hostile('path_solvers_drop_tiny_contour.dbs.json'), /JSON contour at \[1\]\.paths\[0\]: contour spans 9\.99/,
+    /файл не читается: элемент JSON \[1\]\.paths\[0\]: /],
+  ['PCGTSP weights near f64::MAX', () => hostile('pcgtsp_weights_1e308_bad_tour.pcglns'), /\(PCGTSP instance\): line 8: /,
+    /\(задача PCGTSP\): файл не читается: строка 8: /],
 ];
 
 test('every hostile file gets the CLI\'s located error; the open document stays, and a normal file still solves', async () => {
@@ -86,7 +98,7 @@ test('every hostile file gets the CLI\'s located error; the open document stays,
   const parts = await page.locator('#nest-view path.part').count();
   // One drawn path per part of nested.dbs (the CLI counts its sheet as a part).
   assert.equal(parts, cli('inspect', nest('dbs/nested.dbs'), '--json').parts - 1);
-  for (const [what, make, location] of REFUSED) {
+  for (const [what, make, location, russian] of REFUSED) {
     const file = make();
     const oracle = cliError(file, 'inspect', file);
     assert.equal(oracle.status, 1, `${what}: the CLI refuses it`);
@@ -97,6 +109,13 @@ test('every hostile file gets the CLI\'s located error; the open document stays,
     assert.equal(await alertText(page), oracle.message, `${what}: the page shows the CLI's error`);
     assert.match(await page.textContent('#file-name'), /^nested\.dbs \(DBS binary\)$/, `${what}: the document stays open`);
     assert.equal(await page.locator('#nest-view path.part').count(), parts, `${what}: the drawing stays`);
+    // The same error in Russian: the kind and the location worded by the page, with the file's
+    // name; back in English it is the CLI's text again.
+    await page.selectOption('#language', 'ru');
+    assert.match(await alertText(page), russian, `${what}: the Russian error holds the location`);
+    assert.ok((await alertText(page)).startsWith(path.basename(file)), `${what}: the Russian error names the file`);
+    await page.selectOption('#language', 'en');
+    assert.equal(await alertText(page), oracle.message, `${what}: English again`);
   }
   // The page is still usable: a sample opens and solves.
   await page.selectOption('#sample', 'test1.dbs.json');

@@ -1338,7 +1338,7 @@ fn solve_path(
         "route": serde_json::to_value(route).map_err(|e| e.to_string())?,
         "ub": progress.upper_bound,
         "lb": progress.lower_bound,
-        "phase": progress.phase,
+        "phase": progress.phase.to_string(),
         "elapsed_s": started.elapsed().as_secs_f64(),
         "stopped": stopped,
     });

@@ -150,7 +150,7 @@ mod tests {
         let progress = Progress {
             upper_bound: Some(200.0),
             lower_bound: Some(150.0),
-            phase: "bound".into(),
+            phase: cutroute_protocol::Phase::Bound,
             ..Progress::default()
         };
         assert_eq!(

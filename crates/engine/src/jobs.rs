@@ -5,7 +5,7 @@ use cutroute_ccp::{CcpLowerBound, CcpOptions, CcpSolver, DiscreteInstance};
 use cutroute_chains::{ChainOptions, Chained, Chaining};
 use cutroute_geometry::{MachineParameters, Nest, Route};
 use cutroute_pcgtsp::{ExactOptions, ExactSolver, Instance};
-use cutroute_protocol::{JobId, Progress};
+use cutroute_protocol::{CcpStage, JobId, Phase, Progress};
 use web_time::{Duration, Instant};
 
 use crate::{Job, JobStatus};
@@ -133,7 +133,7 @@ impl Job for CcpJob {
             },
             upper_bound: has_route.then_some(state.best_idle_length),
             lower_bound: self.bound.as_ref().map(|b| b.lower_bound()),
-            phase: format!("{:?}", state.phase).to_lowercase(),
+            phase: Phase::Ccp(ccp_stage(state.phase)),
             route: has_route.then_some(state.route),
             tour: None,
             proven_optimal: has_route && self.bound_within(1e-9),
@@ -375,6 +375,10 @@ impl DiscreteJob {
     }
 }
 
+/// Why a discrete job ends when its limit passes before the model is built (the phase says
+/// it as [`Phase::BuildTimedOut`]).
+const BUILD_TIMED_OUT: &str = "the time limit passed while the model was built";
+
 impl Job for DiscreteJob {
     fn step(&mut self, budget: Duration) -> JobStatus {
         if self.failure.is_some() {
@@ -385,7 +389,7 @@ impl Job for DiscreteJob {
             let over = Instant::now() >= self.deadline + self.first_tour_allowance;
             return if self.failure.is_some() || (over && self.alns.is_none()) {
                 if self.failure.is_none() {
-                    self.failure = Some("the time limit passed while the model was built".into());
+                    self.failure = Some(BUILD_TIMED_OUT.into());
                 }
                 JobStatus::Done
             } else {
@@ -466,25 +470,26 @@ impl Job for DiscreteJob {
         };
         let proven_optimal = self.exact_done == Some(true);
         let phase = match (&exact, self.exact_done) {
-            _ if self.failure.is_some() => {
-                format!("stopped: {}", self.failure.as_deref().unwrap_or_default())
-            }
-            (_, Some(true)) => "proven optimal".to_string(),
-            (_, Some(false)) => "stopped".to_string(),
-            (Some(p), None) => format!("layer {} · {} states", p.layer, p.live_states),
+            _ if self.failure.as_deref() == Some(BUILD_TIMED_OUT) => Phase::BuildTimedOut,
+            _ if self.failure.is_some() => Phase::Stopped {
+                reason: self.failure.clone(),
+            },
+            (_, Some(true)) => Phase::ProvenOptimal,
+            (_, Some(false)) => Phase::Stopped { reason: None },
+            (Some(p), None) => Phase::ExactLayer {
+                layer: p.layer,
+                states: p.live_states,
+            },
             (None, _) => match (&self.builder, &self.alns) {
-                (Some(b), _) => format!(
-                    "building the model: {} of {} rows of the cost matrix",
-                    b.rows_done(),
-                    b.node_count()
-                ),
-                (None, None) => "building the model: the heuristic".to_string(),
-                (None, Some(_)) if self.mode == DiscreteMode::Exact => {
-                    "building the model: the exact search".to_string()
-                }
-                (None, Some(alns)) => {
-                    format!("ALNS · {} iterations", alns.progress().iterations)
-                }
+                (Some(b), _) => Phase::BuildingMatrix {
+                    rows_done: b.rows_done(),
+                    rows: b.node_count(),
+                },
+                (None, None) => Phase::BuildingHeuristic,
+                (None, Some(_)) if self.mode == DiscreteMode::Exact => Phase::BuildingExact,
+                (None, Some(alns)) => Phase::Alns {
+                    iterations: alns.progress().iterations,
+                },
             },
         };
         let lower_bound = exact
@@ -617,24 +622,37 @@ impl Job for ChainJob {
             progress.upper_bound = Some(chained.route.idle_length());
             // Links are tool-on travel: no bound on standard cutting's idle length holds here.
             progress.lower_bound = None;
-            progress.phase = format!(
-                "chained: {} of {} pierces saved, {} chains, cost {:.2} → {:.2}",
-                r.pierces_before - r.pierces_after,
-                r.pierces_before,
-                r.chains,
-                r.cost_before,
-                r.cost_after
-            );
+            progress.phase = Phase::Chained {
+                saved: r.pierces_before - r.pierces_after,
+                pierces: r.pierces_before,
+                chains: r.chains,
+                cost_before: r.cost_before,
+                cost_after: r.cost_after,
+            };
             progress.route = Some(chained.route.clone());
             // CCP's certificates are about its own pierce points, which chaining moved.
             progress.certified = Vec::new();
         } else if let Some(failure) = &self.failure {
-            progress.phase = format!("chain cutting failed: {failure}; CCP route kept");
+            progress.phase = Phase::ChainFailed {
+                error: failure.to_string(),
+            };
         } else if self.chaining.is_some() {
-            progress.phase = "chain cutting: joining close contours".into();
-        } else if !progress.phase.is_empty() {
-            progress.phase = format!("ccp: {}", progress.phase);
+            progress.phase = Phase::ChainJoining;
+        } else if let Phase::Ccp(stage) = progress.phase {
+            progress.phase = Phase::ChainCcp(stage);
         }
         progress
+    }
+}
+
+/// CCP-Relax's step in the protocol's words.
+fn ccp_stage(phase: cutroute_ccp::CcpPhase) -> CcpStage {
+    use cutroute_ccp::CcpPhase;
+    match phase {
+        CcpPhase::Start => CcpStage::Start,
+        CcpPhase::Relaxing => CcpStage::Relaxing,
+        CcpPhase::LocalSearch => CcpStage::LocalSearch,
+        CcpPhase::Shaking => CcpStage::Shaking,
+        CcpPhase::Done => CcpStage::Done,
     }
 }

@@ -32,6 +32,7 @@
 #![deny(missing_docs)]
 
 mod jobs;
+mod located;
 mod nearest;
 mod open;
 mod open_files;

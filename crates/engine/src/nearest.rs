@@ -4,7 +4,7 @@ use cutroute_geometry::float::Libm;
 use std::collections::HashMap;
 
 use cutroute_geometry::{ContourRef, CutStep, MachineParameters, Nest, Point, Route};
-use cutroute_protocol::{JobId, Progress};
+use cutroute_protocol::{JobId, Phase, Progress};
 use cutroute_thermal::{HeatModel, Pierce};
 use rstar::primitives::GeomWithData;
 use rstar::RTree;
@@ -265,9 +265,9 @@ impl Job for NearestNeighbourJob {
             upper_bound: self.route.as_ref().map(|_| self.idle_length),
             lower_bound: None,
             phase: if self.route.is_some() {
-                "done".into()
+                Phase::Done
             } else {
-                "starting".into()
+                Phase::Starting
             },
             route: self.route.clone(),
             tour: None,

@@ -6,7 +6,9 @@ use cutroute_cad::tflex::read_tfnesting_project;
 use cutroute_formats::{detect, read_nest, read_result_json, Format};
 use cutroute_geometry::{Nest, Point};
 use cutroute_pcgtsp::Instance;
-use cutroute_protocol::{Document, Problem};
+use cutroute_protocol::{Document, Problem, SourceLocation};
+
+use crate::located::Located;
 
 /// Why a file could not be opened; the message names the file and the place in it.
 #[derive(Debug, thiserror::Error, PartialEq)]
@@ -20,6 +22,8 @@ pub enum OpenError {
         format: &'static str,
         /// The reader's error, with its location.
         message: String,
+        /// Where the reader stopped, as data.
+        location: Option<SourceLocation>,
     },
     /// A task file lists pierce points for a nest stored elsewhere.
     #[error("{0}: a cutting task holds no geometry; open its nest (geometry JSON or DBS) first")]
@@ -38,6 +42,10 @@ pub enum OpenError {
         file_name: String,
         /// What is wrong, with line and column.
         message: String,
+        /// The line and column, as data.
+        location: Option<SourceLocation>,
+        /// What is wrong, without the location.
+        detail: String,
     },
     /// The file reads but holds nothing to cut.
     #[error("{0}: the file holds no closed contours to cut")]
@@ -49,6 +57,8 @@ pub enum OpenError {
         file_name: String,
         /// The reader's error with its line and column.
         message: String,
+        /// The line and column, as data.
+        location: Option<SourceLocation>,
     },
     /// A G-code program that never cuts a closed contour.
     #[error("{0} (G-code): the program cuts no closed contour")]
@@ -145,6 +155,151 @@ pub enum OpenError {
     TaskWithoutNest(String),
 }
 
+impl OpenError {
+    /// The error as the protocol's data: kind, parameters and location for the page to word in
+    /// its language, with the English text the CLI prints.
+    pub fn report(&self) -> cutroute_protocol::OpenError {
+        use cutroute_protocol::OpenErrorKind as Kind;
+        let whole =
+            |file_name: &str, kind: Kind| (file_name.to_string(), kind, None, String::new());
+        let (file_name, kind, location, detail) = match self {
+            OpenError::Unreadable {
+                file_name,
+                format,
+                message,
+                location,
+            } => (
+                file_name.clone(),
+                Kind::Unreadable {
+                    format: format.to_string(),
+                },
+                location.clone(),
+                message.clone(),
+            ),
+            OpenError::TaskWithoutGeometry(f) => whole(f, Kind::TaskWithoutGeometry),
+            OpenError::UnknownFormat(f) => whole(f, Kind::UnknownFormat),
+            OpenError::MalformedJson {
+                file_name,
+                location,
+                detail,
+                ..
+            } => (
+                file_name.clone(),
+                Kind::MalformedJson,
+                location.clone(),
+                detail.clone(),
+            ),
+            OpenError::NothingToCut(f) => whole(f, Kind::NothingToCut),
+            OpenError::Gcode {
+                file_name,
+                message,
+                location,
+            } => (
+                file_name.clone(),
+                Kind::Gcode,
+                location.clone(),
+                message.clone(),
+            ),
+            OpenError::GcodeCutsNothing(f) => whole(f, Kind::GcodeCutsNothing),
+            OpenError::TourAlone(f) => whole(f, Kind::TourAlone),
+            OpenError::TwoOfAKind {
+                kind,
+                first,
+                second,
+            } => whole(
+                first,
+                Kind::TwoOfAKind {
+                    kind: kind.to_string(),
+                    second: second.clone(),
+                },
+            ),
+            OpenError::NotCombinable(f) => whole(f, Kind::NotCombinable),
+            OpenError::InfeasibleTour {
+                file_name,
+                against,
+                reason,
+            } => (
+                file_name.clone(),
+                Kind::InfeasibleTour {
+                    against: against.clone(),
+                },
+                None,
+                reason.clone(),
+            ),
+            OpenError::CostMismatch {
+                file_name,
+                against,
+                reported,
+                checked,
+            } => whole(
+                file_name,
+                Kind::CostMismatch {
+                    against: against.clone(),
+                    reported: *reported,
+                    checked: *checked,
+                },
+            ),
+            OpenError::InstanceNotOfTask {
+                instance,
+                nodes,
+                task,
+                points,
+            } => whole(
+                instance,
+                Kind::InstanceNotOfTask {
+                    nodes: *nodes,
+                    task: task.clone(),
+                    points: *points,
+                },
+            ),
+            OpenError::TaskNotOnNest {
+                task,
+                index,
+                x,
+                y,
+                nest,
+            } => whole(
+                task,
+                Kind::TaskNotOnNest {
+                    index: *index,
+                    x: *x,
+                    y: *y,
+                    nest: nest.clone(),
+                },
+            ),
+            OpenError::InvalidRoute {
+                file_name,
+                nest,
+                reason,
+            } => (
+                file_name.clone(),
+                Kind::InvalidRoute { nest: nest.clone() },
+                None,
+                reason.clone(),
+            ),
+            OpenError::NoSuchSheet {
+                file_name,
+                sheet,
+                count,
+            } => whole(
+                file_name,
+                Kind::NoSuchSheet {
+                    sheet: *sheet,
+                    count: *count,
+                },
+            ),
+            OpenError::TaskWithoutNest(f) => whole(f, Kind::TaskWithoutNest),
+        };
+        cutroute_protocol::OpenError {
+            file_name,
+            kind,
+            location,
+            detail,
+            message: self.to_string(),
+        }
+    }
+}
+
 /// The format's name for people.
 pub fn format_name(format: Format) -> &'static str {
     match format {
@@ -183,25 +338,29 @@ pub(crate) fn open_model_file(
         return Err(no_such_sheet(1));
     }
     let mut sheets = Vec::new();
-    let unreadable = |message: String| OpenError::Unreadable {
+    let unreadable = |message: String, location: Option<SourceLocation>| OpenError::Unreadable {
         file_name: file_name.to_string(),
         format: format_name(format),
         message,
+        location,
     };
     let mut warnings = Vec::new();
     let mut route = None;
     let nest = match format {
         Format::DbsBinary | Format::GeometryJson => {
-            read_nest(bytes).map_err(|e| unreadable(e.to_string()))?
+            read_nest(bytes).map_err(|e| unreadable(e.to_string(), e.location()))?
         }
         Format::ResultJson => {
-            let result = read_result_json(bytes).map_err(|e| unreadable(e.to_string()))?;
+            let result =
+                read_result_json(bytes).map_err(|e| unreadable(e.to_string(), e.location()))?;
             route = Some(result.route());
-            result.nest().map_err(|e| unreadable(e.to_string()))?
+            result
+                .nest()
+                .map_err(|e| unreadable(e.to_string(), e.location()))?
         }
         Format::Dxf => {
-            let import =
-                read_dxf(bytes, &DxfOptions::default()).map_err(|e| unreadable(e.to_string()))?;
+            let import = read_dxf(bytes, &DxfOptions::default())
+                .map_err(|e| unreadable(e.to_string(), e.location()))?;
             warnings.extend(import.warnings.iter().map(ToString::to_string));
             warnings.extend(
                 import
@@ -212,8 +371,8 @@ pub(crate) fn open_model_file(
             import.nest
         }
         Format::Svg => {
-            let import =
-                read_svg(bytes, &SvgOptions::default()).map_err(|e| unreadable(e.to_string()))?;
+            let import = read_svg(bytes, &SvgOptions::default())
+                .map_err(|e| unreadable(e.to_string(), e.location()))?;
             warnings.extend(import.warnings.iter().map(ToString::to_string));
             warnings.extend(
                 import
@@ -224,7 +383,8 @@ pub(crate) fn open_model_file(
             import.nest
         }
         Format::TflexXml => {
-            let project = read_tfnesting_project(bytes).map_err(|e| unreadable(e.to_string()))?;
+            let project = read_tfnesting_project(bytes)
+                .map_err(|e| unreadable(e.to_string(), e.location()))?;
             let count = project.layouts.len();
             if count == 0 {
                 return Err(OpenError::NothingToCut(file_name.to_string()));
@@ -249,9 +409,13 @@ pub(crate) fn open_model_file(
                 .nest
         }
         Format::Pcglns => {
-            let text = std::str::from_utf8(bytes)
-                .map_err(|e| unreadable(format!("byte {}: not UTF-8 text", e.valid_up_to())))?;
-            Instance::parse(text).map_err(|e| unreadable(e.to_string()))?;
+            let text = std::str::from_utf8(bytes).map_err(|e| {
+                unreadable(
+                    format!("byte {}: not UTF-8 text", e.valid_up_to()),
+                    e.location(),
+                )
+            })?;
+            Instance::parse(text).map_err(|e| unreadable(e.to_string(), e.location()))?;
             return Ok(Document {
                 file_name: file_name.to_string(),
                 format: format_name(format).to_string(),
@@ -271,7 +435,8 @@ pub(crate) fn open_model_file(
     };
     // Every reader checks its own values with a location; this catches what a reader builds
     // (DXF and T-FLEX transforms, arcs) against the same domain, located by part and contour.
-    nest.check_domain().map_err(|e| unreadable(e.to_string()))?;
+    nest.check_domain()
+        .map_err(|e| unreadable(e.to_string(), None))?;
     let nest = oriented(nest);
     if nest.contour_count() == 0 {
         return Err(OpenError::NothingToCut(file_name.to_string()));
@@ -302,19 +467,24 @@ fn unknown_format(file_name: &str, bytes: &[u8]) -> OpenError {
     if first != Some(&b'{') {
         return OpenError::UnknownFormat(file_name.to_string());
     }
-    let message = match serde_json::from_slice::<serde::de::IgnoredAny>(bytes) {
-        Err(e) => format!(
-            "line {} column {}: malformed JSON: {e}",
-            e.line(),
-            e.column()
+    let (line, column, detail) = match serde_json::from_slice::<serde::de::IgnoredAny>(bytes) {
+        Err(e) => (e.line(), e.column(), format!("malformed JSON: {e}")),
+        Ok(_) => (
+            1,
+            1,
+            "a JSON object with neither `TaskData` and `Contours` (task) nor `job` and \
+             `results` (result)"
+                .to_string(),
         ),
-        Ok(_) => "line 1 column 1: a JSON object with neither `TaskData` and `Contours` (task) \
-                  nor `job` and `results` (result)"
-            .to_string(),
     };
     OpenError::MalformedJson {
         file_name: file_name.to_string(),
-        message,
+        message: format!("line {line} column {column}: {detail}"),
+        location: Some(SourceLocation::Line {
+            line,
+            column: Some(column),
+        }),
+        detail,
     }
 }
 

@@ -5,6 +5,7 @@
 //! Tours are checked by the independent checker (`cutroute_pcgtsp::check_tour`) and routes by
 //! `Route::problems` before anything is shown.
 
+use crate::located::Located;
 use crate::open::{format_name, open_model_file, OpenError};
 use cutroute_formats::{detect, read_task_json, Format, RmTask};
 use cutroute_gcode::{read_gcode, Motion, ReadOptions};
@@ -77,6 +78,7 @@ pub fn open_gcode(file_name: &str, text: &str) -> Result<Document, OpenError> {
     let program = read_gcode(text, &ReadOptions::default()).map_err(|e| OpenError::Gcode {
         file_name: file_name.to_string(),
         message: e.to_string(),
+        location: Located::location(&e),
     })?;
     let mut warnings = Vec::new();
     // (loop, entry) in cutting order.
@@ -323,18 +325,21 @@ pub fn open_together(files: &[(String, Vec<u8>)]) -> Result<Document, OpenError>
     let mut labels = Vec::new();
     for (name, bytes) in files {
         let format = detect(bytes);
-        let unreadable = |message: String| OpenError::Unreadable {
+        let unreadable = |message: String, location| OpenError::Unreadable {
             file_name: name.clone(),
             format: format_name(format),
             message,
+            location,
         };
         let piece = match format {
-            Format::TaskJson => {
-                Piece::Task(read_task_json(bytes).map_err(|e| unreadable(e.to_string()))?)
-            }
+            Format::TaskJson => Piece::Task(
+                read_task_json(bytes).map_err(|e| unreadable(e.to_string(), e.location()))?,
+            ),
             Format::Pcglns => {
-                let text = std::str::from_utf8(bytes).map_err(|e| unreadable(e.to_string()))?;
-                let parsed = Instance::parse(text).map_err(|e| unreadable(e.to_string()))?;
+                let text = std::str::from_utf8(bytes)
+                    .map_err(|e| unreadable(e.to_string(), e.location()))?;
+                let parsed =
+                    Instance::parse(text).map_err(|e| unreadable(e.to_string(), e.location()))?;
                 Piece::Instance(parsed, text.to_string())
             }
             Format::Unknown if is_pcglns_result(bytes) => {
@@ -344,6 +349,7 @@ pub fn open_together(files: &[(String, Vec<u8>)]) -> Result<Document, OpenError>
                         file_name: name.clone(),
                         format: "PCGLNS result",
                         message: e.to_string(),
+                        location: e.location(),
                     })?,
                 )
             }

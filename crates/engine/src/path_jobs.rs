@@ -7,9 +7,12 @@
 use cutroute_aoe::{AoeSolution, AoeSolveOptions, AoeSolving, PlanGraph, PlanOptions};
 use cutroute_geometry::float::Libm;
 use cutroute_geometry::{MachineParameters, Nest, Objective, PathRoute, Point};
-use cutroute_protocol::{JobId, JobRequest, Problem, Progress, RouteSummary, SolverKind};
+use cutroute_protocol::{
+    Ensemble, JobId, JobRequest, Phase, Problem, Progress, RouteSummary, SolverKind,
+};
 use cutroute_segments::{
-    Candidate, EnsembleKind, EnsembleReport, GsccpOptions, GsccpSearch, SccpOptions, SearchStatus,
+    Candidate, EnsembleKind, EnsembleReport, GsccpOptions, GsccpSearch, GsccpStage, SccpOptions,
+    SearchStatus,
 };
 use web_time::{Duration, Instant};
 
@@ -267,7 +270,7 @@ impl Job for SegmentJob {
             elapsed_s: self.started.elapsed().as_secs_f64(),
             upper_bound: best.map(|c| c.value),
             lower_bound,
-            phase: self.search.phase(),
+            phase: segments_phase(&self.search),
             route: None,
             tour: None,
             proven_optimal: false,
@@ -388,15 +391,16 @@ impl Job for AoeJob {
             _ => None,
         };
         let phase = match &self.outcome {
-            None if self.solved.is_some() => "common-edge routes: measuring the plan bound".into(),
-            None if self.solving.is_some() => "common-edge routes: ordering the components".into(),
-            None => "common-edge routes: building the plan graph".to_string(),
-            Some(Ok((solution, _))) => format!(
-                "common-edge routes: {} chains in {} components",
-                solution.chains.len(),
-                solution.components
-            ),
-            Some(Err(e)) => format!("common-edge routes failed: {e}"),
+            None if self.solved.is_some() => Phase::CommonEdgeBound,
+            None if self.solving.is_some() => Phase::CommonEdgeOrdering,
+            None => Phase::CommonEdgeGraph,
+            Some(Ok((solution, _))) => Phase::CommonEdgeDone {
+                chains: solution.chains.len(),
+                components: solution.components,
+            },
+            Some(Err(e)) => Phase::CommonEdgeFailed {
+                error: e.to_string(),
+            },
         };
         let route = solved.map(|(s, _)| &s.route);
         Progress {
@@ -429,5 +433,36 @@ impl Job for AoeJob {
                 .unwrap_or_default(),
             ..Progress::default()
         }
+    }
+}
+
+/// Segment cutting's stage in the protocol's words.
+fn segments_phase(search: &GsccpSearch) -> Phase {
+    let ensemble = |kind: EnsembleKind| match kind {
+        EnsembleKind::Standard => Ensemble::Standard,
+        EnsembleKind::Chains => Ensemble::Chains,
+        EnsembleKind::Junctions => Ensemble::Junctions,
+    };
+    match search.stage() {
+        GsccpStage::Ccp => Phase::SegmentsCcp,
+        GsccpStage::Building(kind) => Phase::SegmentsBuilding {
+            ensemble: kind.map(ensemble),
+        },
+        GsccpStage::Searching {
+            kind,
+            segments,
+            shakes,
+        } => Phase::SegmentsSearch {
+            ensemble: ensemble(kind),
+            segments,
+            shakes,
+        },
+        GsccpStage::Failed(e) => Phase::SegmentsFailed {
+            error: e.to_string(),
+        },
+        GsccpStage::Done(best) => Phase::SegmentsDone {
+            best: best.map(ensemble),
+        },
+        GsccpStage::NoValidRoute => Phase::SegmentsNoRoute,
     }
 }

@@ -19,7 +19,7 @@ use std::cell::RefCell;
 
 use cutroute_ccp::HeatPenalty;
 use cutroute_geometry::{MachineParameters, Nest, Objective, PathRoute, Route};
-use cutroute_protocol::{Progress, SolverKind, ThermalSettings};
+use cutroute_protocol::{Phase, Progress, SolverKind, ThermalNote, ThermalSettings};
 use cutroute_thermal::{
     admissible_pierce_points, check_rules, enforce_rules, path_route_pierces, relax_pierce_points,
     route_pierces, HeatModel, RuleCounts, RuleParams, Violation,
@@ -375,10 +375,13 @@ impl Job for ThermalJob {
                         .map(|c| c.iter().map(|c| c.condition1).collect())
                         .unwrap_or_default();
                 }
-                progress.phase = if self.settings.hard {
-                    format!("{} · rules enforced", progress.phase)
-                } else {
-                    format!("{} · pierce points relaxed on idle + W·H", progress.phase)
+                progress.phase = Phase::Thermal {
+                    base: Box::new(std::mem::take(&mut progress.phase)),
+                    note: if self.settings.hard {
+                        ThermalNote::RulesEnforced
+                    } else {
+                        ThermalNote::Relaxed
+                    },
                 };
                 progress.route = Some(route.clone());
             }
@@ -392,8 +395,12 @@ impl Job for ThermalJob {
                 progress.proven_optimal = false;
             }
             Some(Err(e)) => {
-                progress.phase =
-                    format!("{} · rule repair failed ({e}); route kept", progress.phase)
+                progress.phase = Phase::Thermal {
+                    base: Box::new(std::mem::take(&mut progress.phase)),
+                    note: ThermalNote::RepairFailed {
+                        error: e.to_string(),
+                    },
+                }
             }
             _ => {}
         }

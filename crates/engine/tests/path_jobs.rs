@@ -141,7 +141,8 @@ fn every_path_solver_returns_a_checked_route_with_its_numbers() {
                     .collect();
                 assert_eq!(listed, names, "{what}");
                 assert!(
-                    result.phase.contains(' ') && !result.phase.contains("failed"),
+                    result.phase.to_string().contains(' ')
+                        && !result.phase.to_string().contains("failed"),
                     "{what}: {}",
                     result.phase
                 );
@@ -250,12 +251,14 @@ fn cancel_mid_run_keeps_the_best_route_so_far() {
         loop {
             assert_eq!(job.step(Duration::from_millis(40)), JobStatus::Running);
             let progress = job.progress();
-            if progress.phase.contains("CCP") && progress.path_route.is_some() {
+            if progress.phase.to_string().contains("CCP") && progress.path_route.is_some() {
                 // The best so far while CCP-Relax runs is its own route, checked.
                 check_progress("during ccp", &problem, &params, &progress);
                 during_ccp = true;
             }
-            if progress.phase.contains("ensemble (") && started.elapsed().as_secs_f64() > 1.0 {
+            if progress.phase.to_string().contains("ensemble (")
+                && started.elapsed().as_secs_f64() > 1.0
+            {
                 break;
             }
             assert!(started.elapsed().as_secs() < 50, "{}", progress.phase);

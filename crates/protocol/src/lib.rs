@@ -26,9 +26,13 @@
 use cutroute_geometry::{MachineParameters, Nest, Objective, PathRoute, Point, Route};
 use serde::{Deserialize, Serialize};
 
+mod open_error;
+mod phase;
 mod profile;
 mod thermal;
 
+pub use open_error::{OpenError, OpenErrorKind, SourceLocation};
+pub use phase::{CcpStage, Ensemble, Phase, ThermalNote};
 pub use profile::{MachineProfile, ProfileError};
 pub use thermal::ThermalSettings;
 // The thermal types a `Progress` carries, so the UI needs no second import path.
@@ -135,8 +139,8 @@ pub enum FromWorker {
     OpenFailed {
         /// The `request_id` of the `Open` message.
         request_id: u64,
-        /// What is wrong and where, in plain words.
-        message: String,
+        /// What is wrong and where.
+        error: OpenError,
     },
     /// The job could not run.
     Failed {
@@ -312,8 +316,8 @@ pub struct Progress {
     /// computes one (sccp, gsccp, aoe: the plan's length cut, the pierces every route needs and
     /// the idle travel to and from the parts, under the same objective).
     pub lower_bound: Option<f64>,
-    /// What the solver is doing, in a few words.
-    pub phase: String,
+    /// What the solver is doing, with its numbers (`Display`: the English words).
+    pub phase: Phase,
     /// The best route so far (nest problems).
     pub route: Option<Route>,
     /// The best tour so far as 0-based node ids, depot first (PCGTSP problems).
@@ -440,7 +444,10 @@ mod tests {
             elapsed_s: 0.25,
             upper_bound: Some(10.0),
             lower_bound: Some(8.0),
-            phase: "layer 3".into(),
+            phase: Phase::ExactLayer {
+                layer: 3,
+                states: 12,
+            },
             route: Some(Route {
                 start: Point::default(),
                 steps: vec![CutStep {

@@ -145,6 +145,30 @@ enum Stage {
     Finished,
 }
 
+/// What a [`GsccpSearch`] is doing ([`GsccpSearch::stage`]).
+#[derive(Clone, Debug, PartialEq)]
+pub enum GsccpStage<'a> {
+    /// CCP-Relax seeds the orders.
+    Ccp,
+    /// An ensemble of this kind is built next.
+    Building(Option<EnsembleKind>),
+    /// An ensemble is searched.
+    Searching {
+        /// Which.
+        kind: EnsembleKind,
+        /// Its base segments.
+        segments: usize,
+        /// Shakes so far.
+        shakes: usize,
+    },
+    /// The run failed.
+    Failed(&'a SegmentError),
+    /// The run ended; the best route comes from this ensemble (`None`: CCP-Relax).
+    Done(Option<EnsembleKind>),
+    /// The run ended with no ensemble giving a valid route.
+    NoValidRoute,
+}
+
 /// GSCCP as a resumable state machine: CCP-Relax (stepped as [`CcpSolver`] steps), then per
 /// ensemble one step that builds it and steps of its [`SccpSearch`]. Each [`step`](Self::step)
 /// returns after about its budget, but for building an ensemble (one plan-graph construction,
@@ -326,6 +350,24 @@ impl GsccpSearch {
     /// Why the run failed, if it did (CCP-Relax gave no usable route).
     pub fn failure(&self) -> Option<&SegmentError> {
         self.failure.as_ref()
+    }
+
+    /// What the run is doing, typed, for callers that word it in their own language.
+    pub fn stage(&self) -> GsccpStage<'_> {
+        match &self.stage {
+            Stage::Ccp(_) => GsccpStage::Ccp,
+            Stage::Build(k) => GsccpStage::Building(self.options.kinds.get(*k).copied()),
+            Stage::Search(_, search, report) => GsccpStage::Searching {
+                kind: report.kind,
+                segments: report.segments,
+                shakes: search.shakes(),
+            },
+            Stage::Finished => match (&self.failure, self.best()) {
+                (Some(e), _) => GsccpStage::Failed(e),
+                (None, Some(best)) => GsccpStage::Done(best.source),
+                (None, None) => GsccpStage::NoValidRoute,
+            },
+        }
     }
 
     /// What the run is doing, in words.

@@ -54,6 +54,7 @@ mod solver;
 pub use cutroute_geometry::Objective;
 pub use gsccp::{
     recut_length, solve_gsccp, Candidate, EnsembleReport, GsccpOptions, GsccpResult, GsccpSearch,
+    GsccpStage,
 };
 pub use segment::{Ensemble, EnsembleKind, Segment};
 pub use solver::{solve_sccp, SccpOptions, SccpSearch, SccpSolution, SearchStatus, SOLVE_SLICE};

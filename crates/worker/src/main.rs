@@ -24,7 +24,7 @@ mod web {
             },
             Err(error) => FromWorker::OpenFailed {
                 request_id,
-                message: error.to_string(),
+                error: error.report(),
             },
         }
     }
@@ -133,7 +133,7 @@ mod web {
                 ToWorker::Cancel { job_id } => {
                     if let Some(running) = self.jobs.remove(&job_id) {
                         let mut progress = running.job.progress();
-                        progress.phase = "cancelled".into();
+                        progress.phase = cutroute_protocol::Phase::Cancelled;
                         scope.respond(running.requester, FromWorker::Cancelled(progress));
                     }
                 }

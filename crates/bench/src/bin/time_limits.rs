@@ -176,7 +176,7 @@ pub fn main() {
                 Err(e) => format!("refused: {e}"),
                 Ok(mut job) => loop {
                     let phase = if trace {
-                        job.progress().phase
+                        job.progress().phase.to_string()
                     } else {
                         String::new()
                     };
