@@ -51,6 +51,7 @@ fn main() {
         budget_seconds: seconds,
         first_stage: Duration::from_secs_f64((seconds / 10.0).clamp(0.5, 5.0)),
         group_size,
+        decompose_above: 0,
         ..LowerBoundOptions::default()
     };
     let mut bound = CcpLowerBound::new(&nest, options).expect("options");

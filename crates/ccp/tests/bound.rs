@@ -404,6 +404,7 @@ fn the_groups_sum_never_above_brute_force() {
                     finish,
                     budget_seconds: 2.0,
                     group_size,
+                    decompose_above: 0,
                     ..LowerBoundOptions::default()
                 };
                 let mut bound = CcpLowerBound::new(&nest, options).unwrap();
