@@ -289,6 +289,11 @@ pub struct CcpLowerBound {
     /// otherwise.
     others: Arc<Vec<PieceShape>>,
     own: Vec<bool>,
+    /// In a group's bound: per kept contour, whether all kept contours inside its outermost
+    /// contour are in this group (that contour's inside then belongs to this group's region);
+    /// and the outermost contours whose insides belong to other groups.
+    absorbed: Vec<bool>,
+    foreign_outlines: Vec<PieceShape>,
     /// The decomposition's group bounds (empty without decomposition), and whether each may
     /// still improve.
     groups: Vec<CcpLowerBound>,
@@ -423,6 +428,8 @@ impl CcpLowerBound {
             fixed: false,
             others,
             own,
+            absorbed: Vec::new(),
+            foreign_outlines: Vec::new(),
             groups: Vec::new(),
             groups_running: Vec::new(),
             own_running: true,
@@ -444,7 +451,25 @@ impl CcpLowerBound {
                 .collect(),
         );
         let count = members.len();
-        for group in &members {
+        // The groups holding the kept contours inside each outermost contour.
+        let mut holders: HashMap<ContourRef, Vec<usize>> = HashMap::new();
+        for (g, group) in members.iter().enumerate() {
+            for &i in group {
+                if let Some(o) = self.leaves[i].outermost {
+                    let list = holders.entry(o).or_default();
+                    if !list.contains(&g) {
+                        list.push(g);
+                    }
+                }
+            }
+        }
+        let absorbed_by = |o: Option<ContourRef>| -> Option<usize> {
+            match holders.get(&o?)?.as_slice() {
+                [g] => Some(*g),
+                _ => None,
+            }
+        };
+        for (g, group) in members.iter().enumerate() {
             let mut own = vec![false; self.leaves.len()];
             for &i in group {
                 own[i] = true;
@@ -466,14 +491,33 @@ impl CcpLowerBound {
                 group_size: 0,
                 ..self.options.clone()
             };
-            self.groups.push(CcpLowerBound::from_leaves(
+            let absorbed: Vec<bool> = leaves
+                .iter()
+                .map(|l| absorbed_by(l.outermost) == Some(g))
+                .collect();
+            let mut foreign: Vec<(ContourRef, usize)> = holders
+                .iter()
+                .filter_map(|(&o, list)| match list.as_slice() {
+                    [h] if *h != g => Some((o, *h)),
+                    _ => None,
+                })
+                .collect();
+            foreign.sort_by_key(|&(o, _)| (o.part, o.contour));
+            let foreign_outlines = foreign
+                .iter()
+                .filter_map(|(o, _)| self.outermost_shapes.get(o).cloned())
+                .collect();
+            let mut bound = CcpLowerBound::from_leaves(
                 leaves,
                 outermost_shapes,
                 options,
                 self.margin,
                 Arc::clone(&whole),
                 own,
-            ));
+            );
+            bound.absorbed = absorbed;
+            bound.foreign_outlines = foreign_outlines;
+            self.groups.push(bound);
             self.groups_running.push(true);
         }
     }
@@ -726,16 +770,33 @@ impl CcpLowerBound {
         }
     }
 
-    /// Half the distance from `piece` to the nearest kept contour of another group: any route
-    /// runs at least this far inside this group's region (the points nearer to this group's
-    /// kept contours than to the others') from a pierce point in `piece` to the region's
-    /// border, since a border point q is no nearer to this group than to another one H, so
-    /// d(piece, H) ≤ d(p, q) + d(q, H) ≤ 2·d(p, q).
-    fn escape(&self, piece: &PieceShape) -> f64 {
+    /// How far any route runs inside this group's region from a pierce point `p` in `piece`
+    /// (of kept contour `leaf`) to the region's border. The region is the points nearer to
+    /// this group's kept contours than to the others', with the insides of *absorbed*
+    /// outermost contours (all kept contours inside them in one group) given to that group.
+    /// A border point q lies in another group H's part of the plane: either q is no nearer to
+    /// this group than to H, so d(p, H) ≤ d(p, q) + d(q, H) ≤ 2·d(p, q), or q is inside or on
+    /// an outermost contour absorbed by H, which `p` lies outside of. And when `leaf`'s own
+    /// outermost contour is absorbed here, q is not inside it, so d(p, q) is at least the
+    /// distance from `p` to that contour.
+    fn escape(&self, leaf: usize, piece: &PieceShape) -> f64 {
         let mut best = f64::INFINITY;
         for (other, _) in self.others.iter().zip(&self.own).filter(|(_, &own)| !own) {
             if 0.5 * piece.bbox.distance_to_box(&other.bbox) < best {
                 best = best.min(0.5 * piece.distance_to(other));
+            }
+        }
+        for outline in &self.foreign_outlines {
+            if piece.bbox.distance_to_box(&outline.bbox) < best {
+                best = best.min(piece.distance_to(outline));
+            }
+        }
+        if self.absorbed.get(leaf).copied().unwrap_or(false) {
+            if let Some(own) = self.leaves[leaf]
+                .outermost
+                .and_then(|o| self.outermost_shapes.get(&o))
+            {
+                best = best.max(piece.distance_to(own));
             }
         }
         best
@@ -752,7 +813,8 @@ impl CcpLowerBound {
     fn build_rows(&self, b: &mut Building, deadline: Instant) -> bool {
         let n = 1 + b.node_piece.len();
         while !self.others.is_empty() && b.escape.len() < n - 1 {
-            let e = self.escape(&b.shapes[b.escape.len()]);
+            let v = b.escape.len();
+            let e = self.escape(b.node_piece[v].0, &b.shapes[v]);
             b.escape.push(e);
             if Instant::now() >= deadline {
                 return false;
