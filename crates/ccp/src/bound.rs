@@ -557,6 +557,7 @@ impl CcpLowerBound {
         // The candidates' instance is solved exactly in one stage: no groups beside it.
         bound.groups.clear();
         bound.groups_running.clear();
+        bound.own_running = true;
         Ok(Some(bound))
     }
 
