@@ -29,6 +29,22 @@
 //! contours (with the tail above) and there is nothing to refine: one stage, solved until
 //! it ends. Its optimum lies between the continuous relaxation's and the discrete optimum.
 //!
+//! **Decomposition by spatial groups** (nests of more than `decompose_above` kept contours):
+//! the kept contours are split into compact groups of at most `group_size` (the holes of one
+//! part together), and each group's region `R_G` is the set of points nearer to its contours
+//! than to any other group's (the regions partition the plane). A route's length is the sum of
+//! its lengths inside the regions, and inside `R_G` it is at least the relaxation above over
+//! `G`'s contours alone with every cost `c(a, b)` replaced by `min(c(a, b), e(a) + e(b))`,
+//! where the *escape* `e(a)` = half the distance from piece `a` to the nearest contour of
+//! another group bounds the way from `a` to the region's border (a border point `q` is no
+//! nearer to `G` than to some other group `H`, so `d(a, H) ≤ d(a, q) + d(q, H) ≤ 2·d(a, q)`):
+//! between two consecutive pierce points of `G` the route stays inside (`c(a, b)`) or leaves
+//! and comes back (`≥ e(a) + e(b)` inside); the first is reached from the start or the border,
+//! the tail after the last one runs inside or leaves. Each group is small enough to be solved
+//! exactly, so the sum of the groups' bounds is a certified bound; the reported bound is the
+//! larger of it and the whole relaxation's. What it loses is the travel across the group
+//! borders, little where groups are separated by space, much on tightly packed sheets.
+//!
 //! **Refinement.** A stage builds the instance (row by row, in slices), then runs the exact
 //! solver for a doubling time share. Then the pieces holding the best route's pierce points and
 //! the pieces of the relaxed tour are halved, and the next stage starts. Finer pieces only raise
@@ -58,6 +74,7 @@
 //! ```
 
 use std::collections::HashMap;
+use std::sync::Arc;
 
 use cutroute_geometry::{BoundingBox, Contour, ContourRef, Nest, Point, Route, Span};
 use cutroute_pcgtsp::{ExactOptions, ExactSolver, Instance, SolverStatus};
@@ -74,6 +91,12 @@ const COST_MARGIN: f64 = 1e-9;
 /// not built and the bound keeps what it has, so a sheet of 100,000 contours cannot ask for a
 /// 137 GB matrix (it did, and aborted the process) and the browser's worker stays in memory.
 pub const MAX_RELAXATION_ENTRIES: usize = 1 << 24;
+
+/// Most groups of the decomposition bound.
+const MAX_GROUPS: usize = 64;
+
+/// Most kept contours for which the whole relaxation runs beside the groups.
+const WHOLE_MAX_KEPT: usize = 256;
 
 /// Settings of [`CcpLowerBound`].
 #[derive(Clone, Debug, PartialEq)]
@@ -94,6 +117,15 @@ pub struct LowerBoundOptions {
     /// Seconds the whole computation is expected to run: the exact solver sizes its bounds'
     /// work for it (the lattice of ideals is built only when there is time for it).
     pub budget_seconds: f64,
+    /// Most kept contours per group of the decomposition bound (see the module
+    /// documentation); with more kept contours than this the bound also runs one relaxation
+    /// per group and reports the larger of the whole relaxation's bound and the groups' sum.
+    /// 0: no decomposition.
+    pub group_size: usize,
+    /// Decompose only with more kept contours than this: up to about 22 the whole relaxation
+    /// is solved exactly stage after stage and converges on its own, and groups would only
+    /// take its time.
+    pub decompose_above: usize,
 }
 
 impl Default for LowerBoundOptions {
@@ -106,11 +138,14 @@ impl Default for LowerBoundOptions {
             memory_limit_bytes: 256 << 20,
             first_stage: Duration::from_millis(500),
             budget_seconds: 10.0,
+            group_size: 16,
+            decompose_above: 24,
         }
     }
 }
 
 /// One kept (innermost) contour.
+#[derive(Clone)]
 struct Leaf {
     contour_ref: ContourRef,
     contour: Contour,
@@ -162,6 +197,7 @@ impl Leaf {
 }
 
 /// A piece with its geometry, for distances.
+#[derive(Clone)]
 struct PieceShape {
     spans: Vec<Span>,
     boxes: Vec<BoundingBox>,
@@ -207,6 +243,10 @@ struct Building {
     /// Per node (after the depot): (leaf, piece index).
     node_piece: Vec<(usize, usize)>,
     shapes: Vec<PieceShape>,
+    /// Per node (after the depot), in a group's bound: half the distance from the piece to the
+    /// nearest kept contour of another group (a lower bound on the length any route runs
+    /// inside the group's region from the piece to the region's border); +∞ otherwise.
+    escape: Vec<f64>,
     cost: Vec<f64>,
     next_row: usize,
 }
@@ -244,6 +284,24 @@ pub struct CcpLowerBound {
     elapsed: Duration,
     /// Pieces are fixed candidates (no refinement; one stage).
     fixed: bool,
+    /// In a group's bound: the whole kept contours of the nest (shared by the groups) and
+    /// which of them are this group's (the escape distances are to the others); empty
+    /// otherwise.
+    others: Arc<Vec<PieceShape>>,
+    own: Vec<bool>,
+    /// In a group's bound: per kept contour, whether all kept contours inside its outermost
+    /// contour are in this group (that contour's inside then belongs to this group's region);
+    /// and the outermost contours whose insides belong to other groups.
+    absorbed: Vec<bool>,
+    foreign_outlines: Vec<PieceShape>,
+    /// The decomposition's group bounds (empty without decomposition), and whether each may
+    /// still improve.
+    groups: Vec<CcpLowerBound>,
+    groups_running: Vec<bool>,
+    /// Whether this bound's own relaxation (of all its kept contours) may still improve.
+    own_running: bool,
+    /// Slices handed out so far (the own relaxation gets every fourth beside the groups).
+    turns: usize,
 }
 
 impl CcpLowerBound {
@@ -288,6 +346,53 @@ impl CcpLowerBound {
                 outermost,
             });
         }
+        let b = nest.bounding_box();
+        let scale = b
+            .max
+            .x
+            .abs()
+            .max(b.max.y.abs())
+            .max(b.min.x.abs())
+            .max(b.min.y.abs())
+            + options.start.x.abs().max(options.start.y.abs());
+        let margin = COST_MARGIN * (1.0 + if scale.is_finite() { scale } else { 0.0 });
+        let group_size = options.group_size;
+        let mut bound = CcpLowerBound::from_leaves(
+            leaves,
+            outermost_shapes,
+            options,
+            margin,
+            Arc::new(Vec::new()),
+            Vec::new(),
+        );
+        // Beyond MAX_GROUPS groups each would get too little time to count, and the sheets
+        // that large do not fit a relaxation anyway.
+        if group_size > 0
+            && bound.leaves.len() > group_size.max(bound.options.decompose_above)
+            && bound.leaves.len() <= MAX_GROUPS * group_size
+        {
+            bound.decompose(group_size);
+            // The exact search keys hold at most 256 clusters: beyond, the whole relaxation
+            // gets no further than its first root bound (4,676 against the groups' 9,502 on
+            // Nest02), and building its solver is the longest step of all; the groups run
+            // alone.
+            if bound.leaves.len() > WHOLE_MAX_KEPT {
+                bound.own_running = false;
+            }
+        }
+        Ok(bound)
+    }
+
+    /// The bound over `leaves` (the first pieces shared by perimeter); in a group's bound,
+    /// `others` are all kept contours and `own` marks the group's.
+    fn from_leaves(
+        leaves: Vec<Leaf>,
+        outermost_shapes: HashMap<ContourRef, PieceShape>,
+        options: LowerBoundOptions,
+        margin: f64,
+        others: Arc<Vec<PieceShape>>,
+        own: Vec<bool>,
+    ) -> CcpLowerBound {
         let by_ref = leaves
             .iter()
             .enumerate()
@@ -306,20 +411,11 @@ impl CcpLowerBound {
                     .collect()
             })
             .collect();
-        let b = nest.bounding_box();
-        let scale = b
-            .max
-            .x
-            .abs()
-            .max(b.max.y.abs())
-            .max(b.min.x.abs())
-            .max(b.min.y.abs())
-            + options.start.x.abs().max(options.start.y.abs());
-        Ok(CcpLowerBound {
+        CcpLowerBound {
             leaves,
             by_ref,
             outermost_shapes,
-            margin: COST_MARGIN * (1.0 + if scale.is_finite() { scale } else { 0.0 }),
+            margin,
             options,
             pieces,
             stage: None,
@@ -330,7 +426,100 @@ impl CcpLowerBound {
             incumbent_offered: false,
             elapsed: Duration::ZERO,
             fixed: false,
-        })
+            others,
+            own,
+            absorbed: Vec::new(),
+            foreign_outlines: Vec::new(),
+            groups: Vec::new(),
+            groups_running: Vec::new(),
+            own_running: true,
+            turns: 0,
+        }
+    }
+
+    /// Splits the kept contours into spatial groups of at most `size` (the contours of one
+    /// outermost contour together where they fit) and prepares one group bound per group.
+    fn decompose(&mut self, size: usize) {
+        let members = spatial_groups(&self.leaves, size);
+        if members.len() < 2 {
+            return;
+        }
+        let whole: Arc<Vec<PieceShape>> = Arc::new(
+            self.leaves
+                .iter()
+                .map(|l| PieceShape::new(l.spans.clone()))
+                .collect(),
+        );
+        let count = members.len();
+        // The groups holding the kept contours inside each outermost contour.
+        let mut holders: HashMap<ContourRef, Vec<usize>> = HashMap::new();
+        for (g, group) in members.iter().enumerate() {
+            for &i in group {
+                if let Some(o) = self.leaves[i].outermost {
+                    let list = holders.entry(o).or_default();
+                    if !list.contains(&g) {
+                        list.push(g);
+                    }
+                }
+            }
+        }
+        let absorbed_by = |o: Option<ContourRef>| -> Option<usize> {
+            match holders.get(&o?)?.as_slice() {
+                [g] => Some(*g),
+                _ => None,
+            }
+        };
+        for (g, group) in members.iter().enumerate() {
+            let mut own = vec![false; self.leaves.len()];
+            for &i in group {
+                own[i] = true;
+            }
+            let leaves: Vec<Leaf> = group.iter().map(|&i| self.leaves[i].clone()).collect();
+            let outermost_shapes = leaves
+                .iter()
+                .filter_map(|l| {
+                    let o = l.outermost?;
+                    Some((o, self.outermost_shapes.get(&o)?.clone()))
+                })
+                .collect();
+            let options = LowerBoundOptions {
+                // Finer first pieces than the whole relaxation: a group's exact search is
+                // cheap, and its bound is only as good as its pieces.
+                initial_pieces: (12 * leaves.len()).min(self.options.initial_pieces),
+                first_stage: (self.options.first_stage / 4).max(Duration::from_millis(100)),
+                budget_seconds: (2.0 * self.options.budget_seconds / count as f64).max(2.0),
+                group_size: 0,
+                ..self.options.clone()
+            };
+            let absorbed: Vec<bool> = leaves
+                .iter()
+                .map(|l| absorbed_by(l.outermost) == Some(g))
+                .collect();
+            let mut foreign: Vec<(ContourRef, usize)> = holders
+                .iter()
+                .filter_map(|(&o, list)| match list.as_slice() {
+                    [h] if *h != g => Some((o, *h)),
+                    _ => None,
+                })
+                .collect();
+            foreign.sort_by_key(|&(o, _)| (o.part, o.contour));
+            let foreign_outlines = foreign
+                .iter()
+                .filter_map(|(o, _)| self.outermost_shapes.get(o).cloned())
+                .collect();
+            let mut bound = CcpLowerBound::from_leaves(
+                leaves,
+                outermost_shapes,
+                options,
+                self.margin,
+                Arc::clone(&whole),
+                own,
+            );
+            bound.absorbed = absorbed;
+            bound.foreign_outlines = foreign_outlines;
+            self.groups.push(bound);
+            self.groups_running.push(true);
+        }
     }
 
     /// The bound for routes that pierce each contour only at one of `candidates` (contour,
@@ -365,6 +554,10 @@ impl CcpLowerBound {
                 .collect();
         }
         bound.fixed = true;
+        // The candidates' instance is solved exactly in one stage: no groups beside it.
+        bound.groups.clear();
+        bound.groups_running.clear();
+        bound.own_running = true;
         Ok(Some(bound))
     }
 
@@ -373,8 +566,28 @@ impl CcpLowerBound {
         self.leaves.len()
     }
 
-    /// The best certified lower bound so far (mm of idle travel; 0 before the first stage).
+    /// The best certified lower bound so far (mm of idle travel; 0 before the first stage):
+    /// the whole relaxation's, or the sum of the groups' bounds when larger.
     pub fn lower_bound(&self) -> f64 {
+        if self.groups.is_empty() {
+            self.best
+        } else {
+            self.best.max(self.group_sum())
+        }
+    }
+
+    /// The decomposition's bound: the sum of the groups' bounds (0 without groups).
+    pub fn group_sum(&self) -> f64 {
+        self.groups.iter().map(|g| g.best).sum()
+    }
+
+    /// Groups of the decomposition bound (0: none).
+    pub fn group_count(&self) -> usize {
+        self.groups.len()
+    }
+
+    /// The bound of the whole relaxation alone (without the groups).
+    pub fn whole_bound(&self) -> f64 {
         self.best
     }
 
@@ -420,6 +633,9 @@ impl CcpLowerBound {
             })
             .collect();
         self.incumbent_offered = false;
+        for group in &mut self.groups {
+            group.offer_route(route);
+        }
     }
 
     /// Works for about `budget`; returns false when nothing is left to do (the bound is exact
@@ -427,9 +643,34 @@ impl CcpLowerBound {
     pub fn step(&mut self, budget: Duration) -> bool {
         let began = Instant::now();
         let deadline = began + budget;
-        let more = self.step_until(deadline);
+        let more = if self.groups.is_empty() {
+            self.own_running = self.own_running && self.step_until(deadline);
+            self.own_running
+        } else {
+            self.step_shared(deadline)
+        };
         self.elapsed += began.elapsed();
         more
+    }
+
+    /// One slice of the decomposition: to the group that has had the least time so far, and
+    /// every fourth to the whole relaxation (which stays the bound where groups lose much at
+    /// their borders).
+    fn step_shared(&mut self, deadline: Instant) -> bool {
+        self.turns += 1;
+        let group = (0..self.groups.len())
+            .filter(|&g| self.groups_running[g])
+            .min_by_key(|&g| self.groups[g].elapsed());
+        match group {
+            Some(g) if !self.own_running || !self.turns.is_multiple_of(4) => {
+                let left = deadline.saturating_duration_since(Instant::now());
+                self.groups_running[g] = self.groups[g].step(left.max(Duration::from_millis(1)));
+            }
+            _ => {
+                self.own_running = self.own_running && self.step_until(deadline);
+            }
+        }
+        self.own_running || self.groups_running.iter().any(|&r| r)
     }
 
     fn step_until(&mut self, deadline: Instant) -> bool {
@@ -509,6 +750,7 @@ impl CcpLowerBound {
         Building {
             node_piece,
             shapes,
+            escape: Vec::with_capacity(if self.others.is_empty() { 0 } else { n - 1 }),
             cost: vec![f64::INFINITY; n * n],
             next_row: 0,
         }
@@ -529,20 +771,74 @@ impl CcpLowerBound {
         }
     }
 
+    /// How far any route runs inside this group's region from a pierce point `p` in `piece`
+    /// (of kept contour `leaf`) to the region's border. The region is the points nearer to
+    /// this group's kept contours than to the others', with the insides of *absorbed*
+    /// outermost contours (all kept contours inside them in one group) given to that group.
+    /// A border point q lies in another group H's part of the plane: either q is no nearer to
+    /// this group than to H, so d(p, H) ≤ d(p, q) + d(q, H) ≤ 2·d(p, q), or q is inside or on
+    /// an outermost contour absorbed by H, which `p` lies outside of. And when `leaf`'s own
+    /// outermost contour is absorbed here, q is not inside it, so d(p, q) is at least the
+    /// distance from `p` to that contour.
+    fn escape(&self, leaf: usize, piece: &PieceShape) -> f64 {
+        let mut best = f64::INFINITY;
+        for (other, _) in self.others.iter().zip(&self.own).filter(|(_, &own)| !own) {
+            if 0.5 * piece.bbox.distance_to_box(&other.bbox) < best {
+                best = best.min(0.5 * piece.distance_to(other));
+            }
+        }
+        for outline in &self.foreign_outlines {
+            if piece.bbox.distance_to_box(&outline.bbox) < best {
+                best = best.min(piece.distance_to(outline));
+            }
+        }
+        if self.absorbed.get(leaf).copied().unwrap_or(false) {
+            if let Some(own) = self.leaves[leaf]
+                .outermost
+                .and_then(|o| self.outermost_shapes.get(&o))
+            {
+                best = best.max(piece.distance_to(own));
+            }
+        }
+        best
+    }
+
     /// Fills rows of the cost matrix until `deadline`; true when complete.
+    ///
+    /// In a group's bound every cost is the least length a route runs inside the group's
+    /// region: between two pierce points either the move stays inside (the piece distance)
+    /// or it leaves and comes back (at least both escapes); the first pierce point is reached
+    /// from the start or from the border, and after the last one the route either leaves the
+    /// region or runs its tail inside it. The regions partition the plane, so the groups'
+    /// bounds add up.
     fn build_rows(&self, b: &mut Building, deadline: Instant) -> bool {
         let n = 1 + b.node_piece.len();
+        while !self.others.is_empty() && b.escape.len() < n - 1 {
+            let v = b.escape.len();
+            let e = self.escape(b.node_piece[v].0, &b.shapes[v]);
+            b.escape.push(e);
+            if Instant::now() >= deadline {
+                return false;
+            }
+        }
+        let escape = |v: usize| b.escape.get(v - 1).copied().unwrap_or(f64::INFINITY);
         while b.next_row < n {
             let a = b.next_row;
             for c in 0..n {
                 let value = match (a, c) {
                     (0, 0) => continue,
-                    (0, c) => b.shapes[c - 1].distance_to_point(self.options.start),
-                    (a, 0) => self.tail(b.node_piece[a - 1].0, &b.shapes[a - 1]),
+                    (0, c) => b.shapes[c - 1]
+                        .distance_to_point(self.options.start)
+                        .min(escape(c)),
+                    (a, 0) => self
+                        .tail(b.node_piece[a - 1].0, &b.shapes[a - 1])
+                        .min(escape(a)),
                     (a, c) if b.node_piece[a - 1].0 == b.node_piece[c - 1].0 => continue,
                     // Symmetric: the lower triangle was filled from the upper one.
                     (a, c) if c < a => b.cost[c * n + a],
-                    (a, c) => b.shapes[a - 1].distance_to(&b.shapes[c - 1]),
+                    (a, c) => b.shapes[a - 1]
+                        .distance_to(&b.shapes[c - 1])
+                        .min(escape(a) + escape(c)),
                 };
                 b.cost[a * n + c] = value;
             }
@@ -729,4 +1025,69 @@ fn debug_log(message: impl FnOnce() -> String) {
     if std::env::var_os("CCP_BOUND_DEBUG").is_some() {
         eprintln!("[ccp bound] {}", message());
     }
+}
+
+/// Splits the kept contours into groups of at most `size` that lie together: units (the kept
+/// contours inside one outermost contour, or a lone contour; a unit larger than `size` is
+/// split into its contours) halved recursively across the longer side of their box, at the
+/// median by count. Few, compact groups keep the decomposition's loss at the group borders
+/// small.
+fn spatial_groups(leaves: &[Leaf], size: usize) -> Vec<Vec<usize>> {
+    let mut by_outer: HashMap<ContourRef, Vec<usize>> = HashMap::new();
+    let mut units: Vec<Vec<usize>> = Vec::new();
+    for (i, leaf) in leaves.iter().enumerate() {
+        match leaf.outermost {
+            Some(o) => by_outer.entry(o).or_default().push(i),
+            None => units.push(vec![i]),
+        }
+    }
+    let mut outer: Vec<(ContourRef, Vec<usize>)> = by_outer.into_iter().collect();
+    // HashMap order is not deterministic: sort so the groups are.
+    outer.sort_by_key(|(_, m)| m[0]);
+    for (_, members) in outer {
+        if members.len() > size {
+            units.extend(members.into_iter().map(|i| vec![i]));
+        } else {
+            units.push(members);
+        }
+    }
+    let centre = |unit: &[usize]| {
+        let b = unit
+            .iter()
+            .map(|&i| leaves[i].contour.bounding_box())
+            .fold(BoundingBox::default(), |acc, b| acc.union(b));
+        Point::new(0.5 * (b.min.x + b.max.x), 0.5 * (b.min.y + b.max.y))
+    };
+    let units: Vec<(Point, Vec<usize>)> = units.into_iter().map(|u| (centre(&u), u)).collect();
+    let mut out = Vec::new();
+    let mut todo = vec![units];
+    while let Some(mut set) = todo.pop() {
+        let count: usize = set.iter().map(|(_, u)| u.len()).sum();
+        if count <= size || set.len() < 2 {
+            out.push(set.into_iter().flat_map(|(_, u)| u).collect());
+            continue;
+        }
+        let b = set
+            .iter()
+            .fold(BoundingBox::default(), |acc, (c, _)| acc.including(*c));
+        if b.width() >= b.height() {
+            set.sort_by(|p, q| p.0.x.total_cmp(&q.0.x).then(p.0.y.total_cmp(&q.0.y)));
+        } else {
+            set.sort_by(|p, q| p.0.y.total_cmp(&q.0.y).then(p.0.x.total_cmp(&q.0.x)));
+        }
+        // Halves of equal count, in multiples of `size` where possible (fewer groups).
+        let parts = count.div_ceil(size);
+        let target = parts / 2 * count / parts;
+        let mut taken = 0;
+        let mut cut = 0;
+        while cut + 1 < set.len() && taken + set[cut].1.len() <= target.max(1) {
+            taken += set[cut].1.len();
+            cut += 1;
+        }
+        let cut = cut.max(1);
+        let rest = set.split_off(cut);
+        todo.push(set);
+        todo.push(rest);
+    }
+    out
 }

@@ -355,3 +355,93 @@ fn at_fixed_candidates_never_above_the_discrete_optimum_and_exact_without_holes(
     }
     assert!(without_holes > 0, "no nest without holes was tried");
 }
+
+/// Six parts packed on a 3 × 2 grid (gaps of a few mm, as on real sheets), the first with a
+/// hole holding a small part: more contours than the random nests, so groups of one or two
+/// kept contours border each other closely.
+fn packed_nest(seed: u64) -> Nest {
+    let mut rng = Rng(seed.wrapping_mul(0x2545_F491_4F6C_DD1D) | 1);
+    let mut parts = Vec::new();
+    for i in 0..6 {
+        let centre = Point::new(
+            28.0 * (i % 3) as f64 + rng.range(-2.0, 2.0),
+            28.0 * (i / 3) as f64 + rng.range(-2.0, 2.0) + 15.0,
+        );
+        let corners = 3 + (rng.next() * 4.0) as usize;
+        let radius = rng.range(9.0, 12.0);
+        let mut contours = vec![polygon(&mut rng, centre, radius, corners, false)];
+        if i == 0 {
+            contours.push(polygon(&mut rng, centre, 0.5 * radius, 5, true));
+            parts.push(Part {
+                name: "inner".into(),
+                contours: vec![polygon(&mut rng, centre, 0.2 * radius, 4, false)],
+            });
+        }
+        parts.push(Part {
+            name: format!("part {i}"),
+            contours,
+        });
+    }
+    Nest { sheet: None, parts }
+}
+
+/// The decomposition bound (the sum of the spatial groups' bounds, each group charged only
+/// for the length a route runs inside its region) is never above a brute-force route, with
+/// groups of one and two kept contours (the most borders), on random and packed nests, open
+/// and closed; and it is not trivially zero.
+#[test]
+fn the_groups_sum_never_above_brute_force() {
+    let mut positive = 0;
+    let mut cases = 0;
+    for seed in 1..=8u64 {
+        for (nest, h) in [(random_nest(seed), 0.25), (packed_nest(seed), 1.0)] {
+            let start = Point::new(-30.0, -10.0);
+            let finish = (seed % 3 == 0).then_some(Point::new(150.0, -20.0));
+            let brute = brute_force(&nest, start, finish, h);
+            for group_size in [1, 2] {
+                let options = LowerBoundOptions {
+                    start,
+                    finish,
+                    budget_seconds: 2.0,
+                    group_size,
+                    decompose_above: 0,
+                    ..LowerBoundOptions::default()
+                };
+                let mut bound = CcpLowerBound::new(&nest, options).unwrap();
+                if bound.kept_contours() <= group_size {
+                    assert_eq!(bound.group_count(), 0);
+                    continue;
+                }
+                assert!(bound.group_count() >= 2, "seed {seed}: no groups");
+                let ccp = solve(
+                    &nest,
+                    CcpOptions {
+                        start,
+                        finish,
+                        time_limit: Duration::from_millis(300),
+                        ..CcpOptions::default()
+                    },
+                    &mut |_| {},
+                )
+                .unwrap();
+                bound.offer_route(&ccp.route);
+                let lb = run_bound(&mut bound, usize::MAX, Duration::from_secs(2));
+                let sum = bound.group_sum();
+                cases += 1;
+                positive += usize::from(sum > 0.05 * brute);
+                assert!(
+                    sum <= brute + 1e-9,
+                    "seed {seed}, groups of {group_size}: sum {sum} above brute force {brute}"
+                );
+                assert!(lb <= brute + 1e-9, "seed {seed}: bound {lb} above {brute}");
+                assert!(lb >= sum && lb >= bound.whole_bound());
+            }
+        }
+    }
+    assert!(cases >= 16, "only {cases} cases had groups");
+    assert!(
+        positive * 2 >= cases,
+        "the groups' sum was trivial in {} of {cases} cases",
+        cases - positive
+    );
+}

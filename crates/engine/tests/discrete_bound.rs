@@ -12,8 +12,9 @@ use web_time::Duration;
 /// The exact job with the interval bound of the nest beside it (`DiscreteJob::with_lower_bound`,
 /// as `start_job` builds it for nests above 35 contours): never above the discrete optimum,
 /// proven here by the exact solver alone on small random nests (5–7 contours, coarse steps),
-/// with and without a finish point, for both the refined continuous bound and the bound at the
-/// discretisation's candidates.
+/// with and without a finish point, for the refined continuous bound, the same with the
+/// decomposition by spatial groups forced on (groups of one and two kept contours), and the
+/// bound at the discretisation's candidates.
 #[test]
 fn discrete_exact_job_bound_never_exceeds_the_discrete_optimum() {
     use cutroute_ccp::{CcpLowerBound, DiscreteNode, LowerBoundOptions};
@@ -54,11 +55,13 @@ fn discrete_exact_job_bound_never_exceeds_the_discrete_optimum() {
                 DiscreteNode::Depot(_) => None,
             })
             .collect();
-        for at_candidates in [false, true] {
+        for (at_candidates, group_size) in [(false, 0), (false, 1), (false, 2), (true, 0)] {
             let options = LowerBoundOptions {
                 start,
                 finish,
                 budget_seconds: 1.0,
+                group_size,
+                decompose_above: 0,
                 ..Default::default()
             };
             let bound = if at_candidates {
@@ -83,7 +86,7 @@ fn discrete_exact_job_bound_never_exceeds_the_discrete_optimum() {
             let lb = result.lower_bound.expect("a lower bound");
             assert!(
                 lb <= optimum * (1.0 + 1e-9) + 1e-9,
-                "seed {seed} ({at_candidates}): job bound {lb} above the discrete optimum {optimum}"
+                "seed {seed} ({at_candidates}, groups of {group_size}): job bound {lb} above the discrete optimum {optimum}"
             );
             let ub = result.upper_bound.expect("a tour");
             assert!(ub >= optimum - 1e-6 * optimum.max(1.0), "seed {seed}");
@@ -109,6 +112,29 @@ fn discrete_exact_job_on_seven_reports_a_bound_below_its_route() {
         solver: SolverKind::Exact,
         params: SolverParams {
             time_limit_s: 3.0,
+            discretisation_step_mm: 25.0,
+            ..SolverParams::default()
+        },
+    };
+    let mut job = start_job(&request).expect("starts");
+    let result = run_to_end(job.as_mut(), &mut |_| {});
+    let idle = check_route(&document.problem, &result);
+    let lb = result.lower_bound.expect("a lower bound");
+    assert!(lb > 0.0 && lb <= idle, "bound {lb} vs route {idle}");
+}
+
+/// On nested.dbs (87 contours, 70 innermost: the bound runs the decomposition by spatial
+/// groups) the job's bound stays below its own route.
+#[test]
+fn discrete_exact_job_on_nested_reports_a_bound_below_its_route() {
+    let (name, bytes) = data("nests/dbs/nested.dbs");
+    let document = open_document(&name, &bytes).expect("opens");
+    let request = JobRequest {
+        job_id: 5,
+        problem: document.problem.clone(),
+        solver: SolverKind::Exact,
+        params: SolverParams {
+            time_limit_s: 4.0,
             discretisation_step_mm: 25.0,
             ..SolverParams::default()
         },
