@@ -1,7 +1,7 @@
 //! The application shell: sample picker, solver panel, live bounds, the route drawing with its
 //! layers, the animation, exports, and the comparison of kept results.
 
-use cutroute_geometry::{MachineParameters, Nest, Objective, PathRoute, Point, Route, Toolpath};
+use cutroute_geometry::{Nest, Objective, PathRoute, Point, Route, Toolpath};
 use cutroute_protocol::{
     Document, FromWorker, JobId, JobRequest, Problem, Progress, SolverKind, SolverParams, ToWorker,
 };
@@ -91,6 +91,7 @@ pub fn App() -> impl IntoView {
         .and_then(|w| w.location().search().ok())
         .unwrap_or_default();
     let initial = Settings::load().with_query(&query);
+    let lecture_url = crate::gallery::list_url(&query);
 
     let document = RwSignal::new(None::<Document>);
     let open_error = RwSignal::new(None::<String>);
@@ -112,27 +113,37 @@ pub fn App() -> impl IntoView {
     let continued_from = StoredValue::new(None::<Progress>);
     let runs = StoredValue::new(0_u64);
     let kept = RwSignal::new(Vec::<Kept>::new());
-    let machine = RwSignal::new(MachineParameters::default());
+    let machine = RwSignal::new(initial.machine);
+    let file_url = RwSignal::new(initial.file_url.clone());
+    let gcode_choice = RwSignal::new(crate::export::GcodeChoice::of_preset(
+        cutroute_gcode::GcodePreset::Generic,
+        &initial.machine,
+    ));
     let objective = RwSignal::new(objective_from_name(&initial.objective).unwrap_or_default());
     let thermal_settings = RwSignal::new(initial.thermal);
     // The tool-on paths a G-code file holds when they are not whole contours.
     let file_paths = RwSignal::new(None::<PathRoute>);
     let presentation = RwSignal::new(false);
 
-    // Everything remembered is saved whenever it changes.
+    // The page's state, as remembered and as linked.
+    let current_settings = move || Settings {
+        sample: sample.get(),
+        last_file: last_file.get(),
+        solver: solver.get().name().to_string(),
+        time_limit_s: time_limit.get(),
+        seed: seed.get(),
+        step_mm: step_mm.get(),
+        hidden_layers: hidden_layers.get(),
+        objective: objective.get().name().to_string(),
+        thermal: thermal_settings.get(),
+        file_url: file_url.get(),
+        machine: machine.get(),
+    };
+    // Everything remembered is saved whenever it changes, and the address bar follows it.
     Effect::new(move |_| {
-        Settings {
-            sample: sample.get(),
-            last_file: last_file.get(),
-            solver: solver.get().name().to_string(),
-            time_limit_s: time_limit.get(),
-            seed: seed.get(),
-            step_mm: step_mm.get(),
-            hidden_layers: hidden_layers.get(),
-            objective: objective.get().name().to_string(),
-            thermal: thermal_settings.get(),
-        }
-        .save();
+        let settings = current_settings();
+        settings.save();
+        crate::links::replace_address(&settings.query());
     });
 
     // Every report of the running job is a point of the bounds chart.
@@ -320,6 +331,7 @@ pub fn App() -> impl IntoView {
     let open_sample = move |file_name: String| {
         let request_id = take_id();
         sample.set(file_name.clone());
+        file_url.set(None);
         leptos::task::spawn_local(async move {
             let url = format!("./assets/samples/{file_name}");
             match fetch_bytes(&url).await {
@@ -333,7 +345,46 @@ pub fn App() -> impl IntoView {
             }
         });
     };
-    open_sample(initial.sample.clone());
+    // A hosted nest (`?file=URL`): fetched here, opened by the worker like a dropped file.
+    let open_url = move |url: String| {
+        let request_id = take_id();
+        file_url.set(Some(url.clone()));
+        last_file.set(None);
+        leptos::task::spawn_local(async move {
+            match fetch_bytes(&url).await {
+                Ok(bytes) => bridge.with_value(|b| {
+                    b.send(ToWorker::Open {
+                        request_id,
+                        files: vec![(crate::links::file_name_of(&url), bytes)],
+                    })
+                }),
+                Err(message) => open_error.set(Some(format!("{url}: {message}"))),
+            }
+        });
+    };
+    match initial.file_url.clone() {
+        Some(url) => open_url(url),
+        None => open_sample(initial.sample.clone()),
+    }
+    // A lecture card: its settings as a link would set them, then its nest.
+    let pick_lecture = Callback::new(move |(url, query): (String, String)| {
+        let s = current_settings().with_query(&query);
+        if let Some(kind) = SolverKind::from_name(&s.solver) {
+            solver.set(kind);
+        }
+        time_limit.set(s.time_limit_s);
+        seed.set(s.seed);
+        step_mm.set(s.step_mm);
+        objective.set(objective_from_name(&s.objective).unwrap_or_default());
+        thermal_settings.set(s.thermal);
+        machine.set(s.machine);
+        hidden_layers.set(s.hidden_layers);
+        last_file.set(None);
+        match crate::gallery::bundled_sample(&url) {
+            Some(name) => open_sample(name),
+            None => open_url(url),
+        }
+    });
 
     // Local files (picker or drag and drop) go to the worker as bytes, all in one request: the
     // engine's one door decides what they are and how they combine (a nest with its task and
@@ -353,6 +404,7 @@ pub fn App() -> impl IntoView {
             }
             let names: Vec<String> = batch.iter().map(|(n, _)| n.clone()).collect();
             last_file.set(Some(names.join(" + ")));
+            file_url.set(None);
             let request_id = take_id();
             bridge.with_value(|b| {
                 b.send(ToWorker::Open {
@@ -488,25 +540,7 @@ pub fn App() -> impl IntoView {
     });
     on_cleanup(move || fullscreen.remove());
 
-    let share_link = move || {
-        let settings = Settings {
-            sample: sample.get(),
-            solver: solver.get().name().to_string(),
-            time_limit_s: time_limit.get(),
-            seed: seed.get(),
-            step_mm: step_mm.get(),
-            objective: objective.get().name().to_string(),
-            thermal: thermal_settings.get(),
-            ..Settings::default()
-        };
-        let base = web_sys::window()
-            .and_then(|w| {
-                let l = w.location();
-                Some(format!("{}{}", l.origin().ok()?, l.pathname().ok()?))
-            })
-            .unwrap_or_default();
-        format!("{base}{}", settings.query())
-    };
+    let share_link = move || crate::links::page_link(&current_settings().query());
 
     // H of the shown route under the panel's σ and τ, for the comparison table.
     let shown_heat = move || {
@@ -592,7 +626,9 @@ pub fn App() -> impl IntoView {
                 paths=shown_paths
                 toolpath=shown_toolpath
                 machine=machine
+                choice=gcode_choice
             />
+            <crate::gallery::LectureGallery list_url=lecture_url pick=pick_lecture />
         </header>
         <section class="solver-panel" aria-label="Solver">
             <label title="Which algorithm routes the tool">
@@ -682,6 +718,7 @@ pub fn App() -> impl IntoView {
                 "Link "
                 <input id="share-link" type="text" readonly prop:value=share_link />
             </label>
+            <crate::links::CopyLinkButton link=Signal::derive(share_link) />
             <p id="solver-uses" class="note">{move || solver_uses(solver.get())}</p>
         </section>
         <main class="workspace">
@@ -740,6 +777,7 @@ pub fn App() -> impl IntoView {
                 <AnimationControls animation=animation />
             </section>
             <aside class="stats" aria-label="Job status">
+                <crate::announce::ProgressAnnouncer progress=progress />
                 <dl>
                     <dt>"File"</dt>
                     <dd id="file-name">
@@ -774,6 +812,7 @@ pub fn App() -> impl IntoView {
                     </dd>
                 </dl>
                 <StatsPanel nest=shown_nest route=shown_route paths=shown_paths machine=machine />
+                <crate::profiles::ProfilesPanel machine=machine choice=gcode_choice />
                 <ThermalPanel settings=thermal_settings />
                 <ThermalStats progress=progress />
                 <AlternativesTable alternatives=alternatives />
@@ -961,14 +1000,14 @@ fn request_fullscreen(element: &web_sys::Element, settled: impl FnOnce() + 'stat
     }
 }
 
-async fn read_file(file: &web_sys::File) -> Result<Vec<u8>, String> {
+pub(crate) async fn read_file(file: &web_sys::File) -> Result<Vec<u8>, String> {
     let buffer = wasm_bindgen_futures::JsFuture::from(file.array_buffer())
         .await
         .map_err(|e| format!("{e:?}"))?;
     Ok(js_sys::Uint8Array::new(&buffer).to_vec())
 }
 
-async fn fetch_bytes(url: &str) -> Result<Vec<u8>, String> {
+pub(crate) async fn fetch_bytes(url: &str) -> Result<Vec<u8>, String> {
     if let Some(bytes) = crate::embedded::file(url) {
         return Ok(bytes);
     }

@@ -16,7 +16,9 @@ use cutroute_formats::{
     route_html, toolpath_html, write_dbs, write_geometry_json, write_result_json, HtmlOptions,
     ResultExportOptions, RmResult,
 };
-use cutroute_gcode::{path_route_gcode, route_gcode, ArcOutput, DistanceMode, GcodeOptions};
+use cutroute_gcode::{
+    path_route_gcode, route_gcode, ArcOutput, DistanceMode, GcodeOptions, GcodePreset,
+};
 use cutroute_geometry::{MachineParameters, Nest, PathRoute, Route, Toolpath};
 use leptos::prelude::*;
 use wasm_bindgen::JsCast;
@@ -149,9 +151,12 @@ pub fn standalone_html_of_paths(
 /// Why the result JSON export is off for routes of tool-on paths.
 pub const RESULT_JSON_CANNOT_HOLD_PATHS: &str = "Result JSON is off for this route: RouteManager's format cuts each contour whole from one pierce and cannot hold tool-on paths that cut common edges once or parts of contours. Use G-code or the standalone HTML page.";
 
-/// What the G-code panel lets the user choose.
+/// What the G-code panel lets the user choose: a post-processor preset (the controller's
+/// dialect: line numbers, dwell unit, decimals) and, over it, the fields the panel shows.
 #[derive(Clone, Debug, PartialEq)]
 pub struct GcodeChoice {
+    /// The controller's dialect.
+    pub preset: GcodePreset,
     /// `G91` instead of `G90`.
     pub incremental: bool,
     /// "ij", "r" or "lines".
@@ -162,10 +167,35 @@ pub struct GcodeChoice {
     pub torch_off: String,
     /// Pierce dwell, s.
     pub dwell_s: f64,
+    /// Lines at the start of the program.
+    pub header: Vec<String>,
+    /// Lines at its end.
+    pub footer: Vec<String>,
 }
 
 impl GcodeChoice {
-    /// The post-processor's options for this choice under `machine`'s feed.
+    /// The panel filled from `preset` under `machine` (its pierce time is the dwell).
+    pub fn of_preset(preset: GcodePreset, machine: &MachineParameters) -> Self {
+        let o = preset.options(machine);
+        GcodeChoice {
+            preset,
+            incremental: o.distance_mode == DistanceMode::Incremental,
+            arcs: match o.arcs {
+                ArcOutput::Radius => "r",
+                ArcOutput::Lines { .. } => "lines",
+                ArcOutput::CentreOffsets => "ij",
+            }
+            .into(),
+            torch_on: o.torch_on,
+            torch_off: o.torch_off,
+            dwell_s: o.pierce_dwell_s,
+            header: o.header,
+            footer: o.footer,
+        }
+    }
+
+    /// The post-processor's options for this choice under `machine`'s feed: the preset's, with
+    /// the panel's fields over them.
     pub fn options(&self, machine: &MachineParameters) -> GcodeOptions {
         GcodeOptions {
             distance_mode: if self.incremental {
@@ -181,7 +211,9 @@ impl GcodeChoice {
             torch_on: self.torch_on.clone(),
             torch_off: self.torch_off.clone(),
             pierce_dwell_s: self.dwell_s,
-            ..GcodeOptions::for_machine(machine)
+            header: self.header.clone(),
+            footer: self.footer.clone(),
+            ..self.preset.options(machine)
         }
     }
 }
@@ -269,6 +301,8 @@ pub fn ExportMenu(
     paths: Signal<Option<PathRoute>>,
     toolpath: Signal<Option<Toolpath>>,
     machine: RwSignal<MachineParameters>,
+    /// The G-code panel's choice, shared with the machine profiles (`profiles.rs`).
+    choice: RwSignal<GcodeChoice>,
 ) -> impl IntoView {
     let message = RwSignal::new(None::<String>);
     let run = move |make: Exporter| {
@@ -289,13 +323,6 @@ pub fn ExportMenu(
     let no_nest = move || nest.with(Option::is_none);
     let no_route = move || route.with(Option::is_none) && paths.with(Option::is_none);
     let is_paths = move || paths.with(Option::is_some);
-    let choice = RwSignal::new(GcodeChoice {
-        incremental: false,
-        arcs: "ij".into(),
-        torch_on: "M03".into(),
-        torch_off: "M05".into(),
-        dwell_s: machine.get_untracked().pierce_time,
-    });
     let preview = RwSignal::new(String::new());
     let make_gcode = move || -> Result<Download, String> {
         let nest = nest.get_untracked().ok_or("no nest")?;
@@ -390,10 +417,12 @@ pub fn ExportMenu(
             }}
             <fieldset class="gcode">
                 <legend>"G-code"</legend>
+                <crate::profiles::PresetPicker choice=choice machine=machine />
                 <label title="G90: positions; G91: increments from the previous point">
                     "Coordinates "
                     <select
                         id="gcode-distance"
+                        prop:value=move || if choice.with(|c| c.incremental) { "incremental" } else { "absolute" }
                         on:change=move |ev| {
                             let incremental = event_target_value(&ev) == "incremental";
                             choice.update(|c| c.incremental = incremental);
@@ -407,6 +436,7 @@ pub fn ExportMenu(
                     "Arcs "
                     <select
                         id="gcode-arcs"
+                        prop:value=move || choice.with(|c| c.arcs.clone())
                         on:change=move |ev| {
                             let arcs = event_target_value(&ev);
                             choice.update(|c| c.arcs = arcs);
@@ -460,6 +490,7 @@ pub fn ExportMenu(
                         }
                     />
                 </label>
+                <crate::profiles::HeaderFooterFields choice=choice />
                 <button id="gcode-preview-button" disabled=no_route on:click=move |_| show_preview()>
                     "Preview"
                 </button>
@@ -492,12 +523,27 @@ const PREVIEW_LINES: usize = 12;
 
 #[cfg(test)]
 mod tests {
-    use super::stem;
+    use super::{stem, GcodeChoice};
+    use cutroute_gcode::GcodePreset;
+    use cutroute_geometry::MachineParameters;
 
     #[test]
     fn stems_drop_folders_and_every_extension() {
         assert_eq!(stem("E1X_6_01.dbs.json"), "E1X_6_01");
         assert_eq!(stem("C:\\nests\\seven.dbs"), "seven");
         assert_eq!(stem(""), "cutroute");
+    }
+
+    #[test]
+    fn a_preset_untouched_writes_exactly_the_preset() {
+        let machine = MachineParameters::default();
+        for preset in GcodePreset::ALL {
+            let choice = GcodeChoice::of_preset(preset, &machine);
+            assert_eq!(
+                choice.options(&machine),
+                preset.options(&machine),
+                "{preset}"
+            );
+        }
     }
 }
