@@ -139,11 +139,15 @@ pub fn App() -> impl IntoView {
         file_url: file_url.get(),
         machine: machine.get(),
     };
+    // The link of the page's state; a lecture list other than the bundled one rides along.
+    let lecture_query = StoredValue::new(crate::gallery::lecture_query(&lecture_url));
+    let link_query =
+        move |settings: &Settings| format!("{}{}", settings.query(), lecture_query.get_value());
     // Everything remembered is saved whenever it changes, and the address bar follows it.
     Effect::new(move |_| {
         let settings = current_settings();
         settings.save();
-        crate::links::replace_address(&settings.query());
+        crate::links::replace_address(&link_query(&settings));
     });
 
     // Every report of the running job is a point of the bounds chart.
@@ -540,7 +544,7 @@ pub fn App() -> impl IntoView {
     });
     on_cleanup(move || fullscreen.remove());
 
-    let share_link = move || crate::links::page_link(&current_settings().query());
+    let share_link = move || crate::links::page_link(&link_query(&current_settings()));
 
     // H of the shown route under the panel's σ and τ, for the comparison table.
     let shown_heat = move || {

@@ -109,6 +109,18 @@ pub fn list_url(query: &str) -> String {
         .unwrap_or_else(|| BUNDLED.to_string())
 }
 
+/// What a link adds for the list at `url`: nothing for the bundled one.
+pub fn lecture_query(url: &str) -> String {
+    if url == BUNDLED {
+        String::new()
+    } else {
+        format!(
+            "&lecture={}",
+            String::from(js_sys::encode_uri_component(url))
+        )
+    }
+}
+
 /// The bundled sample a resolved address names (`./assets/samples/NAME`), opened as a sample
 /// (so the single-file page, which carries the samples, opens it too).
 pub fn bundled_sample(url: &str) -> Option<String> {
