@@ -332,6 +332,8 @@ pub fn App() -> impl IntoView {
         id
     };
 
+    // The single file shown last, kept so another of its sheets can be opened.
+    let opened_file: StoredValue<Option<(String, Vec<u8>)>> = StoredValue::new(None);
     let open_sample = move |file_name: String| {
         let request_id = take_id();
         sample.set(file_name.clone());
@@ -339,12 +341,15 @@ pub fn App() -> impl IntoView {
         leptos::task::spawn_local(async move {
             let url = format!("./assets/samples/{file_name}");
             match fetch_bytes(&url).await {
-                Ok(bytes) => bridge.with_value(|b| {
-                    b.send(ToWorker::Open {
-                        request_id,
-                        files: vec![(file_name, bytes)],
+                Ok(bytes) => {
+                    opened_file.set_value(Some((file_name.clone(), bytes.clone())));
+                    bridge.with_value(|b| {
+                        b.send(ToWorker::Open {
+                            request_id,
+                            files: vec![(file_name, bytes)],
+                        })
                     })
-                }),
+                }
                 Err(message) => open_error.set(Some(format!("{url}: {message}"))),
             }
         });
@@ -356,12 +361,16 @@ pub fn App() -> impl IntoView {
         last_file.set(None);
         leptos::task::spawn_local(async move {
             match fetch_bytes(&url).await {
-                Ok(bytes) => bridge.with_value(|b| {
-                    b.send(ToWorker::Open {
-                        request_id,
-                        files: vec![(crate::links::file_name_of(&url), bytes)],
+                Ok(bytes) => {
+                    let name = crate::links::file_name_of(&url);
+                    opened_file.set_value(Some((name.clone(), bytes.clone())));
+                    bridge.with_value(|b| {
+                        b.send(ToWorker::Open {
+                            request_id,
+                            files: vec![(name, bytes)],
+                        })
                     })
-                }),
+                }
                 Err(message) => open_error.set(Some(format!("{url}: {message}"))),
             }
         });
@@ -370,6 +379,19 @@ pub fn App() -> impl IntoView {
         Some(url) => open_url(url),
         None => open_sample(initial.sample.clone()),
     }
+    // Another sheet of the multi-sheet file shown.
+    let open_sheet = Callback::new(move |sheet: usize| {
+        if let Some(file) = opened_file.get_value() {
+            let request_id = take_id();
+            bridge.with_value(|b| {
+                b.send(ToWorker::OpenSheet {
+                    request_id,
+                    file,
+                    sheet,
+                })
+            });
+        }
+    });
     // A lecture card: its settings as a link would set them, then its nest.
     let pick_lecture = Callback::new(move |(url, query): (String, String)| {
         let s = current_settings().with_query(&query);
@@ -409,6 +431,7 @@ pub fn App() -> impl IntoView {
             let names: Vec<String> = batch.iter().map(|(n, _)| n.clone()).collect();
             last_file.set(Some(names.join(" + ")));
             file_url.set(None);
+            opened_file.set_value((batch.len() == 1).then(|| batch[0].clone()));
             let request_id = take_id();
             bridge.with_value(|b| {
                 b.send(ToWorker::Open {
@@ -613,6 +636,7 @@ pub fn App() -> impl IntoView {
                     }
                 />
             </label>
+            <crate::sheets::SheetPicker document=document open=open_sheet />
             <crate::theme::ThemePicker />
             <crate::i18n::LanguagePicker />
             <button
@@ -822,6 +846,7 @@ pub fn App() -> impl IntoView {
                 <AlternativesTable alternatives=alternatives />
                 <BoundsChart samples=samples log_time=log_time unit=bound_unit />
                 <LayerPanel hidden=hidden_layers />
+                <crate::legend::DrawingLegend />
                 <ComparePanel
                     kept=kept
                     keep=keep

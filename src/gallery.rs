@@ -159,6 +159,7 @@ pub fn Gallery(
     view! {
         <details id="gallery" class="gallery">
             <summary>{tr("Lectures", "Лекции")}</summary>
+            <div class="gallery-panel">
             {move || match list.get() {
                 None => view! { <p class="muted">{tr("loading…", "загрузка…")}</p> }.into_any(),
                 Some(Err(e)) => {
@@ -205,6 +206,7 @@ pub fn Gallery(
                         .into_any()
                 }
             }}
+            </div>
         </details>
     }
 }
