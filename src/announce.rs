@@ -1,7 +1,7 @@
 //! Progress for screen readers: a polite live region that speaks the phase, the bounds and the
 //! gap, not every report (a job reports many times a second), but when the phase changes, when
-//! a bound improves by more than 1 %, or when the job proves optimality; at most one
-//! announcement every few seconds, phase changes and the proof excepted.
+//! a bound improves by more than 1 %, when the job proves optimality, and when it ends; at most
+//! one announcement of improvements every few seconds.
 
 use cutroute_protocol::Progress;
 use leptos::prelude::*;
@@ -18,12 +18,13 @@ struct Said {
     upper: Option<f64>,
     lower: Option<f64>,
     optimal: bool,
+    ended: bool,
     at_ms: f64,
 }
 
 /// Whether `p` is worth announcing after `said` at time `now_ms`.
-fn worth_saying(said: &Said, p: &Progress, now_ms: f64) -> bool {
-    if p.phase != said.phase || p.proven_optimal != said.optimal {
+fn worth_saying(said: &Said, p: &Progress, ended: bool, now_ms: f64) -> bool {
+    if p.phase != said.phase || p.proven_optimal != said.optimal || ended != said.ended {
         return true;
     }
     let moved = |new: Option<f64>, old: Option<f64>| match (new, old) {
@@ -35,9 +36,13 @@ fn worth_saying(said: &Said, p: &Progress, now_ms: f64) -> bool {
         && now_ms - said.at_ms >= QUIET_MS
 }
 
-/// The live region (visually hidden) that announces `progress`.
+/// The live region (visually hidden) that announces `progress`; `ended` is true once the job
+/// has stopped (its last state is always said).
 #[component]
-pub fn ProgressAnnouncer(progress: RwSignal<Option<Progress>>) -> impl IntoView {
+pub fn ProgressAnnouncer(
+    progress: RwSignal<Option<Progress>>,
+    ended: Signal<bool>,
+) -> impl IntoView {
     let language = use_language();
     let said = StoredValue::new(Said::default());
     let text = RwSignal::new(String::new());
@@ -46,8 +51,9 @@ pub fn ProgressAnnouncer(progress: RwSignal<Option<Progress>>) -> impl IntoView 
             said.set_value(Said::default());
             return;
         };
+        let ended = ended.get();
         let now = js_sys::Date::now();
-        if !said.with_value(|s| worth_saying(s, &p, now)) {
+        if !said.with_value(|s| worth_saying(s, &p, ended, now)) {
             return;
         }
         said.set_value(Said {
@@ -55,6 +61,7 @@ pub fn ProgressAnnouncer(progress: RwSignal<Option<Progress>>) -> impl IntoView 
             upper: p.upper_bound,
             lower: p.lower_bound,
             optimal: p.proven_optimal,
+            ended,
             at_ms: now,
         });
         let number = |v: Option<f64>| v.map_or("—".to_string(), |v| format!("{v:.1}"));
@@ -106,21 +113,33 @@ mod tests {
             at_ms: 0.0,
             ..Said::default()
         };
-        assert!(worth_saying(&said, &progress("bound", Some(1000.0)), 10.0));
+        assert!(worth_saying(
+            &said,
+            &progress("bound", Some(1000.0)),
+            false,
+            10.0
+        ));
         assert!(!worth_saying(
             &said,
             &progress("search", Some(995.0)),
+            false,
             10_000.0
         ));
         assert!(!worth_saying(
             &said,
             &progress("search", Some(900.0)),
+            false,
             100.0
         ));
         assert!(worth_saying(
             &said,
             &progress("search", Some(900.0)),
+            false,
             5_000.0
         ));
+        assert!(
+            worth_saying(&said, &progress("search", Some(995.0)), true, 100.0),
+            "the end is said"
+        );
     }
 }

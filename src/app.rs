@@ -637,16 +637,6 @@ pub fn App() -> impl IntoView {
                 />
             </label>
             <crate::sheets::SheetPicker document=document open=open_sheet />
-            <crate::theme::ThemePicker />
-            <crate::i18n::LanguagePicker />
-            <button
-                id="present"
-                aria-pressed=move || presentation.get().to_string()
-                title="Presentation mode: large fonts, full screen (key F)"
-                on:click=move |_| presentation.update(|p| *p = !*p)
-            >
-                "Present"
-            </button>
             <ExportMenu
                 file_name=file_name
                 nest=shown_nest
@@ -657,6 +647,16 @@ pub fn App() -> impl IntoView {
                 choice=gcode_choice
             />
             <crate::gallery::LectureGallery list_url=lecture_url pick=pick_lecture />
+            <crate::theme::ThemePicker />
+            <crate::i18n::LanguagePicker />
+            <button
+                id="present"
+                aria-pressed=move || presentation.get().to_string()
+                title="Presentation mode: large fonts, full screen (key F)"
+                on:click=move |_| presentation.update(|p| *p = !*p)
+            >
+                "Present"
+            </button>
         </header>
         <section class="solver-panel" aria-label="Solver">
             <label title="Which algorithm routes the tool">
@@ -805,7 +805,7 @@ pub fn App() -> impl IntoView {
                 <AnimationControls animation=animation />
             </section>
             <aside class="stats" aria-label="Job status">
-                <crate::announce::ProgressAnnouncer progress=progress />
+                <crate::announce::ProgressAnnouncer progress=progress ended=Signal::derive(move || !running()) />
                 <dl>
                     <dt>"File"</dt>
                     <dd id="file-name">
