@@ -190,8 +190,13 @@ impl Settings {
             }
             match key {
                 "sample" if crate::app::SAMPLES.iter().any(|(f, _)| *f == value) => {
+                    // The address bar follows the page, so a reload brings the query of the
+                    // sample shown beside a remembered local file: that keeps the reminder;
+                    // a link to another sample forgets it.
+                    if value != self.sample {
+                        self.last_file = None;
+                    }
                     self.sample = value;
-                    self.last_file = None;
                     self.file_url = None;
                 }
                 "file" if !value.is_empty() => {
@@ -479,5 +484,18 @@ mod tests {
         assert_eq!(nonsense.machine, MachineParameters::default());
         let sample = Settings::default().with_query("?file=x.dbs&sample=seven.dbs");
         assert_eq!(sample.file_url, None, "the later of file and sample wins");
+    }
+
+    #[test]
+    fn a_reload_keeps_the_local_file_reminder_and_another_sample_forgets_it() {
+        let stored = Settings {
+            sample: "test1.dbs.json".into(),
+            last_file: Some("nested.dbs".into()),
+            ..Settings::default()
+        };
+        let reloaded = stored.clone().with_query(&stored.query());
+        assert_eq!(reloaded.last_file.as_deref(), Some("nested.dbs"));
+        let other = stored.with_query("?sample=seven.dbs");
+        assert_eq!(other.last_file, None);
     }
 }
