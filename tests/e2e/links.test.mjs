@@ -8,7 +8,7 @@ import http from 'node:http';
 import os from 'node:os';
 import path from 'node:path';
 import { execFileSync } from 'node:child_process';
-import { watchErrors, projectRoot, useApp, screenshot } from './harness.mjs';
+import { watchErrors, projectRoot, distDir, useApp, screenshot } from './harness.mjs';
 
 const app = useApp(before, after);
 const nests = path.join(projectRoot, 'data', 'nests');
@@ -210,4 +210,24 @@ test('the lecture gallery opens the bundled samples with their settings, and ?le
   } finally {
     host.server.close();
   }
+});
+
+test('the single-file page from file:// carries the bundled lecture list and opens its cards', async () => {
+  const file = path.join(distDir, 'cutroute.html');
+  assert.ok(fs.existsSync(file), `no ${file}: run scripts/build-release.sh`);
+  const alone = fs.mkdtempSync(path.join(fs.realpathSync(os.tmpdir()), 'cutroute-usb-'));
+  fs.copyFileSync(file, path.join(alone, 'cutroute.html'));
+  const page = await app.browser.newPage({ viewport: { width: 1280, height: 800 } });
+  const errors = watchErrors(page);
+  await page.goto(`file://${path.join(alone, 'cutroute.html')}`);
+  await fileShown(page, 'E1X_6_01');
+  await page.locator('#gallery summary').click();
+  const bundled = JSON.parse(fs.readFileSync(path.join(projectRoot, 'assets', 'lectures.json'), 'utf8'));
+  await page.waitForFunction((n) => document.querySelectorAll('#gallery button.lecture').length === n, bundled.lectures.length);
+  const seven = bundled.lectures.findIndex((l) => l.file.endsWith('seven.dbs'));
+  await page.click(`#lecture-${seven}`);
+  await fileShown(page, 'seven.dbs');
+  assert.equal(await page.inputValue('#solver'), bundled.lectures[seven].solver);
+  assert.deepEqual(errors, []);
+  await page.close();
 });
