@@ -138,6 +138,7 @@ pub fn App() -> impl IntoView {
         thermal: thermal_settings.get(),
         file_url: file_url.get(),
         machine: machine.get(),
+        sheet: document.with(|d| d.as_ref().map_or(0, |d| d.sheet)),
     };
     // The link of the page's state; a lecture list other than the bundled one rides along.
     let lecture_query = StoredValue::new(crate::gallery::lecture_query(&lecture_url));
@@ -354,8 +355,9 @@ pub fn App() -> impl IntoView {
             }
         });
     };
-    // A hosted nest (`?file=URL`): fetched here, opened by the worker like a dropped file.
-    let open_url = move |url: String| {
+    // A hosted nest (`?file=URL`, `&sheet=N` of a multi-sheet one): fetched here, opened by the
+    // worker like a dropped file.
+    let open_url = move |url: String, sheet: usize| {
         let request_id = take_id();
         file_url.set(Some(url.clone()));
         last_file.set(None);
@@ -365,9 +367,17 @@ pub fn App() -> impl IntoView {
                     let name = crate::links::file_name_of(&url);
                     opened_file.set_value(Some((name.clone(), bytes.clone())));
                     bridge.with_value(|b| {
-                        b.send(ToWorker::Open {
-                            request_id,
-                            files: vec![(name, bytes)],
+                        b.send(if sheet > 0 {
+                            ToWorker::OpenSheet {
+                                request_id,
+                                file: (name, bytes),
+                                sheet,
+                            }
+                        } else {
+                            ToWorker::Open {
+                                request_id,
+                                files: vec![(name, bytes)],
+                            }
                         })
                     })
                 }
@@ -376,7 +386,7 @@ pub fn App() -> impl IntoView {
         });
     };
     match initial.file_url.clone() {
-        Some(url) => open_url(url),
+        Some(url) => open_url(url, initial.sheet),
         None => open_sample(initial.sample.clone()),
     }
     // Another sheet of the multi-sheet file shown.
@@ -394,7 +404,12 @@ pub fn App() -> impl IntoView {
     });
     // A lecture card: its settings as a link would set them, then its nest.
     let pick_lecture = Callback::new(move |(url, query): (String, String)| {
-        let s = current_settings().with_query(&query);
+        // A card's file starts at its first sheet unless the card names another.
+        let s = Settings {
+            sheet: 0,
+            ..current_settings()
+        }
+        .with_query(&query);
         if let Some(kind) = SolverKind::from_name(&s.solver) {
             solver.set(kind);
         }
@@ -408,7 +423,7 @@ pub fn App() -> impl IntoView {
         last_file.set(None);
         match crate::gallery::bundled_sample(&url) {
             Some(name) => open_sample(name),
-            None => open_url(url),
+            None => open_url(url, s.sheet),
         }
     });
 

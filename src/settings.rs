@@ -116,6 +116,9 @@ pub struct Settings {
     pub file_url: Option<String>,
     /// Machine speeds, pierce time and prices (the stats panel's, and a profile's).
     pub machine: MachineParameters,
+    /// The sheet shown of a multi-sheet file, from 0 (`sheet=N` in a link counts from 1, as the
+    /// CLI's `--sheet`).
+    pub sheet: usize,
 }
 
 /// The machine parameters a link carries: (query key, getter, setter).
@@ -164,6 +167,7 @@ impl Default for Settings {
             thermal: params.thermal,
             file_url: None,
             machine: MachineParameters::default(),
+            sheet: 0,
         }
     }
 }
@@ -202,6 +206,11 @@ impl Settings {
                 "file" if !value.is_empty() => {
                     self.file_url = Some(value);
                     self.last_file = None;
+                }
+                "sheet" => {
+                    if let Some(n) = value.parse::<usize>().ok().filter(|n| *n >= 1) {
+                        self.sheet = n - 1;
+                    }
                 }
                 "hide" => {
                     self.hidden_layers = value
@@ -273,6 +282,9 @@ impl Settings {
             "?{opened}&solver={}&time={}&seed={}&step={}&objective={}",
             self.solver, self.time_limit_s, self.seed, self.step_mm, self.objective
         );
+        if self.sheet > 0 {
+            query.push_str(&format!("&sheet={}", self.sheet + 1));
+        }
         let defaults = MachineParameters::default();
         for (key, get, _) in MACHINE_KEYS {
             if get(&self.machine) != get(&defaults) {
@@ -482,6 +494,14 @@ mod tests {
         assert!(!hidden.query().contains("hide="));
         let nonsense = Settings::default().with_query("?cut_speed=0&pierce_time=-1&idle_price=x");
         assert_eq!(nonsense.machine, MachineParameters::default());
+        let sheet = Settings {
+            file_url: Some("p.tfnesting".into()),
+            sheet: 1,
+            ..Settings::default()
+        };
+        assert!(sheet.query().contains("&sheet=2"), "{}", sheet.query());
+        assert_eq!(Settings::default().with_query(&sheet.query()).sheet, 1);
+        assert_eq!(Settings::default().with_query("?sheet=0").sheet, 0);
         let sample = Settings::default().with_query("?file=x.dbs&sample=seven.dbs");
         assert_eq!(sample.file_url, None, "the later of file and sample wins");
     }

@@ -231,3 +231,36 @@ test('the single-file page from file:// carries the bundled lecture list and ope
   assert.deepEqual(errors, []);
   await page.close();
 });
+
+test('a hosted multi-sheet project: &sheet=N opens that sheet and the link follows the sheet picker', async () => {
+  const host = await otherHost(nests, true);
+  try {
+    const file = path.join(nests, 'tflex-multi', 'two-sheets.tfnesting');
+    const url = `${host.url}tflex-multi/two-sheets.tfnesting`;
+    const context = await app.browser.newContext({ viewport: { width: 1280, height: 800 } });
+    const page = await context.newPage();
+    const errors = watchErrors(page);
+    const parts = async () => (await page.locator('#nest-view path.part').count())
+      + ((await page.getAttribute('#nest-view path.sheet', 'd'))?.length > 0 ? 1 : 0);
+    // Sheets count from 1 in links, as the CLI's --sheet does.
+    await page.goto(`${app.baseUrl}?file=${encodeURIComponent(url)}&sheet=2`);
+    await fileShown(page, 'two-sheets');
+    await page.waitForFunction(() => document.querySelector('#sheet')?.value === '1');
+    assert.equal(await parts(), inspect2(file, '2').parts);
+    assert.equal(new URL(page.url()).searchParams.get('sheet'), '2');
+    await page.selectOption('#sheet', '0');
+    await page.waitForFunction(() => !new URL(location.href).searchParams.has('sheet'));
+    assert.equal(await parts(), inspect2(file, '1').parts);
+    await page.selectOption('#sheet', '1');
+    await page.waitForFunction(() => new URL(location.href).searchParams.get('sheet') === '2');
+    assert.deepEqual(errors, []);
+    await context.close();
+  } finally {
+    host.server.close();
+  }
+});
+
+function inspect2(file, sheet) {
+  const binary = path.join(projectRoot, 'target', 'release', 'cutroute');
+  return JSON.parse(execFileSync(binary, ['inspect', file, '--json', '--sheet', sheet], { encoding: 'utf8' }));
+}
