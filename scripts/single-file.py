@@ -59,7 +59,10 @@ end = page.index("</script>", start) + len("</script>")
 worker_js = script_safe((dist / "worker.js").read_text(encoding="utf-8"), "worker.js")
 worker_wasm = b64(dist / "worker_bg.wasm")
 samples = sorted((dist / "assets" / "samples").glob("*"))
-files = ",\n".join(f'  "./assets/samples/{p.name}": "{b64(p)}"' for p in samples)
+# The lecture gallery's bundled list (src/gallery.rs) names the samples beside it.
+carried_files = [(f"./assets/samples/{p.name}", p) for p in samples]
+carried_files.append(("./assets/lectures.json", dist / "assets" / "lectures.json"))
+files = ",\n".join(f'  "{url}": "{b64(p)}"' for url, p in carried_files)
 
 carried = f"""<script id="cutroute-worker-js" type="text/plain">
 {worker_js}

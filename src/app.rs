@@ -1,7 +1,7 @@
 //! The application shell: sample picker, solver panel, live bounds, the route drawing with its
 //! layers, the animation, exports, and the comparison of kept results.
 
-use cutroute_geometry::{MachineParameters, Nest, Objective, PathRoute, Point, Route, Toolpath};
+use cutroute_geometry::{Nest, Objective, PathRoute, Point, Route, Toolpath};
 use cutroute_protocol::{
     Document, FromWorker, JobId, JobRequest, Problem, Progress, SolverKind, SolverParams, ToWorker,
 };
@@ -116,6 +116,7 @@ pub fn App() -> impl IntoView {
         .and_then(|w| w.location().search().ok())
         .unwrap_or_default();
     let initial = Settings::load().with_query(&query);
+    let lecture_url = crate::gallery::list_url(&query);
 
     let document = RwSignal::new(None::<Document>);
     let open_error = RwSignal::new(None::<PageError>);
@@ -137,27 +138,42 @@ pub fn App() -> impl IntoView {
     let continued_from = StoredValue::new(None::<Progress>);
     let runs = StoredValue::new(0_u64);
     let kept = RwSignal::new(Vec::<Kept>::new());
-    let machine = RwSignal::new(MachineParameters::default());
+    let machine = RwSignal::new(initial.machine);
+    let file_url = RwSignal::new(initial.file_url.clone());
+    let gcode_choice = RwSignal::new(crate::export::GcodeChoice::of_preset(
+        cutroute_gcode::GcodePreset::Generic,
+        &initial.machine,
+    ));
     let objective = RwSignal::new(objective_from_name(&initial.objective).unwrap_or_default());
     let thermal_settings = RwSignal::new(initial.thermal);
     // The tool-on paths a G-code file holds when they are not whole contours.
     let file_paths = RwSignal::new(None::<PathRoute>);
     let presentation = RwSignal::new(false);
 
-    // Everything remembered is saved whenever it changes.
+    // The page's state, as remembered and as linked.
+    let current_settings = move || Settings {
+        sample: sample.get(),
+        last_file: last_file.get(),
+        solver: solver.get().name().to_string(),
+        time_limit_s: time_limit.get(),
+        seed: seed.get(),
+        step_mm: step_mm.get(),
+        hidden_layers: hidden_layers.get(),
+        objective: objective.get().name().to_string(),
+        thermal: thermal_settings.get(),
+        file_url: file_url.get(),
+        machine: machine.get(),
+        sheet: document.with(|d| d.as_ref().map_or(0, |d| d.sheet)),
+    };
+    // The link of the page's state; a lecture list other than the bundled one rides along.
+    let lecture_query = StoredValue::new(crate::gallery::lecture_query(&lecture_url));
+    let link_query =
+        move |settings: &Settings| format!("{}{}", settings.query(), lecture_query.get_value());
+    // Everything remembered is saved whenever it changes, and the address bar follows it.
     Effect::new(move |_| {
-        Settings {
-            sample: sample.get(),
-            last_file: last_file.get(),
-            solver: solver.get().name().to_string(),
-            time_limit_s: time_limit.get(),
-            seed: seed.get(),
-            step_mm: step_mm.get(),
-            hidden_layers: hidden_layers.get(),
-            objective: objective.get().name().to_string(),
-            thermal: thermal_settings.get(),
-        }
-        .save();
+        let settings = current_settings();
+        settings.save();
+        crate::links::replace_address(&link_query(&settings));
     });
 
     // Every report of the running job is a point of the bounds chart.
@@ -343,23 +359,99 @@ pub fn App() -> impl IntoView {
         id
     };
 
+    // The single file shown last, kept so another of its sheets can be opened.
+    let opened_file: StoredValue<Option<(String, Vec<u8>)>> = StoredValue::new(None);
     let open_sample = move |file_name: String| {
         let request_id = take_id();
         sample.set(file_name.clone());
+        file_url.set(None);
         leptos::task::spawn_local(async move {
             let url = format!("./assets/samples/{file_name}");
             match fetch_bytes(&url).await {
-                Ok(bytes) => bridge.with_value(|b| {
-                    b.send(ToWorker::Open {
-                        request_id,
-                        files: vec![(file_name, bytes)],
+                Ok(bytes) => {
+                    opened_file.set_value(Some((file_name.clone(), bytes.clone())));
+                    bridge.with_value(|b| {
+                        b.send(ToWorker::Open {
+                            request_id,
+                            files: vec![(file_name, bytes)],
+                        })
                     })
-                }),
+                }
                 Err(message) => open_error.set(Some(PageError::Fetch { url, message })),
             }
         });
     };
-    open_sample(initial.sample.clone());
+    // A hosted nest (`?file=URL`, `&sheet=N` of a multi-sheet one): fetched here, opened by the
+    // worker like a dropped file.
+    let open_url = move |url: String, sheet: usize| {
+        let request_id = take_id();
+        file_url.set(Some(url.clone()));
+        last_file.set(None);
+        leptos::task::spawn_local(async move {
+            match fetch_bytes(&url).await {
+                Ok(bytes) => {
+                    let name = crate::links::file_name_of(&url);
+                    opened_file.set_value(Some((name.clone(), bytes.clone())));
+                    bridge.with_value(|b| {
+                        b.send(if sheet > 0 {
+                            ToWorker::OpenSheet {
+                                request_id,
+                                file: (name, bytes),
+                                sheet,
+                            }
+                        } else {
+                            ToWorker::Open {
+                                request_id,
+                                files: vec![(name, bytes)],
+                            }
+                        })
+                    })
+                }
+                Err(message) => open_error.set(Some(PageError::Fetch { url, message })),
+            }
+        });
+    };
+    match initial.file_url.clone() {
+        Some(url) => open_url(url, initial.sheet),
+        None => open_sample(initial.sample.clone()),
+    }
+    // Another sheet of the multi-sheet file shown.
+    let open_sheet = Callback::new(move |sheet: usize| {
+        if let Some(file) = opened_file.get_value() {
+            let request_id = take_id();
+            bridge.with_value(|b| {
+                b.send(ToWorker::OpenSheet {
+                    request_id,
+                    file,
+                    sheet,
+                })
+            });
+        }
+    });
+    // A lecture card: its settings as a link would set them, then its nest.
+    let pick_lecture = Callback::new(move |(url, query): (String, String)| {
+        // A card's file starts at its first sheet unless the card names another.
+        let s = Settings {
+            sheet: 0,
+            ..current_settings()
+        }
+        .with_query(&query);
+        if let Some(kind) = SolverKind::from_name(&s.solver) {
+            solver.set(kind);
+        }
+        time_limit.set(s.time_limit_s);
+        seed.set(s.seed);
+        step_mm.set(s.step_mm);
+        objective.set(objective_from_name(&s.objective).unwrap_or_default());
+        thermal_settings.set(s.thermal);
+        machine.set(s.machine);
+        hidden_layers.set(s.hidden_layers);
+        last_file.set(None);
+        match crate::gallery::bundled_sample(&url) {
+            Some(name) => open_sample(name),
+            None => open_url(url, s.sheet),
+        }
+    });
 
     // Local files (picker or drag and drop) go to the worker as bytes, all in one request: the
     // engine's one door decides what they are and how they combine (a nest with its task and
@@ -382,6 +474,8 @@ pub fn App() -> impl IntoView {
             }
             let names: Vec<String> = batch.iter().map(|(n, _)| n.clone()).collect();
             last_file.set(Some(names.join(" + ")));
+            file_url.set(None);
+            opened_file.set_value((batch.len() == 1).then(|| batch[0].clone()));
             let request_id = take_id();
             bridge.with_value(|b| {
                 b.send(ToWorker::Open {
@@ -517,25 +611,7 @@ pub fn App() -> impl IntoView {
     });
     on_cleanup(move || fullscreen.remove());
 
-    let share_link = move || {
-        let settings = Settings {
-            sample: sample.get(),
-            solver: solver.get().name().to_string(),
-            time_limit_s: time_limit.get(),
-            seed: seed.get(),
-            step_mm: step_mm.get(),
-            objective: objective.get().name().to_string(),
-            thermal: thermal_settings.get(),
-            ..Settings::default()
-        };
-        let base = web_sys::window()
-            .and_then(|w| {
-                let l = w.location();
-                Some(format!("{}{}", l.origin().ok()?, l.pathname().ok()?))
-            })
-            .unwrap_or_default();
-        format!("{base}{}", settings.query())
-    };
+    let share_link = move || crate::links::page_link(&link_query(&current_settings()));
 
     // H of the shown route under the panel's σ and τ, for the comparison table.
     let shown_heat = move || {
@@ -609,6 +685,17 @@ pub fn App() -> impl IntoView {
                     }
                 />
             </label>
+            <crate::sheets::SheetPicker document=document open=open_sheet />
+            <ExportMenu
+                file_name=file_name
+                nest=shown_nest
+                route=shown_route
+                paths=shown_paths
+                toolpath=shown_toolpath
+                machine=machine
+                choice=gcode_choice
+            />
+            <crate::gallery::LectureGallery list_url=lecture_url pick=pick_lecture />
             <crate::theme::ThemePicker />
             <crate::i18n::LanguagePicker />
             <button
@@ -622,14 +709,6 @@ pub fn App() -> impl IntoView {
             >
                 {tr("Present", "Показ")}
             </button>
-            <ExportMenu
-                file_name=file_name
-                nest=shown_nest
-                route=shown_route
-                paths=shown_paths
-                toolpath=shown_toolpath
-                machine=machine
-            />
         </header>
         <section class="solver-panel" aria-label=tr("Solver", "Решатель")>
             <label title=tr("Which algorithm routes the tool", "Какой алгоритм строит маршрут инструмента")>
@@ -737,6 +816,7 @@ pub fn App() -> impl IntoView {
                 {tr("Link ", "Ссылка ")}
                 <input id="share-link" type="text" readonly prop:value=share_link />
             </label>
+            <crate::links::CopyLinkButton link=Signal::derive(share_link) />
             <p id="solver-uses" class="note">{move || solver_uses(solver.get(), language.get())}</p>
         </section>
         <main class="workspace">
@@ -798,6 +878,7 @@ pub fn App() -> impl IntoView {
                 <AnimationControls animation=animation />
             </section>
             <aside class="stats" aria-label=tr("Job status", "Состояние задачи")>
+                <crate::announce::ProgressAnnouncer progress=progress ended=Signal::derive(move || !running()) />
                 <dl>
                     <dt>{tr("File", "Файл")}</dt>
                     <dd id="file-name">
@@ -848,11 +929,13 @@ pub fn App() -> impl IntoView {
                     </dd>
                 </dl>
                 <StatsPanel nest=shown_nest route=shown_route paths=shown_paths machine=machine />
+                <crate::profiles::ProfilesPanel machine=machine choice=gcode_choice />
                 <ThermalPanel settings=thermal_settings />
                 <ThermalStats progress=progress />
                 <AlternativesTable alternatives=alternatives />
                 <BoundsChart samples=samples log_time=log_time unit=bound_unit />
                 <LayerPanel hidden=hidden_layers />
+                <crate::legend::DrawingLegend />
                 <ComparePanel
                     kept=kept
                     keep=keep
@@ -1084,14 +1167,14 @@ fn request_fullscreen(element: &web_sys::Element, settled: impl FnOnce() + 'stat
     }
 }
 
-async fn read_file(file: &web_sys::File) -> Result<Vec<u8>, String> {
+pub(crate) async fn read_file(file: &web_sys::File) -> Result<Vec<u8>, String> {
     let buffer = wasm_bindgen_futures::JsFuture::from(file.array_buffer())
         .await
         .map_err(|e| format!("{e:?}"))?;
     Ok(js_sys::Uint8Array::new(&buffer).to_vec())
 }
 
-async fn fetch_bytes(url: &str) -> Result<Vec<u8>, String> {
+pub(crate) async fn fetch_bytes(url: &str) -> Result<Vec<u8>, String> {
     if let Some(bytes) = crate::embedded::file(url) {
         return Ok(bytes);
     }

@@ -16,7 +16,9 @@ use cutroute_formats::{
     route_html, toolpath_html, write_dbs, write_geometry_json, write_result_json, HtmlOptions,
     ResultExportOptions, RmResult,
 };
-use cutroute_gcode::{path_route_gcode, route_gcode, ArcOutput, DistanceMode, GcodeOptions};
+use cutroute_gcode::{
+    path_route_gcode, route_gcode, ArcOutput, DistanceMode, GcodeOptions, GcodePreset,
+};
 use cutroute_geometry::{MachineParameters, Nest, PathRoute, Route, Toolpath};
 use leptos::prelude::*;
 use wasm_bindgen::JsCast;
@@ -153,9 +155,12 @@ pub const RESULT_JSON_CANNOT_HOLD_PATHS: &str = "Result JSON is off for this rou
 /// [`RESULT_JSON_CANNOT_HOLD_PATHS`] in Russian.
 pub const RESULT_JSON_CANNOT_HOLD_PATHS_RU: &str = "JSON результата недоступен для этого маршрута: в формате RouteManager каждый контур вырезается целиком от одной врезки, и пути, режущие общие кромки один раз или части контуров, в нём не записать. Используйте G-код или отдельную HTML-страницу.";
 
-/// What the G-code panel lets the user choose.
+/// What the G-code panel lets the user choose: a post-processor preset (the controller's
+/// dialect: line numbers, dwell unit, decimals) and, over it, the fields the panel shows.
 #[derive(Clone, Debug, PartialEq)]
 pub struct GcodeChoice {
+    /// The controller's dialect.
+    pub preset: GcodePreset,
     /// `G91` instead of `G90`.
     pub incremental: bool,
     /// "ij", "r" or "lines".
@@ -166,10 +171,35 @@ pub struct GcodeChoice {
     pub torch_off: String,
     /// Pierce dwell, s.
     pub dwell_s: f64,
+    /// Lines at the start of the program.
+    pub header: Vec<String>,
+    /// Lines at its end.
+    pub footer: Vec<String>,
 }
 
 impl GcodeChoice {
-    /// The post-processor's options for this choice under `machine`'s feed.
+    /// The panel filled from `preset` under `machine` (its pierce time is the dwell).
+    pub fn of_preset(preset: GcodePreset, machine: &MachineParameters) -> Self {
+        let o = preset.options(machine);
+        GcodeChoice {
+            preset,
+            incremental: o.distance_mode == DistanceMode::Incremental,
+            arcs: match o.arcs {
+                ArcOutput::Radius => "r",
+                ArcOutput::Lines { .. } => "lines",
+                ArcOutput::CentreOffsets => "ij",
+            }
+            .into(),
+            torch_on: o.torch_on,
+            torch_off: o.torch_off,
+            dwell_s: o.pierce_dwell_s,
+            header: o.header,
+            footer: o.footer,
+        }
+    }
+
+    /// The post-processor's options for this choice under `machine`'s feed: the preset's, with
+    /// the panel's fields over them.
     pub fn options(&self, machine: &MachineParameters) -> GcodeOptions {
         GcodeOptions {
             distance_mode: if self.incremental {
@@ -185,7 +215,9 @@ impl GcodeChoice {
             torch_on: self.torch_on.clone(),
             torch_off: self.torch_off.clone(),
             pierce_dwell_s: self.dwell_s,
-            ..GcodeOptions::for_machine(machine)
+            header: self.header.clone(),
+            footer: self.footer.clone(),
+            ..self.preset.options(machine)
         }
     }
 }
@@ -276,6 +308,8 @@ pub fn ExportMenu(
     paths: Signal<Option<PathRoute>>,
     toolpath: Signal<Option<Toolpath>>,
     machine: RwSignal<MachineParameters>,
+    /// The G-code panel's choice, shared with the machine profiles (`profiles.rs`).
+    choice: RwSignal<GcodeChoice>,
 ) -> impl IntoView {
     let language = use_language();
     let message = RwSignal::new(None::<ExportOutcome>);
@@ -294,13 +328,6 @@ pub fn ExportMenu(
     let no_nest = move || nest.with(Option::is_none);
     let no_route = move || route.with(Option::is_none) && paths.with(Option::is_none);
     let is_paths = move || paths.with(Option::is_some);
-    let choice = RwSignal::new(GcodeChoice {
-        incremental: false,
-        arcs: "ij".into(),
-        torch_on: "M03".into(),
-        torch_off: "M05".into(),
-        dwell_s: machine.get_untracked().pierce_time,
-    });
     let preview = RwSignal::new(String::new());
     let make_gcode = move || -> Result<Download, String> {
         let nest = nest.get_untracked().ok_or("no nest")?;
@@ -404,6 +431,7 @@ pub fn ExportMenu(
             }}
             <fieldset class="gcode">
                 <legend>{tr("G-code", "G-код")}</legend>
+                <crate::profiles::PresetPicker choice=choice machine=machine />
                 <label title=tr(
                     "G90: positions; G91: increments from the previous point",
                     "G90: абсолютные координаты; G91: приращения от предыдущей точки",
@@ -411,6 +439,7 @@ pub fn ExportMenu(
                     {tr("Coordinates ", "Координаты ")}
                     <select
                         id="gcode-distance"
+                        prop:value=move || if choice.with(|c| c.incremental) { "incremental" } else { "absolute" }
                         on:change=move |ev| {
                             let incremental = event_target_value(&ev) == "incremental";
                             choice.update(|c| c.incremental = incremental);
@@ -424,6 +453,7 @@ pub fn ExportMenu(
                     {tr("Arcs ", "Дуги ")}
                     <select
                         id="gcode-arcs"
+                        prop:value=move || choice.with(|c| c.arcs.clone())
                         on:change=move |ev| {
                             let arcs = event_target_value(&ev);
                             choice.update(|c| c.arcs = arcs);
@@ -480,6 +510,7 @@ pub fn ExportMenu(
                         }
                     />
                 </label>
+                <crate::profiles::HeaderFooterFields choice=choice />
                 <button id="gcode-preview-button" disabled=no_route on:click=move |_| show_preview()>
                     {tr("Preview", "Просмотр")}
                 </button>
@@ -516,12 +547,27 @@ const PREVIEW_LINES: usize = 12;
 
 #[cfg(test)]
 mod tests {
-    use super::stem;
+    use super::{stem, GcodeChoice};
+    use cutroute_gcode::GcodePreset;
+    use cutroute_geometry::MachineParameters;
 
     #[test]
     fn stems_drop_folders_and_every_extension() {
         assert_eq!(stem("E1X_6_01.dbs.json"), "E1X_6_01");
         assert_eq!(stem("C:\\nests\\seven.dbs"), "seven");
         assert_eq!(stem(""), "cutroute");
+    }
+
+    #[test]
+    fn a_preset_untouched_writes_exactly_the_preset() {
+        let machine = MachineParameters::default();
+        for preset in GcodePreset::ALL {
+            let choice = GcodeChoice::of_preset(preset, &machine);
+            assert_eq!(
+                choice.options(&machine),
+                preset.options(&machine),
+                "{preset}"
+            );
+        }
     }
 }

@@ -2,15 +2,21 @@
 //! review it (layers, animation, certificates), compare and export it.
 
 mod animation;
+mod announce;
 mod app;
 mod chart;
 mod compare;
 mod drawing;
 mod embedded;
 mod export;
+mod gallery;
 mod i18n;
+mod legend;
+mod links;
 mod pan_zoom;
+mod profiles;
 mod settings;
+mod sheets;
 mod stats;
 mod theme;
 mod thermal;

@@ -1,8 +1,9 @@
-//! What survives a reload (local storage) and what a link can set (`?sample=…&solver=…&time=…`):
-//! the chosen sample or file name, solver settings (objective included) and drawing layers. The theme keeps its own
-//! key (see `theme`).
+//! What survives a reload (local storage) and what a link can set (`?sample=…&solver=…&time=…`,
+//! or `?file=URL` for a hosted nest): the chosen sample, hosted file or local file name, solver
+//! settings (objective included), machine speeds and prices, thermal settings and drawing
+//! layers. The address bar follows these (`links.rs`). The theme keeps its own key (see `theme`).
 
-use cutroute_geometry::Objective;
+use cutroute_geometry::{MachineParameters, Objective};
 use cutroute_protocol::{RuleSet, ThermalSettings};
 use serde::{Deserialize, Serialize};
 
@@ -111,7 +112,43 @@ pub struct Settings {
     pub objective: String,
     /// The material's heat model, heat weight and shop rules (off by default).
     pub thermal: ThermalSettings,
+    /// A nest hosted next to the app or anywhere CORS allows (`?file=URL`), opened instead of
+    /// the sample.
+    pub file_url: Option<String>,
+    /// Machine speeds, pierce time and prices (the stats panel's, and a profile's).
+    pub machine: MachineParameters,
+    /// The sheet shown of a multi-sheet file, from 0 (`sheet=N` in a link counts from 1, as the
+    /// CLI's `--sheet`).
+    pub sheet: usize,
 }
+
+/// The machine parameters a link carries: (query key, getter, setter).
+type MachineKey = (
+    &'static str,
+    fn(&MachineParameters) -> f64,
+    fn(&mut MachineParameters, f64),
+);
+
+const MACHINE_KEYS: [MachineKey; 6] = [
+    ("idle_speed", |m| m.idle_speed, |m, v| m.idle_speed = v),
+    ("cut_speed", |m| m.cut_speed, |m, v| m.cut_speed = v),
+    ("pierce_time", |m| m.pierce_time, |m, v| m.pierce_time = v),
+    (
+        "idle_price",
+        |m| m.idle_price_per_metre,
+        |m, v| m.idle_price_per_metre = v,
+    ),
+    (
+        "cut_price",
+        |m| m.cut_price_per_metre,
+        |m, v| m.cut_price_per_metre = v,
+    ),
+    (
+        "pierce_price",
+        |m| m.pierce_price,
+        |m, v| m.pierce_price = v,
+    ),
+];
 
 impl Default for Settings {
     fn default() -> Self {
@@ -129,21 +166,58 @@ impl Default for Settings {
             hidden_layers: vec![Layer::Heat],
             objective: params.objective.name().to_string(),
             thermal: params.thermal,
+            file_url: None,
+            machine: MachineParameters::default(),
+            sheet: 0,
         }
     }
 }
 
 impl Settings {
-    /// Applies the query of a link: `sample`, `solver`, `time`, `seed`, `step`, `objective`; unknown or
-    /// malformed values are ignored.
+    /// Applies the query of a link: `sample` or `file`, `solver`, `time`, `seed`, `step`,
+    /// `objective`, the thermal and machine settings, `hide` (layers); unknown or malformed values
+    /// are ignored.
     pub fn with_query(mut self, query: &str) -> Self {
         for pair in query.trim_start_matches('?').split('&') {
             let (key, value) = pair.split_once('=').unwrap_or((pair, ""));
             let value = js_decode(value);
+            if let Some((_, _, set)) = MACHINE_KEYS.iter().find(|(k, _, _)| *k == key) {
+                // Speeds must be positive; times and prices may be zero.
+                let speed = key.ends_with("_speed");
+                if let Some(v) = value
+                    .parse::<f64>()
+                    .ok()
+                    .filter(|v| v.is_finite() && (*v > 0.0 || (!speed && *v == 0.0)))
+                {
+                    set(&mut self.machine, v);
+                }
+                continue;
+            }
             match key {
                 "sample" if crate::app::SAMPLES.iter().any(|(f, ..)| *f == value) => {
+                    // The address bar follows the page, so a reload brings the query of the
+                    // sample shown beside a remembered local file: that keeps the reminder;
+                    // a link to another sample forgets it.
+                    if value != self.sample {
+                        self.last_file = None;
+                    }
                     self.sample = value;
+                    self.file_url = None;
+                }
+                "file" if !value.is_empty() => {
+                    self.file_url = Some(value);
                     self.last_file = None;
+                }
+                "sheet" => {
+                    if let Some(n) = value.parse::<usize>().ok().filter(|n| *n >= 1) {
+                        self.sheet = n - 1;
+                    }
+                }
+                "hide" => {
+                    self.hidden_layers = value
+                        .split(',')
+                        .filter_map(|name| Layer::ALL.into_iter().find(|l| l.name() == name))
+                        .collect();
                 }
                 "solver" if cutroute_protocol::SolverKind::from_name(&value).is_some() => {
                     self.solver = value
@@ -195,13 +269,29 @@ impl Settings {
         self
     }
 
-    /// The query of a link that reopens this sample with these solver settings; the thermal
-    /// ones only when they differ from the defaults (old links stay short and the same).
+    /// The query of a link that reopens this sample (or hosted file) with these solver
+    /// settings; the thermal and machine settings only when they differ from the defaults (old
+    /// links stay short and the same). Layers are read from a link (`hide=`, as lecture lists
+    /// set them) but not written: a link's form is pinned by the e2e tests, and the layers a
+    /// viewer switches are their own.
     pub fn query(&self) -> String {
+        let opened = match &self.file_url {
+            Some(url) => format!("file={}", js_encode(url)),
+            None => format!("sample={}", self.sample),
+        };
         let mut query = format!(
-            "?sample={}&solver={}&time={}&seed={}&step={}&objective={}",
-            self.sample, self.solver, self.time_limit_s, self.seed, self.step_mm, self.objective
+            "?{opened}&solver={}&time={}&seed={}&step={}&objective={}",
+            self.solver, self.time_limit_s, self.seed, self.step_mm, self.objective
         );
+        if self.sheet > 0 {
+            query.push_str(&format!("&sheet={}", self.sheet + 1));
+        }
+        let defaults = MachineParameters::default();
+        for (key, get, _) in MACHINE_KEYS {
+            if get(&self.machine) != get(&defaults) {
+                query.push_str(&format!("&{key}={}", get(&self.machine)));
+            }
+        }
         let t = &self.thermal;
         if *t != ThermalSettings::default() {
             let rules = [
@@ -267,7 +357,47 @@ fn js_decode(value: &str) -> String {
     }
     #[cfg(not(target_arch = "wasm32"))]
     {
-        value.to_string()
+        // The same decoding natively, for the tests.
+        let bytes = value.replace('+', " ").into_bytes();
+        let mut out = Vec::with_capacity(bytes.len());
+        let mut i = 0;
+        while i < bytes.len() {
+            let hex = bytes
+                .get(i + 1..i + 3)
+                .and_then(|h| std::str::from_utf8(h).ok())
+                .and_then(|h| u8::from_str_radix(h, 16).ok());
+            match (bytes[i], hex) {
+                (b'%', Some(b)) => {
+                    out.push(b);
+                    i += 3;
+                }
+                (b, _) => {
+                    out.push(b);
+                    i += 1;
+                }
+            }
+        }
+        String::from_utf8(out).unwrap_or_else(|_| value.to_string())
+    }
+}
+
+/// Percent-encoding of a query value (a URL inside a URL).
+fn js_encode(value: &str) -> String {
+    #[cfg(target_arch = "wasm32")]
+    {
+        String::from(js_sys::encode_uri_component(value))
+    }
+    #[cfg(not(target_arch = "wasm32"))]
+    {
+        value
+            .bytes()
+            .map(|b| match b {
+                b'A'..=b'Z' | b'a'..=b'z' | b'0'..=b'9' | b'-' | b'_' | b'.' | b'~' => {
+                    (b as char).to_string()
+                }
+                _ => format!("%{b:02X}"),
+            })
+            .collect()
     }
 }
 
@@ -339,5 +469,54 @@ mod tests {
         assert_eq!(stored.thermal, ThermalSettings::default());
         let nonsense = Settings::default().with_query("?sigma=-3&heat_weight=x&rules=heat");
         assert_eq!(nonsense.thermal, ThermalSettings::default());
+    }
+
+    #[test]
+    fn machine_and_file_ride_the_link_and_layers_are_read() {
+        let s = Settings {
+            solver: "ccp".into(),
+            file_url: Some("https://example.org/nests/a b.dbs".into()),
+            machine: MachineParameters {
+                cut_speed: 25.0,
+                pierce_price: 0.0,
+                ..MachineParameters::default()
+            },
+            ..Settings::default()
+        };
+        let query = s.query();
+        assert!(!query.contains("sample="), "{query}");
+        assert!(!query.contains("idle_speed"), "defaults stay out: {query}");
+        let back = Settings::default().with_query(&query);
+        assert_eq!(back.file_url, s.file_url);
+        assert_eq!(back.machine, s.machine);
+        assert_eq!(back.solver, "ccp");
+        let hidden = Settings::default().with_query("?hide=order,hatch,nonsense");
+        assert_eq!(hidden.hidden_layers, vec![Layer::Order, Layer::Hatch]);
+        assert!(!hidden.query().contains("hide="));
+        let nonsense = Settings::default().with_query("?cut_speed=0&pierce_time=-1&idle_price=x");
+        assert_eq!(nonsense.machine, MachineParameters::default());
+        let sheet = Settings {
+            file_url: Some("p.tfnesting".into()),
+            sheet: 1,
+            ..Settings::default()
+        };
+        assert!(sheet.query().contains("&sheet=2"), "{}", sheet.query());
+        assert_eq!(Settings::default().with_query(&sheet.query()).sheet, 1);
+        assert_eq!(Settings::default().with_query("?sheet=0").sheet, 0);
+        let sample = Settings::default().with_query("?file=x.dbs&sample=seven.dbs");
+        assert_eq!(sample.file_url, None, "the later of file and sample wins");
+    }
+
+    #[test]
+    fn a_reload_keeps_the_local_file_reminder_and_another_sample_forgets_it() {
+        let stored = Settings {
+            sample: "test1.dbs.json".into(),
+            last_file: Some("nested.dbs".into()),
+            ..Settings::default()
+        };
+        let reloaded = stored.clone().with_query(&stored.query());
+        assert_eq!(reloaded.last_file.as_deref(), Some("nested.dbs"));
+        let other = stored.with_query("?sample=seven.dbs");
+        assert_eq!(other.last_file, None);
     }
 }

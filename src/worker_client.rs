@@ -250,6 +250,11 @@ impl SolverWorker {
                     let names = files.iter().map(|(name, _)| name.clone()).collect();
                     in_flight.opens.insert(*request_id, names);
                 }
+                ToWorker::OpenSheet {
+                    request_id, file, ..
+                } => {
+                    in_flight.opens.insert(*request_id, vec![file.0.clone()]);
+                }
                 ToWorker::Cancel { .. } => {}
             }
         }

@@ -85,6 +85,10 @@ enum Command {
         /// (`candidate_points`: every STEP mm along each contour, and its vertices).
         #[arg(long, value_name = "MM", value_parser = step_mm)]
         step: Option<f64>,
+        /// Read a G-code program in this post-processor's dialect (its torch codes, dwell unit
+        /// and arc tolerance), e.g. kometa-2p32m's M71/M74.
+        #[arg(long, value_enum, value_name = "NAME")]
+        preset: Option<inputs::PresetArg>,
     },
     /// Convert a nest between formats (.dbs, .json, .svg), or route it and write the route as
     /// G-code (.nc, .gcode, .ngc, .tap) or a standalone HTML page (.html).
@@ -283,7 +287,8 @@ fn main() -> ExitCode {
             json,
             sheet,
             step,
-        } => inspect(&file, sheet.index(), json, step).map_err(Failure::Error),
+            preset,
+        } => inspect(&file, sheet.index(), json, step, preset).map_err(Failure::Error),
         Command::Convert {
             input,
             output,
@@ -655,8 +660,22 @@ fn open((path, sheet): (&Path, usize)) -> Result<Document, String> {
     open_sheet(&name, &bytes, sheet).map_err(|e| e.to_string())
 }
 
-fn inspect(path: &Path, sheet: usize, as_json: bool, step: Option<f64>) -> Result<(), String> {
-    let document = open((path, sheet))?;
+fn inspect(
+    path: &Path,
+    sheet: usize,
+    as_json: bool,
+    step: Option<f64>,
+    preset: Option<inputs::PresetArg>,
+) -> Result<(), String> {
+    let document = match preset {
+        Some(inputs::PresetArg(preset)) => {
+            let (name, bytes) = stdio::read_input(path)?;
+            let text = String::from_utf8(bytes).map_err(|e| format!("{name}: {e}"))?;
+            cutroute_engine::open_gcode_with(&name, &text, &preset.read_options())
+                .map_err(|e| e.to_string())?
+        }
+        None => open((path, sheet))?,
+    };
     let summary = match &document.problem {
         Problem::Nest { nest, .. } => {
             let mut summary = nest_summary(&document.format, nest);

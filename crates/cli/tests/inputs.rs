@@ -118,6 +118,30 @@ fn a_profile_sets_the_machine_and_flags_override_it() {
 }
 
 #[test]
+fn inspect_reads_a_program_in_its_presets_dialect() {
+    let nest = data("nests/dbs/nested.dbs");
+    let mut pierces = Vec::new();
+    for preset in ["generic", "kometa-2p32m"] {
+        let program = temp(&format!("inspect-{preset}.nc"));
+        let (ok, _, stderr) = cutroute(&[
+            "convert",
+            s(&nest),
+            s(&program),
+            "--solver",
+            "nearest",
+            "--preset",
+            preset,
+        ]);
+        assert!(ok, "{stderr}");
+        let report = json(&["inspect", s(&program), "--json", "--preset", preset]);
+        assert_eq!(report["route_problems"], serde_json::json!([]), "{preset}");
+        pierces.push(report["route_pierces"].as_u64().unwrap());
+    }
+    assert!(pierces[0] > 0);
+    assert_eq!(pierces[0], pierces[1], "the same route in both dialects");
+}
+
+#[test]
 fn presets_write_their_dialect_and_flags_override() {
     let nest = data("nests/dbs/nested.dbs");
     let program = temp("fanuc.nc");

@@ -46,8 +46,8 @@ pub use jobs::{ccp_options, CcpJob, ChainJob, DiscreteJob, DiscreteMode};
 pub use nearest::NearestNeighbourJob;
 pub use open::{format_name, OpenError};
 pub use open_files::{
-    is_pcglns_result, open_document, open_gcode, open_sheet, open_together, task_instance,
-    POINT_TOLERANCE_MM,
+    is_pcglns_result, open_document, open_gcode, open_gcode_with, open_sheet, open_together,
+    task_instance, POINT_TOLERANCE_MM,
 };
 pub use path_jobs::{AoeJob, PlanBound, SegmentJob};
 pub use thermal::{

@@ -75,7 +75,17 @@ fn looks_like_gcode(text: &str) -> bool {
 /// direction is the program's own. Tool-on paths that close no loop are left out with a
 /// warning.
 pub fn open_gcode(file_name: &str, text: &str) -> Result<Document, OpenError> {
-    let program = read_gcode(text, &ReadOptions::default()).map_err(|e| OpenError::Gcode {
+    open_gcode_with(file_name, text, &ReadOptions::default())
+}
+
+/// [`open_gcode`] in a named dialect (`GcodePreset::read_options`: its torch codes, dwell unit
+/// and arc tolerance), for programs whose torch codes are not `M03`/`M04`/`M05`.
+pub fn open_gcode_with(
+    file_name: &str,
+    text: &str,
+    options: &ReadOptions,
+) -> Result<Document, OpenError> {
+    let program = read_gcode(text, options).map_err(|e| OpenError::Gcode {
         file_name: file_name.to_string(),
         message: e.to_string(),
         location: Located::location(&e),

@@ -65,6 +65,16 @@ pub enum ToWorker {
         /// content) and bytes.
         files: Vec<(String, Vec<u8>)>,
     },
+    /// Read sheet `sheet` (from 0) of a multi-sheet file (`Document::sheets`) through
+    /// `cutroute_engine::open_sheet`; answered as `Open` is.
+    OpenSheet {
+        /// Chosen by the sender; echoed in the answer.
+        request_id: u64,
+        /// The file's name and bytes.
+        file: (String, Vec<u8>),
+        /// Which sheet.
+        sheet: usize,
+    },
 }
 
 /// A file the worker has read.

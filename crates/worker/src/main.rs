@@ -11,7 +11,9 @@
 mod web {
     use std::collections::HashMap;
 
-    use cutroute_engine::{open_together, start_job, Job, JobStatus, OpenError, DEFAULT_SLICE};
+    use cutroute_engine::{
+        open_sheet, open_together, start_job, Job, JobStatus, OpenError, DEFAULT_SLICE,
+    };
     use cutroute_protocol::{Document, FromWorker, JobId, ToWorker};
     use gloo_worker::{HandlerId, Worker, WorkerScope};
     use web_time::{Duration, Instant};
@@ -129,6 +131,16 @@ mod web {
                 },
                 ToWorker::Open { request_id, files } => {
                     scope.respond(requester, opened(request_id, open_together(&files)));
+                }
+                ToWorker::OpenSheet {
+                    request_id,
+                    file: (name, bytes),
+                    sheet,
+                } => {
+                    scope.respond(
+                        requester,
+                        opened(request_id, open_sheet(&name, &bytes, sheet)),
+                    );
                 }
                 ToWorker::Cancel { job_id } => {
                     if let Some(running) = self.jobs.remove(&job_id) {

@@ -1,0 +1,351 @@
+//! Machine profiles in the page: the machine's speeds, pierce time and prices with its G-code
+//! dialect (preset, header and footer lines) kept under a name, remembered in local storage,
+//! exported and imported as JSON in exactly the CLI's `--profile` format
+//! (`cutroute_protocol::MachineProfile`), so a profile made in the page drives the CLI and the
+//! other way round. Also the export menu's preset picker and header and footer fields.
+
+use cutroute_gcode::GcodePreset;
+use cutroute_geometry::MachineParameters;
+use cutroute_protocol::MachineProfile;
+use leptos::prelude::*;
+
+use crate::export::{save, Download, GcodeChoice};
+use crate::i18n::{tr, use_language};
+
+/// Local-storage key of the saved profiles.
+const STORAGE_KEY: &str = "cutroute.profiles";
+
+/// The saved profiles (none when nothing or something unreadable is stored).
+pub fn stored() -> Vec<MachineProfile> {
+    storage()
+        .and_then(|s| s.get_item(STORAGE_KEY).ok().flatten())
+        .and_then(|text| serde_json::from_str(&text).ok())
+        .unwrap_or_default()
+}
+
+fn store(profiles: &[MachineProfile]) {
+    if let (Some(storage), Ok(text)) = (storage(), serde_json::to_string(profiles)) {
+        let _ = storage.set_item(STORAGE_KEY, &text);
+    }
+}
+
+fn storage() -> Option<web_sys::Storage> {
+    web_sys::window()?.local_storage().ok()?
+}
+
+/// The profile of the page's machine and G-code choice. Header and footer are written only
+/// when they differ from the preset's (the CLI then takes the preset's own).
+pub fn profile_of(name: &str, machine: &MachineParameters, choice: &GcodeChoice) -> MachineProfile {
+    let preset = choice.preset.options(machine);
+    MachineProfile {
+        name: name.to_string(),
+        machine: *machine,
+        gcode_preset: Some(choice.preset.name().to_string()),
+        gcode_header: (choice.header != preset.header).then(|| choice.header.clone()),
+        gcode_footer: (choice.footer != preset.footer).then(|| choice.footer.clone()),
+    }
+}
+
+/// The machine and G-code choice a profile sets, after the same checks as the CLI's.
+pub fn from_profile(profile: &MachineProfile) -> Result<(MachineParameters, GcodeChoice), String> {
+    profile.check().map_err(|e| e.to_string())?;
+    let preset = match &profile.gcode_preset {
+        Some(name) => name.parse::<GcodePreset>().map_err(|e| e.to_string())?,
+        None => GcodePreset::Generic,
+    };
+    let mut choice = GcodeChoice::of_preset(preset, &profile.machine);
+    if let Some(header) = &profile.gcode_header {
+        choice.header = header.clone();
+    }
+    if let Some(footer) = &profile.gcode_footer {
+        choice.footer = footer.clone();
+    }
+    Ok((profile.machine, choice))
+}
+
+/// Reads a profile file as the CLI does (unknown fields refused, numbers checked).
+pub fn parse_profile(text: &str) -> Result<MachineProfile, String> {
+    let profile: MachineProfile = serde_json::from_str(text).map_err(|e| e.to_string())?;
+    from_profile(&profile)?;
+    Ok(profile)
+}
+
+/// The panel of named machine profiles, beside the machine parameters.
+#[component]
+pub fn ProfilesPanel(
+    machine: RwSignal<MachineParameters>,
+    choice: RwSignal<GcodeChoice>,
+) -> impl IntoView {
+    let language = use_language();
+    let profiles = RwSignal::new(stored());
+    let name = RwSignal::new(
+        profiles.with_untracked(|p| p.first().map(|p| p.name.clone()).unwrap_or_default()),
+    );
+    let status = RwSignal::new(String::new());
+    let apply = move |profile: &MachineProfile| match from_profile(profile) {
+        Ok((m, c)) => {
+            machine.set(m);
+            choice.set(c);
+            name.set(profile.name.clone());
+            true
+        }
+        Err(e) => {
+            status.set(e);
+            false
+        }
+    };
+    let current = move || {
+        let n = name.get_untracked();
+        let n = if n.trim().is_empty() {
+            "machine".to_string()
+        } else {
+            n.trim().to_string()
+        };
+        machine.with_untracked(|m| choice.with_untracked(|c| profile_of(&n, m, c)))
+    };
+    let keep = move |profile: MachineProfile| {
+        profiles.update(|all| {
+            all.retain(|p| p.name != profile.name);
+            all.push(profile);
+            all.sort_by(|a, b| a.name.cmp(&b.name));
+        });
+        profiles.with_untracked(|all| store(all));
+    };
+    let save_profile = move |_| {
+        let profile = current();
+        let saved = profile.name.clone();
+        keep(profile);
+        name.set(saved.clone());
+        status.set(format!("{} {saved}", language.pick("saved", "сохранён")));
+    };
+    let delete = move |_| {
+        let n = name.get_untracked();
+        profiles.update(|all| all.retain(|p| p.name != n));
+        profiles.with_untracked(|all| store(all));
+        status.set(format!("{} {n}", language.pick("deleted", "удалён")));
+    };
+    let export = move |_| {
+        let profile = current();
+        let outcome = serde_json::to_string_pretty(&profile)
+            .map_err(|e| e.to_string())
+            .and_then(|text| {
+                let download = Download {
+                    name: format!("{}.profile.json", crate::export::stem(&profile.name)),
+                    mime: "application/json",
+                    bytes: text.into_bytes(),
+                };
+                save(&download)?;
+                Ok(download.name)
+            });
+        status.set(match outcome {
+            Ok(file) => format!("{} {file}", language.pick("saved", "сохранён")),
+            Err(e) => e,
+        });
+    };
+    let import = move |ev: leptos::ev::Event| {
+        let input: web_sys::HtmlInputElement = event_target(&ev);
+        let Some(file) = input.files().and_then(|f| f.item(0)) else {
+            return;
+        };
+        input.set_value("");
+        leptos::task::spawn_local(async move {
+            let text = crate::app::read_file(&file)
+                .await
+                .and_then(|bytes| String::from_utf8(bytes).map_err(|e| e.to_string()));
+            match text.and_then(|t| parse_profile(&t)) {
+                Ok(profile) => {
+                    if apply(&profile) {
+                        status.set(format!(
+                            "{} {}",
+                            language.pick("imported", "загружен"),
+                            profile.name
+                        ));
+                        keep(profile);
+                    }
+                }
+                Err(e) => status.set(format!("{}: {e}", file.name())),
+            }
+        });
+    };
+    view! {
+        <details id="profiles" class="profiles">
+            <summary>{tr("Machine profiles", "Профили станков")}</summary>
+            <label class="param">
+                <span>{tr("Profile", "Профиль")}</span>
+                <select
+                    id="profile-select"
+                    prop:value=move || name.get()
+                    on:change=move |ev| {
+                        let chosen = event_target_value(&ev);
+                        if let Some(p) = profiles.with_untracked(|all| all.iter().find(|p| p.name == chosen).cloned()) {
+                            apply(&p);
+                        }
+                    }
+                >
+                    <option value="">"—"</option>
+                    {move || {
+                        profiles
+                            .get()
+                            .into_iter()
+                            .map(|p| view! { <option value=p.name.clone()>{p.name.clone()}</option> })
+                            .collect_view()
+                    }}
+                </select>
+            </label>
+            <label class="param">
+                <span>{tr("Name", "Название")}</span>
+                <input
+                    id="profile-name"
+                    type="text"
+                    prop:value=move || name.get()
+                    on:change=move |ev| name.set(event_target_value(&ev))
+                />
+            </label>
+            <div class="profile-buttons">
+                <button
+                    id="profile-save"
+                    type="button"
+                    title=tr(
+                        "Remember the machine parameters and G-code settings under this name",
+                        "Запомнить параметры станка и настройки G-кода под этим названием",
+                    )
+                    on:click=save_profile
+                >
+                    {tr("Save", "Сохранить")}
+                </button>
+                <button id="profile-delete" type="button" on:click=delete>
+                    {tr("Delete", "Удалить")}
+                </button>
+                <button
+                    id="profile-export"
+                    type="button"
+                    title=tr(
+                        "Download the profile as JSON (the CLI reads it: cutroute solve --profile FILE)",
+                        "Скачать профиль в JSON (его читает CLI: cutroute solve --profile ФАЙЛ)",
+                    )
+                    on:click=export
+                >
+                    {tr("Export JSON", "Экспорт JSON")}
+                </button>
+                <label class="file-button">
+                    {tr("Import JSON… ", "Импорт JSON… ")}
+                    <input
+                        id="profile-import"
+                        type="file"
+                        accept=".json,application/json"
+                        on:change=import
+                    />
+                </label>
+            </div>
+            <p id="profile-status" class="muted" role="status" aria-live="polite">
+                {move || status.get()}
+            </p>
+        </details>
+    }
+}
+
+/// The export menu's post-processor preset: choosing one fills the panel's fields from it.
+#[component]
+pub fn PresetPicker(
+    choice: RwSignal<GcodeChoice>,
+    machine: RwSignal<MachineParameters>,
+) -> impl IntoView {
+    view! {
+        <label title=tr(
+            "The controller's G-code dialect; the fields below start from it",
+            "Диалект G-кода стойки ЧПУ; поля ниже заполняются по нему",
+        )>
+            {tr("Post-processor ", "Постпроцессор ")}
+            <select
+                id="gcode-preset"
+                prop:value=move || choice.with(|c| c.preset.name())
+                on:change=move |ev| {
+                    if let Ok(preset) = event_target_value(&ev).parse::<GcodePreset>() {
+                        choice.set(machine.with_untracked(|m| GcodeChoice::of_preset(preset, m)));
+                    }
+                }
+            >
+                {GcodePreset::ALL
+                    .into_iter()
+                    .map(|p| {
+                        view! {
+                            <option value=p.name() title=p.description()>
+                                {format!("{} — {}", p.name(), p.description())}
+                            </option>
+                        }
+                    })
+                    .collect_view()}
+            </select>
+        </label>
+    }
+}
+
+/// Header and footer lines of the program, one per line.
+#[component]
+pub fn HeaderFooterFields(choice: RwSignal<GcodeChoice>) -> impl IntoView {
+    let lines = |text: String| -> Vec<String> {
+        text.lines()
+            .map(str::trim_end)
+            .filter(|l| !l.is_empty())
+            .map(str::to_string)
+            .collect()
+    };
+    view! {
+        <label class="gcode-lines">
+            {tr("Header", "Начало программы")}
+            <textarea
+                id="gcode-header"
+                rows="3"
+                prop:value=move || choice.with(|c| c.header.join("\n"))
+                on:change=move |ev| {
+                    let v = lines(event_target_value(&ev));
+                    choice.update(|c| c.header = v);
+                }
+            />
+        </label>
+        <label class="gcode-lines">
+            {tr("Footer", "Конец программы")}
+            <textarea
+                id="gcode-footer"
+                rows="3"
+                prop:value=move || choice.with(|c| c.footer.join("\n"))
+                on:change=move |ev| {
+                    let v = lines(event_target_value(&ev));
+                    choice.update(|c| c.footer = v);
+                }
+            />
+        </label>
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_profile_round_trips_through_the_page_and_the_cli_format() {
+        let machine = MachineParameters {
+            cut_speed: 25.0,
+            pierce_time: 0.8,
+            ..MachineParameters::default()
+        };
+        let mut choice = GcodeChoice::of_preset(GcodePreset::QtPlasmac, &machine);
+        choice.footer = vec!["M30".into(), "%".into()];
+        let profile = profile_of("Plasma 3", &machine, &choice);
+        assert_eq!(
+            profile.gcode_header, None,
+            "the preset's header stays the preset's"
+        );
+        let text = serde_json::to_string_pretty(&profile).unwrap();
+        let back = parse_profile(&text).unwrap();
+        let (m, c) = from_profile(&back).unwrap();
+        assert_eq!(m, machine);
+        assert_eq!(c, choice);
+        assert!(parse_profile(r#"{"name": "x", "machine": {}}"#).is_err());
+        let bad = MachineProfile {
+            gcode_preset: Some("haas".into()),
+            ..MachineProfile::new("x", machine)
+        };
+        assert!(from_profile(&bad).is_err());
+    }
+}
