@@ -123,7 +123,7 @@ export function cli(...args) {
 }
 let cliBuilt = false;
 
-function cliBinary() {
+export function cliBinary() {
   if (!cliBuilt) {
     execFileSync('cargo', ['build', '--quiet', '-p', 'cutroute-cli'], { cwd: projectRoot, stdio: 'inherit' });
     cliBuilt = true;

@@ -8,12 +8,12 @@ import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import path from 'node:path';
 import { execFileSync } from 'node:child_process';
-import { watchErrors, projectRoot, useApp, screenshot } from './harness.mjs';
+import { watchErrors, projectRoot, useApp, screenshot, cliBinary } from './harness.mjs';
 
 const app = useApp(before, after);
 
 function cutroute(...args) {
-  const binary = path.join(projectRoot, 'target', 'release', 'cutroute');
+  const binary = cliBinary();
   return JSON.parse(execFileSync(binary, args, { encoding: 'utf8', maxBuffer: 64 << 20 }));
 }
 

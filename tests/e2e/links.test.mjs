@@ -8,7 +8,7 @@ import http from 'node:http';
 import os from 'node:os';
 import path from 'node:path';
 import { execFileSync } from 'node:child_process';
-import { watchErrors, projectRoot, distDir, useApp, screenshot } from './harness.mjs';
+import { watchErrors, projectRoot, distDir, useApp, screenshot, cliBinary } from './harness.mjs';
 
 const app = useApp(before, after);
 const nests = path.join(projectRoot, 'data', 'nests');
@@ -29,9 +29,9 @@ async function otherHost(root, cors) {
   return { server, url: `http://127.0.0.1:${server.address().port}/` };
 }
 
-/** The oracle: the project's reader on the same file, through the release CLI. */
+/** The oracle: the project's reader on the same file, through the CLI. */
 function inspect(file) {
-  const binary = path.join(projectRoot, 'target', 'release', 'cutroute');
+  const binary = cliBinary();
   return JSON.parse(execFileSync(binary, ['inspect', file, '--json'], { encoding: 'utf8' }));
 }
 
@@ -261,6 +261,6 @@ test('a hosted multi-sheet project: &sheet=N opens that sheet and the link follo
 });
 
 function inspect2(file, sheet) {
-  const binary = path.join(projectRoot, 'target', 'release', 'cutroute');
+  const binary = cliBinary();
   return JSON.parse(execFileSync(binary, ['inspect', file, '--json', '--sheet', sheet], { encoding: 'utf8' }));
 }

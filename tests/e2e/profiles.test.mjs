@@ -8,14 +8,14 @@ import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
 import { execFileSync } from 'node:child_process';
-import { watchErrors, projectRoot, useApp } from './harness.mjs';
+import { watchErrors, projectRoot, useApp, cliBinary } from './harness.mjs';
 
 const app = useApp(before, after);
 const sample = path.join(projectRoot, 'assets', 'samples', 'E1X_6_01.dbs.json');
 
 /** The release CLI: the oracle outside the page. */
 function cutroute(...args) {
-  const binary = path.join(projectRoot, 'target', 'release', 'cutroute');
+  const binary = cliBinary();
   return JSON.parse(execFileSync(binary, args, { encoding: 'utf8', maxBuffer: 64 << 20 }));
 }
 
@@ -77,7 +77,7 @@ test('a profile round trip: export, the CLI reads it, import gives the same numb
   assert.ok(Math.abs(pageCost - report.cost) < 1e-3, `cost: page ${pageCost}, CLI ${report.cost}`);
   // The CLI writes the profile's dialect with its footer.
   const program = path.join(path.dirname(file), 'cli.nc');
-  execFileSync(path.join(projectRoot, 'target', 'release', 'cutroute'),
+  execFileSync(cliBinary(),
     ['convert', sample, program, '--solver', 'nearest', '--profile', file]);
   const text = fs.readFileSync(program, 'utf8');
   assert.match(text, /M03 \$0 S1/);
