@@ -350,7 +350,7 @@ impl DiscreteJob {
                 heuristic: false,
                 ..ExactOptions::default()
             };
-            match ExactSolver::new(instance, options) {
+            match ExactSolver::deferred(instance, options) {
                 Ok(exact) => self.exact = Some(exact),
                 Err(e) => self.failure = Some(e.to_string()),
             }
