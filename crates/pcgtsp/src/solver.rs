@@ -586,8 +586,9 @@ impl ExactSolver {
         })
     }
 
-    /// Whether every start node's run (model and root bound) is built.
-    fn runs_built(&self) -> bool {
+    /// Whether every start node's run (model and root bound) is built (always, but for a
+    /// [`ExactSolver::deferred`] solver before its first steps).
+    pub fn runs_built(&self) -> bool {
         self.unbuilt.is_empty() && self.unbounded.is_none()
     }
 
