@@ -36,11 +36,7 @@ const LONG_STEPS: &[(SolverKind, &str, &str)] = &[
     (SolverKind::Chain, "", "a chain group"),
     // The exact solver's runs are built in steps (`ExactSolver::deferred`), but one start
     // node's model and its root bound (an assignment over every cluster) are one piece each.
-    (
-        SolverKind::Exact,
-        "",
-        "a start node's model or root bound",
-    ),
+    (SolverKind::Exact, "", "a start node's model or root bound"),
     // The ALNS's first descent runs a move family per step; on hundreds of clusters one
     // family (and `AlnsSolver::new`'s precedence closure) is still a piece of 0.5–1.5 s.
     (

@@ -249,7 +249,7 @@ pub fn main() {
     }
     println!();
     println!(
-        "{} rows; longest single call (start or step) {worst_step:.3} s; {overs} rows over \
+        "{} inputs; longest single call (start or step) {worst_step:.3} s; {overs} rows over \
          (wall > limit + 1 s or a call > slice + 50 ms); worst wall over the limit {worst_over:.2} s",
         inputs.len()
     );
