@@ -323,6 +323,11 @@ struct Run {
     penalties: Option<Rc<NodePenalties>>,
     /// The position-indexed completion bound (when the run has no lattice).
     position: Option<Rc<PositionBound>>,
+    /// The prepared lattice store while the Lagrangian bounds are still to be built: they
+    /// take a step of their own (0.4–1.1 s on ESC78), the position bound the next.
+    prepared: Option<LatticeStore>,
+    /// Whether the Lagrangian bounds of `prepared` are built.
+    penalties_built: bool,
     root_bound: f64,
     engine: Option<Engine>,
     finished_bound: Option<f64>,
@@ -330,7 +335,9 @@ struct Run {
 }
 
 impl Run {
-    /// Builds the bounds until `deadline`; sets `lattice` once they are complete.
+    /// Builds the bounds until `deadline`; sets `lattice` once they are complete. The
+    /// preparation runs in slices; the Lagrangian bounds and then the position bound each take
+    /// a call of their own after it (the caller calls again while `lattice` is unset).
     fn build_lattice(
         &mut self,
         instance: &Instance,
@@ -356,17 +363,26 @@ impl Run {
             )
         });
         debug_log(|| format!("preparation made after {:?}", began.elapsed()));
-        let Some(store) = preparation.advance(&self.model, deadline) else {
-            debug_log(|| format!("preparation advanced after {:?}", began.elapsed()));
+        let Some(store) = self.prepared.take() else {
+            let Some(store) = preparation.advance(&self.model, deadline) else {
+                debug_log(|| format!("preparation advanced after {:?}", began.elapsed()));
+                return;
+            };
+            debug_log(|| format!("preparation done after {:?}", began.elapsed()));
+            self.subset = preparation.subset.clone();
+            self.prepared = Some(store);
             return;
         };
-        debug_log(|| format!("preparation done after {:?}", began.elapsed()));
-        self.subset = preparation.subset.clone();
-        self.preparation = None;
-        if store.root_bound().is_none() {
-            // Without the lattice the DP bounds its states by assignments: strengthen them.
-            self.build_penalties(instance, options, upper_bound);
+        if !self.penalties_built {
+            self.penalties_built = true;
+            if store.root_bound().is_none() {
+                // Without the lattice the DP bounds its states by assignments: strengthen them.
+                self.build_penalties(instance, options, upper_bound);
+            }
+            self.prepared = Some(store);
+            return;
         }
+        self.preparation = None;
         if let Some(root) = store.root_bound() {
             self.root_bound = self.root_bound.max(self.model.round_bound(root));
         }
@@ -610,6 +626,8 @@ impl ExactSolver {
                 subset: None,
                 penalties: None,
                 position: None,
+                prepared: None,
+                penalties_built: false,
                 root_bound,
                 engine: None,
                 finished_bound: None,
