@@ -8,6 +8,7 @@
 //!                   "solver": "ccp", "settings": { "time": 2, "hide": "hatch" } } ] }
 //! ```
 //!
+//! Titles and descriptions are a string, or one per language: `{"en": "Holes", "ru": "Отверстия"}`.
 //! `file` is relative to the list's own address; `settings` are the keys of a link's query
 //! (`Settings::with_query`: `time`, `seed`, `step`, `objective`, machine and thermal keys,
 //! `hide`), so a card sets exactly what a link can.
@@ -15,17 +16,57 @@
 use leptos::prelude::*;
 use serde::Deserialize;
 
-use crate::i18n::tr;
+use crate::i18n::{tr, use_language, Lang};
 
 /// The bundled list, under the app.
 pub const BUNDLED: &str = "./assets/lectures.json";
+
+/// A text of a list: one string for every language, or `{"en": "…", "ru": "…"}` (a missing
+/// language falls back to the other).
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(untagged)]
+pub enum ListText {
+    /// The same in every language.
+    Plain(String),
+    /// Per language.
+    PerLanguage {
+        /// English.
+        #[serde(default)]
+        en: Option<String>,
+        /// Russian.
+        #[serde(default)]
+        ru: Option<String>,
+    },
+}
+
+impl ListText {
+    /// The text in `lang`.
+    pub fn pick(&self, lang: Lang) -> String {
+        match self {
+            ListText::Plain(text) => text.clone(),
+            ListText::PerLanguage { en, ru } => {
+                let (wanted, other) = match lang {
+                    Lang::En => (en, ru),
+                    Lang::Ru => (ru, en),
+                };
+                wanted.clone().or_else(|| other.clone()).unwrap_or_default()
+            }
+        }
+    }
+}
+
+impl std::fmt::Display for ListText {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.pick(Lang::En))
+    }
+}
 
 /// A list of lectures.
 #[derive(Clone, Debug, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LectureList {
     /// The list's title.
-    pub title: String,
+    pub title: ListText,
     /// Its entries, in the order shown.
     pub lectures: Vec<Lecture>,
 }
@@ -35,10 +76,10 @@ pub struct LectureList {
 #[serde(deny_unknown_fields)]
 pub struct Lecture {
     /// What the card says.
-    pub title: String,
+    pub title: ListText,
     /// A line under the title.
     #[serde(default)]
-    pub description: Option<String>,
+    pub description: Option<ListText>,
     /// The nest's file, relative to the list's address (or absolute).
     pub file: String,
     /// The solver's short name (`SolverKind::name`).
@@ -156,6 +197,7 @@ pub fn Gallery(
     list: Signal<Option<Result<LectureList, String>>>,
     pick: Callback<(String, String)>,
 ) -> impl IntoView {
+    let language = use_language();
     view! {
         <details id="gallery" class="gallery">
             <summary>{tr("Lectures", "Лекции")}</summary>
@@ -171,7 +213,10 @@ pub fn Gallery(
                 Some(Ok(list)) => {
                     let base = list_url.get();
                     view! {
-                        <h2 id="gallery-title">{list.title.clone()}</h2>
+                        <h2 id="gallery-title">{
+                            let title = list.title.clone();
+                            move || title.pick(language.get())
+                        }</h2>
                         <ul class="gallery-cards">
                             {list
                                 .lectures
@@ -190,9 +235,15 @@ pub fn Gallery(
                                                 data-file=url.clone()
                                                 on:click=move |_| pick.run((url.clone(), query.clone()))
                                             >
-                                                <strong>{lecture.title.clone()}</strong>
+                                                <strong>{
+                                                    let title = lecture.title.clone();
+                                                    move || title.pick(language.get())
+                                                }</strong>
                                                 <span class="muted">
-                                                    {lecture.description.clone().unwrap_or_default()}
+                                                    {
+                                                        let description = lecture.description.clone();
+                                                        move || description.as_ref().map(|d| d.pick(language.get())).unwrap_or_default()
+                                                    }
                                                     " · "
                                                     {solver}
                                                 </span>

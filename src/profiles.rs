@@ -268,9 +268,11 @@ pub fn PresetPicker(
                 {GcodePreset::ALL
                     .into_iter()
                     .map(|p| {
+                        let language = crate::i18n::use_language();
+                        let text = move || crate::words::preset_text(language.get(), p);
                         view! {
-                            <option value=p.name() title=p.description()>
-                                {format!("{} — {}", p.name(), p.description())}
+                            <option value=p.name() title=text>
+                                {text}
                             </option>
                         }
                     })

@@ -177,6 +177,10 @@ pub fn AlternativesTable(alternatives: Signal<Vec<RouteSummary>>) -> impl IntoVi
     move || {
         let lang = language.get();
         let rows = alternatives.get();
+        let idle_gap = rows
+            .iter()
+            .find(|r| r.chosen)
+            .and_then(|r| Some((r.idle_lower_bound?, r.idle_gap()?)));
         (!rows.is_empty()).then(|| {
             view! {
                 // Scrolls sideways in the narrow panel rather than clipping columns.
@@ -225,6 +229,8 @@ pub fn AlternativesTable(alternatives: Signal<Vec<RouteSummary>>) -> impl IntoVi
                             .collect_view()}
                     </tbody>
                 </table>
+                // The idle part of the gap: cutting time is fixed, so the time gap hides it.
+                {idle_gap.map(|(lb, gap)| view! { <p id="idle-gap" data-mm=format!("{lb:.3}")>{crate::i18n::tr("Idle gap", "Разрыв по холостому ходу")}{format!(": {:.1} % (≥ {lb:.1} mm)", gap * 100.0)}</p> })}
                 </div>
             }
         })

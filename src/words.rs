@@ -337,3 +337,23 @@ fn open_error_ru(error: &OpenError) -> String {
         ),
     }
 }
+
+/// A post-processor preset as the picker shows it: in English its id and the library's
+/// description, in Russian what it is for.
+pub fn preset_text(lang: Lang, preset: cutroute_gcode::GcodePreset) -> String {
+    use cutroute_gcode::GcodePreset::*;
+    match lang {
+        Lang::En => format!("{} — {}", preset.name(), preset.description()),
+        Lang::Ru => match preset {
+            Generic => "Общий: M03/M05, G04 P в секундах, дуги I/J (по умолчанию в cutroute)",
+            GrblLaser => "GRBL 1.1, лазерный режим: M04 S1000 (мощность по скорости), G04 P в секундах",
+            QtPlasmac => "LinuxCNC QtPlasmaC: M03 $0 S1 / M05 $0",
+            Mach3Plasma => "Mach3, плазма: M03/M05, G91.1, номера строк",
+            Fanuc => "В стиле Fanuc: G04 P в миллисекундах, номера строк N10",
+            Kometa2p32m => {
+                "Газовая резка «Комета», ЧПУ 2П32М: G91, M71/M74 T1, без выдержки (мм, см. документацию)"
+            }
+        }
+        .to_string(),
+    }
+}

@@ -28,6 +28,8 @@ const ALLOWED = new Set([
   'cutroute', 'English', 'CCP', 'Relax', 'ALNS', 'SCCP', 'GSCCP', 'AOE', 'VNS', 'PCGTSP',
   'PCGLNS', 'PCGTSPLIB', 'DBS', 'JSON', 'SVG', 'HTML', 'DXF', 'RouteManager', 'nearest', 'ccp',
   'chain', 'heuristic', 'exact', 'exp',
+  // Controllers the G-code presets are named for.
+  'GRBL', 'LinuxCNC', 'QtPlasmaC', 'Mach', 'Fanuc',
 ]);
 
 /** Every Latin word of the page's text nodes and title/aria-label/placeholder attributes that

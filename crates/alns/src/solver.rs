@@ -63,6 +63,15 @@ impl<const N: usize> Adaptive<N> {
     }
 }
 
+/// Where the first tour's descent is: the next unit (0 2-opt, 1 or-opt, 2 reinsertion,
+/// 3 block reversal when the round changed nothing, 4 the node-choice DP) and whether the
+/// round's moves changed the tour.
+#[derive(Clone, Copy, Debug, Default)]
+struct Descent {
+    unit: u8,
+    changed: bool,
+}
+
 /// Anytime ALNS for PCGTSP / GTSP that can be advanced in slices (see [`AlnsSolver::step`]).
 ///
 /// The search trajectory depends only on the seed and the number of iterations: time only
@@ -90,6 +99,9 @@ pub struct AlnsSolver {
     /// The best distinct epoch results, cheapest first: restart points after a stagnant epoch.
     elite: Vec<(Vec<usize>, f64)>,
     started: bool,
+    /// The first tour's descent under way, a move family per [`AlnsSolver::step`] unit (on
+    /// thousands of clusters it takes seconds: one piece would block Stop that long).
+    descent: Option<Descent>,
     stop: Option<StopReason>,
     iterations: u64,
     improvements: u64,
@@ -124,6 +136,7 @@ impl AlnsSolver {
             epoch_improved: false,
             elite: Vec::new(),
             started: false,
+            descent: None,
             stop: None,
             iterations: 0,
             improvements: 0,
@@ -153,10 +166,12 @@ impl AlnsSolver {
                 self.stop = Some(reason);
                 return SolverStatus::Finished;
             }
-            let improved = if self.started {
-                self.iterate()
-            } else {
+            let improved = if !self.started {
                 self.start()
+            } else if let Some(descent) = self.descent.take() {
+                self.descend(descent)
+            } else {
+                self.iterate()
             };
             self.elapsed = base + slice_start.elapsed();
             if improved && self.best().is_some() {
@@ -229,7 +244,9 @@ impl AlnsSolver {
         None
     }
 
-    /// Builds the first tour: cheapest insertion from the depot, then local search.
+    /// Builds the first tour by cheapest insertion from the depot and starts its descent
+    /// ([`AlnsSolver::descend`], the same moves as [`AlnsSolver::improve`] with no depth
+    /// gate). The tour is the best from here on: every unit of the descent keeps it valid.
     fn start(&mut self) -> bool {
         self.started = true;
         let p = &self.problem;
@@ -240,14 +257,57 @@ impl AlnsSolver {
             noisy: false,
         };
         self.operators.repair(p, &mut tour, how, 0.0, &mut self.rng);
-        let cost = self.improve(&mut tour, f64::INFINITY);
+        let cost = self.node_choice.optimise(p, &mut tour);
+        self.publish_first(tour, cost);
+        self.descent = Some(Descent::default());
+        true
+    }
+
+    /// The first tour (or its descent so far) as current, epoch best and best.
+    fn publish_first(&mut self, tour: Vec<usize>, cost: f64) {
         self.current.clone_from(&tour);
         self.current_cost = cost;
         self.epoch_best.clone_from(&tour);
         self.epoch_best_cost = cost;
         self.best = tour;
         self.best_cost = cost;
-        true
+    }
+
+    /// One unit of the first tour's descent: one move family over the tour, or the
+    /// node-choice DP after a round that changed it. The units run the loop of
+    /// [`AlnsSolver::improve`] (with `deep_below` infinite) in the same order, so the tour it
+    /// ends with does not depend on how the units fall into slices; a time limit ends it
+    /// between units as it ended `improve` between rounds. Returns whether the best improved.
+    fn descend(&mut self, mut descent: Descent) -> bool {
+        let p = &self.problem;
+        let mut tour = std::mem::take(&mut self.current);
+        let mut improved = false;
+        match descent.unit {
+            0 => descent.changed = self.local_search.two_opt(p, &mut tour),
+            1 => descent.changed |= self.local_search.or_opt(p, &mut tour),
+            2 => descent.changed |= self.local_search.reinsert(p, &mut tour),
+            3 => {
+                let max_len = self.options.parameters.block_reverse_length;
+                if !descent.changed && !self.local_search.block_reverse(p, &mut tour, max_len) {
+                    // A local optimum: the descent is over.
+                    debug_assert!(p.order_is_valid(&tour));
+                    self.current = tour;
+                    return false;
+                }
+            }
+            _ => {
+                let cost = self.node_choice.optimise(p, &mut tour);
+                improved = cost < self.best_cost;
+                self.publish_first(tour, cost);
+                descent = Descent::default();
+                self.descent = Some(descent);
+                return improved;
+            }
+        }
+        self.current = tour;
+        descent.unit += 1;
+        self.descent = Some(descent);
+        improved
     }
 
     /// Node-choice DP followed by local search until nothing changes. The expensive block
@@ -461,6 +521,68 @@ mod tests {
 
     fn instance(set: &str, name: &str) -> Instance {
         crate::reference_instance(set, name)
+    }
+
+    /// The first descent runs a move family per unit: stepped with no budget (one unit per
+    /// call) it ends with the very tour of one long step, every tour it shows on the way is
+    /// feasible and costs what the solver says, and the costs never rise.
+    #[test]
+    fn the_first_descent_in_units_equals_one_piece() {
+        for (set, name) in [("pcgtsplib", "ry48p.1"), ("industrial", "e1x_2")] {
+            let instance = instance(set, name);
+            let options = AlnsOptions {
+                seed: 5,
+                time_limit: None,
+                max_iterations: Some(1),
+                ..AlnsOptions::default()
+            };
+            let mut whole = AlnsSolver::new(&instance, options.clone()).unwrap();
+            whole.step(Duration::from_secs(3600));
+            let mut units = AlnsSolver::new(&instance, options).unwrap();
+            let mut calls = 0;
+            let mut last = f64::INFINITY;
+            while units.descent.is_some() || !units.started {
+                units.step(Duration::ZERO);
+                calls += 1;
+                let (tour, cost) = units.best().expect("a tour from the first unit");
+                let checked = check_tour(&instance, tour).unwrap();
+                assert!(
+                    (checked - cost).abs() <= 1e-6 * (1.0 + cost.abs()),
+                    "{name}"
+                );
+                assert!(cost <= last + 1e-9, "{name}: {cost} after {last}");
+                last = cost;
+            }
+            assert!(calls > 5, "{name}: {calls} units");
+            assert_eq!(units.current, whole_first_tour(&instance, 5), "{name}");
+            assert!(whole.best_cost <= last + 1e-9);
+        }
+    }
+
+    /// The first tour after the descent in one piece, by the unsliced `improve` loop.
+    fn whole_first_tour(instance: &Instance, seed: u64) -> Vec<usize> {
+        let mut solver = AlnsSolver::new(
+            instance,
+            AlnsOptions {
+                seed,
+                time_limit: None,
+                ..AlnsOptions::default()
+            },
+        )
+        .unwrap();
+        solver.started = true;
+        let p = &solver.problem;
+        let mut tour = Vec::with_capacity(p.m);
+        solver.operators.destroy_all(p, &mut tour);
+        let how = Insertion {
+            selection: Selection::Cheapest,
+            noisy: false,
+        };
+        solver
+            .operators
+            .repair(p, &mut tour, how, 0.0, &mut solver.rng);
+        solver.improve(&mut tour, f64::INFINITY);
+        tour
     }
 
     /// After a stagnant epoch the next one starts from a kicked elite tour: feasible (checked

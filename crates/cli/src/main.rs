@@ -1219,7 +1219,8 @@ fn route_report(
 /// keeping the best by `--objective`; aoe cuts common edges once along AOE-chains. The
 /// report's numbers are recomputed from the route, which must pass `PathRoute::problems` but
 /// for contour cut twice (standard cutting of common edges, reported as `recut_length`);
-/// `ub` and `lb` are the job's bounds in the objective's unit (s or cost).
+/// `ub` and `lb` are the job's bounds in the objective's unit (s or cost); `idle_lb` is its
+/// lower bound on idle length (mm) and `idle_gap` the route's `idle_length` against it.
 fn solve_path(
     input: (&Path, usize),
     solver_name: &str,
@@ -1357,6 +1358,8 @@ fn solve_path(
         "route": serde_json::to_value(route).map_err(|e| e.to_string())?,
         "ub": progress.upper_bound,
         "lb": progress.lower_bound,
+        "idle_lb": progress.idle_lower_bound,
+        "idle_gap": progress.idle_gap(),
         "phase": progress.phase.to_string(),
         "elapsed_s": started.elapsed().as_secs_f64(),
         "stopped": stopped,

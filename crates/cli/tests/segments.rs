@@ -153,6 +153,17 @@ fn path_solvers_report_bounds_in_the_objectives_unit() {
             );
             assert!(lb > 0.0 && lb <= ub, "{solver} {objective}: {lb} > {ub}");
             assert_eq!(v["objective"], objective);
+            // The idle bound (mm) holds for the printed route, and the gap is measured on it.
+            let (idle, idle_lb) = (number(&v, "idle_length"), number(&v, "idle_lb"));
+            assert!(
+                idle_lb >= 0.0 && idle_lb <= idle + 1e-9,
+                "{solver}: idle lb {idle_lb} > idle {idle}"
+            );
+            let gap = number(&v, "idle_gap");
+            assert!(
+                (gap - (idle - idle_lb) / idle).abs() < 1e-9,
+                "{solver}: idle gap {gap}"
+            );
         }
     }
 }

@@ -186,6 +186,9 @@ pub struct DiscreteJob {
     alns_done: bool,
     exact: Option<ExactSolver>,
     exact_done: Option<bool>,
+    /// The longest single piece of the exact solver so far (its making, then its steps): a
+    /// piece is not started when less time than that is left (see `step`).
+    exact_piece: Duration,
     offered_cost: f64,
     /// The continuous bound of the nest the instance discretises, while it may still improve.
     bound: Option<CcpLowerBound>,
@@ -257,6 +260,7 @@ impl DiscreteJob {
             alns_done: false,
             exact: None,
             exact_done: None,
+            exact_piece: Duration::ZERO,
             offered_cost: f64::INFINITY,
             bound: None,
             bound_running: false,
@@ -350,10 +354,12 @@ impl DiscreteJob {
                 heuristic: false,
                 ..ExactOptions::default()
             };
-            match ExactSolver::new(instance, options) {
+            let made = Instant::now();
+            match ExactSolver::deferred(instance, options) {
                 Ok(exact) => self.exact = Some(exact),
                 Err(e) => self.failure = Some(e.to_string()),
             }
+            self.exact_piece = made.elapsed();
             return false;
         }
         true
@@ -378,6 +384,11 @@ impl DiscreteJob {
 /// Why a discrete job ends when its limit passes before the model is built (the phase says
 /// it as [`Phase::BuildTimedOut`]).
 const BUILD_TIMED_OUT: &str = "the time limit passed while the model was built";
+
+/// One slice of the heuristic; whether it has finished.
+fn alns_step(alns: &mut AlnsSolver, budget: Duration) -> bool {
+    alns.step(budget) == cutroute_alns::SolverStatus::Finished
+}
 
 impl Job for DiscreteJob {
     fn step(&mut self, budget: Duration) -> JobStatus {
@@ -445,8 +456,27 @@ impl Job for DiscreteJob {
             }
         }
         let exact = self.exact.as_mut().expect("built");
+        // A piece of the exact solver is not split further (a start node's model or root
+        // bound: seconds on thousands of nodes, several times the instance's copy when it was
+        // made; later pieces no longer than the longest so far): none is started that would
+        // run past the limit. The heuristic takes the slice instead.
+        let left = self.deadline.saturating_duration_since(Instant::now());
+        let piece = if exact.runs_built() {
+            self.exact_piece
+        } else {
+            self.exact_piece * 4
+        };
+        if self.exact_done.is_none() && left < piece {
+            if !self.alns_done {
+                self.alns_done = alns_step(self.alns.as_mut().expect("built"), exact_share);
+            }
+            return JobStatus::Running;
+        }
         if self.exact_done.is_none() {
-            match exact.step(exact_share) {
+            let began = Instant::now();
+            let status = exact.step(exact_share);
+            self.exact_piece = self.exact_piece.max(began.elapsed());
+            match status {
                 cutroute_pcgtsp::SolverStatus::Running => {}
                 cutroute_pcgtsp::SolverStatus::Finished { proven_optimal } => {
                     self.exact_done = Some(proven_optimal)
@@ -537,7 +567,8 @@ pub fn ccp_options(
 }
 
 /// CCP-Relax, then chain cutting of its route (`cutroute-chains`): the CCP phase streams its
-/// progress as a CCP job does; the chaining runs in the step after CCP ends.
+/// progress as a CCP job does; the chaining is set up in the step after CCP ends and tries its
+/// groups in the steps after that.
 pub struct ChainJob {
     ccp: CcpJob,
     nest: Nest,
@@ -546,6 +577,9 @@ pub struct ChainJob {
     chaining: Option<Chaining>,
     chained: Option<Chained>,
     failure: Option<String>,
+    /// Whether CCP-Relax has ended (its last step, `Chaining::new` and the groups each take
+    /// steps of their own: together they ran 2 s on a thousand contours).
+    ccp_done: bool,
     started: Instant,
     /// The job's wall-clock end: chain cutting gives up the group under way there.
     deadline: Option<Instant>,
@@ -564,6 +598,7 @@ impl ChainJob {
             chaining: None,
             chained: None,
             failure: None,
+            ccp_done: false,
             started: Instant::now(),
             deadline: None,
         }
@@ -583,10 +618,14 @@ impl Job for ChainJob {
             return JobStatus::Done;
         }
         let deadline = Instant::now() + budget;
-        if self.chaining.is_none() {
+        if !self.ccp_done {
             if self.ccp.step(budget) == JobStatus::Running {
                 return JobStatus::Running;
             }
+            self.ccp_done = true;
+            return JobStatus::Running;
+        }
+        if self.chaining.is_none() {
             let Some(route) = self.ccp.progress().route else {
                 self.failure = Some("CCP found no route to chain".into());
                 return JobStatus::Done;
@@ -598,6 +637,7 @@ impl Job for ChainJob {
                     return JobStatus::Done;
                 }
             }
+            return JobStatus::Running;
         }
         let chaining = self.chaining.as_mut().expect("set above");
         let job_end = self.deadline;

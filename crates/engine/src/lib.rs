@@ -49,7 +49,7 @@ pub use open_files::{
     is_pcglns_result, open_document, open_gcode, open_gcode_with, open_sheet, open_together,
     task_instance, POINT_TOLERANCE_MM,
 };
-pub use path_jobs::{AoeJob, PlanBound, SegmentJob};
+pub use path_jobs::{idle_tree_bound, AoeJob, PlanBound, SegmentJob};
 pub use thermal::{
     enforce_thermal_rules, heat_penalty, measure_path_route, measure_route, price_consecutive_heat,
     ThermalJob, ThermalMeasure,

@@ -6,7 +6,7 @@
 
 use cutroute_aoe::{AoeSolution, AoeSolveOptions, AoeSolving, PlanGraph, PlanOptions};
 use cutroute_geometry::float::Libm;
-use cutroute_geometry::{MachineParameters, Nest, Objective, PathRoute, Point};
+use cutroute_geometry::{BoundingBox, MachineParameters, Nest, Objective, PathRoute, Point, Span};
 use cutroute_protocol::{
     Ensemble, JobId, JobRequest, Phase, Problem, Progress, RouteSummary, SolverKind,
 };
@@ -14,6 +14,7 @@ use cutroute_segments::{
     Candidate, EnsembleKind, EnsembleReport, GsccpOptions, GsccpSearch, GsccpStage, SccpOptions,
     SearchStatus,
 };
+use std::collections::HashMap;
 use web_time::{Duration, Instant};
 
 use crate::{EngineError, Job, JobStatus};
@@ -34,9 +35,152 @@ pub struct PlanBound {
     /// plan edge exactly once as trails (SCCP's chain segments, AOE's chains). Routes that cut
     /// edges twice (standard cutting) may pierce less.
     pub trail_pierces: usize,
-    /// Idle travel no route avoids (mm): from the start to the parts' bounding box, and from it
-    /// to the finish.
+    /// Idle travel no route of these solvers avoids (mm): the larger of [`idle_tree_bound`]
+    /// over the plan's components and the travel from the start to the parts' bounding box and
+    /// from it to the finish.
     pub idle_length: f64,
+}
+
+/// The work [`idle_tree_bound`] may spend on exact component distances (span pairs measured);
+/// the pairs left then count by their boxes' distance. A count, not a clock, so the bound does
+/// not depend on the machine.
+const EXACT_SPAN_PAIRS: usize = 400_000;
+
+/// Nearest components (by box distance) whose exact distance [`idle_tree_bound`] measures;
+/// the other pairs count by their boxes' distance.
+const EXACT_NEIGHBOURS: usize = 8;
+
+/// Above this many components the O(n²) spanning tree is not built (a single step must stay
+/// short) and [`idle_tree_bound`] returns 0.
+const TREE_COMPONENTS: usize = 3_000;
+
+/// A lower bound (mm) on the idle length of every route that cuts `components` (each a set of
+/// spans) with tool-on paths that never leave a component, from `start` (to `finish`): the
+/// weight of a minimum spanning tree over the start, the components and the finish, each edge
+/// weighted by a lower bound on the distance between its two sets, less `tolerance` (the
+/// plan graph merges common edges, moving them by up to that much).
+///
+/// Why it is sound: a route's tool runs start → pierce → … → finish; tool-on paths stay inside
+/// one component, so every change of component is an idle move from a point of one set to a
+/// point of the other, at least their set distance long. The idle moves between different
+/// nodes, taken in the route's order, form a walk through every node (every component is cut,
+/// so visited), hence a connected spanning subgraph, whose weight is at least the minimum
+/// spanning tree's. The walk never steps from the start straight to the finish (it reaches the
+/// finish from the last component), so that edge is left out of the graph. Idle moves inside a component only add. Edge weights below the true set
+/// distance (box distances, exact distances less the tolerance) can only lower the tree.
+pub fn idle_tree_bound(
+    components: &[Vec<Span>],
+    start: Point,
+    finish: Option<Point>,
+    tolerance: f64,
+) -> f64 {
+    let k = components.len();
+    if k == 0 || k > TREE_COMPONENTS {
+        return 0.0;
+    }
+    let boxes: Vec<BoundingBox> = components
+        .iter()
+        .map(|spans| {
+            spans
+                .iter()
+                .fold(BoundingBox::EMPTY, |b, s| b.union(s.bounding_box()))
+        })
+        .collect();
+    let span_boxes: Vec<Vec<BoundingBox>> = components
+        .iter()
+        .map(|spans| spans.iter().map(|s| s.bounding_box()).collect())
+        .collect();
+    let to_point = |c: usize, p: Point| -> f64 {
+        components[c]
+            .iter()
+            .map(|s| s.distance_to(p))
+            .fold(f64::INFINITY, f64::min)
+    };
+    // Exact distances to each component's nearest neighbours by box, within the work budget.
+    let mut exact: HashMap<(usize, usize), f64> = HashMap::new();
+    let mut work = 0usize;
+    for a in 0..k {
+        let mut near: Vec<(f64, usize)> = (0..k)
+            .filter(|&b| b != a)
+            .map(|b| (boxes[a].distance_to_box(&boxes[b]), b))
+            .collect();
+        let n = near.len().min(EXACT_NEIGHBOURS);
+        if n == 0 {
+            continue;
+        }
+        near.select_nth_unstable_by(n - 1, |x, y| x.0.total_cmp(&y.0));
+        for &(_, b) in &near[..n] {
+            let key = (a.min(b), a.max(b));
+            if exact.contains_key(&key) {
+                continue;
+            }
+            let pairs = components[a].len() * components[b].len();
+            if work + pairs > EXACT_SPAN_PAIRS {
+                continue;
+            }
+            work += pairs;
+            let mut best = f64::INFINITY;
+            for (sa, ba) in components[a].iter().zip(&span_boxes[a]) {
+                if ba.distance_to_box(&boxes[b]) >= best {
+                    continue;
+                }
+                for (sb, bb) in components[b].iter().zip(&span_boxes[b]) {
+                    if ba.distance_to_box(bb) < best {
+                        best = best.min(sa.distance_to_span(sb));
+                    }
+                }
+            }
+            exact.insert(key, best);
+        }
+    }
+    // Nodes: 0 the start, 1..=k the components, k + 1 the finish (if any).
+    let n = k + 1 + usize::from(finish.is_some());
+    let weight = |i: usize, j: usize| -> f64 {
+        let (i, j) = (i.min(j), i.max(j));
+        let raw = if i == 0 && j == k + 1 {
+            // The walk reaches the finish from a component, never from the start (k ≥ 1).
+            f64::INFINITY
+        } else if i == 0 {
+            to_point(j - 1, start)
+        } else if j == k + 1 {
+            to_point(i - 1, finish.expect("the finish node"))
+        } else {
+            let (a, b) = (i - 1, j - 1);
+            exact
+                .get(&(a, b))
+                .copied()
+                .unwrap_or_else(|| boxes[a].distance_to_box(&boxes[b]))
+        };
+        (raw - 2.0 * tolerance).max(0.0)
+    };
+    // Prim's algorithm on the complete graph: O(n²), no edge list.
+    let mut in_tree = vec![false; n];
+    let mut key = vec![f64::INFINITY; n];
+    key[0] = 0.0;
+    let mut total = 0.0;
+    for _ in 0..n {
+        let mut u = usize::MAX;
+        for v in 0..n {
+            if !in_tree[v] && (u == usize::MAX || key[v] < key[u]) {
+                u = v;
+            }
+        }
+        in_tree[u] = true;
+        total += key[u];
+        for v in 0..n {
+            if !in_tree[v] {
+                let w = weight(u, v);
+                if w < key[v] {
+                    key[v] = w;
+                }
+            }
+        }
+    }
+    if total.is_finite() {
+        total
+    } else {
+        0.0
+    }
 }
 
 impl PlanBound {
@@ -66,6 +210,16 @@ impl PlanBound {
             .iter()
             .map(|c| cutroute_aoe::pierce_lower_bound(c.embedding.graph()))
             .sum();
+        let component_spans: Vec<Vec<Span>> = components
+            .iter()
+            .map(|c| {
+                c.edges
+                    .iter()
+                    .flat_map(|&e| plan.edge_spans(e).iter().copied())
+                    .collect()
+            })
+            .collect();
+        let tree = idle_tree_bound(&component_spans, start, finish, tolerance);
         let b = nest.bounding_box();
         let to_box = |p: Point| {
             let dx = (b.min.x - p.x).max(p.x - b.max.x).max(0.0);
@@ -77,7 +231,7 @@ impl PlanBound {
             cut_length: (length - 4.0 * tolerance * edges as f64).max(0.0),
             components: components.len(),
             trail_pierces,
-            idle_length: to_box(start) + finish.map_or(0.0, to_box),
+            idle_length: tree.max(to_box(start) + finish.map_or(0.0, to_box)),
         })
     }
 
@@ -108,6 +262,7 @@ fn summary(name: &str, route: &PathRoute, machine: &MachineParameters) -> RouteS
         cost: route.cost(machine),
         chosen: false,
         failure: None,
+        idle_lower_bound: None,
     }
 }
 
@@ -121,6 +276,7 @@ fn report_summary(report: &EnsembleReport) -> RouteSummary {
         cost: report.cost,
         chosen: false,
         failure: report.failure.clone(),
+        idle_lower_bound: None,
     }
 }
 
@@ -261,10 +417,15 @@ impl Job for SegmentJob {
             s.chosen = chosen == Some(p.source);
             alternatives.push(s);
         }
-        let lower_bound = match &self.bound {
-            Some(Ok(bound)) => Some(bound.any_route(self.objective, &self.machine)),
+        let bound = match &self.bound {
+            Some(Ok(bound)) => Some(bound),
             _ => None,
         };
+        let lower_bound = bound.map(|b| b.any_route(self.objective, &self.machine));
+        let idle_lower_bound = bound.map(|b| b.idle_length);
+        for s in alternatives.iter_mut().filter(|s| s.chosen) {
+            s.idle_lower_bound = idle_lower_bound;
+        }
         Progress {
             job_id: self.job_id,
             elapsed_s: self.started.elapsed().as_secs_f64(),
@@ -278,6 +439,7 @@ impl Job for SegmentJob {
             certified: Vec::new(),
             path_route: best.map(|c| c.route.clone()),
             alternatives,
+            idle_lower_bound,
             ..Progress::default()
         }
     }
@@ -403,6 +565,7 @@ impl Job for AoeJob {
             },
         };
         let route = solved.map(|(s, _)| &s.route);
+        let idle_lower_bound = solved.and_then(|(_, b)| b.as_ref()).map(|b| b.idle_length);
         Progress {
             job_id: self.job_id,
             elapsed_s: self.started.elapsed().as_secs_f64(),
@@ -428,9 +591,11 @@ impl Job for AoeJob {
                 .map(|r| {
                     let mut s = summary("aoe", r, &self.machine);
                     s.chosen = true;
+                    s.idle_lower_bound = idle_lower_bound;
                     vec![s]
                 })
                 .unwrap_or_default(),
+            idle_lower_bound,
             ..Progress::default()
         }
     }

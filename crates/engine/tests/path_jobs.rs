@@ -7,9 +7,12 @@ use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 
 use cutroute_aoe::{PlanGraph, PlanOptions};
-use cutroute_engine::{open_document, run_to_end, start_job, JobStatus};
+use cutroute_engine::{
+    idle_tree_bound, open_document, run_to_end, start_job, JobStatus, PlanBound,
+};
 use cutroute_geometry::{
-    MachineParameters, Nest, Objective, PathRoute, PathRouteError, Point, Span,
+    Contour, MachineParameters, Nest, Objective, Part, PathRoute, PathRouteError, Point, Span,
+    SplitMix64,
 };
 use cutroute_protocol::{JobRequest, Problem, Progress, SolverKind, SolverParams};
 use web_time::{Duration, Instant};
@@ -102,6 +105,15 @@ fn check_progress(
     );
     let lb = progress.lower_bound.expect("a lower bound");
     assert!(lb > 0.0 && lb <= ub, "{what}: lb {lb} ub {ub}");
+    // The idle bound (mm) holds for the route, and the chosen candidate carries it.
+    let idle_lb = progress.idle_lower_bound.expect("an idle lower bound");
+    assert!(
+        idle_lb >= 0.0 && idle_lb <= route.idle_length() + 1e-9,
+        "{what}: idle lb {idle_lb} idle {}",
+        route.idle_length()
+    );
+    assert_eq!(chosen.idle_lower_bound, Some(idle_lb), "{what}");
+    assert_eq!(progress.idle_upper_bound(), Some(route.idle_length()));
     assert_eq!(chosen.pierces, route.pierce_count(), "{what}");
     assert!((chosen.idle_length - route.idle_length()).abs() < 1e-6);
     assert!((chosen.cut_length - route.cut_length()).abs() < 1e-6);
@@ -394,4 +406,150 @@ fn bounds_meet_at_the_known_optimum_of_one_rectangle() {
             );
         }
     }
+}
+
+/// Every order of `0..n`, by Heap's algorithm.
+fn permutations(n: usize) -> Vec<Vec<usize>> {
+    fn heap(k: usize, items: &mut Vec<usize>, out: &mut Vec<Vec<usize>>) {
+        if k <= 1 {
+            out.push(items.clone());
+            return;
+        }
+        for i in 0..k {
+            heap(k - 1, items, out);
+            let j = if k.is_multiple_of(2) { i } else { 0 };
+            items.swap(j, k - 1);
+        }
+    }
+    let mut out = Vec::new();
+    heap(n, &mut (0..n).collect(), &mut out);
+    out
+}
+
+/// The idle bound against brute force on nests of separate circles, cut whole from one
+/// pierce each (standard cutting, every path solver's CCP seed): the optimum over orders and
+/// pierce points, enumerated with `N` pierce candidates per circle, is at most the true optimum
+/// plus one candidate spacing per circle (snapping a pierce point to its nearest candidate moves
+/// it by half a spacing, and it ends two idle moves), so the bound must stay below the
+/// enumerated optimum less those spacings. It must also stay below the set-distance path (the
+/// same enumeration with circles as sets), and be no trivial 0.
+#[test]
+fn the_idle_bound_is_below_brute_force_on_separate_circles() {
+    const N: usize = 48;
+    let mut rng = SplitMix64::new(20261124);
+    for trial in 0..30 {
+        let k = 3 + trial % 3;
+        let mut circles: Vec<(Point, f64)> = Vec::new();
+        while circles.len() < k {
+            let c = Point::new(rng.range(0.0, 200.0), rng.range(0.0, 200.0));
+            let r = rng.range(2.0, 15.0);
+            if circles.iter().all(|&(d, s)| c.distance(d) > r + s + 1.0) {
+                circles.push((c, r));
+            }
+        }
+        let start = Point::new(rng.range(-50.0, 250.0), rng.range(-50.0, 250.0));
+        let finish = (trial % 2 == 0).then(|| Point::new(rng.range(-50.0, 250.0), -60.0));
+        let nest = Nest {
+            sheet: None,
+            parts: circles
+                .iter()
+                .map(|&(c, r)| Part {
+                    name: "circle".into(),
+                    contours: vec![Contour::circle(c, r, false)],
+                })
+                .collect(),
+        };
+        let candidates: Vec<Vec<Point>> = circles
+            .iter()
+            .map(|&(c, r)| {
+                (0..N)
+                    .map(|i| {
+                        let a = i as f64 * std::f64::consts::TAU / N as f64;
+                        Point::new(c.x + r * a.cos(), c.y + r * a.sin())
+                    })
+                    .collect()
+            })
+            .collect();
+        let mut enumerated = f64::INFINITY;
+        let mut set_path = f64::INFINITY;
+        for order in permutations(k) {
+            // Shortest idle over pierce candidates along this order (DP over the candidates).
+            let mut best: Vec<f64> = candidates[order[0]]
+                .iter()
+                .map(|p| start.distance(*p))
+                .collect();
+            for w in order.windows(2) {
+                best = candidates[w[1]]
+                    .iter()
+                    .map(|q| {
+                        candidates[w[0]]
+                            .iter()
+                            .zip(&best)
+                            .map(|(p, b)| b + p.distance(*q))
+                            .fold(f64::INFINITY, f64::min)
+                    })
+                    .collect();
+            }
+            let last = &candidates[order[k - 1]];
+            let total = last
+                .iter()
+                .zip(&best)
+                .map(|(p, b)| b + finish.map_or(0.0, |f| p.distance(f)))
+                .fold(f64::INFINITY, f64::min);
+            enumerated = enumerated.min(total);
+            let to = |p: Point, i: usize| (p.distance(circles[i].0) - circles[i].1).max(0.0);
+            let mut set = to(start, order[0]) + finish.map_or(0.0, |f| to(f, order[k - 1]));
+            for w in order.windows(2) {
+                let ((a, ra), (b, rb)) = (circles[w[0]], circles[w[1]]);
+                set += (a.distance(b) - ra - rb).max(0.0);
+            }
+            set_path = set_path.min(set);
+        }
+        let spacings: f64 = circles
+            .iter()
+            .map(|&(_, r)| std::f64::consts::TAU * r / N as f64)
+            .sum();
+        let spans: Vec<Vec<Span>> = nest
+            .parts
+            .iter()
+            .map(|p| p.contours[0].spans().collect())
+            .collect();
+        let tree = idle_tree_bound(&spans, start, finish, 0.0);
+        let plan = PlanBound::new(&nest, start, finish, nest.check_tolerance()).unwrap();
+        assert_eq!(plan.components, k, "trial {trial}");
+        for (what, lb) in [("tree", tree), ("plan", plan.idle_length)] {
+            assert!(
+                lb <= enumerated - spacings + 1e-9,
+                "trial {trial} {what}: {lb} > {enumerated} − {spacings}"
+            );
+            assert!(
+                lb <= set_path + 1e-9,
+                "trial {trial} {what}: {lb} > {set_path}"
+            );
+        }
+        // Not trivial: a spanning tree is at least half of the shortest path through the
+        // circles' sets when they are small against their distances.
+        assert!(
+            tree >= 0.3 * set_path,
+            "trial {trial}: {tree} vs {set_path}"
+        );
+        // The plan's tree is the same less the merging tolerance on each of its k + 1 edges.
+        let slack = 2.0 * nest.check_tolerance() * (k + 1) as f64;
+        assert!(plan.idle_length >= tree - slack - 1e-9, "trial {trial}");
+    }
+}
+
+/// No components give 0; one gives its distance from the start, and to the finish as well: the
+/// tool never idles from the start straight to the finish, so that edge is not in the tree.
+#[test]
+fn the_idle_tree_of_no_components_is_zero_and_of_one_is_the_start_distance() {
+    let start = Point::new(0.0, 0.0);
+    assert_eq!(idle_tree_bound(&[], start, None, 0.0), 0.0);
+    let ring: Vec<Span> = Contour::circle(Point::new(30.0, 40.0), 10.0, false)
+        .spans()
+        .collect();
+    let one = idle_tree_bound(std::slice::from_ref(&ring), start, None, 0.0);
+    assert!((one - 40.0).abs() < 1e-9, "{one}");
+    let back = idle_tree_bound(&[ring], start, Some(start), 0.0);
+    assert!((back - 80.0).abs() < 1e-9, "{back}");
 }

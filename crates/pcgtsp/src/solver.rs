@@ -8,7 +8,7 @@ use crate::heuristic;
 use crate::instance::Instance;
 use crate::lagrange::{self, NodePenalties, PenaltyOptions};
 use crate::lattice::Lattice;
-use crate::order::OrderError;
+use crate::order::{OrderError, PrecedenceOrder};
 use crate::prepare::{LatticeLimits, Preparation, STRONG_SUBSET_SHARE};
 use crate::subset::SubsetBound;
 use std::rc::Rc;
@@ -323,6 +323,11 @@ struct Run {
     penalties: Option<Rc<NodePenalties>>,
     /// The position-indexed completion bound (when the run has no lattice).
     position: Option<Rc<PositionBound>>,
+    /// The prepared lattice store while the Lagrangian bounds are still to be built: they
+    /// take a step of their own (0.4–1.1 s on ESC78), the position bound the next.
+    prepared: Option<LatticeStore>,
+    /// Whether the Lagrangian bounds of `prepared` are built.
+    penalties_built: bool,
     root_bound: f64,
     engine: Option<Engine>,
     finished_bound: Option<f64>,
@@ -330,7 +335,9 @@ struct Run {
 }
 
 impl Run {
-    /// Builds the bounds until `deadline`; sets `lattice` once they are complete.
+    /// Builds the bounds until `deadline`; sets `lattice` once they are complete. The
+    /// preparation runs in slices; the Lagrangian bounds and then the position bound each take
+    /// a call of their own after it (the caller calls again while `lattice` is unset).
     fn build_lattice(
         &mut self,
         instance: &Instance,
@@ -355,15 +362,27 @@ impl Run {
                 limits,
             )
         });
-        let Some(store) = preparation.advance(&self.model, deadline) else {
+        debug_log(|| format!("preparation made after {:?}", began.elapsed()));
+        let Some(store) = self.prepared.take() else {
+            let Some(store) = preparation.advance(&self.model, deadline) else {
+                debug_log(|| format!("preparation advanced after {:?}", began.elapsed()));
+                return;
+            };
+            debug_log(|| format!("preparation done after {:?}", began.elapsed()));
+            self.subset = preparation.subset.clone();
+            self.prepared = Some(store);
             return;
         };
-        self.subset = preparation.subset.clone();
-        self.preparation = None;
-        if store.root_bound().is_none() {
-            // Without the lattice the DP bounds its states by assignments: strengthen them.
-            self.build_penalties(instance, options, upper_bound);
+        if !self.penalties_built {
+            self.penalties_built = true;
+            if store.root_bound().is_none() {
+                // Without the lattice the DP bounds its states by assignments: strengthen them.
+                self.build_penalties(instance, options, upper_bound);
+            }
+            self.prepared = Some(store);
+            return;
         }
+        self.preparation = None;
         if let Some(root) = store.root_bound() {
             self.root_bound = self.root_bound.max(self.model.round_bound(root));
         }
@@ -380,6 +399,7 @@ impl Run {
             // incumbent, as on the industrial orders) sees precedence per state: add the
             // position bound (on e1x_4, ec_2, … its root stays 17–35 % below the subset's).
             self.build_position_bound(options, upper_bound);
+            debug_log(|| format!("position bound after {:?}", began.elapsed()));
         }
         debug_log(|| {
             format!(
@@ -520,6 +540,10 @@ pub struct ExactSolver {
     instance: Instance,
     options: ExactOptions,
     runs: Vec<Run>,
+    /// Start nodes whose run is still to be built (reversed: next is last).
+    unbuilt: Vec<usize>,
+    /// The model built last, its root bound not yet computed.
+    unbounded: Option<Model>,
     current_run: usize,
     incumbent: Incumbent,
     phase: Phase,
@@ -532,29 +556,24 @@ pub struct ExactSolver {
 impl ExactSolver {
     /// Prepares the solver (preprocessing and root bounds; no search yet).
     pub fn new(instance: &Instance, options: ExactOptions) -> Result<ExactSolver, SolverError> {
+        let mut solver = ExactSolver::deferred(instance, options)?;
+        while solver.build_unit() {}
+        Ok(solver)
+    }
+
+    /// Like [`ExactSolver::new`] but cheap: the instance is checked here and each start
+    /// node's model and root bound are built later, each in a [`ExactSolver::step`] of its own
+    /// (on thousands of nodes each takes seconds, which a caller answering Stop between steps
+    /// cannot wait for). Until they are built, [`ExactSolver::root_bound`] is −∞.
+    pub fn deferred(
+        instance: &Instance,
+        options: ExactOptions,
+    ) -> Result<ExactSolver, SolverError> {
         if instance.node_count > u16::MAX as usize {
             return Err(SolverError::TooManyNodes(instance.node_count));
         }
-        let mut runs = Vec::new();
-        let mut bounder = ResidualBounder::default();
-        for &start in &instance.clusters[instance.depot] {
-            let model = Model::new(instance, start)?;
-            let depot = model.depot;
-            let root_bound =
-                model.round_bound(bounder.compute(&model, &|c| c == depot, depot, options.use_l2));
-            runs.push(Run {
-                model,
-                lattice: None,
-                preparation: None,
-                subset: None,
-                penalties: None,
-                position: None,
-                root_bound,
-                engine: None,
-                finished_bound: None,
-                states_created: 0,
-            });
-        }
+        // The only way a model fails: the precedence pairs are no partial order.
+        PrecedenceOrder::new(instance)?;
         let phase = if options.heuristic {
             Phase::Heuristic {
                 beam: 0,
@@ -563,10 +582,14 @@ impl ExactSolver {
         } else {
             Phase::Exact
         };
+        let mut unbuilt = instance.clusters[instance.depot].clone();
+        unbuilt.reverse();
         Ok(ExactSolver {
             instance: instance.clone(),
             options,
-            runs,
+            runs: Vec::new(),
+            unbuilt,
+            unbounded: None,
             current_run: 0,
             incumbent: Incumbent {
                 upper_bound: INF,
@@ -579,8 +602,58 @@ impl ExactSolver {
         })
     }
 
-    /// The root lower bound (max of L1 and L2 over the empty prefix; min over start nodes).
+    /// Whether every start node's run (model and root bound) is built (always, but for a
+    /// [`ExactSolver::deferred`] solver before its first steps).
+    pub fn runs_built(&self) -> bool {
+        self.unbuilt.is_empty() && self.unbounded.is_none()
+    }
+
+    /// Builds one piece of the runs: the next start node's model, or its root bound. Returns
+    /// whether it did anything (false once all are built).
+    fn build_unit(&mut self) -> bool {
+        if let Some(model) = self.unbounded.take() {
+            let depot = model.depot;
+            let root_bound = model.round_bound(ResidualBounder::default().compute(
+                &model,
+                &|c| c == depot,
+                depot,
+                self.options.use_l2,
+            ));
+            self.runs.push(Run {
+                model,
+                lattice: None,
+                preparation: None,
+                subset: None,
+                penalties: None,
+                position: None,
+                prepared: None,
+                penalties_built: false,
+                root_bound,
+                engine: None,
+                finished_bound: None,
+                states_created: 0,
+            });
+            return true;
+        }
+        let Some(start) = self.unbuilt.pop() else {
+            return false;
+        };
+        let t = Instant::now();
+        // Checked in `deferred`: the order is a partial order, so the model builds.
+        match Model::new(&self.instance, start) {
+            Ok(model) => self.unbounded = Some(model),
+            Err(e) => debug_log(|| format!("start node {start}: no model ({e})")),
+        }
+        debug_log(|| format!("model of start node {start} built in {:?}", t.elapsed()));
+        true
+    }
+
+    /// The root lower bound (max of L1 and L2 over the empty prefix; min over start nodes);
+    /// −∞ until every run is built ([`ExactSolver::deferred`]).
     pub fn root_bound(&self) -> f64 {
+        if !self.runs_built() {
+            return -INF;
+        }
         self.runs.iter().map(|r| r.root_bound).fold(INF, f64::min)
     }
 
@@ -613,7 +686,8 @@ impl ExactSolver {
     fn bounds_meet_incumbent(&self) -> bool {
         let ub = self.incumbent.upper_bound;
         ub.is_finite()
-            && (self.external_bound >= ub || self.runs.iter().all(|r| r.root_bound >= ub))
+            && (self.external_bound >= ub
+                || (self.runs_built() && self.runs.iter().all(|r| r.root_bound >= ub)))
     }
 
     /// Stops the search at the next `step`.
@@ -624,7 +698,8 @@ impl ExactSolver {
     /// The current lower bound.
     fn lower_bound(&self) -> f64 {
         let ub = self.incumbent.upper_bound;
-        let mut lb = INF;
+        // A start node without its run bounds nothing yet.
+        let mut lb = if self.runs_built() { INF } else { -INF };
         for run in &self.runs {
             let run_lb = if let Some(b) = run.finished_bound {
                 b
@@ -697,6 +772,7 @@ impl ExactSolver {
         }
         // Work units between clock reads: small enough to keep steps near their budget.
         const CHUNK: u64 = 200_000;
+        let mut built_one = false;
         loop {
             if self.cancelled {
                 return self.stop(began);
@@ -706,9 +782,18 @@ impl ExactSolver {
                     return self.stop(began);
                 }
             }
+            // The runs of a deferred solver: one model or root bound per piece, at least one
+            // per step whatever its budget (so tiny slices still advance).
+            if !built_one && self.build_unit() {
+                built_one = true;
+                continue;
+            }
             if began.elapsed() >= deadline {
                 self.elapsed += began.elapsed();
                 return SolverStatus::Running;
+            }
+            if self.build_unit() {
+                continue;
             }
             if self.bounds_meet_incumbent() {
                 // A bound (from outside, or a root bound) already meets the incumbent.
@@ -834,7 +919,9 @@ impl ExactSolver {
                     }
                     let _ = max_ideals;
                     if run.engine.is_none() {
+                        let t = Instant::now();
                         run.engine = Some(run.engine(None, memory, use_l2));
+                        debug_log(|| format!("engine made in {:?}", t.elapsed()));
                     }
                     let engine = run.engine.as_mut().expect("created above");
                     let layer_before = engine.stats(&run.model, INF).0;

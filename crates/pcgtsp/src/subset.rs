@@ -229,6 +229,10 @@ impl SubsetBuilder {
                             return Some(None);
                         };
                         self.stage = SubsetBound::start_distances(model, tracked, layers);
+                        // The n² distance table is made: a piece of its own.
+                        if Instant::now() >= deadline {
+                            return None;
+                        }
                         continue;
                     }
                     let candidate = self.detour_order[*next];
@@ -253,6 +257,11 @@ impl SubsetBuilder {
                             is_tracked[candidate] = false;
                             *failures += 1;
                         }
+                    }
+                    // One candidate at a time: on thousands of nodes each is a pass over the
+                    // order, and the choice resumes where it stopped (the same subset).
+                    if Instant::now() >= deadline {
+                        return None;
                     }
                 }
                 Stage::Distances {

@@ -288,3 +288,41 @@ fn lagrangian_bounds_lift_the_assignment_bound_on_ft70_2() {
     assert!(arborescence >= 31900.0, "arborescence: {b:?}");
     assert!(arborescence <= 33374.0, "above a known tour: {b:?}");
 }
+
+/// A deferred solver builds its runs in steps of their own: before they are built its root
+/// bound is −∞ and every lower bound it reports stays below the optimum; after, it has the root
+/// bound of `new` and proves the same optima.
+#[test]
+fn a_deferred_solver_builds_its_runs_in_steps_and_proves_what_new_proves() {
+    for name in ["ESC12", "br17.12", "e1x_8"] {
+        let r = reference(name);
+        let instance = r.load();
+        let options = ExactOptions {
+            heuristic: false,
+            ..ExactOptions::default()
+        };
+        let whole = ExactSolver::new(&instance, options.clone()).unwrap();
+        let mut deferred = ExactSolver::deferred(&instance, options).unwrap();
+        assert_eq!(deferred.root_bound(), f64::NEG_INFINITY, "{name}");
+        let opt = trusted_optimum(&r).unwrap();
+        let mut calls = 0;
+        loop {
+            let status = deferred.step(Duration::ZERO);
+            calls += 1;
+            let p = deferred.progress();
+            assert!(p.lower_bound <= opt, "{name}: LB {} > {opt}", p.lower_bound);
+            if deferred.root_bound() > f64::NEG_INFINITY {
+                break;
+            }
+            assert_eq!(status, SolverStatus::Running, "{name}");
+            assert!(calls < 100, "{name}: runs never built");
+        }
+        assert!(calls >= 2, "{name}: model and root bound in separate steps");
+        assert_eq!(deferred.root_bound(), whole.root_bound(), "{name}");
+        while deferred.step(Duration::from_millis(200)) == SolverStatus::Running {}
+        let p = deferred.progress();
+        check_progress(&instance, &r, &p);
+        assert_eq!(p.upper_bound, opt, "{name}");
+        assert_eq!(p.lower_bound, opt, "{name}: proven");
+    }
+}

@@ -360,6 +360,12 @@ pub struct Progress {
     /// Every violation behind `rule_counts`, by rule group then step.
     #[serde(default)]
     pub violations: Vec<Violation>,
+    /// A proven lower bound (mm) on the idle length of every route the solver can return, for
+    /// the solvers that give a `path_route` (sccp, gsccp, aoe): their `lower_bound` is machine
+    /// time or cost, where the fixed cutting time hides how far the idle travel may still
+    /// shrink. `None` for the other solvers and before the bound is measured.
+    #[serde(default)]
+    pub idle_lower_bound: Option<f64>,
 }
 
 /// One candidate route a solver weighed, in numbers (lengths in mm, time in s).
@@ -381,9 +387,45 @@ pub struct RouteSummary {
     pub chosen: bool,
     /// Why the candidate gave no route, if it did not.
     pub failure: Option<String>,
+    /// The solver's proven lower bound on the idle length (mm) of every route it can return
+    /// ([`Progress::idle_lower_bound`]), on the chosen candidate; `None` elsewhere.
+    #[serde(default)]
+    pub idle_lower_bound: Option<f64>,
+}
+
+impl RouteSummary {
+    /// The relative gap `(idle − idle LB) / idle` of this candidate's idle length, when the
+    /// bound is known.
+    pub fn idle_gap(&self) -> Option<f64> {
+        relative_gap(self.idle_length, self.idle_lower_bound?)
+    }
+}
+
+/// `(ub − lb) / ub`, clamped at 0; 0 when `ub` is 0.
+fn relative_gap(ub: f64, lb: f64) -> Option<f64> {
+    if !(ub.is_finite() && lb.is_finite()) {
+        return None;
+    }
+    Some(if ub > 0.0 {
+        ((ub - lb) / ub).max(0.0)
+    } else {
+        0.0
+    })
 }
 
 impl Progress {
+    /// The idle length (mm) of the best path route: the upper bound the idle gap is measured
+    /// against.
+    pub fn idle_upper_bound(&self) -> Option<f64> {
+        self.path_route.as_ref().map(|r| r.idle_length())
+    }
+
+    /// The relative gap `(idle UB − idle LB) / idle UB` in idle length (path-route solvers),
+    /// when both are known.
+    pub fn idle_gap(&self) -> Option<f64> {
+        relative_gap(self.idle_upper_bound()?, self.idle_lower_bound?)
+    }
+
     /// The relative gap `(UB − LB) / UB`, when both bounds are known.
     pub fn gap(&self) -> Option<f64> {
         match (self.upper_bound, self.lower_bound) {
@@ -444,6 +486,38 @@ mod tests {
     }
 
     #[test]
+    fn idle_gap_is_measured_against_the_path_routes_idle_length() {
+        let route = cutroute_geometry::PathRoute {
+            start: Point::default(),
+            paths: vec![cutroute_geometry::ToolOnPath {
+                pierce: Point::new(30.0, 40.0),
+                spans: vec![cutroute_geometry::Span {
+                    start: Point::new(30.0, 40.0),
+                    end: Point::new(40.0, 40.0),
+                    bulge: 0.0,
+                }],
+            }],
+            finish: None,
+        };
+        let mut progress = Progress {
+            path_route: Some(route),
+            ..Progress::default()
+        };
+        assert_eq!(progress.idle_upper_bound(), Some(50.0));
+        assert_eq!(progress.idle_gap(), None);
+        progress.idle_lower_bound = Some(40.0);
+        assert!((progress.idle_gap().unwrap() - 0.2).abs() < 1e-12);
+        progress.idle_lower_bound = Some(60.0);
+        assert_eq!(progress.idle_gap(), Some(0.0));
+        let summary = RouteSummary {
+            idle_length: 0.0,
+            idle_lower_bound: Some(0.0),
+            ..RouteSummary::default()
+        };
+        assert_eq!(summary.idle_gap(), Some(0.0));
+    }
+
+    #[test]
     fn messages_survive_the_worker_codec() {
         let request = sample_request();
         let bytes = bincode::serialize(&request).unwrap();
@@ -496,6 +570,7 @@ mod tests {
                 cost: 4.0,
                 chosen: true,
                 failure: None,
+                idle_lower_bound: Some(1.5),
             }],
             heat: Some(0.75),
             rule_counts: Some(RuleCounts {
@@ -510,6 +585,7 @@ mod tests {
                     contour: 0,
                 },
             }],
+            idle_lower_bound: Some(1.5),
         });
         let bytes = bincode::serialize(&progress).unwrap();
         assert_eq!(

@@ -3,7 +3,8 @@
 //!
 //! `cargo run --release -p cutroute-bench --bin time_limits -- [--time-limit 5] [--slice-ms 40]
 //! [--step 50] [--solvers ccp,exact,…] [--filter NAME[,NAME…]] [--set nests|pcgtsp|all]
-//! [--generated 1000,10000] [--data DIR] [--trace]`
+//! [--generated 1000,10000] [--data DIR] [--trace]
+//! [--cli BIN --cli-input FILE[,FILE…] --cli-limit S]`
 //!
 //! `--trace` prints every call longer than its slice + 50 ms to stderr, with the job's phase
 //! before and after it.
@@ -17,7 +18,13 @@
 //! job: "limit" when the wall reached the limit, "finished" when the solver ended before it.
 //! A row is marked **over** when the wall exceeds limit + 1 s or one call (start or step)
 //! exceeds its slice by more than 50 ms. A job still running at limit + 60 s is abandoned
-//! ("abandoned").
+//! ("abandoned"). After the table: per solver, the longest single call, the worst wall over
+//! the limit and the rows over.
+//!
+//! `--cli BIN` also runs the command-line tool (`BIN solve FILE --solver S --time-limit S
+//! --json`, the release binary `target/release/cutroute`) on each `--cli-input` file with every
+//! solver that takes it (heuristic and exact for PCGTSP instances), and prints its wall time
+//! (process start to exit, reading included) against `--cli-limit` (default 120 s).
 
 use cutroute_engine::{open_document, start_job, JobStatus};
 use cutroute_protocol::{JobRequest, Problem, SolverKind, SolverParams};
@@ -95,6 +102,9 @@ pub fn main() {
     let mut generated: Vec<usize> = vec![1000];
     let mut data = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../data");
     let mut trace = false;
+    let mut cli: Option<PathBuf> = None;
+    let mut cli_inputs: Vec<PathBuf> = Vec::new();
+    let mut cli_limit = 120.0f64;
     let mut args = std::env::args().skip(1);
     while let Some(arg) = args.next() {
         let mut value = || args.next().unwrap_or_else(|| panic!("{arg} needs a value"));
@@ -131,6 +141,9 @@ pub fn main() {
             }
             "--data" => data = PathBuf::from(value()),
             "--trace" => trace = true,
+            "--cli" => cli = Some(PathBuf::from(value())),
+            "--cli-input" => cli_inputs = value().split(',').map(PathBuf::from).collect(),
+            "--cli-limit" => cli_limit = value().parse().expect("--cli-limit SECONDS"),
             other => panic!("unknown option {other}"),
         }
     }
@@ -151,6 +164,11 @@ pub fn main() {
     let mut worst_step = 0.0f64;
     let mut worst_over = 0.0f64;
     let mut overs = 0;
+    // Per solver: (longest call s, worst wall − limit s, rows over, rows).
+    let mut per_solver: Vec<(SolverKind, f64, f64, usize, usize)> = solvers
+        .iter()
+        .map(|&k| (k, 0.0, f64::NEG_INFINITY, 0, 0))
+        .collect();
     for input in &inputs {
         for &solver in &solvers {
             let is_pcgtsp = matches!(input.problem, Problem::PcgtspText { .. });
@@ -215,6 +233,12 @@ pub fn main() {
                 overs += 1;
                 worst_over = worst_over.max(wall - limit);
             }
+            if let Some(row) = per_solver.iter_mut().find(|r| r.0 == solver) {
+                row.1 = row.1.max(call);
+                row.2 = row.2.max(wall - limit);
+                row.3 += usize::from(over);
+                row.4 += 1;
+            }
             println!(
                 "| {} | {} | {limit} | {wall:.2} | {start_s:.3} | {longest:.3} | {steps} | {ended_by} | {} |",
                 solver.name(),
@@ -225,8 +249,61 @@ pub fn main() {
     }
     println!();
     println!(
-        "{} rows; longest single call (start or step) {worst_step:.3} s; {overs} rows over \
+        "{} inputs; longest single call (start or step) {worst_step:.3} s; {overs} rows over \
          (wall > limit + 1 s or a call > slice + 50 ms); worst wall over the limit {worst_over:.2} s",
         inputs.len()
     );
+    println!();
+    println!("| solver | runs | longest call s | worst wall − limit s | rows over |");
+    println!("|---|---|---|---|---|");
+    for (solver, call, over_by, over_rows, rows) in per_solver.iter().filter(|r| r.4 > 0) {
+        println!(
+            "| {} | {rows} | {call:.3} | {over_by:.2} | {over_rows} |",
+            solver.name()
+        );
+    }
+    if let Some(bin) = cli {
+        println!();
+        println!("| CLI: solver | input | limit s | wall s | exit | |");
+        println!("|---|---|---|---|---|---|");
+        for input in &cli_inputs {
+            let text = std::fs::read_to_string(input).unwrap_or_default();
+            let is_pcgtsp = text.contains("GTSP_SETS");
+            let names: Vec<&str> = if is_pcgtsp {
+                vec!["heuristic", "exact"]
+            } else {
+                solvers.iter().map(|k| k.name()).collect()
+            };
+            for name in names {
+                let started = Instant::now();
+                let status = std::process::Command::new(&bin)
+                    .arg("solve")
+                    .arg(input)
+                    .args([
+                        "--solver",
+                        name,
+                        "--time-limit",
+                        &cli_limit.to_string(),
+                        "--json",
+                    ])
+                    .stdout(std::process::Stdio::null())
+                    .stderr(std::process::Stdio::null())
+                    .status();
+                let wall = started.elapsed().as_secs_f64();
+                let exit = status.map_or_else(
+                    |e| e.to_string(),
+                    |s| s.code().map_or("signal".to_string(), |c| c.to_string()),
+                );
+                println!(
+                    "| {name} | {} | {cli_limit} | {wall:.2} | {exit} | {} |",
+                    input.file_name().unwrap_or_default().to_string_lossy(),
+                    if wall > cli_limit + 1.0 {
+                        "**over**"
+                    } else {
+                        ""
+                    }
+                );
+            }
+        }
+    }
 }
