@@ -221,7 +221,7 @@ pub fn ProfilesPanel(
                     type="button"
                     title=tr(
                         "Download the profile as JSON (the CLI reads it: cutroute solve --profile FILE)",
-                        "Скачать профиль в JSON (его читает CLI: cutroute solve --profile ФАЙЛ)",
+                        "Скачать профиль в JSON (его читает и программа командной строки cutroute, ключ --profile)",
                     )
                     on:click=export
                 >

@@ -54,8 +54,10 @@ async function englishLeft(page) {
   });
   const left = [];
   for (const [text, where] of found) {
-    // Names from the file (parts «…», files) and G-code words (G02, M03, I, J) are not UI text.
+    // Names from the file (parts «…», files), G-code words (G02, M03, I, J) and the CLI's flags
+    // (--profile) are not UI text.
     const cleaned = text
+      .replace(/--[a-z][a-z-]*/g, ' ')
       .replace(/«[^»]*»/g, ' ')
       .replace(/[\w.-]+\.(dbs|json|dxf|nc|svg|html|pcglns|tfnesting)\b/gi, ' ')
       .replace(/\b(E1X_6_01|test1|nested|seven)\b/g, ' ')
