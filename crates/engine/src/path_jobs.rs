@@ -9,7 +9,8 @@ use cutroute_geometry::float::Libm;
 use cutroute_geometry::{MachineParameters, Nest, Objective, PathRoute, Point};
 use cutroute_protocol::{JobId, JobRequest, Problem, Progress, RouteSummary, SolverKind};
 use cutroute_segments::{
-    Candidate, EnsembleKind, EnsembleReport, GsccpOptions, GsccpSearch, SccpOptions, SearchStatus,
+    Candidate, EnsembleKind, EnsembleReport, GsccpOptions, GsccpSearch, PathHeat, SccpOptions,
+    SearchStatus,
 };
 use web_time::{Duration, Instant};
 
@@ -179,6 +180,12 @@ impl SegmentJob {
                 finish,
                 time_limit: Duration::from_secs_f64(params.time_limit_s.clamp(0.0, 1.0e7)),
                 seed: params.seed,
+                // With a heat weight the VNS and the choice between ensembles (and GSCCP's
+                // CCP-Relax seed) add W·H, priced on the machine clock of `params.machine`.
+                heat: params.thermal.penalised().then(|| PathHeat {
+                    penalty: crate::thermal::heat_penalty(&params.thermal, params.objective),
+                    machine: params.machine,
+                }),
                 ..SccpOptions::default()
             },
             kinds,
@@ -265,7 +272,16 @@ impl Job for SegmentJob {
         Progress {
             job_id: self.job_id,
             elapsed_s: self.started.elapsed().as_secs_f64(),
-            upper_bound: best.map(|c| c.value),
+            // The route's own objective value (a candidate's value adds W·H with a heat
+            // weight, which the plan bound does not bound).
+            upper_bound: best.map(|c| {
+                self.objective.value(
+                    &self.machine,
+                    c.route.cut_length(),
+                    c.route.idle_length(),
+                    c.route.pierce_count(),
+                )
+            }),
             lower_bound,
             phase: self.search.phase(),
             route: None,

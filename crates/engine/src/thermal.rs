@@ -12,8 +12,15 @@
 //!   idle + W·H (all terms) along their contours; with hard rules the route is repaired first.
 //!   The reported upper bound is the final route's idle length, and the discrete lower bound
 //!   (about penalised arcs through candidate points) is not reported then;
-//! - sccp, gsccp, aoe: H is reported (one source per tool-on path); the rules are defined on
-//!   routes of whole contours, so they are neither checked nor enforced.
+//! - sccp, gsccp, aoe: H has one source per tool-on path. With a heat weight, SCCP's VNS keeps
+//!   the order of least idle + W·H and GSCCP picks its ensemble (and seeds its orders with
+//!   CCP-Relax) on objective + W·H (`cutroute_segments::PathHeat`); AOE keeps, among its
+//!   orderings, the one of least idle + W·H. The rules are checked on the route's contour route
+//!   (`contour_route_of_paths`: a contour is done when its last piece is cut, and starts where
+//!   its first piece is). Hard rules: a path route that breaks them is replaced by its contour
+//!   route repaired like a contour route (whole contours, so common edges are cut twice), which
+//!   then obeys them; its lower bound is the plan's bound for any route (SCCP, GSCCP) or none
+//!   (AOE's trail bound assumes edges cut once).
 
 use std::cell::RefCell;
 
@@ -21,8 +28,9 @@ use cutroute_ccp::HeatPenalty;
 use cutroute_geometry::{MachineParameters, Nest, Objective, PathRoute, Route};
 use cutroute_protocol::{Progress, SolverKind, ThermalSettings};
 use cutroute_thermal::{
-    admissible_pierce_points, check_rules, enforce_rules, path_route_pierces, relax_pierce_points,
-    route_pierces, HeatModel, RuleCounts, RuleParams, Violation,
+    admissible_pierce_points, check_rules, contour_route_of_paths, enforce_rules,
+    path_route_pierces, relax_pierce_points, route_pierces, HeatModel, RuleCounts, RuleParams,
+    Violation,
 };
 use web_time::{Duration, Instant};
 
@@ -186,6 +194,12 @@ pub fn measure_path_route(
     Ok(model.load(&path_route_pierces(route, machine)))
 }
 
+/// The contour route of a path route, by which the rules judge it (spans within 10× the
+/// nest's check tolerance of a contour lie on it, as AOE's own check allows).
+pub fn path_contour_route(nest: &Nest, route: &PathRoute) -> Route {
+    contour_route_of_paths(nest, route, 10.0 * nest.check_tolerance())
+}
+
 /// The last measured route, so a progress report of an unchanged route costs a comparison.
 #[derive(Default)]
 struct Measured {
@@ -222,6 +236,8 @@ pub struct ThermalJob {
     done: bool,
     /// The repaired final route, or why the repair failed (the solver's route is then kept).
     repaired: Option<Result<Route, String>>,
+    /// The same for a path route: its contour route repaired, as standard cutting.
+    repaired_path: Option<Result<PathRoute, String>>,
     measured: RefCell<Measured>,
 }
 
@@ -245,6 +261,7 @@ impl ThermalJob {
             settings,
             done: false,
             repaired: None,
+            repaired_path: None,
             measured: RefCell::default(),
         }
     }
@@ -260,7 +277,12 @@ impl ThermalJob {
         if !(hard || relax) {
             return;
         }
-        let Some(route) = self.inner.progress().route else {
+        let progress = self.inner.progress();
+        if let (true, Some(path_route)) = (hard, progress.path_route) {
+            self.repaired_path = self.repair_path_route(&path_route);
+            return;
+        }
+        let Some(route) = progress.route else {
             return;
         };
         self.repaired = Some(if hard {
@@ -290,6 +312,32 @@ impl ThermalJob {
                     .map_err(|e| e.to_string())
                 })
         });
+    }
+
+    /// Hard rules on a path route: `None` when its contour route obeys them; else that route
+    /// repaired as a contour route and cut as standard cutting.
+    fn repair_path_route(&self, path_route: &PathRoute) -> Option<Result<PathRoute, String>> {
+        let contours = path_contour_route(&self.nest, path_route);
+        match check_rules(
+            &self.nest,
+            &contours,
+            self.settings.rules,
+            &RuleParams::default(),
+        ) {
+            Ok(report) if report.violations.is_empty() => return None,
+            Err(e) => return Some(Err(e.to_string())),
+            Ok(_) => {}
+        }
+        Some(
+            enforce_thermal_rules(
+                &self.nest,
+                contours,
+                &self.settings,
+                &self.machine,
+                self.objective,
+            )
+            .and_then(|route| PathRoute::from_route(&route, &self.nest).map_err(|e| e.to_string())),
+        )
     }
 
     /// Fills `progress`'s thermal fields from its route, measuring only what changed.
@@ -335,10 +383,32 @@ impl ThermalJob {
                 *measured = Measured {
                     heat: measure_path_route(path_route, &self.settings, &self.machine).ok(),
                     path_route: Some(path_route.clone()),
+                    rules_checked: measured.rules_checked,
                     ..Measured::default()
                 };
             }
+            let live = self.contours <= LIVE_RULES_MAX_CONTOURS;
+            if self.settings.rules.any()
+                && measured.rules.is_none()
+                && (self.done || (live && due(measured.rules_checked, false)))
+            {
+                let started = Instant::now();
+                let contours = path_contour_route(&self.nest, path_route);
+                if let Ok(report) = check_rules(
+                    &self.nest,
+                    &contours,
+                    self.settings.rules,
+                    &RuleParams::default(),
+                ) {
+                    measured.rules = Some((Some(report.counts()), report.violations));
+                }
+                measured.rules_checked = Some((started, started.elapsed()));
+            }
             progress.heat = measured.heat;
+            if let Some((counts, violations)) = &measured.rules {
+                progress.rule_counts = *counts;
+                progress.violations = violations.clone();
+            }
         }
     }
 }
@@ -358,6 +428,32 @@ impl Job for ThermalJob {
 
     fn progress(&self) -> Progress {
         let mut progress = self.inner.progress();
+        if let Some(repaired) = &self.repaired_path {
+            match repaired {
+                Ok(route) => {
+                    progress.upper_bound = Some(self.objective.value(
+                        &self.machine,
+                        route.cut_length(),
+                        route.idle_length(),
+                        route.pierce_count(),
+                    ));
+                    // SCCP's and GSCCP's plan bound holds for any route; AOE's assumes
+                    // every edge cut once, which standard cutting does not.
+                    if self.solver == SolverKind::Aoe {
+                        progress.lower_bound = None;
+                    }
+                    progress.phase = format!(
+                        "{} · rules enforced on whole contours (standard cutting)",
+                        progress.phase
+                    );
+                    progress.path_route = Some(route.clone());
+                }
+                Err(e) => {
+                    progress.phase =
+                        format!("{} · rule repair failed ({e}); route kept", progress.phase)
+                }
+            }
+        }
         match &self.repaired {
             Some(Ok(route)) if progress.route.as_ref() != Some(route) => {
                 // The solver's bounds are those of the problem without rules: a lower bound on

@@ -557,7 +557,7 @@ fn sheet_rigidity(layout: &Layout, route: &Route, params: &RuleParams) -> Vec<Vi
 }
 
 fn islands(layout: &Layout, route: &Route, params: &RuleParams) -> Vec<Violation> {
-    let mut grid = IslandGrid::new(layout, params.strip_width_mm, params.max_grid_cells);
+    let grid = IslandGrid::new(layout, params.strip_width_mm, params.max_grid_cells);
     let steps = layout.root_steps(route);
     let mut order: Vec<(usize, usize)> = steps
         .iter()
@@ -565,23 +565,22 @@ fn islands(layout: &Layout, route: &Route, params: &RuleParams) -> Vec<Violation
         .filter_map(|(u, s)| s.map(|s| (s, u)))
         .collect();
     order.sort();
-    let mut uncut = vec![true; layout.units.len()];
-    let mut counted = vec![false; layout.units.len()];
-    let mut violations = Vec::new();
-    for (step, u) in order {
-        grid.cut(u);
-        uncut[u] = false;
-        for v in grid.islanded(&uncut) {
-            if !counted[v] {
-                counted[v] = true;
-                violations.push(Violation::Island {
-                    step,
-                    part: layout.units[v].root,
-                });
-            }
-        }
-    }
-    violations
+    let units: Vec<usize> = order.iter().map(|&(_, u)| u).collect();
+    // Each unit counts once, at the cut that first isolates it (by step, then unit).
+    let mut isolated: Vec<(usize, usize)> = grid
+        .first_islanded(&units)
+        .into_iter()
+        .enumerate()
+        .filter_map(|(v, at)| at.map(|i| (order[i].0, v)))
+        .collect();
+    isolated.sort();
+    isolated
+        .into_iter()
+        .map(|(step, v)| Violation::Island {
+            step,
+            part: layout.units[v].root,
+        })
+        .collect()
 }
 
 /// What [`enforce_rules`] did.
@@ -606,8 +605,9 @@ pub struct Enforced {
 ///    free edge.
 ///
 /// Moving whole units keeps "inner before outer". A step entered by a tool-on link whose
-/// predecessor changes is entered by a pierce instead; part-rigidity repairs skip steps next
-/// to links. The violations left are reported, not hidden.
+/// predecessor changes is entered by a pierce instead, and so is a linked step whose entry
+/// point breaks part rigidity (with the link out of it: it left from the old point). The
+/// violations left are reported, not hidden.
 pub fn enforce_rules(
     nest: &Nest,
     route: &Route,
@@ -660,14 +660,17 @@ pub fn enforce_rules(
             let Violation::PartRigidity { step, best, .. } = v else {
                 continue;
             };
-            let linked = |i: usize| {
-                repaired
-                    .steps
-                    .get(i)
-                    .is_some_and(|s| matches!(s.entry, Entry::Link(_)))
-            };
-            if !linked(step) && !linked(step + 1) {
-                repaired.steps[step].pierce_point = best;
+            // A linked step starts where its link ends and the next link leaves from that
+            // point (a chain leaves a contour where it entered it), so the chain chose the
+            // point for the link's length, not for the rule. Under hard rules such a link is a
+            // forbidden move: the contour is pierced at its rigid point instead, and the link
+            // that left from the old point becomes a pierce where it ended.
+            repaired.steps[step].entry = Entry::Pierce;
+            repaired.steps[step].pierce_point = best;
+            if let Some(next) = repaired.steps.get_mut(step + 1) {
+                if matches!(next.entry, Entry::Link(_)) {
+                    next.entry = Entry::Pierce;
+                }
             }
         }
     }
