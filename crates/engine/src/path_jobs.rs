@@ -4,7 +4,7 @@
 //! `params.objective`), a lower bound in the same unit, and the candidates weighed as
 //! `alternatives`.
 
-use cutroute_aoe::{AoeSolution, AoeSolveOptions, AoeSolving, PlanGraph, PlanOptions};
+use cutroute_aoe::{AoeHeat, AoeSolution, AoeSolveOptions, AoeSolving, PlanGraph, PlanOptions};
 use cutroute_geometry::float::Libm;
 use cutroute_geometry::{MachineParameters, Nest, Objective, PathRoute, Point};
 use cutroute_protocol::{JobId, JobRequest, Problem, Progress, RouteSummary, SolverKind};
@@ -331,6 +331,19 @@ impl AoeJob {
                 },
                 start,
                 finish,
+                // With a heat weight the orderings compete on idle + W·H (machine clock of
+                // `params.machine`), and a heat-priced greedy ordering joins them.
+                heat: request.params.thermal.penalised().then(|| {
+                    let penalty = crate::thermal::heat_penalty(
+                        &request.params.thermal,
+                        request.params.objective,
+                    );
+                    AoeHeat {
+                        model: penalty.model,
+                        weight_mm: penalty.weight_mm(&request.params.machine),
+                        machine: request.params.machine,
+                    }
+                }),
             },
             finish_bound: (start, finish),
             machine: request.params.machine,

@@ -299,7 +299,7 @@ fn the_heat_weight_lowers_h_of_segment_cutting() {
         weight: 100.0,
         ..plain
     };
-    for solver in [SolverKind::Gsccp] {
+    for solver in [SolverKind::Sccp, SolverKind::Gsccp, SolverKind::Aoe] {
         let a = solve(&problem, solver, plain);
         let b = solve(&problem, solver, heated);
         for (result, settings) in [(&a, &plain), (&b, &heated)] {
@@ -308,7 +308,8 @@ fn the_heat_weight_lowers_h_of_segment_cutting() {
             assert!((result.heat.unwrap() - h).abs() <= 1e-6 * h.max(1e-12));
         }
         let (ha, hb) = (a.heat.unwrap(), b.heat.unwrap());
-        assert!(hb < ha, "{solver:?}: H {ha} → {hb}");
+        // E1X_6_01 has no common edge: the weight can spread the pierces (−80 % and more).
+        assert!(hb <= 0.5 * ha, "{solver:?}: H {ha} → {hb}");
     }
 }
 
