@@ -152,6 +152,7 @@ pub fn start_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
         params.machine,
         params.objective,
         params.thermal,
+        Duration::from_secs_f64(params.time_limit_s.clamp(0.0, 1.0e7)),
     )))
 }
 

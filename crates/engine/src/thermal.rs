@@ -29,8 +29,8 @@ use cutroute_geometry::{MachineParameters, Nest, Objective, PathRoute, Route};
 use cutroute_protocol::{Progress, SolverKind, ThermalSettings};
 use cutroute_thermal::{
     admissible_pierce_points, check_rules, contour_route_of_paths, enforce_rules,
-    path_route_pierces, relax_pierce_points, route_pierces, HeatModel, RuleCounts, RuleParams,
-    Violation,
+    path_route_pierces, relax_pierce_points, route_pierces, HeatModel, RuleCheck, RuleCounts,
+    RuleParams, Violation,
 };
 use web_time::{Duration, Instant};
 
@@ -40,10 +40,18 @@ use crate::{Job, JobStatus};
 const RELAX_PASSES: usize = 3;
 
 /// Rules are checked on routes that are not the final one only on nests of at most this many
-/// contours: the check took 0.7 s on 1,000 generated contours, 15 s on 10,000 and 47 s on
-/// 30,000 (`thermal_measure` example, BENCHMARKS.md), and a slice that long would keep Stop
-/// from reaching the job. The final route is always checked.
+/// contours, where one check is a short piece of a report (92 ms on 1,000 generated contours;
+/// 0.37 s on 10,000 and 1.1 s on 30,000, `thermal_measure` example, BENCHMARKS.md). The final
+/// route is always checked, in slices of `step`.
 const LIVE_RULES_MAX_CONTOURS: usize = 1_000;
+
+/// How long after its time limit a job may still be checking its final route's rules: the
+/// promise is limit + 1 s, and the inner job ends at its limit.
+pub const FINAL_CHECK_GRACE: Duration = Duration::from_millis(800);
+
+/// The final route's rule check: the check, the route it checks (a path route's contour
+/// route), and the progress's (route, path route) it reports on.
+type FinalCheck = (RuleCheck, Route, (Option<Route>, Option<PathRoute>));
 
 /// A measure (H, or the rule check) of a route that is not the final one runs only when at
 /// least this many times its own last duration has passed since it ran: the island check
@@ -238,11 +246,19 @@ pub struct ThermalJob {
     repaired: Option<Result<Route, String>>,
     /// The same for a path route: its contour route repaired, as standard cutting.
     repaired_path: Option<Result<PathRoute, String>>,
+    /// The final route's rule check under way: the check, the (contour) route it checks, and
+    /// the progress's route and path route it belongs to.
+    final_check: Option<FinalCheck>,
+    /// The final check was given up at the deadline (or failed): no counts are reported.
+    final_check_cut: bool,
+    /// The request's time limit + [`FINAL_CHECK_GRACE`] from the job's start.
+    deadline: Option<Instant>,
     measured: RefCell<Measured>,
 }
 
 impl ThermalJob {
-    /// Wraps `inner`, a job of `solver` on `nest`.
+    /// Wraps `inner`, a job of `solver` on `nest` with `time_limit` (the final rule check
+    /// ends by then + [`FINAL_CHECK_GRACE`]).
     pub fn new(
         inner: Box<dyn Job>,
         solver: SolverKind,
@@ -250,6 +266,7 @@ impl ThermalJob {
         machine: MachineParameters,
         objective: Objective,
         settings: ThermalSettings,
+        time_limit: Duration,
     ) -> Self {
         ThermalJob {
             inner,
@@ -262,6 +279,9 @@ impl ThermalJob {
             done: false,
             repaired: None,
             repaired_path: None,
+            final_check: None,
+            final_check_cut: false,
+            deadline: Instant::now().checked_add(time_limit + FINAL_CHECK_GRACE),
             measured: RefCell::default(),
         }
     }
@@ -340,6 +360,16 @@ impl ThermalJob {
         )
     }
 
+    /// Whether a report checks the rules of a route that is not the final one (the final one
+    /// is checked in slices by `step`): on small nests only, and spaced out.
+    fn live_check_due(&self, measured: &Measured) -> bool {
+        self.settings.rules.any()
+            && measured.rules.is_none()
+            && !self.done
+            && self.contours <= LIVE_RULES_MAX_CONTOURS
+            && due(measured.rules_checked, false)
+    }
+
     /// Fills `progress`'s thermal fields from its route, measuring only what changed.
     fn measure(&self, progress: &mut Progress) {
         let mut measured = self.measured.borrow_mut();
@@ -357,11 +387,7 @@ impl ThermalJob {
                 measured.heat = measure_heat(&self.nest, route, &self.settings, &self.machine).ok();
                 measured.heat_measured = Some((started, started.elapsed()));
             }
-            let live = self.contours <= LIVE_RULES_MAX_CONTOURS;
-            if self.settings.rules.any()
-                && measured.rules.is_none()
-                && (self.done || (live && due(measured.rules_checked, false)))
-            {
+            if self.live_check_due(&measured) {
                 let started = Instant::now();
                 if let Ok(report) = check_rules(
                     &self.nest,
@@ -387,11 +413,11 @@ impl ThermalJob {
                     ..Measured::default()
                 };
             }
-            let live = self.contours <= LIVE_RULES_MAX_CONTOURS;
-            if self.settings.rules.any()
-                && measured.rules.is_none()
-                && (self.done || (live && due(measured.rules_checked, false)))
-            {
+            if measured.heat.is_none() {
+                // The final check's record starts without H.
+                measured.heat = measure_path_route(path_route, &self.settings, &self.machine).ok();
+            }
+            if self.live_check_due(&measured) {
                 let started = Instant::now();
                 let contours = path_contour_route(&self.nest, path_route);
                 if let Ok(report) = check_rules(
@@ -418,15 +444,83 @@ impl Job for ThermalJob {
         if self.done {
             return JobStatus::Done;
         }
+        if let Some(check) = self.final_check.as_mut() {
+            if self.deadline.is_some_and(|end| Instant::now() >= end) {
+                // The check would break the time limit: the final report says "not checked"
+                // (`None`) rather than block.
+                self.final_check = None;
+                self.final_check_cut = true;
+                self.done = true;
+                return JobStatus::Done;
+            }
+            let (check, route, key) = check;
+            let started = Instant::now();
+            match check.advance(&self.nest, route, budget) {
+                Ok(None) => return JobStatus::Running,
+                Ok(Some(report)) => {
+                    let (route, path_route) = std::mem::take(key);
+                    let mut measured = self.measured.borrow_mut();
+                    *measured = Measured {
+                        route,
+                        path_route,
+                        rules: Some((Some(report.counts()), report.violations)),
+                        rules_checked: Some((started, started.elapsed())),
+                        ..Measured::default()
+                    };
+                }
+                Err(_) => self.final_check_cut = true,
+            }
+            self.final_check = None;
+            self.done = true;
+            return JobStatus::Done;
+        }
         if self.inner.step(budget) == JobStatus::Running {
             return JobStatus::Running;
         }
         self.repair();
-        self.done = true;
-        JobStatus::Done
+        if !self.settings.rules.any() {
+            self.done = true;
+            return JobStatus::Done;
+        }
+        // The final route's rule check, in slices from the next step on (on 30,000 contours
+        // it takes about a second).
+        let progress = self.base_progress();
+        let checked = match (&progress.route, &progress.path_route) {
+            (Some(route), _) => Some(route.clone()),
+            (None, Some(path_route)) => Some(path_contour_route(&self.nest, path_route)),
+            (None, None) => None,
+        };
+        match (
+            checked,
+            RuleCheck::new(self.settings.rules, RuleParams::default()),
+        ) {
+            (Some(route), Ok(check)) => {
+                self.final_check = Some((check, route, (progress.route, progress.path_route)));
+                JobStatus::Running
+            }
+            _ => {
+                self.done = true;
+                JobStatus::Done
+            }
+        }
     }
 
     fn progress(&self) -> Progress {
+        let mut progress = self.base_progress();
+        if self.final_check_cut {
+            progress.phase = format!(
+                "{} · rules not checked: the check would pass the time limit",
+                progress.phase
+            );
+        }
+        self.measure(&mut progress);
+        progress
+    }
+}
+
+impl ThermalJob {
+    /// The inner job's progress with the repaired route, before the thermal measures.
+    fn base_progress(&self) -> Progress {
         let mut progress = self.inner.progress();
         if let Some(repaired) = &self.repaired_path {
             match repaired {
@@ -493,7 +587,6 @@ impl Job for ThermalJob {
             }
             _ => {}
         }
-        self.measure(&mut progress);
         progress
     }
 }

@@ -15,6 +15,7 @@ use cutroute_geometry::Point;
 
 use crate::layout::Layout;
 
+#[derive(Clone)]
 pub(crate) struct IslandGrid {
     nx: usize,
     ny: usize,

@@ -73,8 +73,8 @@ pub use heat::{path_route_pierces, route_pierces, HeatModel, Pierce};
 pub use paths::contour_route_of_paths;
 pub use pierce::relax_pierce_points;
 pub use rules::{
-    admissible_pierce_points, check_rules, enforce_rules, Enforced, RuleCounts, RuleParams,
-    RuleReport, RuleSet, Side, Violation,
+    admissible_pierce_points, check_rules, enforce_rules, Enforced, RuleCheck, RuleCounts,
+    RuleParams, RuleReport, RuleSet, Side, Violation,
 };
 
 /// What can go wrong.
