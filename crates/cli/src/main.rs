@@ -1288,10 +1288,29 @@ fn solve_path(
             stopped.unwrap_or("")
         )
     })?;
-    let route = progress
+    let solver_route = progress
         .path_route
         .as_ref()
         .ok_or_else(|| format!("the solver found no route ({})", progress.phase))?;
+    // Hard rules: a route whose contour route breaks them is replaced by that route repaired
+    // (standard cutting). Its ub is its own objective; AOE's lb assumed edges cut once.
+    let repaired = thermal.enforce_paths(nest, solver_route, &machine, objective)?;
+    let route = repaired.as_ref().unwrap_or(solver_route);
+    let (ub, lb, phase) = match &repaired {
+        None => (
+            progress.upper_bound,
+            progress.lower_bound,
+            progress.phase.clone(),
+        ),
+        Some(r) => (
+            Some(objective.value(&machine, r.cut_length(), r.idle_length(), r.pierce_count())),
+            progress.lower_bound.filter(|_| solver != SolverKind::Aoe),
+            format!(
+                "{} · rules enforced on whole contours (standard cutting)",
+                progress.phase
+            ),
+        ),
+    };
     // Checked again here, as every route the CLI prints.
     let tolerance = nest.check_tolerance();
     let problems = route.problems(nest, tolerance);
@@ -1318,16 +1337,16 @@ fn solve_path(
         "objective": objective.name(),
         "machine": machine_json(&machine),
         "route": serde_json::to_value(route).map_err(|e| e.to_string())?,
-        "ub": progress.upper_bound,
-        "lb": progress.lower_bound,
-        "phase": progress.phase,
+        "ub": ub,
+        "lb": lb,
+        "phase": phase,
         "elapsed_s": started.elapsed().as_secs_f64(),
         "stopped": stopped,
     });
     if let Value::Object(fields) = &mut report {
         fields.extend(extra);
     }
-    thermal.report_paths(&mut report, route, &machine);
+    thermal.report_paths(&mut report, nest, route, &machine, objective)?;
     Ok(report)
 }
 

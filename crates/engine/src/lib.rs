@@ -50,8 +50,9 @@ pub use open_files::{
 };
 pub use path_jobs::{AoeJob, PlanBound, SegmentJob};
 pub use thermal::{
-    enforce_thermal_rules, heat_penalty, measure_path_route, measure_route, path_contour_route,
-    price_consecutive_heat, ThermalJob, ThermalMeasure,
+    check_path_rules, enforce_thermal_rules, enforce_thermal_rules_on_paths, heat_penalty,
+    measure_path_route, measure_route, path_contour_route, price_consecutive_heat, ThermalJob,
+    ThermalMeasure,
 };
 
 /// How long one [`Job::step`] may run before it returns, so cancel requests are seen quickly.

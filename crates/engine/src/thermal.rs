@@ -97,6 +97,44 @@ pub fn enforce_thermal_rules(
     .map_err(|e| e.to_string())
 }
 
+/// Hard rules on a route of tool-on paths: `Ok(None)` when its contour route
+/// ([`path_contour_route`]) obeys `settings.rules`; else that contour route repaired by
+/// [`enforce_thermal_rules`] and cut as standard cutting (whole contours: common edges are cut
+/// twice), which obeys them.
+pub fn enforce_thermal_rules_on_paths(
+    nest: &Nest,
+    path_route: &PathRoute,
+    settings: &ThermalSettings,
+    machine: &MachineParameters,
+    objective: Objective,
+) -> Result<Option<PathRoute>, String> {
+    let contours = path_contour_route(nest, path_route);
+    let report = check_rules(nest, &contours, settings.rules, &RuleParams::default())
+        .map_err(|e| e.to_string())?;
+    if report.violations.is_empty() {
+        return Ok(None);
+    }
+    let route = enforce_thermal_rules(nest, contours, settings, machine, objective)?;
+    PathRoute::from_route(&route, nest)
+        .map(Some)
+        .map_err(|e| e.to_string())
+}
+
+/// The rule check of a route of tool-on paths, on its contour route.
+pub fn check_path_rules(
+    nest: &Nest,
+    path_route: &PathRoute,
+    settings: &ThermalSettings,
+) -> Result<cutroute_thermal::RuleReport, String> {
+    check_rules(
+        nest,
+        &path_contour_route(nest, path_route),
+        settings.rules,
+        &RuleParams::default(),
+    )
+    .map_err(|e| e.to_string())
+}
+
 /// Adds to every arc between two candidate pierce points of `discrete` the heat term H would
 /// get from that pair being consecutive, `weight_mm · exp(−d²/(2σ²) − Δt/τ)`, with d the
 /// points' distance and Δt = pierce time + the first contour's cut + the idle move (the arc's
@@ -337,27 +375,14 @@ impl ThermalJob {
     /// Hard rules on a path route: `None` when its contour route obeys them; else that route
     /// repaired as a contour route and cut as standard cutting.
     fn repair_path_route(&self, path_route: &PathRoute) -> Option<Result<PathRoute, String>> {
-        let contours = path_contour_route(&self.nest, path_route);
-        match check_rules(
+        enforce_thermal_rules_on_paths(
             &self.nest,
-            &contours,
-            self.settings.rules,
-            &RuleParams::default(),
-        ) {
-            Ok(report) if report.violations.is_empty() => return None,
-            Err(e) => return Some(Err(e.to_string())),
-            Ok(_) => {}
-        }
-        Some(
-            enforce_thermal_rules(
-                &self.nest,
-                contours,
-                &self.settings,
-                &self.machine,
-                self.objective,
-            )
-            .and_then(|route| PathRoute::from_route(&route, &self.nest).map_err(|e| e.to_string())),
+            path_route,
+            &self.settings,
+            &self.machine,
+            self.objective,
         )
+        .transpose()
     }
 
     /// Whether a report checks the rules of a route that is not the final one (the final one
