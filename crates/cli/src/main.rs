@@ -1294,13 +1294,19 @@ fn solve_path(
         .ok_or_else(|| format!("the solver found no route ({})", progress.phase))?;
     // Hard rules: a route whose contour route breaks them is replaced by that route repaired
     // (standard cutting). Its ub is its own objective; AOE's lb assumed edges cut once.
-    let repaired = thermal.enforce_paths(nest, solver_route, &machine, objective)?;
+    let (repaired, failed) = match thermal.enforce_paths(nest, solver_route, &machine, objective) {
+        Ok(repaired) => (repaired, None),
+        Err(e) => (None, Some(e)),
+    };
     let route = repaired.as_ref().unwrap_or(solver_route);
     let (ub, lb, phase) = match &repaired {
         None => (
             progress.upper_bound,
             progress.lower_bound,
-            progress.phase.clone(),
+            match failed {
+                Some(e) => format!("{} · rule repair failed ({e}); route kept", progress.phase),
+                None => progress.phase.clone(),
+            },
         ),
         Some(r) => (
             Some(objective.value(&machine, r.cut_length(), r.idle_length(), r.pierce_count())),

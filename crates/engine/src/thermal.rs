@@ -100,7 +100,8 @@ pub fn enforce_thermal_rules(
 /// Hard rules on a route of tool-on paths: `Ok(None)` when its contour route
 /// ([`path_contour_route`]) obeys `settings.rules`; else that contour route repaired by
 /// [`enforce_thermal_rules`] and cut as standard cutting (whole contours: common edges are cut
-/// twice), which obeys them.
+/// twice), which obeys them; `Err` when that route fails the path checker (the solver's route
+/// is then kept, with its violations).
 pub fn enforce_thermal_rules_on_paths(
     nest: &Nest,
     path_route: &PathRoute,
@@ -115,9 +116,17 @@ pub fn enforce_thermal_rules_on_paths(
         return Ok(None);
     }
     let route = enforce_thermal_rules(nest, contours, settings, machine, objective)?;
-    PathRoute::from_route(&route, nest)
-        .map(Some)
-        .map_err(|e| e.to_string())
+    let paths = PathRoute::from_route(&route, nest).map_err(|e| e.to_string())?;
+    // The repaired route must pass the path checker as the solver's did (pieces cut twice
+    // allowed); when it does not, the repair fails and the caller keeps the solver's route.
+    if let Some(problem) = paths
+        .problems(nest, nest.check_tolerance())
+        .into_iter()
+        .find(|p| !matches!(p, cutroute_geometry::PathRouteError::Overlap { .. }))
+    {
+        return Err(format!("the repaired route fails the checker: {problem}"));
+    }
+    Ok(Some(paths))
 }
 
 /// The rule check of a route of tool-on paths, on its contour route.

@@ -12,7 +12,9 @@
 //! - **hard**: `--rules part,sheet,islands --rules-hard` (weight 0).
 //!
 //! Prints a Markdown table: H plain and W=100 and the drop in %, idle length and machine time
-//! plain → W=100, and for the hard run the violations left (part/sheet/islands) and the
+//! plain → W=100, and for the hard run the violations left (part/sheet/islands, counted here
+//! on the final route; "job: not in time" when the job's own final check would have run past
+//! its time limit + 0.8 s and it reported none) and the
 //! independent checker's verdict on the final route (`Route::problems` for contour routes,
 //! `PathRoute::problems` for path routes; "ok, recut" when the only findings are pieces cut
 //! twice, which standard cutting does on coincident contours and GSCCP accepts). Every H in the
@@ -23,12 +25,14 @@
 
 use std::path::{Path, PathBuf};
 
-use cutroute_engine::{open_document, run_to_end, start_job};
+use cutroute_engine::{check_path_rules, open_document, run_to_end, start_job};
 use cutroute_geometry::{MachineParameters, Nest, PathRouteError, Point};
 use cutroute_protocol::{
     JobRequest, Problem, Progress, RuleSet, SolverKind, SolverParams, ThermalSettings,
 };
-use cutroute_thermal::{path_route_pierces, route_pierces, HeatModel};
+use cutroute_thermal::{
+    check_rules, path_route_pierces, route_pierces, HeatModel, RuleCounts, RuleParams,
+};
 
 struct Input {
     name: String,
@@ -121,6 +125,20 @@ fn measured(input: &Input, p: &Progress, model: &HeatModel) -> Option<(f64, f64,
         );
     }
     Some((h, idle, time))
+}
+
+/// The violations of the final route, counted by the rule check itself (path routes on their
+/// contour route).
+fn left_violations(input: &Input, p: &Progress, settings: &ThermalSettings) -> Option<RuleCounts> {
+    let nest = &input.nest;
+    let report = match (&p.route, &p.path_route) {
+        (Some(route), _) => {
+            check_rules(nest, route, settings.rules, &RuleParams::default()).ok()?
+        }
+        (None, Some(route)) => check_path_rules(nest, route, settings).ok()?,
+        _ => return None,
+    };
+    Some(report.counts())
 }
 
 /// The independent checker's verdict on the final route.
@@ -257,17 +275,28 @@ fn main() {
                 }
                 _ => "—".into(),
             };
-            let left = match c.rule_counts {
+            // Counted here on the final route (the job's own count is asserted equal when it
+            // has one; it has none when its check would have run past the time limit).
+            let counts = left_violations(input, &c, &hard);
+            if let (Some(mine), Some(job)) = (counts, c.rule_counts) {
+                assert_eq!(mine, job, "{} {}", input.name, solver.name());
+            }
+            let left = match counts {
                 Some(counts) => format!(
-                    "{}/{}/{}",
+                    "{}/{}/{}{}",
                     counts.part.unwrap_or(0),
                     counts.sheet.unwrap_or(0),
-                    counts.islands.unwrap_or(0)
+                    counts.islands.unwrap_or(0),
+                    if c.rule_counts.is_none() {
+                        " (job: not in time)"
+                    } else {
+                        ""
+                    }
                 ),
-                None => "not checked".into(),
+                None => "no route".into(),
             };
             let verdict = checker(input, &c);
-            if c.rule_counts.is_none_or(|counts| counts.total() > 0) || !verdict.starts_with("ok") {
+            if counts.is_none_or(|counts| counts.total() > 0) || !verdict.starts_with("ok") {
                 failures.push(format!(
                     "{} {}: {left}, {verdict}",
                     input.name,
