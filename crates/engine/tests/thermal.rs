@@ -265,7 +265,8 @@ fn path_route_solvers_honour_hard_rules_and_report_h() {
             );
             // The contour route the rules judge is itself a valid route of the nest.
             let contours = path_contour_route(nest, route);
-            assert!(contours.validate(nest, 1e-3).is_ok(), "{file} {solver:?}");
+            let valid = contours.validate(nest, 1e-3);
+            assert!(valid.is_ok(), "{file} {solver:?}: {valid:?}");
             let h = path_heat_by_definition(route, &hard);
             assert!(h > 0.0);
             let reported = result.heat.expect("H");

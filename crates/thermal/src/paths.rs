@@ -58,28 +58,33 @@ pub fn contour_route_of_paths(nest: &Nest, route: &PathRoute, tolerance: f64) ->
         let spans: Vec<Vec<usize>> = path.spans.iter().map(|s| lying_on(s.midpoint())).collect();
         // A closed path round one whole contour is that contour's cut alone, even where the
         // contour shares an edge with a neighbour (standard cutting cuts the edge again for
-        // the neighbour): a route of whole contours is its own contour route.
+        // the neighbour): a route of whole contours is its own contour route. Coincident
+        // contours (test0 has two) are all that path's.
         let length: f64 = path.spans.iter().map(|s| s.length()).sum();
-        let whole = (path.end().distance(path.pierce) <= tolerance)
-            .then(|| {
-                spans.first()?.iter().copied().find(|&i| {
+        let closed = path.end().distance(path.pierce) <= tolerance;
+        let whole: Vec<usize> = match spans.first() {
+            Some(first) if closed => first
+                .iter()
+                .copied()
+                .filter(|&i| {
                     spans.iter().all(|on| on.contains(&i))
                         && nest.contour(refs[i]).is_some_and(|c| {
                             (c.perimeter() - length).abs() <= tolerance * (1 + spans.len()) as f64
                         })
                 })
-            })
-            .flatten();
+                .collect(),
+            _ => Vec::new(),
+        };
         for (span, on) in path.spans.iter().zip(&spans) {
             // A whole contour starts at its pierce; a piece at its span's midpoint (on the
             // contour, and off the junctions where pieces meet, where a pierce would touch a
             // neighbour).
-            let point = if whole.is_some() {
-                path.pierce
-            } else {
+            let point = if whole.is_empty() {
                 span.midpoint()
+            } else {
+                path.pierce
             };
-            for &i in on.iter().filter(|&&i| whole.is_none_or(|w| w == i)) {
+            for &i in on.iter().filter(|i| whole.is_empty() || whole.contains(i)) {
                 let t = touches[i].get_or_insert((k, k, point));
                 t.0 = k;
             }
