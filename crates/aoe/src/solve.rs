@@ -467,7 +467,7 @@ fn heated_ready_order(
         }
         (pierces, t)
     };
-    let timelines: Vec<(Vec<(Point, f64)>, f64)> = visits.iter().map(|v| timeline(v)).collect();
+    let timelines: Vec<(Vec<(Point, f64)>, f64)> = visits.iter().map(timeline).collect();
     let horizon = HEAT_CUTOFF * heat.model.tau_s;
     while order.len() < n {
         let mut best: Option<(f64, usize)> = None;
