@@ -111,6 +111,14 @@ fn phase_ru(phase: &Phase) -> String {
                 "{} · исправить нарушения правил не удалось ({error}); маршрут оставлен",
                 phase_ru(base)
             ),
+            ThermalNote::RulesEnforcedOnWholeContours => format!(
+                "{} · правила соблюдены резкой целых контуров (стандартная резка)",
+                phase_ru(base)
+            ),
+            ThermalNote::RulesNotChecked => format!(
+                "{} · правила не проверены: проверка не уложилась бы в лимит времени",
+                phase_ru(base)
+            ),
         },
     }
 }

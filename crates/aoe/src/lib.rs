@@ -58,4 +58,4 @@ pub use embedding::{CutPoint, Embedding, EmbeddingError};
 pub use graph::{Dart, DualGraph, Faces, GraphError, PlaneGraph};
 pub use plan::{CutChain, DirectedEdge, PlanComponent, PlanError, PlanGraph, PlanOptions};
 pub use route::{oe_route, pierce_lower_bound, OeRoute};
-pub use solve::{solve_nest, AoeSolution, AoeSolveError, AoeSolveOptions, AoeSolving};
+pub use solve::{solve_nest, AoeHeat, AoeSolution, AoeSolveError, AoeSolveOptions, AoeSolving};

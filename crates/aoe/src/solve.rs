@@ -9,7 +9,10 @@
 //! another component is cut first (the part it frees would otherwise fall with uncut edges).
 
 use cutroute_geometry::float::Libm;
-use cutroute_geometry::{BoundingBox, Nest, PathRoute, PathRouteError, Point, Span, ToolOnPath};
+use cutroute_geometry::{
+    BoundingBox, MachineParameters, Nest, PathRoute, PathRouteError, Point, Span, ToolOnPath,
+};
+use cutroute_thermal::{path_route_pierces, HeatModel};
 use thiserror::Error;
 
 use crate::{CheckError, CutChain, EmbeddingError, PlanError, PlanGraph, PlanOptions};
@@ -23,6 +26,22 @@ pub struct AoeSolveOptions {
     pub start: Point,
     /// Where the head must return at the end, if anywhere.
     pub finish: Option<Point>,
+    /// The heat penalty (issue #19): the orderings compete on idle + W·H, and one more
+    /// ordering picks the next ready component by its idle move + W·(the H its pierces add).
+    /// `None`: idle alone.
+    pub heat: Option<AoeHeat>,
+}
+
+/// W·H in millimetres of idle travel, H on the machine clock of `machine` with one source per
+/// tool-on path at its pierce.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AoeHeat {
+    /// σ and τ.
+    pub model: HeatModel,
+    /// Millimetres of idle travel per unit of H.
+    pub weight_mm: f64,
+    /// Speeds and pierce time of the clock H runs on.
+    pub machine: MachineParameters,
 }
 
 impl Default for AoeSolveOptions {
@@ -31,6 +50,7 @@ impl Default for AoeSolveOptions {
             plan: PlanOptions::default(),
             start: Point::new(0.0, 0.0),
             finish: None,
+            heat: None,
         }
     }
 }
@@ -138,8 +158,11 @@ pub struct AoeSolving {
     after: Vec<Vec<usize>>,
     pierce_lower_bound: usize,
     unordered_idle_length: f64,
-    /// The shortest ordering so far: idle length, visits (closed curves placed), order.
+    /// The best ordering so far: idle length (+ W·H with a heat penalty), visits (closed
+    /// curves placed), order.
     best: (f64, Vec<Visit>, Vec<usize>),
+    /// Whether the heat-priced ordering is still to try (with a heat penalty only).
+    heated_start: bool,
     /// The starts of the ordering still to try (`choose_points` of each), next last.
     starts: Vec<bool>,
     /// The start under way: its visits, order and rounds done.
@@ -225,10 +248,12 @@ impl AoeSolving {
                 after[a].push(b);
             }
         }
+        let area_value = penalised(&visits, &area_order, options);
         Ok(AoeSolving {
             plan,
             n,
-            best: (unordered_idle_length, visits.clone(), area_order),
+            best: (area_value, visits.clone(), area_order),
+            heated_start: options.heat.is_some_and(|h| h.weight_mm > 0.0),
             visits,
             before,
             after,
@@ -254,6 +279,25 @@ impl AoeSolving {
         // gain. Two starts — closed curves entered at their nearest point, or at their chain's
         // start — each improved; the shorter wins, and the plain area order if both are longer.
         loop {
+            if self.heated_start {
+                // Heat-priced greedy, not improved by the idle moves (they would undo it).
+                self.heated_start = false;
+                if let Some(heat) = options.heat {
+                    let mut placed = self.visits.clone();
+                    if let Some(order) =
+                        heated_ready_order(&mut placed, &self.before, &self.after, start, &heat)
+                    {
+                        let value = penalised(&placed, &order, options);
+                        if value < self.best.0 {
+                            self.best = (value, placed, order);
+                        }
+                    }
+                }
+                if stop() {
+                    return None;
+                }
+                continue;
+            }
             match self.ordering.take() {
                 None => {
                     let Some(choose_points) = self.starts.pop() else {
@@ -277,9 +321,9 @@ impl AoeSolving {
                         improve_by_moves(order, &self.before, &self.after, &placed, start, finish);
                     let settled = relax_openings(&mut placed, &order, start, finish) < 1e-6;
                     if settled || rounds + 1 >= ORDER_ROUNDS {
-                        let idle = idle_length(&placed, &order, start, finish);
-                        if idle < self.best.0 {
-                            self.best = (idle, placed, order);
+                        let value = penalised(&placed, &order, options);
+                        if value < self.best.0 {
+                            self.best = (value, placed, order);
                         }
                     } else {
                         self.ordering = Some((placed, order, rounds + 1));
@@ -301,12 +345,13 @@ impl AoeSolving {
         options: &AoeSolveOptions,
     ) -> Result<AoeSolution, AoeSolveError> {
         if let Some((placed, order, _)) = self.ordering.take() {
-            let idle = idle_length(&placed, &order, options.start, options.finish);
-            if idle < self.best.0 {
-                self.best = (idle, placed, order);
+            let value = penalised(&placed, &order, options);
+            if value < self.best.0 {
+                self.best = (value, placed, order);
             }
         }
         self.starts.clear();
+        self.heated_start = false;
         self.route(nest, options)
     }
 
@@ -327,30 +372,7 @@ impl AoeSolving {
             .flat_map(|&c| visits[c].chains.iter().cloned())
             .collect();
         plan.check_route(&chains)?;
-        let mut paths = Vec::with_capacity(chains.len());
-        for &c in &order {
-            let visit = &visits[c];
-            match visit.opening {
-                Some(opening) => {
-                    let spans = &visit.chains[0].spans;
-                    paths.push(ToolOnPath {
-                        pierce: visit.entry,
-                        spans: opened(spans, opening, visit.entry),
-                    });
-                }
-                None => paths.extend(visit.chains.iter().filter(|c| !c.spans.is_empty()).map(
-                    |c| ToolOnPath {
-                        pierce: c.spans[0].start,
-                        spans: c.spans.clone(),
-                    },
-                )),
-            }
-        }
-        let route = PathRoute {
-            start,
-            paths,
-            finish,
-        };
+        let route = route_of(&visits, &order, start, finish);
         let tolerance = (options.plan.tolerance * 10.0).max(1e-6);
         if let Some(problem) = route.problems(nest, tolerance).into_iter().next() {
             return Err(AoeSolveError::Route(problem));
@@ -363,6 +385,122 @@ impl AoeSolving {
             unordered_idle_length,
         })
     }
+}
+
+/// The tool-on paths of visiting the components in `order`.
+fn route_of(visits: &[Visit], order: &[usize], start: Point, finish: Option<Point>) -> PathRoute {
+    let mut paths = Vec::with_capacity(order.len());
+    for &c in order {
+        let visit = &visits[c];
+        match visit.opening {
+            Some(opening) => {
+                let spans = &visit.chains[0].spans;
+                paths.push(ToolOnPath {
+                    pierce: visit.entry,
+                    spans: opened(spans, opening, visit.entry),
+                });
+            }
+            None => paths.extend(
+                visit
+                    .chains
+                    .iter()
+                    .filter(|c| !c.spans.is_empty())
+                    .map(|c| ToolOnPath {
+                        pierce: c.spans[0].start,
+                        spans: c.spans.clone(),
+                    }),
+            ),
+        }
+    }
+    PathRoute {
+        start,
+        paths,
+        finish,
+    }
+}
+
+/// What the orderings compete on: idle length, + W·H (mm) with a heat penalty.
+fn penalised(visits: &[Visit], order: &[usize], options: &AoeSolveOptions) -> f64 {
+    let idle = idle_length(visits, order, options.start, options.finish);
+    match options.heat {
+        Some(heat) if heat.weight_mm > 0.0 => {
+            let route = route_of(visits, order, options.start, options.finish);
+            idle + heat.weight_mm * heat.model.load(&path_route_pierces(&route, &heat.machine))
+        }
+        _ => idle,
+    }
+}
+
+/// Kernels below e⁻¹² are left out of the greedy's heat increments.
+const HEAT_CUTOFF: f64 = 12.0;
+
+/// Next the ready component of least idle move + W·ΔH, ΔH the heat its pierces add given
+/// the pierces before them on the machine clock (closed curves entered at their chain's
+/// start); `None` when the precedence has a cycle.
+fn heated_ready_order(
+    visits: &mut [Visit],
+    before: &[Vec<usize>],
+    after: &[Vec<usize>],
+    start: Point,
+    heat: &AoeHeat,
+) -> Option<Vec<usize>> {
+    let n = visits.len();
+    let m = &heat.machine;
+    let mut waiting: Vec<usize> = before.iter().map(Vec::len).collect();
+    let mut done = vec![false; n];
+    let mut order = Vec::with_capacity(n);
+    let (mut at, mut clock) = (start, 0.0);
+    // (point, time) of every pierce so far, in time order.
+    let mut history: Vec<(Point, f64)> = Vec::new();
+    // A component's pierces relative to its entry time: (point, offset), and its duration.
+    let timeline = |v: &Visit| {
+        let mut t = 0.0;
+        let mut here = v.entry;
+        let mut pierces = Vec::new();
+        for chain in v.chains.iter().filter(|c| !c.spans.is_empty()) {
+            let p = chain.spans[0].start;
+            t += here.distance(p) / m.idle_speed;
+            pierces.push((p, t));
+            let length: f64 = chain.spans.iter().map(|s| s.length()).sum();
+            t += m.pierce_time + length / m.cut_speed;
+            here = chain.spans[chain.spans.len() - 1].end;
+        }
+        (pierces, t)
+    };
+    let timelines: Vec<(Vec<(Point, f64)>, f64)> = visits.iter().map(timeline).collect();
+    let horizon = HEAT_CUTOFF * heat.model.tau_s;
+    while order.len() < n {
+        let mut best: Option<(f64, usize)> = None;
+        for c in (0..n).filter(|&c| !done[c] && waiting[c] == 0) {
+            let idle = at.distance(visits[c].entry);
+            let arrive = clock + idle / m.idle_speed;
+            let mut added = 0.0;
+            for &(p, offset) in &timelines[c].0 {
+                let t = arrive + offset;
+                for &(q, tq) in history.iter().rev() {
+                    if t - tq > horizon {
+                        break;
+                    }
+                    added += heat.model.kernel((p - q).norm_squared(), t - tq);
+                }
+            }
+            let value = idle + heat.weight_mm * added;
+            if best.is_none_or(|b| value < b.0) {
+                best = Some((value, c));
+            }
+        }
+        let (_, next) = best?;
+        let arrive = clock + at.distance(visits[next].entry) / m.idle_speed;
+        history.extend(timelines[next].0.iter().map(|&(p, o)| (p, arrive + o)));
+        clock = arrive + timelines[next].1;
+        done[next] = true;
+        order.push(next);
+        at = visits[next].exit;
+        for &b in &after[next] {
+            waiting[b] -= 1;
+        }
+    }
+    Some(order)
 }
 
 /// Idle length of visiting the components in `order`: start → entry, exit → next entry, …,

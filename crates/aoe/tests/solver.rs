@@ -197,6 +197,7 @@ fn a_thousand_contour_sheet_gets_a_checked_route() {
         },
         start: b.min,
         finish: None,
+        heat: None,
     };
     let solution = solve_nest(&nest, &options).unwrap_or_else(|e| panic!("{e}"));
     solution

@@ -1326,10 +1326,35 @@ fn solve_path(
             stopped.unwrap_or("")
         )
     })?;
-    let route = progress
+    let solver_route = progress
         .path_route
         .as_ref()
         .ok_or_else(|| format!("the solver found no route ({})", progress.phase))?;
+    // Hard rules: a route whose contour route breaks them is replaced by that route repaired
+    // (standard cutting). Its ub is its own objective; AOE's lb assumed edges cut once.
+    let (repaired, failed) = match thermal.enforce_paths(nest, solver_route, &machine, objective) {
+        Ok(repaired) => (repaired, None),
+        Err(e) => (None, Some(e)),
+    };
+    let route = repaired.as_ref().unwrap_or(solver_route);
+    let (ub, lb, phase) = match &repaired {
+        None => (
+            progress.upper_bound,
+            progress.lower_bound,
+            match failed {
+                Some(e) => format!("{} · rule repair failed ({e}); route kept", progress.phase),
+                None => progress.phase.to_string(),
+            },
+        ),
+        Some(r) => (
+            Some(objective.value(&machine, r.cut_length(), r.idle_length(), r.pierce_count())),
+            progress.lower_bound.filter(|_| solver != SolverKind::Aoe),
+            format!(
+                "{} · rules enforced on whole contours (standard cutting)",
+                progress.phase
+            ),
+        ),
+    };
     // Checked again here, as every route the CLI prints.
     let tolerance = nest.check_tolerance();
     let problems = route.problems(nest, tolerance);
@@ -1356,18 +1381,22 @@ fn solve_path(
         "objective": objective.name(),
         "machine": machine_json(&machine),
         "route": serde_json::to_value(route).map_err(|e| e.to_string())?,
-        "ub": progress.upper_bound,
-        "lb": progress.lower_bound,
+        "ub": ub,
+        "lb": lb,
+        // The idle bound holds for any route that cuts every contour, a repaired one too; the
+        // gap is that of the printed route.
         "idle_lb": progress.idle_lower_bound,
-        "idle_gap": progress.idle_gap(),
-        "phase": progress.phase.to_string(),
+        "idle_gap": progress
+            .idle_lower_bound
+            .map(|lb| if idle_length > 0.0 { ((idle_length - lb) / idle_length).max(0.0) } else { 0.0 }),
+        "phase": phase,
         "elapsed_s": started.elapsed().as_secs_f64(),
         "stopped": stopped,
     });
     if let Value::Object(fields) = &mut report {
         fields.extend(extra);
     }
-    thermal.report_paths(&mut report, route, &machine);
+    thermal.report_paths(&mut report, nest, route, &machine, objective)?;
     Ok(report)
 }
 

@@ -17,17 +17,20 @@ pub struct ThermalArgs {
     /// Cooling time τ of the heat model, s.
     #[arg(long, value_name = "S", default_value_t = 60.0)]
     thermal_tau: f64,
-    /// nearest, ccp and chain minimise their objective + W·H (W in objective units per unit of H;
-    /// 0: plain CCP-Relax); heuristic and exact relax their final pierce points on it.
+    /// nearest, ccp, chain, sccp, gsccp and aoe minimise their objective + W·H (W in objective
+    /// units per unit of H; 0: H only reported); heuristic and exact price H's consecutive
+    /// terms on their arcs and relax their final pierce points on it.
     #[arg(long, value_name = "W", default_value_t = 0.0)]
     thermal_weight: f64,
     /// The rules checked and reported (and enforced with --rules-hard): a list of
-    /// part,sheet,islands. None unless given (all three with --rules-hard): on large sheets
-    /// the island check replays the route on a raster, which a time limit does not bound.
+    /// part,sheet,islands. None unless given (all three with --rules-hard). Path routes
+    /// (sccp, gsccp, aoe) are judged by their contour route: a contour is done when its last
+    /// piece is cut and starts where its first piece does.
     #[arg(long, value_name = "LIST")]
     rules: Option<String>,
     /// Repair the solver's route until the rules hold (whole parts reordered, pierce points
-    /// moved); bounds and certificates stay those of the problem without rules.
+    /// moved; a path route that breaks them becomes its contour route repaired, as standard
+    /// cutting); bounds and certificates stay those of the problem without rules.
     #[arg(long)]
     rules_hard: bool,
 }
@@ -80,21 +83,22 @@ impl Thermal {
         }
     }
 
-    /// Says on stderr when a heat weight is given to a solver that does not price H.
+    /// Says on stderr when a heat weight is given to a solver that prices only part of H.
     pub fn warn_unpriced(&self, solver: SolverKind) {
         if self.weight <= 0.0 {
             return;
         }
         match solver {
-            SolverKind::Ccp | SolverKind::Chain | SolverKind::NearestNeighbour => {}
+            SolverKind::Ccp
+            | SolverKind::Chain
+            | SolverKind::NearestNeighbour
+            | SolverKind::Sccp
+            | SolverKind::Gsccp
+            | SolverKind::Aoe => {}
             SolverKind::Heuristic | SolverKind::Exact => eprintln!(
-                "cutroute: {}'s order search does not price H; --thermal-weight relaxes its final \
-                 pierce points on objective + W·H (and drops the discrete lb)",
-                solver.name()
-            ),
-            _ => eprintln!(
-                "cutroute: --thermal-weight is honoured by nearest, ccp and chain (and heuristic/exact's \
-                 final pierce points); {} only reports H",
+                "cutroute: {}'s order search prices only H's terms between consecutive pierces; \
+                 --thermal-weight also relaxes its final pierce points on objective + W·H (and \
+                 drops the discrete lb)",
                 solver.name()
             ),
         }
@@ -122,22 +126,61 @@ impl Thermal {
         enforce_thermal_rules(nest, route, &settings, machine, objective)
     }
 
-    /// Adds `heat` (one source per tool-on path) and each path's `t` to a path-route report;
-    /// the rules are defined on contour routes, so `rule_violations` is null.
+    /// With `--rules-hard`, a path route whose contour route breaks the rules becomes that
+    /// contour route repaired, cut as standard cutting (`Some`); `None`: the route stays.
+    pub fn enforce_paths(
+        &self,
+        nest: &Nest,
+        route: &cutroute_geometry::PathRoute,
+        machine: &MachineParameters,
+        objective: Objective,
+    ) -> Result<Option<cutroute_geometry::PathRoute>, String> {
+        if !self.hard {
+            return Ok(None);
+        }
+        let settings = ThermalSettings {
+            rules: self.rules,
+            hard: true,
+            ..self.engine_settings()
+        };
+        cutroute_engine::enforce_thermal_rules_on_paths(nest, route, &settings, machine, objective)
+    }
+
+    /// Adds `heat` (one source per tool-on path), `thermal`, `rule_violations` (on the route's
+    /// contour route) and each path's `t` to a path-route report.
     pub fn report_paths(
         &self,
         report: &mut Value,
+        nest: &Nest,
         route: &cutroute_geometry::PathRoute,
         machine: &MachineParameters,
-    ) {
+        objective: Objective,
+    ) -> Result<(), String> {
         let pierces = cutroute_thermal::path_route_pierces(route, machine);
+        let settings = ThermalSettings {
+            rules: self.rules,
+            ..self.engine_settings()
+        };
+        let counts = cutroute_engine::check_path_rules(nest, route, &settings)?.counts();
         report["heat"] = json!(self.model.load(&pierces));
-        report["rule_violations"] = Value::Null;
+        report["thermal"] = json!({
+            "sigma_mm": self.model.sigma_mm,
+            "tau_s": self.model.tau_s,
+            "weight": self.weight,
+            "weight_unit": format!("{} per unit of H", objective.name()),
+            "rules_hard": self.hard,
+        });
+        report["rule_violations"] = json!({
+            "part": counts.part,
+            "sheet": counts.sheet,
+            "islands": counts.islands,
+        });
         if let Some(paths) = report["route"]["paths"].as_array_mut() {
             for (path, pierce) in paths.iter_mut().zip(&pierces) {
                 path["t"] = json!(pierce.time);
             }
         }
+        Ok(())
     }
 
     /// Adds `heat`, `thermal`, `rule_violations` and each step's `t` to a route report.

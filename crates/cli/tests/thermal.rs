@@ -139,3 +139,77 @@ fn bad_thermal_flags_are_refused() {
         assert!(!ok && stderr.contains("--"), "{bad:?}: {stderr}");
     }
 }
+
+/// H by a plain double loop over a path report's paths (`pierce` {x, y}, `t`).
+fn heat_from_path_report(report: &Value, sigma: f64, tau: f64) -> f64 {
+    let paths: Vec<(f64, f64, f64)> = report["route"]["paths"]
+        .as_array()
+        .expect("paths")
+        .iter()
+        .map(|p| {
+            (
+                p["pierce"]["x"].as_f64().unwrap(),
+                p["pierce"]["y"].as_f64().unwrap(),
+                p["t"].as_f64().expect("t per path"),
+            )
+        })
+        .collect();
+    let mut h = 0.0;
+    for i in 0..paths.len() {
+        for j in 0..i {
+            let d2 = (paths[i].0 - paths[j].0).powi(2) + (paths[i].1 - paths[j].1).powi(2);
+            h += (-d2 / (2.0 * sigma * sigma)).exp() * (-(paths[i].2 - paths[j].2) / tau).exp();
+        }
+    }
+    h
+}
+
+#[test]
+fn path_solvers_report_rules_honour_them_hard_and_their_heat_is_recomputed() {
+    let file = data("nests/dbs-json/test0.dbs.json");
+    for solver in ["sccp", "gsccp", "aoe"] {
+        let base = [
+            "solve",
+            &file,
+            "--solver",
+            solver,
+            "--time-limit",
+            "2",
+            "--json",
+        ];
+        let mut checked = base.to_vec();
+        checked.extend(["--rules", "part,sheet,islands"]);
+        let plain = json(&checked);
+        let counts = &plain["rule_violations"];
+        let total: u64 = ["part", "sheet", "islands"]
+            .iter()
+            .map(|g| counts[g].as_u64().expect("counted on the contour route"))
+            .sum();
+        assert!(
+            total > 0,
+            "{solver}: test0's plain route breaks rules ({counts})"
+        );
+
+        let mut hard_args = base.to_vec();
+        hard_args.push("--rules-hard");
+        let hard = json(&hard_args);
+        for group in ["part", "sheet", "islands"] {
+            assert_eq!(hard["rule_violations"][group], 0, "{solver}: {hard}");
+        }
+        for report in [&plain, &hard] {
+            let h = report["heat"].as_f64().expect("heat");
+            let reference = heat_from_path_report(report, 50.0, 60.0);
+            assert!(reference > 0.0);
+            assert!(
+                (h - reference).abs() <= 1e-6 * reference,
+                "{solver}: {h} vs {reference}"
+            );
+        }
+        // ub is the printed route's objective (time), never below lb.
+        let ub = hard["ub"].as_f64().unwrap();
+        assert!((ub - hard["time_s"].as_f64().unwrap()).abs() <= 1e-6 * ub);
+        if let Some(lb) = hard["lb"].as_f64() {
+            assert!(lb <= ub + 1e-6, "{solver}: lb {lb} > ub {ub}");
+        }
+    }
+}

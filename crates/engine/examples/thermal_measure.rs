@@ -12,8 +12,10 @@ use cutroute_protocol::{RuleSet, ThermalSettings};
 use web_time::Instant;
 
 fn main() {
-    println!("| contours | H ms | rules (part, sheet, islands) ms |");
-    println!("|---|---|---|");
+    println!(
+        "| contours | H ms | rules (part, sheet, islands) ms | part ms | sheet ms | islands ms |"
+    );
+    println!("|---|---|---|---|---|---|");
     for contours in [1_000, 10_000, 30_000] {
         let nest = generate_nest(contours, 1);
         let mut job = NearestNeighbourJob::new(1, nest.clone(), Point::new(0.0, 0.0), None)
@@ -31,6 +33,26 @@ fn main() {
             ..ThermalSettings::default()
         });
         eprintln!("{contours}: H {:.4}, {:?}", measured.heat, measured.counts);
-        println!("| {contours} | {heat_ms:.1} | {:.1} |", rules_ms - heat_ms);
+        let only = |rules: RuleSet| {
+            time(ThermalSettings {
+                rules,
+                ..ThermalSettings::default()
+            })
+            .0 - heat_ms
+        };
+        let none = RuleSet::NONE;
+        let part = only(RuleSet { part: true, ..none });
+        let sheet = only(RuleSet {
+            sheet: true,
+            ..none
+        });
+        let islands = only(RuleSet {
+            islands: true,
+            ..none
+        });
+        println!(
+            "| {contours} | {heat_ms:.1} | {:.1} | {part:.1} | {sheet:.1} | {islands:.1} |",
+            rules_ms - heat_ms
+        );
     }
 }

@@ -51,8 +51,9 @@ pub use open_files::{
 };
 pub use path_jobs::{idle_tree_bound, AoeJob, PlanBound, SegmentJob};
 pub use thermal::{
-    enforce_thermal_rules, heat_penalty, measure_path_route, measure_route, price_consecutive_heat,
-    ThermalJob, ThermalMeasure,
+    check_path_rules, enforce_thermal_rules, enforce_thermal_rules_on_paths, heat_penalty,
+    measure_path_route, measure_route, path_contour_route, price_consecutive_heat, ThermalJob,
+    ThermalMeasure,
 };
 
 /// How long one [`Job::step`] may run before it returns, so cancel requests are seen quickly.
@@ -153,6 +154,7 @@ pub fn start_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
         params.machine,
         params.objective,
         params.thermal,
+        Duration::from_secs_f64(params.time_limit_s.clamp(0.0, 1.0e7)),
     )))
 }
 

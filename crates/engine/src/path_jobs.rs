@@ -4,15 +4,15 @@
 //! `params.objective`), a lower bound in the same unit, and the candidates weighed as
 //! `alternatives`.
 
-use cutroute_aoe::{AoeSolution, AoeSolveOptions, AoeSolving, PlanGraph, PlanOptions};
+use cutroute_aoe::{AoeHeat, AoeSolution, AoeSolveOptions, AoeSolving, PlanGraph, PlanOptions};
 use cutroute_geometry::float::Libm;
 use cutroute_geometry::{BoundingBox, MachineParameters, Nest, Objective, PathRoute, Point, Span};
 use cutroute_protocol::{
     Ensemble, JobId, JobRequest, Phase, Problem, Progress, RouteSummary, SolverKind,
 };
 use cutroute_segments::{
-    Candidate, EnsembleKind, EnsembleReport, GsccpOptions, GsccpSearch, GsccpStage, SccpOptions,
-    SearchStatus,
+    Candidate, EnsembleKind, EnsembleReport, GsccpOptions, GsccpSearch, GsccpStage, PathHeat,
+    SccpOptions, SearchStatus,
 };
 use std::collections::HashMap;
 use web_time::{Duration, Instant};
@@ -338,6 +338,12 @@ impl SegmentJob {
                 finish,
                 time_limit: Duration::from_secs_f64(params.time_limit_s.clamp(0.0, 1.0e7)),
                 seed: params.seed,
+                // With a heat weight the VNS and the choice between ensembles (and GSCCP's
+                // CCP-Relax seed) add W·H, priced on the machine clock of `params.machine`.
+                heat: params.thermal.penalised().then(|| PathHeat {
+                    penalty: crate::thermal::heat_penalty(&params.thermal, params.objective),
+                    machine: params.machine,
+                }),
                 ..SccpOptions::default()
             },
             kinds,
@@ -429,7 +435,16 @@ impl Job for SegmentJob {
         Progress {
             job_id: self.job_id,
             elapsed_s: self.started.elapsed().as_secs_f64(),
-            upper_bound: best.map(|c| c.value),
+            // The route's own objective value (a candidate's value adds W·H with a heat
+            // weight, which the plan bound does not bound).
+            upper_bound: best.map(|c| {
+                self.objective.value(
+                    &self.machine,
+                    c.route.cut_length(),
+                    c.route.idle_length(),
+                    c.route.pierce_count(),
+                )
+            }),
             lower_bound,
             phase: segments_phase(&self.search),
             route: None,
@@ -480,6 +495,19 @@ impl AoeJob {
                 },
                 start,
                 finish,
+                // With a heat weight the orderings compete on idle + W·H (machine clock of
+                // `params.machine`), and a heat-priced greedy ordering joins them.
+                heat: request.params.thermal.penalised().then(|| {
+                    let penalty = crate::thermal::heat_penalty(
+                        &request.params.thermal,
+                        request.params.objective,
+                    );
+                    AoeHeat {
+                        model: penalty.model,
+                        weight_mm: penalty.weight_mm(&request.params.machine),
+                        machine: request.params.machine,
+                    }
+                }),
             },
             finish_bound: (start, finish),
             machine: request.params.machine,

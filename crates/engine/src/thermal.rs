@@ -12,8 +12,15 @@
 //!   idle + W·H (all terms) along their contours; with hard rules the route is repaired first.
 //!   The reported upper bound is the final route's idle length, and the discrete lower bound
 //!   (about penalised arcs through candidate points) is not reported then;
-//! - sccp, gsccp, aoe: H is reported (one source per tool-on path); the rules are defined on
-//!   routes of whole contours, so they are neither checked nor enforced.
+//! - sccp, gsccp, aoe: H has one source per tool-on path. With a heat weight, SCCP's VNS keeps
+//!   the order of least idle + W·H and GSCCP picks its ensemble (and seeds its orders with
+//!   CCP-Relax) on objective + W·H (`cutroute_segments::PathHeat`); AOE keeps, among its
+//!   orderings, the one of least idle + W·H. The rules are checked on the route's contour route
+//!   (`contour_route_of_paths`: a contour is done when its last piece is cut, and starts where
+//!   its first piece is). Hard rules: a path route that breaks them is replaced by its contour
+//!   route repaired like a contour route (whole contours, so common edges are cut twice), which
+//!   then obeys them; its lower bound is the plan's bound for any route (SCCP, GSCCP) or none
+//!   (AOE's trail bound assumes edges cut once).
 
 use std::cell::RefCell;
 
@@ -21,8 +28,9 @@ use cutroute_ccp::HeatPenalty;
 use cutroute_geometry::{MachineParameters, Nest, Objective, PathRoute, Route};
 use cutroute_protocol::{Phase, Progress, SolverKind, ThermalNote, ThermalSettings};
 use cutroute_thermal::{
-    admissible_pierce_points, check_rules, enforce_rules, path_route_pierces, relax_pierce_points,
-    route_pierces, HeatModel, RuleCounts, RuleParams, Violation,
+    admissible_pierce_points, check_rules, contour_route_of_paths, enforce_rules,
+    path_route_pierces, relax_pierce_points, route_pierces, HeatModel, RuleCheck, RuleCounts,
+    RuleParams, Violation,
 };
 use web_time::{Duration, Instant};
 
@@ -32,10 +40,18 @@ use crate::{Job, JobStatus};
 const RELAX_PASSES: usize = 3;
 
 /// Rules are checked on routes that are not the final one only on nests of at most this many
-/// contours: the check took 0.7 s on 1,000 generated contours, 15 s on 10,000 and 47 s on
-/// 30,000 (`thermal_measure` example, BENCHMARKS.md), and a slice that long would keep Stop
-/// from reaching the job. The final route is always checked.
+/// contours, where one check is a short piece of a report (92 ms on 1,000 generated contours;
+/// 0.37 s on 10,000 and 1.1 s on 30,000, `thermal_measure` example, BENCHMARKS.md). The final
+/// route is always checked, in slices of `step`.
 const LIVE_RULES_MAX_CONTOURS: usize = 1_000;
+
+/// How long after its time limit a job may still be checking its final route's rules: the
+/// promise is limit + 1 s, and the inner job ends at its limit.
+pub const FINAL_CHECK_GRACE: Duration = Duration::from_millis(800);
+
+/// The final route's rule check: the check, the route it checks (a path route's contour
+/// route), and the progress's (route, path route) it reports on.
+type FinalCheck = (RuleCheck, Route, (Option<Route>, Option<PathRoute>));
 
 /// A measure (H, or the rule check) of a route that is not the final one runs only when at
 /// least this many times its own last duration has passed since it ran: the island check
@@ -77,6 +93,53 @@ pub fn enforce_thermal_rules(
         weight_mm,
         RELAX_PASSES,
         candidates.as_deref(),
+    )
+    .map_err(|e| e.to_string())
+}
+
+/// Hard rules on a route of tool-on paths: `Ok(None)` when its contour route
+/// ([`path_contour_route`]) obeys `settings.rules`; else that contour route repaired by
+/// [`enforce_thermal_rules`] and cut as standard cutting (whole contours: common edges are cut
+/// twice), which obeys them; `Err` when that route fails the path checker (the solver's route
+/// is then kept, with its violations).
+pub fn enforce_thermal_rules_on_paths(
+    nest: &Nest,
+    path_route: &PathRoute,
+    settings: &ThermalSettings,
+    machine: &MachineParameters,
+    objective: Objective,
+) -> Result<Option<PathRoute>, String> {
+    let contours = path_contour_route(nest, path_route);
+    let report = check_rules(nest, &contours, settings.rules, &RuleParams::default())
+        .map_err(|e| e.to_string())?;
+    if report.violations.is_empty() {
+        return Ok(None);
+    }
+    let route = enforce_thermal_rules(nest, contours, settings, machine, objective)?;
+    let paths = PathRoute::from_route(&route, nest).map_err(|e| e.to_string())?;
+    // The repaired route must pass the path checker as the solver's did (pieces cut twice
+    // allowed); when it does not, the repair fails and the caller keeps the solver's route.
+    if let Some(problem) = paths
+        .problems(nest, nest.check_tolerance())
+        .into_iter()
+        .find(|p| !matches!(p, cutroute_geometry::PathRouteError::Overlap { .. }))
+    {
+        return Err(format!("the repaired route fails the checker: {problem}"));
+    }
+    Ok(Some(paths))
+}
+
+/// The rule check of a route of tool-on paths, on its contour route.
+pub fn check_path_rules(
+    nest: &Nest,
+    path_route: &PathRoute,
+    settings: &ThermalSettings,
+) -> Result<cutroute_thermal::RuleReport, String> {
+    check_rules(
+        nest,
+        &path_contour_route(nest, path_route),
+        settings.rules,
+        &RuleParams::default(),
     )
     .map_err(|e| e.to_string())
 }
@@ -186,6 +249,12 @@ pub fn measure_path_route(
     Ok(model.load(&path_route_pierces(route, machine)))
 }
 
+/// The contour route of a path route, by which the rules judge it (spans within 10× the
+/// nest's check tolerance of a contour lie on it, as AOE's own check allows).
+pub fn path_contour_route(nest: &Nest, route: &PathRoute) -> Route {
+    contour_route_of_paths(nest, route, 10.0 * nest.check_tolerance())
+}
+
 /// The last measured route, so a progress report of an unchanged route costs a comparison.
 #[derive(Default)]
 struct Measured {
@@ -222,11 +291,21 @@ pub struct ThermalJob {
     done: bool,
     /// The repaired final route, or why the repair failed (the solver's route is then kept).
     repaired: Option<Result<Route, String>>,
+    /// The same for a path route: its contour route repaired, as standard cutting.
+    repaired_path: Option<Result<PathRoute, String>>,
+    /// The final route's rule check under way: the check, the (contour) route it checks, and
+    /// the progress's route and path route it belongs to.
+    final_check: Option<FinalCheck>,
+    /// The final check was given up at the deadline (or failed): no counts are reported.
+    final_check_cut: bool,
+    /// The request's time limit + [`FINAL_CHECK_GRACE`] from the job's start.
+    deadline: Option<Instant>,
     measured: RefCell<Measured>,
 }
 
 impl ThermalJob {
-    /// Wraps `inner`, a job of `solver` on `nest`.
+    /// Wraps `inner`, a job of `solver` on `nest` with `time_limit` (the final rule check
+    /// ends by then + [`FINAL_CHECK_GRACE`]).
     pub fn new(
         inner: Box<dyn Job>,
         solver: SolverKind,
@@ -234,6 +313,7 @@ impl ThermalJob {
         machine: MachineParameters,
         objective: Objective,
         settings: ThermalSettings,
+        time_limit: Duration,
     ) -> Self {
         ThermalJob {
             inner,
@@ -245,6 +325,10 @@ impl ThermalJob {
             settings,
             done: false,
             repaired: None,
+            repaired_path: None,
+            final_check: None,
+            final_check_cut: false,
+            deadline: Instant::now().checked_add(time_limit + FINAL_CHECK_GRACE),
             measured: RefCell::default(),
         }
     }
@@ -260,7 +344,12 @@ impl ThermalJob {
         if !(hard || relax) {
             return;
         }
-        let Some(route) = self.inner.progress().route else {
+        let progress = self.inner.progress();
+        if let (true, Some(path_route)) = (hard, progress.path_route) {
+            self.repaired_path = self.repair_path_route(&path_route);
+            return;
+        }
+        let Some(route) = progress.route else {
             return;
         };
         self.repaired = Some(if hard {
@@ -292,6 +381,29 @@ impl ThermalJob {
         });
     }
 
+    /// Hard rules on a path route: `None` when its contour route obeys them; else that route
+    /// repaired as a contour route and cut as standard cutting.
+    fn repair_path_route(&self, path_route: &PathRoute) -> Option<Result<PathRoute, String>> {
+        enforce_thermal_rules_on_paths(
+            &self.nest,
+            path_route,
+            &self.settings,
+            &self.machine,
+            self.objective,
+        )
+        .transpose()
+    }
+
+    /// Whether a report checks the rules of a route that is not the final one (the final one
+    /// is checked in slices by `step`): on small nests only, and spaced out.
+    fn live_check_due(&self, measured: &Measured) -> bool {
+        self.settings.rules.any()
+            && measured.rules.is_none()
+            && !self.done
+            && self.contours <= LIVE_RULES_MAX_CONTOURS
+            && due(measured.rules_checked, false)
+    }
+
     /// Fills `progress`'s thermal fields from its route, measuring only what changed.
     fn measure(&self, progress: &mut Progress) {
         let mut measured = self.measured.borrow_mut();
@@ -309,11 +421,7 @@ impl ThermalJob {
                 measured.heat = measure_heat(&self.nest, route, &self.settings, &self.machine).ok();
                 measured.heat_measured = Some((started, started.elapsed()));
             }
-            let live = self.contours <= LIVE_RULES_MAX_CONTOURS;
-            if self.settings.rules.any()
-                && measured.rules.is_none()
-                && (self.done || (live && due(measured.rules_checked, false)))
-            {
+            if self.live_check_due(&measured) {
                 let started = Instant::now();
                 if let Ok(report) = check_rules(
                     &self.nest,
@@ -335,10 +443,32 @@ impl ThermalJob {
                 *measured = Measured {
                     heat: measure_path_route(path_route, &self.settings, &self.machine).ok(),
                     path_route: Some(path_route.clone()),
+                    rules_checked: measured.rules_checked,
                     ..Measured::default()
                 };
             }
+            if measured.heat.is_none() {
+                // The final check's record starts without H.
+                measured.heat = measure_path_route(path_route, &self.settings, &self.machine).ok();
+            }
+            if self.live_check_due(&measured) {
+                let started = Instant::now();
+                let contours = path_contour_route(&self.nest, path_route);
+                if let Ok(report) = check_rules(
+                    &self.nest,
+                    &contours,
+                    self.settings.rules,
+                    &RuleParams::default(),
+                ) {
+                    measured.rules = Some((Some(report.counts()), report.violations));
+                }
+                measured.rules_checked = Some((started, started.elapsed()));
+            }
             progress.heat = measured.heat;
+            if let Some((counts, violations)) = &measured.rules {
+                progress.rule_counts = *counts;
+                progress.violations = violations.clone();
+            }
         }
     }
 }
@@ -348,16 +478,112 @@ impl Job for ThermalJob {
         if self.done {
             return JobStatus::Done;
         }
+        if let Some(check) = self.final_check.as_mut() {
+            if self.deadline.is_some_and(|end| Instant::now() >= end) {
+                // The check would break the time limit: the final report says "not checked"
+                // (`None`) rather than block.
+                self.final_check = None;
+                self.final_check_cut = true;
+                self.done = true;
+                return JobStatus::Done;
+            }
+            let (check, route, key) = check;
+            let started = Instant::now();
+            match check.advance(&self.nest, route, budget) {
+                Ok(None) => return JobStatus::Running,
+                Ok(Some(report)) => {
+                    let (route, path_route) = std::mem::take(key);
+                    let mut measured = self.measured.borrow_mut();
+                    *measured = Measured {
+                        route,
+                        path_route,
+                        rules: Some((Some(report.counts()), report.violations)),
+                        rules_checked: Some((started, started.elapsed())),
+                        ..Measured::default()
+                    };
+                }
+                Err(_) => self.final_check_cut = true,
+            }
+            self.final_check = None;
+            self.done = true;
+            return JobStatus::Done;
+        }
         if self.inner.step(budget) == JobStatus::Running {
             return JobStatus::Running;
         }
         self.repair();
-        self.done = true;
-        JobStatus::Done
+        if !self.settings.rules.any() {
+            self.done = true;
+            return JobStatus::Done;
+        }
+        // The final route's rule check, in slices from the next step on (on 30,000 contours
+        // it takes about a second).
+        let progress = self.base_progress();
+        let checked = match (&progress.route, &progress.path_route) {
+            (Some(route), _) => Some(route.clone()),
+            (None, Some(path_route)) => Some(path_contour_route(&self.nest, path_route)),
+            (None, None) => None,
+        };
+        match (
+            checked,
+            RuleCheck::new(self.settings.rules, RuleParams::default()),
+        ) {
+            (Some(route), Ok(check)) => {
+                self.final_check = Some((check, route, (progress.route, progress.path_route)));
+                JobStatus::Running
+            }
+            _ => {
+                self.done = true;
+                JobStatus::Done
+            }
+        }
     }
 
     fn progress(&self) -> Progress {
+        let mut progress = self.base_progress();
+        if self.final_check_cut {
+            progress.phase = thermal_phase(
+                std::mem::take(&mut progress.phase),
+                ThermalNote::RulesNotChecked,
+            );
+        }
+        self.measure(&mut progress);
+        progress
+    }
+}
+
+impl ThermalJob {
+    /// The inner job's progress with the repaired route, before the thermal measures.
+    fn base_progress(&self) -> Progress {
         let mut progress = self.inner.progress();
+        if let Some(repaired) = &self.repaired_path {
+            match repaired {
+                Ok(route) => {
+                    progress.upper_bound = Some(self.objective.value(
+                        &self.machine,
+                        route.cut_length(),
+                        route.idle_length(),
+                        route.pierce_count(),
+                    ));
+                    // SCCP's and GSCCP's plan bound holds for any route; AOE's assumes
+                    // every edge cut once, which standard cutting does not.
+                    if self.solver == SolverKind::Aoe {
+                        progress.lower_bound = None;
+                    }
+                    progress.phase = thermal_phase(
+                        std::mem::take(&mut progress.phase),
+                        ThermalNote::RulesEnforcedOnWholeContours,
+                    );
+                    progress.path_route = Some(route.clone());
+                }
+                Err(e) => {
+                    progress.phase = thermal_phase(
+                        std::mem::take(&mut progress.phase),
+                        ThermalNote::RepairFailed { error: e.clone() },
+                    )
+                }
+            }
+        }
         match &self.repaired {
             Some(Ok(route)) if progress.route.as_ref() != Some(route) => {
                 // The solver's bounds are those of the problem without rules: a lower bound on
@@ -404,7 +630,14 @@ impl Job for ThermalJob {
             }
             _ => {}
         }
-        self.measure(&mut progress);
         progress
+    }
+}
+
+/// `base` with a thermal job's note on it.
+fn thermal_phase(base: Phase, note: ThermalNote) -> Phase {
+    Phase::Thermal {
+        base: Box::new(base),
+        note,
     }
 }

@@ -335,6 +335,7 @@ fn stepped_runs_equal_one_shot_runs() {
             },
             start,
             finish,
+            heat: None,
         };
         let one_shot = cutroute_aoe::solve_nest(nest, &options).unwrap();
         assert_eq!(

@@ -164,3 +164,57 @@ fn every_solver_keeps_its_limit_on_a_big_generated_nest() {
     };
     assert_promises_kept("generated-600", &problem, 2.0);
 }
+
+/// The final route's rule check (part, sheet, islands) runs in slices of the job's steps, so
+/// Stop still reaches the job, and it is done within the promise: on 10,000 generated
+/// contours the whole check took 0.37 s in release (BENCHMARKS.md), far more than a slice.
+#[test]
+fn the_final_rule_check_runs_in_short_steps_on_a_large_nest() {
+    let _alone = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let limit_s = 5.0;
+    let request = JobRequest {
+        job_id: 1,
+        problem: Problem::Nest {
+            nest: generate_nest(10_000, 1),
+            start: Point::new(0.0, 0.0),
+            finish: None,
+        },
+        solver: SolverKind::NearestNeighbour,
+        params: SolverParams {
+            time_limit_s: limit_s,
+            thermal: cutroute_protocol::ThermalSettings {
+                rules: cutroute_protocol::RuleSet::ALL,
+                ..Default::default()
+            },
+            ..SolverParams::default()
+        },
+    };
+    let started = Instant::now();
+    let mut job = start_job(&request).expect("starts");
+    let (mut longest_step, mut steps) = (0.0f64, 0);
+    loop {
+        let t = Instant::now();
+        let status = job.step(SLICE);
+        longest_step = longest_step.max(t.elapsed().as_secs_f64());
+        steps += 1;
+        if status == JobStatus::Done {
+            break;
+        }
+    }
+    let wall = started.elapsed().as_secs_f64();
+    let result = job.progress();
+    let counts = result
+        .rule_counts
+        .expect("the final route's rules are checked");
+    assert_eq!(counts.total(), result.violations.len());
+    assert!(
+        counts.part.unwrap() > 0,
+        "a nearest-neighbour route breaks part rigidity"
+    );
+    assert!(
+        longest_step <= LONGEST_STEP_S,
+        "a step took {longest_step:.3} s"
+    );
+    assert!(wall <= limit_s + 1.0, "{wall:.2} s on a {limit_s} s limit");
+    assert!(steps > 3, "the check ran in slices ({steps} steps)");
+}

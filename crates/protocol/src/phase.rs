@@ -67,6 +67,11 @@ pub enum ThermalNote {
         /// Why, in English.
         error: String,
     },
+    /// A path route broke a rule and was replaced by its contours cut whole (standard cutting)
+    /// with the rules enforced.
+    RulesEnforcedOnWholeContours,
+    /// The final rule check was left out: it would have passed the time limit.
+    RulesNotChecked,
 }
 
 /// What a job is doing, with its numbers.
@@ -289,6 +294,16 @@ impl fmt::Display for Phase {
                 ThermalNote::RepairFailed { error } => {
                     write!(f, "{base} · rule repair failed ({error}); route kept")
                 }
+                ThermalNote::RulesEnforcedOnWholeContours => {
+                    write!(
+                        f,
+                        "{base} · rules enforced on whole contours (standard cutting)"
+                    )
+                }
+                ThermalNote::RulesNotChecked => write!(
+                    f,
+                    "{base} · rules not checked: the check would pass the time limit"
+                ),
             },
         }
     }

@@ -16,12 +16,13 @@ pub struct ThermalSettings {
     /// Cooling time τ, s.
     pub tau_s: f64,
     /// The penalty's weight in objective units (s for time, price units for cost) per unit of
-    /// H; nearest, ccp and chain minimise objective + weight·H when it is positive.
+    /// H; nearest, ccp, chain, sccp, gsccp and aoe minimise objective + weight·H when it is
+    /// positive (heuristic and exact price its consecutive terms).
     pub weight: f64,
     /// The rules checked (and reported as violations).
     pub rules: RuleSet,
     /// Whether the final route is repaired until the selected rules hold
-    /// (`cutroute_thermal::enforce_rules`); contour-route solvers only.
+    /// (`cutroute_thermal::enforce_rules`; a path route through its contour route).
     pub hard: bool,
 }
 

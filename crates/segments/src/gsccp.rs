@@ -209,6 +209,7 @@ impl GsccpSearch {
                 time_limit: options.sccp.time_limit.mul_f64(options.ccp_share),
                 seed: options.seed,
                 machine: options.machine,
+                heat: options.sccp.heat.map(|h| h.penalty),
                 ..CcpOptions::default()
             },
         )
@@ -422,8 +423,8 @@ impl GsccpSearch {
         })
     }
 
-    /// The objective's value of a route, if it passes the check (contour cut twice allowed),
-    /// with the length cut twice; else the first problem.
+    /// The objective's value of a route (+ W·H with a heat penalty), if it passes the check
+    /// (contour cut twice allowed), with the length cut twice; else the first problem.
     fn checked(&self, route: &PathRoute) -> Result<(f64, f64), PathRouteError> {
         let mut problems = route.problems(&self.nest, self.tolerance);
         let recut = recut_length(&problems, self.tolerance);
@@ -436,7 +437,11 @@ impl GsccpSearch {
                     route.cut_length(),
                     route.idle_length(),
                     route.pierce_count(),
-                ),
+                ) + self
+                    .options
+                    .sccp
+                    .heat
+                    .map_or(0.0, |heat| heat.objective_penalty(route)),
                 recut,
             )),
         }

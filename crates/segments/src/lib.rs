@@ -57,7 +57,9 @@ pub use gsccp::{
     GsccpStage,
 };
 pub use segment::{Ensemble, EnsembleKind, Segment};
-pub use solver::{solve_sccp, SccpOptions, SccpSearch, SccpSolution, SearchStatus, SOLVE_SLICE};
+pub use solver::{
+    solve_sccp, PathHeat, SccpOptions, SccpSearch, SccpSolution, SearchStatus, SOLVE_SLICE,
+};
 
 use cutroute_geometry::{Contour, Nest, Part, Vertex};
 use thiserror::Error;

@@ -19,7 +19,11 @@ use std::collections::{BinaryHeap, HashMap};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
-use cutroute_geometry::{ContourRef, PathRoute, Point, Route, Span, SplitMix64, ToolOnPath};
+use cutroute_ccp::HeatPenalty;
+use cutroute_geometry::{
+    ContourRef, MachineParameters, PathRoute, Point, Route, Span, SplitMix64, ToolOnPath,
+};
+use cutroute_thermal::path_route_pierces;
 use web_time::Instant;
 
 use crate::segment::{Ensemble, Segment};
@@ -50,6 +54,47 @@ pub struct SccpOptions {
     pub max_shake_strength: usize,
     /// Seed of the shakes.
     pub seed: u64,
+    /// The heat penalty (issue #19): the VNS keeps the order with the least idle + W·H
+    /// rather than the least idle. `None`: idle alone.
+    pub heat: Option<PathHeat>,
+}
+
+/// The heat penalty of a segment search: W·H of a route of tool-on paths, H with one source
+/// per path at its pierce on the route's own machine clock (`path_route_pierces`), W in
+/// objective units per unit of H.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PathHeat {
+    /// σ, τ, W and W's unit.
+    pub penalty: HeatPenalty,
+    /// The time model of the clock H runs on, and the prices that convert W to idle length.
+    pub machine: MachineParameters,
+}
+
+impl PathHeat {
+    /// H of `route`.
+    pub fn load(&self, route: &PathRoute) -> f64 {
+        self.penalty
+            .model
+            .load(&path_route_pierces(route, &self.machine))
+    }
+
+    /// W·H of `route` in objective units (what GSCCP adds to a route's time or cost).
+    pub fn objective_penalty(&self, route: &PathRoute) -> f64 {
+        if self.penalty.weight > 0.0 {
+            self.penalty.weight * self.load(route)
+        } else {
+            0.0
+        }
+    }
+
+    /// W·H of `route` in millimetres of idle travel (what the SCCP search adds to idle).
+    pub fn idle_penalty(&self, route: &PathRoute) -> f64 {
+        if self.penalty.weight > 0.0 {
+            self.penalty.weight_mm(&self.machine) * self.load(route)
+        } else {
+            0.0
+        }
+    }
 }
 
 impl Default for SccpOptions {
@@ -66,6 +111,7 @@ impl Default for SccpOptions {
             max_non_improving_shakes: 100,
             max_shake_strength: 4,
             seed: 1,
+            heat: None,
         }
     }
 }
@@ -185,11 +231,28 @@ impl Search {
     }
 
     fn idle_length(&self) -> f64 {
+        self.idle_length_of(&self.order, &self.place)
+    }
+
+    /// What the VNS minimises: idle length, plus W·H in millimetres with a heat penalty.
+    fn penalised_length(&self) -> f64 {
+        let idle = self.idle_length();
+        match &self.options.heat {
+            Some(heat) => idle + heat.idle_penalty(&self.route()),
+            None => idle,
+        }
+    }
+
+    fn idle_length_of(&self, order: &[usize], place: &[Place]) -> f64 {
         let mut at = self.options.start;
         let mut total = 0.0;
-        for &s in &self.order {
-            total += at.distance(self.entry(s));
-            at = self.exit(s);
+        for &s in order {
+            total += at.distance(entry_point(&self.segments[s], place[s]));
+            at = match place[s] {
+                Place::Closed { point, .. } => point,
+                Place::Open { reversed: false } => self.segments[s].last_point(),
+                Place::Open { reversed: true } => self.segments[s].first_point(),
+            };
         }
         if let Some(f) = self.options.finish {
             total += at.distance(f);
@@ -631,7 +694,8 @@ pub struct SccpSearch {
     started: Instant,
     deadline: Instant,
     rng: SplitMix64,
-    /// The best order kept by the VNS (after the first descent): idle, order, places.
+    /// The best order kept by the VNS (after the first descent): idle (+ W·H with a heat
+    /// penalty), order, places.
     best: Option<(f64, Vec<usize>, Vec<Place>)>,
     initial_idle_length: Option<f64>,
     shakes: usize,
@@ -904,7 +968,7 @@ impl SccpSearch {
             self.initial_idle_length = Some(self.search.idle_length());
         }
         if let Some(best) = self.best.take() {
-            if self.search.idle_length() >= best.0 - self.search.options.delta {
+            if self.search.penalised_length() >= best.0 - self.search.options.delta {
                 self.restore(best);
             }
         }
@@ -920,7 +984,9 @@ impl SccpSearch {
     /// the current order, which only improves).
     pub fn best_idle_length(&self) -> f64 {
         match &self.best {
-            Some(best) if !self.is_finished() => best.0,
+            Some((_, order, place)) if !self.is_finished() => {
+                self.search.idle_length_of(order, place)
+            }
             _ => self.search.idle_length(),
         }
     }
@@ -946,9 +1012,11 @@ impl SccpSearch {
     /// The result: after the end, the final route; before it, the best so far (as if stopped).
     pub fn solution(&self) -> SccpSolution {
         let (route, order, idle_length) = match &self.best {
-            Some((idle, order, place)) if !self.is_finished() => {
-                (self.search.route_of(order, place), order.clone(), *idle)
-            }
+            Some((_, order, place)) if !self.is_finished() => (
+                self.search.route_of(order, place),
+                order.clone(),
+                self.search.idle_length_of(order, place),
+            ),
             _ => (
                 self.search.route(),
                 self.search.order.clone(),
@@ -1049,10 +1117,10 @@ impl SccpSearch {
     }
 
     /// A descent reached its local optimum: the first one becomes the best; after a shake the
-    /// result is kept only if shorter (VNS). Then shake again, or end after
-    /// `max_non_improving_shakes` fruitless shakes in a row.
+    /// result is kept only if shorter (VNS; idle + W·H with a heat penalty). Then shake again,
+    /// or end after `max_non_improving_shakes` fruitless shakes in a row.
     fn descent_done(&mut self) {
-        let length = self.search.idle_length();
+        let length = self.search.penalised_length();
         match self.best.take() {
             None => {
                 self.best = Some((length, self.search.order.clone(), self.search.place.clone()))

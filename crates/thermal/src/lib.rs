@@ -19,6 +19,8 @@
 //!   (the relaxation step of a penalised search).
 //! - [`enforce_rules`]: hard-rule mode as a repair of a finished route (whole parts reordered,
 //!   pierce points moved), reporting what is left.
+//! - [`contour_route_of_paths`]: the rules on routes of tool-on paths (segment and common-edge
+//!   cutting), through the contour route they imply.
 //!
 //! Web-free: it depends on `cutroute-geometry` only, so solvers (CCP-Relax's penalty) and the
 //! app can share it.
@@ -63,14 +65,16 @@
 mod heat;
 mod islands;
 mod layout;
+mod paths;
 mod pierce;
 pub mod rules;
 
 pub use heat::{path_route_pierces, route_pierces, HeatModel, Pierce};
+pub use paths::contour_route_of_paths;
 pub use pierce::relax_pierce_points;
 pub use rules::{
-    admissible_pierce_points, check_rules, enforce_rules, Enforced, RuleCounts, RuleParams,
-    RuleReport, RuleSet, Side, Violation,
+    admissible_pierce_points, check_rules, enforce_rules, Enforced, RuleCheck, RuleCounts,
+    RuleParams, RuleReport, RuleSet, Side, Violation,
 };
 
 /// What can go wrong.

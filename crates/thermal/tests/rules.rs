@@ -320,3 +320,57 @@ fn all_rules_together_and_typed_errors() {
         })
     ));
 }
+
+/// The check in pieces finds exactly what the check in one call finds, whatever the budget.
+#[test]
+fn the_check_in_pieces_equals_the_check_in_one_call() {
+    use cutroute_geometry::{generate_nest, SplitMix64};
+    use cutroute_thermal::RuleCheck;
+    use std::time::Duration;
+    // Part rigidity and islands are the pieces that split; sheet rigidity is one piece (its
+    // violations are tested on the hand-built nests above).
+    let mut kinds_seen = [false; 2];
+    for seed in 1..=4u64 {
+        let nest = generate_nest(2_500 + 500 * seed as usize, seed);
+        let mut refs: Vec<ContourRef> = nest.contour_refs().collect();
+        // Deepest contours first keeps inner before outer; a shuffle within each depth makes
+        // part, sheet and island violations.
+        let forest = nest.containment_forest();
+        let mut rng = SplitMix64::new(seed);
+        for i in (1..refs.len()).rev() {
+            refs.swap(i, rng.below(i as u64 + 1) as usize);
+        }
+        refs.sort_by_key(|&r| std::cmp::Reverse(forest.depth(r).unwrap_or(0)));
+        let route = Route {
+            start: Point::new(0.0, 0.0),
+            steps: refs
+                .iter()
+                .map(|&r| CutStep::pierced(r, nest.contour(r).unwrap().vertices[0].point))
+                .collect(),
+            finish: None,
+        };
+        let whole = check_rules(&nest, &route, RuleSet::ALL, &RuleParams::default()).unwrap();
+        for budget in [Duration::ZERO, Duration::from_millis(5)] {
+            let mut check = RuleCheck::new(RuleSet::ALL, RuleParams::default()).unwrap();
+            let mut calls = 0;
+            let report = loop {
+                calls += 1;
+                if let Some(report) = check.advance(&nest, &route, budget).unwrap() {
+                    break report;
+                }
+            };
+            assert_eq!(report, whole, "seed {seed}, budget {budget:?}");
+            if budget.is_zero() {
+                assert!(calls > 4, "{calls} pieces");
+            }
+        }
+        for v in &whole.violations {
+            match v {
+                Violation::PartRigidity { .. } => kinds_seen[0] = true,
+                Violation::LongPartLate { .. } | Violation::WrongStartSide { .. } => {}
+                Violation::Island { .. } => kinds_seen[1] = true,
+            }
+        }
+    }
+    assert_eq!(kinds_seen, [true, true], "both split rules are exercised");
+}
