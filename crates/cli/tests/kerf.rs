@@ -47,6 +47,22 @@ fn point(v: &Value) -> (f64, f64) {
     (v[0].as_f64().unwrap(), v[1].as_f64().unwrap())
 }
 
+/// The report's idle legs recomputed from its points: start → M₁, every M*ᵢ → Mᵢ₊₁, and
+/// M*ₙ → finish.
+fn legs(report: &Value) -> f64 {
+    let distance = |a: (f64, f64), b: (f64, f64)| (b.0 - a.0).hypot(b.1 - a.1);
+    let mut at = point(&report["start"]);
+    let mut legs = 0.0;
+    for step in report["route"].as_array().unwrap() {
+        legs += distance(at, point(&step["pierce"]));
+        at = point(&step["switch_off"]);
+    }
+    if let Some(finish) = report.get("finish").filter(|f| !f.is_null()) {
+        legs += distance(at, point(finish));
+    }
+    legs
+}
+
 #[test]
 fn with_leads_every_step_carries_pierce_entry_leads_and_switch_off() {
     let file = data("nests/dbs-json/E1X_6_01.dbs.json");
@@ -64,12 +80,8 @@ fn with_leads_every_step_carries_pierce_entry_leads_and_switch_off() {
         let report = json(&args);
         let steps = report["route"].as_array().unwrap();
         assert!(!steps.is_empty());
-        // idle_length is the start leg plus every switch-off → next pierce leg.
-        let mut at = point(&report["start"]);
-        let mut idle = 0.0;
         for step in steps {
             let m = point(&step["pierce"]);
-            idle += (m.0 - at.0).hypot(m.1 - at.1);
             let lead_in = step["lead_in"].as_array().unwrap();
             assert_eq!(point(&lead_in[0]), m, "{solver}: the lead-in starts at M");
             assert_eq!(point(lead_in.last().unwrap()), point(&step["entry"]));
@@ -81,12 +93,9 @@ fn with_leads_every_step_carries_pierce_entry_leads_and_switch_off() {
                 (m.0 - c.0).hypot(m.1 - c.1) >= 5.0 - 1e-6,
                 "{solver}: {m:?} vs {c:?}"
             );
-            at = point(&step["switch_off"]);
         }
-        if let Some(finish) = report.get("finish").filter(|f| !f.is_null()) {
-            let f = point(finish);
-            idle += (f.0 - at.0).hypot(f.1 - at.1);
-        }
+        // idle_length is the start leg plus every switch-off → next pierce leg.
+        let idle = legs(&report);
         let reported = report["idle_length"].as_f64().unwrap();
         assert!(
             (idle - reported).abs() < 1e-6,
@@ -212,17 +221,7 @@ fn tabs_add_a_pierce_and_an_idle_crossing_per_gap() {
         steps.len() + gaps
     );
     // idle = the legs between steps plus the crossings of the gaps.
-    let mut at = point(&report["start"]);
-    let mut legs = 0.0;
-    for step in steps {
-        let m = point(&step["pierce"]);
-        legs += (m.0 - at.0).hypot(m.1 - at.1);
-        at = point(&step["switch_off"]);
-    }
-    if let Some(finish) = report.get("finish").filter(|f| !f.is_null()) {
-        let f = point(finish);
-        legs += (f.0 - at.0).hypot(f.1 - at.1);
-    }
+    let legs = legs(&report);
     let idle = report["idle_length"].as_f64().unwrap();
     assert!(
         (legs + crossing - idle).abs() < 1e-6,

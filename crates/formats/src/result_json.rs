@@ -297,11 +297,13 @@ pub fn route_moves(nest: &Nest, route: &Route) -> Result<Vec<ToolMove>, RouteErr
                 contour,
             })
         };
-        let switch_on = match &cut.leads {
-            Some(leads) => leads.pierce,
+        // Idealised: the contour's own cut, from its point nearest the pierce point round to it.
+        let (switch_on, idealised) = match &cut.leads {
+            Some(leads) => (leads.pierce, Vec::new()),
             None => {
-                cut_from(contour, cut.pierce_point).ok_or(RouteError::EmptyContour { step })?[0]
-                    .point
+                let vertices =
+                    cut_from(contour, cut.pierce_point).ok_or(RouteError::EmptyContour { step })?;
+                (vertices[0].point, vertices)
             }
         };
         match &cut.entry {
@@ -314,9 +316,7 @@ pub fn route_moves(nest: &Nest, route: &Route) -> Result<Vec<ToolMove>, RouteErr
         }
         match &cut.leads {
             None => {
-                let vertices =
-                    cut_from(contour, cut.pierce_point).ok_or(RouteError::EmptyContour { step })?;
-                for w in vertices.windows(2) {
+                for w in idealised.windows(2) {
                     push(
                         MoveKind::Cut,
                         Span::new(w[0].point, w[1].point, w[0].bulge),

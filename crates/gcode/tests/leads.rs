@@ -3,14 +3,23 @@
 
 use cutroute_gcode::{read_gcode, route_gcode, ArcOutput, DistanceMode, GcodeOptions, ReadOptions};
 use cutroute_geometry::{
-    generate_nest, KerfSettings, LeadFitter, LeadShape, LeadSpec, Point, Route, TabSpec, Toolpath,
+    generate_nest, KerfSettings, LeadFitter, LeadShape, LeadSpec, Nest, Point, Route, TabSpec,
+    Toolpath,
 };
+
+/// A generated nest and its baseline route (innermost first) with leads fitted under `settings`,
+/// checked.
+fn routed(contours: usize, seed: u64, settings: KerfSettings) -> (Nest, Route) {
+    let nest = generate_nest(contours, seed);
+    let origin = Point::new(0.0, 0.0);
+    let route = Route::innermost_first(&nest, origin, Some(origin));
+    let route = LeadFitter::new(&nest, settings).attach(&route).unwrap();
+    route.validate(&nest, 1e-6).unwrap();
+    (nest, route)
+}
 
 #[test]
 fn a_route_with_leads_reads_back_with_the_same_lengths_and_pierces() {
-    let nest = generate_nest(40, 11);
-    let origin = Point::new(0.0, 0.0);
-    let route = Route::innermost_first(&nest, origin, Some(origin));
     let settings = KerfSettings {
         kerf: 2.0,
         pierce_clearance: 2.0,
@@ -20,8 +29,7 @@ fn a_route_with_leads_reads_back_with_the_same_lengths_and_pierces() {
         overcut: 0.5,
         ..KerfSettings::default()
     };
-    let route = LeadFitter::new(&nest, settings).attach(&route).unwrap();
-    route.validate(&nest, 1e-6).unwrap();
+    let (nest, route) = routed(40, 11, settings);
     let path = Toolpath::new(&route, &nest).unwrap();
     for distance_mode in [DistanceMode::Absolute, DistanceMode::Incremental] {
         for arcs in [ArcOutput::CentreOffsets, ArcOutput::Radius] {
@@ -58,9 +66,6 @@ fn a_route_with_leads_reads_back_with_the_same_lengths_and_pierces() {
 
 #[test]
 fn tabs_read_back_as_pierces_and_idle_gaps() {
-    let nest = generate_nest(40, 7);
-    let origin = Point::new(0.0, 0.0);
-    let route = Route::innermost_first(&nest, origin, Some(origin));
     let settings = KerfSettings {
         kerf: 2.0,
         pierce_clearance: 2.0,
@@ -73,8 +78,7 @@ fn tabs_read_back_as_pierces_and_idle_gaps() {
         },
         ..KerfSettings::default()
     };
-    let route = LeadFitter::new(&nest, settings).attach(&route).unwrap();
-    route.validate(&nest, 1e-6).unwrap();
+    let (nest, route) = routed(40, 7, settings);
     let tabs: usize = route.steps.iter().map(|s| s.tabs().len()).sum();
     assert!(tabs > 0);
     let options = GcodeOptions {
@@ -96,9 +100,6 @@ fn tabs_read_back_as_pierces_and_idle_gaps() {
 #[test]
 fn controller_compensation_reads_back_as_the_route() {
     use cutroute_gcode::KerfCompensation;
-    let nest = generate_nest(30, 4);
-    let origin = Point::new(0.0, 0.0);
-    let route = Route::innermost_first(&nest, origin, Some(origin));
     let settings = KerfSettings {
         kerf: 2.0,
         pierce_clearance: 3.0,
@@ -108,8 +109,7 @@ fn controller_compensation_reads_back_as_the_route() {
         overcut: 1.0,
         ..KerfSettings::default()
     };
-    let route = LeadFitter::new(&nest, settings).attach(&route).unwrap();
-    route.validate(&nest, 1e-6).unwrap();
+    let (nest, route) = routed(30, 4, settings);
     for (compensation, read) in [
         (KerfCompensation::ControllerDiameter, ReadOptions::default()),
         (
