@@ -136,6 +136,25 @@ pub fn run_heuristic_with_snapshots(
     }
 }
 
+/// The real nest files under `data/nests/{dbs,dbs-json,dxf,svg,tflex}`, each folder in name
+/// order, with their file names: the nests the benchmarks run on.
+pub fn real_nest_files(data: &std::path::Path) -> Vec<(String, std::path::PathBuf)> {
+    let mut files = Vec::new();
+    for dir in ["dbs", "dbs-json", "dxf", "svg", "tflex"] {
+        let Ok(entries) = std::fs::read_dir(data.join("nests").join(dir)) else {
+            continue;
+        };
+        let mut paths: Vec<std::path::PathBuf> =
+            entries.filter_map(|e| e.ok().map(|e| e.path())).collect();
+        paths.sort();
+        files.extend(paths.into_iter().filter_map(|path| {
+            let name = path.file_name()?.to_string_lossy().to_string();
+            Some((name, path))
+        }));
+    }
+    files
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

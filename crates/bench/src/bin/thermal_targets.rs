@@ -42,30 +42,22 @@ struct Input {
 
 fn inputs(data: &Path, filter: &Option<Vec<String>>) -> Vec<Input> {
     let mut inputs = Vec::new();
-    for dir in ["dbs", "dbs-json", "dxf", "svg", "tflex"] {
-        let Ok(entries) = std::fs::read_dir(data.join("nests").join(dir)) else {
+    for (name, path) in cutroute_bench::real_nest_files(data) {
+        if filter
+            .as_ref()
+            .is_some_and(|f| !f.iter().any(|n| name.contains(n.as_str())))
+        {
             continue;
-        };
-        let mut paths: Vec<PathBuf> = entries.filter_map(|e| e.ok().map(|e| e.path())).collect();
-        paths.sort();
-        for path in paths {
-            let name = path.file_name().unwrap().to_string_lossy().to_string();
-            if filter
-                .as_ref()
-                .is_some_and(|f| !f.iter().any(|n| name.contains(n.as_str())))
-            {
-                continue;
-            }
-            let bytes = std::fs::read(&path).expect("readable");
-            if let Ok(document) = open_document(&name, &bytes) {
-                if let Problem::Nest { nest, .. } = &document.problem {
-                    if nest.contour_count() >= 2 {
-                        inputs.push(Input {
-                            name,
-                            nest: nest.clone(),
-                            problem: document.problem,
-                        });
-                    }
+        }
+        let bytes = std::fs::read(&path).expect("readable");
+        if let Ok(document) = open_document(&name, &bytes) {
+            if let Problem::Nest { nest, .. } = &document.problem {
+                if nest.contour_count() >= 2 {
+                    inputs.push(Input {
+                        name,
+                        nest: nest.clone(),
+                        problem: document.problem,
+                    });
                 }
             }
         }

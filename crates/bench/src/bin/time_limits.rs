@@ -38,25 +38,17 @@ struct Input {
 
 fn nest_inputs(data: &std::path::Path, generated: &[usize]) -> Vec<Input> {
     let mut inputs = Vec::new();
-    for dir in ["dbs", "dbs-json", "dxf", "svg", "tflex"] {
-        let Ok(entries) = std::fs::read_dir(data.join("nests").join(dir)) else {
-            continue;
-        };
-        let mut paths: Vec<PathBuf> = entries.filter_map(|e| e.ok().map(|e| e.path())).collect();
-        paths.sort();
-        for path in paths {
-            let name = path.file_name().unwrap().to_string_lossy().to_string();
-            let bytes = std::fs::read(&path).expect("readable");
-            match open_document(&name, &bytes) {
-                Ok(document) if matches!(document.problem, Problem::Nest { .. }) => {
-                    inputs.push(Input {
-                        name,
-                        problem: document.problem,
-                    })
-                }
-                Ok(_) => {}
-                Err(e) => eprintln!("{name}: not opened ({e})"),
+    for (name, path) in cutroute_bench::real_nest_files(data) {
+        let bytes = std::fs::read(&path).expect("readable");
+        match open_document(&name, &bytes) {
+            Ok(document) if matches!(document.problem, Problem::Nest { .. }) => {
+                inputs.push(Input {
+                    name,
+                    problem: document.problem,
+                })
             }
+            Ok(_) => {}
+            Err(e) => eprintln!("{name}: not opened ({e})"),
         }
     }
     for &n in generated {
