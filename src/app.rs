@@ -17,7 +17,7 @@ use crate::drawing::{
 };
 use crate::export::ExportMenu;
 use crate::i18n::{tr, use_language, Lang};
-use crate::pan_zoom::PanZoom;
+use crate::pan_zoom::{fitted_view, PanZoom, ViewBox};
 use crate::settings::{objective_from_name, Layer, Settings};
 use crate::stats::{AlternativesTable, StatsPanel};
 use crate::thermal::{HeatMapLayer, ThermalPanel, ThermalStats, ThermalView, ViolationMarks};
@@ -1216,23 +1216,12 @@ fn NestView(
             None
         };
         match (nest_box, paths_box) {
-            (Some([a, b, c, d]), Some([e, f, g, h])) => {
-                Some([a.min(e), b.min(f), c.max(g), d.max(h)])
-            }
+            (Some(n), Some(p)) => Some(n.union(p)),
             (n, p) => n.or(p),
         }
-        .map(|[x0, y0, x1, y1]| {
-            let margin = ((x1 - x0).max(y1 - y0) * 0.03).max(1.0);
-            // The group below flips y, so the box spans [-y1, -y0] vertically.
-            [
-                x0 - margin,
-                -y1 - margin,
-                x1 - x0 + 2.0 * margin,
-                y1 - y0 + 2.0 * margin,
-            ]
-        })
+        .map(fitted_view)
     });
-    let fit: Signal<Option<[f64; 4]>> = Signal::from(fit);
+    let fit: Signal<Option<ViewBox>> = Signal::from(fit);
     // Size of the drawing: fixed-size marks (arrows, dots, numbers) scale with it.
     let extent = Memo::new(move |_| fit.get().map_or(100.0, |f| f[2].max(f[3])));
     let pan_zoom = PanZoom::new(fit);

@@ -6,24 +6,19 @@ use cutroute_geometry::{
     BoundingBox, Contour, Nest, PathRoute, Point, Route, Span, ToolMove, Toolpath,
 };
 
-/// Axis-aligned box `[min_x, min_y, max_x, max_y]` of everything worth showing.
-pub fn nest_bounds(nest: &Nest) -> Option<[f64; 4]> {
-    let mut bounds: Option<[f64; 4]> = None;
-    let parts = nest.sheet.iter().chain(nest.parts.iter());
-    for vertex in parts
-        .flat_map(|p| p.contours.iter())
-        .flat_map(|c| c.vertices.iter())
-    {
-        let Point { x, y } = vertex.point;
-        if !(x.is_finite() && y.is_finite()) {
-            continue;
-        }
-        bounds = Some(match bounds {
-            None => [x, y, x, y],
-            Some([a, b, c, d]) => [a.min(x), b.min(y), c.max(x), d.max(y)],
-        });
-    }
-    bounds
+/// The box of everything worth showing: every finite vertex of the sheet and the parts (`None`
+/// when there is none).
+pub fn nest_bounds(nest: &Nest) -> Option<BoundingBox> {
+    let bounds = BoundingBox::from_points(
+        nest.sheet
+            .iter()
+            .chain(nest.parts.iter())
+            .flat_map(|p| p.contours.iter())
+            .flat_map(|c| c.vertices.iter())
+            .map(|v| v.point)
+            .filter(|p| p.x.is_finite() && p.y.is_finite()),
+    );
+    (!bounds.is_empty()).then_some(bounds)
 }
 
 /// Appends the drawing command of one span (the pen is at its start); arcs are split so no
@@ -252,12 +247,12 @@ pub fn path_route_toolpath(route: &PathRoute, nest: &Nest) -> Toolpath {
 }
 
 /// Box `[min_x, min_y, max_x, max_y]` of everything a toolpath draws (`None` if empty).
-pub fn toolpath_bounds(toolpath: &Toolpath) -> Option<[f64; 4]> {
+pub fn toolpath_bounds(toolpath: &Toolpath) -> Option<BoundingBox> {
     let mut bounds = BoundingBox::from_corners(toolpath.start, toolpath.start);
     for m in &toolpath.moves {
         bounds = bounds.union(move_box(m));
     }
-    (!toolpath.moves.is_empty()).then_some([bounds.min.x, bounds.min.y, bounds.max.x, bounds.max.y])
+    (!toolpath.moves.is_empty()).then_some(bounds)
 }
 
 /// Consecutive moves of a toolpath drawn as one path element: the animation shows the
@@ -725,7 +720,13 @@ mod tests {
     fn a_nest_with_nothing_to_draw_is_fitted_to_the_toolpath() {
         let (_, route) = common_edge_route();
         let toolpath = Toolpath::from_path_route(&route);
-        assert_eq!(toolpath_bounds(&toolpath), Some([0.0, -10.0, 40.0, 20.0]));
+        assert_eq!(
+            toolpath_bounds(&toolpath),
+            Some(BoundingBox::from_corners(
+                Point::new(0.0, -10.0),
+                Point::new(40.0, 20.0)
+            ))
+        );
         // With no contours there is nothing to follow: no move is called a link.
         let bare = path_route_toolpath(&route, &Nest::default());
         assert_eq!(bare.link_length(), 0.0);
@@ -752,16 +753,16 @@ pub struct HeatFrame {
 }
 
 /// The temperature field of `sources` (in time order) at machine time `t`, sampled at the
-/// centres of square cells over `bounds` (`[min_x, min_y, max_x, max_y]`), `cells_across` along
+/// centres of square cells over `bounds`, `cells_across` along
 /// its longer side.
 pub fn heat_frame(
     model: &cutroute_thermal::HeatModel,
     sources: &[cutroute_thermal::Pierce],
-    bounds: [f64; 4],
+    bounds: BoundingBox,
     t: f64,
     cells_across: usize,
 ) -> HeatFrame {
-    let [x0, y0, x1, y1] = bounds;
+    let (Point { x: x0, y: y0 }, Point { x: x1, y: y1 }) = (bounds.min, bounds.max);
     let side = (x1 - x0).max(y1 - y0) / cells_across.max(1) as f64;
     if !(side > 0.0 && side.is_finite()) {
         return HeatFrame::default();
@@ -808,7 +809,7 @@ mod heat_tests {
             point: Point::new(5.0, 5.0),
             time: 10.0,
         }];
-        let bounds = [0.0, 0.0, 100.0, 50.0];
+        let bounds = BoundingBox::from_corners(Point::new(0.0, 0.0), Point::new(100.0, 50.0));
         let before = heat_frame(&model, &sources, bounds, 5.0, 20);
         assert_eq!(before.sum, 0.0, "nothing switched on yet");
         assert!(before.levels.is_empty());

@@ -19,12 +19,27 @@
 use std::collections::HashMap;
 use std::time::Duration;
 
+use cutroute_geometry::BoundingBox;
 use leptos::prelude::*;
 use wasm_bindgen::JsCast;
 use web_sys::{KeyboardEvent, PointerEvent, SvgGraphicsElement, WheelEvent};
 
-/// A view box `[x, y, width, height]`.
+/// An SVG `viewBox` `[x, y, width, height]` in the drawing's flipped frame (y down). Boxes of
+/// the model are geometry's `BoundingBox`; `fitted_view` is where one becomes the other.
 pub type ViewBox = [f64; 4];
+
+/// The view box that shows `bounds` (model coordinates, y up) with a margin of 3 % of its longer
+/// side (at least 1 mm). The drawing's group flips y, so the box spans [−max.y, −min.y].
+pub fn fitted_view(bounds: BoundingBox) -> ViewBox {
+    let (width, height) = (bounds.width(), bounds.height());
+    let margin = (width.max(height) * 0.03).max(1.0);
+    [
+        bounds.min.x - margin,
+        -bounds.max.y - margin,
+        width + 2.0 * margin,
+        height + 2.0 * margin,
+    ]
+}
 
 /// Zoom factor of one key press.
 const KEY_ZOOM: f64 = 1.25;
@@ -361,7 +376,19 @@ fn target_svg<E: AsRef<web_sys::Event>>(ev: &E) -> Option<SvgGraphicsElement> {
 
 #[cfg(test)]
 mod tests {
-    use super::{gesture_transform, zoom_about, LiveMapping};
+    use super::{fitted_view, gesture_transform, zoom_about, LiveMapping, ViewBox};
+    use cutroute_geometry::{BoundingBox, Point};
+
+    #[test]
+    fn the_fitted_view_flips_y_and_keeps_a_margin() {
+        // A 100 × 50 box whose top edge is at y = 60: 3 mm margin, y flipped.
+        let bounds = BoundingBox::from_corners(Point::new(10.0, 10.0), Point::new(110.0, 60.0));
+        assert_eq!(fitted_view(bounds), [7.0, -63.0, 106.0, 56.0]);
+        // A tiny box still gets a 1 mm margin.
+        let dot = BoundingBox::from_corners(Point::new(0.0, 0.0), Point::new(2.0, 1.0));
+        let view: ViewBox = fitted_view(dot);
+        assert_eq!(view, [-1.0, -2.0, 4.0, 3.0]);
+    }
 
     #[test]
     fn zoom_keeps_the_anchor_point_fixed() {

@@ -311,7 +311,10 @@ pub fn HeatMapLayer(
                 // What a test needs to recompute the field: the exact clock time, the sampled
                 // rectangle and its cells across, and the colour levels' thresholds.
                 data-time=format!("{t}")
-                data-grid=format!("{} {} {} {} {HEAT_CELLS_ACROSS}", bounds[0], bounds[1], bounds[2], bounds[3])
+                data-grid=format!(
+                    "{} {} {} {} {HEAT_CELLS_ACROSS}",
+                    bounds.min.x, bounds.min.y, bounds.max.x, bounds.max.y
+                )
                 data-levels=crate::drawing::HEAT_LEVELS.map(|l| l.to_string()).join(" ")
                 data-max=format!("{:.6}", frame.max)
                 data-sum=format!("{:.6}", frame.sum)
