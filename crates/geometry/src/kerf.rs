@@ -109,7 +109,15 @@ pub fn equidistant(contour: &Contour, distance: f64) -> Result<Contour, OffsetEr
             break;
         }
     }
-    let mut loops = loops.ok_or(OffsetError::Failed { distance })?;
+    // Corners drawn as runs of tiny segments can leave degenerate loops of zero area beside
+    // the real one (a 17 mm slot of seven.dbs came back in three pieces at 1 mm: the slot and
+    // two 2-vertex loops); they enclose nothing and are no part of the tool's path.
+    let degenerate = 1e-12 * scale * scale;
+    let mut loops: Vec<Polyline<f64>> = loops
+        .ok_or(OffsetError::Failed { distance })?
+        .into_iter()
+        .filter(|l| from_polyline(l).area().abs() > degenerate)
+        .collect();
     match loops.len() {
         0 => Err(OffsetError::Vanishes { distance }),
         1 => Ok(from_polyline(&loops.remove(0))),
