@@ -27,17 +27,7 @@ impl<const W: usize> Key<W> {
     /// The clusters in the set, in increasing order.
     #[inline]
     pub fn ones(&self) -> impl Iterator<Item = usize> + '_ {
-        (0..W).flat_map(move |i| {
-            let mut w = self.0[i];
-            std::iter::from_fn(move || {
-                if w == 0 {
-                    return None;
-                }
-                let bit = w.trailing_zeros() as usize;
-                w &= w - 1;
-                Some(i * 64 + bit)
-            })
-        })
+        crate::order::set_bits(&self.0)
     }
     #[inline]
     pub fn contains_all(&self, other: &Self) -> bool {
