@@ -10,7 +10,7 @@
 
 use std::collections::HashMap;
 
-use cutroute_geometry::{BoundingBox, Contour, Part, Point, Span, Transform, Vertex};
+use cutroute_geometry::{BoundingBox, Contour, Nest, Part, Point, Span, Transform, Vertex};
 
 /// Where a piece of geometry came from in the file.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -89,6 +89,59 @@ pub(crate) struct Assembled {
     pub parts: Vec<Part>,
     pub open_chains: Vec<OpenChain>,
     pub dropped: Vec<Dropped>,
+}
+
+/// The result of a drawing import (DXF, SVG), with the reader's own kind of warning.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DrawingImport<W> {
+    /// The closed parts found, and the sheet when the drawing marks one. Outer contours run
+    /// clockwise, holes counter-clockwise, in millimetres with y up; a contour inside a hole
+    /// starts a new part.
+    pub nest: Nest,
+    /// Chains of pieces that did not close within the join tolerance, with their end points.
+    pub open_chains: Vec<OpenChain>,
+    /// What was skipped or approximated without failing.
+    pub warnings: Vec<W>,
+}
+
+/// The drawing yields no closed contour: how many chains stayed open, and the first described.
+pub(crate) struct NothingClosed {
+    pub open: usize,
+    pub first: String,
+}
+
+/// The last step of every drawing import: assembles the parts' pieces into a nest with
+/// `sheet`, appending the contours dropped on the way to `warnings` (made by `warning`). With
+/// no closed contour the error describes the first open chain, or — without one —
+/// `nothing_drawn` says why from the warnings.
+pub(crate) fn finish_import<W>(
+    pieces: Vec<Piece>,
+    sheet: Option<Part>,
+    limits: &AssembleLimits,
+    mut warnings: Vec<W>,
+    warning: impl Fn(Dropped) -> W,
+    nothing_drawn: impl FnOnce(&[W]) -> String,
+) -> Result<DrawingImport<W>, NothingClosed> {
+    let assembled = assemble(pieces, limits);
+    warnings.extend(assembled.dropped.into_iter().map(warning));
+    if assembled.parts.is_empty() {
+        let first = match assembled.open_chains.first() {
+            Some(chain) => chain.to_string(),
+            None => nothing_drawn(&warnings),
+        };
+        return Err(NothingClosed {
+            open: assembled.open_chains.len(),
+            first,
+        });
+    }
+    Ok(DrawingImport {
+        nest: Nest {
+            sheet,
+            parts: assembled.parts,
+        },
+        open_chains: assembled.open_chains,
+        warnings,
+    })
 }
 
 /// Most live candidates examined per end-point search: bounds the work on hostile piles of

@@ -42,4 +42,4 @@ pub mod dxf;
 pub mod svg;
 pub mod tflex;
 
-pub use assemble::{EntityRef, OpenChain};
+pub use assemble::{DrawingImport, EntityRef, OpenChain};

@@ -1,5 +1,5 @@
 //! SVG import: nests drawn as SVG (what DeepNest and SVGnest write, and cutroute's own export)
-//! → a [`Nest`] of closed parts plus a report.
+//! → a [`Nest`](cutroute_geometry::Nest) of closed parts plus a report.
 //!
 //! What becomes geometry: `<path>` (every command of SVG 1.1, `M L H V C S Q T A Z`, absolute
 //! and relative), `<polyline>`, `<polygon>`, `<rect>` (rounded corners too), `<circle>`,
@@ -49,10 +49,12 @@
 //! ```
 
 use cutroute_geometry::float::Libm;
-use cutroute_geometry::{Nest, Point, Span, Transform};
+use cutroute_geometry::{Point, Span, Transform};
 use roxmltree::{Document, Node};
 
-use crate::assemble::{assemble, is_bounded, AssembleLimits, EntityRef, OpenChain, Piece};
+use crate::assemble::{
+    assemble, finish_import, is_bounded, AssembleLimits, DrawingImport, EntityRef, Piece,
+};
 use crate::curves::{approximate, elliptic_spans, ApproxFailure, EllipticArc, Nurbs};
 
 /// Deepest nesting of elements followed; deeper content is refused (hostile input).
@@ -111,17 +113,9 @@ impl std::fmt::Display for SvgWarning {
     }
 }
 
-/// The result of an SVG import.
-#[derive(Clone, Debug, PartialEq)]
-pub struct SvgImport {
-    /// The closed parts found, and the sheet when an element is marked as one. Outer contours
-    /// run clockwise, holes counter-clockwise, in millimetres with y up.
-    pub nest: Nest,
-    /// Chains of open subpaths that did not close within the join tolerance.
-    pub open_chains: Vec<OpenChain>,
-    /// What was skipped or approximated without failing.
-    pub warnings: Vec<SvgWarning>,
-}
+/// The result of an SVG import: the closed parts and the sheet when an element is marked as
+/// one, the open chains of subpaths, and the warnings.
+pub type SvgImport = DrawingImport<SvgWarning>;
 
 /// Why an SVG file could not be imported. `line`/`column` are 1-based positions in the file.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -278,30 +272,23 @@ pub fn read_svg(bytes: &[u8], options: &SvgOptions) -> Result<SvgImport, SvgErro
         }
         sheet
     };
-    let assembled = assemble(part_pieces, &limits);
-    warnings.extend(assembled.dropped.into_iter().map(|d| SvgWarning {
+    let dropped = |d: crate::assemble::Dropped| SvgWarning {
         line: u32::try_from(d.line).unwrap_or(u32::MAX),
         column: 0,
         message: d.message,
-    }));
-    if assembled.parts.is_empty() {
-        let first = assembled
-            .open_chains
-            .first()
-            .map(|c| c.to_string())
-            .unwrap_or_else(|| "nothing drawn".to_owned());
-        return Err(SvgError::NothingClosed {
-            open: assembled.open_chains.len(),
-            first,
-        });
-    }
-    Ok(SvgImport {
-        nest: Nest {
-            sheet,
-            parts: assembled.parts,
-        },
-        open_chains: assembled.open_chains,
+    };
+    let nothing_drawn = |_: &[SvgWarning]| "nothing drawn".to_owned();
+    finish_import(
+        part_pieces,
+        sheet,
+        &limits,
         warnings,
+        dropped,
+        nothing_drawn,
+    )
+    .map_err(|e| SvgError::NothingClosed {
+        open: e.open,
+        first: e.first,
     })
 }
 

@@ -11,7 +11,7 @@
 use std::fmt::Write as _;
 
 use cutroute_geometry::{
-    MachineParameters, Nest, Point, Route, RouteError, ToolClock, ToolMove, Toolpath,
+    BoundingBox, MachineParameters, Nest, Point, Route, RouteError, ToolClock, ToolMove, Toolpath,
 };
 use svg::node::element::path::Data;
 use svg::node::element::{Circle, Group, Path, Title};
@@ -188,7 +188,7 @@ pub fn toolpath_html(
 ) -> String {
     let machine = &options.machine;
     let clock = ToolClock::new(toolpath, machine);
-    let (lo, hi) = extent(nest, toolpath);
+    let BoundingBox { min: lo, max: hi } = extent(nest, toolpath);
     let side = (hi.x - lo.x).max(hi.y - lo.y).max(1e-9);
     let margin = side * options.margin.max(0.0);
     let marker = side * options.marker_radius.max(0.0);
@@ -429,7 +429,7 @@ fn samples_json(toolpath: &Toolpath, clock: &ToolClock) -> String {
     out
 }
 
-fn extent(nest: &Nest, toolpath: &Toolpath) -> (Point, Point) {
+fn extent(nest: &Nest, toolpath: &Toolpath) -> BoundingBox {
     crate::svg_export::drawing_extent(
         nest,
         std::iter::once(toolpath.start).chain(toolpath.moves.iter().map(ToolMove::end)),

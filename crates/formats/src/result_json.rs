@@ -13,8 +13,8 @@
 
 use cutroute_geometry::float::Libm;
 use cutroute_geometry::{
-    chain_spans, opened_at, Contour, ContourRef, CutStep, Entry, Nest, Part, Point, Route, Span,
-    StepLeads, Tab, Vertex,
+    chain_spans, opened_at, BoundingBox, Contour, ContourRef, CutStep, Entry, Nest, Part, Point,
+    Route, Span, StepLeads, Tab, Vertex,
 };
 use serde::{Deserialize, Serialize};
 
@@ -727,34 +727,23 @@ type PartGroup = (i64, Option<String>, Vec<(i64, cutroute_geometry::Contour)>);
 
 /// A clockwise rectangle around every part, used as `list` when the nest has no sheet.
 fn bounding_rectangle(nest: &Nest) -> Vec<[f64; 3]> {
-    let mut b = [
-        f64::INFINITY,
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-        f64::NEG_INFINITY,
-    ];
-    for v in nest
-        .parts
-        .iter()
-        .flat_map(|p| &p.contours)
-        .flat_map(|c| &c.vertices)
-    {
-        b = [
-            b[0].min(v.point.x),
-            b[1].min(v.point.y),
-            b[2].max(v.point.x),
-            b[3].max(v.point.y),
-        ];
+    let mut b = BoundingBox::from_points(
+        nest.parts
+            .iter()
+            .flat_map(|p| &p.contours)
+            .flat_map(|c| &c.vertices)
+            .map(|v| v.point),
+    );
+    if !b.min.x.is_finite() {
+        b = BoundingBox::from_corners(Point::ORIGIN, Point::ORIGIN);
     }
-    if !b[0].is_finite() {
-        b = [0.0; 4];
-    }
+    let (lo, hi) = (b.min, b.max);
     vec![
-        [b[0], b[1], 0.0],
-        [b[0], b[3], 0.0],
-        [b[2], b[3], 0.0],
-        [b[2], b[1], 0.0],
-        [b[0], b[1], 0.0],
+        [lo.x, lo.y, 0.0],
+        [lo.x, hi.y, 0.0],
+        [hi.x, hi.y, 0.0],
+        [hi.x, lo.y, 0.0],
+        [lo.x, lo.y, 0.0],
     ]
 }
 

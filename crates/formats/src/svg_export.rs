@@ -7,7 +7,7 @@
 //! `cut`, `link` (chain cutting's tool-on links between contours), `lead` (lead-in/out),
 //! `pierce`, `start`, `finish`.
 
-use cutroute_geometry::{Contour, Nest, Part, Point, Span};
+use cutroute_geometry::{BoundingBox, Contour, Nest, Part, Point, Span};
 use svg::node::element::path::Data;
 use svg::node::element::{Circle, Group, Path, Style, Title};
 use svg::Document;
@@ -49,7 +49,7 @@ impl Default for SvgOptions {
 
 /// Renders a nest, and the tool moves when given, as a standalone SVG document.
 pub fn nest_svg(nest: &Nest, moves: Option<&[ToolMove]>, options: &SvgOptions) -> String {
-    let (min, max) = drawing_extent(
+    let BoundingBox { min, max } = drawing_extent(
         nest,
         moves.unwrap_or(&[]).iter().flat_map(|m| [m.from, m.to]),
     );
@@ -192,35 +192,24 @@ fn route_group(moves: &[ToolMove], marker: f64) -> Group {
 
 /// Bounding box of everything drawn: the nest's contours (arc zeniths included) and `points`
 /// (the route's); a unit box when nothing finite is drawn.
-pub(crate) fn drawing_extent(
-    nest: &Nest,
-    points: impl IntoIterator<Item = Point>,
-) -> (Point, Point) {
-    let mut lo = Point::new(f64::INFINITY, f64::INFINITY);
-    let mut hi = Point::new(f64::NEG_INFINITY, f64::NEG_INFINITY);
-    let mut add = |p: Point| {
-        if p.x.is_finite() && p.y.is_finite() {
-            lo = Point::new(lo.x.min(p.x), lo.y.min(p.y));
-            hi = Point::new(hi.x.max(p.x), hi.y.max(p.y));
-        }
-    };
-    for contour in nest
+pub(crate) fn drawing_extent(nest: &Nest, points: impl IntoIterator<Item = Point>) -> BoundingBox {
+    let corners = nest
         .sheet
         .iter()
         .chain(&nest.parts)
         .flat_map(|p| &p.contours)
-    {
-        let b = contour.bounding_box();
-        if !b.is_empty() {
-            add(b.min);
-            add(b.max);
-        }
+        .map(Contour::bounding_box)
+        .filter(|b| !b.is_empty())
+        .flat_map(|b| [b.min, b.max]);
+    let extent = BoundingBox::from_points(
+        corners
+            .chain(points)
+            .filter(|p| p.x.is_finite() && p.y.is_finite()),
+    );
+    if extent.is_empty() {
+        return BoundingBox::from_corners(Point::default(), Point::new(1.0, 1.0));
     }
-    points.into_iter().for_each(add);
-    if !lo.x.is_finite() {
-        return (Point::default(), Point::new(1.0, 1.0));
-    }
-    (lo, hi)
+    extent
 }
 
 #[cfg(test)]

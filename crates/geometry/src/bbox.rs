@@ -109,6 +109,14 @@ impl BoundingBox {
         !other.is_empty() && self.contains_point(other.min) && self.contains_point(other.max)
     }
 
+    /// The least distance from `p` to a point of the closed box (0 inside; infinite for the
+    /// empty box): a lower bound on the distance from `p` to any shape the box contains.
+    pub fn distance_to_point(&self, p: Point) -> f64 {
+        let dx = (self.min.x - p.x).max(p.x - self.max.x).max(0.0);
+        let dy = (self.min.y - p.y).max(p.y - self.max.y).max(0.0);
+        dx.hypot_libm(dy)
+    }
+
     /// The least distance between a point of this box and a point of `other` (0 when they
     /// overlap; infinite when either is empty): a lower bound on the distance between any
     /// shapes they contain.

@@ -1,6 +1,9 @@
-//! Affine maps of the plane: rotation, reflection, scaling and translation of parts.
+//! Affine maps of the plane: rotation, reflection, scaling and translation of parts. The
+//! linear algebra (products, determinants, inverses) is nalgebra's; the map keeps its plain
+//! row-major fields so readers build it from file records and serde writes it as numbers.
 
 use crate::float::Libm;
+use nalgebra::{Matrix2, Vector2};
 use serde::{Deserialize, Serialize};
 
 use crate::Point;
@@ -89,10 +92,26 @@ impl Transform {
         }
     }
 
+    /// The linear part as a nalgebra matrix.
+    fn linear(&self) -> Matrix2<f64> {
+        let m = &self.matrix;
+        Matrix2::new(m[0][0], m[0][1], m[1][0], m[1][1])
+    }
+
+    /// The map with linear part `linear` and translation `offset`.
+    fn from_linear(linear: &Matrix2<f64>, offset: Point) -> Transform {
+        Transform {
+            matrix: [
+                [linear[(0, 0)], linear[(0, 1)]],
+                [linear[(1, 0)], linear[(1, 1)]],
+            ],
+            offset,
+        }
+    }
+
     /// Determinant of the matrix; negative for a reflection.
     pub fn determinant(&self) -> f64 {
-        let m = &self.matrix;
-        m[0][0] * m[1][1] - m[0][1] * m[1][0]
+        self.linear().determinant()
     }
 
     /// True when the map mirrors the plane (negative determinant), reversing arc orientation.
@@ -104,10 +123,11 @@ impl Transform {
     /// any translation): the matrix's columns are orthogonal and of equal length, within 10⁻⁹
     /// of their squared length. A singular map is not a similarity.
     pub fn is_similarity(&self) -> bool {
-        let m = &self.matrix;
-        let col1 = m[0][0] * m[0][0] + m[1][0] * m[1][0];
-        let col2 = m[0][1] * m[0][1] + m[1][1] * m[1][1];
-        let dot = m[0][0] * m[0][1] + m[1][0] * m[1][1];
+        let linear = self.linear();
+        let (first, second) = (linear.column(0), linear.column(1));
+        let col1 = first.norm_squared();
+        let col2 = second.norm_squared();
+        let dot = first.dot(&second);
         let scale = col1.max(col2);
         scale > 0.0 && (col1 - col2).abs() <= 1e-9 * scale && dot.abs() <= 1e-9 * scale
     }
@@ -119,49 +139,25 @@ impl Transform {
 
     /// The image of a direction vector (the matrix only, no offset).
     pub fn apply_vector(&self, v: Point) -> Point {
-        let m = &self.matrix;
-        Point::new(m[0][0] * v.x + m[0][1] * v.y, m[1][0] * v.x + m[1][1] * v.y)
+        let image = self.linear() * Vector2::new(v.x, v.y);
+        Point::new(image.x, image.y)
     }
 
     /// The map "first `self`, then `next`".
     pub fn then(&self, next: &Transform) -> Transform {
-        let a = &next.matrix;
-        let b = &self.matrix;
-        let matrix = [
-            [
-                a[0][0] * b[0][0] + a[0][1] * b[1][0],
-                a[0][0] * b[0][1] + a[0][1] * b[1][1],
-            ],
-            [
-                a[1][0] * b[0][0] + a[1][1] * b[1][0],
-                a[1][0] * b[0][1] + a[1][1] * b[1][1],
-            ],
-        ];
-        Transform {
-            matrix,
-            offset: next.apply(self.offset),
-        }
+        Transform::from_linear(&(next.linear() * self.linear()), next.apply(self.offset))
     }
 
     /// The inverse map, or `None` when the matrix is singular (or not finite).
     pub fn inverse(&self) -> Option<Transform> {
-        let det = self.determinant();
-        if det == 0.0 || !det.is_finite() {
+        if !self.determinant().is_finite() {
             return None;
         }
-        let m = &self.matrix;
-        let inv = 1.0 / det;
-        let matrix = [
-            [m[1][1] * inv, -m[0][1] * inv],
-            [-m[1][0] * inv, m[0][0] * inv],
-        ];
-        let linear = Transform {
-            matrix,
-            offset: Point::ORIGIN,
-        };
-        Some(Transform {
-            matrix,
-            offset: -linear.apply_vector(self.offset),
-        })
+        let inverse = self.linear().try_inverse()?;
+        let linear = Transform::from_linear(&inverse, Point::ORIGIN);
+        Some(Transform::from_linear(
+            &inverse,
+            -linear.apply_vector(self.offset),
+        ))
     }
 }

@@ -165,6 +165,18 @@ proptest! {
     }
 
     #[test]
+    fn box_distance_to_a_point_is_the_clamped_distance_and_bounds_the_span(s in span(), q in point()) {
+        let b = s.bounding_box();
+        let clamped = Point::new(q.x.clamp(b.min.x, b.max.x), q.y.clamp(b.min.y, b.max.y));
+        let d = b.distance_to_point(q);
+        prop_assert!((d - q.distance(clamped)).abs() <= 1e-12 * (1.0 + d));
+        let eps = 1e-9 * (1.0 + s.length());
+        prop_assert!(samples(&s, 64).iter().all(|p| d <= q.distance(*p) + eps));
+        prop_assert_eq!(b.distance_to_point(b.centre()), 0.0);
+        prop_assert!(cutroute_geometry::BoundingBox::EMPTY.distance_to_point(q).is_infinite());
+    }
+
+    #[test]
     fn split_then_merge_is_identity(s in span(), t in 0.01..0.99f64) {
         let (a, b) = s.split_at(t);
         prop_assert!((a.length() + b.length() - s.length()).abs() < 1e-9 * s.length().max(1.0));

@@ -8,10 +8,11 @@
 //! fewest-children first. It shares the bound code with the DP, which is usually faster; this
 //! variant exists for comparison and for the record of the dissertation's two algorithms.
 
-use crate::bounds::{Model, ResidualBounder};
+use crate::bounds::residual::ResidualBounder;
 use crate::check::check_tour;
 use crate::heuristic::best_nodes;
 use crate::instance::Instance;
+use crate::model::Model;
 use crate::order::ClusterSet;
 use crate::solver::{ExactProgress, ExactResult, SolverError, SolverStatus};
 use std::collections::{HashMap, VecDeque};

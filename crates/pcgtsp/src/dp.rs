@@ -10,53 +10,16 @@
 //! Layers are flat arrays sorted by key (no hash maps); earlier layers keep only the node and
 //! parent index of every state, for reconstruction.
 
-use crate::bounds::{Model, ResidualBounder};
-use crate::completion::{PositionBound, PositionQuery};
-use crate::lagrange::NodePenalties;
-use crate::lattice::Lattice;
-use crate::subset::{SubsetBound, SubsetQuery};
+use crate::bounds::completion::{PositionBound, PositionQuery};
+use crate::bounds::lagrange::NodePenalties;
+use crate::bounds::lattice::Lattice;
+use crate::bounds::residual::ResidualBounder;
+use crate::bounds::subset::{SubsetBound, SubsetQuery};
+use crate::keys::Key;
+use crate::model::Model;
 use std::rc::Rc;
 
 const INF: f64 = f64::INFINITY;
-
-/// An ideal as a fixed-width bitset (`64·W` clusters).
-#[derive(Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Debug)]
-pub(crate) struct Key<const W: usize>(pub [u64; W]);
-
-impl<const W: usize> Key<W> {
-    #[inline]
-    pub fn empty() -> Self {
-        Key([0; W])
-    }
-    #[inline]
-    pub fn contains(&self, c: usize) -> bool {
-        self.0[c / 64] >> (c % 64) & 1 == 1
-    }
-    #[inline]
-    pub fn with(mut self, c: usize) -> Self {
-        self.0[c / 64] |= 1 << (c % 64);
-        self
-    }
-    /// The clusters in the set, in increasing order.
-    #[inline]
-    pub fn ones(&self) -> impl Iterator<Item = usize> + '_ {
-        (0..W).flat_map(move |i| {
-            let mut w = self.0[i];
-            std::iter::from_fn(move || {
-                if w == 0 {
-                    return None;
-                }
-                let bit = w.trailing_zeros() as usize;
-                w &= w - 1;
-                Some(i * 64 + bit)
-            })
-        })
-    }
-    #[inline]
-    pub fn contains_all(&self, other: &Self) -> bool {
-        (0..W).all(|i| other.0[i] & !self.0[i] == 0)
-    }
-}
 
 /// One layer: ideals → groups (ideal, last cluster) → states, all as flat sorted arrays.
 #[derive(Default)]

@@ -2,7 +2,7 @@
 //! order, choose the best node of every cluster (exact, by a DP along the cycle), and move
 //! clusters or short cluster chains to better precedence-feasible positions (or-opt).
 
-use crate::bounds::Model;
+use crate::model::Model;
 use web_time::Instant;
 
 const INF: f64 = f64::INFINITY;

@@ -68,23 +68,30 @@ impl ClusterSet {
 
     /// The clusters in increasing order.
     pub fn iter(&self) -> impl Iterator<Item = usize> + '_ {
-        self.words.iter().enumerate().flat_map(|(i, &word)| {
-            let mut w = word;
-            std::iter::from_fn(move || {
-                if w == 0 {
-                    return None;
-                }
-                let bit = w.trailing_zeros() as usize;
-                w &= w - 1;
-                Some(i * 64 + bit)
-            })
-        })
+        set_bits(&self.words)
     }
 
     /// The raw 64-bit words (cluster `c` is bit `c % 64` of word `c / 64`).
     pub fn words(&self) -> &[u64] {
         &self.words
     }
+}
+
+/// The set bits of a bitset of 64-bit words (bit `c % 64` of word `c / 64` is `c`), in
+/// increasing order: the members of a [`ClusterSet`] or of an ideal key.
+#[inline]
+pub(crate) fn set_bits(words: &[u64]) -> impl Iterator<Item = usize> + '_ {
+    words.iter().enumerate().flat_map(|(i, &word)| {
+        let mut w = word;
+        std::iter::from_fn(move || {
+            if w == 0 {
+                return None;
+            }
+            let bit = w.trailing_zeros() as usize;
+            w &= w - 1;
+            Some(i * 64 + bit)
+        })
+    })
 }
 
 /// Why the precedence pairs of an instance do not form a partial order with the depot first.

@@ -1,12 +1,12 @@
 //! Building the search's bounds in resumable slices: first the subset DP bound
-//! ([`crate::subset`]), then — unless the subset bound is already strong — the pierce-group
-//! lattice ([`crate::lattice`]). The solver advances the preparation with a deadline on every
+//! ([`crate::bounds::subset`]), then — unless the subset bound is already strong — the
+//! pierce-group lattice ([`crate::bounds::lattice`]). The solver advances the preparation with a deadline on every
 //! `step`, so progress is reported and a cancel honoured while the bounds are being built.
 
-use crate::bounds::Model;
-use crate::lattice::{Lattice, LatticeBuilder};
-use crate::solver::LatticeStore;
-use crate::subset::{SubsetBound, SubsetBuilder};
+use crate::bounds::lattice::{LatticeBuilder, LatticeStore};
+use crate::bounds::subset::{SubsetBound, SubsetBuilder};
+use crate::keys::{on_keyed, with_key_width, ByWidth, Keyed};
+use crate::model::Model;
 use std::rc::Rc;
 use web_time::Instant;
 
@@ -30,10 +30,13 @@ pub(crate) struct LatticeLimits {
     pub min_group_share: f64,
 }
 
-enum LatticeJob {
-    W1(LatticeBuilder<1>),
-    W2(LatticeBuilder<2>),
-    W4(LatticeBuilder<4>),
+/// The lattice build at the key width of the model.
+struct LatticeJob(Keyed<LatticeJobWidth>);
+
+struct LatticeJobWidth;
+
+impl ByWidth for LatticeJobWidth {
+    type At<const W: usize> = LatticeBuilder<W>;
 }
 
 impl LatticeJob {
@@ -44,23 +47,16 @@ impl LatticeJob {
             limits.work,
             limits.min_group_share,
         );
-        match model.m {
-            0..=64 => Some(LatticeJob::W1(LatticeBuilder::new(model, i, b, w, g))),
-            65..=128 => Some(LatticeJob::W2(LatticeBuilder::new(model, i, b, w, g))),
-            129..=256 => Some(LatticeJob::W4(LatticeBuilder::new(model, i, b, w, g))),
-            _ => None,
-        }
+        with_key_width!(model.m, |W, wrap| LatticeJob(wrap(
+            LatticeBuilder::<W>::new(model, i, b, w, g)
+        )))
     }
 
     fn advance(&mut self, model: &Model, deadline: Instant) -> Option<LatticeStore> {
-        fn wrap<const W: usize>(l: Option<Lattice<W>>) -> Option<Rc<Lattice<W>>> {
-            l.map(Rc::new)
-        }
-        Some(match self {
-            LatticeJob::W1(b) => LatticeStore::W1(wrap(b.advance(model, deadline)?)),
-            LatticeJob::W2(b) => LatticeStore::W2(wrap(b.advance(model, deadline)?)),
-            LatticeJob::W4(b) => LatticeStore::W4(wrap(b.advance(model, deadline)?)),
-        })
+        let built = on_keyed!(&mut self.0, |builder, wrap| wrap(
+            builder.advance(model, deadline)?.map(Rc::new)
+        ));
+        Some(LatticeStore(Some(built)))
     }
 }
 
@@ -117,12 +113,9 @@ impl Preparation {
                     match LatticeJob::new(model, &limits) {
                         Some(job) if limits.max_ideals > 0 => self.stage = Stage::Lattice(job),
                         _ => {
-                            return Some(match model.m {
-                                0..=64 => LatticeStore::W1(None),
-                                65..=128 => LatticeStore::W2(None),
-                                129..=256 => LatticeStore::W4(None),
-                                _ => LatticeStore::None,
-                            })
+                            return Some(LatticeStore(with_key_width!(model.m, |_W, wrap| wrap(
+                                None
+                            ))))
                         }
                     }
                     if Instant::now() >= deadline {

@@ -1,16 +1,18 @@
 //! The exact solver: an anytime, resumable driver around the DP over order ideals.
 
-use crate::bounds::{Model, ResidualBounder};
+use crate::bounds::completion::{PositionBound, PositionBoundOptions};
+use crate::bounds::lagrange::{self, NodePenalties, PenaltyOptions};
+use crate::bounds::lattice::LatticeStore;
+use crate::bounds::residual::ResidualBounder;
+use crate::bounds::subset::SubsetBound;
 use crate::check::check_tour;
-use crate::completion::{PositionBound, PositionBoundOptions};
 use crate::dp::{Dp, DpStatus, Incumbent};
 use crate::heuristic;
 use crate::instance::Instance;
-use crate::lagrange::{self, NodePenalties, PenaltyOptions};
-use crate::lattice::Lattice;
+use crate::keys::{on_keyed, ByWidth, Keyed};
+use crate::model::Model;
 use crate::order::{OrderError, PrecedenceOrder};
 use crate::prepare::{LatticeLimits, Preparation, STRONG_SUBSET_SHARE};
-use crate::subset::SubsetBound;
 use std::rc::Rc;
 use std::time::Duration;
 use web_time::Instant;
@@ -193,13 +195,16 @@ impl ExactResult {
     }
 }
 
-enum Engine {
-    W1(Dp<1>),
-    W2(Dp<2>),
-    W4(Dp<4>),
-    /// Too many clusters for the DP keys: only bounds and the heuristic.
-    Unsupported,
+/// The DP at the key width of the run's model.
+struct DpWidth;
+
+impl ByWidth for DpWidth {
+    type At<const W: usize> = Dp<W>;
 }
+
+/// The DP of one run; `None` inside when there are too many clusters for the DP keys: only
+/// bounds and the heuristic.
+struct Engine(Option<Keyed<DpWidth>>);
 
 impl Engine {
     fn new(
@@ -207,104 +212,61 @@ impl Engine {
         beam: Option<usize>,
         memory: usize,
         use_l2: bool,
-        store: &mut LatticeStore,
+        store: &LatticeStore,
     ) -> Engine {
         // The lattice bound gets at most half of the memory; the DP keeps the rest.
         let dp_memory = memory - memory / 2;
-        match (model.m, store) {
-            (0..=64, LatticeStore::W1(l)) => {
-                Engine::W1(Dp::new(model, beam, dp_memory, use_l2, l.clone()))
-            }
-            (65..=128, LatticeStore::W2(l)) => {
-                Engine::W2(Dp::new(model, beam, dp_memory, use_l2, l.clone()))
-            }
-            (129..=256, LatticeStore::W4(l)) => {
-                Engine::W4(Dp::new(model, beam, dp_memory, use_l2, l.clone()))
-            }
-            _ => Engine::Unsupported,
-        }
+        Engine(store.0.as_ref().map(|lattice| {
+            on_keyed!(lattice, |l, wrap| wrap(Dp::new(
+                model,
+                beam,
+                dp_memory,
+                use_l2,
+                l.clone()
+            )))
+        }))
+    }
+
+    fn is_unsupported(&self) -> bool {
+        self.0.is_none()
     }
 
     fn set_subset_bound(&mut self, model: &Model, subset: Rc<SubsetBound>) {
-        match self {
-            Engine::W1(dp) => dp.set_subset_bound(model, subset),
-            Engine::W2(dp) => dp.set_subset_bound(model, subset),
-            Engine::W4(dp) => dp.set_subset_bound(model, subset),
-            Engine::Unsupported => {}
+        if let Some(dp) = &mut self.0 {
+            on_keyed!(dp, |dp| dp.set_subset_bound(model, subset))
         }
     }
 
     fn set_penalties(&mut self, model: &Model, penalties: Rc<NodePenalties>) {
-        match self {
-            Engine::W1(dp) => dp.set_penalties(model, penalties),
-            Engine::W2(dp) => dp.set_penalties(model, penalties),
-            Engine::W4(dp) => dp.set_penalties(model, penalties),
-            Engine::Unsupported => {}
+        if let Some(dp) = &mut self.0 {
+            on_keyed!(dp, |dp| dp.set_penalties(model, penalties))
         }
     }
 
     fn set_position_bound(&mut self, model: &Model, position: Rc<PositionBound>) {
-        match self {
-            Engine::W1(dp) => dp.set_position_bound(model, position),
-            Engine::W2(dp) => dp.set_position_bound(model, position),
-            Engine::W4(dp) => dp.set_position_bound(model, position),
-            Engine::Unsupported => {}
+        if let Some(dp) = &mut self.0 {
+            on_keyed!(dp, |dp| dp.set_position_bound(model, position))
         }
     }
 
     fn run(&mut self, model: &Model, incumbent: &mut Incumbent, work: u64) -> DpStatus {
-        match self {
-            Engine::W1(dp) => dp.run(model, incumbent, work),
-            Engine::W2(dp) => dp.run(model, incumbent, work),
-            Engine::W4(dp) => dp.run(model, incumbent, work),
-            Engine::Unsupported => DpStatus::Done,
+        match &mut self.0 {
+            Some(dp) => on_keyed!(dp, |dp| dp.run(model, incumbent, work)),
+            None => DpStatus::Done,
         }
     }
 
     /// (layer, live states, lower bound, dropped_min, states created)
     fn stats(&self, model: &Model, ub: f64) -> (usize, usize, f64, f64, u64) {
-        match self {
-            Engine::W1(dp) => (
+        match &self.0 {
+            Some(dp) => on_keyed!(dp, |dp| (
                 dp.layer,
                 dp.live_states(),
                 dp.lower_bound(model, ub),
                 dp.dropped_min,
                 dp.states_created,
-            ),
-            Engine::W2(dp) => (
-                dp.layer,
-                dp.live_states(),
-                dp.lower_bound(model, ub),
-                dp.dropped_min,
-                dp.states_created,
-            ),
-            Engine::W4(dp) => (
-                dp.layer,
-                dp.live_states(),
-                dp.lower_bound(model, ub),
-                dp.dropped_min,
-                dp.states_created,
-            ),
-            Engine::Unsupported => (0, 0, -INF, -INF, 0),
-        }
-    }
-}
-
-/// The lattice bound of one run, built once and shared by the beam and exact engines.
-pub(crate) enum LatticeStore {
-    W1(Option<Rc<Lattice<1>>>),
-    W2(Option<Rc<Lattice<2>>>),
-    W4(Option<Rc<Lattice<4>>>),
-    None,
-}
-
-impl LatticeStore {
-    fn root_bound(&self) -> Option<f64> {
-        match self {
-            LatticeStore::W1(l) => l.as_ref().map(|l| l.root_bound),
-            LatticeStore::W2(l) => l.as_ref().map(|l| l.root_bound),
-            LatticeStore::W4(l) => l.as_ref().map(|l| l.root_bound),
-            LatticeStore::None => None,
+            )),
+            None => (0, 0, -INF, -INF, 0),
         }
     }
 }
@@ -500,7 +462,7 @@ impl Run {
     fn engine(&mut self, beam: Option<usize>, memory: usize, use_l2: bool) -> Engine {
         let store = self
             .lattice
-            .as_mut()
+            .as_ref()
             .expect("bounds built before the search");
         let mut engine = Engine::new(&self.model, beam, memory, use_l2, store);
         if let Some(subset) = &self.subset {
@@ -930,7 +892,7 @@ impl ExactSolver {
                     if status == DpStatus::Done {
                         let (_, _, _, dropped, created) =
                             engine.stats(&run.model, self.incumbent.upper_bound);
-                        let unsupported = matches!(engine, Engine::Unsupported);
+                        let unsupported = engine.is_unsupported();
                         run.states_created += created;
                         run.finished_bound = Some(if unsupported {
                             run.root_bound

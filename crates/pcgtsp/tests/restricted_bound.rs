@@ -4,6 +4,7 @@
 mod common;
 
 use common::{brute_force, references, trusted_optimum};
+use cutroute_geometry::SplitMix64;
 use cutroute_pcgtsp::{
     check_tour, restricted_bound, ExactOptions, ExactSolver, Instance, RestrictedBoundOptions,
     SolverStatus,
@@ -74,25 +75,10 @@ fn restricted_bound_closes_p43_1() {
     );
 }
 
-/// A tiny deterministic PRNG (xorshift) so the random instances are reproducible.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        self.0
-    }
-    fn below(&mut self, n: u64) -> u64 {
-        self.next() % n
-    }
-}
-
 /// A random instance: `m` clusters (cluster 0 the depot), 1–3 nodes each, random precedence
 /// pairs `a < b` between non-depot clusters. `metric` gives Manhattan distances on integer
 /// points (exact triangle inequality); otherwise random costs with some forbidden arcs.
-fn random_instance(rng: &mut Rng, m: usize, metric: bool) -> Instance {
+fn random_instance(rng: &mut SplitMix64, m: usize, metric: bool) -> Instance {
     let mut clusters = Vec::new();
     let mut node_cluster = Vec::new();
     for c in 0..m {
@@ -143,7 +129,7 @@ fn random_instance(rng: &mut Rng, m: usize, metric: bool) -> Instance {
 /// the costs are metric and the subset holds every cluster.
 #[test]
 fn restricted_bound_matches_brute_force_on_small_random_instances() {
-    let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+    let mut rng = SplitMix64::new(0x9e37_79b9_7f4a_7c15);
     let mut equal = 0;
     let mut checked = 0;
     for round in 0..60 {
@@ -180,7 +166,7 @@ fn restricted_bound_matches_brute_force_on_small_random_instances() {
 /// A guide that is not a tour is rejected with its reason.
 #[test]
 fn infeasible_guide_is_an_error() {
-    let mut rng = Rng(7);
+    let mut rng = SplitMix64::new(7);
     let instance = random_instance(&mut rng, 4, true);
     let err = restricted_bound(&instance, &[0], f64::INFINITY, &options(1.0)).unwrap_err();
     assert!(

@@ -14,14 +14,14 @@
 //! until `max_non_improving_shakes` shakes in a row fail, the time is up or the cancel flag is
 //! raised.
 
-use cutroute_geometry::float::Libm;
 use std::collections::{BinaryHeap, HashMap};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
 use cutroute_ccp::HeatPenalty;
 use cutroute_geometry::{
-    ContourRef, MachineParameters, PathRoute, Point, Route, Span, SplitMix64, ToolOnPath,
+    BoundingBox, ContourRef, MachineParameters, PathRoute, Point, Route, Span, SplitMix64,
+    ToolOnPath,
 };
 use cutroute_thermal::path_route_pierces;
 use web_time::Instant;
@@ -152,19 +152,12 @@ fn entry_point(segment: &Segment, place: Place) -> Point {
     }
 }
 
-/// Distance from `p` to a box given by its corners.
-fn box_distance(p: Point, min: Point, max: Point) -> f64 {
-    let dx = (min.x - p.x).max(p.x - max.x).max(0.0);
-    let dy = (min.y - p.y).max(p.y - max.y).max(0.0);
-    dx.hypot_libm(dy)
-}
-
 /// The point of a closed segment minimising `|a M| + |M b|` (or `|a M|` without `b`), starting
 /// from the value `current` to prune spans: `(span, t, point, value)`, or `None` if no span
 /// beats `current`.
 fn best_point(
     segment: &Segment,
-    boxes: &[(Point, Point)],
+    boxes: &[BoundingBox],
     a: Point,
     b: Option<Point>,
     current: f64,
@@ -172,8 +165,8 @@ fn best_point(
     let mut best: Option<(usize, f64, Point, f64)> = None;
     let mut bound = current;
     for (i, span) in segment.spans.iter().enumerate() {
-        let (min, max) = boxes[i];
-        let lower = box_distance(a, min, max) + b.map_or(0.0, |b| box_distance(b, min, max));
+        let bbox = &boxes[i];
+        let lower = bbox.distance_to_point(a) + b.map_or(0.0, |b| bbox.distance_to_point(b));
         // Not `lower >= …`: a NaN bound must skip the span too.
         if lower.partial_cmp(&(bound - 1e-12)) != Some(std::cmp::Ordering::Less) {
             continue;
@@ -189,8 +182,9 @@ fn best_point(
 
 struct Search {
     segments: Vec<Segment>,
-    boxes: Vec<Vec<(Point, Point)>>,
-    whole_box: Vec<(Point, Point)>,
+    /// The bounding box of every span of every segment, and of every whole segment.
+    boxes: Vec<Vec<BoundingBox>>,
+    whole_box: Vec<BoundingBox>,
     before: Vec<Vec<usize>>,
     after: Vec<Vec<usize>>,
     neighbours: Vec<Vec<usize>>,
@@ -390,9 +384,9 @@ impl Search {
                         }
                     }
                     Place::Closed { .. } => {
-                        let (min, max) = self.whole_box[first];
-                        let lower = box_distance(u, min, max)
-                            + v.map_or(0.0, |v| box_distance(v, min, max))
+                        let bbox = &self.whole_box[first];
+                        let lower = bbox.distance_to_point(u)
+                            + v.map_or(0.0, |v| bbox.distance_to_point(v))
                             - base;
                         if candidate.0 >= removal && lower < removal {
                             let current = candidate.0 + base;
@@ -732,33 +726,15 @@ impl SccpSearch {
             after[a].push(b);
             before[b].push(a);
         }
-        let boxes: Vec<Vec<(Point, Point)>> = segments
+        let boxes: Vec<Vec<BoundingBox>> = segments
             .iter()
-            .map(|s| {
-                s.spans
-                    .iter()
-                    .map(|sp| {
-                        let b = sp.bounding_box();
-                        (b.min, b.max)
-                    })
-                    .collect()
-            })
+            .map(|s| s.spans.iter().map(Span::bounding_box).collect())
             .collect();
-        let whole_box: Vec<(Point, Point)> = boxes
+        let whole_box: Vec<BoundingBox> = boxes
             .iter()
             .map(|bs| {
-                bs.iter().fold(
-                    (
-                        Point::new(f64::INFINITY, f64::INFINITY),
-                        Point::new(f64::NEG_INFINITY, f64::NEG_INFINITY),
-                    ),
-                    |(lo, hi), (a, b)| {
-                        (
-                            Point::new(lo.x.min(a.x), lo.y.min(a.y)),
-                            Point::new(hi.x.max(b.x), hi.y.max(b.y)),
-                        )
-                    },
-                )
+                bs.iter()
+                    .fold(BoundingBox::EMPTY, |whole, b| whole.union(*b))
             })
             .collect();
         // Representative points for neighbour lists: the ends of open segments, the box centre
@@ -766,9 +742,9 @@ impl SccpSearch {
         let reps: Vec<Vec<Point>> = segments
             .iter()
             .zip(&whole_box)
-            .map(|(s, &(lo, hi))| {
+            .map(|(s, whole)| {
                 if s.closed {
-                    vec![lo.midpoint(hi)]
+                    vec![whole.centre()]
                 } else {
                     vec![s.first_point(), s.last_point()]
                 }
@@ -1177,13 +1153,7 @@ mod tests {
                 1e-9,
             );
             assert!(segment.closed);
-            let boxes: Vec<(Point, Point)> = spans
-                .iter()
-                .map(|s| {
-                    let b = s.bounding_box();
-                    (b.min, b.max)
-                })
-                .collect();
+            let boxes: Vec<BoundingBox> = spans.iter().map(Span::bounding_box).collect();
             for _ in 0..200 {
                 let a = Point::new(rng.range(-60.0, 100.0), rng.range(-60.0, 80.0));
                 let b = Point::new(rng.range(-60.0, 100.0), rng.range(-60.0, 80.0));

@@ -1,4 +1,4 @@
-//! DXF import: ASCII DXF drawings (R12 … 2018) → a [`Nest`] of closed parts plus a report.
+//! DXF import: ASCII DXF drawings (R12 … 2018) → a [`Nest`](cutroute_geometry::Nest) of closed parts plus a report.
 //!
 //! The reader is this crate's own group-code parser rather than the `dxf` crate. That crate
 //! reads all eleven reference drawings, but it drops an entity whose number fails to parse
@@ -14,14 +14,12 @@
 //! nested blocks included. Annotation (text, dimensions, leaders, hatches, points, viewports,
 //! attributes) is ignored, and so are paper-space entities. Loose pieces are joined end to end
 //! within [`DxfOptions::join_tolerance`]; what does not close is reported in
-//! [`DxfImport::open_chains`].
+//! [`DrawingImport::open_chains`].
 
 mod entities;
 mod groups;
 
-use cutroute_geometry::Nest;
-
-use crate::assemble::{assemble, AssembleLimits, Piece};
+use crate::assemble::{finish_import, AssembleLimits, DrawingImport, Piece};
 pub use crate::assemble::{EntityRef, OpenChain};
 
 /// Settings of a DXF import.
@@ -66,17 +64,9 @@ impl std::fmt::Display for DxfWarning {
     }
 }
 
-/// The result of a DXF import.
-#[derive(Clone, Debug, PartialEq)]
-pub struct DxfImport {
-    /// The closed parts found (no sheet: a drawing does not describe one). Outer contours run
-    /// clockwise, holes counter-clockwise; a contour inside a hole starts a new part.
-    pub nest: Nest,
-    /// Chains of entities that did not close within the join tolerance, with their end points.
-    pub open_chains: Vec<OpenChain>,
-    /// What was skipped or approximated without failing.
-    pub warnings: Vec<DxfWarning>,
-}
+/// The result of a DXF import: the closed parts (no sheet: a drawing does not describe one),
+/// the open chains of entities, and the warnings.
+pub type DxfImport = DrawingImport<DxfWarning>;
 
 /// Why a DXF file could not be imported. Line numbers are 1-based lines of the file.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -211,37 +201,24 @@ pub fn read_dxf(bytes: &[u8], options: &DxfOptions) -> Result<DxfImport, DxfErro
         join_tolerance: options.join_tolerance,
         flatten_tolerance: options.approximation_tolerance,
     };
-    let assembled = assemble(pieces, &limits);
-    for w in assembled.dropped {
-        warnings.push(DxfWarning {
-            line: w.line,
-            message: w.message,
-        });
-    }
-    if assembled.parts.is_empty() {
-        let first = assembled
-            .open_chains
-            .first()
-            .map(|c| c.to_string())
-            // Without an open chain, the first refused entity is why nothing was drawn: its
-            // warning carries the entity's line.
-            .or_else(|| warnings.first().map(|w| format!("nothing drawn; {w}")))
-            .unwrap_or_else(|| {
-                let lines = bytes.iter().filter(|&&b| b == b'\n').count() + 1;
-                format!("nothing drawn in lines 1 to {lines}")
-            });
-        return Err(DxfError::NothingClosed {
-            open: assembled.open_chains.len(),
-            first,
-        });
-    }
-    Ok(DxfImport {
-        nest: Nest {
-            sheet: None,
-            parts: assembled.parts,
-        },
-        open_chains: assembled.open_chains,
-        warnings,
+    let dropped = |w: crate::assemble::Dropped| DxfWarning {
+        line: w.line,
+        message: w.message,
+    };
+    // Without an open chain, the first refused entity is why nothing was drawn: its warning
+    // carries the entity's line.
+    let nothing_drawn = |warnings: &[DxfWarning]| match warnings.first() {
+        Some(w) => format!("nothing drawn; {w}"),
+        None => {
+            let lines = bytes.iter().filter(|&&b| b == b'\n').count() + 1;
+            format!("nothing drawn in lines 1 to {lines}")
+        }
+    };
+    finish_import(pieces, None, &limits, warnings, dropped, nothing_drawn).map_err(|e| {
+        DxfError::NothingClosed {
+            open: e.open,
+            first: e.first,
+        }
     })
 }
 

@@ -14,8 +14,11 @@
 //! A node-level DP state `(J, x)` with `x` in cluster `L` completes at cost at least
 //! `min_{Y, g ∈ groups(Y)} ( c(x, g) + V(J ∪ {Y}, g) )`.
 
-use crate::bounds::Model;
-use crate::dp::Key;
+use crate::instance::Instance;
+use crate::keys::{with_key_width, ByWidth, Key, Keyed};
+use crate::model::Model;
+use crate::order::OrderError;
+use std::rc::Rc;
 use web_time::Instant;
 
 const INF: f64 = f64::INFINITY;
@@ -578,16 +581,28 @@ fn intersects<const W: usize>(a: &Key<W>, b: &Key<W>) -> bool {
 /// Counts the order ideals of an instance's precedence order (the DP's state space over
 /// clusters), layer by layer; `Ok(None)` when there are more than `limit` (or more than 256
 /// clusters).
-pub fn count_ideals(
-    instance: &crate::instance::Instance,
-    limit: usize,
-) -> Result<Option<usize>, crate::order::OrderError> {
+pub fn count_ideals(instance: &Instance, limit: usize) -> Result<Option<usize>, OrderError> {
     let start = instance.clusters[instance.depot][0];
     let model = Model::new(instance, start)?;
-    Ok(match model.m {
-        0..=64 => count_ideals_width::<1>(&model, limit),
-        65..=128 => count_ideals_width::<2>(&model, limit),
-        129..=256 => count_ideals_width::<4>(&model, limit),
-        _ => None,
-    })
+    Ok(with_key_width!(model.m, |W| count_ideals_width::<W>(&model, limit)).flatten())
+}
+
+/// A lattice shared by the beam and exact engines of one run, at any key width.
+pub(crate) struct SharedLattice;
+
+impl ByWidth for SharedLattice {
+    type At<const W: usize> = Option<Rc<Lattice<W>>>;
+}
+
+/// The lattice bound of one run, built once and shared by the beam and exact engines: at the
+/// key width of the run's model (`None` inside when it was not built), or `None` for orders
+/// too large for any key.
+pub(crate) struct LatticeStore(pub Option<Keyed<SharedLattice>>);
+
+impl LatticeStore {
+    /// The lattice's root bound, when it was built.
+    pub fn root_bound(&self) -> Option<f64> {
+        let keyed = self.0.as_ref()?;
+        crate::keys::on_keyed!(keyed, |lattice| lattice.as_ref().map(|l| l.root_bound))
+    }
 }

@@ -13,8 +13,9 @@
 //! value at `λ` is `in(x) − out(x)` of the node arcs realising the optimal cycle cover.
 
 use crate::assignment::Assignment;
-use crate::bounds::{Model, ResidualBounder};
+use crate::bounds::residual::ResidualBounder;
 use crate::instance::Instance;
+use crate::model::Model;
 
 const INF: f64 = f64::INFINITY;
 

@@ -24,7 +24,7 @@
 //! cluster, node). Which clusters are dropped is chosen from the incumbent tour: those whose
 //! visit costs the least detour go first, until the backward pass fits the work budget.
 
-use crate::bounds::Model;
+use crate::model::Model;
 use web_time::Instant;
 
 const INF: f64 = f64::INFINITY;

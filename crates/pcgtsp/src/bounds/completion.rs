@@ -22,8 +22,8 @@
 //! position `k` (its second-best when the best continues into a cluster of `J`). The table is
 //! built once; a state costs one pass over the candidate next nodes.
 
-use crate::bounds::Model;
 use crate::instance::Instance;
+use crate::model::Model;
 use crate::order::OrderError;
 
 const INF: f64 = f64::INFINITY;
