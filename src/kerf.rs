@@ -184,7 +184,7 @@ pub fn KerfPanel(settings: RwSignal<KerfSettings>) -> impl IntoView {
     view! {
         <details class="machine kerf">
             <summary>{tr("Kerf and leads", "Ширина реза и подводы")}</summary>
-            {number("kerf-width", ("Kerf", "Ширина реза"), ("Kerf width: the tool centre runs kerf/2 off each contour; 0 cuts on the contours", "Ширина реза: центр инструмента идёт на расстоянии kerf/2 от контура; 0 — по контурам"), |k| k.kerf, |k, v| k.kerf = v)}
+            {number("kerf-width", ("Kerf", "Ширина реза"), ("Kerf width: the tool centre runs kerf/2 off each contour; 0 cuts on the contours", "Ширина реза: центр инструмента идёт на половине ширины реза от контура; 0 — по контурам"), |k| k.kerf, |k, v| k.kerf = v)}
             {number("kerf-d1", ("Pierce clearance d₁", "Зазор врезки d₁"), ("Least distance from every contour to a pierce point", "Наименьшее расстояние от любого контура до точки врезки"), |k| k.pierce_clearance, |k, v| k.pierce_clearance = v)}
             {number("kerf-d2", ("Switch-off clearance d₂", "Зазор выключения d₂"), ("Least distance from every contour to a switch-off point", "Наименьшее расстояние от любого контура до точки выключения"), |k| k.switch_off_clearance, |k, v| k.switch_off_clearance = v)}
             {shape("lead-in-shape", ("Lead-in", "Подвод"), |k| k.lead_in.shape, |k, s| k.lead_in.shape = s)}
@@ -192,7 +192,7 @@ pub fn KerfPanel(settings: RwSignal<KerfSettings>) -> impl IntoView {
             {shape("lead-out-shape", ("Lead-out", "Отвод"), |k| k.lead_out.shape, |k, s| k.lead_out.shape = s)}
             {number("lead-out-length", ("Lead-out length", "Длина отвода"), ("Length of the lead-out from the contour to the switch-off point", "Длина отвода от контура до точки выключения"), |k| k.lead_out.length, |k, v| k.lead_out.length = v)}
             {number("kerf-overcut", ("Overcut", "Перебег"), ("How far the cut runs on past the entry before the lead-out", "На сколько рез заходит за точку входа перед отводом"), |k| k.overcut, |k, v| k.overcut = v)}
-            <label class="param" title=tr("Micro-joints: N uncut gaps of WIDTH mm in the outer contour of every part (0:0 for none)", "Микроперемычки: N непрорезанных промежутков шириной WIDTH мм во внешнем контуре каждой детали (0:0 — нет)")>
+            <label class="param" title=tr("Micro-joints: N uncut gaps of WIDTH mm in the outer contour of every part (0:0 for none)", "Микроперемычки: N непрорезанных промежутков шириной W мм во внешнем контуре каждой детали (0:0 — нет)")>
                 <span>{tr("Tabs N:width", "Перемычки N:ширина")}</span>
                 <input
                     id="kerf-tabs"
