@@ -399,12 +399,18 @@ impl Job for KerfJob {
             .collect();
         // Leads are finished one candidate at a time, every attachment before any relaxation,
         // so the first full route is there as soon as one solver has ended (a stop at the
-        // limit then still has one).
+        // limit then still has one); then the shortest route is relaxed first, so a
+        // relaxation cut at the limit has spent its time on the route that is kept.
         let finishing = (0..self.candidates.len())
             .find(|&i| matches!(self.candidates[i].stage, Stage::Attaching(_)))
             .or_else(|| {
                 (0..self.candidates.len())
-                    .find(|&i| matches!(self.candidates[i].stage, Stage::Relaxing { .. }))
+                    .filter_map(|i| match &self.candidates[i].stage {
+                        Stage::Relaxing { route, .. } => Some((i, route.idle_length())),
+                        _ => None,
+                    })
+                    .min_by(|a, b| a.1.total_cmp(&b.1))
+                    .map(|(i, _)| i)
             });
         let mut turns = solving.clone();
         turns.extend(finishing);
