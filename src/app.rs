@@ -146,6 +146,7 @@ pub fn App() -> impl IntoView {
     ));
     let objective = RwSignal::new(objective_from_name(&initial.objective).unwrap_or_default());
     let thermal_settings = RwSignal::new(initial.thermal);
+    let kerf_settings = RwSignal::new(initial.kerf);
     // The tool-on paths a G-code file holds when they are not whole contours.
     let file_paths = RwSignal::new(None::<PathRoute>);
     let presentation = RwSignal::new(false);
@@ -164,6 +165,7 @@ pub fn App() -> impl IntoView {
         file_url: file_url.get(),
         machine: machine.get(),
         sheet: document.with(|d| d.as_ref().map_or(0, |d| d.sheet)),
+        kerf: kerf_settings.get(),
     };
     // The link of the page's state; a lecture list other than the bundled one rides along.
     let lecture_query = StoredValue::new(crate::gallery::lecture_query(&lecture_url));
@@ -444,6 +446,7 @@ pub fn App() -> impl IntoView {
         step_mm.set(s.step_mm);
         objective.set(objective_from_name(&s.objective).unwrap_or_default());
         thermal_settings.set(s.thermal);
+        kerf_settings.set(s.kerf);
         machine.set(s.machine);
         hidden_layers.set(s.hidden_layers);
         last_file.set(None);
@@ -508,6 +511,9 @@ pub fn App() -> impl IntoView {
             machine: machine.get_untracked(),
             objective: objective.get_untracked(),
             thermal: thermal_settings.get_untracked(),
+            // The full cutting route: the engine's kerf job fits and optimises the leads.
+            kerf: kerf_settings.get_untracked(),
+            leads_after: false,
         };
         if from.is_none() {
             progress.set(None);
@@ -929,7 +935,9 @@ pub fn App() -> impl IntoView {
                     </dd>
                 </dl>
                 <StatsPanel nest=shown_nest route=shown_route paths=shown_paths machine=machine />
-                <crate::profiles::ProfilesPanel machine=machine choice=gcode_choice />
+                <crate::kerf::LeadStats route=shown_route />
+                <crate::profiles::ProfilesPanel machine=machine kerf=kerf_settings choice=gcode_choice />
+                <crate::kerf::KerfPanel settings=kerf_settings />
                 <ThermalPanel settings=thermal_settings />
                 <ThermalStats progress=progress />
                 <AlternativesTable alternatives=alternatives />
@@ -1552,6 +1560,7 @@ fn NestView(
                         })
                 }}
                 <g class="route">
+                    <crate::kerf::LeadLayers nest=nest route=route extent=Signal::from(extent) />
                     <path class="cut" d=cuts />
                     <g class="tool-on-paths">{tool_on_paths}</g>
                     <path class="link" d=links />

@@ -24,7 +24,7 @@ pub fn nest_bounds(nest: &Nest) -> Option<BoundingBox> {
 /// Appends the drawing command of one span (the pen is at its start); arcs are split so no
 /// single `A` command sweeps more than 180° (large sweeps are numerically fragile in SVG
 /// renderers).
-fn push_span(span: &Span, out: &mut String) {
+pub fn push_span(span: &Span, out: &mut String) {
     if span.is_line() || !span.bulge.is_finite() {
         let _ = write!(out, "L{:.3} {:.3}", span.end.x, span.end.y);
         return;
@@ -59,15 +59,21 @@ pub fn contour_path(contour: &Contour, out: &mut String) {
 }
 
 /// Path data of the idle (tool-off) moves of a route: start → pierce → … → finish.
+/// With leads, each idle move runs from a switch-off point M* to the next pierce point M.
 pub fn idle_path(route: &Route) -> String {
     let mut out = String::new();
     let _ = write!(out, "M{:.3} {:.3}", route.start.x, route.start.y);
     for step in &route.steps {
-        let _ = write!(
-            out,
-            "L{:.3} {:.3}",
-            step.pierce_point.x, step.pierce_point.y
-        );
+        let (on, off) = step
+            .leads
+            .as_ref()
+            .map_or((step.pierce_point, step.pierce_point), |l| {
+                (l.pierce, l.switch_off)
+            });
+        let _ = write!(out, "L{:.3} {:.3}", on.x, on.y);
+        if off != on {
+            let _ = write!(out, "M{:.3} {:.3}", off.x, off.y);
+        }
     }
     if let Some(finish) = route.finish {
         let _ = write!(out, "L{:.3} {:.3}", finish.x, finish.y);

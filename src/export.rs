@@ -29,6 +29,8 @@ use crate::i18n::{tr, use_language, Lang};
 const SVG_STYLE: &str = ".sheet{fill:#e9e6df;stroke:#6b6b70}.part{fill:#c9d6e8;fill-rule:evenodd;stroke:#2b4a73}\
 .idle{fill:none;stroke:#d55e00;stroke-dasharray:6 4}.cut{fill:none;stroke:#0072b2}\
 .arrows{fill:none;stroke:#2b4a73}.pierce{fill:#009e73}.candidates{fill:none;stroke:#888;stroke-linecap:round;stroke-width:3px}\
+.lead{fill:none;stroke:#e69f00;stroke-width:2.5px;stroke-linecap:round}.equidistants{fill:none;stroke:#cc79a7;stroke-dasharray:3 2}\
+.pierce-m{fill:#e69f00}.switch-off-m{fill:none;stroke:#e69f00}\
 path,circle{vector-effect:non-scaling-stroke}.done,.tool-head{display:none}";
 
 /// Builds a download from the file stem, the nest and the route (if any).

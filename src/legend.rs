@@ -33,6 +33,8 @@ pub fn DrawingLegend() -> impl IntoView {
                 {item("idle", "idle move (tool off)", "холостой ход")}
                 {item("link", "tool-on link", "перемычка (без выключения)")}
                 {item("pierce", "pierce point", "точка врезки")}
+                {item("lead", "lead-in and lead-out", "подвод и отвод")}
+                {item("equidistants", "equidistant (kerf/2)", "эквидистанта (половина ширины реза)")}
                 {item("start-marker", "start", "начало")}
                 {item("finish-marker", "finish", "конец")}
             </ul>

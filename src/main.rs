@@ -11,6 +11,7 @@ mod embedded;
 mod export;
 mod gallery;
 mod i18n;
+mod kerf;
 mod legend;
 mod links;
 mod pan_zoom;

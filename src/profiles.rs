@@ -5,7 +5,7 @@
 //! other way round. Also the export menu's preset picker and header and footer fields.
 
 use cutroute_gcode::GcodePreset;
-use cutroute_geometry::MachineParameters;
+use cutroute_geometry::{KerfSettings, MachineParameters};
 use cutroute_protocol::MachineProfile;
 use leptos::prelude::*;
 
@@ -33,11 +33,18 @@ fn storage() -> Option<web_sys::Storage> {
     web_sys::window()?.local_storage().ok()?
 }
 
-/// The profile of the page's machine and G-code choice. Header and footer are written only
-/// when they differ from the preset's (the CLI then takes the preset's own).
-pub fn profile_of(name: &str, machine: &MachineParameters, choice: &GcodeChoice) -> MachineProfile {
+/// The profile of the page's machine, full-route settings and G-code choice. Header and
+/// footer are written only when they differ from the preset's (the CLI then takes the
+/// preset's own); the kerf only when the route is not idealised.
+pub fn profile_of(
+    name: &str,
+    machine: &MachineParameters,
+    kerf: &KerfSettings,
+    choice: &GcodeChoice,
+) -> MachineProfile {
     let preset = choice.preset.options(machine);
     MachineProfile {
+        kerf: (!kerf.is_idealised()).then_some(*kerf),
         name: name.to_string(),
         machine: *machine,
         gcode_preset: Some(choice.preset.name().to_string()),
@@ -46,8 +53,11 @@ pub fn profile_of(name: &str, machine: &MachineParameters, choice: &GcodeChoice)
     }
 }
 
-/// The machine and G-code choice a profile sets, after the same checks as the CLI's.
-pub fn from_profile(profile: &MachineProfile) -> Result<(MachineParameters, GcodeChoice), String> {
+/// The machine, full-route settings (the page's idealised ones when the profile has none) and
+/// G-code choice a profile sets, after the same checks as the CLI's.
+pub fn from_profile(
+    profile: &MachineProfile,
+) -> Result<(MachineParameters, KerfSettings, GcodeChoice), String> {
     profile.check().map_err(|e| e.to_string())?;
     let preset = match &profile.gcode_preset {
         Some(name) => name.parse::<GcodePreset>().map_err(|e| e.to_string())?,
@@ -60,7 +70,8 @@ pub fn from_profile(profile: &MachineProfile) -> Result<(MachineParameters, Gcod
     if let Some(footer) = &profile.gcode_footer {
         choice.footer = footer.clone();
     }
-    Ok((profile.machine, choice))
+    let kerf = profile.kerf.unwrap_or_else(crate::settings::default_kerf);
+    Ok((profile.machine, kerf, choice))
 }
 
 /// Reads a profile file as the CLI does (unknown fields refused, numbers checked).
@@ -74,6 +85,7 @@ pub fn parse_profile(text: &str) -> Result<MachineProfile, String> {
 #[component]
 pub fn ProfilesPanel(
     machine: RwSignal<MachineParameters>,
+    kerf: RwSignal<KerfSettings>,
     choice: RwSignal<GcodeChoice>,
 ) -> impl IntoView {
     let language = use_language();
@@ -83,8 +95,9 @@ pub fn ProfilesPanel(
     );
     let status = RwSignal::new(String::new());
     let apply = move |profile: &MachineProfile| match from_profile(profile) {
-        Ok((m, c)) => {
+        Ok((m, k, c)) => {
             machine.set(m);
+            kerf.set(k);
             choice.set(c);
             name.set(profile.name.clone());
             true
@@ -101,7 +114,9 @@ pub fn ProfilesPanel(
         } else {
             n.trim().to_string()
         };
-        machine.with_untracked(|m| choice.with_untracked(|c| profile_of(&n, m, c)))
+        machine.with_untracked(|m| {
+            kerf.with_untracked(|k| choice.with_untracked(|c| profile_of(&n, m, k, c)))
+        })
     };
     let keep = move |profile: MachineProfile| {
         profiles.update(|all| {
@@ -333,15 +348,28 @@ mod tests {
         };
         let mut choice = GcodeChoice::of_preset(GcodePreset::QtPlasmac, &machine);
         choice.footer = vec!["M30".into(), "%".into()];
-        let profile = profile_of("Plasma 3", &machine, &choice);
+        let kerf = KerfSettings {
+            kerf: 2.0,
+            pierce_clearance: 5.0,
+            switch_off_clearance: 1.0,
+            lead_in: cutroute_geometry::LeadSpec::new(cutroute_geometry::LeadShape::Arc, 8.0),
+            ..crate::settings::default_kerf()
+        };
+        let profile = profile_of("Plasma 3", &machine, &kerf, &choice);
         assert_eq!(
             profile.gcode_header, None,
             "the preset's header stays the preset's"
         );
         let text = serde_json::to_string_pretty(&profile).unwrap();
         let back = parse_profile(&text).unwrap();
-        let (m, c) = from_profile(&back).unwrap();
+        let (m, k, c) = from_profile(&back).unwrap();
         assert_eq!(m, machine);
+        assert_eq!(k, kerf);
+        let idealised = profile_of("Laser", &machine, &crate::settings::default_kerf(), &choice);
+        assert!(
+            !serde_json::to_string(&idealised).unwrap().contains("kerf"),
+            "idealised profiles stay as they were"
+        );
         assert_eq!(c, choice);
         assert!(parse_profile(r#"{"name": "x", "machine": {}}"#).is_err());
         let bad = MachineProfile {

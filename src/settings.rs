@@ -3,7 +3,7 @@
 //! settings (objective included), machine speeds and prices, thermal settings and drawing
 //! layers. The address bar follows these (`links.rs`). The theme keeps its own key (see `theme`).
 
-use cutroute_geometry::{MachineParameters, Objective};
+use cutroute_geometry::{KerfSettings, LeadShape, LeadSpec, MachineParameters, Objective, TabSpec};
 use cutroute_protocol::{RuleSet, ThermalSettings};
 use serde::{Deserialize, Serialize};
 
@@ -35,11 +35,17 @@ pub enum Layer {
     Heat,
     /// The shop rules' violations.
     Violations,
+    /// Lead-ins and lead-outs of the full cutting route.
+    Leads,
+    /// The kerf offsets (equidistants) the tool centre runs on.
+    Equidistants,
+    /// Pierce points M and switch-off points M* of the full cutting route.
+    PierceRegions,
 }
 
 impl Layer {
     /// Every layer, in the order the panel lists them.
-    pub const ALL: [Layer; 11] = [
+    pub const ALL: [Layer; 14] = [
         Layer::Hatch,
         Layer::Arrows,
         Layer::Candidates,
@@ -51,6 +57,9 @@ impl Layer {
         Layer::Certificates,
         Layer::Heat,
         Layer::Violations,
+        Layer::Leads,
+        Layer::Equidistants,
+        Layer::PierceRegions,
     ];
 
     /// Stable short name (element ids, CSS classes).
@@ -67,6 +76,9 @@ impl Layer {
             Layer::Certificates => "certificates",
             Layer::Heat => "heat",
             Layer::Violations => "violations",
+            Layer::Leads => "leads",
+            Layer::Equidistants => "equidistants",
+            Layer::PierceRegions => "pierce-regions",
         }
     }
 
@@ -84,6 +96,9 @@ impl Layer {
             Layer::Certificates => ("Optimality certificates", "Сертификаты оптимальности"),
             Layer::Heat => ("Heat map", "Тепловая карта"),
             Layer::Violations => ("Rule violations", "Нарушения правил"),
+            Layer::Leads => ("Lead-ins and lead-outs", "Подводы и отводы"),
+            Layer::Equidistants => ("Equidistants (kerf)", "Эквидистанты (ширина реза)"),
+            Layer::PierceRegions => ("Pierce and switch-off points", "Точки врезки и выключения"),
         };
         lang.pick(en, ru)
     }
@@ -120,6 +135,80 @@ pub struct Settings {
     /// The sheet shown of a multi-sheet file, from 0 (`sheet=N` in a link counts from 1, as the
     /// CLI's `--sheet`).
     pub sheet: usize,
+    /// The full cutting route: kerf, clearances d₁ and d₂, leads, overcut, tabs (idealised by
+    /// default).
+    pub kerf: KerfSettings,
+}
+
+/// The full-route settings a link carries (query key, getter, setter); lengths in mm. The
+/// shapes and tabs have keys of their own (`lead_in`, `lead_out`, `tabs`).
+type KerfKey = (
+    &'static str,
+    fn(&KerfSettings) -> f64,
+    fn(&mut KerfSettings, f64),
+);
+
+const KERF_KEYS: [KerfKey; 6] = [
+    ("kerf", |k| k.kerf, |k, v| k.kerf = v),
+    ("d1", |k| k.pierce_clearance, |k, v| k.pierce_clearance = v),
+    (
+        "d2",
+        |k| k.switch_off_clearance,
+        |k, v| k.switch_off_clearance = v,
+    ),
+    (
+        "lead_in_length",
+        |k| k.lead_in.length,
+        |k, v| k.lead_in.length = v,
+    ),
+    (
+        "lead_out_length",
+        |k| k.lead_out.length,
+        |k, v| k.lead_out.length = v,
+    ),
+    ("overcut", |k| k.overcut, |k, v| k.overcut = v),
+];
+
+/// A lead shape's short name (the CLI's `--lead-in` values).
+pub fn shape_name(shape: LeadShape) -> &'static str {
+    match shape {
+        LeadShape::None => "none",
+        LeadShape::Line => "line",
+        LeadShape::Arc => "arc",
+        LeadShape::LineArc => "line-arc",
+    }
+}
+
+/// The lead shape of a short name.
+pub fn shape_from_name(name: &str) -> Option<LeadShape> {
+    [
+        LeadShape::None,
+        LeadShape::Line,
+        LeadShape::Arc,
+        LeadShape::LineArc,
+    ]
+    .into_iter()
+    .find(|s| shape_name(*s) == name)
+}
+
+/// The page's full-route settings when nothing is set: idealised, with the CLI's default lead
+/// lengths ready for when a shape is chosen (5 mm in, 2 mm out).
+pub fn default_kerf() -> KerfSettings {
+    KerfSettings {
+        lead_in: LeadSpec::new(LeadShape::None, 5.0),
+        lead_out: LeadSpec::new(LeadShape::None, 2.0),
+        tabs: TabSpec::default(),
+        ..KerfSettings::default()
+    }
+}
+
+/// `N:WIDTH` of the CLI's `--tabs`.
+pub fn parse_tabs(text: &str) -> Option<TabSpec> {
+    let (count, width) = text.split_once(':')?;
+    let count: usize = count.trim().parse().ok()?;
+    let width: f64 = width.trim().parse().ok()?;
+    (count <= 1000 && width.is_finite() && (width > 0.0 || count == 0))
+        .then_some(TabSpec { count, width })
 }
 
 /// The machine parameters a link carries: (query key, getter, setter).
@@ -169,6 +258,7 @@ impl Default for Settings {
             file_url: None,
             machine: MachineParameters::default(),
             sheet: 0,
+            kerf: default_kerf(),
         }
     }
 }
@@ -193,7 +283,32 @@ impl Settings {
                 }
                 continue;
             }
+            if let Some((_, _, set)) = KERF_KEYS.iter().find(|(k, _, _)| *k == key) {
+                if let Some(v) = value
+                    .parse::<f64>()
+                    .ok()
+                    .filter(|v| v.is_finite() && *v >= 0.0)
+                {
+                    set(&mut self.kerf, v);
+                }
+                continue;
+            }
             match key {
+                "lead_in" => {
+                    if let Some(shape) = shape_from_name(&value) {
+                        self.kerf.lead_in.shape = shape;
+                    }
+                }
+                "lead_out" => {
+                    if let Some(shape) = shape_from_name(&value) {
+                        self.kerf.lead_out.shape = shape;
+                    }
+                }
+                "tabs" => {
+                    if let Some(tabs) = parse_tabs(&value) {
+                        self.kerf.tabs = tabs;
+                    }
+                }
                 "sample" if crate::app::SAMPLES.iter().any(|(f, ..)| *f == value) => {
                     // The address bar follows the page, so a reload brings the query of the
                     // sample shown beside a remembered local file: that keeps the reminder;
@@ -291,6 +406,20 @@ impl Settings {
             if get(&self.machine) != get(&defaults) {
                 query.push_str(&format!("&{key}={}", get(&self.machine)));
             }
+        }
+        // The full route only when it is on: idealised links stay as they were.
+        let k = &self.kerf;
+        if !k.is_idealised() {
+            for (key, get, _) in KERF_KEYS {
+                query.push_str(&format!("&{key}={}", get(k)));
+            }
+            query.push_str(&format!(
+                "&lead_in={}&lead_out={}&tabs={}:{}",
+                shape_name(k.lead_in.shape),
+                shape_name(k.lead_out.shape),
+                k.tabs.count,
+                k.tabs.width
+            ));
         }
         let t = &self.thermal;
         if *t != ThermalSettings::default() {
@@ -441,6 +570,39 @@ mod tests {
         let nonsense = Settings::default().with_query("?objective=speed");
         assert_eq!(nonsense.objective, "time", "unknown objectives are ignored");
         assert_eq!(objective_from_name("cost"), Some(Objective::Cost));
+    }
+
+    #[test]
+    fn the_full_route_rides_the_link_and_old_links_stay_idealised() {
+        let s = Settings {
+            sample: "nested.dbs".into(),
+            solver: "ccp".into(),
+            kerf: KerfSettings {
+                kerf: 2.0,
+                pierce_clearance: 5.0,
+                switch_off_clearance: 1.0,
+                lead_in: LeadSpec::new(LeadShape::Arc, 8.0),
+                lead_out: LeadSpec::new(LeadShape::LineArc, 2.5),
+                overcut: 0.5,
+                tabs: TabSpec {
+                    count: 3,
+                    width: 1.5,
+                },
+            },
+            ..Settings::default()
+        };
+        let query = s.query();
+        assert!(query.contains("&kerf=2&d1=5&d2=1"), "{query}");
+        assert!(
+            query.contains("&lead_in=arc&lead_out=line-arc&tabs=3:1.5"),
+            "{query}"
+        );
+        assert_eq!(Settings::default().with_query(&query), s);
+        assert!(!Settings::default().query().contains("kerf"));
+        let old = Settings::default().with_query("?sample=seven.dbs&solver=ccp&time=3");
+        assert!(old.kerf.is_idealised());
+        let nonsense = Settings::default().with_query("?kerf=-1&lead_in=spiral&tabs=two:1");
+        assert_eq!(nonsense.kerf, Settings::default().kerf);
     }
 
     #[test]

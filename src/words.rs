@@ -3,7 +3,8 @@
 //! the Russian ones are built here from the same typed values.
 
 use cutroute_protocol::{
-    CcpStage, Ensemble, OpenError, OpenErrorKind, Phase, SolverKind, SourceLocation, ThermalNote,
+    CcpStage, Ensemble, KerfNote, KerfSource, OpenError, OpenErrorKind, Phase, SolverKind,
+    SourceLocation, ThermalNote,
 };
 
 use crate::i18n::Lang;
@@ -118,6 +119,31 @@ fn phase_ru(phase: &Phase) -> String {
             ThermalNote::RulesNotChecked => format!(
                 "{} · правила не проверены: проверка не уложилась бы в лимит времени",
                 phase_ru(base)
+            ),
+        },
+        Phase::Kerf { base, note } => match note {
+            KerfNote::Leads {
+                source: KerfSource::PierceCurves,
+            } => format!(
+                "{} · подводы оптимизированы по кривым врезки",
+                phase_ru(base)
+            ),
+            KerfNote::Leads {
+                source: KerfSource::Idealised,
+            } => format!(
+                "{} · подводы добавлены к идеализированному порядку",
+                phase_ru(base)
+            ),
+            // The contours by number, not the engine's English reasons.
+            KerfNote::NoRoom { contours, .. } => format!(
+                "{} · нет места для подводов у контуров ({}): {}",
+                phase_ru(base),
+                contours.len(),
+                contours
+                    .iter()
+                    .map(|(part, contour)| format!("деталь {} контур {contour}", part + 1))
+                    .collect::<Vec<_>>()
+                    .join("; ")
             ),
         },
     }

@@ -3,17 +3,15 @@
 //! idealised model, under which nothing here changes a route or a report.
 //!
 //! With leads on, the contour solvers (nearest, ccp, heuristic, discrete) optimise the full
-//! route: they run over the nest of pierce curves (`LeadFitter::pierce_curve_nest`), so the
-//! idle legs they price run between pierce points off the contours; the route is brought back
-//! onto the nest, every step gets its fitted leads, and the leads are moved along the
-//! equidistants where that shortens the idle legs from M* to the next M. `--leads-after` instead solves the
-//! idealised route and attaches leads to it (the comparison of the benchmark).
+//! route in the engine's kerf job (`cutroute_engine::KerfJob`, the app's code path): the
+//! settings travel in the request, and the job's routes come with their leads.
+//! `--leads-after` instead solves the idealised route and attaches leads to it (the
+//! comparison of the benchmark). This module parses the flags and writes the report.
 
 use cutroute_geometry::{
-    KerfSettings, LeadError, LeadFitter, LeadShape, LeadSpec, Nest, Route, StepLeads, TabSpec,
-    Vertex,
+    KerfSettings, LeadError, LeadShape, LeadSpec, Nest, Route, StepLeads, TabSpec, Vertex,
 };
-use cutroute_protocol::{JobRequest, Problem};
+use cutroute_protocol::{JobRequest, KerfNote, Phase, Progress};
 use serde_json::{json, Value};
 
 /// The full-route flags.
@@ -118,12 +116,22 @@ impl KerfArgs {
 }
 
 impl Kerf {
+    /// These settings, or when the flags leave the route idealised, a profile's (`--profile`
+    /// files carry the machine's kerf and leads as the page's profiles do).
+    pub fn with_profile(self, profile: Option<&cutroute_protocol::MachineProfile>) -> Kerf {
+        match profile.and_then(|p| p.kerf) {
+            Some(settings) if !self.is_on() => Kerf { settings, ..self },
+            _ => self,
+        }
+    }
+
     /// Whether the full route is on (anything but the idealised model).
     pub fn is_on(&self) -> bool {
         !self.settings.is_idealised()
     }
 
-    /// The request the solver runs: over the pierce curves when it optimises with leads.
+    /// The request with the full-route settings: the engine's kerf job then optimises the
+    /// route with its leads (or, with `--leads-after`, attaches them to the idealised route).
     pub fn request(&self, mut request: JobRequest, solver: &str) -> Result<JobRequest, String> {
         if !self.is_on() {
             return Ok(request);
@@ -133,47 +141,31 @@ impl Kerf {
                 "--solver {solver} does not cut with kerf and leads yet (nearest, ccp, heuristic and discrete do)"
             ));
         }
-        if self.after {
-            return Ok(request);
-        }
-        if let Problem::Nest { nest, .. } = &mut request.problem {
-            *nest = LeadFitter::new(nest, self.settings).pierce_curve_nest();
-        }
+        request.params.kerf = self.settings;
+        request.params.leads_after = self.after;
         Ok(request)
     }
 
-    /// The solver's route brought onto `nest` (pierce points on its contours).
-    pub fn project(&self, nest: &Nest, route: Route) -> Route {
-        if self.is_on() {
-            LeadFitter::new(nest, self.settings).project(&route)
-        } else {
-            route
-        }
-    }
-
-    /// `route` with leads on every step; every contour without room is named.
+    /// A route the job did not make (a file's own, or one the thermal repair changed) with
+    /// leads fitted as the engine's kerf job fits them; every contour without room is named.
     pub fn attach(&self, nest: &Nest, route: Route) -> Result<Route, String> {
         if !self.is_on() {
             return Ok(route);
         }
-        let fitter = LeadFitter::new(nest, self.settings);
-        fitter
-            .attach(&route)
-            .map(|route| {
-                if self.after {
-                    route
-                } else {
-                    fitter.relax(&route, 2, 24)
-                }
-            })
-            .map_err(|errors| {
-                let list: Vec<String> = errors.iter().map(LeadError::to_string).collect();
-                format!(
-                    "{} contour(s) without room for the leads: {}",
-                    errors.len(),
-                    list.join("; ")
-                )
-            })
+        let forest = nest.containment_forest();
+        cutroute_engine::fit_leads(nest, &forest, self.settings, &route, !self.after)
+            .map_err(|errors| no_room(&errors.iter().map(LeadError::to_string).collect::<Vec<_>>()))
+    }
+
+    /// The kerf job's word that some contours have no room for their leads, as an error.
+    pub fn refused(&self, progress: Option<&Progress>) -> Result<(), String> {
+        match progress.map(|p| &p.phase) {
+            Some(Phase::Kerf {
+                note: KerfNote::NoRoom { errors, .. },
+                ..
+            }) => Err(no_room(errors)),
+            _ => Ok(()),
+        }
     }
 
     /// Adds the full-route fields to a nest report: `start`, `finish`, the settings, the lead
@@ -225,4 +217,13 @@ impl Kerf {
             }
         }
     }
+}
+
+/// The error of contours without room for their leads, from `LeadError`'s words.
+fn no_room(errors: &[String]) -> String {
+    format!(
+        "{} contour(s) without room for the leads: {}",
+        errors.len(),
+        errors.join("; ")
+    )
 }

@@ -305,7 +305,7 @@ fn main() -> ExitCode {
         } => profile
             .load()
             .and_then(|profile| {
-                let kerf = kerf.parse()?;
+                let kerf = kerf.parse()?.with_profile(profile.as_ref());
                 let (machine, objective) = machine.parse(inputs::base_machine(profile.as_ref()))?;
                 let params = SolverParams {
                     time_limit_s: time_limit,
@@ -315,6 +315,9 @@ fn main() -> ExitCode {
                     machine,
                     objective,
                     thermal: Default::default(),
+                    // Set by `kerf.request` when a solver runs.
+                    kerf: Default::default(),
+                    leads_after: false,
                 };
                 let gcode = gcode.options(profile.as_ref(), &params.machine)?;
                 convert(
@@ -348,8 +351,9 @@ fn main() -> ExitCode {
             sheet,
             profile,
         } => (|| {
-            let kerf = kerf.parse()?;
-            let base = inputs::base_machine(profile.load()?.as_ref());
+            let profile = profile.load()?;
+            let kerf = kerf.parse()?.with_profile(profile.as_ref());
+            let base = inputs::base_machine(profile.as_ref());
             let (machine, objective) = machine.parse(base)?;
             let thermal = thermal.parse()?;
             let params = SolverParams {
@@ -360,6 +364,9 @@ fn main() -> ExitCode {
                 machine,
                 objective,
                 thermal: thermal.engine_settings(),
+                // Set by `kerf.request`.
+                kerf: Default::default(),
+                leads_after: false,
             };
             let input = (file.as_path(), sheet.index());
             let report = match solver.as_str() {
@@ -420,6 +427,11 @@ const KEPT_ROUTES: usize = 8;
 /// best state it published and exits (the promise is limit + 1 s, report included).
 const GRACE: std::time::Duration = std::time::Duration::from_millis(300);
 
+/// How long past its limit a kerf job may take to fit the leads of its first route: leads are
+/// part of the answer, and a route without them is none (on `nested.dbs` in a debug build
+/// under load, attaching every contour's leads takes about half a second).
+const LEADS_GRACE: std::time::Duration = std::time::Duration::from_secs(30);
+
 /// What the CLI's main thread and the solver's thread share.
 #[derive(Default)]
 struct Watch {
@@ -454,8 +466,19 @@ fn run_job(job: &mut dyn Job, watch: &Watch, on_progress: &mut dyn FnMut(&Progre
                 (kept_ub, kept_at) = (ub, elapsed);
             }
         }
+        // A kerf job between its solver's end and its first route with leads: the leads are
+        // part of the answer, so a stop waits for them (the main thread still reports what
+        // was published at the grace's end).
+        let fitting_leads = progress.route.is_none()
+            && matches!(
+                progress.phase,
+                cutroute_protocol::Phase::Kerf {
+                    note: cutroute_protocol::KerfNote::Leads { .. },
+                    ..
+                }
+            );
         seen.last = Some(progress);
-        let stop = watch.stop.load(Ordering::SeqCst);
+        let stop = watch.stop.load(Ordering::SeqCst) && !fitting_leads;
         if status == cutroute_engine::JobStatus::Done || stop {
             if stop {
                 seen.stopped = *watch.reason.lock().unwrap_or_else(|e| e.into_inner());
@@ -480,6 +503,7 @@ fn run_job(job: &mut dyn Job, watch: &Watch, on_progress: &mut dyn FnMut(&Progre
 /// Build phases (matrices, lattices, discretisations) count against the limit.
 fn run_bounded<T: Send + 'static>(
     time_limit_s: f64,
+    grace: std::time::Duration,
     work: impl FnOnce(&Watch) -> Result<T, Failure> + Send + 'static,
 ) -> Result<Result<T, JobRun>, Failure> {
     use std::sync::atomic::Ordering;
@@ -508,7 +532,7 @@ fn run_bounded<T: Send + 'static>(
             watch.stop.store(true, Ordering::SeqCst);
             stop_at = Some(std::time::Instant::now());
         }
-        if stop_at.is_some_and(|at| at.elapsed() >= GRACE) {
+        if stop_at.is_some_and(|at| at.elapsed() >= grace) {
             let mut seen = watch.seen.lock().unwrap_or_else(|e| e.into_inner());
             let mut run = std::mem::take(&mut *seen);
             run.stopped = Some(if limit_passed {
@@ -529,9 +553,16 @@ fn bounded_job_run(
     make_job: impl FnOnce(&JobRequest) -> Result<Option<Box<dyn Job>>, String> + Send + 'static,
 ) -> Result<JobRun, Failure> {
     let time_limit_s = request.params.time_limit_s;
+    // A kerf job stopped before its first route with leads keeps stepping until it has one
+    // (see `run_job`); the grace lets it.
+    let grace = if request.params.kerf.is_idealised() {
+        GRACE
+    } else {
+        LEADS_GRACE
+    };
     let display = stdio::ProgressDisplay::new(as_json);
     let mut shown = display.clone();
-    let outcome = run_bounded(time_limit_s, move |watch| {
+    let outcome = run_bounded(time_limit_s, grace, move |watch| {
         let mut job = match make_job(&request).map_err(Failure::Error)? {
             Some(job) => job,
             None => start_job(&request)
@@ -906,13 +937,11 @@ fn convert(
     let routed = || -> Result<Routed, String> {
         match (solver, &document.route, &document.paths) {
             (None, _, Some(paths)) => Ok(Routed::Paths(paths.clone())),
-            (None, Some(route), None) => Ok(Routed::Contours(route.clone())),
+            // A file's own route gets its leads here; a solved one has them from the job.
+            (None, Some(route), None) => Ok(Routed::Contours(kerf.attach(nest, route.clone())?)),
             (name, ..) => solved(&document, name.unwrap_or("ccp"), params.clone(), kerf),
         }
         .and_then(|routed| match routed {
-            Routed::Contours(route) if kerf.is_on() => Ok(Routed::Contours(
-                kerf.attach(nest, kerf.project(nest, route))?,
-            )),
             Routed::Paths(_) if kerf.is_on() => {
                 Err("path routes (sccp, gsccp, aoe) do not cut with kerf and leads yet".into())
             }
@@ -999,11 +1028,9 @@ fn solved(
         solver,
         params,
     };
-    // The checker's forest is the real nest's: with leads on, the solver runs over the
-    // pierce curves and its routes are projected back before they are checked.
     let forest = forest_in_background(&document.problem);
     let request = kerf.request(request, solver_name)?;
-    let mut run = bounded_job_run(request, true, |_| Ok(None)).map_err(|f| match f {
+    let run = bounded_job_run(request, true, |_| Ok(None)).map_err(|f| match f {
         Failure::Error(m) | Failure::Infeasible(m) => m,
     })?;
     if let Some(paths) = run.last.as_ref().and_then(|p| p.path_route.clone()) {
@@ -1018,7 +1045,7 @@ fn solved(
         }
         return Ok(Routed::Paths(paths));
     }
-    project_routes(&mut run, nest, kerf);
+    kerf.refused(run.last.as_ref())?;
     checked_route(&run, nest, &joined_forest(forest, nest))
         .map(|(route, _)| Routed::Contours(route))
         .map_err(|e| format!("the {solver_name} solver: {e}"))
@@ -1042,22 +1069,6 @@ fn generate(contours: usize, seed: u64, out: &Path) -> Result<(), String> {
     stdio::write_output(out, text.as_bytes())
 }
 
-/// With leads on, the solver ran over the pierce curves: its routes (the last and the earlier
-/// ones kept for the checker's fallback) are brought back onto the real contours.
-fn project_routes(run: &mut JobRun, nest: &Nest, kerf: &kerf::Kerf) {
-    if !kerf.is_on() {
-        return;
-    }
-    if let Some(last) = run.last.as_mut() {
-        if let Some(route) = last.route.take() {
-            last.route = Some(kerf.project(nest, route));
-        }
-    }
-    for route in &mut run.earlier_routes {
-        *route = kerf.project(nest, std::mem::take(route));
-    }
-}
-
 fn solve(
     input: (&Path, usize),
     solver_name: &str,
@@ -1075,8 +1086,6 @@ fn solve(
         solver,
         params,
     };
-    // The checker's forest is the real nest's (with leads on the solver runs over the pierce
-    // curves; its routes are projected back, see `project_routes`).
     let forest = forest_in_background(&document.problem);
     let request = kerf.request(request, solver_name)?;
     thermal.warn_unpriced(solver);
@@ -1085,18 +1094,24 @@ fn solve(
         Problem::PcgtspText { text } => tour_report(solver_name, text, &run)?,
         Problem::Nest { nest, .. } => {
             let forest = joined_forest(forest, nest);
-            project_routes(&mut run, nest, kerf);
+            kerf.refused(run.last.as_ref())?;
             // With `--rules-hard`, the route repaired until the rules hold (and its
             // certificates recomputed): the report describes the route it prints.
             if let Some(last) = run.last.as_mut() {
                 if let Some(route) = last.route.take() {
-                    let route = thermal.enforce(nest, route, &machine, objective)?;
+                    let enforced = thermal.enforce(nest, route.clone(), &machine, objective)?;
                     if !last.certified.is_empty() {
-                        let certified = cutroute_ccp::route_certificates(nest, &route)
+                        let certified = cutroute_ccp::route_certificates(nest, &enforced)
                             .map_err(|e| e.to_string())?;
                         last.certified = certified.iter().map(|c| c.condition1).collect();
                     }
-                    last.route = Some(kerf.attach(nest, route)?);
+                    // The job's route has its leads; a route the repair changed gets them
+                    // fitted again.
+                    last.route = Some(if enforced != route {
+                        kerf.attach(nest, enforced)?
+                    } else {
+                        enforced
+                    });
                 }
             }
             let mut report = route_report(solver_name, nest, &machine, &run, &forest)?;
@@ -1248,7 +1263,7 @@ fn solve_path(
     let started = std::time::Instant::now();
     let display = stdio::ProgressDisplay::new(as_json);
     let mut shown = display.clone();
-    let outcome = run_bounded(time_limit_s, move |watch| {
+    let outcome = run_bounded(time_limit_s, GRACE, move |watch| {
         let mut on_progress = |p: &Progress| shown.show(p);
         let mut extra = serde_json::Map::new();
         let progress = if solver == SolverKind::Aoe {

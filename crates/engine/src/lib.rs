@@ -32,6 +32,7 @@
 #![deny(missing_docs)]
 
 mod jobs;
+mod kerf;
 mod located;
 mod nearest;
 mod open;
@@ -43,6 +44,7 @@ use cutroute_protocol::{JobRequest, Problem, Progress, SolverKind};
 use web_time::Duration;
 
 pub use jobs::{ccp_options, CcpJob, ChainJob, DiscreteJob, DiscreteMode};
+pub use kerf::{fit_leads, supports_kerf, validate_kerf, KerfJob};
 pub use nearest::NearestNeighbourJob;
 pub use open::{format_name, OpenError};
 pub use open_files::{
@@ -131,11 +133,19 @@ fn pierce_candidates(
 /// idle + W·H (see the module `thermal` for what each solver honours).
 ///
 /// [`SolverParams::thermal`]: cutroute_protocol::SolverParams::thermal
+///
+/// With [`SolverParams::kerf`] not idealised, the job is a [`KerfJob`] around such jobs (its
+/// progress carries the full route with leads; see the module `kerf`).
+///
+/// [`SolverParams::kerf`]: cutroute_protocol::SolverParams::kerf
 pub fn start_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
     let params = &request.params;
     let Problem::Nest { nest, .. } = &request.problem else {
         return start_solver_job(request);
     };
+    if !params.kerf.is_idealised() {
+        return Ok(Box::new(KerfJob::from_request(request, start_job)?));
+    }
     params
         .thermal
         .validate()

@@ -122,6 +122,18 @@ impl LeadSpec {
         }
     }
 
+    /// The longest path the fitter may lay for this lead (the asked one; its variants are
+    /// shorter, or lines of the same length turned): the straight part plus the arc, mm.
+    pub fn longest_chain(self) -> f64 {
+        let (radius, sweep) = self.arc();
+        match self.shape {
+            LeadShape::None => 0.0,
+            LeadShape::Line => self.length,
+            LeadShape::Arc => (radius * sweep).max(self.length),
+            LeadShape::LineArc => self.length + radius * sweep,
+        }
+    }
+
     /// The arc's radius and sweep (radians).
     fn arc(self) -> (f64, f64) {
         let quarter = std::f64::consts::FRAC_PI_2;
@@ -953,51 +965,73 @@ impl<'a> LeadFitter<'a> {
     /// order is kept; leads stay valid.
     pub fn relax(&self, route: &Route, passes: usize, positions: usize) -> Route {
         let mut route = route.clone();
-        let n = route.steps.len();
         for _ in 0..passes {
-            for i in 0..n {
-                let step = &route.steps[i];
-                let (Some(current), true) = (&step.leads, step.is_pierced()) else {
-                    continue;
-                };
-                let Ok(eq) = self.equidistant(step.contour) else {
-                    continue;
-                };
-                let before = if i == 0 {
-                    route.start
-                } else {
-                    route.steps[i - 1].switch_off_point()
-                };
-                let after = match route.steps.get(i + 1) {
-                    Some(next) if next.is_pierced() => Some(next.switch_on_point()),
-                    Some(_) => None,
-                    None => route.finish,
-                };
-                let legs = |l: &StepLeads| {
-                    before.distance(l.pierce) + after.map_or(0.0, |a| l.switch_off.distance(a))
-                };
-                let perimeter = eq.perimeter();
-                let mut best = (legs(current), None);
-                for k in 0..positions {
-                    let s = perimeter * k as f64 / positions as f64;
-                    if let Ok(leads) = self.fit_at(step.contour, &eq, s) {
-                        let value = legs(&leads);
-                        if value < best.0 - 1e-9 {
-                            best = (value, Some(leads));
-                        }
-                    }
-                }
-                if let Some(leads) = best.1 {
-                    let contour = self.nest.contour(step.contour).expect("fitted contour");
-                    let step = &mut route.steps[i];
-                    if let Some(p) = contour.nearest_point(leads.entry) {
-                        step.pierce_point = p.point;
-                    }
-                    step.leads = Some(leads);
-                }
+            for i in 0..route.steps.len() {
+                self.relax_step(&mut route, i, positions);
             }
         }
         route
+    }
+
+    /// One step of [`LeadFitter::relax`]: the leads of step `i` moved to the best of
+    /// `positions` entries round its equidistant (if one shortens its idle legs). Returns
+    /// whether they moved. Callers that work in time slices relax step by step.
+    pub fn relax_step(&self, route: &mut Route, i: usize, positions: usize) -> bool {
+        let Some(step) = route.steps.get(i) else {
+            return false;
+        };
+        let (Some(current), true) = (&step.leads, step.is_pierced()) else {
+            return false;
+        };
+        let Ok(eq) = self.equidistant(step.contour) else {
+            return false;
+        };
+        let before = if i == 0 {
+            route.start
+        } else {
+            route.steps[i - 1].switch_off_point()
+        };
+        let after = match route.steps.get(i + 1) {
+            Some(next) if next.is_pierced() => Some(next.switch_on_point()),
+            Some(_) => None,
+            None => route.finish,
+        };
+        let legs = |l: &StepLeads| {
+            before.distance(l.pierce) + after.map_or(0.0, |a| l.switch_off.distance(a))
+        };
+        // Every lead the fitter makes at an entry P is at most this long (shorter and turned
+        // variants included), so M lies within `lead_in` of P and M* within `lead_out` of it:
+        // an entry whose legs cannot beat the best even so is not fitted (the result is the
+        // same, the fits are the cost).
+        let lead_in = self.settings.lead_in.longest_chain();
+        let lead_out = self.settings.lead_out.longest_chain() + self.settings.overcut;
+        let perimeter = eq.perimeter();
+        let mut best = (legs(current), None);
+        for k in 0..positions {
+            let s = perimeter * k as f64 / positions as f64;
+            let (entry, _) = frame_at(&eq, s);
+            let least = (before.distance(entry) - lead_in).max(0.0)
+                + after.map_or(0.0, |a| (a.distance(entry) - lead_out).max(0.0));
+            if least >= best.0 - 1e-9 {
+                continue;
+            }
+            if let Ok(leads) = self.fit_at(step.contour, &eq, s) {
+                let value = legs(&leads);
+                if value < best.0 - 1e-9 {
+                    best = (value, Some(leads));
+                }
+            }
+        }
+        let Some(leads) = best.1 else {
+            return false;
+        };
+        let contour = self.nest.contour(step.contour).expect("fitted contour");
+        let step = &mut route.steps[i];
+        if let Some(p) = contour.nearest_point(leads.entry) {
+            step.pierce_point = p.point;
+        }
+        step.leads = Some(leads);
+        true
     }
 
     /// Every rule that `leads` breaks as the leads of contour `r` (the checker used by

@@ -23,7 +23,9 @@
 //! ```
 #![deny(missing_docs)]
 
-use cutroute_geometry::{MachineParameters, Nest, Objective, PathRoute, Point, Route};
+use cutroute_geometry::{
+    KerfSettings, MachineParameters, Nest, Objective, PathRoute, Point, Route,
+};
 use serde::{Deserialize, Serialize};
 
 mod open_error;
@@ -32,7 +34,7 @@ mod profile;
 mod thermal;
 
 pub use open_error::{OpenError, OpenErrorKind, SourceLocation};
-pub use phase::{CcpStage, Ensemble, Phase, ThermalNote};
+pub use phase::{CcpStage, Ensemble, KerfNote, KerfSource, Phase, ThermalNote};
 pub use profile::{MachineProfile, ProfileError};
 pub use thermal::ThermalSettings;
 // The thermal types a `Progress` carries, so the UI needs no second import path.
@@ -281,6 +283,16 @@ pub struct SolverParams {
     /// default (weight 0, no rules), so requests without it run as before.
     #[serde(default)]
     pub thermal: ThermalSettings,
+    /// The full cutting route (issue #17): kerf, the pierce and switch-off clearances d₁ and
+    /// d₂, lead-in, lead-out, overcut and tabs. The default is the idealised model (requests
+    /// and links without it run as before); otherwise the engine's kerf job optimises the route
+    /// with its leads (nearest, ccp, heuristic).
+    #[serde(default)]
+    pub kerf: KerfSettings,
+    /// With kerf on: solve the idealised route, then attach leads (no optimisation with them;
+    /// the comparison of the benchmark, the CLI's `--leads-after`).
+    #[serde(default)]
+    pub leads_after: bool,
 }
 
 impl Default for SolverParams {
@@ -293,6 +305,8 @@ impl Default for SolverParams {
             machine: MachineParameters::default(),
             objective: Objective::default(),
             thermal: ThermalSettings::default(),
+            kerf: KerfSettings::default(),
+            leads_after: false,
         }
     }
 }
@@ -637,6 +651,54 @@ mod tests {
         };
         let bytes = bincode::serialize(&route).unwrap();
         assert_eq!(bincode::deserialize::<Route>(&bytes).unwrap(), route);
+    }
+
+    #[test]
+    fn kerf_settings_and_notes_survive_both_codecs_and_old_requests_stay_idealised() {
+        use cutroute_geometry::{KerfSettings, LeadShape, LeadSpec, TabSpec};
+        let mut request = match sample_request() {
+            ToWorker::Start(request) => request,
+            other => panic!("{other:?}"),
+        };
+        request.params.kerf = KerfSettings {
+            kerf: 2.0,
+            pierce_clearance: 5.0,
+            switch_off_clearance: 1.0,
+            lead_in: LeadSpec::new(LeadShape::Arc, 8.0),
+            lead_out: LeadSpec::new(LeadShape::LineArc, 2.0),
+            overcut: 0.5,
+            tabs: TabSpec {
+                count: 2,
+                width: 1.5,
+            },
+        };
+        request.params.leads_after = true;
+        let message = ToWorker::Start(request.clone());
+        let bytes = bincode::serialize(&message).unwrap();
+        assert_eq!(bincode::deserialize::<ToWorker>(&bytes).unwrap(), message);
+        let text = serde_json::to_string(&message).unwrap();
+        assert_eq!(serde_json::from_str::<ToWorker>(&text).unwrap(), message);
+        // A request written before kerf existed (links, scripts) reads as idealised.
+        let mut old: serde_json::Value = serde_json::to_value(&request).unwrap();
+        let params = old["params"].as_object_mut().unwrap();
+        params.remove("kerf");
+        params.remove("leads_after");
+        let read: JobRequest = serde_json::from_value(old).unwrap();
+        assert!(read.params.kerf.is_idealised());
+        assert!(!read.params.leads_after);
+        let phase = Phase::Kerf {
+            base: Box::new(Phase::Done),
+            note: KerfNote::NoRoom {
+                contours: vec![(1, 0)],
+                errors: vec!["no lead fits".into()],
+            },
+        };
+        let bytes = bincode::serialize(&phase).unwrap();
+        assert_eq!(bincode::deserialize::<Phase>(&bytes).unwrap(), phase);
+        assert_eq!(
+            phase.to_string(),
+            "done · 1 contour(s) without room for the leads: no lead fits"
+        );
     }
 
     #[test]

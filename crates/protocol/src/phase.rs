@@ -74,6 +74,36 @@ pub enum ThermalNote {
     RulesNotChecked,
 }
 
+/// Which candidate route a kerf job kept (its optimised route is never longer than the
+/// idealised order with leads attached and relaxed: both are evaluated, the shorter is kept).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum KerfSource {
+    /// The solver's route over the pierce curves, leads fitted and moved along the equidistants.
+    PierceCurves,
+    /// The solver's idealised route with leads attached (and, unless asked for the plain
+    /// "after" route, moved along the equidistants).
+    Idealised,
+}
+
+/// What a kerf job (the full cutting route: kerf, leads, tabs) did to the route of the solver
+/// it wraps.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum KerfNote {
+    /// Leads are attached to every pierced step; the route came from `source`.
+    Leads {
+        /// Which candidate route was kept.
+        source: KerfSource,
+    },
+    /// Some contours have no room for a lead-in/lead-out pair: no full route exists under the
+    /// settings, so the progress carries no route.
+    NoRoom {
+        /// The contours without room, as (part, contour) indices.
+        contours: Vec<(usize, usize)>,
+        /// Why, per contour, in English (`LeadError`'s words).
+        errors: Vec<String>,
+    },
+}
+
 /// What a job is doing, with its numbers.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub enum Phase {
@@ -195,6 +225,13 @@ pub enum Phase {
         /// What the thermal pass did.
         note: ThermalNote,
     },
+    /// A kerf job's note on the phase of the solver it wraps.
+    Kerf {
+        /// The wrapped solver's phase.
+        base: Box<Phase>,
+        /// What the kerf job did.
+        note: KerfNote,
+    },
 }
 
 impl Phase {
@@ -202,7 +239,7 @@ impl Phase {
     pub fn fraction(&self) -> Option<(usize, usize)> {
         match self {
             Phase::BuildingMatrix { rows_done, rows } => Some((*rows_done, *rows)),
-            Phase::Thermal { base, .. } => base.fraction(),
+            Phase::Thermal { base, .. } | Phase::Kerf { base, .. } => base.fraction(),
             _ => None,
         }
     }
@@ -303,6 +340,20 @@ impl fmt::Display for Phase {
                 ThermalNote::RulesNotChecked => write!(
                     f,
                     "{base} · rules not checked: the check would pass the time limit"
+                ),
+            },
+            Phase::Kerf { base, note } => match note {
+                KerfNote::Leads {
+                    source: KerfSource::PierceCurves,
+                } => write!(f, "{base} · leads optimised over the pierce curves"),
+                KerfNote::Leads {
+                    source: KerfSource::Idealised,
+                } => write!(f, "{base} · leads attached to the idealised order"),
+                KerfNote::NoRoom { errors, .. } => write!(
+                    f,
+                    "{base} · {} contour(s) without room for the leads: {}",
+                    errors.len(),
+                    errors.join("; ")
                 ),
             },
         }

@@ -24,7 +24,7 @@
 //! assert_eq!(profile.gcode_header, None); // the preset's header stays
 //! ```
 
-use cutroute_geometry::MachineParameters;
+use cutroute_geometry::{KerfSettings, MachineParameters};
 use serde::{Deserialize, Serialize};
 
 /// A named machine: its time and cost model and its G-code dialect.
@@ -45,6 +45,11 @@ pub struct MachineProfile {
     /// Footer lines replacing the preset's, when given.
     #[serde(default)]
     pub gcode_footer: Option<Vec<String>>,
+    /// The full cutting route of the machine and material: kerf, clearances d₁ and d₂, leads,
+    /// overcut, tabs (the CLI's `--kerf` … flags, which win when they turn kerf on); `None`
+    /// keeps the idealised route.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub kerf: Option<KerfSettings>,
 }
 
 /// A profile whose numbers cannot be a machine's.
@@ -85,6 +90,7 @@ impl MachineProfile {
             gcode_preset: None,
             gcode_header: None,
             gcode_footer: None,
+            kerf: None,
         }
     }
 
@@ -104,6 +110,21 @@ impl MachineProfile {
         ] {
             if !(value.is_finite() && value >= 0.0) {
                 return Err(ProfileError::Negative { field, value });
+            }
+        }
+        if let Some(k) = &self.kerf {
+            for (field, value) in [
+                ("kerf.kerf", k.kerf),
+                ("kerf.pierce_clearance", k.pierce_clearance),
+                ("kerf.switch_off_clearance", k.switch_off_clearance),
+                ("kerf.lead_in.length", k.lead_in.length),
+                ("kerf.lead_out.length", k.lead_out.length),
+                ("kerf.overcut", k.overcut),
+                ("kerf.tabs.width", k.tabs.width),
+            ] {
+                if !(value.is_finite() && value >= 0.0) {
+                    return Err(ProfileError::Negative { field, value });
+                }
             }
         }
         for (field, lines) in [
@@ -130,6 +151,12 @@ mod tests {
         let profile = MachineProfile {
             gcode_preset: Some("fanuc".into()),
             gcode_header: Some(vec!["G54".into()]),
+            kerf: Some(KerfSettings {
+                kerf: 2.0,
+                pierce_clearance: 5.0,
+                lead_in: cutroute_geometry::LeadSpec::new(cutroute_geometry::LeadShape::Arc, 8.0),
+                ..KerfSettings::default()
+            }),
             ..MachineProfile::new("Kometa", MachineParameters::default())
         };
         let json = serde_json::to_string_pretty(&profile).unwrap();
@@ -155,6 +182,18 @@ mod tests {
             })
         ));
         profile.machine.cut_speed = 1.0;
+        profile.kerf = Some(KerfSettings {
+            kerf: -1.0,
+            ..KerfSettings::default()
+        });
+        assert!(matches!(
+            profile.check(),
+            Err(ProfileError::Negative {
+                field: "kerf.kerf",
+                ..
+            })
+        ));
+        profile.kerf = None;
         profile.gcode_footer = Some(vec!["M30\nG00 X0".into()]);
         assert!(matches!(
             profile.check(),

@@ -1,0 +1,520 @@
+//! The full cutting route in every contour job (issue #17): kerf, the pierce and switch-off
+//! clearances d₁ and d₂, lead-ins, lead-outs, overcut and tabs ([`KerfSettings`]). The one
+//! place where a solver's idealised route becomes a route with leads; the CLI and the page
+//! both get their full routes from [`KerfJob`].
+//!
+//! Optimising with leads: the solver runs over the nest of *pierce curves*
+//! ([`LeadFitter::pierce_curve_nest`]), so the idle legs it prices run between pierce points
+//! off the contours; its route is projected back onto the nest, leads are fitted to every step
+//! and moved along the equidistants where that shortens the M* → next M legs
+//! ([`LeadFitter::relax`]). The curve model prices M = M*, which the real leads break (the
+//! lead-out ends elsewhere than the lead-in starts), so on some nests the idealised order with
+//! leads attached and relaxed is shorter. The job therefore also runs the solver on the nest
+//! itself, within the same time limit (the two share every slice), and keeps the shorter of the
+//! two full routes: its route is never longer than the idealised order with leads attached and
+//! relaxed, and so never longer than that order with leads attached.
+//!
+//! With `leads_after` the job runs the solver on the nest only and attaches leads (no
+//! relaxation): the "solve, then attach leads" route of the benchmark.
+
+use cutroute_geometry::{
+    ContainmentForest, CutStep, KerfSettings, LeadError, LeadFitter, Nest, Route,
+};
+use cutroute_protocol::{JobRequest, KerfNote, KerfSource, Phase, Problem, Progress, SolverKind};
+use web_time::{Duration, Instant};
+
+use crate::{EngineError, Job, JobStatus};
+
+/// Sweeps of [`LeadFitter::relax`] over a finished route, and the entries it tries round each
+/// equidistant (as the CLI always did).
+const RELAX_PASSES: usize = 2;
+const RELAX_POSITIONS: usize = 24;
+
+/// The share of the request's time limit kept for fitting and relaxing the leads of the
+/// finished routes (at most [`FIT_RESERVE_MAX_S`]): the inner solvers end that much earlier,
+/// so the final full route is there by the limit (the CLI stops a job at it).
+const FIT_RESERVE_SHARE: f64 = 0.25;
+const FIT_RESERVE_MAX_S: f64 = 2.0;
+
+/// Whether the kerf job can wrap `solver`'s job. Nearest, ccp and heuristic (the CLI's
+/// "discrete") route whole contours through pierce points, which the pierce curves carry
+/// over. Chain links start and end with leads, and the path solvers (sccp, gsccp, aoe) cut
+/// pieces of contours: they get their own full-route models (the `kerfpath` work), and join
+/// here by a new arm.
+pub fn supports_kerf(solver: SolverKind) -> bool {
+    match solver {
+        SolverKind::NearestNeighbour | SolverKind::Ccp | SolverKind::Heuristic => true,
+        // The exact solver's bounds are about the idealised (or curve) nest, not the full
+        // route: without a sound bound of the full route it would prove nothing.
+        SolverKind::Exact => false,
+        SolverKind::Chain | SolverKind::Sccp | SolverKind::Gsccp | SolverKind::Aoe => false,
+    }
+}
+
+/// Checks the settings a request carries: every length finite and non-negative, and d₂ < d₁
+/// when d₁ is set (the model's 0 ≤ d₂ < d₁).
+pub fn validate_kerf(settings: &KerfSettings) -> Result<(), String> {
+    let lengths = [
+        ("kerf", settings.kerf),
+        ("pierce clearance", settings.pierce_clearance),
+        ("switch-off clearance", settings.switch_off_clearance),
+        ("lead-in length", settings.lead_in.length),
+        ("lead-out length", settings.lead_out.length),
+        ("overcut", settings.overcut),
+        ("tab width", settings.tabs.width),
+    ];
+    for (name, value) in lengths {
+        if !(value.is_finite() && value >= 0.0) {
+            return Err(format!("{name} {value}: must be finite and non-negative"));
+        }
+    }
+    if settings.tabs.count > 0 && settings.tabs.width <= 0.0 {
+        return Err("tabs need a positive width".into());
+    }
+    Ok(())
+}
+
+/// `route` with leads fitted to every pierced step under `settings` on `nest` (every contour
+/// without room named), then, with `relax`, moved along the equidistants to shorten the idle
+/// legs (the order kept). Used by [`KerfJob`] and for routes a file already holds.
+pub fn fit_leads(
+    nest: &Nest,
+    forest: &ContainmentForest,
+    settings: KerfSettings,
+    route: &Route,
+    relax: bool,
+) -> Result<Route, Vec<LeadError>> {
+    let fitter = LeadFitter::with_forest(nest, forest, settings);
+    // A route that is not over this nest's contours (the curve nest's) is brought back first.
+    let attached = fitter.attach(&fitter.project(route))?;
+    Ok(if relax {
+        fitter.relax(&attached, RELAX_PASSES, RELAX_POSITIONS)
+    } else {
+        attached
+    })
+}
+
+/// One solver run whose routes the kerf job fits with leads.
+struct Candidate {
+    source: KerfSource,
+    job: Box<dyn Job>,
+    stage: Stage,
+    /// The last route of the running solver whose leads are fitted, and what the fit gave.
+    fitted: Option<(Route, Result<Route, Vec<LeadError>>)>,
+    /// A newer route of the running solver whose leads are being fitted step by step.
+    pending: Option<Attach>,
+}
+
+/// Where a candidate is: its solver runs, then its final route gets leads step by step, then
+/// they are relaxed step by step (every stage in slices, so a cancel is seen and no step runs
+/// long).
+enum Stage {
+    Solving,
+    Attaching(Attach),
+    Relaxing {
+        route: Route,
+        pass: usize,
+        next: usize,
+        /// Steps whose neighbours moved since they were last relaxed: a step whose idle legs
+        /// are unchanged would not move again (it holds the best of its positions), so only
+        /// these are tried (the same route as `LeadFitter::relax`, fewer fits).
+        dirty: Vec<bool>,
+    },
+    Finished(Option<Result<Route, Vec<LeadError>>>),
+}
+
+/// Leads attached to a solver's route, one step at a time.
+struct Attach {
+    /// The solver's route.
+    from: Route,
+    /// It projected onto the nest.
+    route: Route,
+    steps: Vec<CutStep>,
+    errors: Vec<LeadError>,
+}
+
+impl Attach {
+    fn new(fitter: &LeadFitter<'_>, from: Route) -> Attach {
+        Attach {
+            route: fitter.project(&from),
+            steps: Vec::with_capacity(from.steps.len()),
+            errors: Vec::new(),
+            from,
+        }
+    }
+
+    /// Attaches steps until `until`; the route with leads (or every contour without room)
+    /// once every step is done.
+    fn advance(
+        &mut self,
+        fitter: &LeadFitter<'_>,
+        until: Instant,
+    ) -> Option<Result<Route, Vec<LeadError>>> {
+        loop {
+            let done = self.steps.len() + self.errors.len();
+            let Some(step) = self.route.steps.get(done) else {
+                let steps = std::mem::take(&mut self.steps);
+                return Some(if self.errors.is_empty() {
+                    Ok(Route {
+                        steps,
+                        ..self.route.clone()
+                    })
+                } else {
+                    Err(std::mem::take(&mut self.errors))
+                });
+            };
+            if !step.is_pierced() {
+                self.steps.push(step.clone());
+            } else {
+                match fitter.attach_to_step(step) {
+                    Ok(step) => self.steps.push(step),
+                    Err(e) => self.errors.push(e),
+                }
+            }
+            if Instant::now() >= until {
+                return None;
+            }
+        }
+    }
+}
+
+/// A contour job (nearest, ccp, heuristic) under [`KerfSettings`]: every [`Progress`] carries
+/// the best route found with its leads (pierce M, lead-in, entry on the equidistant, lead-out,
+/// switch-off M*, tabs), its idle length as the upper bound, and a [`Phase::Kerf`] note. When a
+/// contour has no room for its leads the progress carries no route and the note lists the
+/// contours ([`KerfNote::NoRoom`]).
+pub struct KerfJob {
+    nest: Nest,
+    forest: ContainmentForest,
+    settings: KerfSettings,
+    /// Whether finished routes are relaxed (not in the "attach after" mode).
+    relax: bool,
+    candidates: Vec<Candidate>,
+    /// Which candidate the next slice starts with (they take turns).
+    turn: usize,
+    /// The request's time limit from the job's start: relaxing stops there (every relaxed
+    /// route is valid; attaching, which validity needs, does not stop).
+    deadline: Option<Instant>,
+}
+
+impl KerfJob {
+    /// The kerf job of `request` (a nest, settings not idealised, a solver that
+    /// [`supports_kerf`]); its inner jobs are built by `start` (the engine's `start_job`, so
+    /// each runs inside its thermal job).
+    pub fn from_request(
+        request: &JobRequest,
+        start: impl Fn(&JobRequest) -> Result<Box<dyn Job>, EngineError>,
+    ) -> Result<KerfJob, EngineError> {
+        let started = Instant::now();
+        let solver = request.solver;
+        let refused = |message: String| EngineError::SolverRefused {
+            solver: solver.name(),
+            message,
+        };
+        let Problem::Nest { nest, .. } = &request.problem else {
+            return Err(EngineError::UnsupportedProblem {
+                solver: solver.name(),
+                problem: "a PCGTSP instance with kerf and leads",
+            });
+        };
+        if !supports_kerf(solver) {
+            return Err(refused(
+                "does not cut with kerf and leads yet (nearest, ccp and heuristic do)".into(),
+            ));
+        }
+        let settings = request.params.kerf;
+        validate_kerf(&settings).map_err(refused)?;
+        let forest = nest.containment_forest();
+        // The inner requests are idealised: the kerf is this job's.
+        let mut idealised = request.clone();
+        idealised.params.kerf = KerfSettings::default();
+        idealised.params.leads_after = false;
+        let limit = request.params.time_limit_s;
+        if limit.is_finite() && limit > 0.0 {
+            idealised.params.time_limit_s =
+                limit - (limit * FIT_RESERVE_SHARE).min(FIT_RESERVE_MAX_S);
+        }
+        let mut candidates = Vec::new();
+        let after = request.params.leads_after;
+        if !after {
+            let curves = LeadFitter::with_forest(nest, &forest, settings).pierce_curve_nest();
+            let mut over_curves = idealised.clone();
+            if let Problem::Nest { nest, .. } = &mut over_curves.problem {
+                *nest = curves;
+            }
+            candidates.push(Candidate::new(
+                KerfSource::PierceCurves,
+                start(&over_curves)?,
+            ));
+        }
+        candidates.push(Candidate::new(KerfSource::Idealised, start(&idealised)?));
+        Ok(KerfJob {
+            nest: nest.clone(),
+            forest,
+            settings,
+            relax: !after,
+            candidates,
+            turn: 0,
+            deadline: started.checked_add(Duration::from_secs_f64(limit.clamp(0.0, 1.0e7))),
+        })
+    }
+
+    fn done(&self) -> bool {
+        self.candidates
+            .iter()
+            .all(|c| matches!(c.stage, Stage::Finished(_)))
+    }
+
+    /// Advances candidate `i` for about `budget`.
+    fn advance(&mut self, i: usize, budget: Duration) {
+        let started = Instant::now();
+        let until = started + budget;
+        let fitter = LeadFitter::with_forest(&self.nest, &self.forest, self.settings);
+        let relax = self.relax;
+        let deadline = self.deadline;
+        let relaxing = |route: Route| Stage::Relaxing {
+            dirty: vec![true; route.steps.len()],
+            route,
+            pass: 0,
+            next: 0,
+        };
+        let candidate = &mut self.candidates[i];
+        loop {
+            let stage = std::mem::replace(&mut candidate.stage, Stage::Finished(None));
+            candidate.stage = match stage {
+                Stage::Solving => {
+                    let status = candidate.job.step(budget);
+                    let route = candidate.job.progress().route;
+                    let fitted_from = candidate.fitted.as_ref().map(|(from, _)| from);
+                    let pending_from = candidate.pending.as_ref().map(|a| &a.from);
+                    if status == JobStatus::Done {
+                        match route {
+                            None => Stage::Finished(None),
+                            // Its leads were fitted already for a report: attached, they are.
+                            Some(route) if fitted_from == Some(&route) => {
+                                match candidate.fitted.as_ref().map(|(_, r)| r.clone()) {
+                                    Some(Ok(route)) if relax => relaxing(route),
+                                    other => Stage::Finished(other),
+                                }
+                            }
+                            Some(route) if pending_from == Some(&route) => Stage::Attaching(
+                                candidate.pending.take().expect("the pending attachment"),
+                            ),
+                            Some(route) => Stage::Attaching(Attach::new(&fitter, route)),
+                        }
+                    } else {
+                        // The solver's newer route gets its leads in a quarter more of the
+                        // slice, the first one in as much again as the solver had (one at a
+                        // time: a report shows the last fitted one meanwhile).
+                        if let Some(route) = route {
+                            if candidate.pending.is_none() && fitted_from != Some(&route) {
+                                candidate.pending = Some(Attach::new(&fitter, route));
+                            }
+                        }
+                        let spare = if candidate.fitted.is_some() {
+                            budget / 4
+                        } else {
+                            budget
+                        };
+                        if let Some(pending) = candidate.pending.as_mut() {
+                            if let Some(result) = pending.advance(&fitter, Instant::now() + spare) {
+                                let from = candidate.pending.take().expect("pending").from;
+                                candidate.fitted = Some((from, result));
+                            }
+                        }
+                        candidate.stage = Stage::Solving;
+                        return;
+                    }
+                }
+                Stage::Attaching(mut attach) => match attach.advance(&fitter, until) {
+                    None => Stage::Attaching(attach),
+                    Some(Ok(route)) if relax => relaxing(route),
+                    Some(result) => Stage::Finished(Some(result)),
+                },
+                Stage::Relaxing {
+                    mut route,
+                    mut pass,
+                    mut next,
+                    mut dirty,
+                } => {
+                    if deadline.is_some_and(|end| Instant::now() >= end) {
+                        Stage::Finished(Some(Ok(route)))
+                    } else {
+                        if dirty[next] {
+                            dirty[next] = false;
+                            if fitter.relax_step(&mut route, next, RELAX_POSITIONS) {
+                                if let Some(before) = next.checked_sub(1) {
+                                    dirty[before] = true;
+                                }
+                                if let Some(after) = dirty.get_mut(next + 1) {
+                                    *after = true;
+                                }
+                            }
+                        }
+                        next += 1;
+                        if next >= route.steps.len() {
+                            (pass, next) = (pass + 1, 0);
+                        }
+                        if pass >= RELAX_PASSES {
+                            Stage::Finished(Some(Ok(route)))
+                        } else {
+                            Stage::Relaxing {
+                                route,
+                                pass,
+                                next,
+                                dirty,
+                            }
+                        }
+                    }
+                }
+                finished @ Stage::Finished(_) => finished,
+            };
+            let working = matches!(
+                candidate.stage,
+                Stage::Attaching(_) | Stage::Relaxing { .. }
+            );
+            if !working || Instant::now() >= until {
+                return;
+            }
+        }
+    }
+}
+
+impl Candidate {
+    fn new(source: KerfSource, job: Box<dyn Job>) -> Candidate {
+        Candidate {
+            source,
+            job,
+            stage: Stage::Solving,
+            fitted: None,
+            pending: None,
+        }
+    }
+}
+
+impl Job for KerfJob {
+    fn step(&mut self, budget: Duration) -> JobStatus {
+        let solving: Vec<usize> = (0..self.candidates.len())
+            .filter(|&i| matches!(self.candidates[i].stage, Stage::Solving))
+            .collect();
+        // Leads are finished one candidate at a time, every attachment before any relaxation,
+        // so the first full route is there as soon as one solver has ended (a stop at the
+        // limit then still has one); then the shortest route is relaxed first, so a
+        // relaxation cut at the limit has spent its time on the route that is kept.
+        let finishing = (0..self.candidates.len())
+            .find(|&i| matches!(self.candidates[i].stage, Stage::Attaching(_)))
+            .or_else(|| {
+                (0..self.candidates.len())
+                    .filter_map(|i| match &self.candidates[i].stage {
+                        Stage::Relaxing { route, .. } => Some((i, route.idle_length())),
+                        _ => None,
+                    })
+                    .min_by(|a, b| a.1.total_cmp(&b.1))
+                    .map(|(i, _)| i)
+            });
+        let mut turns = solving.clone();
+        turns.extend(finishing);
+        if turns.is_empty() {
+            return JobStatus::Done;
+        }
+        // The solvers (and the finishing) share the slice, in turns, so each solver gets its
+        // share of the time limit's processor time and all end at the request's limit.
+        let share = budget / turns.len() as u32;
+        let first = self.turn % turns.len();
+        self.turn += 1;
+        for k in 0..turns.len() {
+            self.advance(turns[(first + k) % turns.len()], share);
+        }
+        if self.done() {
+            JobStatus::Done
+        } else {
+            JobStatus::Running
+        }
+    }
+
+    fn progress(&self) -> Progress {
+        let done = self.done();
+        let mut inner: Vec<Progress> = self.candidates.iter().map(|c| c.job.progress()).collect();
+        // Each candidate's full route: the finished one, the one being relaxed, or the last
+        // route of its solver whose leads are fitted.
+        let fitted: Vec<Option<Result<Route, Vec<LeadError>>>> = self
+            .candidates
+            .iter()
+            .map(|c| match &c.stage {
+                Stage::Finished(last) => last.clone(),
+                Stage::Relaxing { route, .. } => Some(Ok(route.clone())),
+                Stage::Solving | Stage::Attaching(_) => c.fitted.as_ref().map(|(_, r)| r.clone()),
+            })
+            .collect();
+        // The shorter full route (the first candidate, the curves', on a tie).
+        let best = fitted
+            .iter()
+            .enumerate()
+            .filter_map(|(i, f)| match f {
+                Some(Ok(route)) => Some((i, route)),
+                _ => None,
+            })
+            .min_by(|a, b| {
+                a.1.idle_length()
+                    .total_cmp(&b.1.idle_length())
+                    .then(a.0.cmp(&b.0))
+            });
+        let (index, note, route) = match best {
+            Some((i, route)) => (
+                i,
+                KerfNote::Leads {
+                    source: self.candidates[i].source,
+                },
+                Some(route.clone()),
+            ),
+            None => match fitted
+                .iter()
+                .enumerate()
+                .find_map(|(i, f)| f.as_ref().and_then(|f| f.as_ref().err()).map(|e| (i, e)))
+            {
+                Some((i, errors)) => (i, no_room(errors), None),
+                None => (
+                    0,
+                    KerfNote::Leads {
+                        source: self.candidates[0].source,
+                    },
+                    None,
+                ),
+            },
+        };
+        let slowest = inner.iter().map(|p| p.elapsed_s).fold(0.0, f64::max);
+        let mut progress = inner.swap_remove(index);
+        // The inner bounds, certificates and optimality proof are about the idealised (or the
+        // curve) nest, not the full route: none of them is reported for it.
+        progress.upper_bound = route.as_ref().map(Route::idle_length);
+        progress.lower_bound = None;
+        progress.proven_optimal = false;
+        progress.tour = None;
+        progress.certified = Vec::new();
+        progress.route = route;
+        if done {
+            // The slower candidate's clock is the job's.
+            progress.elapsed_s = slowest;
+        }
+        progress.phase = Phase::Kerf {
+            base: Box::new(std::mem::take(&mut progress.phase)),
+            note,
+        };
+        progress
+    }
+}
+
+fn no_room(errors: &[LeadError]) -> KerfNote {
+    let contours = errors
+        .iter()
+        .map(|e| match e {
+            LeadError::UnknownContour { contour }
+            | LeadError::Offset { contour, .. }
+            | LeadError::NoFit { contour, .. } => (contour.part, contour.contour),
+        })
+        .collect();
+    KerfNote::NoRoom {
+        contours,
+        errors: errors.iter().map(LeadError::to_string).collect(),
+    }
+}

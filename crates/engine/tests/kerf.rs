@@ -1,0 +1,190 @@
+//! The full cutting route through the engine (issue #17): the kerf job's every progress carries
+//! its route with leads, every final route passes the independent checker, its route is never
+//! longer than the idealised order with leads attached, and contours without room are named.
+
+use std::path::PathBuf;
+
+use cutroute_engine::{open_document, run_to_end, start_job, EngineError};
+use cutroute_geometry::{KerfSettings, LeadShape, LeadSpec, Nest, Route, TabSpec};
+use cutroute_protocol::{JobRequest, KerfNote, Phase, Problem, Progress, SolverKind, SolverParams};
+
+fn nest_problem(relative: &str) -> Problem {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../data")
+        .join(relative);
+    let bytes = std::fs::read(&path).expect("test file");
+    open_document(relative, &bytes).expect("opens").problem
+}
+
+fn nest_of(problem: &Problem) -> &Nest {
+    match problem {
+        Problem::Nest { nest, .. } => nest,
+        Problem::PcgtspText { .. } => panic!("a nest"),
+    }
+}
+
+/// Kerf 2, d₁ 5, d₂ 1, an 8 mm arc lead-in and a 2 mm line lead-out (the issue's plasma).
+fn plasma() -> KerfSettings {
+    KerfSettings {
+        kerf: 2.0,
+        pierce_clearance: 5.0,
+        switch_off_clearance: 1.0,
+        lead_in: LeadSpec::new(LeadShape::Arc, 8.0),
+        lead_out: LeadSpec::new(LeadShape::Line, 2.0),
+        overcut: 0.0,
+        tabs: TabSpec::default(),
+    }
+}
+
+fn request(problem: &Problem, solver: SolverKind, kerf: KerfSettings, after: bool) -> JobRequest {
+    JobRequest {
+        job_id: 7,
+        problem: problem.clone(),
+        solver,
+        params: SolverParams {
+            time_limit_s: 1.0,
+            kerf,
+            leads_after: after,
+            ..SolverParams::default()
+        },
+    }
+}
+
+/// Runs the job to its end; every progress with a route must have leads on each pierced step.
+fn run(request: &JobRequest) -> Progress {
+    let mut job = start_job(request).expect("starts");
+    run_to_end(job.as_mut(), &mut |p| {
+        if let Some(route) = &p.route {
+            assert_leads_everywhere(route);
+            assert_eq!(p.upper_bound, Some(route.idle_length()));
+            assert!(p.lower_bound.is_none());
+        }
+        assert!(matches!(p.phase, Phase::Kerf { .. }), "{:?}", p.phase);
+    })
+}
+
+fn assert_leads_everywhere(route: &Route) {
+    for step in &route.steps {
+        if step.is_pierced() {
+            assert!(step.leads.is_some(), "a pierced step without leads");
+        }
+    }
+}
+
+fn checked(problem: &Problem, progress: &Progress) -> Route {
+    let nest = nest_of(problem);
+    let route = progress.route.clone().expect("a route");
+    let problems = route.problems(nest, &nest.containment_forest(), 1e-6);
+    assert!(problems.is_empty(), "{:?}", problems.first());
+    assert_leads_everywhere(&route);
+    route
+}
+
+#[test]
+fn nearest_with_leads_is_never_longer_than_nearest_then_leads() {
+    // Nearest is deterministic: the kerf job's idealised candidate is exactly the route the
+    // "after" job attaches leads to, so the comparison is exact.
+    for file in [
+        "nests/dbs-json/E1X_6_01.dbs.json",
+        "nests/dbs/seven.dbs",
+        "nests/dbs/seven_3717.dbs",
+        "nests/dbs-json/test1.dbs.json",
+    ] {
+        let problem = nest_problem(file);
+        let mut job_request = request(&problem, SolverKind::NearestNeighbour, plasma(), false);
+        // Time for every relaxation to run to its end.
+        job_request.params.time_limit_s = 60.0;
+        let optimised = checked(&problem, &run(&job_request));
+        let after = checked(
+            &problem,
+            &run(&request(
+                &problem,
+                SolverKind::NearestNeighbour,
+                plasma(),
+                true,
+            )),
+        );
+        assert!(
+            optimised.idle_length() <= after.idle_length() + 1e-9,
+            "{file}: optimised {} > after {}",
+            optimised.idle_length(),
+            after.idle_length()
+        );
+    }
+}
+
+#[test]
+fn ccp_and_heuristic_give_checked_routes_with_leads() {
+    let problem = nest_problem("nests/dbs-json/E1X_6_01.dbs.json");
+    for solver in [SolverKind::Ccp, SolverKind::Heuristic] {
+        let progress = run(&request(&problem, solver, plasma(), false));
+        checked(&problem, &progress);
+        assert!(
+            matches!(
+                progress.phase,
+                Phase::Kerf {
+                    note: KerfNote::Leads { .. },
+                    ..
+                }
+            ),
+            "{solver:?}: {:?}",
+            progress.phase
+        );
+    }
+}
+
+#[test]
+fn a_contour_without_room_is_named_not_dropped() {
+    // ring.dbs: a 4 mm ring, no room inside for an 8 mm lead-in at kerf 2 and d₁ 5.
+    let problem = nest_problem("nests/dbs/ring.dbs");
+    let progress = run(&request(
+        &problem,
+        SolverKind::NearestNeighbour,
+        plasma(),
+        false,
+    ));
+    assert!(progress.route.is_none());
+    let Phase::Kerf {
+        note: KerfNote::NoRoom { contours, errors },
+        ..
+    } = &progress.phase
+    else {
+        panic!("{:?}", progress.phase);
+    };
+    assert!(!contours.is_empty());
+    assert_eq!(contours.len(), errors.len());
+    assert!(progress.phase.to_string().contains("without room"));
+}
+
+#[test]
+fn solvers_without_a_full_route_model_are_refused_and_bad_settings_too() {
+    let problem = nest_problem("nests/dbs-json/E1X_6_01.dbs.json");
+    for solver in [SolverKind::Aoe, SolverKind::Sccp, SolverKind::Chain] {
+        let refused = start_job(&request(&problem, solver, plasma(), false));
+        assert!(
+            matches!(refused, Err(EngineError::SolverRefused { .. })),
+            "{solver:?}"
+        );
+    }
+    let bad = KerfSettings {
+        kerf: f64::NAN,
+        ..plasma()
+    };
+    assert!(start_job(&request(&problem, SolverKind::Ccp, bad, false)).is_err());
+}
+
+#[test]
+fn idealised_settings_leave_the_job_as_it_was() {
+    let problem = nest_problem("nests/dbs-json/E1X_6_01.dbs.json");
+    let plain = request(
+        &problem,
+        SolverKind::NearestNeighbour,
+        KerfSettings::default(),
+        false,
+    );
+    let mut job = start_job(&plain).expect("starts");
+    let progress = run_to_end(job.as_mut(), &mut |_| {});
+    assert!(!matches!(progress.phase, Phase::Kerf { .. }));
+    let route = progress.route.expect("a route");
+    assert!(route.steps.iter().all(|s| s.leads.is_none()));
+}

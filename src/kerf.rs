@@ -1,0 +1,239 @@
+//! The full cutting route in the page (issue #17): the machine panel's kerf, clearances d₁
+//! and d₂, lead shapes and lengths, overcut and tabs (sent in every job request as
+//! `SolverParams::kerf`; the engine's kerf job returns the route with its leads), and the
+//! drawing's layers of it: one lead path per step (lead-in and lead-out), the equidistants the
+//! tool centre runs on, and the pierce (M) and switch-off (M*) points. The cuts themselves
+//! (along the equidistants, tabs left as gaps) and the animation come from the route's
+//! `Toolpath`, which follows lead-in → contour → lead-out.
+
+use std::fmt::Write;
+
+use cutroute_geometry::{chain_spans, equidistant, KerfSettings, LeadShape, Nest, Route};
+use leptos::prelude::*;
+
+use crate::drawing::{contour_path, push_span};
+use crate::i18n::tr;
+use crate::settings::{parse_tabs, shape_from_name, shape_name};
+
+/// Path data of each step's leads (lead-in, then lead-out as a second subpath), one entry per
+/// step that has leads.
+pub fn lead_paths(route: &Route) -> Vec<String> {
+    route
+        .steps
+        .iter()
+        .filter_map(|s| s.leads.as_ref())
+        .map(|leads| {
+            let mut d = String::new();
+            for chain in [&leads.lead_in, &leads.lead_out] {
+                let Some(first) = chain.first() else { continue };
+                let _ = write!(d, "M{:.3} {:.3}", first.point.x, first.point.y);
+                chain_spans(chain).for_each(|span| push_span(&span, &mut d));
+            }
+            d
+        })
+        .collect()
+}
+
+/// Path data of the equidistants of the route's contours (kerf/2 off each, on its scrap side).
+pub fn equidistants_path(nest: &Nest, route: &Route) -> String {
+    let mut d = String::new();
+    for step in &route.steps {
+        let (Some(leads), Some(contour)) = (&step.leads, nest.contour(step.contour)) else {
+            continue;
+        };
+        if let Ok(eq) = equidistant(contour, leads.offset) {
+            contour_path(&eq, &mut d);
+        }
+    }
+    d
+}
+
+/// Lead-in and lead-out lengths of a route, mm (0 without leads).
+pub fn lead_lengths(route: &Route) -> (f64, f64) {
+    route
+        .steps
+        .iter()
+        .filter_map(|s| s.leads.as_ref())
+        .fold((0.0, 0.0), |(i, o), l| {
+            (i + l.lead_in_length(), o + l.lead_out_length())
+        })
+}
+
+/// The lead layers of the drawing: leads, equidistants, pierce and switch-off points.
+#[component]
+pub fn LeadLayers(
+    nest: Signal<Option<Nest>>,
+    route: Signal<Option<Route>>,
+    extent: Signal<f64>,
+) -> impl IntoView {
+    let leads = move || {
+        route.with(|r| {
+            r.as_ref().map(|r| {
+                lead_paths(r)
+                    .into_iter()
+                    .map(|d| view! { <path class="lead" d=d /> })
+                    .collect_view()
+            })
+        })
+    };
+    let equidistants = move || {
+        route.with(|r| {
+            let r = r.as_ref()?;
+            nest.with(|n| n.as_ref().map(|n| equidistants_path(n, r)))
+        })
+    };
+    let marks = move || {
+        let size = extent.get() / 300.0;
+        route.with(|r| {
+            r.as_ref().map(|r| {
+                r.steps
+                    .iter()
+                    .filter_map(|s| s.leads.as_ref())
+                    .map(|l| {
+                        view! {
+                            <circle class="pierce-m" cx=l.pierce.x cy=l.pierce.y r=size />
+                            <rect
+                                class="switch-off-m"
+                                x=l.switch_off.x - size
+                                y=l.switch_off.y - size
+                                width=2.0 * size
+                                height=2.0 * size
+                            />
+                        }
+                    })
+                    .collect_view()
+            })
+        })
+    };
+    view! {
+        <path class="equidistants" d=equidistants />
+        <g class="leads">{leads}</g>
+        <g class="pierce-regions">{marks}</g>
+    }
+}
+
+/// The full-route settings, beside the machine parameters.
+#[component]
+pub fn KerfPanel(settings: RwSignal<KerfSettings>) -> impl IntoView {
+    type Words = (&'static str, &'static str);
+    let number = move |id: &'static str,
+                       label: Words,
+                       tip: Words,
+                       get: fn(&KerfSettings) -> f64,
+                       set: fn(&mut KerfSettings, f64)| {
+        view! {
+            <label class="param" title=tr(tip.0, tip.1)>
+                <span>{tr(label.0, label.1)}</span>
+                <input
+                    id=id
+                    type="number"
+                    min="0"
+                    step="any"
+                    prop:value=move || get(&settings.get()).to_string()
+                    on:change=move |ev| {
+                        if let Ok(v) = event_target_value(&ev).parse::<f64>() {
+                            if v.is_finite() && v >= 0.0 {
+                                settings.update(|s| set(s, v));
+                            }
+                        }
+                    }
+                />
+                <span class="unit">{tr("mm", "мм")}</span>
+            </label>
+        }
+    };
+    let shape = move |id: &'static str,
+                      label: Words,
+                      get: fn(&KerfSettings) -> LeadShape,
+                      set: fn(&mut KerfSettings, LeadShape)| {
+        let options: [(LeadShape, Words); 4] = [
+            (LeadShape::None, ("none", "нет")),
+            (LeadShape::Line, ("line", "прямая")),
+            (LeadShape::Arc, ("arc", "дуга")),
+            (LeadShape::LineArc, ("line + arc", "прямая + дуга")),
+        ];
+        view! {
+            <label class="param">
+                <span>{tr(label.0, label.1)}</span>
+                <select
+                    id=id
+                    prop:value=move || shape_name(get(&settings.get()))
+                    on:change=move |ev| {
+                        if let Some(s) = shape_from_name(&event_target_value(&ev)) {
+                            settings.update(|k| set(k, s));
+                        }
+                    }
+                >
+                    {options
+                        .into_iter()
+                        .map(|(s, words)| {
+                            view! {
+                                <option
+                                    value=shape_name(s)
+                                    selected=move || get(&settings.get()) == s
+                                >
+                                    {tr(words.0, words.1)}
+                                </option>
+                            }
+                        })
+                        .collect_view()}
+                </select>
+            </label>
+        }
+    };
+    view! {
+        <details class="machine kerf">
+            <summary>{tr("Kerf and leads", "Ширина реза и подводы")}</summary>
+            {number("kerf-width", ("Kerf", "Ширина реза"), ("Kerf width: the tool centre runs kerf/2 off each contour; 0 cuts on the contours", "Ширина реза: центр инструмента идёт на половине ширины реза от контура; 0 — по контурам"), |k| k.kerf, |k, v| k.kerf = v)}
+            {number("kerf-d1", ("Pierce clearance d₁", "Зазор врезки d₁"), ("Least distance from every contour to a pierce point", "Наименьшее расстояние от любого контура до точки врезки"), |k| k.pierce_clearance, |k, v| k.pierce_clearance = v)}
+            {number("kerf-d2", ("Switch-off clearance d₂", "Зазор выключения d₂"), ("Least distance from every contour to a switch-off point", "Наименьшее расстояние от любого контура до точки выключения"), |k| k.switch_off_clearance, |k, v| k.switch_off_clearance = v)}
+            {shape("lead-in-shape", ("Lead-in", "Подвод"), |k| k.lead_in.shape, |k, s| k.lead_in.shape = s)}
+            {number("lead-in-length", ("Lead-in length", "Длина подвода"), ("Length of the lead-in from the pierce point to the contour", "Длина подвода от точки врезки до контура"), |k| k.lead_in.length, |k, v| k.lead_in.length = v)}
+            {shape("lead-out-shape", ("Lead-out", "Отвод"), |k| k.lead_out.shape, |k, s| k.lead_out.shape = s)}
+            {number("lead-out-length", ("Lead-out length", "Длина отвода"), ("Length of the lead-out from the contour to the switch-off point", "Длина отвода от контура до точки выключения"), |k| k.lead_out.length, |k, v| k.lead_out.length = v)}
+            {number("kerf-overcut", ("Overcut", "Перебег"), ("How far the cut runs on past the entry before the lead-out", "На сколько рез заходит за точку входа перед отводом"), |k| k.overcut, |k, v| k.overcut = v)}
+            <label class="param" title=tr("Micro-joints: N uncut gaps of WIDTH mm in the outer contour of every part (0:0 for none)", "Микроперемычки: N непрорезанных промежутков шириной W мм во внешнем контуре каждой детали (0:0 — нет)")>
+                <span>{tr("Tabs N:width", "Перемычки N:ширина")}</span>
+                <input
+                    id="kerf-tabs"
+                    type="text"
+                    inputmode="decimal"
+                    prop:value=move || settings.with(|k| format!("{}:{}", k.tabs.count, k.tabs.width))
+                    on:change=move |ev| {
+                        if let Some(tabs) = parse_tabs(&event_target_value(&ev)) {
+                            settings.update(|k| k.tabs = tabs);
+                        }
+                    }
+                />
+            </label>
+        </details>
+    }
+}
+
+/// The lead lengths of the shown route, for the statistics.
+#[component]
+pub fn LeadStats(route: Signal<Option<Route>>) -> impl IntoView {
+    let language = crate::i18n::use_language();
+    let lengths = move || route.with(|r| r.as_ref().map(lead_lengths));
+    let mm = move || language.pick("mm", "мм");
+    let has_leads = move || {
+        route.with(|r| {
+            r.as_ref()
+                .is_some_and(|r| r.steps.iter().any(|s| s.leads.is_some()))
+        })
+    };
+    view! {
+        <Show when=has_leads>
+            <dl class="lead-stats">
+                <dt>{tr("Lead-ins", "Подводы")}</dt>
+                <dd id="lead-in-length" data-mm=move || lengths().map(|l| format!("{:.3}", l.0))>
+                    {move || lengths().map(|l| format!("{:.1} {}", l.0, mm())).unwrap_or_default()}
+                </dd>
+                <dt>{tr("Lead-outs", "Отводы")}</dt>
+                <dd id="lead-out-length" data-mm=move || lengths().map(|l| format!("{:.3}", l.1))>
+                    {move || lengths().map(|l| format!("{:.1} {}", l.1, mm())).unwrap_or_default()}
+                </dd>
+            </dl>
+        </Show>
+    }
+}
