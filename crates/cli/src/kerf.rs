@@ -8,6 +8,11 @@
 //! onto the nest, every step gets its fitted leads, and the leads are moved along the
 //! equidistants where that shortens the idle legs from M* to the next M. `--leads-after` instead solves the
 //! idealised route and attaches leads to it (the comparison of the benchmark).
+//!
+//! Chain cutting runs over the nest of equidistants (`LeadFitter::kerf_nest`): its links run
+//! between entries on the equidistants, and `LeadFitter::attach_chained` gives each chain a
+//! lead-in at its first contour and a lead-out at its last (`--leads-after`: without moving
+//! the free leads afterwards).
 
 use cutroute_geometry::{
     KerfSettings, LeadError, LeadFitter, LeadShape, LeadSpec, Nest, Route, StepLeads, TabSpec,
@@ -56,6 +61,8 @@ pub struct KerfArgs {
 pub struct Kerf {
     settings: KerfSettings,
     after: bool,
+    /// Chain links given up for pierces where a lead found no room (see `project`).
+    broken_links: std::cell::Cell<usize>,
 }
 
 fn shape(flag: &str, text: &str) -> Result<LeadShape, String> {
@@ -113,6 +120,7 @@ impl KerfArgs {
         Ok(Kerf {
             settings,
             after: self.leads_after,
+            broken_links: Default::default(),
         })
     }
 }
@@ -128,10 +136,19 @@ impl Kerf {
         if !self.is_on() {
             return Ok(request);
         }
-        if !matches!(solver, "nearest" | "ccp" | "heuristic" | "discrete") {
+        if !matches!(
+            solver,
+            "nearest" | "ccp" | "heuristic" | "discrete" | "chain"
+        ) {
             return Err(format!(
-                "--solver {solver} does not cut with kerf and leads yet (nearest, ccp, heuristic and discrete do)"
+                "--solver {solver} does not cut with kerf and leads yet (nearest, ccp, heuristic, discrete and chain do)"
             ));
+        }
+        if solver == "chain" {
+            if let Problem::Nest { nest, .. } = &mut request.problem {
+                *nest = LeadFitter::new(nest, self.settings).kerf_nest();
+            }
+            return Ok(request);
         }
         if self.after {
             return Ok(request);
@@ -142,18 +159,31 @@ impl Kerf {
         Ok(request)
     }
 
-    /// The solver's route brought onto `nest` (pierce points on its contours).
-    pub fn project(&self, nest: &Nest, route: Route) -> Route {
-        if self.is_on() {
-            LeadFitter::new(nest, self.settings).project(&route)
-        } else {
-            route
+    /// The solver's route brought onto `nest` (pierce points on its contours). A chained
+    /// route (over the kerf nest) comes back with its leads; every contour without room is
+    /// named.
+    pub fn project(&self, nest: &Nest, route: Route) -> Result<Route, String> {
+        if !self.is_on() {
+            return Ok(route);
         }
+        let fitter = LeadFitter::new(nest, self.settings);
+        if route.steps.iter().any(|s| !s.is_pierced()) {
+            let passes = if self.after { 0 } else { 2 };
+            return fitter
+                .attach_chained(&route, passes, 24)
+                .map(|chained| {
+                    self.broken_links.set(chained.broken_links);
+                    chained.route
+                })
+                .map_err(no_room);
+        }
+        Ok(fitter.project(&route))
     }
 
-    /// `route` with leads on every step; every contour without room is named.
+    /// `route` with leads on every step; every contour without room is named. A route that
+    /// has its leads already (a chained route, see `project`) is kept.
     pub fn attach(&self, nest: &Nest, route: Route) -> Result<Route, String> {
-        if !self.is_on() {
+        if !self.is_on() || route.steps.iter().any(|s| s.leads.is_some()) {
             return Ok(route);
         }
         let fitter = LeadFitter::new(nest, self.settings);
@@ -166,14 +196,7 @@ impl Kerf {
                     fitter.relax(&route, 2, 24)
                 }
             })
-            .map_err(|errors| {
-                let list: Vec<String> = errors.iter().map(LeadError::to_string).collect();
-                format!(
-                    "{} contour(s) without room for the leads: {}",
-                    errors.len(),
-                    list.join("; ")
-                )
-            })
+            .map_err(no_room)
     }
 
     /// Adds the full-route fields to a nest report: `start`, `finish`, the settings, the lead
@@ -196,6 +219,9 @@ impl Kerf {
             "optimised_with_leads": !self.after,
         });
         let leads = || route.steps.iter().filter_map(|s| s.leads.as_ref());
+        if route.steps.iter().any(|s| !s.is_pierced()) || self.broken_links.get() > 0 {
+            report["chain_links_broken"] = json!(self.broken_links.get());
+        }
         report["lead_in_length"] = json!(leads().map(StepLeads::lead_in_length).sum::<f64>());
         report["lead_out_length"] = json!(leads().map(StepLeads::lead_out_length).sum::<f64>());
         let Some(steps) = report["route"].as_array_mut() else {
@@ -225,4 +251,14 @@ impl Kerf {
             }
         }
     }
+}
+
+/// The error of contours where no lead fits, each named.
+fn no_room(errors: Vec<LeadError>) -> String {
+    let list: Vec<String> = errors.iter().map(LeadError::to_string).collect();
+    format!(
+        "{} contour(s) without room for the leads: {}",
+        errors.len(),
+        list.join("; ")
+    )
 }

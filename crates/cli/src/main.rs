@@ -34,8 +34,9 @@
 //! nearest, ccp and chain minimise objective + W·H (heuristic and exact relax their final pierce
 //! points on it), `--rules-hard` repairs the route until the rules hold.
 //! With `--kerf`/leads on (`kerf.rs`), nearest, ccp, heuristic and discrete optimise the full
-//! route (pierce points off the contours, leads, cut on the equidistants) and each route step
-//! carries `pierce` (M), `entry`, `lead_in`, `lead_out` and `switch_off`.
+//! route (pierce points off the contours, leads, cut on the equidistants), chain links its
+//! chains between the equidistants (a lead-in at each chain's start, a lead-out at its end),
+//! and each route step carries `pierce` (M), `entry`, `lead_in`, `lead_out` and `switch_off`.
 //! `--sheet`, `--profile` and `--preset` are described in `inputs.rs` (profile < task <
 //! flags; `--preset` < the G-code flags).
 //! `-` as a file name is standard input (FILE, IN) or standard output (OUT, `--out`); files are
@@ -911,7 +912,7 @@ fn convert(
         }
         .and_then(|routed| match routed {
             Routed::Contours(route) if kerf.is_on() => Ok(Routed::Contours(
-                kerf.attach(nest, kerf.project(nest, route))?,
+                kerf.attach(nest, kerf.project(nest, route)?)?,
             )),
             Routed::Paths(_) if kerf.is_on() => {
                 Err("path routes (sccp, gsccp, aoe) do not cut with kerf and leads yet".into())
@@ -1018,7 +1019,7 @@ fn solved(
         }
         return Ok(Routed::Paths(paths));
     }
-    project_routes(&mut run, nest, kerf);
+    project_routes(&mut run, nest, kerf)?;
     checked_route(&run, nest, &joined_forest(forest, nest))
         .map(|(route, _)| Routed::Contours(route))
         .map_err(|e| format!("the {solver_name} solver: {e}"))
@@ -1042,20 +1043,25 @@ fn generate(contours: usize, seed: u64, out: &Path) -> Result<(), String> {
     stdio::write_output(out, text.as_bytes())
 }
 
-/// With leads on, the solver ran over the pierce curves: its routes (the last and the earlier
-/// ones kept for the checker's fallback) are brought back onto the real contours.
-fn project_routes(run: &mut JobRun, nest: &Nest, kerf: &kerf::Kerf) {
+/// With leads on, the solver ran over the pierce curves (chain: the equidistants): its routes
+/// (the last and the earlier ones kept for the checker's fallback) are brought back onto the
+/// real contours. The last route's contours without room for leads are an error; earlier
+/// routes that cannot be brought back are dropped from the fallback.
+fn project_routes(run: &mut JobRun, nest: &Nest, kerf: &kerf::Kerf) -> Result<(), String> {
     if !kerf.is_on() {
-        return;
+        return Ok(());
     }
     if let Some(last) = run.last.as_mut() {
         if let Some(route) = last.route.take() {
-            last.route = Some(kerf.project(nest, route));
+            last.route = Some(kerf.project(nest, route)?);
         }
     }
-    for route in &mut run.earlier_routes {
-        *route = kerf.project(nest, std::mem::take(route));
-    }
+    let earlier = std::mem::take(&mut run.earlier_routes);
+    run.earlier_routes = earlier
+        .into_iter()
+        .filter_map(|route| kerf.project(nest, route).ok())
+        .collect();
+    Ok(())
 }
 
 fn solve(
@@ -1085,7 +1091,7 @@ fn solve(
         Problem::PcgtspText { text } => tour_report(solver_name, text, &run)?,
         Problem::Nest { nest, .. } => {
             let forest = joined_forest(forest, nest);
-            project_routes(&mut run, nest, kerf);
+            project_routes(&mut run, nest, kerf)?;
             // With `--rules-hard`, the route repaired until the rules hold (and its
             // certificates recomputed): the report describes the route it prints.
             if let Some(last) = run.last.as_mut() {
