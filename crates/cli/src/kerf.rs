@@ -227,8 +227,11 @@ impl Kerf {
         let Some(steps) = report["route"].as_array_mut() else {
             return;
         };
-        for (step, cut) in steps.iter_mut().zip(&route.steps) {
+        for (k, (step, cut)) in steps.iter_mut().zip(&route.steps).enumerate() {
             let Some(l) = &cut.leads else { continue };
+            // In a chain, a step entered by a link is not pierced and one left by a link is
+            // not switched off: those points are the link's ends, not M or M*.
+            let linked_out = route.steps.get(k + 1).is_some_and(|n| !n.is_pierced());
             let triples = |chain: &[Vertex]| {
                 chain
                     .iter()
@@ -236,11 +239,17 @@ impl Kerf {
                     .collect::<Vec<_>>()
             };
             step["contour_point"] = json!([cut.pierce_point.x, cut.pierce_point.y]);
-            step["pierce"] = json!([l.pierce.x, l.pierce.y]);
+            if cut.is_pierced() {
+                step["pierce"] = json!([l.pierce.x, l.pierce.y]);
+            } else if let Some(fields) = step.as_object_mut() {
+                fields.remove("pierce");
+            }
             step["entry"] = json!([l.entry.x, l.entry.y]);
             step["lead_in"] = json!(triples(&l.lead_in));
             step["lead_out"] = json!(triples(&l.lead_out));
-            step["switch_off"] = json!([l.switch_off.x, l.switch_off.y]);
+            if !linked_out {
+                step["switch_off"] = json!([l.switch_off.x, l.switch_off.y]);
+            }
             if !l.tabs.is_empty() {
                 // Each gap: where the torch stops and where it pierces again.
                 step["tabs"] = json!(l
