@@ -181,12 +181,31 @@ impl Kerf {
     }
 
     /// `route` with leads on every step; every contour without room is named. A route that
-    /// has its leads already (a chained route, see `project`) is kept.
+    /// has its leads already (a chained route, see `project`) is kept, or fitted again where
+    /// its links changed since (`--rules-hard` turns links that break a rule into pierces).
     pub fn attach(&self, nest: &Nest, route: Route) -> Result<Route, String> {
-        if !self.is_on() || route.steps.iter().any(|s| s.leads.is_some()) {
+        if !self.is_on() {
             return Ok(route);
         }
         let fitter = LeadFitter::new(nest, self.settings);
+        if route.steps.iter().any(|s| s.leads.is_some()) {
+            let forest = nest.containment_forest();
+            if route
+                .problems(nest, &forest, nest.check_tolerance())
+                .is_empty()
+            {
+                return Ok(route);
+            }
+            // No relaxing: the pierce points stay where the rules repair put them.
+            return fitter
+                .attach_chained(&route, 0, 0)
+                .map(|chained| {
+                    let broken = self.broken_links.get() + chained.broken_links;
+                    self.broken_links.set(broken);
+                    chained.route
+                })
+                .map_err(no_room);
+        }
         fitter
             .attach(&route)
             .map(|route| {

@@ -37,7 +37,8 @@ impl LeadFitter<'_> {
 
     /// `route`, a route over [`LeadFitter::kerf_nest`] (its pierce points on the
     /// equidistants, chains as steps entered by [`Entry::Link`]), with leads on every step over
-    /// this fitter's nest (see the module notes). Steps cut on their own are then moved along
+    /// this fitter's nest (see the module notes). A route over the nest whose steps carry leads
+    /// already (whose links were changed since) is fitted again from its entries. Steps cut on their own are then moved along
     /// their equidistants to shorten the idle legs ([`LeadFitter::relax`], `passes` sweeps of
     /// `positions` entries). Fails with every contour where no lead fits.
     pub fn attach_chained(
@@ -56,11 +57,26 @@ impl LeadFitter<'_> {
             .collect();
         // Each step's equidistant and the arc length of its entry on it.
         let mut eqs: Vec<Option<(Contour, f64)>> = Vec::with_capacity(n);
+        // Where each step cut on its own wants its pierce point.
+        let mut near = Vec::with_capacity(n);
         for (i, step) in route.steps.iter().enumerate() {
+            // A step with leads already (a route being fitted again after a change of its
+            // links) keeps its entry, unless its point on the contour moved away from it.
+            let (at, wanted) = match (&step.leads, self.nest().contour(step.contour)) {
+                (Some(l), Some(c))
+                    if c.nearest_point(l.entry).is_some_and(|p| {
+                        p.point.distance(step.pierce_point) <= self.nest().check_tolerance()
+                    }) =>
+                {
+                    (l.entry, l.pierce)
+                }
+                _ => (step.pierce_point, step.pierce_point),
+            };
+            near.push(wanted);
             match self.equidistant(step.contour) {
                 Ok(eq) => {
                     let s = eq
-                        .nearest_point(step.pierce_point)
+                        .nearest_point(at)
                         .map_or(0.0, |p| eq.length_at(p.position));
                     eqs.push(Some((eq, s)));
                 }
@@ -93,7 +109,7 @@ impl LeadFitter<'_> {
                 let r = route.steps[i].contour;
                 let (linked_in, linked_out) = (linked[i], i + 1 < n && linked[i + 1]);
                 if !linked_in && !linked_out {
-                    match self.fit_on(r, eq, route.steps[i].pierce_point) {
+                    match self.fit_on(r, eq, near[i]) {
                         Ok(l) => leads[i] = Some(l),
                         Err(e) => {
                             errors.push(e);

@@ -208,3 +208,26 @@ proptest! {
         }
     }
 }
+
+/// A link turned into a pierce after the leads were fitted (as `--rules-hard` does) is fitted
+/// again: the step gets a lead-in from M in G_M, the one before a lead-out.
+#[test]
+fn a_chain_fitted_again_after_a_link_became_a_pierce_is_valid() {
+    let nest = row(20.0, &[12.0]);
+    let fitter = LeadFitter::new(&nest, plasma());
+    let mut route = fitter
+        .attach_chained(&chained_over_kerf_nest(&nest, 1.0, 10.0), 0, 0)
+        .unwrap()
+        .route;
+    route.steps[1].entry = Entry::Pierce;
+    assert!(route.validate(&nest, 1e-6).is_err());
+    let again = fitter.attach_chained(&route, 0, 0).unwrap();
+    assert_eq!(again.broken_links, 0);
+    assert_eq!(again.route.validate(&nest, 1e-6), Ok(()));
+    assert_eq!(again.route.pierce_count(), 2);
+    // The first contour keeps its entry.
+    assert_eq!(
+        again.route.steps[0].leads.as_ref().unwrap().entry,
+        route.steps[0].leads.as_ref().unwrap().entry
+    );
+}
