@@ -103,9 +103,9 @@ fn a_chain_pierces_once_with_a_lead_in_and_ends_with_a_lead_out() {
     // the entries on the equidistants; the last step leads out.
     assert!(leads[0].lead_in_length() > 0.0 && leads[0].lead_out_length() == 0.0);
     assert!(leads[1].lead_in_length() == 0.0 && leads[1].lead_out_length() > 0.0);
-    for k in 0..2 {
+    for (k, l) in leads.iter().enumerate() {
         let contour = nest.contour(r(k)).unwrap();
-        assert!((contour.distance_to(leads[k].entry) - 1.0).abs() < 1e-9);
+        assert!((contour.distance_to(l.entry) - 1.0).abs() < 1e-9);
     }
     assert!(nest.contour(r(0)).unwrap().distance_to(leads[0].pierce) >= 5.0 - 1e-9);
     // The link ends where the cut of the previous contour ends.
