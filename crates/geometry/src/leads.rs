@@ -46,8 +46,10 @@ use std::borrow::Cow;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
-use crate::kerf::{clearance, equidistant, in_clear_scrap, OffsetError};
-use crate::{ContainmentForest, Contour, ContourRef, CutStep, Nest, Point, Route, Span, Vertex};
+use crate::kerf::{equidistant, OffsetError};
+use crate::{
+    BoundingBox, ContainmentForest, Contour, ContourRef, CutStep, Nest, Point, Route, Span, Vertex,
+};
 
 /// The shape of a lead-in or lead-out.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -569,6 +571,9 @@ pub struct LeadFitter<'a> {
     nest: &'a Nest,
     forest: Cow<'a, ContainmentForest>,
     settings: KerfSettings,
+    /// The contours' boxes by part and contour, built on first use: a box is a pass over
+    /// the contour's spans, and the fitter tests thousands of points.
+    boxes: std::cell::OnceCell<Vec<Vec<BoundingBox>>>,
 }
 
 impl<'a> LeadFitter<'a> {
@@ -578,6 +583,7 @@ impl<'a> LeadFitter<'a> {
             nest,
             forest: Cow::Owned(nest.containment_forest()),
             settings,
+            boxes: Default::default(),
         }
     }
 
@@ -591,7 +597,58 @@ impl<'a> LeadFitter<'a> {
             nest,
             forest: Cow::Borrowed(forest),
             settings,
+            boxes: Default::default(),
         }
+    }
+
+    fn box_of(&self, r: ContourRef) -> Option<&BoundingBox> {
+        let boxes = self.boxes.get_or_init(|| {
+            self.nest
+                .parts
+                .iter()
+                .map(|p| p.contours.iter().map(Contour::bounding_box).collect())
+                .collect()
+        });
+        boxes.get(r.part)?.get(r.contour)
+    }
+
+    /// [`crate::clearance`] with the boxes built once.
+    fn clearance(&self, p: Point, limit: f64) -> f64 {
+        self.nest
+            .contour_refs()
+            .filter(|&r| {
+                self.box_of(r)
+                    .is_some_and(|b| b.expanded(limit).contains_point(p))
+            })
+            .filter_map(|r| self.nest.contour(r))
+            .map(|c| c.distance_to(p))
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// [`crate::in_clear_scrap`] with the boxes built once: a contour contains no point outside its
+    /// box.
+    fn in_clear_scrap(&self, r: ContourRef, p: Point, distance: f64) -> bool {
+        if self.nest.contour(r).is_none() {
+            return false;
+        }
+        let region = if self.is_hole(r) {
+            Some(r)
+        } else {
+            self.forest.parent(r)
+        };
+        let contains = |c: ContourRef| {
+            self.box_of(c).is_some_and(|b| b.contains_point(p))
+                && self.nest.contour(c).is_some_and(|c| c.contains(p))
+        };
+        let inside_region = region.is_none_or(contains);
+        let children = match region {
+            None => self.forest.roots(),
+            Some(c) => self.forest.children(c),
+        };
+        p.is_finite()
+            && inside_region
+            && !children.iter().any(|&c| contains(c))
+            && !(self.clearance(p, distance) < distance)
     }
 
     /// The settings.
@@ -817,7 +874,7 @@ impl<'a> LeadFitter<'a> {
         } else {
             (chain.last()?.point, self.settings.switch_off_clearance)
         };
-        if !linked && !in_clear_scrap(self.nest, &self.forest, r, free, distance - TOLERANCE) {
+        if !linked && !self.in_clear_scrap(r, free, distance - TOLERANCE) {
             return Some(if lead_in {
                 LeadProblem::PierceOutsideRegion {
                     x: free.x,
@@ -835,7 +892,7 @@ impl<'a> LeadFitter<'a> {
             let samples = ((span.length() / (half / 4.0).clamp(0.05, 0.5)).ceil() as usize).max(2);
             for i in 0..=samples {
                 let p = span.point_at(i as f64 / samples as f64);
-                let d = clearance(self.nest, p, half + 1.0);
+                let d = self.clearance(p, half + 1.0);
                 if d < half - TOLERANCE {
                     return Some(LeadProblem::LeadTooClose {
                         x: p.x,
