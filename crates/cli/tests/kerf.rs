@@ -166,6 +166,41 @@ fn chains_pierce_once_with_a_lead_in_and_end_with_a_lead_out() {
     }
 }
 
+/// `--rules-hard` turns chain links that break a rule into pierces after the leads were fitted:
+/// those steps get leads of their own (a lead-in from M), and the route printed is the one
+/// repaired, not an earlier one.
+#[test]
+fn chains_repaired_by_hard_rules_keep_their_leads() {
+    let file = data("nests/dbs/test0.json.dbs");
+    let mut args = vec![
+        "solve",
+        &file,
+        "--solver",
+        "chain",
+        "--time-limit",
+        "3",
+        "--rules",
+        "part,sheet,islands",
+        "--rules-hard",
+        "--json",
+    ];
+    args.extend(PLASMA);
+    let report = json(&args);
+    assert!(report["final_route_rejected"].is_null(), "{report}");
+    let steps = report["route"].as_array().unwrap();
+    for (k, step) in steps.iter().enumerate() {
+        assert!(step.get("lead_in").is_some(), "step {k} has no leads");
+        if step.get("link").is_none() {
+            let lead_in = step["lead_in"].as_array().unwrap();
+            assert_eq!(point(&lead_in[0]), point(&step["pierce"]));
+            assert!(lead_in.len() > 1, "step {k}: a pierce without a lead-in");
+        }
+    }
+    for rule in ["part", "sheet", "islands"] {
+        assert_eq!(report["rule_violations"][rule], 0, "{rule}");
+    }
+}
+
 #[test]
 fn the_defaults_keep_the_idealised_report() {
     let file = data("nests/dbs-json/E1X_6_01.dbs.json");
