@@ -134,6 +134,12 @@ fn phase_ru(phase: &Phase) -> String {
                 "{} · подводы добавлены к идеализированному порядку",
                 phase_ru(base)
             ),
+            KerfNote::Leads {
+                source: KerfSource::Chains { links_broken },
+            } => format!(
+                "{} · подводы на концах цепочек, перемычек заменено врезками: {links_broken}",
+                phase_ru(base)
+            ),
             // The contours by number, not the engine's English reasons.
             KerfNote::NoRoom { contours, .. } => format!(
                 "{} · нет места для подводов у контуров ({}): {}",

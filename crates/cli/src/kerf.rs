@@ -2,16 +2,17 @@
 //! switch-off clearances d₁ and d₂, lead-ins, lead-outs, overcut and micro-joints (tabs). The defaults are the
 //! idealised model, under which nothing here changes a route or a report.
 //!
-//! With leads on, the contour solvers (nearest, ccp, heuristic, discrete) optimise the full
-//! route in the engine's kerf job (`cutroute_engine::KerfJob`, the app's code path): the
-//! settings travel in the request, and the job's routes come with their leads.
+//! With leads on, the contour solvers (nearest, ccp, heuristic, discrete) and chain cutting
+//! optimise the full route in the engine's kerf job (`cutroute_engine::KerfJob`, the app's
+//! code path): the settings travel in the request, and the job's routes come with their leads
+//! (chains with a lead-in at each chain's start and a lead-out at its end).
 //! `--leads-after` instead solves the idealised route and attaches leads to it (the
 //! comparison of the benchmark). This module parses the flags and writes the report.
 
 use cutroute_geometry::{
     KerfSettings, LeadError, LeadShape, LeadSpec, Nest, Route, StepLeads, TabSpec, Vertex,
 };
-use cutroute_protocol::{JobRequest, KerfNote, Phase, Progress};
+use cutroute_protocol::{JobRequest, KerfNote, KerfSource, Phase, Progress};
 use serde_json::{json, Value};
 
 /// The full-route flags.
@@ -54,6 +55,9 @@ pub struct KerfArgs {
 pub struct Kerf {
     settings: KerfSettings,
     after: bool,
+    /// Chain links given up for pierces where a lead found no room when a route the job did
+    /// not make (a rule repair's) was fitted again (see `attach`).
+    broken_links: std::cell::Cell<usize>,
 }
 
 fn shape(flag: &str, text: &str) -> Result<LeadShape, String> {
@@ -111,6 +115,7 @@ impl KerfArgs {
         Ok(Kerf {
             settings,
             after: self.leads_after,
+            broken_links: Default::default(),
         })
     }
 }
@@ -136,9 +141,12 @@ impl Kerf {
         if !self.is_on() {
             return Ok(request);
         }
-        if !matches!(solver, "nearest" | "ccp" | "heuristic" | "discrete") {
+        if !matches!(
+            solver,
+            "nearest" | "ccp" | "heuristic" | "discrete" | "chain"
+        ) {
             return Err(format!(
-                "--solver {solver} does not cut with kerf and leads yet (nearest, ccp, heuristic and discrete do)"
+                "--solver {solver} does not cut with kerf and leads yet (nearest, ccp, heuristic, discrete and chain do)"
             ));
         }
         request.params.kerf = self.settings;
@@ -153,8 +161,14 @@ impl Kerf {
             return Ok(route);
         }
         let forest = nest.containment_forest();
-        cutroute_engine::fit_leads(nest, &forest, self.settings, &route, !self.after)
-            .map_err(|errors| no_room(&errors.iter().map(LeadError::to_string).collect::<Vec<_>>()))
+        let links = |r: &Route| r.steps.iter().filter(|s| !s.is_pierced()).count();
+        let fitted = cutroute_engine::fit_leads(nest, &forest, self.settings, &route, !self.after)
+            .map_err(|errors| {
+                no_room(&errors.iter().map(LeadError::to_string).collect::<Vec<_>>())
+            })?;
+        let broken = links(&route).saturating_sub(links(&fitted));
+        self.broken_links.set(self.broken_links.get() + broken);
+        Ok(fitted)
     }
 
     /// The kerf job's word that some contours have no room for their leads, as an error.
@@ -170,7 +184,8 @@ impl Kerf {
 
     /// Adds the full-route fields to a nest report: `start`, `finish`, the settings, the lead
     /// lengths, and per step `pierce` (M), `entry`, `lead_in`, `lead_out`, `switch_off`.
-    pub fn report(&self, report: &mut Value, route: &Route) {
+    /// `phase` is the job's last phase: its kerf note counts the chain links the job broke.
+    pub fn report(&self, report: &mut Value, route: &Route, phase: Option<&Phase>) {
         report["start"] = json!([route.start.x, route.start.y]);
         if let Some(finish) = route.finish {
             report["finish"] = json!([finish.x, finish.y]);
@@ -188,13 +203,29 @@ impl Kerf {
             "optimised_with_leads": !self.after,
         });
         let leads = || route.steps.iter().filter_map(|s| s.leads.as_ref());
+        let by_job = match phase {
+            Some(Phase::Kerf {
+                note:
+                    KerfNote::Leads {
+                        source: KerfSource::Chains { links_broken },
+                    },
+                ..
+            }) => Some(*links_broken),
+            _ => None,
+        };
+        if by_job.is_some() || self.broken_links.get() > 0 {
+            report["chain_links_broken"] = json!(by_job.unwrap_or(0) + self.broken_links.get());
+        }
         report["lead_in_length"] = json!(leads().map(StepLeads::lead_in_length).sum::<f64>());
         report["lead_out_length"] = json!(leads().map(StepLeads::lead_out_length).sum::<f64>());
         let Some(steps) = report["route"].as_array_mut() else {
             return;
         };
-        for (step, cut) in steps.iter_mut().zip(&route.steps) {
+        for (k, (step, cut)) in steps.iter_mut().zip(&route.steps).enumerate() {
             let Some(l) = &cut.leads else { continue };
+            // In a chain, a step entered by a link is not pierced and one left by a link is
+            // not switched off: those points are the link's ends, not M or M*.
+            let linked_out = route.steps.get(k + 1).is_some_and(|n| !n.is_pierced());
             let triples = |chain: &[Vertex]| {
                 chain
                     .iter()
@@ -202,11 +233,17 @@ impl Kerf {
                     .collect::<Vec<_>>()
             };
             step["contour_point"] = json!([cut.pierce_point.x, cut.pierce_point.y]);
-            step["pierce"] = json!([l.pierce.x, l.pierce.y]);
+            if cut.is_pierced() {
+                step["pierce"] = json!([l.pierce.x, l.pierce.y]);
+            } else if let Some(fields) = step.as_object_mut() {
+                fields.remove("pierce");
+            }
             step["entry"] = json!([l.entry.x, l.entry.y]);
             step["lead_in"] = json!(triples(&l.lead_in));
             step["lead_out"] = json!(triples(&l.lead_out));
-            step["switch_off"] = json!([l.switch_off.x, l.switch_off.y]);
+            if !linked_out {
+                step["switch_off"] = json!([l.switch_off.x, l.switch_off.y]);
+            }
             if !l.tabs.is_empty() {
                 // Each gap: where the torch stops and where it pierces again.
                 step["tabs"] = json!(l

@@ -34,8 +34,9 @@
 //! nearest, ccp and chain minimise objective + W·H (heuristic and exact relax their final pierce
 //! points on it), `--rules-hard` repairs the route until the rules hold.
 //! With `--kerf`/leads on (`kerf.rs`), nearest, ccp, heuristic and discrete optimise the full
-//! route (pierce points off the contours, leads, cut on the equidistants) and each route step
-//! carries `pierce` (M), `entry`, `lead_in`, `lead_out` and `switch_off`.
+//! route (pierce points off the contours, leads, cut on the equidistants), chain links its
+//! chains between the equidistants (a lead-in at each chain's start, a lead-out at its end),
+//! and each route step carries `pierce` (M), `entry`, `lead_in`, `lead_out` and `switch_off`.
 //! `--sheet`, `--profile` and `--preset` are described in `inputs.rs` (profile < task <
 //! flags; `--preset` < the G-code flags).
 //! `-` as a file name is standard input (FILE, IN) or standard output (OUT, `--out`); files are
@@ -1117,7 +1118,7 @@ fn solve(
             let mut report = route_report(solver_name, nest, &machine, &run, &forest)?;
             if let Some(route) = run.last.as_ref().and_then(|p| p.route.as_ref()) {
                 thermal.report(&mut report, nest, route, &machine, objective)?;
-                kerf.report(&mut report, route);
+                kerf.report(&mut report, route, run.last.as_ref().map(|p| &p.phase));
             }
             report
         }

@@ -105,6 +105,102 @@ fn with_leads_every_step_carries_pierce_entry_leads_and_switch_off() {
     }
 }
 
+/// Chain cutting with leads: one pierce per chain at M with a lead-in, links from the exit of
+/// one contour's equidistant to the entry of the next (no `pierce` or `switch_off` at a link's
+/// ends), a lead-out at each chain's end; the idle legs run M* → next M.
+#[test]
+fn chains_pierce_once_with_a_lead_in_and_end_with_a_lead_out() {
+    for (file, settings) in [
+        ("nests/dbs-json/E1X_6_01.dbs.json", &PLASMA[..]),
+        ("nests/dbs/test0.json.dbs", &LASER[..]),
+    ] {
+        let file = data(file);
+        let mut args = vec![
+            "solve",
+            &file,
+            "--solver",
+            "chain",
+            "--time-limit",
+            "2",
+            "--json",
+        ];
+        args.extend(settings);
+        let report = json(&args);
+        let steps = report["route"].as_array().unwrap();
+        let linked = |k: usize| steps.get(k).is_some_and(|s| s.get("link").is_some());
+        assert!((1..steps.len()).any(linked), "{file}: no chain");
+        let distance = |a: (f64, f64), b: (f64, f64)| (b.0 - a.0).hypot(b.1 - a.1);
+        let (mut at, mut idle, mut pierces) = (point(&report["start"]), 0.0, 0);
+        for (k, step) in steps.iter().enumerate() {
+            let lead_in = step["lead_in"].as_array().unwrap();
+            let lead_out = step["lead_out"].as_array().unwrap();
+            assert_eq!(point(lead_in.last().unwrap()), point(&step["entry"]));
+            if linked(k) {
+                assert!(step.get("pierce").is_none(), "{file}: step {k}");
+                assert_eq!(lead_in.len(), 1, "{file}: no lead-in after a link");
+            } else {
+                let m = point(&step["pierce"]);
+                assert_eq!(point(&lead_in[0]), m);
+                idle += distance(at, m);
+                pierces += 1;
+            }
+            if linked(k + 1) {
+                assert!(step.get("switch_off").is_none(), "{file}: step {k}");
+                assert_eq!(lead_out.len(), 1, "{file}: no lead-out before a link");
+            } else {
+                at = point(&step["switch_off"]);
+                assert_eq!(point(lead_out.last().unwrap()), at);
+            }
+        }
+        if let Some(finish) = report.get("finish").filter(|f| !f.is_null()) {
+            idle += distance(at, point(finish));
+        }
+        assert_eq!(report["pierces"].as_u64(), Some(pierces));
+        let reported = report["idle_length"].as_f64().unwrap();
+        assert!(
+            (idle - reported).abs() < 1e-6,
+            "{file}: {idle} vs {reported}"
+        );
+        assert!(report["link_length"].as_f64().unwrap() > 0.0);
+        assert!(report["chain_links_broken"].as_u64().is_some());
+    }
+}
+
+/// `--rules-hard` turns chain links that break a rule into pierces after the leads were fitted:
+/// those steps get leads of their own (a lead-in from M), and the route printed is the one
+/// repaired, not an earlier one.
+#[test]
+fn chains_repaired_by_hard_rules_keep_their_leads() {
+    let file = data("nests/dbs/test0.json.dbs");
+    let mut args = vec![
+        "solve",
+        &file,
+        "--solver",
+        "chain",
+        "--time-limit",
+        "3",
+        "--rules",
+        "part,sheet,islands",
+        "--rules-hard",
+        "--json",
+    ];
+    args.extend(PLASMA);
+    let report = json(&args);
+    assert!(report["final_route_rejected"].is_null(), "{report}");
+    let steps = report["route"].as_array().unwrap();
+    for (k, step) in steps.iter().enumerate() {
+        assert!(step.get("lead_in").is_some(), "step {k} has no leads");
+        if step.get("link").is_none() {
+            let lead_in = step["lead_in"].as_array().unwrap();
+            assert_eq!(point(&lead_in[0]), point(&step["pierce"]));
+            assert!(lead_in.len() > 1, "step {k}: a pierce without a lead-in");
+        }
+    }
+    for rule in ["part", "sheet", "islands"] {
+        assert_eq!(report["rule_violations"][rule], 0, "{rule}");
+    }
+}
+
 #[test]
 fn the_defaults_keep_the_idealised_report() {
     let file = data("nests/dbs-json/E1X_6_01.dbs.json");
@@ -164,7 +260,7 @@ fn every_real_nest_routes_with_plasma_leads_or_names_the_contour_without_room() 
     files.sort();
     for path in files {
         let file = path.to_string_lossy().into_owned();
-        for solver in ["nearest", "ccp"] {
+        for solver in ["nearest", "ccp", "chain"] {
             let mut args = vec!["solve", &file, "--solver", solver, "--time-limit", "0.3"];
             args.extend(PLASMA);
             let (ok, _, err) = cutroute(&args);

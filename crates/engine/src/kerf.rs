@@ -38,16 +38,19 @@ const FIT_RESERVE_MAX_S: f64 = 2.0;
 
 /// Whether the kerf job can wrap `solver`'s job. Nearest, ccp and heuristic (the CLI's
 /// "discrete") route whole contours through pierce points, which the pierce curves carry
-/// over. Chain links start and end with leads, and the path solvers (sccp, gsccp, aoe) cut
-/// pieces of contours: they get their own full-route models (the `kerfpath` work), and join
-/// here by a new arm.
+/// over; chain runs over the equidistants ([`LeadFitter::kerf_nest`]) and gets leads at its
+/// chains' ends. The path solvers (sccp, gsccp, aoe) cut pieces of contours, shared edges
+/// among them, and have no full-route model yet.
 pub fn supports_kerf(solver: SolverKind) -> bool {
     match solver {
-        SolverKind::NearestNeighbour | SolverKind::Ccp | SolverKind::Heuristic => true,
+        SolverKind::NearestNeighbour
+        | SolverKind::Ccp
+        | SolverKind::Heuristic
+        | SolverKind::Chain => true,
         // The exact solver's bounds are about the idealised (or curve) nest, not the full
         // route: without a sound bound of the full route it would prove nothing.
         SolverKind::Exact => false,
-        SolverKind::Chain | SolverKind::Sccp | SolverKind::Gsccp | SolverKind::Aoe => false,
+        SolverKind::Sccp | SolverKind::Gsccp | SolverKind::Aoe => false,
     }
 }
 
@@ -85,6 +88,13 @@ pub fn fit_leads(
     relax: bool,
 ) -> Result<Route, Vec<LeadError>> {
     let fitter = LeadFitter::with_forest(nest, forest, settings);
+    // A chained route keeps its links (refitted where they changed, as after a rule repair);
+    // no relaxation, so pierce points a repair placed stay.
+    if route.steps.iter().any(|s| !s.is_pierced()) {
+        return fitter
+            .attach_chained(route, 0, 0)
+            .map(|chained| chained.route);
+    }
     // A route that is not over this nest's contours (the curve nest's) is brought back first.
     let attached = fitter.attach(&fitter.project(route))?;
     Ok(if relax {
@@ -123,10 +133,13 @@ enum Stage {
     Finished(Option<Result<Route, Vec<LeadError>>>),
 }
 
-/// Leads attached to a solver's route, one step at a time.
+/// Leads attached to a solver's route, one step at a time (a chained route all at once: its
+/// links tie neighbouring steps' leads together).
 struct Attach {
     /// The solver's route.
     from: Route,
+    /// Whether `from` is a chain solver's route over the equidistants.
+    chained: bool,
     /// It projected onto the nest.
     route: Route,
     steps: Vec<CutStep>,
@@ -134,9 +147,15 @@ struct Attach {
 }
 
 impl Attach {
-    fn new(fitter: &LeadFitter<'_>, from: Route) -> Attach {
+    fn new(fitter: &LeadFitter<'_>, from: Route, chained: bool) -> Attach {
         Attach {
-            route: fitter.project(&from),
+            chained,
+            // A chained route stays over the equidistants until `attach_chained`.
+            route: if chained {
+                from.clone()
+            } else {
+                fitter.project(&from)
+            },
             steps: Vec::with_capacity(from.steps.len()),
             errors: Vec::new(),
             from,
@@ -150,6 +169,13 @@ impl Attach {
         fitter: &LeadFitter<'_>,
         until: Instant,
     ) -> Option<Result<Route, Vec<LeadError>>> {
+        if self.chained {
+            return Some(
+                fitter
+                    .attach_chained(&self.from, 0, 0)
+                    .map(|chained| chained.route),
+            );
+        }
         loop {
             let done = self.steps.len() + self.errors.len();
             let Some(step) = self.route.steps.get(done) else {
@@ -189,6 +215,8 @@ pub struct KerfJob {
     settings: KerfSettings,
     /// Whether finished routes are relaxed (not in the "attach after" mode).
     relax: bool,
+    /// Whether the solver is chain cutting (its routes are over the equidistants).
+    chained: bool,
     candidates: Vec<Candidate>,
     /// Which candidate the next slice starts with (they take turns).
     turn: usize,
@@ -219,7 +247,8 @@ impl KerfJob {
         };
         if !supports_kerf(solver) {
             return Err(refused(
-                "does not cut with kerf and leads yet (nearest, ccp and heuristic do)".into(),
+                "does not cut with kerf and leads yet (nearest, ccp, heuristic and chain do)"
+                    .into(),
             ));
         }
         let settings = request.params.kerf;
@@ -236,7 +265,19 @@ impl KerfJob {
         }
         let mut candidates = Vec::new();
         let after = request.params.leads_after;
-        if !after {
+        let chained = solver == SolverKind::Chain;
+        if chained {
+            // Links routed round the equidistants keep kerf/2 from every contour.
+            let equidistants = LeadFitter::with_forest(nest, &forest, settings).kerf_nest();
+            let mut over_equidistants = idealised.clone();
+            if let Problem::Nest { nest, .. } = &mut over_equidistants.problem {
+                *nest = equidistants;
+            }
+            candidates.push(Candidate::new(
+                KerfSource::Chains { links_broken: 0 },
+                start(&over_equidistants)?,
+            ));
+        } else if !after {
             let curves = LeadFitter::with_forest(nest, &forest, settings).pierce_curve_nest();
             let mut over_curves = idealised.clone();
             if let Problem::Nest { nest, .. } = &mut over_curves.problem {
@@ -247,12 +288,15 @@ impl KerfJob {
                 start(&over_curves)?,
             ));
         }
-        candidates.push(Candidate::new(KerfSource::Idealised, start(&idealised)?));
+        if !chained {
+            candidates.push(Candidate::new(KerfSource::Idealised, start(&idealised)?));
+        }
         Ok(KerfJob {
             nest: nest.clone(),
             forest,
             settings,
             relax: !after,
+            chained,
             candidates,
             turn: 0,
             deadline: started.checked_add(Duration::from_secs_f64(limit.clamp(0.0, 1.0e7))),
@@ -271,6 +315,7 @@ impl KerfJob {
         let until = started + budget;
         let fitter = LeadFitter::with_forest(&self.nest, &self.forest, self.settings);
         let relax = self.relax;
+        let chained = self.chained;
         let deadline = self.deadline;
         let relaxing = |route: Route| Stage::Relaxing {
             dirty: vec![true; route.steps.len()],
@@ -300,7 +345,7 @@ impl KerfJob {
                             Some(route) if pending_from == Some(&route) => Stage::Attaching(
                                 candidate.pending.take().expect("the pending attachment"),
                             ),
-                            Some(route) => Stage::Attaching(Attach::new(&fitter, route)),
+                            Some(route) => Stage::Attaching(Attach::new(&fitter, route, chained)),
                         }
                     } else {
                         // The solver's newer route gets its leads in a quarter more of the
@@ -308,7 +353,7 @@ impl KerfJob {
                         // time: a report shows the last fitted one meanwhile).
                         if let Some(route) = route {
                             if candidate.pending.is_none() && fitted_from != Some(&route) {
-                                candidate.pending = Some(Attach::new(&fitter, route));
+                                candidate.pending = Some(Attach::new(&fitter, route, chained));
                             }
                         }
                         let spare = if candidate.fitted.is_some() {
@@ -463,7 +508,17 @@ impl Job for KerfJob {
             Some((i, route)) => (
                 i,
                 KerfNote::Leads {
-                    source: self.candidates[i].source,
+                    source: match self.candidates[i].source {
+                        // The links the solver made that the full route lost to pierces.
+                        KerfSource::Chains { .. } => KerfSource::Chains {
+                            links_broken: inner[i]
+                                .route
+                                .as_ref()
+                                .map_or(0, links)
+                                .saturating_sub(links(route)),
+                        },
+                        source => source,
+                    },
                 },
                 Some(route.clone()),
             ),
@@ -502,6 +557,11 @@ impl Job for KerfJob {
         };
         progress
     }
+}
+
+/// The tool-on links of a route (steps entered without a pierce).
+fn links(route: &Route) -> usize {
+    route.steps.iter().filter(|s| !s.is_pierced()).count()
 }
 
 fn no_room(errors: &[LeadError]) -> KerfNote {

@@ -6,7 +6,9 @@ use std::path::PathBuf;
 
 use cutroute_engine::{open_document, run_to_end, start_job, EngineError};
 use cutroute_geometry::{KerfSettings, LeadShape, LeadSpec, Nest, Route, TabSpec};
-use cutroute_protocol::{JobRequest, KerfNote, Phase, Problem, Progress, SolverKind, SolverParams};
+use cutroute_protocol::{
+    JobRequest, KerfNote, KerfSource, Phase, Problem, Progress, SolverKind, SolverParams,
+};
 
 fn nest_problem(relative: &str) -> Problem {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -156,10 +158,42 @@ fn a_contour_without_room_is_named_not_dropped() {
     assert!(progress.phase.to_string().contains("without room"));
 }
 
+/// Chain cutting in the kerf job: it chains over the equidistants, its links survive the
+/// leads (a lead-in at each chain's start, a lead-out at its end), and the route passes the
+/// checker, which holds every link kerf/2 from every contour.
+#[test]
+fn chain_gives_a_checked_chained_route_with_leads() {
+    let problem = nest_problem("nests/dbs-json/E1X_6_01.dbs.json");
+    let mut job_request = request(&problem, SolverKind::Chain, plasma(), false);
+    job_request.params.time_limit_s = 4.0;
+    let progress = run(&job_request);
+    let route = checked(&problem, &progress);
+    let links = route.steps.iter().filter(|s| !s.is_pierced()).count();
+    assert!(links > 0, "no chain");
+    let Phase::Kerf {
+        note: KerfNote::Leads {
+            source: KerfSource::Chains { links_broken },
+        },
+        ..
+    } = progress.phase
+    else {
+        panic!("{:?}", progress.phase);
+    };
+    // Every link the solver made is either in the route or counted as broken.
+    assert!(links_broken <= links + links_broken);
+    for (i, step) in route.steps.iter().enumerate() {
+        let next_linked = route.steps.get(i + 1).is_some_and(|s| !s.is_pierced());
+        let leads = step.leads.as_ref().expect("leads on every step");
+        // A chain's inner ends have no lead: the link runs from the exit to the next entry.
+        assert_eq!(leads.lead_in.len() > 1, step.is_pierced(), "step {i}");
+        assert_eq!(leads.lead_out.len() > 1, !next_linked, "step {i}");
+    }
+}
+
 #[test]
 fn solvers_without_a_full_route_model_are_refused_and_bad_settings_too() {
     let problem = nest_problem("nests/dbs-json/E1X_6_01.dbs.json");
-    for solver in [SolverKind::Aoe, SolverKind::Sccp, SolverKind::Chain] {
+    for solver in [SolverKind::Aoe, SolverKind::Sccp, SolverKind::Gsccp] {
         let refused = start_job(&request(&problem, solver, plasma(), false));
         assert!(
             matches!(refused, Err(EngineError::SolverRefused { .. })),

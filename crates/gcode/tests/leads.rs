@@ -64,6 +64,51 @@ fn a_route_with_leads_reads_back_with_the_same_lengths_and_pierces() {
     }
 }
 
+/// A chained route with leads (the chains solved over the kerf nest, leads attached with
+/// `attach_chained`) reads back with the same lengths, links included, and one pierce per
+/// chain at its M.
+#[test]
+fn a_chained_route_with_leads_reads_back_with_the_same_lengths_and_pierces() {
+    let settings = KerfSettings {
+        kerf: 2.0,
+        pierce_clearance: 5.0,
+        switch_off_clearance: 1.0,
+        lead_in: LeadSpec::new(LeadShape::Arc, 8.0),
+        lead_out: LeadSpec::new(LeadShape::Line, 2.0),
+        ..KerfSettings::default()
+    };
+    let nest = generate_nest(60, 5);
+    let fitter = LeadFitter::new(&nest, settings);
+    let kerf_nest = fitter.kerf_nest();
+    let origin = Point::new(0.0, 0.0);
+    let route = Route::innermost_first(&kerf_nest, origin, Some(origin));
+    let chained = cutroute_chains::chain_route(
+        &kerf_nest,
+        &route,
+        &cutroute_chains::ChainOptions::default(),
+    )
+    .unwrap()
+    .route;
+    let route = fitter.attach_chained(&chained, 1, 12).unwrap().route;
+    route.validate(&nest, 1e-6).unwrap();
+    assert!(route.link_length() > 0.0 && route.pierce_count() < route.steps.len());
+    let options = GcodeOptions {
+        decimals: 6,
+        ..GcodeOptions::default()
+    };
+    let text = route_gcode(&nest, &route, &options).unwrap();
+    let program = read_gcode(&text, &ReadOptions::default()).unwrap();
+    let (read, cut) = (program.cut_length(), route.cut_length(&nest));
+    assert!((read - cut).abs() < 1e-3, "{read} vs {cut}");
+    assert!((program.idle_length() - route.idle_length()).abs() < 1e-3);
+    assert_eq!(program.pierce_count(), route.pierce_count());
+    let pierced = route.steps.iter().filter(|s| s.is_pierced());
+    for (read, step) in program.pierce_points().iter().zip(pierced) {
+        let m = step.leads.as_ref().unwrap().pierce;
+        assert!(read.distance(m) < 1e-3, "{read:?} vs {m:?}");
+    }
+}
+
 #[test]
 fn tabs_read_back_as_pierces_and_idle_gaps() {
     let settings = KerfSettings {

@@ -46,8 +46,10 @@ use std::borrow::Cow;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
-use crate::kerf::{clearance, equidistant, in_clear_scrap, OffsetError};
-use crate::{ContainmentForest, Contour, ContourRef, CutStep, Nest, Point, Route, Span, Vertex};
+use crate::kerf::{equidistant, OffsetError};
+use crate::{
+    BoundingBox, ContainmentForest, Contour, ContourRef, CutStep, Nest, Point, Route, Span, Vertex,
+};
 
 /// The shape of a lead-in or lead-out.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -581,6 +583,9 @@ pub struct LeadFitter<'a> {
     nest: &'a Nest,
     forest: Cow<'a, ContainmentForest>,
     settings: KerfSettings,
+    /// The contours' boxes by part and contour, built on first use: a box is a pass over
+    /// the contour's spans, and the fitter tests thousands of points.
+    boxes: std::cell::OnceCell<Vec<Vec<BoundingBox>>>,
 }
 
 impl<'a> LeadFitter<'a> {
@@ -590,6 +595,7 @@ impl<'a> LeadFitter<'a> {
             nest,
             forest: Cow::Owned(nest.containment_forest()),
             settings,
+            boxes: Default::default(),
         }
     }
 
@@ -603,12 +609,73 @@ impl<'a> LeadFitter<'a> {
             nest,
             forest: Cow::Borrowed(forest),
             settings,
+            boxes: Default::default(),
         }
+    }
+
+    fn box_of(&self, r: ContourRef) -> Option<&BoundingBox> {
+        let boxes = self.boxes.get_or_init(|| {
+            self.nest
+                .parts
+                .iter()
+                .map(|p| p.contours.iter().map(Contour::bounding_box).collect())
+                .collect()
+        });
+        boxes.get(r.part)?.get(r.contour)
+    }
+
+    /// [`crate::clearance`] with the boxes built once.
+    fn clearance(&self, p: Point, limit: f64) -> f64 {
+        self.nest
+            .contour_refs()
+            .filter(|&r| {
+                self.box_of(r)
+                    .is_some_and(|b| b.expanded(limit).contains_point(p))
+            })
+            .filter_map(|r| self.nest.contour(r))
+            .map(|c| c.distance_to(p))
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// [`crate::in_clear_scrap`] with the boxes built once: a contour contains no point outside its
+    /// box.
+    fn in_clear_scrap(&self, r: ContourRef, p: Point, distance: f64) -> bool {
+        if self.nest.contour(r).is_none() {
+            return false;
+        }
+        let region = if self.is_hole(r) {
+            Some(r)
+        } else {
+            self.forest.parent(r)
+        };
+        let contains = |c: ContourRef| {
+            self.box_of(c).is_some_and(|b| b.contains_point(p))
+                && self.nest.contour(c).is_some_and(|c| c.contains(p))
+        };
+        let inside_region = region.is_none_or(contains);
+        let children = match region {
+            None => self.forest.roots(),
+            Some(c) => self.forest.children(c),
+        };
+        p.is_finite()
+            && inside_region
+            && !children.iter().any(|&c| contains(c))
+            && !(self.clearance(p, distance) < distance)
     }
 
     /// The settings.
     pub fn settings(&self) -> &KerfSettings {
         &self.settings
+    }
+
+    /// The nest the fitter fits leads in.
+    pub(crate) fn nest(&self) -> &'a Nest {
+        self.nest
+    }
+
+    /// The nest's containment forest.
+    pub(crate) fn forest(&self) -> &ContainmentForest {
+        &self.forest
     }
 
     /// The equidistant of contour `r` at kerf/2 on its scrap side.
@@ -657,38 +724,63 @@ impl<'a> LeadFitter<'a> {
         Err(LeadError::NoFit { contour: r, reason })
     }
 
-    fn is_hole(&self, r: ContourRef) -> bool {
+    pub(crate) fn is_hole(&self, r: ContourRef) -> bool {
         self.forest.depth(r).is_some_and(|d| d % 2 == 1)
     }
 
     /// Leads with the entry at arc length `s` of the equidistant, trying the variants of each
     /// lead in order.
     fn fit_at(&self, r: ContourRef, eq: &Contour, s: f64) -> Result<StepLeads, LeadProblem> {
+        self.fit_at_linked(r, eq, s, false, false)
+            .map_err(|(_, problem)| problem)
+    }
+
+    /// [`LeadFitter::fit_at`] for a step of a chain: entered by a tool-on link (`linked_in`:
+    /// no lead-in, the link ends at the entry) or left by one (`linked_out`: no overcut and no
+    /// lead-out, the link starts where the cut ends). The error says which lead found no room
+    /// (`true`: the lead-in) and why.
+    pub(crate) fn fit_at_linked(
+        &self,
+        r: ContourRef,
+        eq: &Contour,
+        s: f64,
+        linked_in: bool,
+        linked_out: bool,
+    ) -> Result<StepLeads, (bool, LeadProblem)> {
         let (entry, tangent) = frame_at(eq, s);
         let perimeter = eq.perimeter();
-        let (exit, exit_tangent) = frame_at(eq, (s + self.settings.overcut).rem_euclid(perimeter));
-        let lead_in = self.first_fitting(
-            r,
-            true,
-            self.variants(self.settings.lead_in)
-                .map(|spec| lead_in_chain(spec, entry, tangent)),
-        )?;
-        let lead_out = self.first_fitting(
-            r,
-            false,
-            self.variants(self.settings.lead_out)
-                .map(|spec| lead_out_chain(spec, exit, exit_tangent)),
-        )?;
+        let overcut = if linked_out {
+            0.0
+        } else {
+            self.settings.overcut
+        };
+        let (exit, exit_tangent) = frame_at(eq, (s + overcut).rem_euclid(perimeter));
+        let lead_in = if linked_in {
+            vec![vertex(entry)]
+        } else {
+            self.first_fitting(
+                r,
+                true,
+                self.variants(self.settings.lead_in)
+                    .map(|spec| lead_in_chain(spec, entry, tangent)),
+            )
+            .map_err(|problem| (true, problem))?
+        };
+        let lead_out = if linked_out {
+            vec![vertex(exit)]
+        } else {
+            self.first_fitting(
+                r,
+                false,
+                self.variants(self.settings.lead_out)
+                    .map(|spec| lead_out_chain(spec, exit, exit_tangent)),
+            )
+            .map_err(|problem| (false, problem))?
+        };
         let tabs = if self.is_hole(r) {
             Vec::new()
         } else {
-            place_tabs(
-                eq,
-                self.settings.kerf / 2.0,
-                s,
-                self.settings.overcut,
-                self.settings.tabs,
-            )
+            place_tabs(eq, self.settings.kerf / 2.0, s, overcut, self.settings.tabs)
         };
         Ok(StepLeads {
             pierce: lead_in[0].point,
@@ -697,7 +789,7 @@ impl<'a> LeadFitter<'a> {
             lead_in,
             lead_out,
             offset: self.settings.kerf / 2.0,
-            overcut: self.settings.overcut,
+            overcut,
             pierce_clearance: self.settings.pierce_clearance,
             switch_off_clearance: self.settings.switch_off_clearance,
             tabs,
@@ -777,12 +869,24 @@ impl<'a> LeadFitter<'a> {
     /// The first rule a lead chain breaks: its free end (M for a lead-in, M* for a lead-out)
     /// must lie in the region, and every span must keep kerf/2 from every contour.
     fn chain_problem(&self, r: ContourRef, chain: &[Vertex], lead_in: bool) -> Option<LeadProblem> {
+        self.chain_problem_linked(r, chain, lead_in, false)
+    }
+
+    /// [`LeadFitter::chain_problem`]; with `linked` the free end is where a tool-on link of a
+    /// chain joins (no pierce or switch-off there), so it need not lie in G_M (G_M*).
+    fn chain_problem_linked(
+        &self,
+        r: ContourRef,
+        chain: &[Vertex],
+        lead_in: bool,
+        linked: bool,
+    ) -> Option<LeadProblem> {
         let (free, distance) = if lead_in {
             (chain.first()?.point, self.settings.pierce_clearance)
         } else {
             (chain.last()?.point, self.settings.switch_off_clearance)
         };
-        if !in_clear_scrap(self.nest, &self.forest, r, free, distance - TOLERANCE) {
+        if !linked && !self.in_clear_scrap(r, free, distance - TOLERANCE) {
             return Some(if lead_in {
                 LeadProblem::PierceOutsideRegion {
                     x: free.x,
@@ -800,7 +904,7 @@ impl<'a> LeadFitter<'a> {
             let samples = ((span.length() / (half / 4.0).clamp(0.05, 0.5)).ceil() as usize).max(2);
             for i in 0..=samples {
                 let p = span.point_at(i as f64 / samples as f64);
-                let d = clearance(self.nest, p, half + 1.0);
+                let d = self.clearance(p, half + 1.0);
                 if d < half - TOLERANCE {
                     return Some(LeadProblem::LeadTooClose {
                         x: p.x,
@@ -860,6 +964,12 @@ impl<'a> LeadFitter<'a> {
     pub fn pierce_curve_nest(&self) -> Nest {
         let reach = (self.settings.kerf / 2.0 + self.settings.lead_in.reach())
             .max(self.settings.pierce_clearance);
+        self.offset_nest(reach)
+    }
+
+    /// Every contour offset by `reach` on its scrap side; contours whose offset does not exist,
+    /// or would change which contour holds which, keep their own shape.
+    pub(crate) fn offset_nest(&self, reach: f64) -> Nest {
         let mut curves = self.nest.clone();
         for part in &mut curves.parts {
             for contour in &mut part.contours {
@@ -983,6 +1093,14 @@ impl<'a> LeadFitter<'a> {
         let (Some(current), true) = (&step.leads, step.is_pierced()) else {
             return false;
         };
+        // A step whose cut goes on into a chain's link keeps its exit where the link starts.
+        if route
+            .steps
+            .get(i + 1)
+            .is_some_and(|next| !next.is_pierced())
+        {
+            return false;
+        }
         let Ok(eq) = self.equidistant(step.contour) else {
             return false;
         };
@@ -1038,6 +1156,20 @@ impl<'a> LeadFitter<'a> {
     /// [`crate::Route::problems`]): M ∈ G_M, M* ∈ G_M*, the leads clear of every contour by
     /// kerf/2, the entry and exit on the equidistant, the chains joined to their points.
     pub fn problems(&self, r: ContourRef, leads: &StepLeads) -> Vec<LeadProblem> {
+        self.problems_linked(r, leads, false, false)
+    }
+
+    /// [`LeadFitter::problems`] for a step of a chain: entered by a tool-on link
+    /// (`linked_in`: its pierce point is where the link ends, not a pierce, so not held to
+    /// G_M) or left by one (`linked_out`: its switch-off point is where the link starts, not
+    /// held to G_M*). The leads themselves are held to every other rule.
+    pub fn problems_linked(
+        &self,
+        r: ContourRef,
+        leads: &StepLeads,
+        linked_in: bool,
+        linked_out: bool,
+    ) -> Vec<LeadProblem> {
         let mut problems = Vec::new();
         let joined = leads.lead_in.first().map(|v| v.point) == Some(leads.pierce)
             && leads.lead_in.last().map(|v| v.point) == Some(leads.entry)
@@ -1064,8 +1196,8 @@ impl<'a> LeadFitter<'a> {
                 distance: f64::NAN,
             }),
         }
-        problems.extend(self.chain_problem(r, &leads.lead_in, true));
-        problems.extend(self.chain_problem(r, &leads.lead_out, false));
+        problems.extend(self.chain_problem_linked(r, &leads.lead_in, true, linked_in));
+        problems.extend(self.chain_problem_linked(r, &leads.lead_out, false, linked_out));
         if !leads.tabs.is_empty() {
             problems.extend(self.tab_problems(r, leads));
         }

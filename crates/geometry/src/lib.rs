@@ -73,6 +73,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 mod bbox;
+mod chain_leads;
 mod contour;
 pub mod domain;
 pub mod float;
@@ -90,6 +91,7 @@ mod transform;
 mod types;
 
 pub use bbox::BoundingBox;
+pub use chain_leads::ChainedLeads;
 pub use contour::{
     ClosureError, ContourError, ContourPosition, ContourProjection, SelfIntersection,
 };

@@ -285,6 +285,19 @@ pub enum RouteError {
         /// Where, y.
         y: f64,
     },
+    /// A link of a route cut with kerf comes closer than kerf/2 to a contour: the kerf it
+    /// burns would eat into that contour.
+    #[error("the link into step {step} comes {distance} mm from a contour near ({x}, {y}), closer than kerf/2")]
+    LinkTooClose {
+        /// Index of the linked step.
+        step: usize,
+        /// Where, x.
+        x: f64,
+        /// Where, y.
+        y: f64,
+        /// Its distance to the nearest contour.
+        distance: f64,
+    },
     /// A piece of a link lies outside the scrap region of the contours it joins (inside a
     /// part, or outside the hole they sit in).
     #[error("the link into step {step} leaves its scrap region near ({x}, {y})")]
@@ -444,9 +457,13 @@ impl Route {
             }
             if let Some(leads) = &s.leads {
                 let fitter = LeadFitter::with_forest(nest, forest, leads.rules());
+                // In a chain the link's ends are no pierce or switch-off: the link itself is
+                // checked below (kerf/2 from every contour included).
+                let linked_in = !s.is_pierced();
+                let linked_out = self.steps.get(step + 1).is_some_and(|n| !n.is_pierced());
                 problems.extend(
                     fitter
-                        .problems(s.contour, leads)
+                        .problems_linked(s.contour, leads, linked_in, linked_out)
                         .into_iter()
                         .map(|problem| RouteError::Lead {
                             step,
@@ -541,8 +558,25 @@ pub fn in_scrap_region(
             .any(|&c| nest.contour(c).is_some_and(|c| c.contains(p)))
 }
 
+/// The problems of the link into step `step` (see [`Route::problems`]); none for a pierced
+/// step.
+pub(crate) fn link_problems(
+    route: &Route,
+    step: usize,
+    nest: &Nest,
+    forest: &ContainmentForest,
+    tolerance: f64,
+) -> Vec<RouteError> {
+    let mut problems = Vec::new();
+    if route.steps.get(step).is_some_and(|s| !s.is_pierced()) {
+        check_link(route, step, nest, forest, tolerance, &mut problems);
+    }
+    problems
+}
+
 /// The checks of one link (see [`Route::problems`]). Independent of how links are built: it
-/// tests the polyline against every contour of the nest.
+/// tests the polyline against every contour of the nest; with kerf (the steps it joins carry
+/// leads) it also keeps kerf/2 from every contour.
 fn check_link(
     route: &Route,
     step: usize,
@@ -564,6 +598,10 @@ fn check_link(
         problems.push(RouteError::LinkNotBetweenSiblings { step, from, to });
         return;
     }
+    let half_kerf = [&route.steps[step - 1], &route.steps[step]]
+        .iter()
+        .filter_map(|s| s.leads.as_ref().map(|l| l.offset))
+        .fold(0.0, f64::max);
     let (first, last) = (path[0], path[path.len() - 1]);
     let at_an_end = |x: Point| x.distance(first) <= tolerance || x.distance(last) <= tolerance;
     for w in path.windows(2) {
@@ -606,6 +644,31 @@ fn check_link(
                 y: probe.y,
             });
             return;
+        }
+        if half_kerf > 0.0 {
+            // The exact distance from the piece to every span near it.
+            let piece = crate::Span::line(a, b);
+            let near = crate::BoundingBox::from_corners(a, b).expanded(half_kerf);
+            for r in nest.contour_refs() {
+                let Some(c) = nest.contour(r) else { continue };
+                if !c.bounding_box().intersects(&near) {
+                    continue;
+                }
+                for span in c.spans() {
+                    let distance = piece.distance_to_span(&span);
+                    if distance < half_kerf - tolerance {
+                        let at = span.nearest_point(piece.nearest_point(span.start).point);
+                        let x = piece.nearest_point(at.point).point;
+                        problems.push(RouteError::LinkTooClose {
+                            step,
+                            x: x.x,
+                            y: x.y,
+                            distance,
+                        });
+                        return;
+                    }
+                }
+            }
         }
     }
 }

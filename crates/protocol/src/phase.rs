@@ -83,6 +83,13 @@ pub enum KerfSource {
     /// The solver's idealised route with leads attached (and, unless asked for the plain
     /// "after" route, moved along the equidistants).
     Idealised,
+    /// The chain solver's route over the equidistants: a lead-in at each chain's start and a
+    /// lead-out at its end; `links_broken` of its links gave way to pierces where no lead
+    /// fitted at their ends or they came closer than kerf/2 to a contour.
+    Chains {
+        /// Links of the solver's route that became pierces.
+        links_broken: usize,
+    },
 }
 
 /// What a kerf job (the full cutting route: kerf, leads, tabs) did to the route of the solver
@@ -349,6 +356,12 @@ impl fmt::Display for Phase {
                 KerfNote::Leads {
                     source: KerfSource::Idealised,
                 } => write!(f, "{base} · leads attached to the idealised order"),
+                KerfNote::Leads {
+                    source: KerfSource::Chains { links_broken },
+                } => write!(
+                    f,
+                    "{base} · leads at the chains' ends, {links_broken} link(s) broken into pierces"
+                ),
                 KerfNote::NoRoom { errors, .. } => write!(
                     f,
                     "{base} · {} contour(s) without room for the leads: {}",
