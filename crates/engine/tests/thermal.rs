@@ -292,6 +292,32 @@ fn path_route_solvers_honour_hard_rules_and_report_h() {
     }
 }
 
+/// Nest02's parts placed in holes touch them; the AOE route breaks the rules, and its repair
+/// (whole contours, standard cutting) must cut every such part before its hole: it passes the
+/// path checker and leaves no violation (it once failed it, and the AOE route was kept with
+/// 183/0/12 violations, because a part touching its hole a rounding error outside it was
+/// taken for a top-level part).
+#[test]
+fn aoe_with_hard_rules_repairs_nest02_into_a_valid_route() {
+    let problem = nest_problem("nests/tflex/Nest02.tfnesting");
+    let nest = nest_of(&problem);
+    let hard = ThermalSettings {
+        rules: RuleSet::ALL,
+        hard: true,
+        ..ThermalSettings::default()
+    };
+    let result = solve(&problem, SolverKind::Aoe, hard);
+    let route = result.path_route.as_ref().expect("a path route");
+    let mut problems = route.problems(nest, nest.check_tolerance());
+    problems.retain(|p| !matches!(p, PathRouteError::Overlap { .. }));
+    assert!(problems.is_empty(), "{problems:?}");
+    let counts = result.rule_counts.expect("rules checked");
+    assert_eq!(counts.total(), 0, "{:?}", result.violations);
+    let contours = path_contour_route(nest, route);
+    let valid = contours.validate(nest, 1e-3);
+    assert!(valid.is_ok(), "{valid:?}");
+}
+
 #[test]
 fn the_heat_weight_lowers_h_of_segment_cutting() {
     let problem = nest_problem("nests/dbs-json/E1X_6_01.dbs.json");
