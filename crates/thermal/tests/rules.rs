@@ -374,3 +374,62 @@ fn the_check_in_pieces_equals_the_check_in_one_call() {
     }
     assert_eq!(kinds_seen, [true, true], "both split rules are exercised");
 }
+
+/// The repair in pieces (a unit of the island replay, a range of the part rule, a piece of the
+/// final check at a time) returns exactly what the one-call repair returns, whatever the budget,
+/// and refuses to go on once it has.
+#[test]
+fn the_repair_in_pieces_equals_the_repair_in_one_call() {
+    use cutroute_geometry::{generate_nest, SplitMix64};
+    use cutroute_thermal::RuleRepair;
+    use std::time::Duration;
+    let mut changed = 0;
+    for seed in 1..=3u64 {
+        let nest = generate_nest(300 * seed as usize, seed);
+        let forest = nest.containment_forest();
+        let mut refs: Vec<ContourRef> = nest.contour_refs().collect();
+        let mut rng = SplitMix64::new(seed);
+        for i in (1..refs.len()).rev() {
+            refs.swap(i, rng.below(i as u64 + 1) as usize);
+        }
+        refs.sort_by_key(|&r| std::cmp::Reverse(forest.depth(r).unwrap_or(0)));
+        let route = Route {
+            start: Point::new(0.0, 0.0),
+            steps: refs
+                .iter()
+                .map(|&r| CutStep::pierced(r, nest.contour(r).unwrap().vertices[0].point))
+                .collect(),
+            finish: None,
+        };
+        let params = RuleParams::default();
+        for rules in [
+            RuleSet::ALL,
+            only(true, false, false),
+            only(false, true, true),
+        ] {
+            let whole = enforce_rules(&nest, &route, rules, &params).unwrap();
+            changed += usize::from(whole.route != route);
+            for budget in [Duration::ZERO, Duration::from_millis(3)] {
+                let mut repair = RuleRepair::new(&route, rules, params).unwrap();
+                let mut calls = 0;
+                let pieced = loop {
+                    calls += 1;
+                    if let Some(enforced) = repair.advance(&nest, budget).unwrap() {
+                        break enforced;
+                    }
+                };
+                assert_eq!(pieced, whole, "seed {seed}, {rules:?}, budget {budget:?}");
+                if budget.is_zero() && rules.islands {
+                    // One piece per unit placed on the island raster at least.
+                    assert!(calls > forest.roots().len(), "{calls} pieces");
+                }
+                assert!(matches!(
+                    repair.advance(&nest, budget),
+                    Err(ThermalError::RepairFinished)
+                ));
+            }
+        }
+    }
+    // Most repairs move something: the equality is not that of untouched routes.
+    assert!(changed >= 6, "{changed} of 9 repairs changed the route");
+}
