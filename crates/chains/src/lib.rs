@@ -760,6 +760,7 @@ impl Context<'_> {
                     points,
                     round: 0,
                     k: 0,
+                    trial: None,
                 }
             }
             ChainStage::Refine {
@@ -767,22 +768,55 @@ impl Context<'_> {
                 mut points,
                 round,
                 k,
+                trial,
             } if round < self.options.refinement_rounds => {
                 if abort() {
                     return None;
                 }
-                let chain_k = contours[order[k]];
-                self.refine_point(chain_k, &mut points, k, before, after, region);
-                let (round, k) = if k + 1 < n {
-                    (round, k + 1)
-                } else {
-                    (round + 1, 0)
+                let ends = (before, after);
+                // Point k's refinement a candidate per piece: each costs two obstacle-avoiding
+                // links, and a contour of a big scrap region took up to a second in one piece.
+                let trial = match trial {
+                    None => {
+                        let candidates =
+                            self.refine_candidates(contours[order[k]], &points, k, ends);
+                        let here = self.refine_cost(points[k], &points, k, ends, region);
+                        Some(Trial {
+                            candidates,
+                            next: 0,
+                            best: (here, points[k]),
+                        })
+                    }
+                    Some(mut trial) if trial.next < trial.candidates.len() => {
+                        let x = trial.candidates[trial.next];
+                        trial.next += 1;
+                        // Links are never shorter than straight: a candidate whose
+                        // straight-line cost is no better than the best true cost so far
+                        // cannot win.
+                        if self.refine_lower_bound(x, &points, k, ends) < trial.best.0 {
+                            let c = self.refine_cost(x, &points, k, ends, region);
+                            if c < trial.best.0 - 1e-12 {
+                                trial.best = (c, x);
+                            }
+                        }
+                        Some(trial)
+                    }
+                    Some(trial) => {
+                        points[k] = trial.best.1;
+                        None
+                    }
+                };
+                let (round, k) = match (&trial, k + 1 < n) {
+                    (Some(_), _) => (round, k),
+                    (None, true) => (round, k + 1),
+                    (None, false) => (round + 1, 0),
                 };
                 ChainStage::Refine {
                     order,
                     points,
                     round,
                     k,
+                    trial,
                 }
             }
             ChainStage::Refine { order, points, .. } => ChainStage::Links {
@@ -840,19 +874,18 @@ impl Context<'_> {
         Some(None)
     }
 
-    /// The refinement of the chain's `k`-th pierce point against true link costs. The
-    /// straight-line model misses that a contour blocks the way out of itself (a chain leaves
-    /// a contour where it entered it), so the contour's corners are tried, where the way round
-    /// starts shortest.
-    fn refine_point(
+    /// The true cost of chain point `k` at `x`: the links (or pierces) into and out of it,
+    /// on obstacle-avoiding paths, and the idle moves at the chain's ends (`ends`: where the
+    /// tool comes from and goes to). The straight-line model of the descent misses that a
+    /// contour blocks the way out of itself (a chain leaves a contour where it entered it).
+    fn refine_cost(
         &self,
-        contour: &Contour,
-        points: &mut [Point],
+        x: Point,
+        points: &[Point],
         k: usize,
-        before: Point,
-        after: Option<Point>,
+        (before, after): (Point, Option<Point>),
         region: &Region,
-    ) {
+    ) -> f64 {
         let (on, off) = self.per_mm();
         let pierce = self.machine.pierce_price;
         let n = points.len();
@@ -864,20 +897,61 @@ impl Context<'_> {
                 None => idle,
             }
         };
-        let entering = |x: Point| {
-            if k == 0 {
-                off * before.distance(x)
-            } else {
-                transition(points[k - 1], x)
+        let entering = if k == 0 {
+            off * before.distance(x)
+        } else {
+            transition(points[k - 1], x)
+        };
+        let leaving = if k + 1 < n {
+            transition(x, points[k + 1])
+        } else {
+            after.map_or(0.0, |a| off * x.distance(a))
+        };
+        entering + leaving
+    }
+
+    /// A lower bound on [`Context::refine_cost`] from straight distances.
+    fn refine_lower_bound(
+        &self,
+        x: Point,
+        points: &[Point],
+        k: usize,
+        (before, after): (Point, Option<Point>),
+    ) -> f64 {
+        let (on, off) = self.per_mm();
+        let pierce = self.machine.pierce_price;
+        let n = points.len();
+        let at_least = |a: Point, b: Point, end_price: Option<f64>| {
+            let d = a.distance(b);
+            match end_price {
+                Some(price) => price * d,
+                None => (on * d).min(pierce + off * d),
             }
         };
-        let leaving = |x: Point| {
-            if k + 1 < n {
-                transition(x, points[k + 1])
-            } else {
-                after.map_or(0.0, |a| off * x.distance(a))
-            }
+        let entering = if k == 0 {
+            at_least(before, x, Some(off))
+        } else {
+            at_least(points[k - 1], x, None)
         };
+        let leaving = if k + 1 < n {
+            at_least(x, points[k + 1], None)
+        } else {
+            after.map_or(0.0, |a| at_least(x, a, Some(off)))
+        };
+        entering + leaving
+    }
+
+    /// The corners of `contour` tried for chain point `k`: the `REFINEMENT_CANDIDATES`
+    /// nearest its neighbours in straight line, where the way round the contour starts
+    /// shortest.
+    fn refine_candidates(
+        &self,
+        contour: &Contour,
+        points: &[Point],
+        k: usize,
+        (before, _): (Point, Option<Point>),
+    ) -> Vec<Point> {
+        let n = points.len();
         let straight_cost = |x: Point| {
             let prev = if k == 0 { before } else { points[k - 1] };
             x.distance(prev)
@@ -890,39 +964,7 @@ impl Context<'_> {
         let mut candidates: Vec<Point> = contour.spans().map(|s| s.start).collect();
         candidates.sort_by(|a, b| straight_cost(*a).total_cmp(&straight_cost(*b)));
         candidates.truncate(REFINEMENT_CANDIDATES);
-        // Links are never shorter than straight: a candidate whose straight-line cost is no
-        // better than the best true cost so far cannot win.
-        let at_least = |a: Point, b: Point, end_price: Option<f64>| {
-            let d = a.distance(b);
-            match end_price {
-                Some(price) => price * d,
-                None => (on * d).min(pierce + off * d),
-            }
-        };
-        let lower_bound = |x: Point| {
-            let entering = if k == 0 {
-                at_least(before, x, Some(off))
-            } else {
-                at_least(points[k - 1], x, None)
-            };
-            let leaving = if k + 1 < n {
-                at_least(x, points[k + 1], None)
-            } else {
-                after.map_or(0.0, |a| at_least(x, a, Some(off)))
-            };
-            entering + leaving
-        };
-        let mut best = (entering(points[k]) + leaving(points[k]), points[k]);
-        for x in candidates {
-            if lower_bound(x) >= best.0 {
-                continue;
-            }
-            let c = entering(x) + leaving(x);
-            if c < best.0 - 1e-12 {
-                best = (c, x);
-            }
-        }
-        points[k] = best.1;
+        candidates
     }
 }
 
@@ -937,6 +979,14 @@ struct GroupWork {
     best: Option<(f64, Route)>,
     /// The chain under way at one place.
     at: Option<ChainAt>,
+}
+
+/// The refinement of one chain point: its candidate corners, the next to try, and the best
+/// (true cost, point) so far (the current point first).
+struct Trial {
+    candidates: Vec<Point>,
+    next: usize,
+    best: (f64, Point),
 }
 
 /// What a call of [`Context::advance_group`] ended with.
@@ -959,12 +1009,14 @@ struct ChainAt {
 enum ChainStage {
     /// The member-to-member costs, row `i` next.
     Between { i: usize, between: Vec<Vec<f64>> },
-    /// Pierce point `k` of refinement round `round` next (members in chain `order`).
+    /// Pierce point `k` of refinement round `round` under way (members in chain `order`).
     Refine {
         order: Vec<usize>,
         points: Vec<Point>,
         round: usize,
         k: usize,
+        /// Its candidates being tried (`None`: not started).
+        trial: Option<Trial>,
     },
     /// The steps of the chain, one link decided per piece.
     Links {
