@@ -406,9 +406,12 @@ impl Job for DiscreteJob {
             return JobStatus::Done;
         }
         if !self.build(budget) {
-            // A build past the limit ends the job (no solver yet: no tour to keep).
+            // A build past the limit ends the job (no solver yet: no tour to keep). The
+            // heuristic's own preparation, once started, is finished (it is one pass over the
+            // matrix, bounded, and then gives the first tour), as when it was one step.
             let over = Instant::now() >= self.deadline + self.first_tour_allowance;
-            return if self.failure.is_some() || (over && self.alns.is_none()) {
+            let preparing = self.alns_builder.is_some();
+            return if self.failure.is_some() || (over && self.alns.is_none() && !preparing) {
                 if self.failure.is_none() {
                     self.failure = Some(BUILD_TIMED_OUT.into());
                 }
