@@ -1004,6 +1004,54 @@ impl IslandReplay {
     }
 }
 
+/// The step indices of `indexed` ((unit rank, step) sorted) with every contour after the
+/// contours inside it in the layout's forest: a step is held back until the steps of the
+/// contours inside it are out, the rest keep their order. The route is valid under the
+/// solvers' exact forest; the layout's forest (within the check tolerance) may also put a part
+/// touching the hole it sits in inside that hole, and a route may have cut it after the hole.
+fn inner_first(layout: &Layout, route: &Route, indexed: &[(usize, usize)]) -> Vec<usize> {
+    let forest = &layout.forest;
+    // Per forest index: how many steps of contours inside it are still to come.
+    let mut waiting = vec![0usize; forest.len()];
+    for &(_, i) in indexed {
+        for a in forest.ancestors(route.steps[i].contour) {
+            if let Some(k) = forest.index_of(a) {
+                waiting[k] += 1;
+            }
+        }
+    }
+    let ready = |waiting: &[usize], i: usize| {
+        forest
+            .index_of(route.steps[i].contour)
+            .is_none_or(|k| waiting[k] == 0)
+    };
+    let mut order = Vec::with_capacity(indexed.len());
+    let mut held: Vec<usize> = Vec::new();
+    let emit = |i: usize, waiting: &mut [usize], order: &mut Vec<usize>| {
+        order.push(i);
+        for a in forest.ancestors(route.steps[i].contour) {
+            if let Some(k) = forest.index_of(a) {
+                waiting[k] -= 1;
+            }
+        }
+    };
+    for &(_, i) in indexed {
+        if !ready(&waiting, i) {
+            held.push(i);
+            continue;
+        }
+        emit(i, &mut waiting, &mut order);
+        // Steps held back may be ready now (an outer contour once its last inner one is out).
+        while let Some(pos) = held.iter().position(|&h| ready(&waiting, h)) {
+            let h = held.remove(pos);
+            emit(h, &mut waiting, &mut order);
+        }
+    }
+    // Contours the forest cannot order (never the case for a route of its nest) keep theirs.
+    order.extend(held);
+    order
+}
+
 /// The route with its steps grouped by unit in `units` order (each unit's steps in their
 /// original order); links whose predecessor changed become pierces.
 fn reorder(layout: &Layout, route: &Route, units: &[usize]) -> Route {
@@ -1025,9 +1073,10 @@ fn reorder(layout: &Layout, route: &Route, units: &[usize]) -> Route {
         .map(|(i, s)| (unit_rank(s.contour), i))
         .collect();
     indexed.sort();
+    let order = inner_first(layout, route, &indexed);
     let mut steps = Vec::with_capacity(route.steps.len());
     let mut previous: Option<usize> = None;
-    for &(_, i) in &indexed {
+    for &i in &order {
         let mut s = route.steps[i].clone();
         if matches!(s.entry, Entry::Link(_)) && previous != Some(i.wrapping_sub(1)) {
             s.entry = Entry::Pierce;
