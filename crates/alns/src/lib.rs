@@ -59,7 +59,7 @@ use std::time::Duration;
 
 use cutroute_pcgtsp::Instance;
 
-pub use solver::AlnsSolver;
+pub use solver::{AlnsBuilder, AlnsSolver};
 
 /// Why an instance cannot be searched.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]

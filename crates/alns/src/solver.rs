@@ -9,7 +9,7 @@ use web_time::Instant;
 use crate::local_search::{eps, LocalSearch};
 use crate::nodes::NodeChoice;
 use crate::operators::{Insertion, Operators, Removal, Selection, INSERTIONS, REMOVALS};
-use crate::problem::Problem;
+use crate::problem::{Problem, ProblemBuild};
 use crate::{AlnsError, AlnsOptions, AlnsProgress, SolverStatus, StopReason};
 use cutroute_geometry::Xoshiro256 as Rng;
 
@@ -111,13 +111,55 @@ pub struct AlnsSolver {
     elapsed: Duration,
 }
 
+/// An [`AlnsSolver`] being prepared in slices ([`AlnsSolver::builder`]).
+#[derive(Clone, Debug)]
+pub struct AlnsBuilder {
+    build: ProblemBuild,
+    options: AlnsOptions,
+}
+
+impl AlnsBuilder {
+    /// Prepares for about `budget` (a piece at least: a few matrix rows or one pivot of the
+    /// closure); `Some(solver)` once ready, the solver [`AlnsSolver::new`] makes. Pass the
+    /// instance given to [`AlnsSolver::builder`] on every call.
+    pub fn advance(
+        &mut self,
+        instance: &Instance,
+        budget: Duration,
+    ) -> Result<Option<AlnsSolver>, AlnsError> {
+        let started = Instant::now();
+        let problem = self
+            .build
+            .advance(instance, &|| started.elapsed() >= budget)?;
+        Ok(problem.map(|problem| AlnsSolver::from_problem(problem, self.options.clone())))
+    }
+}
+
 impl AlnsSolver {
     /// Prepares a solver (validates the instance and closes its precedence relation); no search
     /// happens until [`AlnsSolver::step`].
     pub fn new(instance: &Instance, options: AlnsOptions) -> Result<Self, AlnsError> {
-        let problem = Problem::new(instance)?;
+        let mut builder = AlnsSolver::builder(instance, options)?;
+        loop {
+            if let Some(solver) = builder.advance(instance, Duration::MAX)? {
+                return Ok(solver);
+            }
+        }
+    }
+
+    /// [`AlnsSolver::new`] in slices: checks the instance's shape now, and
+    /// [`AlnsBuilder::advance`] does the rest (the cost matrix and the precedence closure,
+    /// seconds on a discretisation of thousands of nodes) a piece at a time.
+    pub fn builder(instance: &Instance, options: AlnsOptions) -> Result<AlnsBuilder, AlnsError> {
+        Ok(AlnsBuilder {
+            build: ProblemBuild::new(instance)?,
+            options,
+        })
+    }
+
+    fn from_problem(problem: Problem, options: AlnsOptions) -> Self {
         let epoch_length = options.parameters.epoch_iterations.max(1);
-        Ok(AlnsSolver {
+        AlnsSolver {
             rng: Rng::new(options.seed),
             problem,
             options,
@@ -144,7 +186,7 @@ impl AlnsSolver {
             epoch_iteration: 0,
             epoch_length,
             elapsed: Duration::ZERO,
-        })
+        }
     }
 
     /// Searches for about `budget` of time (at least one iteration unless already finished) and

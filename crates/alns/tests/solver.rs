@@ -484,3 +484,56 @@ fn plain_gtsp_with_symmetric_and_asymmetric_costs_is_feasible_and_deterministic(
         checked(&instance, first.tour.as_ref().unwrap(), first.cost.unwrap());
     }
 }
+
+/// The solver prepared in pieces (a job's steps) is the one `AlnsSolver::new` makes: the same
+/// instance checks, and the same tour after the same iterations.
+#[test]
+fn a_solver_built_in_pieces_searches_as_one_built_at_once() {
+    let instance = load("pcgtsplib", "kro124p.1");
+    let options = AlnsOptions {
+        max_iterations: Some(300),
+        time_limit: None,
+        seed: 7,
+        ..AlnsOptions::default()
+    };
+    let mut whole = AlnsSolver::new(&instance, options.clone()).unwrap();
+    let mut builder = AlnsSolver::builder(&instance, options).unwrap();
+    let mut pieces = 1;
+    let mut pieced = loop {
+        match builder.advance(&instance, Duration::ZERO).unwrap() {
+            Some(solver) => break solver,
+            None => pieces += 1,
+        }
+    };
+    // A row block or a pivot per piece: many pieces on 100 clusters.
+    assert!(pieces > 100, "{pieces} pieces");
+    while whole.step(Duration::from_secs(60)) == SolverStatus::Running {}
+    while pieced.step(Duration::from_secs(60)) == SolverStatus::Running {}
+    let (tour, cost) = pieced.best().unwrap();
+    assert_eq!(whole.best(), Some((tour, cost)));
+    checked(&instance, tour, cost);
+
+    // The checks the pieces make (costs, precedence) fail as the one-piece build's do.
+    let mut broken = random_instance(5, 4, false, 0, 0);
+    broken.precedence = vec![(1, 2), (2, 3), (3, 1)];
+    let mut builder = AlnsSolver::builder(&broken, AlnsOptions::default()).unwrap();
+    let failed = loop {
+        match builder.advance(&broken, Duration::ZERO) {
+            Ok(None) => continue,
+            Ok(Some(_)) => panic!("a cycle was accepted"),
+            Err(e) => break e,
+        }
+    };
+    assert!(matches!(failed, AlnsError::PrecedenceCycle(_)));
+    let mut broken = random_instance(5, 4, false, 0, 0);
+    broken.cost[7] = f64::NAN;
+    let mut builder = AlnsSolver::builder(&broken, AlnsOptions::default()).unwrap();
+    let failed = loop {
+        match builder.advance(&broken, Duration::ZERO) {
+            Ok(None) => continue,
+            Ok(Some(_)) => panic!("a NaN cost was accepted"),
+            Err(e) => break e,
+        }
+    };
+    assert!(matches!(failed, AlnsError::BadCost { .. }));
+}

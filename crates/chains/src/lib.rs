@@ -237,6 +237,8 @@ pub struct Chaining {
     /// The region being worked on and its groups still to try (reversed: next is last).
     region: usize,
     groups: Option<Vec<Vec<ContourRef>>>,
+    /// The group under way, when a slice ended inside it.
+    work: Option<GroupWork>,
 }
 
 impl Chaining {
@@ -280,11 +282,12 @@ impl Chaining {
             regions,
             region: 0,
             groups: None,
+            work: None,
         })
     }
 
     /// Tries groups of close contours until all are done (`true`) or `stop()` says so after a
-    /// group (`false`: call again).
+    /// piece of a group (`false`: call again; the group goes on from there).
     pub fn step(&mut self, nest: &Nest, options: &ChainOptions, stop: &dyn Fn() -> bool) -> bool {
         self.step_within(nest, options, stop, &|| false)
     }
@@ -292,8 +295,10 @@ impl Chaining {
     /// [`Chaining::step`] that also gives up when `abort()` says so, inside a group too (between
     /// its contours): the group under way is left as it was, chaining ends (`true`) and the
     /// route keeps every group done before. One group of a big scrap region can take seconds
-    /// (seven.dbs: 20 s), so a caller with a time limit passes its end here; groups are never
-    /// cut short by `stop`, so where slices end does not change the route.
+    /// (seven.dbs: 20 s), so a caller with a time limit passes its end here. `stop` ends a
+    /// slice between pieces of a group (a row of its distances, its order, one contour's
+    /// refinement or link) and the next call resumes it: where slices end does not change the
+    /// route.
     pub fn step_within(
         &mut self,
         nest: &Nest,
@@ -324,14 +329,20 @@ impl Chaining {
                 groups.reverse();
                 groups
             });
-            let Some(group) = groups.pop() else {
-                self.groups = None;
-                self.region += 1;
-                continue;
+            let mut work = match self.work.take() {
+                Some(work) => work,
+                None => {
+                    let Some(group) = groups.pop() else {
+                        self.groups = None;
+                        self.region += 1;
+                        continue;
+                    };
+                    context.start_group(&self.current, group)
+                }
             };
             // Far stricter than the checker's tolerance, so every link the region accepts
             // passes `Route::validate` (a crossing near but not at a link's end is a crossing).
-            // Rebuilt per group: cheap (boxes of the siblings), and it borrows the nest.
+            // Rebuilt per slice: cheap (boxes of the siblings), and it borrows the nest.
             let region = Region::new(
                 nest,
                 *parent,
@@ -339,11 +350,19 @@ impl Chaining {
                 options.clearance_mm,
                 1e-9 * self.scale,
             );
-            let Some(candidate) = context.chain_group(&self.current, &group, &region, abort) else {
-                self.region = self.regions.len();
-                self.groups = None;
-                return true;
-            };
+            let candidate =
+                match context.advance_group(&self.current, &mut work, &region, stop, abort) {
+                    GroupStatus::Done(candidate) => candidate,
+                    GroupStatus::Paused => {
+                        self.work = Some(work);
+                        return false;
+                    }
+                    GroupStatus::Aborted => {
+                        self.region = self.regions.len();
+                        self.groups = None;
+                        return true;
+                    }
+                };
             let cost = candidate.cost(nest, m);
             if cost < self.current_cost - 1e-12 * self.current_cost.abs().max(1.0) {
                 self.current = candidate;
@@ -518,15 +537,10 @@ impl Context<'_> {
         reach.min(straight + 2.0 * self.scale)
     }
 
-    /// `current` with `group` cut as one chain where its last member stood; `None` when
-    /// `abort()` said so on the way.
-    fn chain_group(
-        &self,
-        current: &Route,
-        group: &[ContourRef],
-        region: &Region,
-        abort: &dyn Fn() -> bool,
-    ) -> Option<Route> {
+    /// The work of chaining `group` in `current`: the places to try. The chain goes where its
+    /// last member stood (the paper's place) and, when another is feasible and cheaper in idle
+    /// detour, there too; the cheaper result wins.
+    fn start_group(&self, current: &Route, group: Vec<ContourRef>) -> GroupWork {
         let is_member = |c: ContourRef| group.contains(&c);
         let last = current
             .steps
@@ -574,32 +588,67 @@ impl Context<'_> {
         let nearest_at = (after_inner..=before_parent.max(after_inner))
             .min_by(|&a, &b| detour(a).total_cmp(&detour(b)))
             .unwrap_or(paper_at);
-        let mut best: Option<(f64, Route)> = None;
-        for k in [paper_at, nearest_at] {
-            if best.is_some() && k == paper_at {
-                continue;
-            }
-            let route = self.chain_at(current, group, &rest, k, region, abort)?;
-            let cost = route.cost(self.nest, self.machine);
-            if best.as_ref().is_none_or(|(c, _)| cost < *c) {
-                best = Some((cost, route));
-            }
+        // Tried last to first.
+        let mut places = Vec::with_capacity(2);
+        if nearest_at != paper_at {
+            places.push(nearest_at);
         }
-        Some(best.map_or_else(|| current.clone(), |(_, r)| r))
+        places.push(paper_at);
+        GroupWork {
+            group,
+            rest,
+            places,
+            best: None,
+            at: None,
+        }
     }
 
-    /// `current` with `group` cut as one chain, inserted into `rest` (the other steps) at
-    /// `insert_at`; `None` when `abort()` said so (asked per contour of the group).
-    fn chain_at(
+    /// Works on `work` (a group of `current`) a piece at a time until it is done (`current`
+    /// with the group cut as one chain at its best place), `stop()` says so after a piece
+    /// (`Paused`: call again with the same `current`), or `abort()` does (`Aborted`: asked per
+    /// contour of the group).
+    fn advance_group(
+        &self,
+        current: &Route,
+        work: &mut GroupWork,
+        region: &Region,
+        stop: &dyn Fn() -> bool,
+        abort: &dyn Fn() -> bool,
+    ) -> GroupStatus {
+        loop {
+            if work.at.is_none() {
+                let Some(insert_at) = work.places.pop() else {
+                    let best = work.best.take();
+                    return GroupStatus::Done(best.map_or_else(|| current.clone(), |(_, r)| r));
+                };
+                work.at = Some(self.start_chain(current, &work.group, &work.rest, insert_at));
+            }
+            let at = work.at.as_mut().expect("set above");
+            match self.advance_chain(current, &work.group, &work.rest, at, region, abort) {
+                None => return GroupStatus::Aborted,
+                Some(Some(route)) => {
+                    work.at = None;
+                    let cost = route.cost(self.nest, self.machine);
+                    if work.best.as_ref().is_none_or(|(c, _)| cost < *c) {
+                        work.best = Some((cost, route));
+                    }
+                }
+                Some(None) => {}
+            }
+            if stop() {
+                return GroupStatus::Paused;
+            }
+        }
+    }
+
+    /// The chain of `group` to be inserted into `rest` (the other steps) at `insert_at`.
+    fn start_chain(
         &self,
         current: &Route,
         group: &[ContourRef],
         rest: &[CutStep],
         insert_at: usize,
-        region: &Region,
-        abort: &dyn Fn() -> bool,
-    ) -> Option<Route> {
-        let rest = rest.to_vec();
+    ) -> ChainAt {
         let before = if insert_at > 0 {
             rest[insert_at - 1].pierce_point
         } else {
@@ -609,75 +658,237 @@ impl Context<'_> {
             .get(insert_at)
             .map(|s| s.pierce_point)
             .or(current.finish);
+        let n = group.len();
+        ChainAt {
+            insert_at,
+            before,
+            after,
+            stage: ChainStage::Between {
+                i: 0,
+                between: vec![vec![0.0; n]; n],
+            },
+        }
+    }
+
+    /// One piece of the chain `at`: a row of the member-to-member costs, the order with the
+    /// pierce points' descent, one contour's refinement or one link. `Some(Some(route))`:
+    /// `current` with the chain inserted; `Some(None)`: more pieces to go; `None`: `abort()`
+    /// said so.
+    fn advance_chain(
+        &self,
+        current: &Route,
+        group: &[ContourRef],
+        rest: &[CutStep],
+        at: &mut ChainAt,
+        region: &Region,
+        abort: &dyn Fn() -> bool,
+    ) -> Option<Option<Route>> {
+        let (before, after) = (at.before, at.after);
         let contours: Vec<&Contour> = group
             .iter()
             .map(|&r| self.nest.contour(r).expect("validated route"))
             .collect();
-
-        // Order: open-path TSP over contour-to-contour distances.
         let (on, off) = self.per_mm();
         let pierce = self.machine.pierce_price;
         let n = group.len();
-        let enter: Vec<f64> = contours
-            .iter()
-            .map(|c| off * c.distance_to(before))
-            .collect();
-        let leave: Vec<f64> = contours
-            .iter()
-            .map(|c| after.map_or(0.0, |a| off * c.distance_to(a)))
-            .collect();
-        let boxes: Vec<BoundingBox> = contours.iter().map(|c| c.bounding_box()).collect();
-        let mut between = vec![vec![0.0; n]; n];
-        for i in 0..n {
-            if abort() {
-                return None;
-            }
-            for j in i + 1..n {
-                let near = box_distance(&boxes[i], &boxes[j]);
-                let d = if near < self.threshold {
-                    contour_distance(contours[i], contours[j])
-                } else {
-                    near.max(boxes[i].centre().distance(boxes[j].centre()) * 0.5)
-                };
-                let w = (on * d).min(pierce + off * d);
-                between[i][j] = w;
-                between[j][i] = w;
-            }
-        }
-        let order =
-            order::open_path_order(&enter, &leave, &between, self.options.exact_order_limit);
-        let chain: Vec<&Contour> = order.iter().map(|&i| contours[i]).collect();
-
-        // Pierce points: the paper's rule (nearest to the middle of before–after) as a start,
-        // then coordinate descent on the weighted link + end-idle length.
-        let middle = match after {
-            Some(a) => before.midpoint(a),
-            None => before,
-        };
-        let mut points: Vec<Point> = chain
-            .iter()
-            .map(|c| c.nearest_point(middle).map_or(middle, |p| p.point))
-            .collect();
-        for _ in 0..self.options.descent_rounds {
-            for k in 0..n {
-                let mut terms = Vec::with_capacity(2);
-                terms.push(if k == 0 {
-                    (before, off)
-                } else {
-                    (points[k - 1], on)
-                });
-                if k + 1 < n {
-                    terms.push((points[k + 1], on));
-                } else if let Some(a) = after {
-                    terms.push((a, off));
+        let stage = std::mem::replace(&mut at.stage, ChainStage::Taken);
+        at.stage = match stage {
+            ChainStage::Between { i, mut between } if i < n => {
+                // Order: open-path TSP over contour-to-contour distances, a row at a time.
+                if abort() {
+                    return None;
                 }
-                points[k] = best_point(chain[k], &terms);
+                let boxes: Vec<BoundingBox> = contours.iter().map(|c| c.bounding_box()).collect();
+                for j in i + 1..n {
+                    let near = box_distance(&boxes[i], &boxes[j]);
+                    let d = if near < self.threshold {
+                        contour_distance(contours[i], contours[j])
+                    } else {
+                        near.max(boxes[i].centre().distance(boxes[j].centre()) * 0.5)
+                    };
+                    let w = (on * d).min(pierce + off * d);
+                    between[i][j] = w;
+                    between[j][i] = w;
+                }
+                ChainStage::Between { i: i + 1, between }
             }
-        }
+            ChainStage::Between { between, .. } => {
+                let enter: Vec<f64> = contours
+                    .iter()
+                    .map(|c| off * c.distance_to(before))
+                    .collect();
+                let leave: Vec<f64> = contours
+                    .iter()
+                    .map(|c| after.map_or(0.0, |a| off * c.distance_to(a)))
+                    .collect();
+                let order = order::open_path_order(
+                    &enter,
+                    &leave,
+                    &between,
+                    self.options.exact_order_limit,
+                );
+                let chain: Vec<&Contour> = order.iter().map(|&i| contours[i]).collect();
 
-        // The straight-line model misses that a contour blocks the way out of itself (a chain
-        // leaves a contour where it entered it): refine against true link costs, trying the
-        // contour's corners, where the way round starts shortest.
+                // Pierce points: the paper's rule (nearest to the middle of before–after) as a
+                // start, then coordinate descent on the weighted link + end-idle length.
+                let middle = match after {
+                    Some(a) => before.midpoint(a),
+                    None => before,
+                };
+                let mut points: Vec<Point> = chain
+                    .iter()
+                    .map(|c| c.nearest_point(middle).map_or(middle, |p| p.point))
+                    .collect();
+                for _ in 0..self.options.descent_rounds {
+                    for k in 0..n {
+                        let mut terms = Vec::with_capacity(2);
+                        terms.push(if k == 0 {
+                            (before, off)
+                        } else {
+                            (points[k - 1], on)
+                        });
+                        if k + 1 < n {
+                            terms.push((points[k + 1], on));
+                        } else if let Some(a) = after {
+                            terms.push((a, off));
+                        }
+                        points[k] = best_point(chain[k], &terms);
+                    }
+                }
+                ChainStage::Refine {
+                    order,
+                    points,
+                    round: 0,
+                    k: 0,
+                    trial: None,
+                }
+            }
+            ChainStage::Refine {
+                order,
+                mut points,
+                round,
+                k,
+                trial,
+            } if round < self.options.refinement_rounds => {
+                if abort() {
+                    return None;
+                }
+                let ends = (before, after);
+                // Point k's refinement a candidate per piece: each costs two obstacle-avoiding
+                // links, and a contour of a big scrap region took up to a second in one piece.
+                let trial = match trial {
+                    None => {
+                        let candidates =
+                            self.refine_candidates(contours[order[k]], &points, k, ends);
+                        let here = self.refine_cost(points[k], &points, k, ends, region);
+                        Some(Trial {
+                            candidates,
+                            next: 0,
+                            best: (here, points[k]),
+                        })
+                    }
+                    Some(mut trial) if trial.next < trial.candidates.len() => {
+                        let x = trial.candidates[trial.next];
+                        trial.next += 1;
+                        // Links are never shorter than straight: a candidate whose
+                        // straight-line cost is no better than the best true cost so far
+                        // cannot win.
+                        if self.refine_lower_bound(x, &points, k, ends) < trial.best.0 {
+                            let c = self.refine_cost(x, &points, k, ends, region);
+                            if c < trial.best.0 - 1e-12 {
+                                trial.best = (c, x);
+                            }
+                        }
+                        Some(trial)
+                    }
+                    Some(trial) => {
+                        points[k] = trial.best.1;
+                        None
+                    }
+                };
+                let (round, k) = match (&trial, k + 1 < n) {
+                    (Some(_), _) => (round, k),
+                    (None, true) => (round, k + 1),
+                    (None, false) => (round + 1, 0),
+                };
+                ChainStage::Refine {
+                    order,
+                    points,
+                    round,
+                    k,
+                    trial,
+                }
+            }
+            ChainStage::Refine { order, points, .. } => ChainStage::Links {
+                order,
+                points,
+                steps: Vec::with_capacity(n),
+            },
+            ChainStage::Links {
+                order,
+                points,
+                mut steps,
+            } if steps.len() < n => {
+                // Links that pay, on obstacle-avoiding paths; elsewhere the chain is cut.
+                if abort() {
+                    return None;
+                }
+                let k = steps.len();
+                let contour = group[order[k]];
+                let entry = if k == 0 {
+                    Entry::Pierce
+                } else {
+                    let straight = points[k - 1].distance(points[k]);
+                    let reach = self.link_reach(straight);
+                    match region.shortest_link(points[k - 1], points[k], reach) {
+                        Some((corners, length))
+                            if on * length < pierce + off * straight - 1e-12 =>
+                        {
+                            Entry::Link(corners)
+                        }
+                        _ => Entry::Pierce,
+                    }
+                };
+                steps.push(CutStep {
+                    contour,
+                    pierce_point: points[k],
+                    entry,
+                    leads: None,
+                });
+                ChainStage::Links {
+                    order,
+                    points,
+                    steps,
+                }
+            }
+            ChainStage::Links { steps, .. } => {
+                let mut new_steps = rest.to_vec();
+                new_steps.splice(at.insert_at..at.insert_at, steps);
+                return Some(Some(Route {
+                    steps: new_steps,
+                    ..current.clone()
+                }));
+            }
+            ChainStage::Taken => unreachable!("a chain's stage is put back after every piece"),
+        };
+        Some(None)
+    }
+
+    /// The true cost of chain point `k` at `x`: the links (or pierces) into and out of it,
+    /// on obstacle-avoiding paths, and the idle moves at the chain's ends (`ends`: where the
+    /// tool comes from and goes to). The straight-line model of the descent misses that a
+    /// contour blocks the way out of itself (a chain leaves a contour where it entered it).
+    fn refine_cost(
+        &self,
+        x: Point,
+        points: &[Point],
+        k: usize,
+        (before, after): (Point, Option<Point>),
+        region: &Region,
+    ) -> f64 {
+        let (on, off) = self.per_mm();
+        let pierce = self.machine.pierce_price;
+        let n = points.len();
         let transition = |a: Point, b: Point| -> f64 {
             let straight = a.distance(b);
             let idle = pierce + off * straight;
@@ -686,106 +897,135 @@ impl Context<'_> {
                 None => idle,
             }
         };
-        for _ in 0..self.options.refinement_rounds {
-            for k in 0..n {
-                if abort() {
-                    return None;
-                }
-                let entering = |x: Point| {
-                    if k == 0 {
-                        off * before.distance(x)
-                    } else {
-                        transition(points[k - 1], x)
-                    }
-                };
-                let leaving = |x: Point| {
-                    if k + 1 < n {
-                        transition(x, points[k + 1])
-                    } else {
-                        after.map_or(0.0, |a| off * x.distance(a))
-                    }
-                };
-                let straight_cost = |x: Point| {
-                    let prev = if k == 0 { before } else { points[k - 1] };
-                    x.distance(prev)
-                        + (if k + 1 < n {
-                            x.distance(points[k + 1])
-                        } else {
-                            0.0
-                        })
-                };
-                let mut candidates: Vec<Point> = chain[k].spans().map(|s| s.start).collect();
-                candidates.sort_by(|a, b| straight_cost(*a).total_cmp(&straight_cost(*b)));
-                candidates.truncate(REFINEMENT_CANDIDATES);
-                // Links are never shorter than straight: a candidate whose straight-line cost
-                // is no better than the best true cost so far cannot win.
-                let at_least = |a: Point, b: Point, end_price: Option<f64>| {
-                    let d = a.distance(b);
-                    match end_price {
-                        Some(price) => price * d,
-                        None => (on * d).min(pierce + off * d),
-                    }
-                };
-                let lower_bound = |x: Point| {
-                    let entering = if k == 0 {
-                        at_least(before, x, Some(off))
-                    } else {
-                        at_least(points[k - 1], x, None)
-                    };
-                    let leaving = if k + 1 < n {
-                        at_least(x, points[k + 1], None)
-                    } else {
-                        after.map_or(0.0, |a| at_least(x, a, Some(off)))
-                    };
-                    entering + leaving
-                };
-                let mut best = (entering(points[k]) + leaving(points[k]), points[k]);
-                for x in candidates {
-                    if lower_bound(x) >= best.0 {
-                        continue;
-                    }
-                    let c = entering(x) + leaving(x);
-                    if c < best.0 - 1e-12 {
-                        best = (c, x);
-                    }
-                }
-                points[k] = best.1;
-            }
-        }
-
-        // Links that pay, on obstacle-avoiding paths; elsewhere the chain is cut.
-        let mut steps = Vec::with_capacity(n);
-        for k in 0..n {
-            if abort() {
-                return None;
-            }
-            let contour = group[order[k]];
-            let entry = if k == 0 {
-                Entry::Pierce
-            } else {
-                let straight = points[k - 1].distance(points[k]);
-                let reach = self.link_reach(straight);
-                match region.shortest_link(points[k - 1], points[k], reach) {
-                    Some((corners, length)) if on * length < pierce + off * straight - 1e-12 => {
-                        Entry::Link(corners)
-                    }
-                    _ => Entry::Pierce,
-                }
-            };
-            steps.push(CutStep {
-                contour,
-                pierce_point: points[k],
-                entry,
-                leads: None,
-            });
-        }
-        let mut new_steps = rest;
-        new_steps.splice(insert_at..insert_at, steps);
-        Some(Route {
-            steps: new_steps,
-            ..current.clone()
-        })
+        let entering = if k == 0 {
+            off * before.distance(x)
+        } else {
+            transition(points[k - 1], x)
+        };
+        let leaving = if k + 1 < n {
+            transition(x, points[k + 1])
+        } else {
+            after.map_or(0.0, |a| off * x.distance(a))
+        };
+        entering + leaving
     }
+
+    /// A lower bound on [`Context::refine_cost`] from straight distances.
+    fn refine_lower_bound(
+        &self,
+        x: Point,
+        points: &[Point],
+        k: usize,
+        (before, after): (Point, Option<Point>),
+    ) -> f64 {
+        let (on, off) = self.per_mm();
+        let pierce = self.machine.pierce_price;
+        let n = points.len();
+        let at_least = |a: Point, b: Point, end_price: Option<f64>| {
+            let d = a.distance(b);
+            match end_price {
+                Some(price) => price * d,
+                None => (on * d).min(pierce + off * d),
+            }
+        };
+        let entering = if k == 0 {
+            at_least(before, x, Some(off))
+        } else {
+            at_least(points[k - 1], x, None)
+        };
+        let leaving = if k + 1 < n {
+            at_least(x, points[k + 1], None)
+        } else {
+            after.map_or(0.0, |a| at_least(x, a, Some(off)))
+        };
+        entering + leaving
+    }
+
+    /// The corners of `contour` tried for chain point `k`: the `REFINEMENT_CANDIDATES`
+    /// nearest its neighbours in straight line, where the way round the contour starts
+    /// shortest.
+    fn refine_candidates(
+        &self,
+        contour: &Contour,
+        points: &[Point],
+        k: usize,
+        (before, _): (Point, Option<Point>),
+    ) -> Vec<Point> {
+        let n = points.len();
+        let straight_cost = |x: Point| {
+            let prev = if k == 0 { before } else { points[k - 1] };
+            x.distance(prev)
+                + (if k + 1 < n {
+                    x.distance(points[k + 1])
+                } else {
+                    0.0
+                })
+        };
+        let mut candidates: Vec<Point> = contour.spans().map(|s| s.start).collect();
+        candidates.sort_by(|a, b| straight_cost(*a).total_cmp(&straight_cost(*b)));
+        candidates.truncate(REFINEMENT_CANDIDATES);
+        candidates
+    }
+}
+
+/// A group being chained ([`Context::advance_group`]).
+struct GroupWork {
+    group: Vec<ContourRef>,
+    /// The route's steps that are not members, in order.
+    rest: Vec<CutStep>,
+    /// Where in `rest` the chain is still to be tried (next last).
+    places: Vec<usize>,
+    /// The cheapest route so far, with its cost.
+    best: Option<(f64, Route)>,
+    /// The chain under way at one place.
+    at: Option<ChainAt>,
+}
+
+/// The refinement of one chain point: its candidate corners, the next to try, and the best
+/// (true cost, point) so far (the current point first).
+struct Trial {
+    candidates: Vec<Point>,
+    next: usize,
+    best: (f64, Point),
+}
+
+/// What a call of [`Context::advance_group`] ended with.
+enum GroupStatus {
+    Done(Route),
+    Paused,
+    Aborted,
+}
+
+/// The chain of a group at one place, under way.
+struct ChainAt {
+    insert_at: usize,
+    /// Where the tool comes from (the step before the place, or the route's start).
+    before: Point,
+    /// Where it goes next (the step at the place, or the route's finish).
+    after: Option<Point>,
+    stage: ChainStage,
+}
+
+enum ChainStage {
+    /// The member-to-member costs, row `i` next.
+    Between { i: usize, between: Vec<Vec<f64>> },
+    /// Pierce point `k` of refinement round `round` under way (members in chain `order`).
+    Refine {
+        order: Vec<usize>,
+        points: Vec<Point>,
+        round: usize,
+        k: usize,
+        /// Its candidates being tried (`None`: not started).
+        trial: Option<Trial>,
+    },
+    /// The steps of the chain, one link decided per piece.
+    Links {
+        order: Vec<usize>,
+        points: Vec<Point>,
+        steps: Vec<CutStep>,
+    },
+    /// Only while a piece runs.
+    Taken,
 }
 
 /// The point of `contour` minimising `Σ w·|x − a|` over `terms`: every span is sampled, the

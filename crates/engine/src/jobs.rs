@@ -1,6 +1,6 @@
 //! The solver jobs: each wraps one resumable solver (or two that cooperate) behind [`Job`].
 
-use cutroute_alns::{AlnsOptions, AlnsSolver};
+use cutroute_alns::{AlnsBuilder, AlnsOptions, AlnsSolver};
 use cutroute_ccp::{CcpLowerBound, CcpOptions, CcpSolver, DiscreteInstance};
 use cutroute_chains::{ChainOptions, Chained, Chaining};
 use cutroute_geometry::{MachineParameters, Nest, Route};
@@ -183,6 +183,8 @@ pub struct DiscreteJob {
     instance: Option<Instance>,
     discrete: Option<DiscreteInstance>,
     alns: Option<AlnsSolver>,
+    /// The heuristic being prepared, a piece per step (seconds on a big discretisation).
+    alns_builder: Option<AlnsBuilder>,
     alns_done: bool,
     exact: Option<ExactSolver>,
     exact_done: Option<bool>,
@@ -257,6 +259,7 @@ impl DiscreteJob {
             instance: None,
             discrete: None,
             alns: None,
+            alns_builder: None,
             alns_done: false,
             exact: None,
             exact_done: None,
@@ -334,13 +337,20 @@ impl DiscreteJob {
             return false;
         };
         if self.alns.is_none() {
-            let options = AlnsOptions {
-                seed: self.seed,
-                time_limit: Some(self.time_left()),
-                ..AlnsOptions::default()
+            let builder = match self.alns_builder.take() {
+                Some(builder) => Ok(builder),
+                None => AlnsSolver::builder(
+                    instance,
+                    AlnsOptions {
+                        seed: self.seed,
+                        time_limit: Some(self.time_left()),
+                        ..AlnsOptions::default()
+                    },
+                ),
             };
-            match AlnsSolver::new(instance, options) {
-                Ok(alns) => self.alns = Some(alns),
+            match builder.and_then(|mut b| b.advance(instance, budget).map(|done| (b, done))) {
+                Ok((_, Some(alns))) => self.alns = Some(alns),
+                Ok((builder, None)) => self.alns_builder = Some(builder),
                 Err(e) => self.failure = Some(e.to_string()),
             }
             return false;
@@ -396,9 +406,12 @@ impl Job for DiscreteJob {
             return JobStatus::Done;
         }
         if !self.build(budget) {
-            // A build past the limit ends the job (no solver yet: no tour to keep).
+            // A build past the limit ends the job (no solver yet: no tour to keep). The
+            // heuristic's own preparation, once started, is finished (it is one pass over the
+            // matrix, bounded, and then gives the first tour), as when it was one step.
             let over = Instant::now() >= self.deadline + self.first_tour_allowance;
-            return if self.failure.is_some() || (over && self.alns.is_none()) {
+            let preparing = self.alns_builder.is_some();
+            return if self.failure.is_some() || (over && self.alns.is_none() && !preparing) {
                 if self.failure.is_none() {
                     self.failure = Some(BUILD_TIMED_OUT.into());
                 }

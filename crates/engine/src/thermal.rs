@@ -30,7 +30,7 @@ use cutroute_protocol::{Phase, Progress, SolverKind, ThermalNote, ThermalSetting
 use cutroute_thermal::{
     admissible_pierce_points, check_rules, contour_route_of_paths, enforce_rules,
     path_route_pierces, relax_pierce_points, route_pierces, HeatModel, RuleCheck, RuleCounts,
-    RuleParams, Violation,
+    RuleParams, RuleRepair, Violation,
 };
 use web_time::{Duration, Instant};
 
@@ -53,6 +53,17 @@ pub const FINAL_CHECK_GRACE: Duration = Duration::from_millis(800);
 /// route), and the progress's (route, path route) it reports on.
 type FinalCheck = (RuleCheck, Route, (Option<Route>, Option<PathRoute>));
 
+/// The hard-rule repair of a finished route, in pieces.
+enum RepairWork {
+    /// A path route's contour route being checked: a path route obeying the rules is kept.
+    PathCheck { contours: Route, check: RuleCheck },
+    /// The repair of a contour route; `path`: it is the contour route of a path route, and the
+    /// repaired route is cut as standard cutting.
+    Rules { repair: RuleRepair, path: bool },
+    /// The repair could not start (reported as the repair's failure).
+    Failed(String),
+}
+
 /// A measure (H, or the rule check) of a route that is not the final one runs only when at
 /// least this many times its own last duration has passed since it ran: the island check
 /// replays the route on a raster, and H lays out the route on the machine clock, which on a
@@ -71,14 +82,26 @@ pub fn enforce_thermal_rules(
     machine: &MachineParameters,
     objective: Objective,
 ) -> Result<Route, String> {
-    let model = settings.model().map_err(|e| e.to_string())?;
-    let params = RuleParams::default();
-    let route = enforce_rules(nest, &route, settings.rules, &params)
+    let route = enforce_rules(nest, &route, settings.rules, &RuleParams::default())
         .map_err(|e| e.to_string())?
         .route;
+    relax_repaired(nest, route, settings, machine, objective)
+}
+
+/// The end of [`enforce_thermal_rules`] after the rule repair: with a heat weight, the
+/// repaired route's pierce points relaxed on idle + W·H among those the part rule admits.
+fn relax_repaired(
+    nest: &Nest,
+    route: Route,
+    settings: &ThermalSettings,
+    machine: &MachineParameters,
+    objective: Objective,
+) -> Result<Route, String> {
     if !settings.penalised() {
         return Ok(route);
     }
+    let model = settings.model().map_err(|e| e.to_string())?;
+    let params = RuleParams::default();
     let candidates = if settings.rules.part {
         Some(admissible_pierce_points(nest, &route, &params).map_err(|e| e.to_string())?)
     } else {
@@ -116,7 +139,13 @@ pub fn enforce_thermal_rules_on_paths(
         return Ok(None);
     }
     let route = enforce_thermal_rules(nest, contours, settings, machine, objective)?;
-    let paths = PathRoute::from_route(&route, nest).map_err(|e| e.to_string())?;
+    cut_as_standard(nest, &route).map(Some)
+}
+
+/// A repaired contour route as a route of tool-on paths (standard cutting: whole contours,
+/// common edges cut twice), or why it fails the path checker.
+fn cut_as_standard(nest: &Nest, route: &Route) -> Result<PathRoute, String> {
+    let paths = PathRoute::from_route(route, nest).map_err(|e| e.to_string())?;
     // The repaired route must pass the path checker as the solver's did (pieces cut twice
     // allowed); when it does not, the repair fails and the caller keeps the solver's route.
     if let Some(problem) = paths
@@ -126,7 +155,7 @@ pub fn enforce_thermal_rules_on_paths(
     {
         return Err(format!("the repaired route fails the checker: {problem}"));
     }
-    Ok(Some(paths))
+    Ok(paths)
 }
 
 /// The rule check of a route of tool-on paths, on its contour route.
@@ -293,6 +322,8 @@ pub struct ThermalJob {
     repaired: Option<Result<Route, String>>,
     /// The same for a path route: its contour route repaired, as standard cutting.
     repaired_path: Option<Result<PathRoute, String>>,
+    /// The hard-rule repair under way, a piece per step (about a second on Nest02/03).
+    repair_work: Option<RepairWork>,
     /// The final route's rule check under way: the check, the (contour) route it checks, and
     /// the progress's route and path route it belongs to.
     final_check: Option<FinalCheck>,
@@ -326,6 +357,7 @@ impl ThermalJob {
             done: false,
             repaired: None,
             repaired_path: None,
+            repair_work: None,
             final_check: None,
             final_check_cut: false,
             deadline: Instant::now().checked_add(time_limit + FINAL_CHECK_GRACE),
@@ -346,21 +378,32 @@ impl ThermalJob {
         }
         let progress = self.inner.progress();
         if let (true, Some(path_route)) = (hard, progress.path_route) {
-            self.repaired_path = self.repair_path_route(&path_route);
+            let contours = path_contour_route(&self.nest, &path_route);
+            self.repair_work = Some(
+                match RuleCheck::new(self.settings.rules, RuleParams::default()) {
+                    Ok(check) => RepairWork::PathCheck { contours, check },
+                    Err(e) => RepairWork::Failed(e.to_string()),
+                },
+            );
             return;
         }
         let Some(route) = progress.route else {
             return;
         };
-        self.repaired = Some(if hard {
-            enforce_thermal_rules(
-                &self.nest,
-                route,
-                &self.settings,
-                &self.machine,
-                self.objective,
-            )
-        } else {
+        if hard {
+            self.repair_work = Some(
+                match RuleRepair::new(&route, self.settings.rules, RuleParams::default()) {
+                    Ok(repair) => RepairWork::Rules {
+                        repair,
+                        path: false,
+                    },
+                    Err(e) => RepairWork::Failed(e.to_string()),
+                },
+            );
+            return;
+        }
+        // Not hard: the discrete solvers' pierce points relaxed on the heat weight.
+        self.repaired = Some(
             self.settings
                 .model()
                 .map_err(|e| e.to_string())
@@ -377,21 +420,69 @@ impl ThermalJob {
                         None,
                     )
                     .map_err(|e| e.to_string())
-                })
-        });
+                }),
+        );
     }
 
-    /// Hard rules on a path route: `None` when its contour route obeys them; else that route
-    /// repaired as a contour route and cut as standard cutting.
-    fn repair_path_route(&self, path_route: &PathRoute) -> Option<Result<PathRoute, String>> {
-        enforce_thermal_rules_on_paths(
-            &self.nest,
-            path_route,
-            &self.settings,
-            &self.machine,
-            self.objective,
-        )
-        .transpose()
+    /// Works on the repair under way for about `budget`; true when it is over (its result is
+    /// in `repaired` or `repaired_path`).
+    fn advance_repair(&mut self, budget: Duration) -> bool {
+        let Some(work) = self.repair_work.take() else {
+            return true;
+        };
+        let nest = &self.nest;
+        let next = match work {
+            RepairWork::PathCheck {
+                contours,
+                mut check,
+            } => match check.advance(nest, &contours, budget) {
+                Ok(None) => RepairWork::PathCheck { contours, check },
+                // A path route whose contour route obeys the rules is kept as it is.
+                Ok(Some(report)) if report.violations.is_empty() => return true,
+                Ok(Some(_)) => {
+                    match RuleRepair::new(&contours, self.settings.rules, RuleParams::default()) {
+                        Ok(repair) => RepairWork::Rules { repair, path: true },
+                        Err(e) => RepairWork::Failed(e.to_string()),
+                    }
+                }
+                Err(e) => RepairWork::Failed(e.to_string()),
+            },
+            RepairWork::Rules { mut repair, path } => match repair.advance(nest, budget) {
+                Ok(None) => RepairWork::Rules { repair, path },
+                Ok(Some(enforced)) => {
+                    let route = relax_repaired(
+                        nest,
+                        enforced.route,
+                        &self.settings,
+                        &self.machine,
+                        self.objective,
+                    );
+                    if path {
+                        self.repaired_path =
+                            Some(route.and_then(|route| cut_as_standard(nest, &route)));
+                    } else {
+                        self.repaired = Some(route);
+                    }
+                    return true;
+                }
+                Err(e) => RepairWork::Failed(e.to_string()),
+            },
+            RepairWork::Failed(e) => {
+                if self.base_is_path() {
+                    self.repaired_path = Some(Err(e));
+                } else {
+                    self.repaired = Some(Err(e));
+                }
+                return true;
+            }
+        };
+        self.repair_work = Some(next);
+        false
+    }
+
+    /// Whether the inner job's result is a route of tool-on paths.
+    fn base_is_path(&self) -> bool {
+        self.inner.progress().path_route.is_some()
     }
 
     /// Whether a report checks the rules of a route that is not the final one (the final one
@@ -508,10 +599,19 @@ impl Job for ThermalJob {
             self.done = true;
             return JobStatus::Done;
         }
-        if self.inner.step(budget) == JobStatus::Running {
-            return JobStatus::Running;
+        if self.repair_work.is_some() {
+            if !self.advance_repair(budget) {
+                return JobStatus::Running;
+            }
+        } else {
+            if self.inner.step(budget) == JobStatus::Running {
+                return JobStatus::Running;
+            }
+            self.repair();
+            if self.repair_work.is_some() {
+                return JobStatus::Running;
+            }
         }
-        self.repair();
         if !self.settings.rules.any() {
             self.done = true;
             return JobStatus::Done;

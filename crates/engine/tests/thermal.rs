@@ -5,7 +5,10 @@
 
 use std::path::PathBuf;
 
-use cutroute_engine::{open_document, path_contour_route, run_to_end, start_job};
+use cutroute_engine::{
+    check_path_rules, enforce_thermal_rules_on_paths, open_document, path_contour_route,
+    run_to_end, start_job,
+};
 use cutroute_geometry::{MachineParameters, Nest, Objective, PathRoute, PathRouteError};
 use cutroute_protocol::{
     JobRequest, Problem, Progress, RuleSet, SolverKind, SolverParams, ThermalSettings,
@@ -290,6 +293,48 @@ fn path_route_solvers_honour_hard_rules_and_report_h() {
             }
         }
     }
+}
+
+/// Nest02's parts placed in holes touch them; the AOE route breaks the rules, and its repair
+/// (whole contours, standard cutting) must cut every such part before its hole: it passes the
+/// path checker and leaves no violation (it once failed it, and the AOE route was kept with
+/// 183/0/12 violations, because a part touching its hole a rounding error outside it was
+/// taken for a top-level part).
+#[test]
+fn aoe_with_hard_rules_repairs_nest02_into_a_valid_route() {
+    let problem = nest_problem("nests/tflex/Nest02.tfnesting");
+    let nest = nest_of(&problem);
+    let hard = ThermalSettings {
+        rules: RuleSet::ALL,
+        hard: true,
+        ..ThermalSettings::default()
+    };
+    // The AOE route, then the repair the job makes in hard mode, called whole (the job's
+    // final check may run out of its grace in a debug build).
+    let plain = solve(&problem, SolverKind::Aoe, ThermalSettings::default());
+    let aoe = plain.path_route.as_ref().expect("a path route");
+    let before = check_path_rules(nest, aoe, &hard).expect("checked");
+    assert!(
+        !before.violations.is_empty(),
+        "the AOE route breaks the rules"
+    );
+    let route = enforce_thermal_rules_on_paths(
+        nest,
+        aoe,
+        &hard,
+        &MachineParameters::default(),
+        Objective::Time,
+    )
+    .expect("the repaired route passes the path checker")
+    .expect("a repaired route");
+    let mut problems = route.problems(nest, nest.check_tolerance());
+    problems.retain(|p| !matches!(p, PathRouteError::Overlap { .. }));
+    assert!(problems.is_empty(), "{problems:?}");
+    let after = check_path_rules(nest, &route, &hard).expect("checked");
+    assert!(after.violations.is_empty(), "{:?}", after.violations);
+    let contours = path_contour_route(nest, &route);
+    let valid = contours.validate(nest, 1e-3);
+    assert!(valid.is_ok(), "{valid:?}");
 }
 
 #[test]

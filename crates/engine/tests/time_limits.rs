@@ -32,13 +32,11 @@ const LONG_STEPS: &[(SolverKind, &str, &str)] = &[
         "",
         "the interval relaxation's first exact step",
     ),
-    // Chaining::new validates the route; one group of close contours is one piece.
-    (SolverKind::Chain, "", "a chain group"),
     // The exact solver's runs are built in steps (`ExactSolver::deferred`), but one start
     // node's model and its root bound (an assignment over every cluster) are one piece each.
     (SolverKind::Exact, "", "a start node's model or root bound"),
     // The ALNS's first descent runs a move family per step; on hundreds of clusters one
-    // family (and `AlnsSolver::new`'s precedence closure) is still a piece of 0.5–1.5 s.
+    // family is still a piece of 0.5–1.5 s.
     (
         SolverKind::Heuristic,
         "generated",

@@ -135,12 +135,44 @@ fn summarize(contour: &Contour) -> ContourSummary {
 }
 
 /// Does contour `outer` contain contour `inner`? Strictly larger area (which keeps the
-/// relation acyclic), box containment, then the exact arc-aware point test on inner's probe.
-fn contains(outer: &Contour, o: &ContourSummary, i: &ContourSummary) -> bool {
-    match i.probe {
-        Some(p) => o.area > i.area && o.bbox.contains_box(&i.bbox) && outer.contains(p),
-        None => false,
+/// relation acyclic), box containment within `tolerance`, then the exact arc-aware point test
+/// on inner's probe.
+///
+/// With a tolerance, boxes are compared within it because a part placed in a hole often
+/// touches it: its edge lies on the hole's edge, and after the placement's rotation and
+/// translation a rounding error may put it a hair outside (Nest02: part 119 sticks 2·10⁻⁵ mm
+/// out of the hole of part 20 along the edge it shares). Compared exactly, such a part is a
+/// top-level part.
+fn contains(
+    outer: &Contour,
+    o: &ContourSummary,
+    inner: &Contour,
+    i: &ContourSummary,
+    tolerance: f64,
+) -> bool {
+    let Some(probe) = i.probe else {
+        return false;
+    };
+    if !(o.area > i.area && box_holds(&o.bbox, &i.bbox, tolerance)) {
+        return false;
     }
+    if tolerance > 0.0 {
+        // The probe may lie on the shared edge, a rounding error outside: the first span
+        // middle clear of the outer boundary decides (the contours do not cross).
+        if let Some(p) = inner
+            .spans()
+            .map(|s| s.point_at(0.5))
+            .find(|&p| p.is_finite() && outer.distance_to(p) > tolerance)
+        {
+            return outer.contains(p);
+        }
+    }
+    outer.contains(probe)
+}
+
+/// Whether box `outer` contains box `inner` within `tolerance`.
+fn box_holds(outer: &BoundingBox, inner: &BoundingBox, tolerance: f64) -> bool {
+    outer.expanded(tolerance).contains_box(inner)
 }
 
 impl ContainmentForest {
@@ -151,6 +183,17 @@ impl ContainmentForest {
     /// bounding boxes, and are tried from the smallest area up; the first that contains the
     /// contour is its parent. Contours with non-finite data become roots.
     pub fn new(nest: &Nest) -> Self {
+        Self::with_tolerance(nest, 0.0)
+    }
+
+    /// [`ContainmentForest::new`] with the contours' boxes compared within `tolerance` (see
+    /// [`contains`]): a part placed in a hole and touching it, its shared edge a rounding error
+    /// outside the hole's, is inside the hole. The thermal rules group parts into units by
+    /// this forest (`cutroute-thermal`'s layout, with the nest's check tolerance), so their
+    /// repair never moves such a part after the hole that drops it. The solvers' forest
+    /// ([`ContainmentForest::new`]) stays exact: the segment plan takes a part sharing an edge
+    /// with its parent hole for no common edge (SCCP/GSCCP lost their gains on Nest02/Nest03).
+    pub fn with_tolerance(nest: &Nest, tolerance: f64) -> Self {
         let refs: Vec<ContourRef> = nest.contour_refs().collect();
         let contours: Vec<&Contour> = nest.parts.iter().flat_map(|p| &p.contours).collect();
         let summaries: Vec<ContourSummary> = contours.iter().map(|c| summarize(c)).collect();
@@ -175,13 +218,16 @@ impl ContainmentForest {
                 let p = s.probe?;
                 candidates.clear();
                 candidates.extend(
-                    tree.locate_in_envelope_intersecting(&AABB::from_point([p.x, p.y]))
-                        .map(|e| e.index)
-                        .filter(|&j| {
-                            j != i
-                                && summaries[j].area > s.area
-                                && summaries[j].bbox.contains_box(&s.bbox)
-                        }),
+                    tree.locate_in_envelope_intersecting(&AABB::from_corners(
+                        [p.x - tolerance, p.y - tolerance],
+                        [p.x + tolerance, p.y + tolerance],
+                    ))
+                    .map(|e| e.index)
+                    .filter(|&j| {
+                        j != i
+                            && summaries[j].area > s.area
+                            && box_holds(&summaries[j].bbox, &s.bbox, tolerance)
+                    }),
                 );
                 candidates.sort_by(|&a, &b| {
                     summaries[a]
@@ -192,7 +238,7 @@ impl ContainmentForest {
                 candidates
                     .iter()
                     .copied()
-                    .find(|&j| contains(contours[j], &summaries[j], s))
+                    .find(|&j| contains(contours[j], &summaries[j], contours[i], s, tolerance))
             })
             .collect();
         Self::from_parents(nest, refs, parent)
@@ -200,13 +246,27 @@ impl ContainmentForest {
 
     /// The same forest computed by testing every pair: O(n²), for checking [`Self::new`].
     pub fn brute_force(nest: &Nest) -> Self {
+        Self::brute_force_with_tolerance(nest, 0.0)
+    }
+
+    /// [`ContainmentForest::brute_force`] for [`ContainmentForest::with_tolerance`].
+    pub fn brute_force_with_tolerance(nest: &Nest, tolerance: f64) -> Self {
         let refs: Vec<ContourRef> = nest.contour_refs().collect();
         let contours: Vec<&Contour> = nest.parts.iter().flat_map(|p| &p.contours).collect();
         let summaries: Vec<ContourSummary> = contours.iter().map(|c| summarize(c)).collect();
         let parent = (0..contours.len())
             .map(|i| {
                 (0..contours.len())
-                    .filter(|&j| j != i && contains(contours[j], &summaries[j], &summaries[i]))
+                    .filter(|&j| {
+                        j != i
+                            && contains(
+                                contours[j],
+                                &summaries[j],
+                                contours[i],
+                                &summaries[i],
+                                tolerance,
+                            )
+                    })
                     .min_by(|&a, &b| {
                         summaries[a]
                             .area

@@ -204,3 +204,53 @@ fn generated_nests_follow_the_conventions() {
         assert_eq!(generate_nest(n, 1).contour_count(), n);
     }
 }
+
+/// A part placed in a hole touching it, its shared edge a rounding error outside the hole's
+/// (as T-FLEX placements leave it: Nest02's part 119 sticks out of its hole by 2·10⁻⁵ mm), is
+/// inside the hole in the forest with the check tolerance (the thermal rules' units): a repair
+/// must cut it before the hole that drops it. A part merely touching the plate from outside
+/// stays a root. The exact forest keeps the touching part a root.
+#[test]
+fn a_part_touching_the_hole_it_sits_in_is_inside_it_within_the_tolerance() {
+    let plate = Part {
+        name: "plate".into(),
+        contours: vec![
+            square(0.0, 0.0, 400.0, true),
+            square(100.0, 100.0, 200.0, false),
+        ],
+    };
+    // Its left edge on the hole's left edge, 2·10⁻⁵ mm out; its other sides well inside.
+    let touching = Part {
+        name: "touching".into(),
+        contours: vec![square(100.0 - 2e-5, 150.0, 80.0, true)],
+    };
+    // Beside the plate, sharing its right edge.
+    let beside = Part {
+        name: "beside".into(),
+        contours: vec![square(400.0 + 2e-5, 0.0, 80.0, true)],
+    };
+    let nest = Nest {
+        parts: vec![plate, touching, beside],
+        ..Nest::default()
+    };
+    let tolerance = nest.check_tolerance();
+    assert!(2e-5 < tolerance);
+    for forest in [
+        ContainmentForest::with_tolerance(&nest, tolerance),
+        ContainmentForest::brute_force_with_tolerance(&nest, tolerance),
+    ] {
+        assert_eq!(forest.parent(r(1, 0)), Some(r(0, 1)));
+        assert_eq!(forest.depth(r(1, 0)), Some(2));
+        assert_eq!(forest.parent(r(2, 0)), None);
+        assert!(forest
+            .all_precedence_pairs()
+            .into_iter()
+            .any(|(inner, outer)| inner == r(1, 0) && outer == r(0, 1)));
+    }
+    for forest in [
+        ContainmentForest::new(&nest),
+        ContainmentForest::brute_force(&nest),
+    ] {
+        assert_eq!(forest.parent(r(1, 0)), Some(r(0, 0)));
+    }
+}

@@ -31,7 +31,10 @@ pub(crate) struct Layout<'a> {
 
 impl<'a> Layout<'a> {
     pub fn new(nest: &'a Nest) -> Layout<'a> {
-        let forest = nest.containment_forest();
+        // Within the check tolerance: a part touching the hole it sits in belongs to the
+        // hole's unit (it drops with the hole's slug), so a repair that moves whole units
+        // never cuts it after the hole.
+        let forest = ContainmentForest::with_tolerance(nest, nest.check_tolerance());
         let sheet_contour = nest
             .sheet
             .as_ref()

@@ -18,7 +18,8 @@
 //! - [`relax_pierce_points`]: pierce points moved along their contours to lower idle + weight·H
 //!   (the relaxation step of a penalised search).
 //! - [`enforce_rules`]: hard-rule mode as a repair of a finished route (whole parts reordered,
-//!   pierce points moved), reporting what is left.
+//!   pierce points moved), reporting what is left; [`RuleRepair`] is the same repair in
+//!   resumable pieces.
 //! - [`contour_route_of_paths`]: the rules on routes of tool-on paths (segment and common-edge
 //!   cutting), through the contour route they imply.
 //!
@@ -74,7 +75,7 @@ pub use paths::contour_route_of_paths;
 pub use pierce::relax_pierce_points;
 pub use rules::{
     admissible_pierce_points, check_rules, enforce_rules, Enforced, RuleCheck, RuleCounts,
-    RuleParams, RuleReport, RuleSet, Side, Violation,
+    RuleParams, RuleRepair, RuleReport, RuleSet, Side, Violation,
 };
 
 /// What can go wrong.
@@ -96,4 +97,7 @@ pub enum ThermalError {
     /// The route does not fit the nest.
     #[error(transparent)]
     Route(cutroute_geometry::RouteError),
+    /// [`RuleRepair::advance`] was called again after it returned its result.
+    #[error("the rule repair has already returned its result")]
+    RepairFinished,
 }

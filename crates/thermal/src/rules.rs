@@ -748,28 +748,175 @@ pub fn enforce_rules(
     rules: RuleSet,
     params: &RuleParams,
 ) -> Result<Enforced, ThermalError> {
-    params.validate()?;
-    check_steps(route, nest)?;
-    let layout = Layout::new(nest);
+    let mut repair = RuleRepair::new(route, rules, *params)?;
+    loop {
+        if let Some(enforced) = repair.advance(nest, web_time::Duration::MAX)? {
+            return Ok(enforced);
+        }
+    }
+}
+
+/// [`enforce_rules`] in pieces, for a job that must answer Stop between slices (on Nest02/03
+/// the repair took about a second in one piece): the sheet rule's reorder, the island raster's
+/// build, the island replay a unit at a time, the part rule a range of steps at a time, then
+/// the check of the repaired route as a [`RuleCheck`]. Call [`RuleRepair::advance`] with the
+/// same nest until it returns the result, which is [`enforce_rules`]'s.
+#[derive(Clone)]
+pub struct RuleRepair {
+    rules: RuleSet,
+    params: RuleParams,
+    route: Route,
+    stage: RepairStage,
+}
+
+#[derive(Clone)]
+enum RepairStage {
+    Start,
+    IslandGrid(Vec<usize>),
+    Islands(Box<IslandReplay>),
+    Reorder(Vec<usize>),
+    Part {
+        repaired: Route,
+        from: usize,
+        violations: Vec<Violation>,
+    },
+    Check(Route, RuleCheck),
+    Done,
+}
+
+/// The island repair under way: the raster, the units still uncut, those to place (in order)
+/// and those placed.
+#[derive(Clone)]
+struct IslandReplay {
+    grid: IslandGrid,
+    uncut: Vec<bool>,
+    pending: Vec<usize>,
+    done: Vec<usize>,
+}
+
+impl RuleRepair {
+    /// A repair of `route` under `rules` with `params` (refused when a parameter is out of
+    /// range).
+    pub fn new(
+        route: &Route,
+        rules: RuleSet,
+        params: RuleParams,
+    ) -> Result<RuleRepair, ThermalError> {
+        params.validate()?;
+        Ok(RuleRepair {
+            rules,
+            params,
+            route: route.clone(),
+            stage: RepairStage::Start,
+        })
+    }
+
+    /// Works on the repair for about `budget` (a piece at least); `Some` once done.
+    pub fn advance(
+        &mut self,
+        nest: &Nest,
+        budget: web_time::Duration,
+    ) -> Result<Option<Enforced>, ThermalError> {
+        let started = web_time::Instant::now();
+        let layout = Layout::new(nest);
+        let params = &self.params;
+        let route = &self.route;
+        loop {
+            self.stage = match std::mem::replace(&mut self.stage, RepairStage::Done) {
+                RepairStage::Start => {
+                    check_steps(route, nest)?;
+                    let units = sheet_order(&layout, route, self.rules, params);
+                    if self.rules.islands {
+                        RepairStage::IslandGrid(units)
+                    } else {
+                        RepairStage::Reorder(units)
+                    }
+                }
+                RepairStage::IslandGrid(units) => RepairStage::Islands(Box::new(IslandReplay {
+                    grid: IslandGrid::new(&layout, params.strip_width_mm, params.max_grid_cells),
+                    uncut: vec![true; layout.units.len()],
+                    pending: units,
+                    done: Vec::new(),
+                })),
+                RepairStage::Islands(mut replay) => {
+                    if replay.pending.is_empty() {
+                        RepairStage::Reorder(replay.done)
+                    } else {
+                        replay.place_next();
+                        RepairStage::Islands(replay)
+                    }
+                }
+                RepairStage::Reorder(units) => RepairStage::Part {
+                    repaired: reorder(&layout, route, &units),
+                    from: 0,
+                    violations: Vec::new(),
+                },
+                RepairStage::Part {
+                    repaired,
+                    from,
+                    mut violations,
+                } if self.rules.part && from < repaired.steps.len() => {
+                    // The free edges depend on the order only, so the violations of the
+                    // reordered route are found a range of steps at a time before any pierce
+                    // point moves.
+                    let to = (from + PART_STEPS_PER_PIECE).min(repaired.steps.len());
+                    violations.extend(part_rigidity_range(&layout, &repaired, params, from..to));
+                    RepairStage::Part {
+                        repaired,
+                        from: to,
+                        violations,
+                    }
+                }
+                RepairStage::Part {
+                    mut repaired,
+                    violations,
+                    ..
+                } => {
+                    move_pierce_points(&mut repaired, violations);
+                    RepairStage::Check(repaired, RuleCheck::new(self.rules, *params)?)
+                }
+                RepairStage::Check(repaired, mut check) => {
+                    let left = budget.saturating_sub(started.elapsed());
+                    match check.advance(nest, &repaired, left)? {
+                        Some(report) => {
+                            return Ok(Some(Enforced {
+                                route: repaired,
+                                report,
+                            }))
+                        }
+                        None => RepairStage::Check(repaired, check),
+                    }
+                }
+                RepairStage::Done => return Err(ThermalError::RepairFinished),
+            };
+            if started.elapsed() >= budget {
+                return Ok(None);
+            }
+        }
+    }
+}
+
+/// Step 1 of [`enforce_rules`]: the units in route order (by their root's step; units never
+/// cut go last), with sheet rule 1's units first and rules 2/3's start moved.
+fn sheet_order(layout: &Layout, route: &Route, rules: RuleSet, params: &RuleParams) -> Vec<usize> {
     let steps = layout.root_steps(route);
-    // Units in route order (by their root's step; units never cut go last).
     let mut units: Vec<usize> = (0..layout.units.len()).collect();
     units.sort_by_key(|&u| (steps[u].unwrap_or(usize::MAX), u));
     if rules.sheet {
-        let long = rule1_units(&layout, params);
+        let long = rule1_units(layout, params);
         let (mut order, rest): (Vec<usize>, Vec<usize>) = units.iter().partition(|&&u| long[u]);
         let mut rest = rest;
         if let (Some((required, _, mid)), Some(&first)) =
-            (required_side(&layout, params), rest.first())
+            (required_side(layout, params), rest.first())
         {
-            if side_of(&layout, first, mid) != required {
+            if side_of(layout, first, mid) != required {
                 let start = route.start;
                 if let Some(pick) = rest
                     .iter()
-                    .position(|&u| side_of(&layout, u, mid) == required)
+                    .position(|&u| side_of(layout, u, mid) == required)
                     .map(|_| {
                         (0..rest.len())
-                            .filter(|&i| side_of(&layout, rest[i], mid) == required)
+                            .filter(|&i| side_of(layout, rest[i], mid) == required)
                             .min_by(|&a, &b| {
                                 box_distance(&layout.units[rest[a]].bbox, start)
                                     .total_cmp(&box_distance(&layout.units[rest[b]].bbox, start))
@@ -785,50 +932,49 @@ pub fn enforce_rules(
         order.extend(rest);
         units = order;
     }
-    if rules.islands {
-        units = island_order(&layout, &units, params);
-    }
-    let mut repaired = reorder(&layout, route, &units);
-    if rules.part {
-        for v in part_rigidity(&layout, &repaired, params) {
-            let Violation::PartRigidity { step, best, .. } = v else {
-                continue;
-            };
-            // A linked step starts where its link ends and the next link leaves from that
-            // point (a chain leaves a contour where it entered it), so the chain chose the
-            // point for the link's length, not for the rule. Under hard rules such a link is a
-            // forbidden move: the contour is pierced at its rigid point instead, and the link
-            // that left from the old point becomes a pierce where it ended.
-            repaired.steps[step].entry = Entry::Pierce;
-            repaired.steps[step].pierce_point = best;
-            if let Some(next) = repaired.steps.get_mut(step + 1) {
-                if matches!(next.entry, Entry::Link(_)) {
-                    next.entry = Entry::Pierce;
-                }
+    units
+}
+
+/// Step 3 of [`enforce_rules`]: each violating pierce point moves to the contour's point
+/// nearest the free edge.
+fn move_pierce_points(repaired: &mut Route, violations: Vec<Violation>) {
+    for v in violations {
+        let Violation::PartRigidity { step, best, .. } = v else {
+            continue;
+        };
+        // A linked step starts where its link ends and the next link leaves from that
+        // point (a chain leaves a contour where it entered it), so the chain chose the
+        // point for the link's length, not for the rule. Under hard rules such a link is a
+        // forbidden move: the contour is pierced at its rigid point instead, and the link
+        // that left from the old point becomes a pierce where it ended.
+        repaired.steps[step].entry = Entry::Pierce;
+        repaired.steps[step].pierce_point = best;
+        if let Some(next) = repaired.steps.get_mut(step + 1) {
+            if matches!(next.entry, Entry::Link(_)) {
+                next.entry = Entry::Pierce;
             }
         }
     }
-    let report = check_rules(nest, &repaired, rules, params)?;
-    Ok(Enforced {
-        route: repaired,
-        report,
-    })
 }
 
-/// The island repair of [`enforce_rules`] over units in order.
-fn island_order(layout: &Layout, units: &[usize], params: &RuleParams) -> Vec<usize> {
-    let mut grid = IslandGrid::new(layout, params.strip_width_mm, params.max_grid_cells);
-    let mut uncut = vec![true; layout.units.len()];
-    let mut pending: Vec<usize> = units.to_vec();
-    let mut done = Vec::with_capacity(units.len());
-    while !pending.is_empty() {
+impl IslandReplay {
+    /// Places the next unit: the first pending one whose cut isolates nothing, after moving
+    /// the units it would isolate to the front (repeatedly); if the units isolate each other,
+    /// the one isolating the fewest.
+    fn place_next(&mut self) {
+        let IslandReplay {
+            grid,
+            uncut,
+            pending,
+            done,
+        } = self;
         let mut tried: Vec<(usize, usize)> = Vec::new(); // (unit, islands it makes)
         let choice = loop {
             let u = pending[0];
             let saved = grid.save();
             grid.cut(u);
             uncut[u] = false;
-            let isolated = grid.islanded(&uncut);
+            let isolated = grid.islanded(uncut);
             grid.restore(saved);
             uncut[u] = true;
             if isolated.is_empty() {
@@ -849,14 +995,61 @@ fn island_order(layout: &Layout, units: &[usize], params: &RuleParams) -> Vec<us
             let (mut front, back): (Vec<usize>, Vec<usize>) =
                 pending.iter().partition(|p| fresh.contains(p));
             front.extend(back);
-            pending = front;
+            *pending = front;
         };
         let u = pending.remove(choice);
         grid.cut(u);
         uncut[u] = false;
         done.push(u);
     }
-    done
+}
+
+/// The step indices of `indexed` ((unit rank, step) sorted) with every contour after the
+/// contours inside it in the layout's forest: a step is held back until the steps of the
+/// contours inside it are out, the rest keep their order. The route is valid under the
+/// solvers' exact forest; the layout's forest (within the check tolerance) may also put a part
+/// touching the hole it sits in inside that hole, and a route may have cut it after the hole.
+fn inner_first(layout: &Layout, route: &Route, indexed: &[(usize, usize)]) -> Vec<usize> {
+    let forest = &layout.forest;
+    // Per forest index: how many steps of contours inside it are still to come.
+    let mut waiting = vec![0usize; forest.len()];
+    for &(_, i) in indexed {
+        for a in forest.ancestors(route.steps[i].contour) {
+            if let Some(k) = forest.index_of(a) {
+                waiting[k] += 1;
+            }
+        }
+    }
+    let ready = |waiting: &[usize], i: usize| {
+        forest
+            .index_of(route.steps[i].contour)
+            .is_none_or(|k| waiting[k] == 0)
+    };
+    let mut order = Vec::with_capacity(indexed.len());
+    let mut held: Vec<usize> = Vec::new();
+    let emit = |i: usize, waiting: &mut [usize], order: &mut Vec<usize>| {
+        order.push(i);
+        for a in forest.ancestors(route.steps[i].contour) {
+            if let Some(k) = forest.index_of(a) {
+                waiting[k] -= 1;
+            }
+        }
+    };
+    for &(_, i) in indexed {
+        if !ready(&waiting, i) {
+            held.push(i);
+            continue;
+        }
+        emit(i, &mut waiting, &mut order);
+        // Steps held back may be ready now (an outer contour once its last inner one is out).
+        while let Some(pos) = held.iter().position(|&h| ready(&waiting, h)) {
+            let h = held.remove(pos);
+            emit(h, &mut waiting, &mut order);
+        }
+    }
+    // Contours the forest cannot order (never the case for a route of its nest) keep theirs.
+    order.extend(held);
+    order
 }
 
 /// The route with its steps grouped by unit in `units` order (each unit's steps in their
@@ -880,9 +1073,10 @@ fn reorder(layout: &Layout, route: &Route, units: &[usize]) -> Route {
         .map(|(i, s)| (unit_rank(s.contour), i))
         .collect();
     indexed.sort();
+    let order = inner_first(layout, route, &indexed);
     let mut steps = Vec::with_capacity(route.steps.len());
     let mut previous: Option<usize> = None;
-    for &(_, i) in &indexed {
+    for &i in &order {
         let mut s = route.steps[i].clone();
         if matches!(s.entry, Entry::Link(_)) && previous != Some(i.wrapping_sub(1)) {
             s.entry = Entry::Pierce;

@@ -3,8 +3,11 @@
 //!
 //! `cargo run --release -p cutroute-bench --bin time_limits -- [--time-limit 5] [--slice-ms 40]
 //! [--step 50] [--solvers ccp,exact,…] [--filter NAME[,NAME…]] [--set nests|pcgtsp|all]
-//! [--generated 1000,10000] [--data DIR] [--trace]
+//! [--generated 1000,10000] [--data DIR] [--trace] [--rules-hard]
 //! [--cli BIN --cli-input FILE[,FILE…] --cli-limit S]`
+//!
+//! `--rules-hard` runs every job with `--rules part,sheet,islands --rules-hard` (the repair and
+//! the rule check after the solver are steps of the job too).
 //!
 //! `--trace` prints every call longer than its slice + 50 ms to stderr, with the job's phase
 //! before and after it.
@@ -94,6 +97,7 @@ pub fn main() {
     let mut generated: Vec<usize> = vec![1000];
     let mut data = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../data");
     let mut trace = false;
+    let mut thermal = cutroute_protocol::ThermalSettings::default();
     let mut cli: Option<PathBuf> = None;
     let mut cli_inputs: Vec<PathBuf> = Vec::new();
     let mut cli_limit = 120.0f64;
@@ -133,6 +137,13 @@ pub fn main() {
             }
             "--data" => data = PathBuf::from(value()),
             "--trace" => trace = true,
+            "--rules-hard" => {
+                thermal = cutroute_protocol::ThermalSettings {
+                    rules: cutroute_protocol::RuleSet::ALL,
+                    hard: true,
+                    ..thermal
+                }
+            }
             "--cli" => cli = Some(PathBuf::from(value())),
             "--cli-input" => cli_inputs = value().split(',').map(PathBuf::from).collect(),
             "--cli-limit" => cli_limit = value().parse().expect("--cli-limit SECONDS"),
@@ -174,6 +185,7 @@ pub fn main() {
                 params: SolverParams {
                     time_limit_s: limit,
                     discretisation_step_mm: step_mm,
+                    thermal,
                     ..SolverParams::default()
                 },
             };
