@@ -52,6 +52,8 @@ pub struct NgPathBound {
     /// `related[c * m + d]`: whether entering `d` from `c` can depend on the memory (d in
     /// ng(c), or ng(c) and ng(d) share a cluster).
     related: Vec<bool>,
+    /// `gap[c * m + d]`: the least arc cost between clusters `c` and `d` (either way).
+    gap: Vec<f64>,
     /// Penalty per cluster visit.
     lambda: Vec<f64>,
     /// Layers of the DP under way (index k = k + 1 visits), each sorted by node.
@@ -151,6 +153,7 @@ impl NgPathBound {
             ng,
             position,
             related,
+            gap: near,
             best_lambda: lambda.clone(),
             lambda,
             layers: Vec::new(),
@@ -265,6 +268,23 @@ impl NgPathBound {
             runs.push((v, i, j));
             i = j;
         }
+        // Per run: its cheapest label; per cluster: its runs and their cheapest label.
+        let run_best: Vec<(f64, u32)> = runs
+            .iter()
+            .map(|&(_, start, end)| {
+                (start..end)
+                    .map(|i| (prev[i].value, i as u32))
+                    .min_by(|a, b| a.0.total_cmp(&b.0))
+                    .expect("a run is not empty")
+            })
+            .collect();
+        let mut cluster_runs: Vec<Vec<usize>> = vec![Vec::new(); m];
+        let mut cluster_best = vec![f64::INFINITY; m];
+        for (r, &(v, _, _)) in runs.iter().enumerate() {
+            let c = self.cluster[v];
+            cluster_runs[c].push(r);
+            cluster_best[c] = cluster_best[c].min(run_best[r].0);
+        }
         // Candidates per target node of one cluster, a dense table over the memories (bit 0,
         // the cluster itself, is always set): (value, pred), and the memories touched.
         let width = 1usize << (self.ng[0].len() - 1);
@@ -278,62 +298,62 @@ impl NgPathBound {
             table.resize(targets.len() * width, (f64::INFINITY, u32::MAX));
             touched.clear();
             touched.resize(targets.len(), Vec::new());
-            for &(v, start, end) in &runs {
-                let c = self.cluster[v];
-                if c == d {
-                    continue;
+            // The source clusters by their least possible arrival (cheapest label plus least
+            // arc to d). A cluster whose arrival is no lower than every target's entry with
+            // the memory {d} cannot improve any entry (that one dominates all it would add,
+            // whatever their memories), nor can the clusters after it.
+            let mut order: Vec<(f64, usize)> = (0..m)
+                .filter(|&c| c != d && !cluster_runs[c].is_empty())
+                .map(|c| (cluster_best[c] + self.gap[c * m + d], c))
+                .collect();
+            order.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let mut threshold = f64::INFINITY;
+            for &(key, c) in &order {
+                if key >= threshold {
+                    break;
                 }
-                // The labels of v as they enter d: memory projected on ng(d), dominated ones
-                // dropped.
-                projected.clear();
-                if !self.related[c * m + d] {
+                if self.related[c * m + d] {
+                    // The memory matters: every label.
+                    for &r in &cluster_runs[c] {
+                        let (v, start, end) = runs[r];
+                        self.relax_from(
+                            v,
+                            c,
+                            d,
+                            &prev[start..end],
+                            start,
+                            &mut projected,
+                            targets,
+                            &mut table,
+                            &mut touched,
+                            width,
+                        );
+                    }
+                } else {
                     // No cluster of ng(c) is in ng(d), nor d in ng(c): every label enters
                     // with the memory {d}, so only the cheapest counts.
-                    let (k, label) = prev[start..end]
-                        .iter()
-                        .enumerate()
-                        .min_by(|a, b| a.1.value.total_cmp(&b.1.value))
-                        .expect("a run is not empty");
-                    projected.push((1, label.value, (start + k) as u32));
-                }
-                for (k, label) in prev[start..end]
-                    .iter()
-                    .enumerate()
-                    .filter(|_| self.related[c * m + d])
-                {
-                    if let Some(mask) = self.enter(c, label.mask, d) {
-                        let value = label.value;
-                        if projected
-                            .iter()
-                            .any(|&(pm, pv, _)| pm & mask == pm && pv <= value)
-                        {
-                            continue;
-                        }
-                        projected.retain(|&(pm, pv, _)| !(mask & pm == mask && value <= pv));
-                        projected.push((mask, value, (start + k) as u32));
-                    }
-                }
-                if projected.is_empty() {
-                    continue;
-                }
-                let row = &self.cost[v * n..(v + 1) * n];
-                for (t, &w) in targets.iter().enumerate() {
-                    let arc = row[w];
-                    if !arc.is_finite() {
-                        continue;
-                    }
-                    let row = &mut table[t * width..(t + 1) * width];
-                    for &(mask, value, pred) in &projected {
-                        let total = value + arc;
-                        let e = &mut row[(mask >> 1) as usize];
-                        if e.1 == u32::MAX {
-                            touched[t].push(mask);
-                        }
-                        if total < e.0 {
-                            *e = (total, pred);
+                    for &r in &cluster_runs[c] {
+                        let (v, _, _) = runs[r];
+                        let (value, index) = run_best[r];
+                        let row = &self.cost[v * n..(v + 1) * n];
+                        for (t, &w) in targets.iter().enumerate() {
+                            let arc = row[w];
+                            if !arc.is_finite() {
+                                continue;
+                            }
+                            let e = &mut table[t * width];
+                            if e.1 == u32::MAX {
+                                touched[t].push(1);
+                            }
+                            if value + arc < e.0 {
+                                *e = (value + arc, index);
+                            }
                         }
                     }
                 }
+                threshold = (0..targets.len())
+                    .map(|t| table[t * width].0)
+                    .fold(f64::NEG_INFINITY, f64::max);
             }
             let penalty = self.lambda[d];
             for (t, &w) in targets.iter().enumerate() {
@@ -368,6 +388,61 @@ impl NgPathBound {
         }
         next.sort_by_key(|l| l.node);
         self.layers.push(next);
+    }
+
+    /// Offers the labels `labels` of source node `v` (cluster `c`; `start`: the index of the
+    /// first in the previous layer) to the targets of cluster `d`: each label's memory as it
+    /// enters `d`, dominated ones dropped, then every arc into the table.
+    #[allow(clippy::too_many_arguments)]
+    fn relax_from(
+        &self,
+        v: usize,
+        c: usize,
+        d: usize,
+        labels: &[Label],
+        start: usize,
+        projected: &mut Vec<(u32, f64, u32)>,
+        targets: &[usize],
+        table: &mut [(f64, u32)],
+        touched: &mut [Vec<u32>],
+        width: usize,
+    ) {
+        let n = self.n;
+        projected.clear();
+        for (k, label) in labels.iter().enumerate() {
+            if let Some(mask) = self.enter(c, label.mask, d) {
+                let value = label.value;
+                if projected
+                    .iter()
+                    .any(|&(pm, pv, _)| pm & mask == pm && pv <= value)
+                {
+                    continue;
+                }
+                projected.retain(|&(pm, pv, _)| !(mask & pm == mask && value <= pv));
+                projected.push((mask, value, (start + k) as u32));
+            }
+        }
+        if projected.is_empty() {
+            return;
+        }
+        let row = &self.cost[v * n..(v + 1) * n];
+        for (t, &w) in targets.iter().enumerate() {
+            let arc = row[w];
+            if !arc.is_finite() {
+                continue;
+            }
+            let row = &mut table[t * width..(t + 1) * width];
+            for &(mask, value, pred) in projected.iter() {
+                let total = value + arc;
+                let e = &mut row[(mask >> 1) as usize];
+                if e.1 == u32::MAX {
+                    touched[t].push(mask);
+                }
+                if total < e.0 {
+                    *e = (total, pred);
+                }
+            }
+        }
     }
 
     /// Closes the walks (return arc), records the bound and takes a subgradient step.
