@@ -142,7 +142,28 @@ impl NgPathBound {
         let lambda = if lambda.len() == m {
             lambda.to_vec()
         } else {
-            vec![0.0; m]
+            // A start near the node-penalty bound: each visit is worth half its cheapest way
+            // in plus half its cheapest way out through the same node.
+            members
+                .iter()
+                .map(|nodes| {
+                    nodes
+                        .iter()
+                        .map(|&w| {
+                            let least = |f: &dyn Fn(usize) -> f64| {
+                                (0..n)
+                                    .filter(|&v| v != w)
+                                    .map(f)
+                                    .fold(f64::INFINITY, f64::min)
+                            };
+                            let into = least(&|v| instance.cost[v * n + w]);
+                            let out = least(&|v| instance.cost[w * n + v]);
+                            0.5 * (into + out)
+                        })
+                        .fold(f64::INFINITY, f64::min)
+                })
+                .map(|x| if x.is_finite() { x } else { 0.0 })
+                .collect()
         };
         Some(NgPathBound {
             n,
