@@ -104,13 +104,11 @@ impl NgPathBound {
         }
         // Least arc cost between clusters: the neighbourhoods are the nearest ones.
         let mut near = vec![f64::INFINITY; m * m];
-        for a in 1..n {
-            let ca = cluster[a];
+        for (a, &ca) in cluster.iter().enumerate() {
             if ca == usize::MAX {
                 continue;
             }
-            for b in 1..n {
-                let cb = cluster[b];
+            for (b, &cb) in cluster.iter().enumerate() {
                 if cb == usize::MAX || cb == ca {
                     continue;
                 }
