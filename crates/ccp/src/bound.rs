@@ -689,9 +689,10 @@ impl CcpLowerBound {
             .min_by_key(|&g| self.groups[g].elapsed());
         // With the ng-path bound the whole relaxation is the stronger one (the groups' exact
         // optima saturate within seconds at the loss on their borders): it gets three slices
-        // of four; without it, one.
+        // of four, seven of eight once its bound is above the groups' sum; without it, one.
         let own_turn = if self.ng_active() {
-            !self.turns.is_multiple_of(4)
+            let every = if self.best > self.group_sum() { 8 } else { 4 };
+            !self.turns.is_multiple_of(every)
         } else {
             self.turns.is_multiple_of(4)
         };
