@@ -81,6 +81,7 @@
 mod bound;
 mod discrete;
 mod geom;
+mod ngpath;
 mod problem;
 mod relax;
 mod route;
@@ -92,6 +93,7 @@ pub use discrete::{
     build_pcgtsp, DiscreteInstance, DiscreteNode, DiscretisationOptions, PcgtspBuilder,
     MAX_DISCRETE_NODES,
 };
+pub use ngpath::NgPathBound;
 pub use route::{idle_length, route_certificates, route_metrics, ContourCertificate, RouteMetrics};
 pub use solver::{
     solve, solve_with_cancel, CcpOptions, CcpPhase, CcpProgress, CcpResult, CcpSolver, HeatPenalty,

@@ -445,3 +445,57 @@ fn the_groups_sum_never_above_brute_force() {
         cases - positive
     );
 }
+
+/// The ng-path bound on the whole relaxation (forced on small nests, neighbourhoods of 2 and 8
+/// contours) is never above a brute-force route, on random and packed nests, open and closed;
+/// and it is not trivial.
+#[test]
+fn the_ng_path_bound_never_above_brute_force() {
+    let mut strong = 0;
+    let mut cases = 0;
+    for seed in 1..=8u64 {
+        for (nest, h) in [(random_nest(seed), 0.25), (packed_nest(seed), 1.0)] {
+            let start = Point::new(-30.0, -10.0);
+            let finish = (seed % 3 == 0).then_some(Point::new(150.0, -20.0));
+            let brute = brute_force(&nest, start, finish, h);
+            let ccp = solve(
+                &nest,
+                CcpOptions {
+                    start,
+                    finish,
+                    time_limit: Duration::from_millis(300),
+                    ..CcpOptions::default()
+                },
+                &mut |_| {},
+            )
+            .unwrap();
+            for ng_size in [2, 8] {
+                let options = LowerBoundOptions {
+                    start,
+                    finish,
+                    budget_seconds: 2.0,
+                    group_size: 0,
+                    ng_size,
+                    ng_above: 0,
+                    ..LowerBoundOptions::default()
+                };
+                let mut bound = CcpLowerBound::new(&nest, options).unwrap();
+                bound.offer_route(&ccp.route);
+                let lb = run_bound(&mut bound, 4, Duration::from_secs(2));
+                let ng = bound.ng_bound();
+                cases += 1;
+                strong += usize::from(ng >= 0.8 * brute);
+                assert!(
+                    ng <= brute + 1e-9 && lb <= brute + 1e-9,
+                    "seed {seed}, ng {ng_size}: ng-path bound {ng}, bound {lb}, brute force {brute}"
+                );
+                assert!(lb <= ccp.metrics.idle_length + 1e-9);
+            }
+        }
+    }
+    assert!(
+        strong * 4 >= cases * 3,
+        "the ng-path bound was below 80 % of the optimum in {} of {cases} cases",
+        cases - strong
+    );
+}

@@ -55,13 +55,22 @@ fn discrete_exact_job_bound_never_exceeds_the_discrete_optimum() {
                 DiscreteNode::Depot(_) => None,
             })
             .collect();
-        for (at_candidates, group_size) in [(false, 0), (false, 1), (false, 2), (true, 0)] {
+        // (at the candidates, group size, ng-path bound forced on the whole relaxation)
+        for (at_candidates, group_size, ng) in [
+            (false, 0, false),
+            (false, 1, false),
+            (false, 2, false),
+            (true, 0, false),
+            (false, 0, true),
+            (false, 2, true),
+        ] {
             let options = LowerBoundOptions {
                 start,
                 finish,
                 budget_seconds: 1.0,
                 group_size,
                 decompose_above: 0,
+                ng_above: if ng { 0 } else { usize::MAX },
                 ..Default::default()
             };
             let bound = if at_candidates {
@@ -86,7 +95,7 @@ fn discrete_exact_job_bound_never_exceeds_the_discrete_optimum() {
             let lb = result.lower_bound.expect("a lower bound");
             assert!(
                 lb <= optimum * (1.0 + 1e-9) + 1e-9,
-                "seed {seed} ({at_candidates}, groups of {group_size}): job bound {lb} above the discrete optimum {optimum}"
+                "seed {seed} ({at_candidates}, groups of {group_size}, ng {ng}): job bound {lb} above the discrete optimum {optimum}"
             );
             let ub = result.upper_bound.expect("a tour");
             assert!(ub >= optimum - 1e-6 * optimum.max(1.0), "seed {seed}");

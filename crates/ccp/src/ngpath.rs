@@ -1,0 +1,681 @@
+//! A lower bound for a PCGTSP without precedence (the interval relaxation's instances): the
+//! *ng-path relaxation* with Lagrangian penalties on cluster visits.
+//!
+//! Why it is needed: the bounds of the exact machinery either drop clusters (the subset DP
+//! beyond ~20 tracked clusters) or relax the node-level consistency of a visit (assignment,
+//! 1-tree: a contour "entered at one piece, left at another"). On tightly packed sheets both
+//! lose the short back-and-forth between neighbouring contours that no real route can make.
+//!
+//! The relaxation: walks from the depot that make exactly `m` cluster visits (m = the number of
+//! clusters besides the depot's) and return, each visit entering and leaving at *one* node, with
+//! a memory: each cluster `c` has a neighbourhood `ng(c)` (itself and its nearest clusters), the
+//! walk remembers `M ⊆ ng(current)` and may not enter a remembered cluster; entering `d` makes
+//! the memory `(M ∩ ng(d)) ∪ {d}`. So a cluster cannot be revisited before the walk has been
+//! away from its neighbourhood, which forbids the short loops among neighbours. Every tour
+//! (each cluster once) is such a walk. With penalties λ per visit of each cluster,
+//!
+//! `L(λ) = min over walks W of [cost(W) − Σ_visits λ_cluster] + Σ_c λ_c ≤ cost(any tour)`,
+//!
+//! for every real λ (a tour visits each cluster once, so both sums cancel), hence `L(λ)` is a
+//! certified lower bound of the PCGTSP optimum, and with it of the continuous route (the module
+//! `bound`). The minimum is a dynamic programme over (visits so far, node, memory); subgradient
+//! steps on λ (visits − 1 per cluster) raise the bound. Labels whose memory is a superset of
+//! another label's at no lower value are dropped (the other allows every extension it does).
+
+use cutroute_pcgtsp::Instance;
+use web_time::Instant;
+
+/// One label of a layer: a walk with `k` visits ending at `node` with memory `mask` (bits over
+/// the positions of `ng(cluster(node))`) and reduced cost `value`; `pred` is the label it came
+/// from in the previous layer (`u32::MAX` for the first visit).
+#[derive(Clone, Copy, Debug)]
+struct Label {
+    node: u32,
+    mask: u32,
+    pred: u32,
+    value: f64,
+}
+
+/// The resumable subgradient search of the ng-path bound on one instance.
+pub struct NgPathBound {
+    n: usize,
+    cost: Vec<f64>,
+    depot: usize,
+    /// Per node: its cluster's index among the non-depot clusters (`usize::MAX` for the depot).
+    cluster: Vec<usize>,
+    /// Per non-depot cluster: its nodes.
+    members: Vec<Vec<usize>>,
+    /// Per cluster: `ng(c)`, `c` first.
+    ng: Vec<Vec<usize>>,
+    /// `position[c * m + x]`: position of cluster `x` in `ng(c)`, or -1.
+    position: Vec<i8>,
+    /// `related[c * m + d]`: whether entering `d` from `c` can depend on the memory (d in
+    /// ng(c), or ng(c) and ng(d) share a cluster).
+    related: Vec<bool>,
+    /// `gap[c * m + d]`: the least arc cost between clusters `c` and `d` (either way).
+    gap: Vec<f64>,
+    /// Penalty per cluster visit.
+    lambda: Vec<f64>,
+    /// Layers of the DP under way (index k = k + 1 visits), each sorted by node.
+    layers: Vec<Vec<Label>>,
+    best: f64,
+    best_lambda: Vec<f64>,
+    /// Nodes of the walk of the last completed pass (for refinement).
+    last_walk: Vec<usize>,
+    /// Subgradient step factor (Polyak), halved when the bound stalls.
+    mu: f64,
+    since_improvement: usize,
+    iterations: usize,
+    /// An upper bound on the instance's optimum (a known tour's cost), for the step size.
+    upper: f64,
+}
+
+/// Most clusters in a neighbourhood (the DP keeps a dense table over the memories).
+pub const MAX_NG: usize = 12;
+
+impl NgPathBound {
+    /// Prepares the bound with neighbourhoods of `ng_size` clusters (nearest by least arc cost)
+    /// and initial penalties `lambda` (one per non-depot cluster, in the instance's cluster
+    /// order without the depot's; zeros when the length does not match). `None` when the
+    /// depot's cluster does not hold exactly one node or there is no other cluster.
+    pub fn new(instance: &Instance, ng_size: usize, lambda: &[f64]) -> Option<NgPathBound> {
+        let n = instance.node_count;
+        let depot_nodes = instance.clusters.get(instance.depot)?;
+        let [depot] = depot_nodes.as_slice() else {
+            return None;
+        };
+        let mut index = vec![usize::MAX; instance.clusters.len()];
+        let mut members = Vec::new();
+        for (c, nodes) in instance.clusters.iter().enumerate() {
+            if c != instance.depot && !nodes.is_empty() {
+                index[c] = members.len();
+                members.push(nodes.clone());
+            }
+        }
+        let m = members.len();
+        if m == 0 {
+            return None;
+        }
+        let mut cluster = vec![usize::MAX; n];
+        for (c, nodes) in members.iter().enumerate() {
+            for &v in nodes {
+                cluster[v] = c;
+            }
+        }
+        // Least arc cost between clusters: the neighbourhoods are the nearest ones.
+        let mut near = vec![f64::INFINITY; m * m];
+        for (a, &ca) in cluster.iter().enumerate() {
+            if ca == usize::MAX {
+                continue;
+            }
+            for (b, &cb) in cluster.iter().enumerate() {
+                if cb == usize::MAX || cb == ca {
+                    continue;
+                }
+                let c = instance.cost[a * n + b].min(instance.cost[b * n + a]);
+                let e = &mut near[ca * m + cb];
+                *e = e.min(c);
+            }
+        }
+        let size = ng_size.clamp(1, MAX_NG).min(m);
+        let mut ng = Vec::with_capacity(m);
+        let mut position = vec![-1i8; m * m];
+        for c in 0..m {
+            let mut others: Vec<usize> = (0..m).filter(|&x| x != c).collect();
+            others.sort_by(|&x, &y| near[c * m + x].total_cmp(&near[c * m + y]).then(x.cmp(&y)));
+            let mut list = vec![c];
+            list.extend(others.into_iter().take(size - 1));
+            for (p, &x) in list.iter().enumerate() {
+                position[c * m + x] = p as i8;
+            }
+            ng.push(list);
+        }
+        let mut related = vec![false; m * m];
+        for c in 0..m {
+            for d in 0..m {
+                related[c * m + d] =
+                    position[c * m + d] >= 0 || ng[c].iter().any(|&x| position[d * m + x] >= 0);
+            }
+        }
+        let lambda = if lambda.len() == m {
+            lambda.to_vec()
+        } else {
+            // A start near the node-penalty bound: each visit is worth half its cheapest way
+            // in plus half its cheapest way out through the same node.
+            members
+                .iter()
+                .map(|nodes| {
+                    nodes
+                        .iter()
+                        .map(|&w| {
+                            let least = |f: &dyn Fn(usize) -> f64| {
+                                (0..n)
+                                    .filter(|&v| v != w)
+                                    .map(f)
+                                    .fold(f64::INFINITY, f64::min)
+                            };
+                            let into = least(&|v| instance.cost[v * n + w]);
+                            let out = least(&|v| instance.cost[w * n + v]);
+                            0.5 * (into + out)
+                        })
+                        .fold(f64::INFINITY, f64::min)
+                })
+                .map(|x| if x.is_finite() { x } else { 0.0 })
+                .collect()
+        };
+        Some(NgPathBound {
+            n,
+            cost: instance.cost.clone(),
+            depot: *depot,
+            cluster,
+            members,
+            ng,
+            position,
+            related,
+            gap: near,
+            best_lambda: lambda.clone(),
+            lambda,
+            layers: Vec::new(),
+            best: f64::NEG_INFINITY,
+            last_walk: Vec::new(),
+            mu: 1.0,
+            since_improvement: 0,
+            iterations: 0,
+            upper: f64::INFINITY,
+        })
+    }
+
+    /// Tells the step size about a tour's cost (an upper bound of the optimum).
+    pub fn set_upper(&mut self, upper: f64) {
+        if upper < self.upper {
+            self.upper = upper;
+        }
+    }
+
+    /// The best certified bound so far (−∞ before the first pass ends).
+    pub fn lower_bound(&self) -> f64 {
+        self.best
+    }
+
+    /// The penalties of the best bound (to warm-start a finer instance with the same clusters).
+    pub fn best_lambda(&self) -> &[f64] {
+        &self.best_lambda
+    }
+
+    /// Nodes of the cheapest walk of the last pass (pieces worth refining).
+    pub fn last_walk(&self) -> &[usize] {
+        &self.last_walk
+    }
+
+    /// Subgradient iterations completed.
+    pub fn iterations(&self) -> usize {
+        self.iterations
+    }
+
+    /// Works until `deadline` (at least one layer of the DP); false when the search has
+    /// converged (the step factor is negligible) or the bound meets the upper bound.
+    pub fn step(&mut self, deadline: Instant) -> bool {
+        loop {
+            if self.mu < 1e-4 || self.best >= self.upper - 1e-9 * self.upper.abs() {
+                return false;
+            }
+            self.extend_layer();
+            if self.layers.len() == self.members.len() {
+                self.finish_pass();
+            }
+            if Instant::now() >= deadline {
+                return true;
+            }
+        }
+    }
+
+    /// The memory after entering cluster `d` from a label at cluster `c` with memory `mask`,
+    /// or `None` when `d` is remembered.
+    #[inline]
+    fn enter(&self, c: usize, mask: u32, d: usize) -> Option<u32> {
+        let m = self.members.len();
+        let p = self.position[c * m + d];
+        if p >= 0 && mask & (1 << p) != 0 {
+            return None;
+        }
+        let mut out = 1u32;
+        let mut bits = mask;
+        while bits != 0 {
+            let p = bits.trailing_zeros() as usize;
+            bits &= bits - 1;
+            let q = self.position[d * m + self.ng[c][p]];
+            if q >= 0 {
+                out |= 1 << q;
+            }
+        }
+        Some(out)
+    }
+
+    /// Computes the next layer of the DP.
+    fn extend_layer(&mut self) {
+        let n = self.n;
+        let m = self.members.len();
+        let mut next: Vec<Label> = Vec::new();
+        if self.layers.is_empty() {
+            for (d, nodes) in self.members.iter().enumerate() {
+                for &w in nodes {
+                    let c = self.cost[self.depot * n + w];
+                    if c.is_finite() {
+                        next.push(Label {
+                            node: w as u32,
+                            mask: 1,
+                            pred: u32::MAX,
+                            value: c - self.lambda[d],
+                        });
+                    }
+                }
+            }
+            next.sort_by_key(|l| l.node);
+            self.layers.push(next);
+            return;
+        }
+        let prev = self.layers.last().expect("a layer");
+        // Per source node: its labels (a contiguous run of `prev`) and its cheapest one.
+        let mut runs: Vec<(usize, usize, usize)> = Vec::new(); // (node, start, end)
+        let mut i = 0;
+        while i < prev.len() {
+            let v = prev[i].node as usize;
+            let mut j = i;
+            while j < prev.len() && prev[j].node as usize == v {
+                j += 1;
+            }
+            runs.push((v, i, j));
+            i = j;
+        }
+        // Per run: its cheapest label; per cluster: its runs and their cheapest label.
+        let run_best: Vec<(f64, u32)> = runs
+            .iter()
+            .map(|&(_, start, end)| {
+                (start..end)
+                    .map(|i| (prev[i].value, i as u32))
+                    .min_by(|a, b| a.0.total_cmp(&b.0))
+                    .expect("a run is not empty")
+            })
+            .collect();
+        let mut cluster_runs: Vec<Vec<usize>> = vec![Vec::new(); m];
+        let mut cluster_best = vec![f64::INFINITY; m];
+        for (r, &(v, _, _)) in runs.iter().enumerate() {
+            let c = self.cluster[v];
+            cluster_runs[c].push(r);
+            cluster_best[c] = cluster_best[c].min(run_best[r].0);
+        }
+        // Candidates per target node of one cluster, a dense table over the memories (bit 0,
+        // the cluster itself, is always set): (value, pred), and the memories touched.
+        let width = 1usize << (self.ng[0].len() - 1);
+        let mut table: Vec<(f64, u32)> = Vec::new();
+        let mut touched: Vec<Vec<u32>> = Vec::new();
+        let mut projected: Vec<(u32, f64, u32)> = Vec::new();
+        let mut list: Vec<(u32, f64, u32)> = Vec::new();
+        for d in 0..m {
+            let targets = &self.members[d];
+            table.clear();
+            table.resize(targets.len() * width, (f64::INFINITY, u32::MAX));
+            touched.clear();
+            touched.resize(targets.len(), Vec::new());
+            // The source clusters by their least possible arrival (cheapest label plus least
+            // arc to d). A cluster whose arrival is no lower than every target's entry with
+            // the memory {d} cannot improve any entry (that one dominates all it would add,
+            // whatever their memories), nor can the clusters after it.
+            let mut order: Vec<(f64, usize)> = (0..m)
+                .filter(|&c| c != d && !cluster_runs[c].is_empty())
+                .map(|c| (cluster_best[c] + self.gap[c * m + d], c))
+                .collect();
+            order.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let mut threshold = f64::INFINITY;
+            for &(key, c) in &order {
+                if key >= threshold {
+                    break;
+                }
+                if self.related[c * m + d] {
+                    // The memory matters: every label.
+                    for &r in &cluster_runs[c] {
+                        let (v, start, end) = runs[r];
+                        self.relax_from(
+                            v,
+                            c,
+                            d,
+                            &prev[start..end],
+                            start,
+                            &mut projected,
+                            targets,
+                            &mut table,
+                            &mut touched,
+                            width,
+                        );
+                    }
+                } else {
+                    // No cluster of ng(c) is in ng(d), nor d in ng(c): every label enters
+                    // with the memory {d}, so only the cheapest counts.
+                    for &r in &cluster_runs[c] {
+                        let (v, _, _) = runs[r];
+                        let (value, index) = run_best[r];
+                        let row = &self.cost[v * n..(v + 1) * n];
+                        for (t, &w) in targets.iter().enumerate() {
+                            let arc = row[w];
+                            if !arc.is_finite() {
+                                continue;
+                            }
+                            let e = &mut table[t * width];
+                            if e.1 == u32::MAX {
+                                touched[t].push(1);
+                            }
+                            if value + arc < e.0 {
+                                *e = (value + arc, index);
+                            }
+                        }
+                    }
+                }
+                threshold = (0..targets.len())
+                    .map(|t| table[t * width].0)
+                    .fold(f64::NEG_INFINITY, f64::max);
+            }
+            let penalty = self.lambda[d];
+            for (t, &w) in targets.iter().enumerate() {
+                list.clear();
+                list.extend(touched[t].iter().map(|&mask| {
+                    let (value, pred) = table[t * width + (mask >> 1) as usize];
+                    (mask, value, pred)
+                }));
+                // Fewer remembered clusters first: a label is dropped when one with a subset
+                // of its memory is no dearer.
+                list.sort_by(|a, b| {
+                    a.0.count_ones()
+                        .cmp(&b.0.count_ones())
+                        .then(a.1.total_cmp(&b.1))
+                });
+                let start = next.len();
+                for &(mask, value, pred) in list.iter() {
+                    if next[start..]
+                        .iter()
+                        .any(|l| l.mask & mask == l.mask && l.value <= value - penalty)
+                    {
+                        continue;
+                    }
+                    next.push(Label {
+                        node: w as u32,
+                        mask,
+                        pred,
+                        value: value - penalty,
+                    });
+                }
+            }
+        }
+        next.sort_by_key(|l| l.node);
+        self.layers.push(next);
+    }
+
+    /// Offers the labels `labels` of source node `v` (cluster `c`; `start`: the index of the
+    /// first in the previous layer) to the targets of cluster `d`: each label's memory as it
+    /// enters `d`, dominated ones dropped, then every arc into the table.
+    #[allow(clippy::too_many_arguments)]
+    fn relax_from(
+        &self,
+        v: usize,
+        c: usize,
+        d: usize,
+        labels: &[Label],
+        start: usize,
+        projected: &mut Vec<(u32, f64, u32)>,
+        targets: &[usize],
+        table: &mut [(f64, u32)],
+        touched: &mut [Vec<u32>],
+        width: usize,
+    ) {
+        let n = self.n;
+        projected.clear();
+        for (k, label) in labels.iter().enumerate() {
+            if let Some(mask) = self.enter(c, label.mask, d) {
+                let value = label.value;
+                if projected
+                    .iter()
+                    .any(|&(pm, pv, _)| pm & mask == pm && pv <= value)
+                {
+                    continue;
+                }
+                projected.retain(|&(pm, pv, _)| !(mask & pm == mask && value <= pv));
+                projected.push((mask, value, (start + k) as u32));
+            }
+        }
+        if projected.is_empty() {
+            return;
+        }
+        let row = &self.cost[v * n..(v + 1) * n];
+        for (t, &w) in targets.iter().enumerate() {
+            let arc = row[w];
+            if !arc.is_finite() {
+                continue;
+            }
+            let row = &mut table[t * width..(t + 1) * width];
+            for &(mask, value, pred) in projected.iter() {
+                let total = value + arc;
+                let e = &mut row[(mask >> 1) as usize];
+                if e.1 == u32::MAX {
+                    touched[t].push(mask);
+                }
+                if total < e.0 {
+                    *e = (total, pred);
+                }
+            }
+        }
+    }
+
+    /// Closes the walks (return arc), records the bound and takes a subgradient step.
+    fn finish_pass(&mut self) {
+        let n = self.n;
+        let m = self.members.len();
+        let last = self.layers.last().expect("a layer");
+        let mut best = (f64::INFINITY, usize::MAX);
+        for (i, l) in last.iter().enumerate() {
+            let total = l.value + self.cost[l.node as usize * n + self.depot];
+            if total < best.0 {
+                best = (total, i);
+            }
+        }
+        let mut walk = Vec::with_capacity(m);
+        if best.1 != usize::MAX {
+            let mut i = best.1;
+            for layer in self.layers.iter().rev() {
+                let l = layer[i];
+                walk.push(l.node as usize);
+                i = l.pred as usize;
+            }
+            walk.reverse();
+        }
+        self.layers.clear();
+        self.iterations += 1;
+        let sum: f64 = self.lambda.iter().sum();
+        let value = best.0 + sum;
+        // The DP adds ~2m terms; this margin absorbs their rounding.
+        let scale: f64 = self.lambda.iter().map(|l| l.abs()).sum::<f64>() + best.0.abs() + 1.0;
+        let certified = value - 1e-10 * scale * (m as f64 + 1.0);
+        if !certified.is_finite() {
+            self.mu = 0.0;
+            return;
+        }
+        if self.best == f64::NEG_INFINITY || certified > self.best + 1e-9 * self.best.abs().max(1.0)
+        {
+            self.best = certified;
+            self.best_lambda = self.lambda.clone();
+            self.since_improvement = 0;
+        } else {
+            self.since_improvement += 1;
+            if self.since_improvement >= 8 {
+                self.mu *= 0.5;
+                self.since_improvement = 0;
+                // Restart from the best penalties: the walk has drifted.
+                self.lambda = self.best_lambda.clone();
+            }
+        }
+        let mut visits = vec![0i64; m];
+        for &v in &walk {
+            visits[self.cluster[v]] += 1;
+        }
+        let norm: f64 = visits.iter().map(|&k| ((1 - k) * (1 - k)) as f64).sum();
+        self.last_walk = walk;
+        if norm == 0.0 {
+            // The walk is a tour: the bound is its cost, the optimum.
+            self.mu = 0.0;
+            return;
+        }
+        let target = if self.upper.is_finite() {
+            self.upper
+        } else {
+            value.abs() * 1.05 + 1.0
+        };
+        let t = self.mu * (target - value).max(1e-3 * value.abs().max(1.0)) / norm;
+        for (l, &k) in self.lambda.iter_mut().zip(&visits) {
+            *l += t * (1 - k) as f64;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use web_time::Duration;
+
+    struct Rng(u64);
+    impl Rng {
+        fn next(&mut self) -> f64 {
+            self.0 ^= self.0 << 13;
+            self.0 ^= self.0 >> 7;
+            self.0 ^= self.0 << 17;
+            (self.0 >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
+    /// A random instance: points in clusters (each cluster's nodes near one centre, like the
+    /// pieces of a contour), Euclidean costs, an asymmetric return arc (the tail).
+    fn random_instance(seed: u64, clusters: usize, per: usize) -> Instance {
+        let mut rng = Rng(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1);
+        let mut points = vec![(0.0, 0.0)];
+        let mut node_cluster = vec![0];
+        let mut list = vec![vec![0]];
+        for c in 1..=clusters {
+            let (cx, cy) = (rng.next() * 100.0, rng.next() * 100.0);
+            let mut nodes = Vec::new();
+            for _ in 0..1 + (rng.next() * per as f64) as usize {
+                nodes.push(points.len());
+                node_cluster.push(c);
+                points.push((cx + rng.next() * 15.0, cy + rng.next() * 15.0));
+            }
+            list.push(nodes);
+        }
+        let n = points.len();
+        let mut cost = vec![f64::INFINITY; n * n];
+        for a in 0..n {
+            for b in 0..n {
+                if node_cluster[a] == node_cluster[b] {
+                    continue;
+                }
+                let (p, q) = (points[a], points[b]);
+                let d = ((p.0 - q.0).powi(2) + (p.1 - q.1).powi(2)).sqrt();
+                // The return arc: a tail cheaper than the straight way back.
+                cost[a * n + b] = if b == 0 { 0.3 * d } else { d };
+            }
+        }
+        Instance {
+            name: "random".into(),
+            node_count: n,
+            cost,
+            clusters: list,
+            node_cluster,
+            precedence: Vec::new(),
+            depot: 0,
+        }
+    }
+
+    /// The optimum by enumeration of cluster orders and nodes (DP over subsets).
+    fn brute_force(instance: &Instance) -> f64 {
+        let n = instance.node_count;
+        let m = instance.clusters.len() - 1;
+        let full = (1usize << m) - 1;
+        let mut f = vec![f64::INFINITY; (1 << m) * n];
+        for c in 1..=m {
+            for &w in &instance.clusters[c] {
+                f[(1 << (c - 1)) * n + w] = instance.cost[w];
+            }
+        }
+        for set in 1..=full {
+            for v in 1..n {
+                let value = f[set * n + v];
+                if !value.is_finite() {
+                    continue;
+                }
+                for d in 1..=m {
+                    if set & (1 << (d - 1)) != 0 {
+                        continue;
+                    }
+                    for &w in &instance.clusters[d] {
+                        let next = set | (1 << (d - 1));
+                        let total = value + instance.cost[v * n + w];
+                        if total < f[next * n + w] {
+                            f[next * n + w] = total;
+                        }
+                    }
+                }
+            }
+        }
+        (1..n)
+            .map(|v| f[full * n + v] + instance.cost[v * n])
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    #[test]
+    fn never_above_the_optimum_and_close_to_it_with_full_memory() {
+        let mut closed_at_least_once = 0;
+        for seed in 0..40u64 {
+            let clusters = 3 + (seed % 6) as usize;
+            let instance = random_instance(seed, clusters, 3);
+            let optimum = brute_force(&instance);
+            for ng_size in [1, 2, 4, clusters] {
+                let mut bound = NgPathBound::new(&instance, ng_size, &[]).unwrap();
+                bound.set_upper(optimum);
+                let mut iterations = 0;
+                while iterations < 300 {
+                    // Every pass's bound is checked, not only the last one.
+                    let more = bound.step(Instant::now() + Duration::from_micros(1));
+                    let lb = bound.lower_bound();
+                    assert!(
+                        lb <= optimum + 1e-9,
+                        "seed {seed}, ng {ng_size}: bound {lb} above the optimum {optimum}"
+                    );
+                    if !more {
+                        break;
+                    }
+                    iterations = bound.iterations();
+                }
+                if ng_size == clusters && bound.lower_bound() >= optimum - 1e-6 * optimum {
+                    closed_at_least_once += 1;
+                }
+                // With the whole instance as memory the walks are tours; the bound without
+                // penalties is then the optimum itself.
+                if ng_size == clusters {
+                    let mut plain = NgPathBound::new(&instance, ng_size, &[]).unwrap();
+                    while plain.iterations() == 0 {
+                        plain.step(Instant::now());
+                    }
+                    assert!(plain.lower_bound() <= optimum + 1e-9);
+                    assert!(
+                        plain.lower_bound() >= optimum - 1e-6 * optimum,
+                        "seed {seed}: full memory gives {} for {optimum}",
+                        plain.lower_bound()
+                    );
+                }
+            }
+        }
+        assert!(closed_at_least_once >= 30, "{closed_at_least_once}");
+    }
+
+    #[test]
+    fn a_depot_cluster_of_several_nodes_is_refused() {
+        let mut instance = random_instance(1, 3, 2);
+        instance.clusters[0].push(1);
+        assert!(NgPathBound::new(&instance, 4, &[]).is_none());
+    }
+}
