@@ -515,6 +515,15 @@ pub fn App() -> impl IntoView {
             kerf: kerf_settings.get_untracked(),
             leads_after: false,
         };
+        let solver_kind = solver.get_untracked();
+        // Refused here, in the page's words (the engine's refusal is English), and before the
+        // shown result is cleared.
+        if !params.kerf.is_idealised() && !solver_kind.cuts_with_kerf() {
+            job_state.set(JobState::Failed(JobFailure::NoKerfModel {
+                solver: solver_kind.name(),
+            }));
+            return;
+        }
         if from.is_none() {
             progress.set(None);
             samples.set(Vec::new());
@@ -524,7 +533,7 @@ pub fn App() -> impl IntoView {
         let request = JobRequest {
             job_id,
             problem,
-            solver: solver.get_untracked(),
+            solver: solver_kind,
             params,
         };
         bridge.with_value(|b| b.send(ToWorker::Start(request)));

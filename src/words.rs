@@ -183,12 +183,23 @@ pub enum JobFailure {
     WorkerStopped,
     /// The engine refused the job (its English words).
     Engine(String),
+    /// Kerf and leads are on, and the solver has no full-route model.
+    NoKerfModel { solver: &'static str },
 }
 
 impl JobFailure {
     /// The failure in the page's language.
     pub fn text(&self, lang: Lang) -> String {
         match (self, lang) {
+            (JobFailure::NoKerfModel { solver }, Lang::En) => format!(
+                "the {solver} solver does not cut with kerf and leads yet (nearest, ccp, \
+                 heuristic and chain do): choose one of those, or set the kerf and leads to none"
+            ),
+            (JobFailure::NoKerfModel { solver }, Lang::Ru) => format!(
+                "решатель {solver} пока не строит маршрут с шириной реза и подводами (это \
+                 умеют nearest, ccp, heuristic и chain): выберите один из них или отключите \
+                 ширину реза и подводы"
+            ),
             (JobFailure::NoTourExists { solver }, Lang::En) => {
                 format!("the {solver} solver proved that the instance has no feasible tour")
             }

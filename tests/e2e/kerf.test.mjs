@@ -125,6 +125,15 @@ test('kerf and an arc lead-in: leads drawn and animated, G-code reads back with 
   fs.rmSync(dir, { recursive: true, force: true });
 
   await screenshot(page, 'kerf.png');
+
+  // A solver without a full-route model is refused by the page, in its language, and the
+  // route with leads stays on screen.
+  await page.selectOption('#solver', 'aoe');
+  await page.click('#start');
+  await page.waitForFunction(() => /^failed/.test(document.querySelector('#job-status')?.textContent ?? ''),
+    null, { timeout: 10000 });
+  assert.match(await page.textContent('#job-status'), /aoe solver does not cut with kerf and leads yet/);
+  assert.equal(await page.locator('#nest-view .leads path.lead').count(), steps);
   assert.deepEqual(errors, []);
   await context.close();
 });

@@ -36,22 +36,10 @@ const RELAX_POSITIONS: usize = 24;
 const FIT_RESERVE_SHARE: f64 = 0.25;
 const FIT_RESERVE_MAX_S: f64 = 2.0;
 
-/// Whether the kerf job can wrap `solver`'s job. Nearest, ccp and heuristic (the CLI's
-/// "discrete") route whole contours through pierce points, which the pierce curves carry
-/// over; chain runs over the equidistants ([`LeadFitter::kerf_nest`]) and gets leads at its
-/// chains' ends. The path solvers (sccp, gsccp, aoe) cut pieces of contours, shared edges
-/// among them, and have no full-route model yet.
+/// Whether the kerf job can wrap `solver`'s job ([`SolverKind::cuts_with_kerf`], which the page
+/// asks before it sends a job).
 pub fn supports_kerf(solver: SolverKind) -> bool {
-    match solver {
-        SolverKind::NearestNeighbour
-        | SolverKind::Ccp
-        | SolverKind::Heuristic
-        | SolverKind::Chain => true,
-        // The exact solver's bounds are about the idealised (or curve) nest, not the full
-        // route: without a sound bound of the full route it would prove nothing.
-        SolverKind::Exact => false,
-        SolverKind::Sccp | SolverKind::Gsccp | SolverKind::Aoe => false,
-    }
+    solver.cuts_with_kerf()
 }
 
 /// Checks the settings a request carries: every length finite and non-negative, and d₂ < d₁

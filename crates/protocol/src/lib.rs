@@ -226,6 +226,22 @@ impl SolverKind {
         matches!(self, SolverKind::Sccp | SolverKind::Gsccp | SolverKind::Aoe)
     }
 
+    /// Whether the solver has a full-route model (kerf, pierce regions, leads, tabs): nearest,
+    /// ccp and heuristic route whole contours through pierce points, which the pierce curves
+    /// carry over, and chain runs over the equidistants with leads at its chains' ends. The
+    /// exact solver's bounds are about the idealised nest, so with leads it would prove
+    /// nothing; the path solvers (sccp, gsccp, aoe) cut pieces of contours, shared edges among
+    /// them, and have no full-route model yet.
+    pub fn cuts_with_kerf(self) -> bool {
+        match self {
+            SolverKind::NearestNeighbour
+            | SolverKind::Ccp
+            | SolverKind::Heuristic
+            | SolverKind::Chain => true,
+            SolverKind::Exact | SolverKind::Sccp | SolverKind::Gsccp | SolverKind::Aoe => false,
+        }
+    }
+
     /// The short name used on the command line and in links.
     pub fn name(self) -> &'static str {
         match self {
