@@ -20,7 +20,16 @@ fn main() {
         .and_then(|s| s.parse().ok())
         .unwrap_or(f64::INFINITY);
     let bytes = std::fs::read(path).expect("readable");
-    let mut nest = cutroute_formats::read_nest(&bytes).expect("a nest");
+    let mut nest = if path.ends_with(".tfnesting") {
+        // T-FLEX files hold sheets; the first is the nest.
+        cutroute_cad::tflex::read_tfnesting(&bytes)
+            .expect("a T-FLEX nesting")
+            .into_iter()
+            .next()
+            .expect("a sheet")
+    } else {
+        cutroute_formats::read_nest(&bytes).expect("a nest")
+    };
     nest.normalize_orientation();
     let options = LowerBoundOptions {
         budget_seconds: 30.0,
@@ -29,7 +38,17 @@ fn main() {
         initial_pieces: pieces,
         ..LowerBoundOptions::default()
     };
-    let mut bound = CcpLowerBound::new(&nest, options).expect("options");
+    let mut bound = CcpLowerBound::new(&nest, options.clone()).expect("options");
+    if bound.kept_contours() > 256 {
+        // Beyond the exact search's keys the relaxation is built only for the ng-path bound.
+        let options = LowerBoundOptions {
+            ng_size,
+            ng_above: 0,
+            ng_alone: true,
+            ..options
+        };
+        bound = CcpLowerBound::new(&nest, options).expect("options");
+    }
     while bound.relaxed_instance().is_none() && bound.step(Duration::from_millis(100)) {}
     println!(
         "{:.1} s: exact search's bound {:.1}",

@@ -45,6 +45,11 @@
 //! larger of it and the whole relaxation's. What it loses is the travel across the group
 //! borders, little where groups are separated by space, much on tightly packed sheets.
 //!
+//! **The ng-path bound** ([`NgPathBound`], more kept contours than `ng_above`) runs on the whole
+//! relaxation's instance beside its exact search, and, with `ng_alone`, alone where the exact
+//! search cannot run (more kept contours than its keys hold, `exact_max_kept`); any lower bound
+//! of that PCGTSP is sound by step 3.
+//!
 //! **Refinement.** A stage builds the instance (row by row, in slices), then runs the exact
 //! solver for a doubling time share. Then the pieces holding the best route's pierce points and
 //! the pieces of the relaxed tour are halved, and the next stage starts. Finer pieces only raise
@@ -95,11 +100,17 @@ pub const MAX_RELAXATION_ENTRIES: usize = 1 << 24;
 /// First pieces of a relaxation that runs the ng-path bound.
 const NG_INITIAL_PIECES: usize = 1600;
 
+/// Most nodes of a relaxation that runs the ng-path bound without the exact search: one DP
+/// pass over Nest02's 359 kept contours took ~2 s at 824 nodes, ~5 s at 1,627 and over 20 s
+/// at 2,500, and the subgradient needs many passes.
+const NG_ALONE_MAX_NODES: usize = 1200;
+
 /// Most groups of the decomposition bound.
 const MAX_GROUPS: usize = 64;
 
-/// Most kept contours for which the whole relaxation runs beside the groups.
-const WHOLE_MAX_KEPT: usize = 256;
+/// Most kept contours for which the whole relaxation's exact search runs (its keys hold at
+/// most 256 clusters).
+const EXACT_MAX_KEPT: usize = 256;
 
 /// Settings of [`CcpLowerBound`].
 #[derive(Clone, Debug, PartialEq)]
@@ -135,6 +146,15 @@ pub struct LowerBoundOptions {
     /// Run the ng-path bound only on relaxations of more kept contours than this (up to about
     /// 22 the exact search solves each stage, and the ng-path bound would only take its time).
     pub ng_above: usize,
+    /// Most kept contours for which the whole relaxation runs the exact search (at most 256,
+    /// its keys' width); above, the whole relaxation runs the ng-path bound alone when
+    /// `ng_alone` is set, or not at all. Lower values are for tests of that path.
+    pub exact_max_kept: usize,
+    /// Run the whole relaxation with the ng-path bound alone above `exact_max_kept` kept
+    /// contours. Off by default: on Nest02/Nest03 (359 kept contours) its DP passes take
+    /// seconds, it reached 3,400–4,000 in 120 s against the groups' 12,000–12,800, and the
+    /// slices it took lowered the groups' sum (BENCHMARKS.md).
+    pub ng_alone: bool,
 }
 
 impl Default for LowerBoundOptions {
@@ -151,6 +171,8 @@ impl Default for LowerBoundOptions {
             decompose_above: 24,
             ng_size: 8,
             ng_above: 24,
+            exact_max_kept: EXACT_MAX_KEPT,
+            ng_alone: false,
         }
     }
 }
@@ -266,7 +288,8 @@ struct Building {
 struct Solving {
     node_piece: Vec<(usize, usize)>,
     instance: Instance,
-    solver: ExactSolver,
+    /// `None` above `exact_max_kept` kept contours: the ng-path bound runs alone.
+    solver: Option<ExactSolver>,
     spent: Duration,
     share: Duration,
     /// The ng-path bound on the same instance (large relaxations only), sharing the slices.
@@ -396,10 +419,10 @@ impl CcpLowerBound {
         {
             bound.decompose(group_size);
             // The exact search keys hold at most 256 clusters: beyond, the whole relaxation
-            // gets no further than its first root bound (4,676 against the groups' 9,502 on
-            // Nest02), and building its solver is the longest step of all; the groups run
-            // alone.
-            if bound.leaves.len() > WHOLE_MAX_KEPT {
+            // runs the ng-path bound alone (its own DP needs no keys) when asked, or not at
+            // all (its first root bound was 4,676 against the groups' 9,502 on Nest02).
+            let ng_alone = bound.options.ng_alone && bound.ng_active();
+            if !bound.exact_whole() && !ng_alone {
                 bound.own_running = false;
             }
         }
@@ -426,7 +449,12 @@ impl CcpLowerBound {
         // below the route (6,759 at 383 pieces against 9,535 on nested.dbs), and the ng-path
         // bound gained more from 2,400 uniform pieces in 30 s (7,796) than from the doubling
         // stages in 60 s (7,211).
-        let ng_wide = options.ng_size > 0 && leaves.len() > options.ng_above;
+        // Not without the exact search (more kept contours than its keys hold): there one DP
+        // pass costs ~5 s at 1,600 pieces on Nest02 (359 kept contours), and the subgradient
+        // needs many passes.
+        let ng_wide = options.ng_size > 0
+            && leaves.len() > options.ng_above
+            && leaves.len() <= options.exact_max_kept.min(EXACT_MAX_KEPT);
         let initial = if ng_wide {
             options.initial_pieces.max(NG_INITIAL_PIECES)
         } else {
@@ -524,6 +552,8 @@ impl CcpLowerBound {
                 first_stage: (self.options.first_stage / 4).max(Duration::from_millis(100)),
                 budget_seconds: (2.0 * self.options.budget_seconds / count as f64).max(2.0),
                 group_size: 0,
+                // Groups are small: the test threshold is the whole relaxation's only.
+                exact_max_kept: EXACT_MAX_KEPT,
                 ..self.options.clone()
             };
             let absorbed: Vec<bool> = leaves
@@ -703,10 +733,13 @@ impl CcpLowerBound {
         // With the ng-path bound the whole relaxation is the stronger one (the groups' exact
         // optima saturate within seconds at the loss on their borders): it gets three slices
         // of four, seven of eight once its bound is above the groups' sum; without it, one.
-        let own_turn = if self.ng_active() {
+        let own_turn = if self.ng_active() && (self.exact_whole() || self.best > self.group_sum()) {
             let every = if self.best > self.group_sum() { 8 } else { 4 };
             !self.turns.is_multiple_of(every)
         } else {
+            // Without the exact search (hundreds of kept contours) the ng-path bound's passes
+            // are slow and it starts far below the groups' sum: one slice of four until it is
+            // above, so the groups keep most of the time.
             self.turns.is_multiple_of(4)
         };
         match group {
@@ -719,6 +752,12 @@ impl CcpLowerBound {
             }
         }
         self.own_running || self.groups_running.iter().any(|&r| r)
+    }
+
+    /// Whether this bound's own relaxation runs the exact search (few enough kept contours
+    /// for its keys; fixed candidates always do, they are within the discrete solver's).
+    fn exact_whole(&self) -> bool {
+        self.fixed || self.leaves.len() <= self.options.exact_max_kept.min(EXACT_MAX_KEPT)
     }
 
     /// Whether this bound's own relaxation runs the ng-path bound beside the exact search.
@@ -759,16 +798,18 @@ impl CcpLowerBound {
                         return true;
                     }
                     self.stages_done += 1;
-                    let progress = s.solver.progress();
+                    let progress = s.solver.as_ref().map(ExactSolver::progress);
                     debug_log(|| {
                         format!(
-                            "stage {} ({} nodes, {:.2} s of {:.2} s): relaxed lb {:.3} ub {:.3}, best {:.3}, incumbent {:.3}",
+                            "stage {} ({} nodes, {:.2} s of {:.2} s): relaxed lb {:.3} ub {:.3}, ng {:.3} ({} passes), best {:.3}, incumbent {:.3}",
                             self.stages_done,
                             s.instance.node_count,
                             s.spent.as_secs_f64(),
                             s.share.as_secs_f64(),
-                            progress.lower_bound,
-                            progress.upper_bound,
+                            progress.as_ref().map_or(f64::NAN, |p| p.lower_bound),
+                            progress.as_ref().map_or(f64::NAN, |p| p.upper_bound),
+                            s.ng.as_ref().map_or(f64::NAN, NgPathBound::lower_bound),
+                            s.ng.as_ref().map_or(0, NgPathBound::iterations),
                             self.best,
                             self.incumbent_length
                         )
@@ -780,7 +821,7 @@ impl CcpLowerBound {
                     }
                     // The pieces of the relaxed tour and of the ng-path bound's cheapest walk
                     // are where the next relaxed optimum tends to lie.
-                    let mut marked = progress.best_tour.unwrap_or_default();
+                    let mut marked = progress.and_then(|p| p.best_tour).unwrap_or_default();
                     if let Some(ng) = &s.ng {
                         marked.extend_from_slice(ng.last_walk());
                     }
@@ -911,17 +952,11 @@ impl CcpLowerBound {
     fn start_solving(&mut self, b: Building) -> Option<Solving> {
         let n = 1 + b.node_piece.len();
         let margin = self.margin;
-        let cost: Vec<f64> = b
-            .cost
-            .iter()
-            .map(|&c| {
-                if c.is_finite() {
-                    (c - margin).max(0.0)
-                } else {
-                    c
-                }
-            })
-            .collect();
+        // In place: at 2,500 pieces the matrix is 50 MB, and the ng-path bound keeps its own.
+        let mut cost = b.cost;
+        for c in cost.iter_mut().filter(|c| c.is_finite()) {
+            *c = (*c - margin).max(0.0);
+        }
         let mut clusters: Vec<Vec<usize>> = vec![Vec::new(); 1 + self.leaves.len()];
         clusters[0].push(0);
         let mut node_cluster = vec![0usize; n];
@@ -957,13 +992,21 @@ impl CcpLowerBound {
             position_iterations: 0,
             ..ExactOptions::default()
         };
-        let solver = ExactSolver::new(&instance, options).ok()?;
-        self.best = self.best.max(solver.root_bound());
+        let solver = if self.exact_whole() {
+            let solver = ExactSolver::new(&instance, options).ok()?;
+            self.best = self.best.max(solver.root_bound());
+            Some(solver)
+        } else {
+            None
+        };
         self.incumbent_offered = false;
         let ng = self
             .ng_active()
             .then(|| NgPathBound::new(&instance, self.options.ng_size, &self.ng_lambda))
             .flatten();
+        if solver.is_none() && ng.is_none() {
+            return None;
+        }
         Some(Solving {
             node_piece: b.node_piece,
             instance,
@@ -1014,7 +1057,9 @@ impl CcpLowerBound {
         if !self.incumbent_offered {
             if let Some(tour) = self.incumbent_tour(&s.node_piece) {
                 let cost = cutroute_pcgtsp::check_tour(&s.instance, &tour).unwrap_or(f64::INFINITY);
-                s.solver.offer_incumbent(&tour, cost);
+                if let Some(solver) = &mut s.solver {
+                    solver.offer_incumbent(&tour, cost);
+                }
                 if let Some(ng) = &mut s.ng {
                     ng.set_upper(cost);
                 }
@@ -1026,10 +1071,11 @@ impl CcpLowerBound {
         // With the ng-path bound beside it, the exact search (which cannot solve a relaxation
         // this large; its bounds stall early) gets every eighth slice.
         s.turns += 1;
-        if !s.exact_over && (!s.ng_running || s.turns.is_multiple_of(8)) {
-            let status = s.solver.step(slice.max(Duration::from_millis(1)));
+        let exact_turn = !s.ng_running || s.turns.is_multiple_of(8);
+        if let Some(solver) = s.solver.as_mut().filter(|_| !s.exact_over && exact_turn) {
+            let status = solver.step(slice.max(Duration::from_millis(1)));
             s.exact_over = status != SolverStatus::Running;
-            let progress = s.solver.progress();
+            let progress = solver.progress();
             if progress.lower_bound.is_finite() {
                 self.best = self.best.max(progress.lower_bound);
             }
@@ -1044,7 +1090,7 @@ impl CcpLowerBound {
         s.spent += now.elapsed();
         // The stage is over when the exact search ended (its bound is then the relaxation's
         // optimum), when neither search can go on, or when its time is up.
-        s.exact_over || s.spent >= s.share
+        s.exact_over || s.spent >= s.share || (s.solver.is_none() && !s.ng_running)
     }
 
     /// Splits the pieces of the relaxed tour and those holding the incumbent's pierce points
@@ -1074,14 +1120,18 @@ impl CcpLowerBound {
             }
         }
         let mut nodes = self.node_count();
+        let max_nodes = if self.exact_whole() {
+            self.options.max_nodes
+        } else {
+            self.options.max_nodes.min(NG_ALONE_MAX_NODES)
+        };
         let mut split_any = false;
         for (leaf, pieces) in self.pieces.iter_mut().enumerate() {
             let min_length = 1e-6 * (1.0 + self.leaves[leaf].perimeter());
             let mut out = Vec::with_capacity(pieces.len() + 8);
             for (k, &(a, b)) in pieces.iter().enumerate() {
                 let n = parts[leaf][k];
-                if n > 1 && b - a > n as f64 * min_length && nodes + n - 1 <= self.options.max_nodes
-                {
+                if n > 1 && b - a > n as f64 * min_length && nodes + n - 1 <= max_nodes {
                     out.extend((0..n).map(|i| {
                         (
                             a + (b - a) * i as f64 / n as f64,

@@ -499,3 +499,69 @@ fn the_ng_path_bound_never_above_brute_force() {
         cases - strong
     );
 }
+
+/// Above `exact_max_kept` kept contours (256 on real nests, forced to 1 here) the whole
+/// relaxation runs the ng-path bound alone, beside the spatial groups: the reported bound (the
+/// larger of the groups' sum and the ng-path bound) is never above a brute-force route or
+/// CCP's route, on random and packed nests, open and closed; and the ng-path bound is not
+/// trivial.
+#[test]
+fn the_ng_path_bound_without_the_exact_search_never_above_brute_force() {
+    let mut strong = 0;
+    let mut cases = 0;
+    for seed in 1..=8u64 {
+        for (nest, h) in [(random_nest(seed), 0.25), (packed_nest(seed), 1.0)] {
+            let start = Point::new(-30.0, -10.0);
+            let finish = (seed % 3 == 0).then_some(Point::new(150.0, -20.0));
+            let brute = brute_force(&nest, start, finish, h);
+            let ccp = solve(
+                &nest,
+                CcpOptions {
+                    start,
+                    finish,
+                    time_limit: Duration::from_millis(300),
+                    ..CcpOptions::default()
+                },
+                &mut |_| {},
+            )
+            .unwrap();
+            let options = LowerBoundOptions {
+                start,
+                finish,
+                budget_seconds: 2.0,
+                group_size: 2,
+                decompose_above: 0,
+                ng_size: 8,
+                ng_above: 0,
+                exact_max_kept: 1,
+                ng_alone: true,
+                ..LowerBoundOptions::default()
+            };
+            let mut bound = CcpLowerBound::new(&nest, options).unwrap();
+            if bound.kept_contours() <= 2 {
+                continue;
+            }
+            assert!(bound.group_count() >= 2, "seed {seed}: no groups");
+            bound.offer_route(&ccp.route);
+            let lb = run_bound(&mut bound, usize::MAX, Duration::from_secs(2));
+            let ng = bound.ng_bound();
+            cases += 1;
+            strong += usize::from(ng >= 0.8 * brute);
+            // Without the exact search only the ng-path bound raises the whole relaxation's.
+            assert_eq!(bound.whole_bound(), ng, "seed {seed}: the exact search ran");
+            assert!(ng > 0.0, "seed {seed}: the ng-path bound did not run");
+            assert!(
+                ng <= brute + 1e-9 && lb <= brute + 1e-9,
+                "seed {seed}: ng-path bound {ng}, bound {lb}, brute force {brute}"
+            );
+            assert!(lb <= ccp.metrics.idle_length + 1e-9);
+            assert!(lb >= bound.group_sum() && lb >= ng);
+        }
+    }
+    assert!(cases >= 12, "only {cases} cases had groups");
+    assert!(
+        strong * 4 >= cases * 3,
+        "the ng-path bound was below 80 % of the optimum in {} of {cases} cases",
+        cases - strong
+    );
+}
