@@ -73,10 +73,15 @@ fn phase_ru(phase: &Phase) -> String {
             reason: Some(reason),
         } => format!("остановлено: {reason}"),
         Phase::SegmentsCcp => "резка сегментами: CCP-Relax задаёт порядки".into(),
-        Phase::SegmentsBuilding { ensemble } => format!(
+        Phase::SegmentsBuilding {
+            ensemble: Some(ensemble),
+        } => format!(
             "резка сегментами: построение ансамбля «{}»",
-            ensemble.map_or("", ensemble_ru)
+            ensemble_ru(*ensemble)
         ),
+        Phase::SegmentsBuilding { ensemble: None } => {
+            "резка сегментами: построение ансамблей".into()
+        }
         Phase::SegmentsSearch {
             ensemble,
             segments,

@@ -297,11 +297,17 @@ impl fmt::Display for Phase {
                 reason: Some(reason),
             } => write!(f, "stopped: {reason}"),
             Phase::SegmentsCcp => write!(f, "segment cutting: CCP-Relax seeds the orders"),
-            Phase::SegmentsBuilding { ensemble } => write!(
+            Phase::SegmentsBuilding {
+                ensemble: Some(ensemble),
+            } => write!(
                 f,
                 "segment cutting: building the {} ensemble",
-                ensemble.map_or("", Ensemble::name)
+                ensemble.name()
             ),
+            // Between ensembles (the last one built, the searches not started).
+            Phase::SegmentsBuilding { ensemble: None } => {
+                write!(f, "segment cutting: building the ensembles")
+            }
             Phase::SegmentsSearch {
                 ensemble,
                 segments,
@@ -388,6 +394,18 @@ mod tests {
             "building the model: 3 of 40 rows of the cost matrix"
         );
         assert_eq!(Phase::Ccp(CcpStage::LocalSearch).to_string(), "localsearch");
+        // Between two ensembles no name is left blank.
+        assert_eq!(
+            Phase::SegmentsBuilding { ensemble: None }.to_string(),
+            "segment cutting: building the ensembles"
+        );
+        assert_eq!(
+            Phase::SegmentsBuilding {
+                ensemble: Some(Ensemble::Chains)
+            }
+            .to_string(),
+            "segment cutting: building the chains ensemble"
+        );
         assert_eq!(
             Phase::ChainCcp(CcpStage::Relaxing).to_string(),
             "ccp: relaxing"
