@@ -371,31 +371,6 @@ impl GsccpSearch {
         }
     }
 
-    /// What the run is doing, in words.
-    pub fn phase(&self) -> String {
-        match &self.stage {
-            Stage::Ccp(_) => "segment cutting: CCP-Relax seeds the orders".into(),
-            Stage::Build(k) => format!(
-                "segment cutting: building the {} ensemble",
-                self.options.kinds.get(*k).map_or("", |kind| kind.name())
-            ),
-            Stage::Search(_, search, report) => format!(
-                "segment cutting: {} ensemble ({} segments, {} shakes)",
-                report.kind.name(),
-                report.segments,
-                search.shakes()
-            ),
-            Stage::Finished => match (&self.failure, self.best()) {
-                (Some(e), _) => format!("segment cutting failed: {e}"),
-                (None, Some(best)) => format!(
-                    "segment cutting: done, best {}",
-                    best.source.map_or("ccp", |k| k.name())
-                ),
-                (None, None) => "segment cutting: no ensemble gave a valid route".into(),
-            },
-        }
-    }
-
     /// The outcome (after the end; before it, what there is so far).
     pub fn result(&self) -> Result<GsccpResult, SegmentError> {
         if let Some(e) = &self.failure {
