@@ -12,6 +12,7 @@ use cutroute_geometry::{chain_spans, equidistant, KerfSettings, LeadShape, Nest,
 use leptos::prelude::*;
 
 use crate::drawing::{contour_path, push_span};
+use crate::fields::{setting_field, Accept};
 use crate::i18n::tr;
 use crate::settings::{parse_tabs, shape_from_name, shape_name};
 
@@ -115,32 +116,22 @@ pub fn LeadLayers(
 /// The full-route settings, beside the machine parameters.
 #[component]
 pub fn KerfPanel(settings: RwSignal<KerfSettings>) -> impl IntoView {
-    type Words = (&'static str, &'static str);
+    use crate::fields::Words;
     let number = move |id: &'static str,
                        label: Words,
                        tip: Words,
                        get: fn(&KerfSettings) -> f64,
                        set: fn(&mut KerfSettings, f64)| {
-        view! {
-            <label class="param" title=tr(tip.0, tip.1)>
-                <span>{tr(label.0, label.1)}</span>
-                <input
-                    id=id
-                    type="number"
-                    min="0"
-                    step="any"
-                    prop:value=move || get(&settings.get()).to_string()
-                    on:change=move |ev| {
-                        if let Ok(v) = event_target_value(&ev).parse::<f64>() {
-                            if v.is_finite() && v >= 0.0 {
-                                settings.update(|s| set(s, v));
-                            }
-                        }
-                    }
-                />
-                <span class="unit">{tr("mm", "мм")}</span>
-            </label>
-        }
+        setting_field(
+            settings,
+            id,
+            label,
+            ("mm", "мм"),
+            Some(tip),
+            Accept::NonNegative,
+            get,
+            set,
+        )
     };
     let shape = move |id: &'static str,
                       label: Words,

@@ -9,6 +9,7 @@ mod compare;
 mod drawing;
 mod embedded;
 mod export;
+mod fields;
 mod gallery;
 mod i18n;
 mod kerf;

@@ -6,6 +6,7 @@ use cutroute_geometry::{MachineParameters, Nest, PathRoute, Route};
 use cutroute_protocol::RouteSummary;
 use leptos::prelude::*;
 
+use crate::fields::{setting_field, Accept};
 use crate::i18n::{tr, use_language, Lang};
 
 /// One editable machine parameter: (id, (label, Russian label), (unit, Russian unit), getter,
@@ -143,26 +144,7 @@ pub fn StatsPanel(
             {FIELDS
                 .into_iter()
                 .map(|(id, label, unit, get, set)| {
-                    view! {
-                        <label class="param">
-                            <span>{tr(label.0, label.1)}</span>
-                            <input
-                                id=id
-                                type="number"
-                                min="0"
-                                step="any"
-                                prop:value=move || get(&machine.get()).to_string()
-                                on:change=move |ev| {
-                                    if let Ok(v) = event_target_value(&ev).parse::<f64>() {
-                                        if v.is_finite() && v >= 0.0 {
-                                            machine.update(|m| set(m, v));
-                                        }
-                                    }
-                                }
-                            />
-                            <span class="unit">{tr(unit.0, unit.1)}</span>
-                        </label>
-                    }
+                    setting_field(machine, id, label, unit, None, Accept::NonNegative, get, set)
                 })
                 .collect_view()}
         </details>

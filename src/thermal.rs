@@ -14,6 +14,7 @@ use leptos::prelude::*;
 
 use crate::animation::Animation;
 use crate::drawing::{contour_path, heat_frame, nest_bounds};
+use crate::fields::{setting_field, Accept};
 use crate::i18n::{tr, use_language, Lang};
 use crate::settings::Layer;
 
@@ -68,7 +69,7 @@ impl ThermalView {
 #[component]
 pub fn ThermalPanel(settings: RwSignal<ThermalSettings>) -> impl IntoView {
     // Labels, units and tips as (English, Russian).
-    type Words = (&'static str, &'static str);
+    use crate::fields::Words;
     let number = move |id: &'static str,
                        label: Words,
                        unit: Words,
@@ -76,26 +77,12 @@ pub fn ThermalPanel(settings: RwSignal<ThermalSettings>) -> impl IntoView {
                        get: fn(&ThermalSettings) -> f64,
                        set: fn(&mut ThermalSettings, f64),
                        min_exclusive: bool| {
-        view! {
-            <label class="param" title=tr(tip.0, tip.1)>
-                <span>{tr(label.0, label.1)}</span>
-                <input
-                    id=id
-                    type="number"
-                    min="0"
-                    step="any"
-                    prop:value=move || get(&settings.get()).to_string()
-                    on:change=move |ev| {
-                        if let Ok(v) = event_target_value(&ev).parse::<f64>() {
-                            if v.is_finite() && (v > 0.0 || (!min_exclusive && v == 0.0)) {
-                                settings.update(|s| set(s, v));
-                            }
-                        }
-                    }
-                />
-                <span class="unit">{tr(unit.0, unit.1)}</span>
-            </label>
-        }
+        let accept = if min_exclusive {
+            Accept::Positive
+        } else {
+            Accept::NonNegative
+        };
+        setting_field(settings, id, label, unit, Some(tip), accept, get, set)
     };
     let rule = move |id: &'static str,
                      label: Words,
