@@ -578,8 +578,8 @@ fn run_bounded<T: Send + 'static>(
 /// ensembles, AOE's chains).
 enum SolverJob {
     Engine(Box<dyn Job>),
-    Segments(SegmentJob),
-    Aoe(AoeJob),
+    Segments(Box<SegmentJob>),
+    Aoe(Box<AoeJob>),
 }
 
 impl SolverJob {
@@ -591,10 +591,12 @@ impl SolverJob {
             source: e,
         };
         Ok(match request.solver {
-            SolverKind::Aoe => SolverJob::Aoe(AoeJob::from_request(request).map_err(refused)?),
-            SolverKind::Sccp | SolverKind::Gsccp => {
-                SolverJob::Segments(SegmentJob::from_request(request).map_err(refused)?)
+            SolverKind::Aoe => {
+                SolverJob::Aoe(Box::new(AoeJob::from_request(request).map_err(refused)?))
             }
+            SolverKind::Sccp | SolverKind::Gsccp => SolverJob::Segments(Box::new(
+                SegmentJob::from_request(request).map_err(refused)?,
+            )),
             _ => SolverJob::Engine(start_job(request).map_err(refused)?),
         })
     }
@@ -602,8 +604,8 @@ impl SolverJob {
     fn job(&mut self) -> &mut dyn Job {
         match self {
             SolverJob::Engine(job) => job.as_mut(),
-            SolverJob::Segments(job) => job,
-            SolverJob::Aoe(job) => job,
+            SolverJob::Segments(job) => job.as_mut(),
+            SolverJob::Aoe(job) => job.as_mut(),
         }
     }
 
