@@ -1268,9 +1268,15 @@ fn solve(
     thermal.warn_unpriced(solver);
     let started = std::time::Instant::now();
     let mut finished = bounded_job_run(request, as_json)?;
+    // The report follows the solution's shape.
+    let path_report = match finished.run.last.as_ref().and_then(|p| p.solution.as_ref()) {
+        Some(solution) => solution.path_route().is_some(),
+        None => solver.gives_path_route(),
+    };
     let report = match &document.problem {
         Problem::PcgtspText { text } => tour_report(solver_name, text, &finished.run)?,
-        Problem::Nest { nest, .. } if solver.gives_path_route() => {
+        // Tool-on paths, or none from a path solver (its report says why).
+        Problem::Nest { nest, .. } if path_report => {
             let report = PathReport {
                 solver,
                 solver_name,
