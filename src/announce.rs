@@ -35,7 +35,7 @@ fn worth_saying(said: &Said, p: &Progress, ended: bool, now_ms: f64) -> bool {
         (Some(_), None) => true,
         _ => false,
     };
-    (moved(p.upper_bound, said.upper) || moved(p.lower_bound, said.lower))
+    (moved(p.bounds.upper, said.upper) || moved(p.bounds.lower, said.lower))
         && now_ms - said.at_ms >= QUIET_MS
 }
 
@@ -61,8 +61,8 @@ pub fn ProgressAnnouncer(
         }
         said.set_value(Said {
             phase: Some(p.phase.clone()),
-            upper: p.upper_bound,
-            lower: p.lower_bound,
+            upper: p.bounds.upper,
+            lower: p.bounds.lower,
             optimal: p.proven_optimal,
             ended,
             at_ms: now,
@@ -73,9 +73,9 @@ pub fn ProgressAnnouncer(
             language.pick("Phase", "Этап"),
             crate::words::phase_text(language.get_untracked(), &p.phase),
             language.pick("upper bound", "верхняя оценка"),
-            number(p.upper_bound),
+            number(p.bounds.upper),
             language.pick("lower bound", "нижняя оценка"),
-            number(p.lower_bound),
+            number(p.bounds.lower),
         );
         if let Some(gap) = p.gap() {
             line.push_str(&format!(
@@ -103,7 +103,10 @@ mod tests {
     fn progress(phase: Phase, upper: Option<f64>) -> Progress {
         Progress {
             phase,
-            upper_bound: upper,
+            bounds: cutroute_protocol::Bounds {
+                upper,
+                ..Default::default()
+            },
             ..Progress::default()
         }
     }

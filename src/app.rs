@@ -1,9 +1,10 @@
 //! The application shell: sample picker, solver panel, live bounds, the route drawing with its
 //! layers, the animation, exports, and the comparison of kept results.
 
-use cutroute_geometry::{Nest, Objective, PathRoute, Point, Route, Toolpath};
+use cutroute_geometry::{Nest, PathRoute, Point, Route, Toolpath};
 use cutroute_protocol::{
-    Document, FromWorker, JobId, JobRequest, Problem, Progress, SolverKind, SolverParams, ToWorker,
+    Bounds, CostUnit, Document, FromWorker, JobId, JobRequest, Problem, Progress, SolverKind,
+    SolverParams, ToWorker,
 };
 use leptos::prelude::*;
 use wasm_bindgen::JsCast;
@@ -79,12 +80,12 @@ impl JobState {
 /// A continued job reports on its own run; the page shows the better of that and the result it
 /// continued from, with the time of both runs added up.
 fn continued(from: &Progress, update: Progress) -> Progress {
-    let improved = match (update.upper_bound, from.upper_bound) {
+    let improved = match (update.bounds.upper, from.bounds.upper) {
         (Some(new), Some(old)) => new < old - 1e-9,
         (Some(_), None) => true,
         (None, _) => false,
     };
-    let lower_bound = match (update.lower_bound, from.lower_bound) {
+    let lower_bound = match (update.bounds.lower, from.bounds.lower) {
         (Some(a), Some(b)) => Some(a.max(b)),
         (a, b) => a.or(b),
     };
@@ -92,14 +93,20 @@ fn continued(from: &Progress, update: Progress) -> Progress {
     if improved {
         Progress {
             elapsed_s,
-            lower_bound,
+            bounds: Bounds {
+                lower: lower_bound,
+                ..update.bounds
+            },
             ..update
         }
     } else {
         Progress {
             job_id: update.job_id,
             elapsed_s,
-            lower_bound,
+            bounds: Bounds {
+                lower: lower_bound,
+                ..from.bounds
+            },
             phase: update.phase,
             states: update.states,
             ..from.clone()
@@ -183,8 +190,8 @@ pub fn App() -> impl IntoView {
         samples.update(|s| {
             s.push(BoundSample {
                 elapsed_s: p.elapsed_s,
-                upper_bound: p.upper_bound,
-                lower_bound: p.lower_bound,
+                upper_bound: p.bounds.upper,
+                lower_bound: p.bounds.lower,
             })
         })
     };
@@ -280,7 +287,7 @@ pub fn App() -> impl IntoView {
     // paths of a G-code file that cuts open paths.
     let shown_paths =
         Memo::new(
-            move |_| match progress.with(|p| p.as_ref().map(|p| p.path_route.clone())) {
+            move |_| match progress.with(|p| p.as_ref().map(|p| p.path_route().cloned())) {
                 Some(paths) => paths,
                 None => file_paths.get(),
             },
@@ -293,7 +300,7 @@ pub fn App() -> impl IntoView {
             return None;
         }
         progress
-            .with(|p| p.as_ref().and_then(|p| p.route.clone()))
+            .with(|p| p.as_ref().and_then(|p| p.route().cloned()))
             .or_else(|| document.with(|d| d.as_ref().and_then(|d| d.route.clone())))
     });
     let shown_route = Signal::from(shown_route);
@@ -315,20 +322,10 @@ pub fn App() -> impl IntoView {
                 .unwrap_or_default()
         })
     });
-    // What the bounds measure: the objective for the solvers that minimise it, else idle mm.
+    // What the bounds measure, as the job reports it (nothing before a job reports).
     let bound_unit = Signal::derive(move || {
-        let instance = document.with(|d| {
-            d.as_ref()
-                .is_some_and(|d| matches!(d.problem, Problem::PcgtspText { .. }))
-        });
-        let lang = language.get();
-        if instance {
-            lang.pick("tour cost", "стоимость обхода")
-        } else if solver.get().gives_path_route() {
-            objective_unit(objective.get(), lang)
-        } else {
-            lang.pick("mm idle", "мм холостого хода")
-        }
+        let unit = progress.with(|p| p.as_ref().map(|p| p.bounds.unit));
+        unit.map_or("", |unit| unit_words(unit, language.get()))
     });
     let certified = Memo::new(move |_| {
         progress.with(|p| p.as_ref().map(|p| p.certified.clone()).unwrap_or_default())
@@ -506,7 +503,7 @@ pub fn App() -> impl IntoView {
             // A continued run explores with another seed, pruned by the best cost found.
             seed: seed.get_untracked().wrapping_add(run),
             discretisation_step_mm: step_mm.get_untracked(),
-            initial_upper_bound: from.as_ref().and_then(|p| p.upper_bound),
+            initial_upper_bound: from.as_ref().and_then(|p| p.bounds.upper),
             // The stats panel's speeds and prices: chain cutting decides by this cost model.
             machine: machine.get_untracked(),
             objective: objective.get_untracked(),
@@ -574,7 +571,7 @@ pub fn App() -> impl IntoView {
     let running = move || matches!(job_state.get(), JobState::Running(_));
     let can_continue = move || {
         !running()
-            && progress.with(|p| p.as_ref().is_some_and(|p| p.upper_bound.is_some()))
+            && progress.with(|p| p.as_ref().is_some_and(|p| p.bounds.upper.is_some()))
             && !progress.with(|p| p.as_ref().is_some_and(|p| p.proven_optimal))
     };
 
@@ -918,9 +915,9 @@ pub fn App() -> impl IntoView {
                         })}
                     </dd>
                     <dt>{tr("Upper bound", "Верхняя оценка")}</dt>
-                    <dd id="upper-bound" data-unit=move || bound_unit.get()>{move || format_bound(progress.get().and_then(|p| p.upper_bound))}</dd>
+                    <dd id="upper-bound" data-unit=move || bound_unit.get()>{move || format_bound(progress.get().and_then(|p| p.bounds.upper))}</dd>
                     <dt>{tr("Lower bound", "Нижняя оценка")}</dt>
-                    <dd id="lower-bound">{move || format_bound(progress.get().and_then(|p| p.lower_bound))}</dd>
+                    <dd id="lower-bound">{move || format_bound(progress.get().and_then(|p| p.bounds.lower))}</dd>
                     <dt>{tr("Gap", "Разрыв")}</dt>
                     <dd id="gap">
                         {move || progress.get().and_then(|p| {
@@ -980,7 +977,7 @@ fn missing_tour(
     }
     // `Progress::missing_tour`'s cases (the CLI's words), as data the page words itself.
     let solver = solver.get_untracked().name();
-    if last.tour.is_some() {
+    if last.tour().is_some() {
         None
     } else if last.proven_optimal {
         Some(JobFailure::NoTourExists { solver })
@@ -1122,10 +1119,13 @@ fn LayerPanel(hidden: RwSignal<Vec<Layer>>) -> impl IntoView {
 }
 
 /// The unit of an objective's values, as the chart and bounds show it.
-fn objective_unit(objective: Objective, lang: Lang) -> &'static str {
-    match objective {
-        Objective::Time => lang.pick("s (machine time)", "с (время работы станка)"),
-        Objective::Cost => lang.pick("cost", "стоимость"),
+/// What bounds in `unit` measure, in words.
+fn unit_words(unit: CostUnit, lang: Lang) -> &'static str {
+    match unit {
+        CostUnit::IdleMm => lang.pick("mm idle", "мм холостого хода"),
+        CostUnit::Seconds => lang.pick("s (machine time)", "с (время работы станка)"),
+        CostUnit::Cost => lang.pick("cost", "стоимость"),
+        CostUnit::TourCost => lang.pick("tour cost", "стоимость обхода"),
     }
 }
 

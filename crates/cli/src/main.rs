@@ -52,7 +52,9 @@ use cutroute_engine::{open_sheet, start_job, AoeJob, Job, SegmentJob};
 use cutroute_geometry::{
     ContainmentForest, Entry, MachineParameters, Nest, Objective, PathRoute, Route,
 };
-use cutroute_protocol::{Document, JobRequest, Problem, Progress, SolverKind, SolverParams};
+use cutroute_protocol::{
+    Document, JobRequest, Problem, Progress, Solution, SolverKind, SolverParams,
+};
 use serde_json::{json, Value};
 
 mod inputs;
@@ -267,15 +269,44 @@ fn finite_non_negative(text: &str) -> Result<f64, String> {
 /// Exit code of a PCGTSP instance without a feasible tour (errors are 1, usage errors 2).
 const EXIT_INFEASIBLE: u8 = 3;
 
-/// Why the CLI failed: an error (exit 1) or a proof that no tour exists (exit 3).
+/// Why the CLI failed: an error (exit 1) or a proof that no tour exists (exit 3). The printed
+/// message is the `Display`; a typed cause stays reachable as the error's `source`.
+#[derive(Debug, thiserror::Error)]
 enum Failure {
-    Error(String),
+    /// The CLI's own words: a flag, a file, a checker's verdict.
+    #[error("{0}")]
+    Message(String),
+    /// The instance has no feasible tour, or none was found in time.
+    #[error("{0}")]
     Infeasible(String),
+    /// A file the engine could not open.
+    #[error(transparent)]
+    Open(#[from] cutroute_engine::OpenError),
+    /// The engine refused to start the solver's job.
+    #[error("--solver {solver}: {source}")]
+    Engine {
+        solver: &'static str,
+        #[source]
+        source: cutroute_engine::EngineError,
+    },
+    /// Segment cutting failed.
+    #[error("--solver {solver}: {source}")]
+    Segments {
+        solver: &'static str,
+        #[source]
+        source: cutroute_segments::SegmentError,
+    },
+    /// A solver ended with an error it reports in words (AOE's job).
+    #[error("--solver {solver}: {message}")]
+    Solver {
+        solver: &'static str,
+        message: String,
+    },
 }
 
 impl From<String> for Failure {
     fn from(message: String) -> Self {
-        Failure::Error(message)
+        Failure::Message(message)
     }
 }
 
@@ -289,7 +320,7 @@ fn main() -> ExitCode {
             sheet,
             step,
             preset,
-        } => inspect(&file, sheet.index(), json, step, preset).map_err(Failure::Error),
+        } => inspect(&file, sheet.index(), json, step, preset),
         Command::Convert {
             input,
             output,
@@ -303,9 +334,9 @@ fn main() -> ExitCode {
             kerf,
             sheet,
             profile,
-        } => profile
-            .load()
-            .and_then(|profile| {
+        } => (|| -> Result<(), Failure> {
+            let profile = profile.load()?;
+            {
                 let kerf = kerf.parse()?.with_profile(profile.as_ref());
                 let (machine, objective) = machine.parse(inputs::base_machine(profile.as_ref()))?;
                 let params = SolverParams {
@@ -330,13 +361,13 @@ fn main() -> ExitCode {
                     &gcode,
                     &kerf,
                 )
-            })
-            .map_err(Failure::Error),
+            }
+        })(),
         Command::Generate {
             contours,
             seed,
             out,
-        } => generate(contours as usize, seed, &out).map_err(Failure::Error),
+        } => generate(contours as usize, seed, &out).map_err(Failure::Message),
         Command::Solve {
             file,
             solver,
@@ -370,25 +401,19 @@ fn main() -> ExitCode {
                 leads_after: false,
             };
             let input = (file.as_path(), sheet.index());
-            let report = match solver.as_str() {
-                "sccp" | "gsccp" | "aoe" if kerf.is_on() => Err(Failure::Error(format!(
-                    "--solver {solver} does not cut with kerf and leads yet"
-                ))),
-                "sccp" | "gsccp" | "aoe" => Ok(solve_path(input, &solver, params, json, &thermal)?),
-                _ => solve(input, &solver, params, json, &thermal, &kerf),
-            }?;
+            let report = solve(input, &solver, params, json, &thermal, &kerf)?;
             Ok(write_report(&report, json, out.as_deref())?)
         })(),
     };
     match outcome {
         Ok(()) => ExitCode::SUCCESS,
-        Err(Failure::Error(message)) => {
-            eprintln!("cutroute: {message}");
-            ExitCode::FAILURE
-        }
-        Err(Failure::Infeasible(message)) => {
-            eprintln!("cutroute: {message}");
+        Err(failure @ Failure::Infeasible(_)) => {
+            eprintln!("cutroute: {failure}");
             ExitCode::from(EXIT_INFEASIBLE)
+        }
+        Err(failure) => {
+            eprintln!("cutroute: {failure}");
+            ExitCode::FAILURE
         }
     }
 }
@@ -458,7 +483,7 @@ fn run_job(job: &mut dyn Job, watch: &Watch, on_progress: &mut dyn FnMut(&Progre
         on_progress(&progress);
         let elapsed = started.elapsed().as_secs_f64();
         let mut seen = watch.seen.lock().unwrap_or_else(|e| e.into_inner());
-        if let (Some(route), Some(ub)) = (&progress.route, progress.upper_bound) {
+        if let (Some(route), Some(ub)) = (progress.route(), progress.bounds.upper) {
             if ub < kept_ub && elapsed - kept_at >= 0.5 {
                 if seen.earlier_routes.len() == KEPT_ROUTES {
                     seen.earlier_routes.remove(0);
@@ -470,7 +495,7 @@ fn run_job(job: &mut dyn Job, watch: &Watch, on_progress: &mut dyn FnMut(&Progre
         // A kerf job between its solver's end and its first route with leads: the leads are
         // part of the answer, so a stop waits for them (the main thread still reports what
         // was published at the grace's end).
-        let fitting_leads = progress.route.is_none()
+        let fitting_leads = progress.route().is_none()
             && matches!(
                 progress.phase,
                 cutroute_protocol::Phase::Kerf {
@@ -522,7 +547,9 @@ fn run_bounded<T: Send + 'static>(
             Ok(outcome) => return outcome.map(Ok),
             // A panic in the solver's thread: reported as an error, not as a crash.
             Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => {
-                return Err(Failure::Error("the solver failed (internal error)".into()))
+                return Err(Failure::Message(
+                    "the solver failed (internal error)".into(),
+                ))
             }
             Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {}
         }
@@ -546,13 +573,123 @@ fn run_bounded<T: Send + 'static>(
     }
 }
 
-/// The run of the request's job on the solver's thread, bounded by [`run_bounded`]: the job
-/// `make_job` builds (a heated one), else the engine's own.
-fn bounded_job_run(
-    request: JobRequest,
-    as_json: bool,
-    make_job: impl FnOnce(&JobRequest) -> Result<Option<Box<dyn Job>>, String> + Send + 'static,
-) -> Result<JobRun, Failure> {
+/// The job the CLI steps: the engine's job for the request, or, for the path-route solvers,
+/// their own job kept by its type so the report can add what only it knows (GSCCP's
+/// ensembles, AOE's chains).
+enum SolverJob {
+    Engine(Box<dyn Job>),
+    Segments(Box<SegmentJob>),
+    Aoe(Box<AoeJob>),
+}
+
+impl SolverJob {
+    /// The request's job; the path-route solvers (sccp, gsccp, aoe) run their job as the app's
+    /// worker steps it.
+    fn start(request: &JobRequest) -> Result<Self, Failure> {
+        let refused = |e: cutroute_engine::EngineError| Failure::Engine {
+            solver: request.solver.name(),
+            source: e,
+        };
+        Ok(match request.solver {
+            SolverKind::Aoe => {
+                SolverJob::Aoe(Box::new(AoeJob::from_request(request).map_err(refused)?))
+            }
+            SolverKind::Sccp | SolverKind::Gsccp => SolverJob::Segments(Box::new(
+                SegmentJob::from_request(request).map_err(refused)?,
+            )),
+            _ => SolverJob::Engine(start_job(request).map_err(refused)?),
+        })
+    }
+
+    fn job(&mut self) -> &mut dyn Job {
+        match self {
+            SolverJob::Engine(job) => job.as_mut(),
+            SolverJob::Segments(job) => job.as_mut(),
+            SolverJob::Aoe(job) => job.as_mut(),
+        }
+    }
+
+    /// What the report adds for this job after its run, under `machine`: AOE's pierce bound
+    /// and components; GSCCP's chosen ensemble, every ensemble's numbers and the CCP route's.
+    fn report_extras(
+        &self,
+        solver: SolverKind,
+        machine: &MachineParameters,
+    ) -> Result<serde_json::Map<String, Value>, Failure> {
+        let mut extra = serde_json::Map::new();
+        match self {
+            SolverJob::Engine(_) => {}
+            SolverJob::Aoe(job) => {
+                let (solution, _) = match job.outcome() {
+                    Some(Ok(solved)) => solved,
+                    Some(Err(e)) => {
+                        return Err(Failure::Solver {
+                            solver: solver.name(),
+                            message: e.clone(),
+                        })
+                    }
+                    None => return Err(Failure::Message("the aoe job did not run".into())),
+                };
+                extra.insert(
+                    "pierce_lower_bound".into(),
+                    json!(solution.pierce_lower_bound),
+                );
+                extra.insert("components".into(), json!(solution.components));
+            }
+            SolverJob::Segments(job) => {
+                let result = job.search().result().map_err(|e| Failure::Segments {
+                    solver: solver.name(),
+                    source: e,
+                })?;
+                extra.insert(
+                    "ensemble".into(),
+                    json!(result.best.map_or("ccp", |kind| kind.name())),
+                );
+                extra.insert(
+                    "ensembles".into(),
+                    json!(result
+                        .reports
+                        .iter()
+                        .map(|r| json!({
+                            "kind": r.kind.name(),
+                            "segments": r.segments,
+                            "pierces": r.pierces,
+                            "idle_length": finite(r.idle_length),
+                            "cut_length": finite(r.cut_length),
+                            "recut_length": r.recut_length,
+                            "time_s": finite(r.time_s),
+                            "cost": finite(r.cost),
+                            "failure": r.failure,
+                        }))
+                        .collect::<Vec<_>>()),
+                );
+                extra.insert(
+                    "ccp".into(),
+                    json!({
+                        "idle_length": result.ccp_route.idle_length(),
+                        "cut_length": result.ccp_route.cut_length(),
+                        "pierces": result.ccp_route.pierce_count(),
+                        "time_s": result.ccp_route.time(machine),
+                        "cost": result.ccp_route.cost(machine),
+                    }),
+                );
+            }
+        }
+        Ok(extra)
+    }
+}
+
+/// A finished run: its states, what the job adds to the report ([`SolverJob::report_extras`];
+/// empty when the run was cut in a long step), and whether the job returned by itself.
+struct FinishedRun {
+    run: JobRun,
+    extras: serde_json::Map<String, Value>,
+    /// False when the run was taken from the last published state at the grace's end.
+    returned: bool,
+}
+
+/// The run of the request's job on the solver's thread, bounded by [`run_bounded`].
+fn bounded_job_run(request: JobRequest, as_json: bool) -> Result<FinishedRun, Failure> {
     let time_limit_s = request.params.time_limit_s;
     // A kerf job stopped before its first route with leads keeps stepping until it has one
     // (see `run_job`); the grace lets it.
@@ -564,17 +701,22 @@ fn bounded_job_run(
     let display = stdio::ProgressDisplay::new(as_json);
     let mut shown = display.clone();
     let outcome = run_bounded(time_limit_s, grace, move |watch| {
-        let mut job = match make_job(&request).map_err(Failure::Error)? {
-            Some(job) => job,
-            None => start_job(&request)
-                .map_err(|e| Failure::Error(format!("--solver {}: {e}", request.solver.name())))?,
-        };
-        Ok(run_job(job.as_mut(), watch, &mut |p| shown.show(p)))
+        let mut job = SolverJob::start(&request)?;
+        let run = run_job(job.job(), watch, &mut |p| shown.show(p));
+        let extras = job.report_extras(request.solver, &request.params.machine)?;
+        Ok((run, extras))
     })?;
     drop(display);
-    let mut run = outcome.unwrap_or_else(|snapshot| snapshot);
+    let (mut run, extras, returned) = match outcome {
+        Ok((run, extras)) => (run, extras, true),
+        Err(snapshot) => (snapshot, serde_json::Map::new(), false),
+    };
     run.time_limit_s = time_limit_s;
-    Ok(run)
+    Ok(FinishedRun {
+        run,
+        extras,
+        returned,
+    })
 }
 
 /// The run's route if it passes the checker, else the newest earlier route that does (with
@@ -597,7 +739,7 @@ fn checked_route(
     let route = run
         .last
         .as_ref()
-        .and_then(|p| p.route.as_ref())
+        .and_then(Progress::route)
         .ok_or_else(no_route)?;
     let problem = match first_problem(route) {
         None => return Ok((route.clone(), None)),
@@ -687,9 +829,9 @@ fn machine_parameters(
 }
 
 /// Opens sheet `sheet` (from 0) of the file; every file has sheet 0.
-fn open((path, sheet): (&Path, usize)) -> Result<Document, String> {
+fn open((path, sheet): (&Path, usize)) -> Result<Document, Failure> {
     let (name, bytes) = stdio::read_input(path)?;
-    open_sheet(&name, &bytes, sheet).map_err(|e| e.to_string())
+    Ok(open_sheet(&name, &bytes, sheet)?)
 }
 
 fn inspect(
@@ -698,13 +840,12 @@ fn inspect(
     as_json: bool,
     step: Option<f64>,
     preset: Option<inputs::PresetArg>,
-) -> Result<(), String> {
+) -> Result<(), Failure> {
     let document = match preset {
         Some(inputs::PresetArg(preset)) => {
             let (name, bytes) = stdio::read_input(path)?;
             let text = String::from_utf8(bytes).map_err(|e| format!("{name}: {e}"))?;
-            cutroute_engine::open_gcode_with(&name, &text, &preset.read_options())
-                .map_err(|e| e.to_string())?
+            cutroute_engine::open_gcode_with(&name, &text, &preset.read_options())?
         }
         None => open((path, sheet))?,
     };
@@ -899,8 +1040,25 @@ fn convert(
     params: SolverParams,
     gcode: &cutroute_gcode::GcodeOptions,
     kerf: &kerf::Kerf,
-) -> Result<(), String> {
+) -> Result<(), Failure> {
     let document = open((input, sheet))?;
+    Ok(convert_document(
+        &document, input, output, to, solver, params, gcode, kerf,
+    )?)
+}
+
+/// `convert` of an opened document.
+#[allow(clippy::too_many_arguments)]
+fn convert_document(
+    document: &Document,
+    input: &Path,
+    output: &Path,
+    to: Option<&str>,
+    solver: Option<&str>,
+    params: SolverParams,
+    gcode: &cutroute_gcode::GcodeOptions,
+    kerf: &kerf::Kerf,
+) -> Result<(), String> {
     let Problem::Nest { nest, .. } = &document.problem else {
         return Err(format!(
             "{}: line 1 starts a PCGTSP instance, not a nest; only nests can be converted",
@@ -940,7 +1098,7 @@ fn convert(
             (None, _, Some(paths)) => Ok(Routed::Paths(paths.clone())),
             // A file's own route gets its leads here; a solved one has them from the job.
             (None, Some(route), None) => Ok(Routed::Contours(kerf.attach(nest, route.clone())?)),
-            (name, ..) => solved(&document, name.unwrap_or("ccp"), params.clone(), kerf),
+            (name, ..) => solved(document, name.unwrap_or("ccp"), params.clone(), kerf),
         }
         .and_then(|routed| match routed {
             Routed::Paths(_) if kerf.is_on() => {
@@ -1031,10 +1189,10 @@ fn solved(
     };
     let forest = forest_in_background(&document.problem);
     let request = kerf.request(request, solver_name)?;
-    let run = bounded_job_run(request, true, |_| Ok(None)).map_err(|f| match f {
-        Failure::Error(m) | Failure::Infeasible(m) => m,
-    })?;
-    if let Some(paths) = run.last.as_ref().and_then(|p| p.path_route.clone()) {
+    let run = bounded_job_run(request, true)
+        .map_err(|f| f.to_string())?
+        .run;
+    if let Some(paths) = run.last.as_ref().and_then(Progress::path_route).cloned() {
         // As `solve` checks path routes: a contour cut twice (standard cutting of common
         // edges) is allowed, nothing else.
         let problems = paths.problems(nest, nest.check_tolerance());
@@ -1070,6 +1228,9 @@ fn generate(contours: usize, seed: u64, out: &Path) -> Result<(), String> {
     stdio::write_output(out, text.as_bytes())
 }
 
+/// `solve` for every solver: one job run ([`bounded_job_run`]), then the report of the
+/// solution's shape (a tour, a route of whole contours, or tool-on paths), each checked again
+/// by the independent checker before it is printed.
 fn solve(
     input: (&Path, usize),
     solver_name: &str,
@@ -1078,8 +1239,18 @@ fn solve(
     thermal: &thermal::Thermal,
     kerf: &kerf::Kerf,
 ) -> Result<Value, Failure> {
-    let document = open(input)?;
     let solver = solver_kind(solver_name)?;
+    if solver.gives_path_route() && kerf.is_on() {
+        return Err(Failure::Message(format!(
+            "--solver {solver_name} does not cut with kerf and leads yet"
+        )));
+    }
+    let document = open(input)?;
+    if solver.gives_path_route() && matches!(document.problem, Problem::PcgtspText { .. }) {
+        return Err(Failure::Message(format!(
+            "--solver {solver_name}: routes nests, not PCGTSP instances"
+        )));
+    }
     let (machine, objective) = (params.machine, params.objective);
     let request = JobRequest {
         job_id: 1,
@@ -1087,36 +1258,60 @@ fn solve(
         solver,
         params,
     };
-    let forest = forest_in_background(&document.problem);
+    // The checker's forest of routes of whole contours (path routes are checked without it).
+    let forest = if solver.gives_path_route() {
+        None
+    } else {
+        forest_in_background(&document.problem)
+    };
     let request = kerf.request(request, solver_name)?;
     thermal.warn_unpriced(solver);
-    let mut run = bounded_job_run(request, as_json, |_| Ok(None))?;
+    let started = std::time::Instant::now();
+    let mut finished = bounded_job_run(request, as_json)?;
+    // The report follows the solution's shape.
+    let path_report = match finished.run.last.as_ref().and_then(|p| p.solution.as_ref()) {
+        Some(solution) => solution.path_route().is_some(),
+        None => solver.gives_path_route(),
+    };
     let report = match &document.problem {
-        Problem::PcgtspText { text } => tour_report(solver_name, text, &run)?,
+        Problem::PcgtspText { text } => tour_report(solver_name, text, &finished.run)?,
+        // Tool-on paths, or none from a path solver (its report says why).
+        Problem::Nest { nest, .. } if path_report => {
+            let report = PathReport {
+                solver,
+                solver_name,
+                machine: &machine,
+                objective,
+                thermal,
+                started,
+            };
+            report.of(nest, finished)?
+        }
         Problem::Nest { nest, .. } => {
             let forest = joined_forest(forest, nest);
+            let run = &mut finished.run;
             kerf.refused(run.last.as_ref())?;
             // With `--rules-hard`, the route repaired until the rules hold (and its
             // certificates recomputed): the report describes the route it prints.
             if let Some(last) = run.last.as_mut() {
-                if let Some(route) = last.route.take() {
+                if let Some(Solution::Route(route)) = last.solution.take() {
                     let enforced = thermal.enforce(nest, route.clone(), &machine, objective)?;
                     if !last.certified.is_empty() {
                         let certified = cutroute_ccp::route_certificates(nest, &enforced)
-                            .map_err(|e| e.to_string())?;
+                            .map_err(|e| Failure::Message(e.to_string()))?;
                         last.certified = certified.iter().map(|c| c.condition1).collect();
                     }
                     // The job's route has its leads; a route the repair changed gets them
                     // fitted again.
-                    last.route = Some(if enforced != route {
+                    last.solution = Some(Solution::Route(if enforced != route {
                         kerf.attach(nest, enforced)?
                     } else {
                         enforced
-                    });
+                    }));
                 }
             }
-            let mut report = route_report(solver_name, nest, &machine, &run, &forest)?;
-            if let Some(route) = run.last.as_ref().and_then(|p| p.route.as_ref()) {
+            let mut report = route_report(solver_name, nest, &machine, run, &forest)?;
+            if let Some(route) = run.last.as_ref().and_then(Progress::route) {
                 thermal.report(&mut report, nest, route, &machine, objective)?;
                 kerf.report(&mut report, route, run.last.as_ref().map(|p| &p.phase));
             }
@@ -1164,7 +1359,7 @@ fn tour_report(solver: &str, text: &str, run: &JobRun) -> Result<Value, Failure>
             run.time_limit_s
         )));
     };
-    let Some(tour) = &result.tour else {
+    let Some(tour) = result.tour() else {
         let why = result.missing_tour(solver, run.stopped.is_some());
         return Err(Failure::Infeasible(why.unwrap_or_default()));
     };
@@ -1172,8 +1367,8 @@ fn tour_report(solver: &str, text: &str, run: &JobRun) -> Result<Value, Failure>
         .map_err(|e| format!("the {solver} solver's tour fails the checker: {e}"))?;
     Ok(json!({
         "solver": solver,
-        "ub": result.upper_bound,
-        "lb": result.lower_bound,
+        "ub": result.bounds.upper,
+        "lb": result.bounds.lower,
         "gap": result.gap(),
         "proven_optimal": result.proven_optimal,
         "cost": cost,
@@ -1220,8 +1415,8 @@ fn route_report(
             step
         }).collect::<Vec<_>>(),
         "certified_contours": result.certified.iter().filter(|c| **c).count(),
-        "ub": if final_route_rejected.is_some() { Some(route.idle_length()) } else { result.upper_bound },
-        "lb": result.lower_bound,
+        "ub": if final_route_rejected.is_some() { Some(route.idle_length()) } else { result.bounds.upper },
+        "lb": result.bounds.lower,
         "gap": result.gap(),
         "proven_optimal": result.proven_optimal,
         "elapsed_s": result.elapsed_s,
@@ -1230,190 +1425,117 @@ fn route_report(
     }))
 }
 
-/// `--solver sccp|gsccp|aoe`: the engine's path-route jobs (the app's code path), stepped to
-/// their end. sccp solves the multi-contour chain ensemble alone, gsccp every ensemble,
-/// keeping the best by `--objective`; aoe cuts common edges once along AOE-chains. The
-/// report's numbers are recomputed from the route, which must pass `PathRoute::problems` but
-/// for contour cut twice (standard cutting of common edges, reported as `recut_length`);
-/// `ub` and `lb` are the job's bounds in the objective's unit (s or cost); `idle_lb` is its
-/// lower bound on idle length (mm) and `idle_gap` the route's `idle_length` against it.
-fn solve_path(
-    input: (&Path, usize),
-    solver_name: &str,
-    params: SolverParams,
-    as_json: bool,
-    thermal: &thermal::Thermal,
-) -> Result<Value, String> {
-    let document = open(input)?;
-    let Problem::Nest { nest, .. } = &document.problem else {
-        return Err(format!(
-            "--solver {solver_name}: routes nests, not PCGTSP instances"
-        ));
-    };
-    let solver = solver_kind(solver_name)?;
-    let machine = params.machine;
-    let time_limit_s = params.time_limit_s;
-    let objective = params.objective;
-    thermal.warn_unpriced(solver);
-    let request = JobRequest {
-        job_id: 1,
-        problem: document.problem.clone(),
-        solver,
-        params,
-    };
-    let started = std::time::Instant::now();
-    let display = stdio::ProgressDisplay::new(as_json);
-    let mut shown = display.clone();
-    let outcome = run_bounded(time_limit_s, GRACE, move |watch| {
-        let mut on_progress = |p: &Progress| shown.show(p);
-        let mut extra = serde_json::Map::new();
-        let progress = if solver == SolverKind::Aoe {
-            let mut job =
-                AoeJob::from_request(&request).map_err(|e| format!("--solver aoe: {e}"))?;
-            let progress = run_job(&mut job, watch, &mut on_progress).last;
-            let (solution, _) = match job.outcome() {
-                Some(Ok(solved)) => solved,
-                Some(Err(e)) => return Err(Failure::Error(format!("--solver aoe: {e}"))),
-                None => return Err(Failure::Error("the aoe job did not run".into())),
-            };
-            extra.insert(
-                "pierce_lower_bound".into(),
-                json!(solution.pierce_lower_bound),
-            );
-            extra.insert("components".into(), json!(solution.components));
-            progress
+/// The report of a path route (sccp, gsccp, aoe: the engine's path-route jobs, the app's code
+/// path). Its numbers are recomputed from the route, which must pass `PathRoute::problems` but
+/// for contour cut twice (standard cutting of common edges, reported as `recut_length`); `ub`
+/// and `lb` are the job's bounds in the objective's unit (s or cost); `idle_lb` is its lower
+/// bound on idle length (mm) and `idle_gap` the route's `idle_length` against it.
+struct PathReport<'a> {
+    solver: SolverKind,
+    solver_name: &'a str,
+    machine: &'a MachineParameters,
+    objective: Objective,
+    thermal: &'a thermal::Thermal,
+    /// When the run started (the report's `elapsed_s` runs to the report).
+    started: std::time::Instant,
+}
+
+impl PathReport<'_> {
+    fn of(&self, nest: &Nest, finished: FinishedRun) -> Result<Value, Failure> {
+        let (solver, solver_name, machine, objective) =
+            (self.solver, self.solver_name, self.machine, self.objective);
+        // Stopped in a long step: the latest published state, without the job's own extras.
+        let stopped = if finished.returned {
+            None
         } else {
-            let mut job = SegmentJob::from_request(&request)
-                .map_err(|e| format!("--solver {}: {e}", request.solver.name()))?;
-            let progress = run_job(&mut job, watch, &mut on_progress).last;
-            let result = job
-                .search()
-                .result()
-                .map_err(|e| format!("--solver {}: {e}", request.solver.name()))?;
-            extra.insert(
-                "ensemble".into(),
-                json!(result.best.map_or("ccp", |kind| kind.name())),
-            );
-            extra.insert(
-                "ensembles".into(),
-                json!(result
-                    .reports
-                    .iter()
-                    .map(|r| json!({
-                        "kind": r.kind.name(),
-                        "segments": r.segments,
-                        "pierces": r.pierces,
-                        "idle_length": finite(r.idle_length),
-                        "cut_length": finite(r.cut_length),
-                        "recut_length": r.recut_length,
-                        "time_s": finite(r.time_s),
-                        "cost": finite(r.cost),
-                        "failure": r.failure,
-                    }))
-                    .collect::<Vec<_>>()),
-            );
-            extra.insert(
-                "ccp".into(),
-                json!({
-                    "idle_length": result.ccp_route.idle_length(),
-                    "cut_length": result.ccp_route.cut_length(),
-                    "pierces": result.ccp_route.pierce_count(),
-                    "time_s": result.ccp_route.time(&machine),
-                    "cost": result.ccp_route.cost(&machine),
-                }),
-            );
-            progress
+            finished.run.stopped
         };
-        Ok((progress, extra))
-    })
-    .map_err(|f| match f {
-        Failure::Error(m) | Failure::Infeasible(m) => m,
-    })?;
-    drop(display);
-    // Stopped in a long step: the latest published state, without the job's own extras.
-    let (progress, extra, stopped) = match outcome {
-        Ok((progress, extra)) => (progress, extra, None),
-        Err(run) => (run.last, serde_json::Map::new(), run.stopped),
-    };
-    let progress = progress.ok_or_else(|| {
-        format!(
-            "--time-limit {time_limit_s}: the {solver_name} solver found no route before it \
-             was stopped ({})",
-            stopped.unwrap_or("")
-        )
-    })?;
-    let solver_route = progress
-        .path_route
-        .as_ref()
-        .ok_or_else(|| format!("the solver found no route ({})", progress.phase))?;
-    // Hard rules: a route whose contour route breaks them is replaced by that route repaired
-    // (standard cutting). Its ub is its own objective; AOE's lb assumed edges cut once.
-    let (repaired, failed) = match thermal.enforce_paths(nest, solver_route, &machine, objective) {
-        Ok(repaired) => (repaired, None),
-        Err(e) => (None, Some(e)),
-    };
-    let route = repaired.as_ref().unwrap_or(solver_route);
-    let (ub, lb, phase) = match &repaired {
-        None => (
-            progress.upper_bound,
-            progress.lower_bound,
-            match failed {
-                Some(e) => format!("{} · rule repair failed ({e}); route kept", progress.phase),
-                None => progress.phase.to_string(),
-            },
-        ),
-        Some(r) => (
-            Some(objective.value(&machine, r.cut_length(), r.idle_length(), r.pierce_count())),
-            progress.lower_bound.filter(|_| solver != SolverKind::Aoe),
+        let time_limit_s = finished.run.time_limit_s;
+        let progress = finished.run.last.ok_or_else(|| {
             format!(
-                "{} · rules enforced on whole contours (standard cutting)",
-                progress.phase
+                "--time-limit {time_limit_s}: the {solver_name} solver found no route before it \
+                 was stopped ({})",
+                stopped.unwrap_or("")
+            )
+        })?;
+        let solver_route = progress
+            .path_route()
+            .ok_or_else(|| format!("the solver found no route ({})", progress.phase))?;
+        // Hard rules: a route whose contour route breaks them is replaced by that route
+        // repaired (standard cutting). Its ub is its own objective; AOE's lb assumed edges cut
+        // once.
+        let (repaired, failed) =
+            match self
+                .thermal
+                .enforce_paths(nest, solver_route, machine, objective)
+            {
+                Ok(repaired) => (repaired, None),
+                Err(e) => (None, Some(e)),
+            };
+        let route = repaired.as_ref().unwrap_or(solver_route);
+        let (ub, lb, phase) = match &repaired {
+            None => (
+                progress.bounds.upper,
+                progress.bounds.lower,
+                match failed {
+                    Some(e) => format!("{} · rule repair failed ({e}); route kept", progress.phase),
+                    None => progress.phase.to_string(),
+                },
             ),
-        ),
-    };
-    // Checked again here, as every route the CLI prints.
-    let tolerance = nest.check_tolerance();
-    let problems = route.problems(nest, tolerance);
-    if let Some(other) = problems
-        .iter()
-        .find(|p| !matches!(p, cutroute_geometry::PathRouteError::Overlap { .. }))
-    {
-        return Err(format!("invalid route: {other}"));
+            Some(r) => (
+                Some(objective.value(machine, r.cut_length(), r.idle_length(), r.pierce_count())),
+                progress.bounds.lower.filter(|_| solver != SolverKind::Aoe),
+                format!(
+                    "{} · rules enforced on whole contours (standard cutting)",
+                    progress.phase
+                ),
+            ),
+        };
+        // Checked again here, as every route the CLI prints.
+        let tolerance = nest.check_tolerance();
+        let problems = route.problems(nest, tolerance);
+        if let Some(other) = problems
+            .iter()
+            .find(|p| !matches!(p, cutroute_geometry::PathRouteError::Overlap { .. }))
+        {
+            return Err(Failure::Message(format!("invalid route: {other}")));
+        }
+        let recut_length = cutroute_segments::recut_length(&problems, tolerance);
+        let (idle_length, cut_length, pierces) = (
+            route.idle_length(),
+            route.cut_length(),
+            route.pierce_count(),
+        );
+        let mut report = json!({
+            "solver": solver_name,
+            "idle_length": idle_length,
+            "cut_length": cut_length,
+            "recut_length": recut_length,
+            "pierces": pierces,
+            "time_s": machine.time(cut_length, idle_length, pierces),
+            "cost": machine.cost(cut_length, idle_length, pierces),
+            "objective": objective.name(),
+            "machine": machine_json(machine),
+            "route": serde_json::to_value(route).map_err(|e| Failure::Message(e.to_string()))?,
+            "ub": ub,
+            "lb": lb,
+            // The idle bound holds for any route that cuts every contour, a repaired one too;
+            // the gap is that of the printed route.
+            "idle_lb": progress.idle_lower_bound,
+            "idle_gap": progress
+                .idle_lower_bound
+                .map(|lb| if idle_length > 0.0 { ((idle_length - lb) / idle_length).max(0.0) } else { 0.0 }),
+            "phase": phase,
+            "elapsed_s": self.started.elapsed().as_secs_f64(),
+            "stopped": stopped,
+        });
+        if let Value::Object(fields) = &mut report {
+            fields.extend(finished.extras);
+        }
+        self.thermal
+            .report_paths(&mut report, nest, route, machine, objective)?;
+        Ok(report)
     }
-    let recut_length = cutroute_segments::recut_length(&problems, tolerance);
-    let (idle_length, cut_length, pierces) = (
-        route.idle_length(),
-        route.cut_length(),
-        route.pierce_count(),
-    );
-    let mut report = json!({
-        "solver": solver_name,
-        "idle_length": idle_length,
-        "cut_length": cut_length,
-        "recut_length": recut_length,
-        "pierces": pierces,
-        "time_s": machine.time(cut_length, idle_length, pierces),
-        "cost": machine.cost(cut_length, idle_length, pierces),
-        "objective": objective.name(),
-        "machine": machine_json(&machine),
-        "route": serde_json::to_value(route).map_err(|e| e.to_string())?,
-        "ub": ub,
-        "lb": lb,
-        // The idle bound holds for any route that cuts every contour, a repaired one too; the
-        // gap is that of the printed route.
-        "idle_lb": progress.idle_lower_bound,
-        "idle_gap": progress
-            .idle_lower_bound
-            .map(|lb| if idle_length > 0.0 { ((idle_length - lb) / idle_length).max(0.0) } else { 0.0 }),
-        "phase": phase,
-        "elapsed_s": started.elapsed().as_secs_f64(),
-        "stopped": stopped,
-    });
-    if let Value::Object(fields) = &mut report {
-        fields.extend(extra);
-    }
-    thermal.report_paths(&mut report, nest, route, &machine, objective)?;
-    Ok(report)
 }
 
 /// A number for JSON: `null` when not finite (an ensemble that gave no route).
@@ -1458,13 +1580,34 @@ mod tests {
     fn run_ending_with(last: Route, earlier: Vec<Route>) -> JobRun {
         JobRun {
             last: Some(Progress {
-                route: Some(last),
+                solution: Some(Solution::Route(last)),
                 ..Progress::default()
             }),
             earlier_routes: earlier,
             stopped: None,
             time_limit_s: 1.0,
         }
+    }
+
+    /// The CLI's words stay those of the engine, and the engine's error stays the source.
+    #[test]
+    fn an_engine_refusal_keeps_its_words_and_its_source() {
+        use cutroute_engine::{EngineError, Refusal};
+        let refusal = || EngineError::SolverRefused {
+            solver: "exact",
+            reason: Refusal::Settings("thermal weight must be finite".into()),
+        };
+        let failure = Failure::Engine {
+            solver: "exact",
+            source: refusal(),
+        };
+        assert_eq!(
+            failure.to_string(),
+            "--solver exact: exact: thermal weight must be finite"
+        );
+        let source = std::error::Error::source(&failure).expect("a source");
+        assert_eq!(source.downcast_ref::<EngineError>(), Some(&refusal()));
+        assert!(std::error::Error::source(source).is_some());
     }
 
     /// Item 13 of issue #15: a final route that fails the checker never hides a valid one.

@@ -106,14 +106,15 @@ impl Drop for ProgressDisplay {
 /// `ub …  lb …  gap …  phase`.
 fn summary(progress: &Progress) -> String {
     let number = |v: Option<f64>| v.map_or_else(|| "—".to_string(), |v| format!("{v:.3}"));
-    let gap = match (progress.upper_bound, progress.lower_bound) {
+    let bounds = &progress.bounds;
+    let gap = match (bounds.upper, bounds.lower) {
         (Some(ub), Some(lb)) if ub > 0.0 => format!("{:.2} %", 100.0 * (ub - lb).max(0.0) / ub),
         _ => "—".into(),
     };
     format!(
         "ub {:>12}  lb {:>12}  gap {:>8}  {}",
-        number(progress.upper_bound),
-        number(progress.lower_bound),
+        number(bounds.upper),
+        number(bounds.lower),
         gap,
         progress.phase
     )
@@ -148,8 +149,7 @@ mod tests {
     #[test]
     fn the_summary_shows_the_gap() {
         let progress = Progress {
-            upper_bound: Some(200.0),
-            lower_bound: Some(150.0),
+            bounds: cutroute_protocol::Bounds::idle_mm(Some(200.0), Some(150.0)),
             phase: cutroute_protocol::Phase::Bound,
             ..Progress::default()
         };

@@ -83,12 +83,12 @@ fn main() {
             KerfSettings::default(),
             false,
         );
-        let ideal_idle = ideal.route.as_ref().map_or(f64::NAN, Route::idle_length);
+        let ideal_idle = ideal.route().map_or(f64::NAN, Route::idle_length);
         let after = ccp(&document.problem, time_limit, settings, true);
         let started = std::time::Instant::now();
         let optimised = ccp(&document.problem, time_limit, settings, false);
         let job_s = started.elapsed().as_secs_f64();
-        let (Some(after_route), Some(optimised_route)) = (&after.route, &optimised.route) else {
+        let (Some(after_route), Some(optimised_route)) = (after.route(), optimised.route()) else {
             let no_room = [&after.phase, &optimised.phase]
                 .iter()
                 .filter_map(|phase| match phase {

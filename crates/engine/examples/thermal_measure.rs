@@ -20,7 +20,10 @@ fn main() {
         let nest = generate_nest(contours, 1);
         let mut job = NearestNeighbourJob::new(1, nest.clone(), Point::new(0.0, 0.0), None)
             .expect("a nest with contours");
-        let route = run_to_end(&mut job, &mut |_| {}).route.expect("a route");
+        let route = run_to_end(&mut job, &mut |_| {})
+            .route()
+            .cloned()
+            .expect("a route");
         let machine = MachineParameters::default();
         let time = |settings: ThermalSettings| {
             let started = Instant::now();

@@ -5,10 +5,10 @@ use cutroute_ccp::{CcpLowerBound, CcpOptions, CcpSolver, DiscreteInstance};
 use cutroute_chains::{ChainOptions, Chained, Chaining};
 use cutroute_geometry::{MachineParameters, Nest, Route};
 use cutroute_pcgtsp::{ExactOptions, ExactSolver, Instance};
-use cutroute_protocol::{CcpStage, JobId, Phase, Progress};
+use cutroute_protocol::{Bounds, CcpStage, CostUnit, JobId, Phase, Progress, Solution};
 use web_time::{Duration, Instant};
 
-use crate::{Job, JobStatus};
+use crate::{Job, JobStatus, Refusal};
 
 /// CCP-Relax on a nest, and beside it (when given) the certified lower bound of the interval
 /// relaxation (`cutroute_ccp::CcpLowerBound`), each slice shared half and half; the bound
@@ -131,15 +131,15 @@ impl Job for CcpJob {
             } else {
                 state.elapsed.as_secs_f64()
             },
-            upper_bound: has_route.then_some(state.best_idle_length),
-            lower_bound: self.bound.as_ref().map(|b| b.lower_bound()),
+            bounds: Bounds::idle_mm(
+                has_route.then_some(state.best_idle_length),
+                self.bound.as_ref().map(|b| b.lower_bound()),
+            ),
             phase: Phase::Ccp(ccp_stage(state.phase)),
-            route: has_route.then_some(state.route),
-            tour: None,
+            solution: has_route.then_some(Solution::Route(state.route)),
             proven_optimal: has_route && self.bound_within(1e-9),
             states: None,
             certified,
-            path_route: None,
             alternatives: Vec::new(),
             ..Progress::default()
         }
@@ -197,8 +197,11 @@ pub struct DiscreteJob {
     bound_running: bool,
     offered_route_cost: f64,
     started: Instant,
-    /// Why the job ended without a search (a solver refused the instance).
+    /// Why the job ended without a search (a solver refused the instance, or the build
+    /// outlasted the limit), in words for the phase.
     failure: Option<String>,
+    /// The error of the solver that refused the instance, for [`DiscreteJob::new`].
+    refusal: Option<Refusal>,
 }
 
 impl DiscreteJob {
@@ -214,13 +217,13 @@ impl DiscreteJob {
         time_limit: Duration,
         started: Instant,
         seed: u64,
-    ) -> Result<Self, String> {
+    ) -> Result<Self, Refusal> {
         let mut job = Self::pending(job_id, mode, time_limit, started, seed);
         job.instance = Some(instance);
         job.discrete = discrete;
         while !job.build(Duration::MAX) {
-            if let Some(failure) = job.failure.take() {
-                return Err(failure);
+            if let Some(refusal) = job.refusal.take() {
+                return Err(refusal);
             }
         }
         Ok(job)
@@ -270,6 +273,7 @@ impl DiscreteJob {
             offered_route_cost: f64::INFINITY,
             started,
             failure: None,
+            refusal: None,
         }
     }
 
@@ -351,7 +355,7 @@ impl DiscreteJob {
             match builder.and_then(|mut b| b.advance(instance, budget).map(|done| (b, done))) {
                 Ok((_, Some(alns))) => self.alns = Some(alns),
                 Ok((builder, None)) => self.alns_builder = Some(builder),
-                Err(e) => self.failure = Some(e.to_string()),
+                Err(e) => self.refuse(e.into()),
             }
             return false;
         }
@@ -367,12 +371,18 @@ impl DiscreteJob {
             let made = Instant::now();
             match ExactSolver::deferred(instance, options) {
                 Ok(exact) => self.exact = Some(exact),
-                Err(e) => self.failure = Some(e.to_string()),
+                Err(e) => self.refuse(e.into()),
             }
             self.exact_piece = made.elapsed();
             return false;
         }
         true
+    }
+
+    /// A solver refused the instance: the job ends, its phase saying why.
+    fn refuse(&mut self, refusal: Refusal) {
+        self.failure = Some(refusal.to_string());
+        self.refusal = Some(refusal);
     }
 
     fn best_tour(&self) -> Option<(Vec<usize>, f64)> {
@@ -539,22 +549,33 @@ impl Job for DiscreteJob {
             .as_ref()
             .map(|p| p.lower_bound)
             .filter(|lb| lb.is_finite());
+        // A discretised nest's tour is reported as its route, in idle mm; an instance's tour
+        // in the instance's weights.
+        let nest = self.discrete.is_some() || self.builder.is_some();
+        let (solution, unit) = match nest {
+            true => (route.map(Solution::Route), CostUnit::IdleMm),
+            false => (
+                best.as_ref().map(|(tour, _)| Solution::Tour(tour.clone())),
+                CostUnit::TourCost,
+            ),
+        };
         Progress {
             job_id: self.job_id,
             elapsed_s: self.started.elapsed().as_secs_f64(),
-            upper_bound: best.as_ref().map(|(_, cost)| *cost),
-            lower_bound: if proven_optimal {
-                best.as_ref().map(|(_, c)| *c)
-            } else {
-                lower_bound
+            bounds: Bounds {
+                upper: best.as_ref().map(|(_, cost)| *cost),
+                lower: if proven_optimal {
+                    best.as_ref().map(|(_, c)| *c)
+                } else {
+                    lower_bound
+                },
+                unit,
             },
             phase,
-            route,
-            tour: best.map(|(tour, _)| tour),
+            solution,
             proven_optimal,
             states: self.exact.as_ref().map(|e| e.states_created()),
             certified: Vec::new(),
-            path_route: None,
             alternatives: Vec::new(),
             ..Progress::default()
         }
@@ -639,7 +660,7 @@ impl Job for ChainJob {
             return JobStatus::Running;
         }
         if self.chaining.is_none() {
-            let Some(route) = self.ccp.progress().route else {
+            let Some(route) = self.ccp.progress().solution.and_then(Solution::into_route) else {
                 self.failure = Some("CCP found no route to chain".into());
                 return JobStatus::Done;
             };
@@ -672,9 +693,9 @@ impl Job for ChainJob {
         if let Some(chained) = &self.chained {
             let r = &chained.report;
             progress.elapsed_s = self.started.elapsed().as_secs_f64();
-            progress.upper_bound = Some(chained.route.idle_length());
-            // Links are tool-on travel: no bound on standard cutting's idle length holds here.
-            progress.lower_bound = None;
+            progress.bounds = Bounds::idle_mm(Some(chained.route.idle_length()), None);
+            // (No lower bound: links are tool-on travel, so no bound on standard cutting's
+            // idle length holds here.)
             progress.phase = Phase::Chained {
                 saved: r.pierces_before - r.pierces_after,
                 pierces: r.pierces_before,
@@ -682,7 +703,7 @@ impl Job for ChainJob {
                 cost_before: r.cost_before,
                 cost_after: r.cost_after,
             };
-            progress.route = Some(chained.route.clone());
+            progress.solution = Some(Solution::Route(chained.route.clone()));
             // CCP's certificates are about its own pierce points, which chaining moved.
             progress.certified = Vec::new();
         } else if let Some(failure) = &self.failure {

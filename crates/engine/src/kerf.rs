@@ -20,10 +20,12 @@
 use cutroute_geometry::{
     ContainmentForest, CutStep, KerfSettings, LeadError, LeadFitter, Nest, Route,
 };
-use cutroute_protocol::{JobRequest, KerfNote, KerfSource, Phase, Problem, Progress, SolverKind};
+use cutroute_protocol::{
+    Bounds, JobRequest, KerfNote, KerfSource, Phase, Problem, Progress, Solution, SolverKind,
+};
 use web_time::{Duration, Instant};
 
-use crate::{EngineError, Job, JobStatus};
+use crate::{EngineError, Job, JobStatus, Refusal};
 
 /// Sweeps of [`LeadFitter::relax`] over a finished route, and the entries it tries round each
 /// equidistant (as the CLI always did).
@@ -223,9 +225,9 @@ impl KerfJob {
     ) -> Result<KerfJob, EngineError> {
         let started = Instant::now();
         let solver = request.solver;
-        let refused = |message: String| EngineError::SolverRefused {
+        let refused = |reason: Refusal| EngineError::SolverRefused {
             solver: solver.name(),
-            message,
+            reason,
         };
         let Problem::Nest { nest, .. } = &request.problem else {
             return Err(EngineError::UnsupportedProblem {
@@ -234,13 +236,10 @@ impl KerfJob {
             });
         };
         if !supports_kerf(solver) {
-            return Err(refused(
-                "does not cut with kerf and leads yet (nearest, ccp, heuristic and chain do)"
-                    .into(),
-            ));
+            return Err(refused(Refusal::NoFullRouteModel));
         }
         let settings = request.params.kerf;
-        validate_kerf(&settings).map_err(refused)?;
+        validate_kerf(&settings).map_err(|message| refused(Refusal::Settings(message)))?;
         let forest = nest.containment_forest();
         // The inner requests are idealised: the kerf is this job's.
         let mut idealised = request.clone();
@@ -317,7 +316,11 @@ impl KerfJob {
             candidate.stage = match stage {
                 Stage::Solving => {
                     let status = candidate.job.step(budget);
-                    let route = candidate.job.progress().route;
+                    let route = candidate
+                        .job
+                        .progress()
+                        .solution
+                        .and_then(Solution::into_route);
                     let fitted_from = candidate.fitted.as_ref().map(|(from, _)| from);
                     let pending_from = candidate.pending.as_ref().map(|a| &a.from);
                     if status == JobStatus::Done {
@@ -500,8 +503,7 @@ impl Job for KerfJob {
                         // The links the solver made that the full route lost to pierces.
                         KerfSource::Chains { .. } => KerfSource::Chains {
                             links_broken: inner[i]
-                                .route
-                                .as_ref()
+                                .route()
                                 .map_or(0, links)
                                 .saturating_sub(links(route)),
                         },
@@ -529,12 +531,10 @@ impl Job for KerfJob {
         let mut progress = inner.swap_remove(index);
         // The inner bounds, certificates and optimality proof are about the idealised (or the
         // curve) nest, not the full route: none of them is reported for it.
-        progress.upper_bound = route.as_ref().map(Route::idle_length);
-        progress.lower_bound = None;
+        progress.bounds = Bounds::idle_mm(route.as_ref().map(Route::idle_length), None);
         progress.proven_optimal = false;
-        progress.tour = None;
         progress.certified = Vec::new();
-        progress.route = route;
+        progress.solution = route.map(Solution::Route);
         if done {
             // The slower candidate's clock is the job's.
             progress.elapsed_s = slowest;

@@ -25,9 +25,9 @@
 //! };
 //! let mut job = start_job(&request).unwrap();
 //! let result = run_to_end(job.as_mut(), &mut |_| {});
-//! let route = result.route.unwrap();
+//! let route = result.route().unwrap();
 //! assert_eq!(route.steps[0].contour.part, 1); // the nearer part is cut first
-//! assert_eq!(result.upper_bound, Some(20.0 + 80.0));
+//! assert_eq!(result.bounds.upper, Some(20.0 + 80.0));
 //! ```
 #![deny(missing_docs)]
 
@@ -96,13 +96,44 @@ pub enum EngineError {
     #[error("the nest has no contours to cut")]
     EmptyNest,
     /// The solver refused the problem (bad instance, no feasible tour, …).
-    #[error("{solver}: {message}")]
+    #[error("{solver}: {reason}")]
     SolverRefused {
         /// The solver's short name.
         solver: &'static str,
-        /// Its reason.
-        message: String,
+        /// Its reason: the solver crate's own error, kept as the source.
+        #[source]
+        reason: Refusal,
     },
+}
+
+/// Why a solver refused a problem: the error of the crate that refused it, or a setting out
+/// of range. The words are the refusing crate's.
+#[derive(Clone, Debug, thiserror::Error, PartialEq)]
+pub enum Refusal {
+    /// CCP-Relax, its lower bound or the discretisation refused the nest.
+    #[error("{0}")]
+    Ccp(#[from] cutroute_ccp::CcpError),
+    /// The PCGTSP instance does not parse.
+    #[error("{0}")]
+    Instance(#[from] cutroute_pcgtsp::ParseError),
+    /// The exact solver refused the instance.
+    #[error("{0}")]
+    Exact(#[from] cutroute_pcgtsp::SolverError),
+    /// The ALNS heuristic refused the instance.
+    #[error("{0}")]
+    Alns(#[from] cutroute_alns::AlnsError),
+    /// Segment cutting refused the nest.
+    #[error("{0}")]
+    Segments(#[from] cutroute_segments::SegmentError),
+    /// The heat model's σ or τ is out of range.
+    #[error("{0}")]
+    Thermal(#[from] cutroute_thermal::ThermalError),
+    /// The solver has no model of the full cutting route (kerf, leads).
+    #[error("does not cut with kerf and leads yet (nearest, ccp, heuristic and chain do)")]
+    NoFullRouteModel,
+    /// A setting the solver cannot run with, in words (thermal weight, kerf lengths).
+    #[error("{0}")]
+    Settings(String),
 }
 
 /// Most kept (innermost) contours for which the discrete exact job bounds at the
@@ -151,7 +182,7 @@ pub fn start_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
         .validate()
         .map_err(|message| EngineError::SolverRefused {
             solver: request.solver.name(),
-            message,
+            reason: Refusal::Settings(message),
         })?;
     let inner = match heated_job(request)? {
         Some(job) => job,
@@ -190,11 +221,11 @@ fn heated_job(request: &JobRequest) -> Result<Option<Box<dyn Job>>, EngineError>
     {
         return Ok(None);
     }
-    let refused = |message: String| EngineError::SolverRefused {
+    let refused = |reason: Refusal| EngineError::SolverRefused {
         solver: solver.name(),
-        message,
+        reason,
     };
-    let model = params.thermal.model().map_err(|e| refused(e.to_string()))?;
+    let model = params.thermal.model().map_err(|e| refused(e.into()))?;
     let penalty = thermal::heat_penalty(&params.thermal, params.objective);
     if solver == SolverKind::NearestNeighbour {
         let job = NearestNeighbourJob::new(request.job_id, nest.clone(), *start, *finish)?
@@ -209,7 +240,7 @@ fn heated_job(request: &JobRequest) -> Result<Option<Box<dyn Job>>, EngineError>
     };
     let mut options = jobs::ccp_options(*start, *finish, ccp_limit, params.seed, params.machine);
     options.heat = Some(penalty);
-    let ccp = cutroute_ccp::CcpSolver::new(nest, options).map_err(|e| refused(e.to_string()))?;
+    let ccp = cutroute_ccp::CcpSolver::new(nest, options).map_err(|e| refused(e.into()))?;
     Ok(Some(if solver == SolverKind::Chain {
         Box::new(ChainJob::new(
             request.job_id,
@@ -229,9 +260,9 @@ fn start_solver_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
     // Building the problem (a discretisation's dense matrix) counts against the limit.
     let started = web_time::Instant::now();
     let solver = request.solver;
-    let refused = |message: String| EngineError::SolverRefused {
+    let refused = |reason: Refusal| EngineError::SolverRefused {
         solver: solver.name(),
-        message,
+        reason,
     };
     let discrete_mode = match solver {
         SolverKind::Heuristic => Some(DiscreteMode::Heuristic),
@@ -281,8 +312,7 @@ fn start_solver_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
             };
             let options =
                 jobs::ccp_options(*start, *finish, ccp_limit, params.seed, params.machine);
-            let ccp =
-                cutroute_ccp::CcpSolver::new(nest, options).map_err(|e| refused(e.to_string()))?;
+            let ccp = cutroute_ccp::CcpSolver::new(nest, options).map_err(|e| refused(e.into()))?;
             if solver == SolverKind::Chain {
                 return Ok(Box::new(
                     ChainJob::new(request.job_id, ccp, nest.clone(), params.machine)
@@ -302,7 +332,7 @@ fn start_solver_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
                     ..Default::default()
                 },
             )
-            .map_err(|e| refused(e.to_string()))?;
+            .map_err(|e| refused(e.into()))?;
             Ok(Box::new(
                 CcpJob::new(request.job_id, ccp).with_lower_bound(bound, time_limit),
             ))
@@ -330,9 +360,9 @@ fn start_solver_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
             // one piece. Otherwise the matrix is filled in the job's first steps (seconds on
             // big nests), so no step runs long.
             let (job, candidates) = if params.thermal.penalised() {
-                let mut discrete = cutroute_ccp::build_pcgtsp(nest, &options)
-                    .map_err(|e| refused(e.to_string()))?;
-                let model = params.thermal.model().map_err(|e| refused(e.to_string()))?;
+                let mut discrete =
+                    cutroute_ccp::build_pcgtsp(nest, &options).map_err(|e| refused(e.into()))?;
+                let model = params.thermal.model().map_err(|e| refused(e.into()))?;
                 let weight_mm = thermal::heat_penalty(&params.thermal, params.objective)
                     .weight_mm(&params.machine);
                 thermal::price_consecutive_heat(
@@ -357,7 +387,7 @@ fn start_solver_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
                 (job, candidates)
             } else {
                 let builder = cutroute_ccp::PcgtspBuilder::new(nest, &options)
-                    .map_err(|e| refused(e.to_string()))?;
+                    .map_err(|e| refused(e.into()))?;
                 let candidates = pierce_candidates(builder.nodes());
                 let job = DiscreteJob::building(
                     request.job_id,
@@ -391,7 +421,7 @@ fn start_solver_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
                 ..Default::default()
             };
             let bound = cutroute_ccp::CcpLowerBound::new(nest, bound_options.clone())
-                .map_err(|e| refused(e.to_string()))?;
+                .map_err(|e| refused(e.into()))?;
             // Where the relaxed instance is solved exactly (the lattice of its ideals, 2^kept
             // without precedence, is built up to a few million), the bound at the
             // discretisation's own candidates is tighter than the continuous one and needs no
@@ -405,7 +435,7 @@ fn start_solver_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
                     },
                     &candidates,
                 )
-                .map_err(|e| refused(e.to_string()))?
+                .map_err(|e| refused(e.into()))?
                 .unwrap_or(bound)
             } else {
                 bound
@@ -419,8 +449,7 @@ fn start_solver_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
                     problem: "a PCGTSP instance",
                 });
             };
-            let instance =
-                cutroute_pcgtsp::Instance::parse(text).map_err(|e| refused(e.to_string()))?;
+            let instance = cutroute_pcgtsp::Instance::parse(text).map_err(|e| refused(e.into()))?;
             discrete_job(instance, mode)
         }
     }

@@ -4,7 +4,7 @@ use cutroute_geometry::float::Libm;
 use std::collections::HashMap;
 
 use cutroute_geometry::{ContourRef, CutStep, MachineParameters, Nest, Point, Route};
-use cutroute_protocol::{JobId, Phase, Progress};
+use cutroute_protocol::{Bounds, JobId, Phase, Progress, Solution};
 use cutroute_thermal::{HeatModel, Pierce};
 use rstar::primitives::GeomWithData;
 use rstar::RTree;
@@ -262,19 +262,16 @@ impl Job for NearestNeighbourJob {
         Progress {
             job_id: self.job_id,
             elapsed_s: self.started.elapsed().as_secs_f64(),
-            upper_bound: self.route.as_ref().map(|_| self.idle_length),
-            lower_bound: None,
+            bounds: Bounds::idle_mm(self.route.as_ref().map(|_| self.idle_length), None),
             phase: if self.route.is_some() {
                 Phase::Done
             } else {
                 Phase::Starting
             },
-            route: self.route.clone(),
-            tour: None,
+            solution: self.route.clone().map(Solution::Route),
             proven_optimal: false,
             states: None,
             certified: Vec::new(),
-            path_route: None,
             alternatives: Vec::new(),
             ..Progress::default()
         }

@@ -874,7 +874,10 @@ mod tests {
             params: Default::default(),
         };
         let mut job = crate::start_job(&request).unwrap();
-        let route = crate::run_to_end(job.as_mut(), &mut |_| {}).route.unwrap();
+        let route = crate::run_to_end(job.as_mut(), &mut |_| {})
+            .route()
+            .cloned()
+            .unwrap();
         let program =
             cutroute_gcode::route_gcode(&nest, &route, &cutroute_gcode::GcodeOptions::default())
                 .unwrap();

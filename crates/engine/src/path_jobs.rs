@@ -8,7 +8,8 @@ use cutroute_aoe::{AoeHeat, AoeSolution, AoeSolveOptions, AoeSolving, PlanGraph,
 use cutroute_geometry::float::Libm;
 use cutroute_geometry::{BoundingBox, MachineParameters, Nest, Objective, PathRoute, Point, Span};
 use cutroute_protocol::{
-    Ensemble, JobId, JobRequest, Phase, Problem, Progress, RouteSummary, SolverKind,
+    Bounds, CostUnit, Ensemble, JobId, JobRequest, Phase, Problem, Progress, RouteSummary,
+    Solution, SolverKind,
 };
 use cutroute_segments::{
     Candidate, EnsembleKind, EnsembleReport, GsccpOptions, GsccpSearch, GsccpStage, PathHeat,
@@ -354,7 +355,7 @@ impl SegmentJob {
         };
         let search = GsccpSearch::new(nest, &options).map_err(|e| EngineError::SolverRefused {
             solver: request.solver.name(),
-            message: e.to_string(),
+            reason: e.into(),
         })?;
         Ok(SegmentJob {
             job_id: request.job_id,
@@ -437,22 +438,23 @@ impl Job for SegmentJob {
             elapsed_s: self.started.elapsed().as_secs_f64(),
             // The route's own objective value (a candidate's value adds W·H with a heat
             // weight, which the plan bound does not bound).
-            upper_bound: best.map(|c| {
-                self.objective.value(
-                    &self.machine,
-                    c.route.cut_length(),
-                    c.route.idle_length(),
-                    c.route.pierce_count(),
-                )
-            }),
-            lower_bound,
+            bounds: Bounds {
+                upper: best.map(|c| {
+                    self.objective.value(
+                        &self.machine,
+                        c.route.cut_length(),
+                        c.route.idle_length(),
+                        c.route.pierce_count(),
+                    )
+                }),
+                lower: lower_bound,
+                unit: CostUnit::of_objective(self.objective),
+            },
             phase: segments_phase(&self.search),
-            route: None,
-            tour: None,
+            solution: best.map(|c| Solution::PathRoute(c.route.clone())),
             proven_optimal: false,
             states: None,
             certified: Vec::new(),
-            path_route: best.map(|c| c.route.clone()),
             alternatives,
             idle_lower_bound,
             ..Progress::default()
@@ -597,24 +599,25 @@ impl Job for AoeJob {
         Progress {
             job_id: self.job_id,
             elapsed_s: self.started.elapsed().as_secs_f64(),
-            upper_bound: route.map(|r| {
-                self.objective.value(
-                    &self.machine,
-                    r.cut_length(),
-                    r.idle_length(),
-                    r.pierce_count(),
-                )
-            }),
-            lower_bound: solved
-                .and_then(|(_, b)| b.as_ref())
-                .map(|b| b.trail_route(self.objective, &self.machine)),
+            bounds: Bounds {
+                upper: route.map(|r| {
+                    self.objective.value(
+                        &self.machine,
+                        r.cut_length(),
+                        r.idle_length(),
+                        r.pierce_count(),
+                    )
+                }),
+                lower: solved
+                    .and_then(|(_, b)| b.as_ref())
+                    .map(|b| b.trail_route(self.objective, &self.machine)),
+                unit: CostUnit::of_objective(self.objective),
+            },
             phase,
-            route: None,
-            tour: None,
+            solution: route.cloned().map(Solution::PathRoute),
             proven_optimal: false,
             states: None,
             certified: Vec::new(),
-            path_route: route.cloned(),
             alternatives: route
                 .map(|r| {
                     let mut s = summary("aoe", r, &self.machine);

@@ -26,7 +26,7 @@ use std::cell::RefCell;
 
 use cutroute_ccp::HeatPenalty;
 use cutroute_geometry::{MachineParameters, Nest, Objective, PathRoute, Route};
-use cutroute_protocol::{Phase, Progress, SolverKind, ThermalNote, ThermalSettings};
+use cutroute_protocol::{Phase, Progress, Solution, SolverKind, ThermalNote, ThermalSettings};
 use cutroute_thermal::{
     admissible_pierce_points, check_rules, contour_route_of_paths, enforce_rules,
     path_route_pierces, relax_pierce_points, route_pierces, HeatModel, RuleCheck, RuleCounts,
@@ -377,8 +377,8 @@ impl ThermalJob {
             return;
         }
         let progress = self.inner.progress();
-        if let (true, Some(path_route)) = (hard, progress.path_route) {
-            let contours = path_contour_route(&self.nest, &path_route);
+        if let (true, Some(path_route)) = (hard, progress.path_route()) {
+            let contours = path_contour_route(&self.nest, path_route);
             self.repair_work = Some(
                 match RuleCheck::new(self.settings.rules, RuleParams::default()) {
                     Ok(check) => RepairWork::PathCheck { contours, check },
@@ -387,7 +387,7 @@ impl ThermalJob {
             );
             return;
         }
-        let Some(route) = progress.route else {
+        let Some(route) = progress.solution.and_then(Solution::into_route) else {
             return;
         };
         if hard {
@@ -482,7 +482,7 @@ impl ThermalJob {
 
     /// Whether the inner job's result is a route of tool-on paths.
     fn base_is_path(&self) -> bool {
-        self.inner.progress().path_route.is_some()
+        self.inner.progress().path_route().is_some()
     }
 
     /// Whether a report checks the rules of a route that is not the final one (the final one
@@ -498,7 +498,7 @@ impl ThermalJob {
     /// Fills `progress`'s thermal fields from its route, measuring only what changed.
     fn measure(&self, progress: &mut Progress) {
         let mut measured = self.measured.borrow_mut();
-        if let Some(route) = &progress.route {
+        if let Some(route) = progress.route() {
             if measured.route.as_ref() != Some(route) {
                 *measured = Measured {
                     route: Some(route.clone()),
@@ -529,7 +529,7 @@ impl ThermalJob {
                 progress.rule_counts = *counts;
                 progress.violations = violations.clone();
             }
-        } else if let Some(path_route) = &progress.path_route {
+        } else if let Some(path_route) = progress.path_route() {
             if measured.path_route.as_ref() != Some(path_route) {
                 *measured = Measured {
                     heat: measure_path_route(path_route, &self.settings, &self.machine).ok(),
@@ -619,17 +619,20 @@ impl Job for ThermalJob {
         // The final route's rule check, in slices from the next step on (on 30,000 contours
         // it takes about a second).
         let progress = self.base_progress();
-        let checked = match (&progress.route, &progress.path_route) {
-            (Some(route), _) => Some(route.clone()),
-            (None, Some(path_route)) => Some(path_contour_route(&self.nest, path_route)),
-            (None, None) => None,
+        let checked = match &progress.solution {
+            Some(Solution::Route(route)) => Some(route.clone()),
+            Some(Solution::PathRoute(path_route)) => {
+                Some(path_contour_route(&self.nest, path_route))
+            }
+            Some(Solution::Tour(_)) | None => None,
         };
         match (
             checked,
             RuleCheck::new(self.settings.rules, RuleParams::default()),
         ) {
             (Some(route), Ok(check)) => {
-                self.final_check = Some((check, route, (progress.route, progress.path_route)));
+                let key = (progress.route().cloned(), progress.path_route().cloned());
+                self.final_check = Some((check, route, key));
                 JobStatus::Running
             }
             _ => {
@@ -659,7 +662,7 @@ impl ThermalJob {
         if let Some(repaired) = &self.repaired_path {
             match repaired {
                 Ok(route) => {
-                    progress.upper_bound = Some(self.objective.value(
+                    progress.bounds.upper = Some(self.objective.value(
                         &self.machine,
                         route.cut_length(),
                         route.idle_length(),
@@ -668,13 +671,13 @@ impl ThermalJob {
                     // SCCP's and GSCCP's plan bound holds for any route; AOE's assumes
                     // every edge cut once, which standard cutting does not.
                     if self.solver == SolverKind::Aoe {
-                        progress.lower_bound = None;
+                        progress.bounds.lower = None;
                     }
                     progress.phase = thermal_phase(
                         std::mem::take(&mut progress.phase),
                         ThermalNote::RulesEnforcedOnWholeContours,
                     );
-                    progress.path_route = Some(route.clone());
+                    progress.solution = Some(Solution::PathRoute(route.clone()));
                 }
                 Err(e) => {
                     progress.phase = thermal_phase(
@@ -685,17 +688,16 @@ impl ThermalJob {
             }
         }
         match &self.repaired {
-            Some(Ok(route)) if progress.route.as_ref() != Some(route) => {
+            Some(Ok(route)) if progress.route() != Some(route) => {
                 // The solver's bounds are those of the problem without rules: a lower bound on
                 // every route stays sound (the rules only remove routes); the discrete one is
                 // about routes through its candidate points, which the changed route leaves.
                 // The optimality proof and the tour do not describe the changed route.
-                progress.upper_bound = Some(route.idle_length());
+                progress.bounds.upper = Some(route.idle_length());
                 if self.discrete() {
-                    progress.lower_bound = None;
+                    progress.bounds.lower = None;
                 }
                 progress.proven_optimal = false;
-                progress.tour = None;
                 if !progress.certified.is_empty() {
                     progress.certified = cutroute_ccp::route_certificates(&self.nest, route)
                         .map(|c| c.iter().map(|c| c.condition1).collect())
@@ -709,15 +711,15 @@ impl ThermalJob {
                         ThermalNote::Relaxed
                     },
                 };
-                progress.route = Some(route.clone());
+                progress.solution = Some(Solution::Route(route.clone()));
             }
             _ if self.discrete() && self.settings.penalised() => {
                 // The tour's cost includes the arcs' heat terms: report the route's idle
                 // length, and no discrete bound (it bounds the penalised arcs).
-                if let Some(route) = &progress.route {
-                    progress.upper_bound = Some(route.idle_length());
+                if let Some(route) = progress.route() {
+                    progress.bounds.upper = Some(route.idle_length());
                 }
-                progress.lower_bound = None;
+                progress.bounds.lower = None;
                 progress.proven_optimal = false;
             }
             Some(Err(e)) => {

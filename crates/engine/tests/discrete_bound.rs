@@ -92,12 +92,12 @@ fn discrete_exact_job_bound_never_exceeds_the_discrete_optimum() {
             .unwrap()
             .with_lower_bound(bound);
             let result = run_to_end(&mut job, &mut |_| {});
-            let lb = result.lower_bound.expect("a lower bound");
+            let lb = result.bounds.lower.expect("a lower bound");
             assert!(
                 lb <= optimum * (1.0 + 1e-9) + 1e-9,
                 "seed {seed} ({at_candidates}, groups of {group_size}, ng {ng}): job bound {lb} above the discrete optimum {optimum}"
             );
-            let ub = result.upper_bound.expect("a tour");
+            let ub = result.bounds.upper.expect("a tour");
             assert!(ub >= optimum - 1e-6 * optimum.max(1.0), "seed {seed}");
             // A bound offered above the optimum would end the search with a worse tour "proven".
             if result.proven_optimal {
@@ -128,7 +128,7 @@ fn discrete_exact_job_on_seven_reports_a_bound_below_its_route() {
     let mut job = start_job(&request).expect("starts");
     let result = run_to_end(job.as_mut(), &mut |_| {});
     let idle = check_route(&document.problem, &result);
-    let lb = result.lower_bound.expect("a lower bound");
+    let lb = result.bounds.lower.expect("a lower bound");
     assert!(lb > 0.0 && lb <= idle, "bound {lb} vs route {idle}");
 }
 
@@ -151,6 +151,6 @@ fn discrete_exact_job_on_nested_reports_a_bound_below_its_route() {
     let mut job = start_job(&request).expect("starts");
     let result = run_to_end(job.as_mut(), &mut |_| {});
     let idle = check_route(&document.problem, &result);
-    let lb = result.lower_bound.expect("a lower bound");
+    let lb = result.bounds.lower.expect("a lower bound");
     assert!(lb > 0.0 && lb <= idle, "bound {lb} vs route {idle}");
 }

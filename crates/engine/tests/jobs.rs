@@ -4,7 +4,9 @@ mod common;
 
 use common::{check_route, data};
 use cutroute_engine::{open_document, run_to_end, start_job, EngineError, Job, JobStatus};
-use cutroute_protocol::{JobRequest, Problem, Progress, SolverKind, SolverParams};
+use cutroute_protocol::{
+    CostUnit, JobRequest, Problem, Progress, Solution, SolverKind, SolverParams,
+};
 use web_time::Duration;
 
 fn run(relative: &str, solver: SolverKind, time_limit_s: f64) -> (Problem, Progress) {
@@ -44,9 +46,10 @@ fn every_nest_solver_returns_a_valid_route() {
             ccp_idle < nearest_idle,
             "{file}: CCP {ccp_idle} should beat nearest neighbour {nearest_idle}"
         );
-        assert_eq!(ccp.certified.len(), ccp.route.as_ref().unwrap().steps.len());
+        assert_eq!(ccp.certified.len(), ccp.route().unwrap().steps.len());
         // The interval relaxation's bound on the same objective (idle mm), below the route.
-        let lb = ccp.lower_bound.expect("CCP reports a lower bound");
+        let lb = ccp.bounds.lower.expect("CCP reports a lower bound");
+        assert_eq!(ccp.bounds.unit, CostUnit::IdleMm, "{file}");
         assert!(
             lb > 0.0 && lb <= ccp_idle,
             "{file}: bound {lb} vs route {ccp_idle}"
@@ -64,7 +67,7 @@ fn the_chain_solver_saves_pierces_and_cost_over_its_ccp_route() {
         let Problem::Nest { nest, .. } = &problem else {
             panic!("a nest")
         };
-        let route = chained.route.as_ref().unwrap();
+        let route = chained.route().unwrap();
         assert!(
             route.pierce_count() < nest.contour_count(),
             "{file}: no pierce saved"
@@ -77,7 +80,7 @@ fn the_chain_solver_saves_pierces_and_cost_over_its_ccp_route() {
         );
         let machine = SolverParams::default().machine;
         let (_, ccp) = run(file, SolverKind::Ccp, 1.0);
-        let ccp_cost = ccp.route.as_ref().unwrap().cost(nest, &machine);
+        let ccp_cost = ccp.route().unwrap().cost(nest, &machine);
         // The CCP phases of the two runs may differ (timed), but chaining saves far more.
         assert!(
             route.cost(nest, &machine) < ccp_cost,
@@ -102,11 +105,12 @@ fn exact_job_proves_an_industrial_optimum_and_the_tour_checks() {
         panic!("an instance")
     };
     let instance = cutroute_pcgtsp::Instance::parse(&text).unwrap();
-    let tour = result.tour.clone().expect("a tour");
+    let tour = result.tour().map(<[usize]>::to_vec).expect("a tour");
     let cost = cutroute_pcgtsp::check_tour(&instance, &tour).expect("feasible tour");
     assert_eq!(cost, 1513.0, "reference.csv: known optimum of e1x_6");
     assert!(result.proven_optimal);
-    assert_eq!(result.lower_bound, Some(1513.0));
+    assert_eq!(result.bounds.lower, Some(1513.0));
+    assert_eq!(result.bounds.unit, CostUnit::TourCost);
     assert_eq!(result.gap(), Some(0.0));
 }
 
@@ -117,9 +121,9 @@ fn heuristic_job_tours_are_feasible() {
         panic!("an instance")
     };
     let instance = cutroute_pcgtsp::Instance::parse(&text).unwrap();
-    let cost = cutroute_pcgtsp::check_tour(&instance, result.tour.as_ref().unwrap()).unwrap();
-    assert_eq!(Some(cost), result.upper_bound);
-    assert_eq!(result.lower_bound, None);
+    let cost = cutroute_pcgtsp::check_tour(&instance, result.tour().unwrap()).unwrap();
+    assert_eq!(Some(cost), result.bounds.upper);
+    assert_eq!(result.bounds.lower, None);
 }
 
 #[test]
@@ -251,10 +255,44 @@ fn the_chain_job_gives_the_same_route_whatever_the_slice_size() {
             result.phase
         );
         check_route(&document.problem, &result);
-        result.route.expect("a route")
+        result
+            .solution
+            .and_then(Solution::into_route)
+            .expect("a route")
     })
     .collect();
     assert!(routes[0].link_length() > 0.0, "nothing chained");
     assert_eq!(routes[0], routes[1], "1 ms and 40 ms slices");
     assert_eq!(routes[0], routes[2], "1 ms slices and one step");
+}
+
+#[test]
+fn a_refused_instance_keeps_the_parsers_error_as_its_source() {
+    let request = JobRequest {
+        job_id: 1,
+        problem: Problem::PcgtspText {
+            text: "NAME: broken\nTYPE: PCGTSP\nDIMENSION: x\n".into(),
+        },
+        solver: SolverKind::Exact,
+        params: SolverParams::default(),
+    };
+    let Err(error) = start_job(&request) else {
+        panic!("a broken instance starts no job");
+    };
+    let EngineError::SolverRefused {
+        solver,
+        reason: cutroute_engine::Refusal::Instance(parse),
+    } = &error
+    else {
+        panic!("{error:?}");
+    };
+    assert_eq!(*solver, "exact");
+    // The words are the parser's, and its error is reachable as the source.
+    assert_eq!(error.to_string(), format!("exact: {parse}"));
+    let source = std::error::Error::source(&error).expect("a source");
+    let inner = std::error::Error::source(source).expect("the parser's error");
+    assert_eq!(
+        inner.downcast_ref::<cutroute_pcgtsp::ParseError>(),
+        Some(parse)
+    );
 }

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use cutroute_engine::{open_document, run_to_end, start_job, EngineError};
 use cutroute_geometry::{KerfSettings, LeadShape, LeadSpec, Nest, Route, TabSpec};
 use cutroute_protocol::{
-    JobRequest, KerfNote, KerfSource, Phase, Problem, Progress, SolverKind, SolverParams,
+    JobRequest, KerfNote, KerfSource, Phase, Problem, Progress, Solution, SolverKind, SolverParams,
 };
 
 fn nest_problem(relative: &str) -> Problem {
@@ -56,10 +56,10 @@ fn request(problem: &Problem, solver: SolverKind, kerf: KerfSettings, after: boo
 fn run(request: &JobRequest) -> Progress {
     let mut job = start_job(request).expect("starts");
     run_to_end(job.as_mut(), &mut |p| {
-        if let Some(route) = &p.route {
+        if let Some(route) = p.route() {
             assert_leads_everywhere(route);
-            assert_eq!(p.upper_bound, Some(route.idle_length()));
-            assert!(p.lower_bound.is_none());
+            assert_eq!(p.bounds.upper, Some(route.idle_length()));
+            assert!(p.bounds.lower.is_none());
         }
         assert!(matches!(p.phase, Phase::Kerf { .. }), "{:?}", p.phase);
     })
@@ -75,7 +75,7 @@ fn assert_leads_everywhere(route: &Route) {
 
 fn checked(problem: &Problem, progress: &Progress) -> Route {
     let nest = nest_of(problem);
-    let route = progress.route.clone().expect("a route");
+    let route = progress.route().cloned().expect("a route");
     let problems = route.problems(nest, &nest.containment_forest(), 1e-6);
     assert!(problems.is_empty(), "{:?}", problems.first());
     assert_leads_everywhere(&route);
@@ -145,7 +145,7 @@ fn a_contour_without_room_is_named_not_dropped() {
         plasma(),
         false,
     ));
-    assert!(progress.route.is_none());
+    assert!(progress.route().is_none());
     let Phase::Kerf {
         note: KerfNote::NoRoom { contours, errors },
         ..
@@ -219,6 +219,9 @@ fn idealised_settings_leave_the_job_as_it_was() {
     let mut job = start_job(&plain).expect("starts");
     let progress = run_to_end(job.as_mut(), &mut |_| {});
     assert!(!matches!(progress.phase, Phase::Kerf { .. }));
-    let route = progress.route.expect("a route");
+    let route = progress
+        .solution
+        .and_then(Solution::into_route)
+        .expect("a route");
     assert!(route.steps.iter().all(|s| s.leads.is_none()));
 }

@@ -14,7 +14,9 @@ use cutroute_geometry::{
     Contour, MachineParameters, Nest, Objective, Part, PathRoute, PathRouteError, Point, Span,
     SplitMix64,
 };
-use cutroute_protocol::{JobRequest, Problem, Progress, SolverKind, SolverParams};
+use cutroute_protocol::{
+    CostUnit, JobRequest, Problem, Progress, Solution, SolverKind, SolverParams,
+};
 use web_time::{Duration, Instant};
 
 const NEST01: &str = "nests/tflex/Nest01.tfnesting";
@@ -79,8 +81,8 @@ fn check_progress(
     progress: &Progress,
 ) -> PathRoute {
     let (nest, start, finish) = nest_of(problem);
-    assert!(progress.route.is_none(), "{what}: a path route only");
-    let route = progress.path_route.clone().expect("a path route");
+    assert!(progress.route().is_none(), "{what}: a path route only");
+    let route = progress.path_route().cloned().expect("a path route");
     assert_eq!((route.start, route.finish), (start, finish), "{what}");
     let chosen: Vec<_> = progress.alternatives.iter().filter(|a| a.chosen).collect();
     assert_eq!(chosen.len(), 1, "{what}: {:?}", progress.alternatives);
@@ -98,13 +100,18 @@ fn check_progress(
     );
     let machine = &params.machine;
     let expected = value(params.objective, machine, &route);
-    let ub = progress.upper_bound.expect("an upper bound");
+    let ub = progress.bounds.upper.expect("an upper bound");
     assert!(
         (ub - expected).abs() <= 1e-9 * expected,
         "{what}: {ub} vs {expected}"
     );
-    let lb = progress.lower_bound.expect("a lower bound");
+    let lb = progress.bounds.lower.expect("a lower bound");
     assert!(lb > 0.0 && lb <= ub, "{what}: lb {lb} ub {ub}");
+    assert_eq!(
+        progress.bounds.unit,
+        CostUnit::of_objective(params.objective),
+        "{what}: the bounds are in the objective's unit"
+    );
     // The idle bound (mm) holds for the route, and the chosen candidate carries it.
     let idle_lb = progress.idle_lower_bound.expect("an idle lower bound");
     assert!(
@@ -141,7 +148,7 @@ fn every_path_solver_returns_a_checked_route_with_its_numbers() {
                 let mut reports = 0;
                 let result = run_to_end(job.as_mut(), &mut |p| {
                     reports += 1;
-                    if p.path_route.is_some() {
+                    if p.path_route().is_some() {
                         check_progress(&what, &problem, &params, p);
                     }
                 });
@@ -197,7 +204,7 @@ fn common_edges_are_cut_once_on_nest01() {
         let params = params(1.0, Objective::Time);
         let mut job = start_job(&request(&problem, solver, params)).unwrap();
         let result = run_to_end(job.as_mut(), &mut |_| {});
-        let route = result.path_route.unwrap();
+        let route = result.solution.and_then(Solution::into_path_route).unwrap();
         let spans: Vec<&Span> = route.paths.iter().flat_map(|p| &p.spans).collect();
         for (i, &m) in common.iter().enumerate() {
             let cuts = spans.iter().filter(|s| s.distance_to(m) <= near).count();
@@ -235,7 +242,7 @@ fn the_aoe_lower_bound_is_the_known_optimum_of_cut_and_pierces_on_grids() {
             assert_eq!(route.pierce_count(), pierces.max(1));
             assert!((route.cut_length() - cut).abs() < 1e-6);
             let known = objective.value(&machine, cut, 20.0, pierces.max(1));
-            let lb = result.lower_bound.unwrap();
+            let lb = result.bounds.lower.unwrap();
             // Equal but for the slack the bound leaves for the plan's merging tolerance (four
             // tolerances, here 10⁻⁶ of the grid's width plus height, per plan edge).
             assert!(
@@ -263,7 +270,7 @@ fn cancel_mid_run_keeps_the_best_route_so_far() {
         loop {
             assert_eq!(job.step(Duration::from_millis(40)), JobStatus::Running);
             let progress = job.progress();
-            if progress.phase.to_string().contains("CCP") && progress.path_route.is_some() {
+            if progress.phase.to_string().contains("CCP") && progress.path_route().is_some() {
                 // The best so far while CCP-Relax runs is its own route, checked.
                 check_progress("during ccp", &problem, &params, &progress);
                 during_ccp = true;
@@ -317,7 +324,7 @@ fn stepped_runs_equal_one_shot_runs() {
             let one_shot =
                 cutroute_segments::solve_gsccp(nest, &options, &AtomicBool::new(false)).unwrap();
             assert_eq!(
-                stepped.path_route.as_ref(),
+                stepped.path_route(),
                 Some(&one_shot.route),
                 "{file} {solver:?}"
             );
@@ -339,7 +346,7 @@ fn stepped_runs_equal_one_shot_runs() {
         };
         let one_shot = cutroute_aoe::solve_nest(nest, &options).unwrap();
         assert_eq!(
-            job.progress().path_route,
+            job.progress().solution.and_then(Solution::into_path_route),
             Some(one_shot.route),
             "{file} aoe"
         );
@@ -358,7 +365,7 @@ fn runs_in_one_millisecond_slices_stay_valid() {
                 steps += 1;
                 if steps % 97 == 0 {
                     let p = job.progress();
-                    if p.path_route.is_some() {
+                    if p.path_route().is_some() {
                         check_progress("1 ms", &problem, &params, &p);
                     }
                 }
@@ -398,7 +405,7 @@ fn bounds_meet_at_the_known_optimum_of_one_rectangle() {
             let result = run_to_end(job.as_mut(), &mut |_| {});
             check_progress("rectangle", &problem, &params, &result);
             let optimum = objective.value(&machine, 160.0, 7.0, 1);
-            let (lb, ub) = (result.lower_bound.unwrap(), result.upper_bound.unwrap());
+            let (lb, ub) = (result.bounds.lower.unwrap(), result.bounds.upper.unwrap());
             assert!((ub - optimum).abs() <= 1e-9 * optimum, "{solver:?}: {ub}");
             // Equal but for the slack the bound leaves for the plan's merging tolerance.
             assert!(

@@ -11,7 +11,7 @@ use cutroute_engine::{
 };
 use cutroute_geometry::{MachineParameters, Nest, Objective, PathRoute, PathRouteError};
 use cutroute_protocol::{
-    JobRequest, Problem, Progress, RuleSet, SolverKind, SolverParams, ThermalSettings,
+    JobRequest, Problem, Progress, RuleSet, Solution, SolverKind, SolverParams, ThermalSettings,
 };
 use cutroute_thermal::route_pierces;
 
@@ -48,7 +48,7 @@ fn nest_of(problem: &Problem) -> &Nest {
 /// H straight from its definition, every pair, no cut-off.
 fn heat_by_definition(problem: &Problem, progress: &Progress, settings: &ThermalSettings) -> f64 {
     let nest = nest_of(problem);
-    let route = progress.route.as_ref().expect("a route");
+    let route = progress.route().expect("a route");
     let pierces = route_pierces(route, nest, &MachineParameters::default()).unwrap();
     let mut h = 0.0;
     for (i, a) in pierces.iter().enumerate() {
@@ -85,7 +85,7 @@ fn hard_rules_leave_no_violation_on_every_contour_route_solver() {
         assert_eq!(counts.total(), plain.violations.len(), "{solver:?}");
 
         let result = solve(&problem, solver, hard);
-        let route = result.route.as_ref().expect("a route");
+        let route = result.route().expect("a route");
         route
             .validate(nest_of(&problem), 1e-3)
             .unwrap_or_else(|e| panic!("{solver:?}: the repaired route fails the checker: {e}"));
@@ -110,12 +110,12 @@ fn hard_rules_leave_no_violation_on_every_contour_route_solver() {
             )
         );
         let idle = route.idle_length();
-        let ub = result.upper_bound.expect("an upper bound");
+        let ub = result.bounds.upper.expect("an upper bound");
         assert!(
             (idle - ub).abs() <= 1e-6 * idle,
             "{solver:?}: ub {ub} vs idle {idle}"
         );
-        if let Some(lb) = result.lower_bound {
+        if let Some(lb) = result.bounds.lower {
             assert!(
                 lb <= idle + 1e-6,
                 "{solver:?}: lb {lb} above the route {idle}"
@@ -168,8 +168,7 @@ fn the_heat_weight_lowers_h_where_a_solver_prices_it() {
         let b = solve(&problem, solver, heated);
         for (result, settings) in [(&a, &plain), (&b, &heated)] {
             result
-                .route
-                .as_ref()
+                .route()
                 .unwrap()
                 .validate(nest_of(&problem), 1e-3)
                 .unwrap();
@@ -193,16 +192,18 @@ fn discrete_solvers_relax_their_pierce_points_on_the_heat_weight() {
     for solver in [SolverKind::Heuristic, SolverKind::Exact] {
         let a = solve(&problem, solver, plain);
         let b = solve(&problem, solver, heated);
-        let route = b.route.as_ref().unwrap();
+        let route = b.route().unwrap();
         route.validate(nest_of(&problem), 1e-3).unwrap();
         let h = heat_by_definition(&problem, &b, &heated);
         assert!((b.heat.unwrap() - h).abs() <= 1e-6 * h.max(1e-12));
         let (ha, hb) = (a.heat.unwrap(), b.heat.unwrap());
         assert!(hb < ha, "{solver:?}: H {ha} → {hb}");
         // The relaxed route left the candidate points: no discrete bound is claimed for it.
-        assert_eq!(b.lower_bound, None, "{solver:?}");
+        assert_eq!(b.bounds.lower, None, "{solver:?}");
         assert!(!b.proven_optimal);
-        assert!((b.upper_bound.unwrap() - route.idle_length()).abs() <= 1e-6 * route.idle_length());
+        assert!(
+            (b.bounds.upper.unwrap() - route.idle_length()).abs() <= 1e-6 * route.idle_length()
+        );
     }
 }
 
@@ -253,7 +254,7 @@ fn path_route_solvers_honour_hard_rules_and_report_h() {
             assert_eq!(counts.total(), plain.violations.len(), "{solver:?}");
 
             let result = solve(&problem, solver, hard);
-            let route = result.path_route.as_ref().expect("a path route");
+            let route = result.path_route().expect("a path route");
             // Standard cutting cuts test0's coincident contours twice (`Overlap`), which
             // GSCCP accepts too; nothing else may be wrong.
             let mut problems = route.problems(nest, 10.0 * nest.check_tolerance());
@@ -283,9 +284,9 @@ fn path_route_solvers_honour_hard_rules_and_report_h() {
                 route.idle_length(),
                 route.pierce_count(),
             );
-            let ub = result.upper_bound.expect("an upper bound");
+            let ub = result.bounds.upper.expect("an upper bound");
             assert!((ub - objective).abs() <= 1e-6 * objective, "{solver:?}");
-            if let Some(lb) = result.lower_bound {
+            if let Some(lb) = result.bounds.lower {
                 assert!(
                     lb <= objective + 1e-6,
                     "{solver:?}: lb {lb} above {objective}"
@@ -312,7 +313,7 @@ fn aoe_with_hard_rules_repairs_nest02_into_a_valid_route() {
     // The AOE route, then the repair the job makes in hard mode, called whole (the job's
     // final check may run out of its grace in a debug build).
     let plain = solve(&problem, SolverKind::Aoe, ThermalSettings::default());
-    let aoe = plain.path_route.as_ref().expect("a path route");
+    let aoe = plain.path_route().expect("a path route");
     let before = check_path_rules(nest, aoe, &hard).expect("checked");
     assert!(
         !before.violations.is_empty(),
@@ -349,7 +350,7 @@ fn the_heat_weight_lowers_h_of_segment_cutting() {
         let a = solve(&problem, solver, plain);
         let b = solve(&problem, solver, heated);
         for (result, settings) in [(&a, &plain), (&b, &heated)] {
-            let route = result.path_route.as_ref().unwrap();
+            let route = result.path_route().unwrap();
             let h = path_heat_by_definition(route, settings);
             assert!((result.heat.unwrap() - h).abs() <= 1e-6 * h.max(1e-12));
         }
@@ -408,7 +409,8 @@ fn the_discrete_arcs_carry_exactly_the_consecutive_terms_of_h() {
         SolverKind::NearestNeighbour,
         ThermalSettings::default(),
     )
-    .route
+    .solution
+    .and_then(Solution::into_route)
     .unwrap();
     let cluster_of = |c: cutroute_geometry::ContourRef| {
         1 + nest.parts[..c.part]

@@ -126,16 +126,14 @@ fn assert_promises_kept(name: &str, problem: &Problem, limit_s: f64) {
         if solver.gives_path_route() {
             let route = run
                 .result
-                .path_route
-                .as_ref()
+                .path_route()
                 .unwrap_or_else(|| panic!("{}: a path route", solver.name()));
             let problems = route.problems(nest, nest.check_tolerance() * 10.0);
             assert!(problems.is_empty(), "{}: {problems:?}", solver.name());
         } else {
             let route = run
                 .result
-                .route
-                .as_ref()
+                .route()
                 .unwrap_or_else(|| panic!("{} on {name}: a route", solver.name()));
             route
                 .validate(nest, 1e-3)

@@ -4,7 +4,7 @@
 #![cfg(target_arch = "wasm32")]
 
 use cutroute_engine::{open_document, run_to_end, start_job};
-use cutroute_protocol::{JobRequest, Problem, SolverKind, SolverParams};
+use cutroute_protocol::{JobRequest, Problem, Solution, SolverKind, SolverParams};
 use wasm_bindgen_test::{wasm_bindgen_test, wasm_bindgen_test_configure};
 
 wasm_bindgen_test_configure!(run_in_browser);
@@ -26,14 +26,17 @@ fn opens_a_sample_and_routes_it_in_the_browser() {
     };
     let mut job = start_job(&request).expect("job starts");
     let result = run_to_end(job.as_mut(), &mut |_| {});
-    let route = result.route.expect("a route");
+    let route = result
+        .solution
+        .and_then(Solution::into_route)
+        .expect("a route");
     assert_eq!(route.steps.len(), 16);
     // The route computed in the browser passes the same independent checker as natively, and
     // the bound the page would show is its idle length.
     let problems = route.problems(&nest, &nest.containment_forest(), 1e-3);
     assert!(problems.is_empty(), "{problems:?}");
     let idle = route.idle_length();
-    let reported = result.upper_bound.expect("an upper bound");
+    let reported = result.bounds.upper.expect("an upper bound");
     assert!(
         (reported - idle).abs() <= 1e-6 * idle,
         "{reported} vs {idle}"

@@ -31,11 +31,13 @@ use serde::{Deserialize, Serialize};
 mod open_error;
 mod phase;
 mod profile;
+mod solution;
 mod thermal;
 
 pub use open_error::{OpenError, OpenErrorKind, SourceLocation};
 pub use phase::{CcpStage, Ensemble, KerfNote, KerfSource, Phase, ThermalNote};
 pub use profile::{MachineProfile, ProfileError};
+pub use solution::{Bounds, CostUnit, Solution};
 pub use thermal::ThermalSettings;
 // The thermal types a `Progress` carries, so the UI needs no second import path.
 pub use cutroute_thermal::{HeatModel, RuleCounts, RuleSet, Violation};
@@ -197,13 +199,13 @@ pub enum SolverKind {
     /// pierce, joined by tool-on links that pay under the machine's prices.
     Chain,
     /// Segment cutting (SCCP): the multi-contour chains of the nest's plan graph (parts
-    /// sharing edges cut along them once) as base segments; reports a [`Progress::path_route`].
+    /// sharing edges cut along them once) as base segments; reports a [`Solution::PathRoute`].
     Sccp,
     /// Generalised segment cutting (GSCCP): standard, chain and junction-split ensembles, the
-    /// best by the chosen [`Objective`]; reports a [`Progress::path_route`].
+    /// best by the chosen [`Objective`]; reports a [`Solution::PathRoute`].
     Gsccp,
     /// Common-edge routes along AOE-chains of the nest's plane graph (each edge cut once, no
-    /// self-crossing, nothing enclosed before it is cut); reports a [`Progress::path_route`].
+    /// self-crossing, nothing enclosed before it is cut); reports a [`Solution::PathRoute`].
     Aoe,
 }
 
@@ -347,33 +349,23 @@ pub struct Progress {
     pub job_id: JobId,
     /// Seconds since the job started.
     pub elapsed_s: f64,
-    /// The cost of the best solution so far, if any: idle length in mm for nest solvers whose
-    /// result is a `route`; for the solvers that give a `path_route` (sccp, gsccp, aoe; see
-    /// [`SolverKind::gives_path_route`]) the value of [`SolverParams::objective`] for it under
-    /// [`SolverParams::machine`]: machining time in seconds, or cost.
-    pub upper_bound: Option<f64>,
-    /// A proven lower bound on the optimal cost, in the unit of `upper_bound`, if the solver
-    /// computes one (sccp, gsccp, aoe: the plan's length cut, the pierces every route needs and
-    /// the idle travel to and from the parts, under the same objective).
-    pub lower_bound: Option<f64>,
+    /// The cost of the best solution so far and a proven lower bound on the optimum (if the
+    /// solver computes one), in the unit the job states: idle mm for routes of whole contours,
+    /// the value of [`SolverParams::objective`] under [`SolverParams::machine`] for path routes
+    /// (sccp, gsccp, aoe: the plan's length cut, the pierces every route needs and the idle
+    /// travel to and from the parts), the instance's weights for tours.
+    pub bounds: Bounds,
     /// What the solver is doing, with its numbers (`Display`: the English words).
     pub phase: Phase,
-    /// The best route so far (nest problems).
-    pub route: Option<Route>,
-    /// The best tour so far as 0-based node ids, depot first (PCGTSP problems).
-    pub tour: Option<Vec<usize>>,
+    /// The best solution so far: a route of whole contours, tool-on paths or a tour.
+    pub solution: Option<Solution>,
     /// Whether the best solution is proven optimal.
     pub proven_optimal: bool,
     /// States the exact search has created so far (exact solver only).
     pub states: Option<u64>,
-    /// Per step of `route`: whether its pierce point is certified optimal for the order
+    /// Per step of the route: whether its pierce point is certified optimal for the order
     /// (CCP's Condition 1); empty when the solver does not certify.
     pub certified: Vec<bool>,
-    /// The best route so far as tool-on paths, for solvers whose routes cut parts of several
-    /// contours in one path (sccp, gsccp, aoe; see [`SolverKind::gives_path_route`]); `route`
-    /// is then `None`.
-    #[serde(default)]
-    pub path_route: Option<PathRoute>,
     /// The candidates the solver weighed (GSCCP: each ensemble and the CCP route that seeded
     /// them), with their numbers under the machine's model; empty for other solvers.
     #[serde(default)]
@@ -391,7 +383,7 @@ pub struct Progress {
     #[serde(default)]
     pub violations: Vec<Violation>,
     /// A proven lower bound (mm) on the idle length of every route the solver can return, for
-    /// the solvers that give a `path_route` (sccp, gsccp, aoe): their `lower_bound` is machine
+    /// the solvers that give a path route (sccp, gsccp, aoe): their `bounds` are machine
     /// time or cost, where the fixed cutting time hides how far the idle travel may still
     /// shrink. `None` for the other solvers and before the bound is measured.
     #[serde(default)]
@@ -444,10 +436,25 @@ fn relative_gap(ub: f64, lb: f64) -> Option<f64> {
 }
 
 impl Progress {
+    /// The best route of whole contours so far, if the solution is one.
+    pub fn route(&self) -> Option<&Route> {
+        self.solution.as_ref().and_then(Solution::route)
+    }
+
+    /// The best tool-on paths so far, if the solution is a path route.
+    pub fn path_route(&self) -> Option<&PathRoute> {
+        self.solution.as_ref().and_then(Solution::path_route)
+    }
+
+    /// The best tour so far, if the solution is a PCGTSP tour.
+    pub fn tour(&self) -> Option<&[usize]> {
+        self.solution.as_ref().and_then(Solution::tour)
+    }
+
     /// The idle length (mm) of the best path route: the upper bound the idle gap is measured
     /// against.
     pub fn idle_upper_bound(&self) -> Option<f64> {
-        self.path_route.as_ref().map(|r| r.idle_length())
+        self.path_route().map(|r| r.idle_length())
     }
 
     /// The relative gap `(idle UB − idle LB) / idle UB` in idle length (path-route solvers),
@@ -458,11 +465,7 @@ impl Progress {
 
     /// The relative gap `(UB − LB) / UB`, when both bounds are known.
     pub fn gap(&self) -> Option<f64> {
-        match (self.upper_bound, self.lower_bound) {
-            (Some(ub), Some(lb)) if ub > 0.0 => Some(((ub - lb) / ub).max(0.0)),
-            (Some(_), Some(_)) => Some(0.0),
-            _ => None,
-        }
+        self.bounds.gap()
     }
 
     /// Why a PCGTSP job that ended holds no tour, in the words the CLI and the page both use;
@@ -470,7 +473,7 @@ impl Progress {
     /// and proved its result proves infeasibility; otherwise nothing is proved.
     /// `solver` is the solver's name ([`SolverKind::name`]).
     pub fn missing_tour(&self, solver: &str, stopped_early: bool) -> Option<String> {
-        if self.tour.is_some() {
+        if self.tour().is_some() {
             return None;
         }
         Some(if self.proven_optimal && !stopped_early {
@@ -530,7 +533,7 @@ mod tests {
             finish: None,
         };
         let mut progress = Progress {
-            path_route: Some(route),
+            solution: Some(Solution::PathRoute(route)),
             ..Progress::default()
         };
         assert_eq!(progress.idle_upper_bound(), Some(50.0));
@@ -547,50 +550,61 @@ mod tests {
         assert_eq!(summary.idle_gap(), Some(0.0));
     }
 
-    #[test]
-    fn messages_survive_the_worker_codec() {
-        let request = sample_request();
-        let bytes = bincode::serialize(&request).unwrap();
-        assert_eq!(bincode::deserialize::<ToWorker>(&bytes).unwrap(), request);
+    /// One solution of each shape, as the jobs report them.
+    fn every_solution_kind() -> Vec<(Solution, CostUnit)> {
+        vec![
+            (
+                Solution::Route(Route {
+                    start: Point::default(),
+                    steps: vec![CutStep {
+                        contour: ContourRef {
+                            part: 0,
+                            contour: 0,
+                        },
+                        pierce_point: Point::new(0.0, 0.0),
+                        entry: Default::default(),
+                        leads: None,
+                    }],
+                    finish: None,
+                }),
+                CostUnit::IdleMm,
+            ),
+            (Solution::Tour(vec![0, 3, 2]), CostUnit::TourCost),
+            (
+                Solution::PathRoute(cutroute_geometry::PathRoute {
+                    start: Point::default(),
+                    paths: vec![cutroute_geometry::ToolOnPath {
+                        pierce: Point::new(0.0, 0.0),
+                        spans: vec![cutroute_geometry::Span {
+                            start: Point::new(0.0, 0.0),
+                            end: Point::new(10.0, 0.0),
+                            bulge: 0.5,
+                        }],
+                    }],
+                    finish: Some(Point::new(1.0, 1.0)),
+                }),
+                CostUnit::Seconds,
+            ),
+        ]
+    }
 
-        let progress = FromWorker::Progress(Progress {
+    fn progress_with(solution: Solution, unit: CostUnit) -> Progress {
+        Progress {
             job_id: 7,
             elapsed_s: 0.25,
-            upper_bound: Some(10.0),
-            lower_bound: Some(8.0),
+            bounds: Bounds {
+                upper: Some(10.0),
+                lower: Some(8.0),
+                unit,
+            },
             phase: Phase::ExactLayer {
                 layer: 3,
                 states: 12,
             },
-            route: Some(Route {
-                start: Point::default(),
-                steps: vec![CutStep {
-                    contour: ContourRef {
-                        part: 0,
-                        contour: 0,
-                    },
-                    pierce_point: Point::new(0.0, 0.0),
-                    entry: Default::default(),
-                    leads: None,
-                }],
-                finish: None,
-            }),
-            tour: Some(vec![0, 3, 2]),
+            solution: Some(solution),
             proven_optimal: false,
             states: Some(12),
             certified: vec![true],
-            path_route: Some(cutroute_geometry::PathRoute {
-                start: Point::default(),
-                paths: vec![cutroute_geometry::ToolOnPath {
-                    pierce: Point::new(0.0, 0.0),
-                    spans: vec![cutroute_geometry::Span {
-                        start: Point::new(0.0, 0.0),
-                        end: Point::new(10.0, 0.0),
-                        bulge: 0.5,
-                    }],
-                }],
-                finish: Some(Point::new(1.0, 1.0)),
-            }),
             alternatives: vec![RouteSummary {
                 name: "chains".into(),
                 pierces: 1,
@@ -616,12 +630,46 @@ mod tests {
                 },
             }],
             idle_lower_bound: Some(1.5),
-        });
-        let bytes = bincode::serialize(&progress).unwrap();
-        assert_eq!(
-            bincode::deserialize::<FromWorker>(&bytes).unwrap(),
-            progress
-        );
+        }
+    }
+
+    #[test]
+    fn progress_of_every_solution_kind_survives_both_codecs() {
+        for (solution, unit) in every_solution_kind() {
+            let progress = progress_with(solution.clone(), unit);
+            for message in [
+                FromWorker::Progress(progress.clone()),
+                FromWorker::Finished(progress.clone()),
+            ] {
+                let bytes = bincode::serialize(&message).unwrap();
+                assert_eq!(bincode::deserialize::<FromWorker>(&bytes).unwrap(), message);
+                let text = serde_json::to_string(&message).unwrap();
+                assert_eq!(serde_json::from_str::<FromWorker>(&text).unwrap(), message);
+            }
+            // Each shape answers only to its own accessor, and the bounds keep their unit.
+            assert_eq!(progress.route().is_some(), solution.route().is_some());
+            assert_eq!(
+                progress.path_route().is_some(),
+                solution.path_route().is_some()
+            );
+            assert_eq!(progress.tour().is_some(), solution.tour().is_some());
+            let shapes = [
+                progress.route().is_some(),
+                progress.path_route().is_some(),
+                progress.tour().is_some(),
+            ];
+            assert_eq!(shapes.iter().filter(|s| **s).count(), 1, "{solution:?}");
+            assert_eq!(progress.bounds.unit, unit);
+        }
+    }
+
+    #[test]
+    fn the_objective_names_the_unit_of_path_route_bounds() {
+        assert_eq!(CostUnit::of_objective(Objective::Time), CostUnit::Seconds);
+        assert_eq!(CostUnit::of_objective(Objective::Cost), CostUnit::Cost);
+        assert_eq!(Bounds::default().unit, CostUnit::IdleMm);
+        assert_eq!(Bounds::idle_mm(Some(4.0), Some(3.0)).gap(), Some(0.25));
+        assert_eq!(Bounds::unknown(CostUnit::Cost).gap(), None);
     }
 
     #[test]
@@ -727,8 +775,7 @@ mod tests {
     #[test]
     fn gap_is_relative_to_the_upper_bound() {
         let p = Progress {
-            upper_bound: Some(200.0),
-            lower_bound: Some(150.0),
+            bounds: Bounds::idle_mm(Some(200.0), Some(150.0)),
             ..Progress::default()
         };
         assert_eq!(p.gap(), Some(0.25));
@@ -738,7 +785,7 @@ mod tests {
     #[test]
     fn a_missing_tour_is_proved_infeasible_only_by_a_finished_proof() {
         let with_tour = Progress {
-            tour: Some(vec![0, 1]),
+            solution: Some(Solution::Tour(vec![0, 1])),
             proven_optimal: true,
             ..Progress::default()
         };

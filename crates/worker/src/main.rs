@@ -84,8 +84,8 @@ mod web {
                 scope.respond(requester, FromWorker::Finished(progress));
                 return;
             }
-            let bounds_changed = progress.upper_bound != running.last_upper_bound
-                || progress.lower_bound != running.last_lower_bound;
+            let bounds_changed = progress.bounds.upper != running.last_upper_bound
+                || progress.bounds.lower != running.last_lower_bound;
             let due = running
                 .last_report
                 .is_none_or(|at| at.elapsed() >= PROGRESS_INTERVAL);
@@ -96,8 +96,8 @@ mod web {
                         .is_none_or(|at| at.elapsed() >= PROGRESS_INTERVAL / 3))
             {
                 running.last_report = Some(Instant::now());
-                running.last_upper_bound = progress.upper_bound;
-                running.last_lower_bound = progress.lower_bound;
+                running.last_upper_bound = progress.bounds.upper;
+                running.last_lower_bound = progress.bounds.lower;
                 scope.respond(running.requester, FromWorker::Progress(progress));
             }
             schedule(scope, job_id);

@@ -298,11 +298,11 @@ fn print_bound_table(small_seconds: f64, big_seconds: f64, only: Option<&String>
         }
         let progress = job.progress();
         let wall = t.elapsed().as_secs_f64();
-        let route = progress.route.as_ref().expect("a route");
+        let route = progress.route().expect("a route");
         assert!(route.validate(&nest, 1e-6).is_ok(), "invalid CCP route");
         let (ub, lb) = (
-            progress.upper_bound.unwrap_or(f64::NAN),
-            progress.lower_bound.unwrap_or(f64::NAN),
+            progress.bounds.upper.unwrap_or(f64::NAN),
+            progress.bounds.lower.unwrap_or(f64::NAN),
         );
         assert!(lb <= ub + 1e-6, "{name}: bound {lb} above the route {ub}");
         let exact = small_nest_lower_bound(&nest, Point::new(0.0, 0.0), 6)

@@ -38,7 +38,7 @@ fn chain(problem: &Problem, nest: &Nest, limit: f64) -> Option<Route> {
         },
     };
     let mut job = start_job(&request).ok()?;
-    run_to_end(job.as_mut(), &mut |_| {}).route
+    run_to_end(job.as_mut(), &mut |_| {}).route().cloned()
 }
 
 fn settings(kerf: f64, d1: f64, d2: f64, lead_in: f64, lead_out: f64) -> KerfSettings {

@@ -91,7 +91,7 @@ fn solve(input: &Input, solver: SolverKind, thermal: ThermalSettings, limit: f64
 /// machine time.
 fn measured(input: &Input, p: &Progress, model: &HeatModel) -> Option<(f64, f64, f64)> {
     let machine = MachineParameters::default();
-    let (pierces, idle, time) = match (&p.route, &p.path_route) {
+    let (pierces, idle, time) = match (p.route(), p.path_route()) {
         (Some(r), _) => (
             route_pierces(r, &input.nest, &machine).ok()?,
             r.idle_length(),
@@ -124,7 +124,7 @@ fn measured(input: &Input, p: &Progress, model: &HeatModel) -> Option<(f64, f64,
 /// contour route).
 fn left_violations(input: &Input, p: &Progress, settings: &ThermalSettings) -> Option<RuleCounts> {
     let nest = &input.nest;
-    let report = match (&p.route, &p.path_route) {
+    let report = match (p.route(), p.path_route()) {
         (Some(route), _) => {
             check_rules(nest, route, settings.rules, &RuleParams::default()).ok()?
         }
@@ -137,14 +137,14 @@ fn left_violations(input: &Input, p: &Progress, settings: &ThermalSettings) -> O
 /// The independent checker's verdict on the final route.
 fn checker(input: &Input, p: &Progress) -> String {
     let nest = &input.nest;
-    if let Some(route) = &p.route {
+    if let Some(route) = p.route() {
         let problems = route.problems(nest, &nest.containment_forest(), 1e-3);
         return match problems.first() {
             None => "ok".into(),
             Some(e) => format!("FAILS: {e}"),
         };
     }
-    if let Some(route) = &p.path_route {
+    if let Some(route) = p.path_route() {
         let problems = route.problems(nest, 10.0 * nest.check_tolerance());
         let recut = problems
             .iter()

@@ -48,7 +48,7 @@ pub fn run(log: &dyn Fn(String)) {
         log(format!(
             "BENCH exact:{name} {:.3} {} {}",
             result.elapsed_s,
-            result.upper_bound.unwrap_or(f64::NAN),
+            result.bounds.upper.unwrap_or(f64::NAN),
             result.proven_optimal
         ));
     }

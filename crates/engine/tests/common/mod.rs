@@ -22,12 +22,12 @@ pub fn check_route(problem: &Problem, result: &Progress) -> f64 {
     let Problem::Nest { nest, .. } = problem else {
         panic!("a nest")
     };
-    let route = result.route.as_ref().expect("a route");
+    let route = result.route().expect("a route");
     route
         .validate(nest, 1e-3)
         .expect("the route passes the independent checker");
     let idle = route.idle_length();
-    let reported = result.upper_bound.expect("an upper bound");
+    let reported = result.bounds.upper.expect("an upper bound");
     assert!(
         (idle - reported).abs() <= 1e-6 * idle.max(1.0),
         "reported {reported} vs recomputed {idle}"
