@@ -12,6 +12,8 @@ use std::collections::HashMap;
 
 use cutroute_geometry::{BoundingBox, Contour, Nest, Part, Point, Span, Transform, Vertex};
 
+use crate::CadError;
+
 /// Where a piece of geometry came from in the file.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct EntityRef {
@@ -104,12 +106,6 @@ pub struct DrawingImport<W> {
     pub warnings: Vec<W>,
 }
 
-/// The drawing yields no closed contour: how many chains stayed open, and the first described.
-pub(crate) struct NothingClosed {
-    pub open: usize,
-    pub first: String,
-}
-
 /// The last step of every drawing import: assembles the parts' pieces into a nest with
 /// `sheet`, appending the contours dropped on the way to `warnings` (made by `warning`). With
 /// no closed contour the error describes the first open chain, or — without one —
@@ -121,7 +117,7 @@ pub(crate) fn finish_import<W>(
     mut warnings: Vec<W>,
     warning: impl Fn(Dropped) -> W,
     nothing_drawn: impl FnOnce(&[W]) -> String,
-) -> Result<DrawingImport<W>, NothingClosed> {
+) -> Result<DrawingImport<W>, CadError> {
     let assembled = assemble(pieces, limits);
     warnings.extend(assembled.dropped.into_iter().map(warning));
     if assembled.parts.is_empty() {
@@ -129,7 +125,7 @@ pub(crate) fn finish_import<W>(
             Some(chain) => chain.to_string(),
             None => nothing_drawn(&warnings),
         };
-        return Err(NothingClosed {
+        return Err(CadError::NothingClosed {
             open: assembled.open_chains.len(),
             first,
         });

@@ -39,7 +39,9 @@
 mod assemble;
 mod curves;
 pub mod dxf;
+mod error;
 pub mod svg;
 pub mod tflex;
 
 pub use assemble::{DrawingImport, EntityRef, OpenChain};
+pub use error::CadError;

@@ -117,87 +117,10 @@ impl std::fmt::Display for SvgWarning {
 /// one, the open chains of subpaths, and the warnings.
 pub type SvgImport = DrawingImport<SvgWarning>;
 
-/// Why an SVG file could not be imported. `line`/`column` are 1-based positions in the file.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum SvgError {
-    /// The file is not UTF-8.
-    #[error("byte {byte}: the file is not valid UTF-8")]
-    NotUtf8 {
-        /// Offset of the first invalid byte.
-        byte: usize,
-    },
-    /// The file is not well-formed XML.
-    #[error("{line}:{column}: malformed XML: {message}")]
-    Xml {
-        /// What the XML parser says.
-        message: String,
-        /// Line of the error.
-        line: u32,
-        /// Column of the error.
-        column: u32,
-    },
-    /// The root element is not `<svg>`.
-    #[error("the root element is <{found}>, expected <svg>")]
-    NotSvg {
-        /// The root element found.
-        found: String,
-    },
-    /// An attribute's value is not what it must be.
-    #[error("{line}:{column}: <{element}> attribute {attribute}={value:?}: {reason}")]
-    BadAttribute {
-        /// The element's tag name.
-        element: String,
-        /// The attribute.
-        attribute: String,
-        /// Its value (shortened to 80 characters).
-        value: String,
-        /// What is wrong.
-        reason: String,
-        /// Line of the element.
-        line: u32,
-        /// Column of the element.
-        column: u32,
-    },
-    /// Path data that does not parse.
-    #[error("{line}:{column}: <path> d, character {offset}: {reason}")]
-    BadPathData {
-        /// 0-based character offset in the `d` attribute.
-        offset: usize,
-        /// What is wrong.
-        reason: String,
-        /// Line of the element.
-        line: u32,
-        /// Column of the element.
-        column: u32,
-    },
-    /// Elements nest deeper than the limit.
-    #[error("{line}:{column}: elements nest deeper than {limit} levels")]
-    TooDeep {
-        /// The limit.
-        limit: usize,
-        /// Line of the innermost element.
-        line: u32,
-        /// Column of the innermost element.
-        column: u32,
-    },
-    /// The drawing would produce more spans than [`SvgOptions::max_spans`].
-    #[error("the drawing needs more than {limit} spans (too fine a tolerance?)")]
-    TooComplex {
-        /// The limit that was hit.
-        limit: usize,
-    },
-    /// The options are unusable (tolerances and scales must be finite and positive).
-    #[error("invalid options: {0}")]
-    InvalidOptions(String),
-    /// The drawing yields no closed contour.
-    #[error("no closed contour in the drawing ({open} open chains, first: {first})")]
-    NothingClosed {
-        /// How many open chains there are.
-        open: usize,
-        /// The first open chain, described.
-        first: String,
-    },
-}
+/// Why an SVG file could not be imported: the CAD readers' shared [`CadError`](crate::CadError),
+/// whose shared and `SVG:` variants this reader returns. `line`/`column` are 1-based positions
+/// in the file.
+pub type SvgError = crate::CadError;
 
 /// Reads an SVG drawing into closed parts (and the sheet, when one is marked), reporting open
 /// chains and skipped elements.
@@ -206,20 +129,13 @@ pub enum SvgError {
 /// least one closed contour results.
 pub fn read_svg(bytes: &[u8], options: &SvgOptions) -> Result<SvgImport, SvgError> {
     check_options(options)?;
-    let text = std::str::from_utf8(bytes).map_err(|e| SvgError::NotUtf8 {
-        byte: e.valid_up_to(),
-    })?;
-    let text = text.strip_prefix('\u{FEFF}').unwrap_or(text);
+    let text = crate::error::xml_text(bytes)?;
     let parsing = roxmltree::ParsingOptions {
         // Illustrator and Inkscape write a DOCTYPE; roxmltree bounds entity expansion.
         allow_dtd: true,
         ..Default::default()
     };
-    let doc = Document::parse_with_options(text, parsing).map_err(|e| SvgError::Xml {
-        message: e.to_string(),
-        line: e.pos().row,
-        column: e.pos().col,
-    })?;
+    let doc = crate::error::xml_document(text, parsing)?;
     let root = doc.root_element();
     if root.tag_name().name() != "svg" {
         return Err(SvgError::NotSvg {
@@ -286,10 +202,6 @@ pub fn read_svg(bytes: &[u8], options: &SvgOptions) -> Result<SvgImport, SvgErro
         dropped,
         nothing_drawn,
     )
-    .map_err(|e| SvgError::NothingClosed {
-        open: e.open,
-        first: e.first,
-    })
 }
 
 fn check_options(options: &SvgOptions) -> Result<(), SvgError> {

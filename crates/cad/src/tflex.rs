@@ -40,104 +40,11 @@ const MAX_PLACED_VERTICES: usize = 5_000_000;
 /// Largest gap (mm) between one contour object's end and the next one's beginning.
 const CONTINUITY_TOLERANCE: f64 = 0.01;
 
-/// Why a T-FLEX project could not be read. `path` is the element path, e.g.
+/// Why a T-FLEX project could not be read: the CAD readers' shared [`CadError`](crate::CadError),
+/// whose shared and `T-FLEX:` variants this reader returns. `path` is the element path, e.g.
 /// `/Project/Parts/PartDefinition[2]/PartProfile/Contours/Contour[1]`, and `line`/`column`
 /// locate it in the file (1-based).
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum TflexError {
-    /// The file is not UTF-8.
-    #[error("byte {byte}: the file is not valid UTF-8")]
-    NotUtf8 {
-        /// Offset of the first invalid byte.
-        byte: usize,
-    },
-    /// The file is not well-formed XML.
-    #[error("{line}:{column}: malformed XML: {message}")]
-    Xml {
-        /// What the XML parser says.
-        message: String,
-        /// Line of the error.
-        line: u32,
-        /// Column of the error.
-        column: u32,
-    },
-    /// The root element is not `Project`.
-    #[error("the root element is <{found}>, expected <Project>")]
-    NotAProject {
-        /// The root element found.
-        found: String,
-    },
-    /// A required child element is missing.
-    #[error("{line}:{column}: {path} has no <{element}>")]
-    MissingElement {
-        /// Path of the parent element.
-        path: String,
-        /// The missing child.
-        element: &'static str,
-        /// Line of the parent.
-        line: u32,
-        /// Column of the parent.
-        column: u32,
-    },
-    /// An element's text is not what it must be (a finite number, a boolean, an integer).
-    #[error("{line}:{column}: {path} must be {expected}, found {text:?}")]
-    BadValue {
-        /// Path of the element.
-        path: String,
-        /// What was expected.
-        expected: &'static str,
-        /// The text found.
-        text: String,
-        /// Line of the element.
-        line: u32,
-        /// Column of the element.
-        column: u32,
-    },
-    /// A contour or contour object of a type this reader does not know.
-    #[error("{line}:{column}: {path} has unknown type {found:?}")]
-    UnknownType {
-        /// Path of the element.
-        path: String,
-        /// The `xsi:type` found.
-        found: String,
-        /// Line of the element.
-        line: u32,
-        /// Column of the element.
-        column: u32,
-    },
-    /// Geometry that cannot be cut: zero radius, a broken contour, an empty profile, …
-    #[error("{line}:{column}: {path}: {reason}")]
-    InvalidGeometry {
-        /// Path of the element.
-        path: String,
-        /// What is wrong.
-        reason: String,
-        /// Line of the element.
-        line: u32,
-        /// Column of the element.
-        column: u32,
-    },
-    /// A placement names a part or sheet the project does not define.
-    #[error("{line}:{column}: {path} refers to undefined {what} {id}")]
-    UnknownReference {
-        /// Path of the referring element.
-        path: String,
-        /// `part` or `sheet`.
-        what: &'static str,
-        /// The missing ID.
-        id: i64,
-        /// Line of the element.
-        line: u32,
-        /// Column of the element.
-        column: u32,
-    },
-    /// The placed geometry would exceed the size limit.
-    #[error("the placed parts would have more than {limit} vertices")]
-    TooLarge {
-        /// The vertex limit.
-        limit: usize,
-    },
-}
+pub type TflexError = crate::CadError;
 
 /// One part placement of a sheet layout, as stored in the project.
 #[derive(Clone, Debug, PartialEq)]
@@ -187,24 +94,8 @@ pub fn read_tfnesting(bytes: &[u8]) -> Result<Vec<Nest>, TflexError> {
 
 /// Reads a T-FLEX nesting project with its sheet and placement details.
 pub fn read_tfnesting_project(bytes: &[u8]) -> Result<TflexProject, TflexError> {
-    let text = std::str::from_utf8(bytes).map_err(|e| TflexError::NotUtf8 {
-        byte: e.valid_up_to(),
-    })?;
-    let text = text.strip_prefix('\u{FEFF}').unwrap_or(text);
-    let doc = Document::parse(text).map_err(|e| {
-        let (line, column) = match e {
-            // The parser places this at the start; the truncation is at the end of the text.
-            roxmltree::Error::UnclosedRootNode | roxmltree::Error::UnexpectedEndOfStream => {
-                end_position(text)
-            }
-            _ => (e.pos().row, e.pos().col),
-        };
-        TflexError::Xml {
-            message: e.to_string(),
-            line,
-            column,
-        }
-    })?;
+    let text = crate::error::xml_text(bytes)?;
+    let doc = crate::error::xml_document(text, roxmltree::ParsingOptions::default())?;
     let root = doc.root_element();
     if root.tag_name().name() != "Project" {
         return Err(TflexError::NotAProject {
@@ -314,16 +205,6 @@ pub fn read_tfnesting_project(bytes: &[u8]) -> Result<TflexProject, TflexError> 
         }
     }
     Ok(TflexProject { name, layouts })
-}
-
-/// 1-based line and column just past the end of `text`.
-fn end_position(text: &str) -> (u32, u32) {
-    let line = text.bytes().filter(|&b| b == b'\n').count() + 1;
-    let column = text.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
-    (
-        u32::try_from(line).unwrap_or(u32::MAX),
-        u32::try_from(column).unwrap_or(u32::MAX),
-    )
 }
 
 /// Applies a placement to a part definition's contours and re-orients them: mirrored in the

@@ -5,7 +5,7 @@ mod common;
 
 use common::{area, distance_to_contour, exact_bounds, polygon, shared_dir_files, shared_file};
 use cutroute_cad::dxf::{read_dxf, DxfImport, DxfOptions};
-use cutroute_geometry::{Contour, Point};
+use cutroute_geometry::{BoundingBox, Contour, Point};
 
 fn import(name: &str) -> DxfImport {
     let bytes = shared_file(&format!("nests/dxf/{name}"));
@@ -17,7 +17,7 @@ fn arcs(contour: &Contour) -> usize {
 }
 
 fn assert_box(contour: &Contour, lo: (f64, f64), hi: (f64, f64)) {
-    let (a, b) = exact_bounds(contour);
+    let BoundingBox { min: a, max: b } = exact_bounds(contour);
     let ok = (a.x - lo.0).abs() < 1e-3
         && (a.y - lo.1).abs() < 1e-3
         && (b.x - hi.0).abs() < 1e-3
@@ -252,7 +252,7 @@ fn planka_block_insert_with_four_holes() {
     );
     for hole in &part.contours[1..] {
         assert_eq!((hole.vertices.len(), arcs(hole)), (2, 2));
-        let (lo, hi) = exact_bounds(hole);
+        let BoundingBox { min: lo, max: hi } = exact_bounds(hole);
         assert!((hi.x - lo.x - 6.5).abs() < 1e-9 && (hi.y - lo.y - 6.5).abs() < 1e-9);
     }
 }

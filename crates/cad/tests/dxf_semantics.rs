@@ -5,7 +5,7 @@ mod common;
 
 use common::{area, distance_to_contour, exact_bounds, polygon};
 use cutroute_cad::dxf::{read_dxf, DxfImport, DxfOptions};
-use cutroute_geometry::Point;
+use cutroute_geometry::{BoundingBox, Point};
 
 fn drawing(entities: &str) -> String {
     format!("0\nSECTION\n2\nENTITIES\n{entities}0\nENDSEC\n0\nEOF\n")
@@ -81,7 +81,7 @@ fn part_in_a_hole_is_a_new_part_and_orientation_is_normalised() {
             "hole counter-clockwise"
         );
     }
-    let (lo, hi) = exact_bounds(&import.nest.parts[1].contours[0]);
+    let BoundingBox { min: lo, max: hi } = exact_bounds(&import.nest.parts[1].contours[0]);
     assert_eq!((lo, hi), (Point::new(30.0, 30.0), Point::new(70.0, 70.0)));
 }
 
@@ -114,7 +114,7 @@ fn mirrored_ocs_arcs_land_where_they_are_drawn() {
     let text = drawing(&format!("{arc}{}", line((4.0, 0.0), (6.0, 0.0))));
     let import = read(&text);
     let outer = &import.nest.parts[0].contours[0];
-    let (lo, hi) = exact_bounds(outer);
+    let BoundingBox { min: lo, max: hi } = exact_bounds(outer);
     assert!((lo.x - 4.0).abs() < 1e-12 && (hi.x - 6.0).abs() < 1e-12);
     assert!(lo.y.abs() < 1e-12 && (hi.y - 1.0).abs() < 1e-12);
 }
@@ -128,7 +128,7 @@ fn inserts_rotate_scale_and_nest() {
         square(0.0, 0.0, 10.0)
     );
     let import = read(&with_blocks(&blocks, "0\nINSERT\n2\nc\n10\n0\n20\n50\n"));
-    let (lo, hi) = exact_bounds(&import.nest.parts[0].contours[0]);
+    let BoundingBox { min: lo, max: hi } = exact_bounds(&import.nest.parts[0].contours[0]);
     let near = |a: Point, b: Point| (a.x - b.x).abs() < 1e-9 && (a.y - b.y).abs() < 1e-9;
     assert!(
         near(lo, Point::new(90.0, 40.0)) && near(hi, Point::new(110.0, 60.0)),
@@ -232,6 +232,6 @@ fn unevenly_scaled_bulge_polyline_within_tolerance() {
         let p = Point::new(20.0 * t.cos(), 10.0 * t.sin());
         assert!(distance_to_contour(p, outer) <= 0.01 * (1.0 + 1e-6));
     }
-    let (lo, hi) = exact_bounds(outer);
+    let BoundingBox { min: lo, max: hi } = exact_bounds(outer);
     assert!((lo.x + 20.0).abs() < 0.011 && (hi.y - 10.0).abs() < 0.011);
 }

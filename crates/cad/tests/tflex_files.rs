@@ -5,7 +5,7 @@ mod common;
 
 use common::{bounds, overlapping_pairs, polygon, shared_dir_files, shared_file, Solid};
 use cutroute_cad::tflex::{read_tfnesting, read_tfnesting_project, TflexProject};
-use cutroute_geometry::{Contour, Point, Vertex};
+use cutroute_geometry::{BoundingBox, Contour, Point, Vertex};
 
 const TOLERANCE: f64 = 0.05;
 
@@ -28,7 +28,7 @@ fn assert_valid_layout(project: &TflexProject) {
     for layout in &project.layouts {
         let sheet = layout.nest.sheet.as_ref().expect("sheet contour");
         let sheet_polygon = polygon(&sheet.contours[0]);
-        let (slo, shi) = bounds(&sheet_polygon);
+        let BoundingBox { min: slo, max: shi } = bounds(&sheet_polygon);
         let solids: Vec<Solid> = layout
             .nest
             .parts
@@ -37,14 +37,14 @@ fn assert_valid_layout(project: &TflexProject) {
             .collect();
         for (part, solid) in layout.nest.parts.iter().zip(&solids) {
             assert!(
-                solid.lo.x >= slo.x - TOLERANCE
-                    && solid.lo.y >= slo.y - TOLERANCE
-                    && solid.hi.x <= shi.x + TOLERANCE
-                    && solid.hi.y <= shi.y + TOLERANCE,
+                solid.bounds.min.x >= slo.x - TOLERANCE
+                    && solid.bounds.min.y >= slo.y - TOLERANCE
+                    && solid.bounds.max.x <= shi.x + TOLERANCE
+                    && solid.bounds.max.y <= shi.y + TOLERANCE,
                 "{} lies off the sheet: {:?}–{:?}",
                 part.name,
-                solid.lo,
-                solid.hi
+                solid.bounds.min,
+                solid.bounds.max
             );
         }
         let pairs = overlapping_pairs(&solids, TOLERANCE);
@@ -107,7 +107,8 @@ fn nest01_five_rectangles_on_a_3000_by_1000_sheet() {
     assert_eq!(p.layouts.len(), 1);
     let layout = &p.layouts[0];
     assert_eq!(layout.sheet_name, "List1");
-    let (lo, hi) = bounds(&polygon(&layout.nest.sheet.as_ref().unwrap().contours[0]));
+    let BoundingBox { min: lo, max: hi } =
+        bounds(&polygon(&layout.nest.sheet.as_ref().unwrap().contours[0]));
     assert_eq!((lo, hi), (Point::new(0.0, 0.0), Point::new(3000.0, 1000.0)));
     assert_eq!(layout.nest.parts.len(), 5);
     assert_eq!(count_named(&p, "Rect12"), 2);
@@ -123,7 +124,7 @@ fn nest01_five_rectangles_on_a_3000_by_1000_sheet() {
             .count(),
         1
     );
-    let (lo, hi) = bounds(&polygon(&layout.nest.parts[4].contours[0]));
+    let BoundingBox { min: lo, max: hi } = bounds(&polygon(&layout.nest.parts[4].contours[0]));
     assert_eq!(
         (lo, hi),
         (Point::new(1200.0, 0.0), Point::new(1300.0, 100.0))
@@ -151,7 +152,8 @@ fn nest02_places_406_parts_without_overlap() {
     for (name, count) in expected {
         assert_eq!(count_named(&p, name), count, "{name}");
     }
-    let (lo, hi) = bounds(&polygon(&layout.nest.sheet.as_ref().unwrap().contours[0]));
+    let BoundingBox { min: lo, max: hi } =
+        bounds(&polygon(&layout.nest.sheet.as_ref().unwrap().contours[0]));
     assert_eq!((lo, hi), (Point::new(0.0, 0.0), Point::new(6000.0, 2000.0)));
     let mut angles: Vec<i64> = layout
         .placements
@@ -253,7 +255,7 @@ fn the_other_readings_of_the_placements_do_overlap() {
         .collect();
     let off_sheet = solids
         .iter()
-        .filter(|s| s.lo.y < -TOLERANCE || s.lo.x < -TOLERANCE)
+        .filter(|s| s.bounds.min.y < -TOLERANCE || s.bounds.min.x < -TOLERANCE)
         .count();
     assert!(off_sheet + overlapping_pairs(&solids, TOLERANCE).len() > 10);
 }

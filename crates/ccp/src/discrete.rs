@@ -4,7 +4,6 @@
 use cutroute_geometry::{ContourRef, CutStep, Nest, Point, Route};
 use cutroute_pcgtsp::Instance;
 
-use crate::geom::V;
 use crate::problem::Problem;
 use crate::CcpError;
 
@@ -90,11 +89,11 @@ pub fn build_pcgtsp(
 /// rows, 0.7 s), and a worker that must answer Stop within 200 ms cannot wait for it.
 pub struct PcgtspBuilder {
     nodes: Vec<DiscreteNode>,
-    points: Vec<V>,
+    points: Vec<Point>,
     clusters: Vec<Vec<usize>>,
     node_cluster: Vec<usize>,
     precedence: Vec<(usize, usize)>,
-    finish: Option<V>,
+    finish: Option<Point>,
     round_costs: bool,
     start_point: Point,
     finish_point: Option<Point>,
@@ -109,8 +108,8 @@ impl PcgtspBuilder {
         if !(options.step > 0.0 && options.step.is_finite()) {
             return Err(CcpError::InvalidOption("step must be positive".into()));
         }
-        let start = V::from(options.start);
-        let finish = options.finish.map(V::from);
+        let start = options.start;
+        let finish = options.finish;
         let prob = Problem::new(nest, start, finish);
         // Sized before anything is allocated: a contour gives at most one point per step of its
         // perimeter, one more, and (with vertices) one per span.
@@ -147,14 +146,13 @@ impl PcgtspBuilder {
             for x in contour
                 .candidate_points(options.step, options.include_vertices)
                 .into_iter()
-                .map(V::from)
             {
                 cl.push(points.len());
                 node_cluster.push(i + 1);
                 points.push(x);
                 nodes.push(DiscreteNode::Pierce {
                     contour: prob.refs[i],
-                    point: x.into(),
+                    point: x,
                 });
             }
             clusters.push(cl);
@@ -212,9 +210,9 @@ impl PcgtspBuilder {
                 let d = if self.node_cluster[a] == self.node_cluster[b] {
                     f64::INFINITY
                 } else if b == 0 {
-                    self.finish.map_or(0.0, |f| self.points[a].dist(f))
+                    self.finish.map_or(0.0, |f| self.points[a].fast_distance(f))
                 } else {
-                    self.points[a].dist(self.points[b])
+                    self.points[a].fast_distance(self.points[b])
                 };
                 self.cost.push(if self.round_costs && d.is_finite() {
                     d.round()

@@ -124,7 +124,7 @@ pub enum CcpError {
 /// The containment forest of a nest's contours: pairs `(inner, outer)` for every contour lying
 /// inside another (transitively closed), in "inner before outer" precedence form.
 pub fn containment_pairs(nest: &Nest) -> Vec<(ContourRef, ContourRef)> {
-    let prob = problem::Problem::new(nest, geom::V::default(), None);
+    let prob = problem::Problem::new(nest, cutroute_geometry::Point::ORIGIN, None);
     prob.precedence_pairs()
         .into_iter()
         .map(|(a, b)| (prob.refs[a], prob.refs[b]))

@@ -537,32 +537,23 @@ impl NgPathBound {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use cutroute_geometry::SplitMix64;
     use web_time::Duration;
-
-    struct Rng(u64);
-    impl Rng {
-        fn next(&mut self) -> f64 {
-            self.0 ^= self.0 << 13;
-            self.0 ^= self.0 >> 7;
-            self.0 ^= self.0 << 17;
-            (self.0 >> 11) as f64 / (1u64 << 53) as f64
-        }
-    }
 
     /// A random instance: points in clusters (each cluster's nodes near one centre, like the
     /// pieces of a contour), Euclidean costs, an asymmetric return arc (the tail).
     fn random_instance(seed: u64, clusters: usize, per: usize) -> Instance {
-        let mut rng = Rng(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1);
+        let mut rng = SplitMix64::new(seed);
         let mut points = vec![(0.0, 0.0)];
         let mut node_cluster = vec![0];
         let mut list = vec![vec![0]];
         for c in 1..=clusters {
-            let (cx, cy) = (rng.next() * 100.0, rng.next() * 100.0);
+            let (cx, cy) = (rng.next_f64() * 100.0, rng.next_f64() * 100.0);
             let mut nodes = Vec::new();
-            for _ in 0..1 + (rng.next() * per as f64) as usize {
+            for _ in 0..1 + (rng.next_f64() * per as f64) as usize {
                 nodes.push(points.len());
                 node_cluster.push(c);
-                points.push((cx + rng.next() * 15.0, cy + rng.next() * 15.0));
+                points.push((cx + rng.next_f64() * 15.0, cy + rng.next_f64() * 15.0));
             }
             list.push(nodes);
         }

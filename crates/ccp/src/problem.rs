@@ -2,13 +2,13 @@
 //! forest, the kept (innermost) and removed (outer) contours, a uniform grid, k-nearest
 //! candidate lists and the nearest-neighbour construction.
 
-use cutroute_geometry::{ContourRef, Nest, SplitMix64};
+use cutroute_geometry::{BoundingBox, ContourRef, Nest, Point, SplitMix64};
 
-use crate::geom::{BBox, Shape, V};
+use crate::geom::Shape;
 
 /// A uniform grid of boxes: each cell lists the items whose box overlaps it.
 pub(crate) struct Grid {
-    min: V,
+    min: Point,
     cell: f64,
     nx: usize,
     ny: usize,
@@ -17,7 +17,7 @@ pub(crate) struct Grid {
 
 impl Grid {
     /// A grid over `bounds` with about `per_cell` items per cell for `n` items.
-    pub fn new(bounds: BBox, n: usize, per_cell: f64) -> Grid {
+    pub fn new(bounds: BoundingBox, n: usize, per_cell: f64) -> Grid {
         let w = (bounds.max.x - bounds.min.x).max(1e-6);
         let h = (bounds.max.y - bounds.min.y).max(1e-6);
         let cells_wanted = (n as f64 / per_cell).clamp(1.0, 4.0e6);
@@ -39,7 +39,7 @@ impl Grid {
     fn iy(&self, y: f64) -> usize {
         (((y - self.min.y) / self.cell).floor().max(0.0) as usize).min(self.ny - 1)
     }
-    fn range(&self, b: &BBox) -> (usize, usize, usize, usize) {
+    fn range(&self, b: &BoundingBox) -> (usize, usize, usize, usize) {
         (
             self.ix(b.min.x),
             self.iy(b.min.y),
@@ -47,7 +47,7 @@ impl Grid {
             self.iy(b.max.y),
         )
     }
-    pub fn insert(&mut self, id: u32, b: &BBox) {
+    pub fn insert(&mut self, id: u32, b: &BoundingBox) {
         let (x0, y0, x1, y1) = self.range(b);
         for y in y0..=y1 {
             for x in x0..=x1 {
@@ -56,7 +56,7 @@ impl Grid {
         }
     }
     /// Visits every cell overlapping `b`.
-    pub fn cells_in(&self, b: &BBox, mut f: impl FnMut(&[u32])) {
+    pub fn cells_in(&self, b: &BoundingBox, mut f: impl FnMut(&[u32])) {
         let (x0, y0, x1, y1) = self.range(b);
         for y in y0..=y1 {
             for x in x0..=x1 {
@@ -67,7 +67,7 @@ impl Grid {
 
     /// Visits the cells of ring `r` around the cell range of `b` (ring 0 = the range itself);
     /// returns false when the ring lies wholly outside the grid.
-    pub fn ring(&self, b: &BBox, r: usize, mut f: impl FnMut(&[u32])) -> bool {
+    pub fn ring(&self, b: &BoundingBox, r: usize, mut f: impl FnMut(&[u32])) -> bool {
         let (bx0, by0, bx1, by1) = self.range(b);
         let (nx, ny) = (self.nx as isize, self.ny as isize);
         let r = r as isize;
@@ -116,11 +116,11 @@ pub(crate) struct Problem {
     /// Flat ids of the outer contours (restored in step 4).
     pub removed: Vec<usize>,
     /// Bounds of all contours, the start and the finish.
-    pub bounds: BBox,
+    pub bounds: BoundingBox,
 }
 
 impl Problem {
-    pub fn new(nest: &Nest, start: V, finish: Option<V>) -> Problem {
+    pub fn new(nest: &Nest, start: Point, finish: Option<Point>) -> Problem {
         let mut refs = Vec::new();
         let mut shapes = Vec::new();
         for (pi, part) in nest.parts.iter().enumerate() {
@@ -135,13 +135,13 @@ impl Problem {
                 shapes.push(Shape::new(c));
             }
         }
-        let mut bounds = BBox::empty();
+        let mut bounds = BoundingBox::EMPTY;
         for s in &shapes {
-            bounds.union(&s.bbox);
+            bounds = bounds.union(s.bbox);
         }
-        bounds.add(start);
+        bounds = bounds.including(start);
         if let Some(f) = finish {
-            bounds.add(f);
+            bounds = bounds.including(f);
         }
         let parent = containment_parents(nest, &refs);
         let mut has_child = vec![false; shapes.len()];
@@ -200,7 +200,7 @@ fn containment_parents(nest: &Nest, refs: &[ContourRef]) -> Vec<Option<usize>> {
 }
 
 /// For each item, up to `k` others nearest by box gap (ties by centre distance).
-pub(crate) fn nearest_lists(boxes: &[BBox], bounds: BBox, k: usize) -> Vec<Vec<u32>> {
+pub(crate) fn nearest_lists(boxes: &[BoundingBox], bounds: BoundingBox, k: usize) -> Vec<Vec<u32>> {
     let n = boxes.len();
     let mut grid = Grid::new(bounds, n, 2.0);
     for (i, b) in boxes.iter().enumerate() {
@@ -219,7 +219,11 @@ pub(crate) fn nearest_lists(boxes: &[BBox], bounds: BBox, k: usize) -> Vec<Vec<u
                     if stamp[j as usize] != i {
                         stamp[j as usize] = i;
                         let bj = &boxes[j as usize];
-                        cand.push((bi.gap(bj), bi.center().dist(bj.center()), j));
+                        cand.push((
+                            bi.gap_to_box(bj).fast_norm(),
+                            bi.centre().fast_distance(bj.centre()),
+                            j,
+                        ));
                     }
                 }
             });
@@ -242,10 +246,10 @@ pub(crate) fn nearest_lists(boxes: &[BBox], bounds: BBox, k: usize) -> Vec<Vec<u
 /// `rng` (when given) sometimes takes the second nearest, for restarts.
 pub(crate) fn nearest_neighbour_order(
     shapes: &[&Shape],
-    bounds: BBox,
-    start: V,
+    bounds: BoundingBox,
+    start: Point,
     mut rng: Option<&mut SplitMix64>,
-) -> (Vec<u32>, Vec<V>) {
+) -> (Vec<u32>, Vec<Point>) {
     let n = shapes.len();
     let mut grid = Grid::new(bounds, n, 2.0);
     for (i, s) in shapes.iter().enumerate() {
@@ -253,12 +257,12 @@ pub(crate) fn nearest_neighbour_order(
     }
     let mut visited = vec![false; n];
     let mut order = Vec::with_capacity(n);
-    let mut points = vec![V::default(); n];
+    let mut points = vec![Point::ORIGIN; n];
     let mut cur = start;
     let mut stamp = vec![usize::MAX; n];
     for step in 0..n {
-        let qb = BBox { min: cur, max: cur };
-        let mut best = (f64::INFINITY, usize::MAX, V::default());
+        let qb = BoundingBox { min: cur, max: cur };
+        let mut best = (f64::INFINITY, usize::MAX, Point::ORIGIN);
         let mut second = best;
         let mut r = 0;
         loop {
@@ -269,11 +273,11 @@ pub(crate) fn nearest_neighbour_order(
                         continue;
                     }
                     stamp[j] = step;
-                    if shapes[j].bbox.dist(cur) >= second.0 {
+                    if shapes[j].bbox.gap_to_point(cur).fast_norm() >= second.0 {
                         continue;
                     }
                     let x = shapes[j].nearest(cur);
-                    let d = x.dist(cur);
+                    let d = x.fast_distance(cur);
                     if d < best.0 {
                         second = best;
                         best = (d, j, x);

@@ -5,23 +5,25 @@
 //! exists; otherwise every sign change `− → +` of the derivative on a fine angular grid brackets a
 //! local minimum that bisection refines, and the endpoints are candidates too.
 
-use crate::geom::{Shape, Span, V};
+use crate::geom::{ArcCache, PreparedSpan, Shape};
 use cutroute_geometry::float::Libm;
+use cutroute_geometry::Point;
 
 /// `|P X| + |X Q|`, or `|P X|` at an open end.
 #[inline]
-pub(crate) fn cost(p: V, q: Option<V>, x: V) -> f64 {
-    p.dist(x) + q.map_or(0.0, |q| x.dist(q))
+pub(crate) fn cost(p: Point, q: Option<Point>, x: Point) -> f64 {
+    p.fast_distance(x) + q.map_or(0.0, |q| x.fast_distance(q))
 }
 
 /// The minimiser of `cost` over one span: `(value, point)`.
-pub(crate) fn best_on_span(span: &Span, p: V, q: Option<V>) -> (f64, V) {
+pub(crate) fn best_on_span(span: &PreparedSpan, p: Point, q: Option<Point>) -> (f64, Point) {
     let Some(q) = q else {
         let (_, x) = span.nearest(p);
-        return (p.dist(x), x);
+        return (p.fast_distance(x), x);
     };
-    match *span {
-        Span::Seg { a, b } => {
+    let (a, b) = (span.a(), span.b());
+    match span.arc {
+        None => {
             let u = b - a;
             let uu = u.dot(u);
             if uu <= 0.0 {
@@ -33,12 +35,12 @@ pub(crate) fn best_on_span(span: &Span, p: V, q: Option<V>) -> (f64, V) {
             let q2 = if sp * sq < 0.0 {
                 q
             } else {
-                let n = u.perp() * (1.0 / uu.sqrt());
+                let n = u.rotated_quarter() * (1.0 / uu.sqrt());
                 q - n * (2.0 * n.dot(q - a))
             };
             let w = q2 - p;
             let den = u.cross(w);
-            let t = if den.abs() < 1e-14 * (uu.sqrt() * w.norm()).max(1e-300) {
+            let t = if den.abs() < 1e-14 * (uu.sqrt() * w.fast_norm()).max(1e-300) {
                 ((p - a).dot(u) / uu).clamp(0.0, 1.0)
             } else {
                 ((p - a).cross(w) / den).clamp(0.0, 1.0)
@@ -46,14 +48,12 @@ pub(crate) fn best_on_span(span: &Span, p: V, q: Option<V>) -> (f64, V) {
             let x = a + u * t;
             (cost(p, Some(q), x), x)
         }
-        Span::Arc {
-            a,
-            b,
+        Some(ArcCache {
             center,
             radius,
             sweep,
             ..
-        } => {
+        }) => {
             let mut hits = Vec::new();
             span.intersect_segment(p, q, &mut hits);
             if let Some(&(_, t)) = hits.first() {
@@ -68,14 +68,14 @@ pub(crate) fn best_on_span(span: &Span, p: V, q: Option<V>) -> (f64, V) {
             // Derivative of f along the arc (up to the positive factor r·|φ|), from the unit
             // radius vector u: tangent = ±perp(u).
             let dir = sweep.signum();
-            let g_of = |u: V| {
+            let g_of = |u: Point| {
                 let x = center + u * radius;
-                ((x - p).unit() + (x - q).unit()).dot(u.perp() * dir)
+                ((x - p).fast_unit() + (x - q).fast_unit()).dot(u.rotated_quarter() * dir)
             };
             let n = ((sweep.abs() / (std::f64::consts::PI / 10.0)).ceil() as usize).max(2);
             let step = sweep / n as f64;
             let (sd, cd) = step.sin_cos_libm();
-            let rot = |u: V| V::new(u.x * cd - u.y * sd, u.x * sd + u.y * cd);
+            let rot = |u: Point| Point::new(u.x * cd - u.y * sd, u.x * sd + u.y * cd);
             let u0 = (a - center) * (1.0 / radius);
             let mut u_prev = u0;
             let mut g_prev = g_of(u0);
@@ -92,14 +92,14 @@ pub(crate) fn best_on_span(span: &Span, p: V, q: Option<V>) -> (f64, V) {
                     // by normalised vector sums rather than trigonometry.
                     let (mut lo, mut hi) = (u_prev, u);
                     for _ in 0..30 {
-                        let mid = (lo + hi).unit();
+                        let mid = (lo + hi).fast_unit();
                         if g_of(mid) < 0.0 {
                             lo = mid;
                         } else {
                             hi = mid;
                         }
                     }
-                    let um = (lo + hi).unit();
+                    let um = (lo + hi).fast_unit();
                     let x = center + um * radius;
                     let v = cost(p, Some(q), x);
                     if v < best.0 {
@@ -117,14 +117,19 @@ pub(crate) fn best_on_span(span: &Span, p: V, q: Option<V>) -> (f64, V) {
 /// The minimiser of `cost` over a whole contour. `current` (the warm start) seeds the pruning
 /// bound, and is returned unchanged unless a strictly better point exists, so relaxation is
 /// monotone.
-pub(crate) fn best_on_shape(shape: &Shape, p: V, q: Option<V>, current: Option<V>) -> (f64, V) {
+pub(crate) fn best_on_shape(
+    shape: &Shape,
+    p: Point,
+    q: Option<Point>,
+    current: Option<Point>,
+) -> (f64, Point) {
     let mut best = match current {
         Some(c) => (cost(p, q, c), c),
         None => (f64::INFINITY, shape.spans[0].a()),
     };
     for (span, bb) in shape.spans.iter().zip(&shape.span_boxes) {
         // Lower bound of the span: distances to its box.
-        let lb = bb.dist(p) + q.map_or(0.0, |q| bb.dist(q));
+        let lb = bb.gap_to_point(p).fast_norm() + q.map_or(0.0, |q| bb.gap_to_point(q).fast_norm());
         if lb >= best.0 {
             continue;
         }
@@ -142,30 +147,27 @@ mod tests {
 
     #[test]
     fn segment_mirror_and_crossing() {
-        let s = Span::Seg {
-            a: V::new(0.0, 0.0),
-            b: V::new(10.0, 0.0),
-        };
+        let s = PreparedSpan::segment(Point::new(0.0, 0.0), Point::new(10.0, 0.0));
         // Opposite sides: the chord crossing.
-        let (v, x) = best_on_span(&s, V::new(2.0, 5.0), Some(V::new(6.0, -5.0)));
+        let (v, x) = best_on_span(&s, Point::new(2.0, 5.0), Some(Point::new(6.0, -5.0)));
         assert!((x.x - 4.0).abs() < 1e-12 && x.y.abs() < 1e-12);
-        assert!((v - V::new(2.0, 5.0).dist(V::new(6.0, -5.0))).abs() < 1e-12);
+        assert!((v - Point::new(2.0, 5.0).fast_distance(Point::new(6.0, -5.0))).abs() < 1e-12);
         // Same side: the reflection point.
-        let (_, x) = best_on_span(&s, V::new(2.0, 5.0), Some(V::new(8.0, 5.0)));
+        let (_, x) = best_on_span(&s, Point::new(2.0, 5.0), Some(Point::new(8.0, 5.0)));
         assert!((x.x - 5.0).abs() < 1e-12);
         // Clamped to an endpoint.
-        let (_, x) = best_on_span(&s, V::new(20.0, 5.0), Some(V::new(30.0, 5.0)));
-        assert_eq!(x, V::new(10.0, 0.0));
+        let (_, x) = best_on_span(&s, Point::new(20.0, 5.0), Some(Point::new(30.0, 5.0)));
+        assert_eq!(x, Point::new(10.0, 0.0));
     }
 
     #[test]
     fn arc_matches_dense_sampling() {
         // A half circle of radius 10 around the origin, counter-clockwise from (10,0) to (−10,0).
-        let s = Span::new(V::new(10.0, 0.0), V::new(-10.0, 0.0), 1.0);
+        let s = PreparedSpan::new(Point::new(10.0, 0.0), Point::new(-10.0, 0.0), 1.0);
         for (p, q) in [
-            (V::new(0.0, 30.0), V::new(25.0, 20.0)),
-            (V::new(-30.0, 5.0), V::new(30.0, 6.0)),
-            (V::new(3.0, 15.0), V::new(-4.0, 12.0)),
+            (Point::new(0.0, 30.0), Point::new(25.0, 20.0)),
+            (Point::new(-30.0, 5.0), Point::new(30.0, 6.0)),
+            (Point::new(3.0, 15.0), Point::new(-4.0, 12.0)),
         ] {
             let (v, _) = best_on_span(&s, p, Some(q));
             let dense = (0..=20000)

@@ -1,10 +1,10 @@
 //! Step 4 (restoring the removed contours at the route's last crossing), the optimality
 //! certificates (Conditions 1 and 2) and the machine metrics of a route.
 
-use cutroute_geometry::{ContourRef, CutStep, MachineParameters, Nest, Point, Route};
+use cutroute_geometry::{BoundingBox, ContourRef, CutStep, MachineParameters, Nest, Point, Route};
 use serde::{Deserialize, Serialize};
 
-use crate::geom::{on_segment, BBox, Shape, Span, V};
+use crate::geom::{on_segment, ArcCache, PreparedSpan, Shape};
 use crate::problem::{Grid, Problem};
 use crate::search::Search;
 use crate::CcpError;
@@ -18,7 +18,7 @@ const TOUCH: f64 = 1e-3;
 /// The last point (largest position λ along `a b`) where the move `a b` touches `span` within
 /// [`TOUCH`]: `(λ, point on the span)`. Candidates are the span's ends, the span points nearest
 /// the move's ends, and for an arc the circle point nearest the move's line.
-fn last_touch(span: &Span, a: V, b: V) -> Option<(f64, V)> {
+fn last_touch(span: &PreparedSpan, a: Point, b: Point) -> Option<(f64, Point)> {
     let w = b - a;
     let ww = w.dot(w);
     let mut cands = [
@@ -28,21 +28,21 @@ fn last_touch(span: &Span, a: V, b: V) -> Option<(f64, V)> {
         span.nearest(b).1,
         span.a(),
     ];
-    if let Span::Arc { center, radius, .. } = *span {
+    if let Some(ArcCache { center, radius, .. }) = span.arc {
         if ww > 0.0 {
-            let n = w.perp() * (1.0 / ww.sqrt());
+            let n = w.rotated_quarter() * (1.0 / ww.sqrt());
             let side = if n.dot(a - center) >= 0.0 { 1.0 } else { -1.0 };
             cands[4] = span.nearest(center + n * (side * radius)).1;
         }
     }
-    let mut best: Option<(f64, V)> = None;
+    let mut best: Option<(f64, Point)> = None;
     for x in cands {
         let lam = if ww > 0.0 {
             ((x - a).dot(w) / ww).clamp(0.0, 1.0)
         } else {
             0.0
         };
-        if (a + w * lam).dist(x) <= TOUCH && best.is_none_or(|b| lam > b.0) {
+        if (a + w * lam).fast_distance(x) <= TOUCH && best.is_none_or(|b| lam > b.0) {
             best = Some((lam, x));
         }
     }
@@ -53,10 +53,10 @@ fn last_touch(span: &Span, a: V, b: V) -> Option<(f64, V)> {
 /// open route, and every removed contour inserted at the last crossing of the air path with it
 /// (ties on one air move ordered by position along the move), or at its last contact within
 /// [`TOUCH`] when no move crosses it.
-pub(crate) fn assemble_route(s: &Search, order: &[u32], pts: &[V]) -> Route {
+pub(crate) fn assemble_route(s: &Search, order: &[u32], pts: &[Point]) -> Route {
     let prob = &s.prob;
     // The air path: start, kept pierce points, exit chain (open routes), finish.
-    let mut poly: Vec<V> = Vec::with_capacity(order.len() + 4);
+    let mut poly: Vec<Point> = Vec::with_capacity(order.len() + 4);
     let mut poly_step: Vec<Option<usize>> = Vec::with_capacity(order.len() + 4);
     poly.push(s.start);
     poly_step.push(None);
@@ -79,19 +79,17 @@ pub(crate) fn assemble_route(s: &Search, order: &[u32], pts: &[V]) -> Route {
         poly_step.push(None);
     }
     let moves = poly.len().saturating_sub(1);
-    let mut inserted: Vec<Vec<(f64, usize, V)>> = vec![Vec::new(); moves.max(1)];
+    let mut inserted: Vec<Vec<(f64, usize, Point)>> = vec![Vec::new(); moves.max(1)];
     let mut leftovers = Vec::new();
     let mut hits = Vec::new();
     // A grid of the air moves: each removed contour only looks at the moves near it.
     let mut area = prob.bounds;
     for p in &poly {
-        area.add(*p);
+        area = area.including(*p);
     }
     let mut grid = Grid::new(area, moves.max(1), 2.0);
     for t in 0..moves {
-        let mut bb = BBox::empty();
-        bb.add(poly[t]);
-        bb.add(poly[t + 1]);
+        let bb = BoundingBox::from_corners(poly[t], poly[t + 1]);
         grid.insert(t as u32, &bb);
     }
     let mut candidates: Vec<u32> = Vec::new();
@@ -105,12 +103,14 @@ pub(crate) fn assemble_route(s: &Search, order: &[u32], pts: &[V]) -> Route {
         for &t in &candidates {
             let t = t as usize;
             let (a, b) = (poly[t], poly[t + 1]);
-            if !shape.bbox.overlaps_segment(a, b) {
+            // A cheap conservative test: the move may touch what its box meets.
+            let move_box = BoundingBox::from_corners(a, b);
+            if !shape.bbox.intersects(&move_box) {
                 continue;
             }
-            let mut best: Option<(f64, V)> = None;
+            let mut best: Option<(f64, Point)> = None;
             for (span, bb) in shape.spans.iter().zip(&shape.span_boxes) {
-                if !bb.overlaps_segment(a, b) {
+                if !bb.intersects(&move_box) {
                     continue;
                 }
                 hits.clear();
@@ -126,7 +126,13 @@ pub(crate) fn assemble_route(s: &Search, order: &[u32], pts: &[V]) -> Route {
                 // arc (grid-like nests move along the contours' own lines). Its last contact
                 // serves as well: after it the route stays outside the contour.
                 for (span, bb) in shape.spans.iter().zip(&shape.span_boxes) {
-                    if bb.dist(a).min(bb.dist(b)) > TOUCH && !bb.overlaps_segment(a, b) {
+                    if bb
+                        .gap_to_point(a)
+                        .fast_norm()
+                        .min(bb.gap_to_point(b).fast_norm())
+                        > TOUCH
+                        && !bb.intersects(&move_box)
+                    {
                         continue;
                     }
                     if let Some((lam, x)) = last_touch(span, a, b) {
@@ -163,7 +169,7 @@ pub(crate) fn assemble_route(s: &Search, order: &[u32], pts: &[V]) -> Route {
         leftovers = (0..prob.shapes.len()).filter(|&c| late[c]).collect();
     }
     // The route as (contour, pierce point), in the order the air path meets them.
-    let mut seq: Vec<(usize, V)> = Vec::with_capacity(prob.shapes.len());
+    let mut seq: Vec<(usize, Point)> = Vec::with_capacity(prob.shapes.len());
     for t in 0..poly.len() {
         if let Some(c) = poly_step[t] {
             seq.push((c, poly[t]));
@@ -194,15 +200,15 @@ pub(crate) fn assemble_route(s: &Search, order: &[u32], pts: &[V]) -> Route {
         .into_iter()
         .map(|(c, x)| CutStep {
             contour: prob.refs[c],
-            pierce_point: x.into(),
+            pierce_point: x,
             entry: Default::default(),
             leads: None,
         })
         .collect();
     Route {
-        start: s.start.into(),
+        start: s.start,
         steps,
-        finish: s.finish.map(Into::into),
+        finish: s.finish,
     }
 }
 
@@ -217,7 +223,7 @@ pub(crate) fn assemble_route(s: &Search, order: &[u32], pts: &[V]) -> Route {
 /// leave an outer contour before visiting a contour the forest puts inside it, and the checker
 /// (`Route::problems`, on the same forest) rejects the route. The forest is the one authority
 /// on "inside"; crossings only choose where, among the places it allows.
-fn inner_first(prob: &Problem, seq: Vec<(usize, V)>) -> (Vec<(usize, V)>, Vec<usize>) {
+fn inner_first(prob: &Problem, seq: Vec<(usize, Point)>) -> (Vec<(usize, Point)>, Vec<usize>) {
     let mut uncut_children = vec![0_usize; prob.shapes.len()];
     for p in prob.parent.iter().flatten() {
         uncut_children[*p] += 1;
@@ -249,15 +255,15 @@ fn inner_first(prob: &Problem, seq: Vec<(usize, V)>) -> (Vec<(usize, V)>, Vec<us
 
 /// Idle (air) length of a route: start → pierce points in order → finish.
 pub fn idle_length(route: &Route) -> f64 {
-    let mut cur = V::from(route.start);
+    let mut cur = route.start;
     let mut len = 0.0;
     for st in &route.steps {
-        let p = V::from(st.pierce_point);
-        len += cur.dist(p);
+        let p = st.pierce_point;
+        len += cur.fast_distance(p);
         cur = p;
     }
     if let Some(f) = route.finish {
-        len += cur.dist(V::from(f));
+        len += cur.fast_distance(f);
     }
     len
 }
@@ -331,16 +337,16 @@ pub fn route_certificates(nest: &Nest, route: &Route) -> Result<Vec<ContourCerti
     for (i, st) in route.steps.iter().enumerate() {
         let shape = Shape::new(contour_of(nest, st.contour)?);
         let p = if i == 0 {
-            V::from(route.start)
+            route.start
         } else {
-            V::from(route.steps[i - 1].pierce_point)
+            route.steps[i - 1].pierce_point
         };
         let q = if i + 1 < n {
-            Some(V::from(route.steps[i + 1].pierce_point))
+            Some(route.steps[i + 1].pierce_point)
         } else {
-            route.finish.map(V::from)
+            route.finish
         };
-        let m = V::from(st.pierce_point);
+        let m = st.pierce_point;
         let (on_chord, c1, c2) = certify(&shape, p, q, m);
         out.push(ContourCertificate {
             contour: st.contour,
@@ -354,51 +360,55 @@ pub fn route_certificates(nest: &Nest, route: &Route) -> Result<Vec<ContourCerti
 }
 
 /// `(on_chord, condition1, condition2)` at pierce point `m` of `shape` between `p` and `q`.
-pub(crate) fn certify(shape: &Shape, p: V, q: Option<V>, m: V) -> (bool, bool, bool) {
-    let scale = shape.bbox.max.dist(shape.bbox.min).max(1.0);
+pub(crate) fn certify(shape: &Shape, p: Point, q: Option<Point>, m: Point) -> (bool, bool, bool) {
+    let scale = shape.bbox.max.fast_distance(shape.bbox.min).max(1.0);
     let tol = 1e-7 * scale;
     let on_chord = match q {
         Some(q) => on_segment(p, q, m, tol),
-        None => m.dist(p) <= tol,
+        None => m.fast_distance(p) <= tol,
     };
-    let n = (m - p).unit() + q.map_or(V::default(), |q| (m - q).unit());
-    let c1 = on_chord || n.norm() < 1e-12 || shape.min_dot(n.unit(), m) >= -tol;
+    let n = (m - p).fast_unit() + q.map_or(Point::ORIGIN, |q| (m - q).fast_unit());
+    let c1 = on_chord || n.fast_norm() < 1e-12 || shape.min_dot(n.fast_unit(), m) >= -tol;
     let c2 = on_chord || condition2_shape(shape, m, tol);
     (on_chord, c1, c2)
 }
 
-fn condition2_shape(shape: &Shape, m: V, tol: f64) -> bool {
+fn condition2_shape(shape: &Shape, m: Point, tol: f64) -> bool {
     let nspan = shape.spans.len();
     for (si, span) in shape.spans.iter().enumerate() {
-        let Span::Seg { a, b } = *span else { continue };
+        if span.arc.is_some() {
+            continue;
+        }
+        let (a, b) = (span.a(), span.b());
         let u = b - a;
-        if u.norm() < 1e-12 {
+        if u.fast_norm() < 1e-12 {
             continue;
         }
         let on = on_segment(a, b, m, tol);
         if !on {
             continue;
         }
-        if m.dist(a) > tol && m.dist(b) > tol {
+        if m.fast_distance(a) > tol && m.fast_distance(b) > tol {
             // Interior of an edge: the contour on one side of its line.
-            let nl = u.perp().unit();
+            let nl = u.rotated_quarter().fast_unit();
             if shape.min_dot(nl, m) >= -tol || shape.min_dot(nl * -1.0, m) >= -tol {
                 return true;
             }
         } else {
             // At a vertex: both incident spans must be segments; the contour inside their angle.
-            let (prev, next) = if m.dist(a) <= tol {
+            let (prev, next) = if m.fast_distance(a) <= tol {
                 (shape.spans[(si + nspan - 1) % nspan], *span)
             } else {
                 (*span, shape.spans[(si + 1) % nspan])
             };
-            if let (Span::Seg { a: pa, .. }, Span::Seg { b: nb, .. }) = (prev, next) {
-                let e1 = (nb - m).unit();
-                let e2 = (pa - m).unit();
+            if prev.arc.is_none() && next.arc.is_none() {
+                let (pa, nb) = (prev.a(), next.b());
+                let e1 = (nb - m).fast_unit();
+                let e2 = (pa - m).fast_unit();
                 let s = e1.cross(e2);
                 if s.abs() > 1e-12 {
-                    let n1 = e1.perp() * s.signum();
-                    let n2 = e2.perp() * -s.signum();
+                    let n1 = e1.rotated_quarter() * s.signum();
+                    let n2 = e2.rotated_quarter() * -s.signum();
                     if shape.min_dot(n1, m) >= -tol && shape.min_dot(n2, m) >= -tol {
                         return true;
                     }
@@ -432,34 +442,34 @@ mod tests {
         // Reflection point on the bottom edge: the bottom line supports the whole contour.
         let (chord, c1, c2) = certify(
             &s,
-            V::new(5.0, -10.0),
-            Some(V::new(15.0, -10.0)),
-            V::new(10.0, 0.0),
+            Point::new(5.0, -10.0),
+            Some(Point::new(15.0, -10.0)),
+            Point::new(10.0, 0.0),
         );
         assert!(!chord && c1 && c2);
         // At the convex corner (20, 0) seen from outside: the contour lies in its right angle.
         let (_, c1, c2) = certify(
             &s,
-            V::new(30.0, -5.0),
-            Some(V::new(25.0, -10.0)),
-            V::new(20.0, 0.0),
+            Point::new(30.0, -5.0),
+            Some(Point::new(25.0, -10.0)),
+            Point::new(20.0, 0.0),
         );
         assert!(c1 && c2);
         // In the notch, on the edge x = 10: neither condition holds (the contour is on both sides
         // of that edge's line, and the ellipse tangent cuts through the L).
         let (_, c1, c2) = certify(
             &s,
-            V::new(30.0, 25.0),
-            Some(V::new(30.0, 5.0)),
-            V::new(10.0, 15.0),
+            Point::new(30.0, 25.0),
+            Some(Point::new(30.0, 5.0)),
+            Point::new(10.0, 15.0),
         );
         assert!(!c1 && !c2);
         // On the chord between the neighbours.
         let (chord, c1, c2) = certify(
             &s,
-            V::new(-5.0, 5.0),
-            Some(V::new(25.0, 5.0)),
-            V::new(0.0, 5.0),
+            Point::new(-5.0, 5.0),
+            Some(Point::new(25.0, 5.0)),
+            Point::new(0.0, 5.0),
         );
         assert!(chord && c1 && c2);
     }

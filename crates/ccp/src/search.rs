@@ -12,7 +12,7 @@ use std::collections::VecDeque;
 use cutroute_geometry::{MachineParameters, Nest, Point};
 use cutroute_thermal::{HeatModel, Pierce};
 
-use crate::geom::{Shape, V};
+use crate::geom::Shape;
 use crate::problem::{nearest_lists, nearest_neighbour_order, Problem};
 use crate::relax::{best_on_shape, cost};
 use cutroute_geometry::SplitMix64;
@@ -107,21 +107,21 @@ impl Edges {
 /// The search state over the kept contours.
 pub(crate) struct Search {
     pub prob: Problem,
-    pub start: V,
-    pub finish: Option<V>,
+    pub start: Point,
+    pub finish: Option<Point>,
     pub params: SearchParams,
     /// Per kept contour: the removed contours enclosing it, innermost first (open routes exit them).
     pub ancestors: Vec<Vec<usize>>,
     pub knn: Vec<Vec<u32>>,
     pub order: Vec<u32>,
     pub pos: Vec<u32>,
-    pub pts: Vec<V>,
+    pub pts: Vec<Point>,
     pub total: f64,
     pub queue: VecDeque<u32>,
     queued: Vec<bool>,
     pub rng: SplitMix64,
     recording: bool,
-    saved_pts: Vec<(u32, V)>,
+    saved_pts: Vec<(u32, Point)>,
     saved_slice: Vec<u32>,
     relax_queue: Vec<usize>,
     /// Moves evaluated (fixed-point deltas computed).
@@ -141,8 +141,8 @@ pub(crate) struct Search {
 impl Search {
     pub fn new(
         prob: Problem,
-        start: V,
-        finish: Option<V>,
+        start: Point,
+        finish: Option<Point>,
         params: SearchParams,
         seed: u64,
     ) -> Search {
@@ -166,7 +166,7 @@ impl Search {
             knn,
             order: Vec::new(),
             pos: vec![0; k],
-            pts: vec![V::default(); k],
+            pts: vec![Point::ORIGIN; k],
             total: 0.0,
             queue: VecDeque::new(),
             queued: vec![false; k],
@@ -257,8 +257,8 @@ impl Search {
         h.events.sort_unstable();
         h.sources.clear();
         let (mut t, mut at, mut e) = (0.0, self.start, 0);
-        let visit = |x: V, c: usize, t: &mut f64, at: &mut V, sources: &mut Vec<Pierce>| {
-            *t += at.dist(x) / h.idle_speed;
+        let visit = |x: Point, c: usize, t: &mut f64, at: &mut Point, sources: &mut Vec<Pierce>| {
+            *t += at.fast_distance(x) / h.idle_speed;
             sources.push(Pierce {
                 point: Point::new(x.x, x.y),
                 time: *t,
@@ -339,12 +339,12 @@ impl Search {
 
     /// The exit chain of kept contour `k` leaving point `x` (open routes only): the nearest point
     /// on each enclosing removed contour in turn. Returns its length.
-    pub fn exit_chain(&self, k: usize, x: V, mut out: Option<&mut Vec<V>>) -> f64 {
+    pub fn exit_chain(&self, k: usize, x: Point, mut out: Option<&mut Vec<Point>>) -> f64 {
         let mut cur = x;
         let mut len = 0.0;
         for &a in &self.ancestors[k] {
             let y = self.prob.shapes[a].nearest(cur);
-            len += cur.dist(y);
+            len += cur.fast_distance(y);
             if let Some(o) = out.as_deref_mut() {
                 o.push(y);
             }
@@ -355,9 +355,9 @@ impl Search {
 
     /// The cost of ending the route at kept contour `k` pierced at `x`.
     #[inline]
-    pub fn end_cost(&self, k: usize, x: V) -> f64 {
+    pub fn end_cost(&self, k: usize, x: Point) -> f64 {
         match self.finish {
-            Some(f) => x.dist(f),
+            Some(f) => x.fast_distance(f),
             None if self.ancestors[k].is_empty() => 0.0,
             None => self.exit_chain(k, x, None),
         }
@@ -365,7 +365,7 @@ impl Search {
 
     /// What follows the last contour's point, for the relaxation: the finish, the first exit
     /// point, or nothing.
-    fn end_target(&self, k: usize, x: V) -> Option<V> {
+    fn end_target(&self, k: usize, x: Point) -> Option<Point> {
         match self.finish {
             Some(f) => Some(f),
             None => self.ancestors[k]
@@ -377,10 +377,10 @@ impl Search {
     #[inline]
     fn w(&self, a: i64, b: i64) -> f64 {
         match (a, b) {
-            (START, END) | (END, START) => self.finish.map_or(0.0, |f| self.start.dist(f)),
-            (START, k) | (k, START) => self.start.dist(self.pts[k as usize]),
+            (START, END) | (END, START) => self.finish.map_or(0.0, |f| self.start.fast_distance(f)),
+            (START, k) | (k, START) => self.start.fast_distance(self.pts[k as usize]),
             (k, END) | (END, k) => self.end_cost(k as usize, self.pts[k as usize]),
-            (a, b) => self.pts[a as usize].dist(self.pts[b as usize]),
+            (a, b) => self.pts[a as usize].fast_distance(self.pts[b as usize]),
         }
     }
 
@@ -408,8 +408,8 @@ impl Search {
             let q = self.end_target(k, cur);
             let (_, x) = best_on_shape(self.shape(k), p, q, Some(cur));
             (
-                p.dist(cur) + self.end_cost(k, cur),
-                p.dist(x) + self.end_cost(k, x),
+                p.fast_distance(cur) + self.end_cost(k, cur),
+                p.fast_distance(x) + self.end_cost(k, x),
                 x,
             )
         };
@@ -419,7 +419,7 @@ impl Search {
             }
             self.pts[k] = x;
             self.total -= old - new;
-            cur.dist(x)
+            cur.fast_distance(x)
         } else {
             0.0
         }
@@ -702,12 +702,12 @@ impl Search {
         // With a heat penalty a longer route may still be better: every move is checked.
         if d0 >= -IMPROVE && self.heat.is_none() {
             // Estimate what relaxing each junction could win against its new neighbours.
-            let mut targets = [(V::default(), None::<V>, 0usize); 12];
+            let mut targets = [(Point::ORIGIN, None::<Point>, 0usize); 12];
             let mut ub = 0.0;
             for (t, &c) in junctions[..nj].iter().enumerate() {
                 let (a, b) = self.new_neighbours(c, &e);
                 let cur = self.pts[c as usize];
-                let at = |x: Option<i64>| -> Option<V> {
+                let at = |x: Option<i64>| -> Option<Point> {
                     match x {
                         Some(START) => Some(self.start),
                         Some(END) | None => self.end_target(c as usize, cur),
@@ -724,8 +724,10 @@ impl Search {
                 // Nothing on the contour beats the distances to its bounding box, nor |PQ|.
                 let bb = &self.shape(c as usize).bbox;
                 let lower = match q {
-                    Some(q) => p.dist(q).max(bb.dist(p) + bb.dist(q)),
-                    None => bb.dist(p),
+                    Some(q) => p
+                        .fast_distance(q)
+                        .max(bb.gap_to_point(p).fast_norm() + bb.gap_to_point(q).fast_norm()),
+                    None => bb.gap_to_point(p).fast_norm(),
                 };
                 ub += here - lower;
                 targets[t] = (p, q, c as usize);
@@ -1153,12 +1155,12 @@ impl Search {
 
     /// A copy of the route state; its third element is the objective (the idle length when
     /// there is no heat penalty).
-    pub fn snapshot(&self) -> (Vec<u32>, Vec<V>, f64) {
+    pub fn snapshot(&self) -> (Vec<u32>, Vec<Point>, f64) {
         (self.order.clone(), self.pts.clone(), self.objective())
     }
 
     /// Restores a copy made by `snapshot`.
-    pub fn restore(&mut self, snap: &(Vec<u32>, Vec<V>, f64)) {
+    pub fn restore(&mut self, snap: &(Vec<u32>, Vec<Point>, f64)) {
         self.order.clone_from(&snap.0);
         self.pts.clone_from(&snap.1);
         self.reindex(0, self.order.len());
@@ -1179,8 +1181,8 @@ mod tests {
     #[test]
     fn relaxation_never_increases_length() {
         let nest = cutroute_geometry::generate_nest(150, 11);
-        for finish in [None, Some(V::new(0.0, 0.0))] {
-            let prob = Problem::new(&nest, V::default(), finish);
+        for finish in [None, Some(Point::new(0.0, 0.0))] {
+            let prob = Problem::new(&nest, Point::ORIGIN, finish);
             let params = SearchParams {
                 delta: 1e-9,
                 max_relaxation_sweeps: 1000,
@@ -1189,7 +1191,7 @@ mod tests {
                 max_block: 3,
                 reinsert_block: 6,
             };
-            let mut s = Search::new(prob, V::default(), finish, params, 3);
+            let mut s = Search::new(prob, Point::ORIGIN, finish, params, 3);
             let n = s.len();
             // A random order and arbitrary pierce points (first vertices).
             let mut order: Vec<u32> = (0..n as u32).collect();
@@ -1215,7 +1217,7 @@ mod tests {
             // Every pierce point lies on its contour.
             for k in 0..n {
                 let x = s.pts[k];
-                assert!(s.shape(k).nearest(x).dist(x) < 1e-7);
+                assert!(s.shape(k).nearest(x).fast_distance(x) < 1e-7);
             }
         }
     }
@@ -1223,7 +1225,7 @@ mod tests {
     #[test]
     fn accepted_moves_keep_the_running_length_exact() {
         let nest = cutroute_geometry::generate_nest(120, 4);
-        let prob = Problem::new(&nest, V::default(), None);
+        let prob = Problem::new(&nest, Point::ORIGIN, None);
         let params = SearchParams {
             delta: 1e-9,
             max_relaxation_sweeps: 1000,
@@ -1232,7 +1234,7 @@ mod tests {
             max_block: 3,
             reinsert_block: 6,
         };
-        let mut s = Search::new(prob, V::default(), None, params, 5);
+        let mut s = Search::new(prob, Point::ORIGIN, None, params, 5);
         s.construct(false);
         s.relax_full();
         s.queue_all();

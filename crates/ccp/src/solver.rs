@@ -8,7 +8,6 @@ use cutroute_thermal::HeatModel;
 use serde::{Deserialize, Serialize};
 use web_time::Instant;
 
-use crate::geom::V;
 use crate::problem::Problem;
 use crate::route::{
     assemble_route, idle_length, route_certificates, route_metrics, ContourCertificate,
@@ -188,7 +187,7 @@ pub struct CcpSolver {
     search: Search,
     phase: CcpPhase,
     elapsed: Duration,
-    best: Option<(Vec<u32>, Vec<V>, f64)>,
+    best: Option<(Vec<u32>, Vec<Point>, f64)>,
     route: Route,
     route_length: f64,
     local_optimum_time: Option<Duration>,
@@ -254,8 +253,8 @@ impl CcpSolver {
             }
         }
         let t0 = Instant::now();
-        let start = V::from(options.start);
-        let finish = options.finish.map(V::from);
+        let start = options.start;
+        let finish = options.finish;
         let prob = Problem::new(nest, start, finish);
         let params = SearchParams {
             delta: options.delta,

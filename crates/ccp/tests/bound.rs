@@ -6,33 +6,17 @@
 use std::time::Duration;
 
 use cutroute_ccp::{containment_pairs, solve, CcpLowerBound, CcpOptions, LowerBoundOptions};
-use cutroute_geometry::{Contour, ContourRef, Nest, Part, Point, Vertex};
-
-/// xorshift64*: a few random numbers without a dependency.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
-    }
-
-    fn range(&mut self, a: f64, b: f64) -> f64 {
-        a + (b - a) * self.next()
-    }
-}
+use cutroute_geometry::{Contour, ContourRef, Nest, Part, Point, SplitMix64, Vertex};
 
 /// A convex polygon of `n` corners around `centre` (some sides bulged outwards), clockwise as
 /// outer contours are after opening; `hole` gives the counter-clockwise orientation of holes.
-fn polygon(rng: &mut Rng, centre: Point, radius: f64, n: usize, hole: bool) -> Contour {
+fn polygon(rng: &mut SplitMix64, centre: Point, radius: f64, n: usize, hole: bool) -> Contour {
     let turn = rng.range(0.0, std::f64::consts::TAU);
     let mut vertices: Vec<Vertex> = (0..n)
         .map(|k| {
             let a = turn - std::f64::consts::TAU * k as f64 / n as f64;
             // Clockwise sides bulge outwards with a negative bulge.
-            let bulge = if rng.next() < 0.4 {
+            let bulge = if rng.next_f64() < 0.4 {
                 -rng.range(0.05, 0.4)
             } else {
                 0.0
@@ -52,18 +36,18 @@ fn polygon(rng: &mut Rng, centre: Point, radius: f64, n: usize, hole: bool) -> C
 
 /// 2–4 parts in separate cells of a grid; sometimes one has a hole with a small part in it.
 fn random_nest(seed: u64) -> Nest {
-    let mut rng = Rng(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1);
-    let count = 2 + (rng.next() * 3.0) as usize;
+    let mut rng = SplitMix64::new(seed);
+    let count = 2 + (rng.next_f64() * 3.0) as usize;
     let mut parts = Vec::new();
     for i in 0..count {
         let centre = Point::new(
             60.0 * (i % 2) as f64 + rng.range(-8.0, 8.0),
             60.0 * (i / 2) as f64 + rng.range(-8.0, 8.0) + 20.0,
         );
-        let corners = 3 + (rng.next() * 4.0) as usize;
+        let corners = 3 + (rng.next_f64() * 4.0) as usize;
         let radius = rng.range(10.0, 20.0);
         let mut contours = vec![polygon(&mut rng, centre, radius, corners, false)];
-        if i == 0 && rng.next() < 0.6 {
+        if i == 0 && rng.next_f64() < 0.6 {
             contours.push(polygon(&mut rng, centre, 0.5 * radius, 5, true));
             parts.push(Part {
                 name: "inner".into(),
@@ -360,14 +344,14 @@ fn at_fixed_candidates_never_above_the_discrete_optimum_and_exact_without_holes(
 /// hole holding a small part: more contours than the random nests, so groups of one or two
 /// kept contours border each other closely.
 fn packed_nest(seed: u64) -> Nest {
-    let mut rng = Rng(seed.wrapping_mul(0x2545_F491_4F6C_DD1D) | 1);
+    let mut rng = SplitMix64::new(seed ^ 0x2545_F491_4F6C_DD1D);
     let mut parts = Vec::new();
     for i in 0..6 {
         let centre = Point::new(
             28.0 * (i % 3) as f64 + rng.range(-2.0, 2.0),
             28.0 * (i / 3) as f64 + rng.range(-2.0, 2.0) + 15.0,
         );
-        let corners = 3 + (rng.next() * 4.0) as usize;
+        let corners = 3 + (rng.next_f64() * 4.0) as usize;
         let radius = rng.range(9.0, 12.0);
         let mut contours = vec![polygon(&mut rng, centre, radius, corners, false)];
         if i == 0 {

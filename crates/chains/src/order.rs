@@ -225,13 +225,8 @@ mod tests {
 
     #[test]
     fn held_karp_matches_brute_force_and_the_heuristic_is_never_better() {
-        let mut state = 12345u64;
-        let mut rnd = || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 33) as f64 / (1u64 << 31) as f64
-        };
+        let mut rng = cutroute_geometry::SplitMix64::new(12345);
+        let mut rnd = || rng.next_f64();
         for n in 1..=7 {
             for _ in 0..20 {
                 let pts: Vec<(f64, f64)> = (0..n).map(|_| (rnd() * 100.0, rnd() * 100.0)).collect();

@@ -1,9 +1,7 @@
 //! Where a reader's typed error points in its file, for the page's located error messages
 //! ([`cutroute_protocol::OpenError`]).
 
-use cutroute_cad::dxf::DxfError;
-use cutroute_cad::svg::SvgError;
-use cutroute_cad::tflex::TflexError;
+use cutroute_cad::CadError;
 use cutroute_formats::{DbsError, JsonError, ReadError};
 use cutroute_gcode::GcodeReadError;
 use cutroute_pcgtsp::ParseError;
@@ -75,52 +73,39 @@ impl Located for DbsError {
     }
 }
 
-impl Located for DxfError {
+impl Located for CadError {
     fn location(&self) -> Option<SourceLocation> {
         match self {
-            DxfError::BadGroupCode { line, .. }
-            | DxfError::MissingValue { line, .. }
-            | DxfError::BadNumber { line, .. }
-            | DxfError::OutOfRange { line, .. }
-            | DxfError::Unterminated { line, .. }
-            | DxfError::MissingGroup { line, .. }
-            | DxfError::InvalidSpline { line, .. }
-            | DxfError::InvalidEntity { line, .. }
-            | DxfError::UnknownBlock { line, .. }
-            | DxfError::BlockNestingTooDeep { line, .. } => at_line(*line),
-            _ => None,
-        }
-    }
-}
-
-impl Located for SvgError {
-    fn location(&self) -> Option<SourceLocation> {
-        match self {
-            SvgError::NotUtf8 { byte } => Some(SourceLocation::Byte { offset: *byte }),
-            SvgError::Xml { line, column, .. }
-            | SvgError::BadAttribute { line, column, .. }
-            | SvgError::BadPathData { line, column, .. }
-            | SvgError::TooDeep { line, column, .. } => {
+            CadError::NotUtf8 { byte } => Some(SourceLocation::Byte { offset: *byte }),
+            CadError::BadGroupCode { line, .. }
+            | CadError::MissingValue { line, .. }
+            | CadError::BadNumber { line, .. }
+            | CadError::OutOfRange { line, .. }
+            | CadError::Unterminated { line, .. }
+            | CadError::MissingGroup { line, .. }
+            | CadError::InvalidSpline { line, .. }
+            | CadError::InvalidEntity { line, .. }
+            | CadError::UnknownBlock { line, .. }
+            | CadError::BlockNestingTooDeep { line, .. } => at_line(*line),
+            CadError::Xml { line, column, .. }
+            | CadError::BadAttribute { line, column, .. }
+            | CadError::BadPathData { line, column, .. }
+            | CadError::TooDeep { line, column, .. }
+            | CadError::MissingElement { line, column, .. }
+            | CadError::BadValue { line, column, .. }
+            | CadError::UnknownType { line, column, .. }
+            | CadError::InvalidGeometry { line, column, .. }
+            | CadError::UnknownReference { line, column, .. } => {
                 line_column(*line as usize, *column as usize)
             }
-            _ => None,
-        }
-    }
-}
-
-impl Located for TflexError {
-    fn location(&self) -> Option<SourceLocation> {
-        match self {
-            TflexError::NotUtf8 { byte } => Some(SourceLocation::Byte { offset: *byte }),
-            TflexError::Xml { line, column, .. }
-            | TflexError::MissingElement { line, column, .. }
-            | TflexError::BadValue { line, column, .. }
-            | TflexError::UnknownType { line, column, .. }
-            | TflexError::InvalidGeometry { line, column, .. }
-            | TflexError::UnknownReference { line, column, .. } => {
-                line_column(*line as usize, *column as usize)
-            }
-            _ => None,
+            CadError::TooComplex { .. }
+            | CadError::InvalidOptions(_)
+            | CadError::NothingClosed { .. }
+            | CadError::BinaryDxf
+            | CadError::NoEntities
+            | CadError::NotSvg { .. }
+            | CadError::NotAProject { .. }
+            | CadError::TooLarge { .. } => None,
         }
     }
 }

@@ -1,6 +1,5 @@
 //! Axis-aligned bounding boxes.
 
-use crate::float::Libm;
 use serde::{Deserialize, Serialize};
 
 use crate::Point;
@@ -112,9 +111,26 @@ impl BoundingBox {
     /// The least distance from `p` to a point of the closed box (0 inside; infinite for the
     /// empty box): a lower bound on the distance from `p` to any shape the box contains.
     pub fn distance_to_point(&self, p: Point) -> f64 {
-        let dx = (self.min.x - p.x).max(p.x - self.max.x).max(0.0);
-        let dy = (self.min.y - p.y).max(p.y - self.max.y).max(0.0);
-        dx.hypot_libm(dy)
+        self.gap_to_point(p).norm()
+    }
+
+    /// How far `p` lies outside the box along each axis (0 on an axis where it lies within the
+    /// box's extent; infinite for the empty box): the vector whose length is
+    /// [`BoundingBox::distance_to_point`], for callers that take the length by
+    /// [`Point::fast_norm`] in an inner loop.
+    ///
+    /// ```
+    /// use cutroute_geometry::{BoundingBox, Point};
+    /// let b = BoundingBox::from_corners(Point::new(0.0, 0.0), Point::new(2.0, 1.0));
+    /// assert_eq!(b.gap_to_point(Point::new(5.0, 0.5)), Point::new(3.0, 0.0));
+    /// assert_eq!(b.gap_to_point(Point::new(-3.0, 5.0)).fast_norm(), 5.0);
+    /// ```
+    #[inline]
+    pub fn gap_to_point(&self, p: Point) -> Point {
+        Point::new(
+            (self.min.x - p.x).max(p.x - self.max.x).max(0.0),
+            (self.min.y - p.y).max(p.y - self.max.y).max(0.0),
+        )
     }
 
     /// The least distance between a point of this box and a point of `other` (0 when they
@@ -124,13 +140,30 @@ impl BoundingBox {
         if self.is_empty() || other.is_empty() {
             return f64::INFINITY;
         }
-        let dx = (other.min.x - self.max.x)
-            .max(self.min.x - other.max.x)
-            .max(0.0);
-        let dy = (other.min.y - self.max.y)
-            .max(self.min.y - other.max.y)
-            .max(0.0);
-        dx.hypot_libm(dy)
+        self.gap_to_box(other).norm()
+    }
+
+    /// How far apart the two boxes lie along each axis (0 on an axis where their extents
+    /// overlap): the vector whose length is [`BoundingBox::distance_to_box`] for non-empty
+    /// boxes, for callers that take the length by [`Point::fast_norm`] in an inner loop.
+    ///
+    /// ```
+    /// use cutroute_geometry::{BoundingBox, Point};
+    /// let a = BoundingBox::from_corners(Point::new(0.0, 0.0), Point::new(1.0, 1.0));
+    /// let b = BoundingBox::from_corners(Point::new(4.0, 5.0), Point::new(6.0, 6.0));
+    /// assert_eq!(a.gap_to_box(&b), Point::new(3.0, 4.0));
+    /// assert_eq!(b.gap_to_box(&a).fast_norm(), 5.0);
+    /// ```
+    #[inline]
+    pub fn gap_to_box(&self, other: &BoundingBox) -> Point {
+        Point::new(
+            (other.min.x - self.max.x)
+                .max(self.min.x - other.max.x)
+                .max(0.0),
+            (other.min.y - self.max.y)
+                .max(self.min.y - other.max.y)
+                .max(0.0),
+        )
     }
 
     /// The closed boxes share at least one point.

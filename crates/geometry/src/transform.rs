@@ -60,6 +60,22 @@ impl Transform {
         }
     }
 
+    /// Scaling by `sx` along x and `sy` along y about the origin (a DXF block insert's scale).
+    /// Unless `|sx| = |sy|` it is not a similarity: circles become ellipses.
+    ///
+    /// ```
+    /// use cutroute_geometry::{Point, Transform};
+    /// let map = Transform::axis_scaling(2.0, -3.0);
+    /// assert_eq!(map.apply(Point::new(1.0, 1.0)), Point::new(2.0, -3.0));
+    /// assert!(map.is_reflection() && !map.is_similarity());
+    /// ```
+    pub const fn axis_scaling(sx: f64, sy: f64) -> Self {
+        Transform {
+            matrix: [[sx, 0.0], [0.0, sy]],
+            offset: Point::ORIGIN,
+        }
+    }
+
     /// Reflection in the x axis (`y ↦ −y`).
     pub const fn mirror_x() -> Self {
         Transform {

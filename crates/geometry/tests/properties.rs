@@ -177,6 +177,34 @@ proptest! {
     }
 
     #[test]
+    fn fast_norms_agree_with_the_hypot_ones(p in point(), q in point()) {
+        let v = q - p;
+        prop_assert!((v.fast_norm() - v.norm()).abs() <= 4.0 * f64::EPSILON * v.norm());
+        prop_assert_eq!(p.fast_distance(q), v.fast_norm());
+        prop_assert_eq!(p.fast_distance(q), q.fast_distance(p));
+        let u = v.fast_unit();
+        if v.fast_norm() > 0.0 {
+            prop_assert!((u.fast_norm() - 1.0).abs() <= 1e-15);
+            prop_assert!(u.cross(v).abs() <= 1e-12 * v.fast_norm() && u.dot(v) > 0.0);
+        } else {
+            prop_assert_eq!(u, Point::ORIGIN);
+        }
+    }
+
+    #[test]
+    fn box_gaps_are_the_box_distances(s in span(), o in span(), q in point()) {
+        let (a, b) = (s.bounding_box(), o.bounding_box());
+        prop_assert_eq!(a.gap_to_point(q).norm(), a.distance_to_point(q));
+        prop_assert_eq!(a.gap_to_box(&b).norm(), a.distance_to_box(&b));
+        prop_assert_eq!(a.gap_to_box(&b), b.gap_to_box(&a));
+        let scale = 1e-12 * (1.0 + a.distance_to_box(&b));
+        prop_assert!((a.gap_to_box(&b).fast_norm() - a.distance_to_box(&b)).abs() <= scale);
+        // The gap to the box of a point is the gap to the point.
+        let point_box = cutroute_geometry::BoundingBox::from_corners(q, q);
+        prop_assert_eq!(a.gap_to_box(&point_box), a.gap_to_point(q));
+    }
+
+    #[test]
     fn split_then_merge_is_identity(s in span(), t in 0.01..0.99f64) {
         let (a, b) = s.split_at(t);
         prop_assert!((a.length() + b.length() - s.length()).abs() < 1e-9 * s.length().max(1.0));

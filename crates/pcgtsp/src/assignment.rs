@@ -131,13 +131,8 @@ mod tests {
 
     #[test]
     fn matches_brute_force_and_duals_are_feasible() {
-        let mut seed = 12345u64;
-        let mut next = || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            seed
-        };
+        let mut rng = cutroute_geometry::SplitMix64::new(12345);
+        let mut next = || rng.next_u64();
         let mut solver = Assignment::default();
         for round in 0..300 {
             let k = 1 + (round % 7);

@@ -128,15 +128,11 @@ fn insert_placement(
     base: Point,
     offset: Point,
 ) -> Transform {
-    let (s, c) = rotation_deg.to_radians().sin_cos_libm();
-    let (sx, sy) = (scale.x, scale.y);
-    // Local: q = (sx·(x − bx) + ox, sy·(y − by) + oy); world = at + R·q.
-    let qx_t = -sx * base.x + offset.x;
-    let qy_t = -sy * base.y + offset.y;
-    Transform {
-        matrix: [[c * sx, -s * sy], [s * sx, c * sy]],
-        offset: Point::new(at.x + c * qx_t - s * qy_t, at.y + s * qx_t + c * qy_t),
-    }
+    Transform::translation(-base.x, -base.y)
+        .then(&Transform::axis_scaling(scale.x, scale.y))
+        .then(&Transform::translation(offset.x, offset.y))
+        .then(&Transform::rotation(rotation_deg.to_radians()))
+        .then(&Transform::translation(at.x, at.y))
 }
 
 /// A block definition: base point and its entity records.

@@ -68,125 +68,10 @@ impl std::fmt::Display for DxfWarning {
 /// the open chains of entities, and the warnings.
 pub type DxfImport = DrawingImport<DxfWarning>;
 
-/// Why a DXF file could not be imported. Line numbers are 1-based lines of the file.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum DxfError {
-    /// The file is a binary DXF, which this reader does not read.
-    #[error("binary DXF is not supported; save the drawing as ASCII DXF")]
-    BinaryDxf,
-    /// A group code line does not hold an integer.
-    #[error("line {line}: group code expected, found {text:?}")]
-    BadGroupCode {
-        /// Line of the would-be group code.
-        line: usize,
-        /// What stands there.
-        text: String,
-    },
-    /// The file ends after a group code, before its value (truncated file).
-    #[error("line {line}: group code {code} has no value line (file truncated?)")]
-    MissingValue {
-        /// Line of the group code.
-        line: usize,
-        /// The group code.
-        code: i32,
-    },
-    /// A value that must be a number is not one (or is NaN or infinite).
-    #[error("line {line}: group {code} must be a finite number, found {text:?}")]
-    BadNumber {
-        /// Line of the value.
-        line: usize,
-        /// Its group code.
-        code: i32,
-        /// What stands there.
-        text: String,
-    },
-    /// A number is beyond ±1e9, larger than any drawing in millimetres.
-    #[error("line {line}: group {code} value {value} is out of range (|value| > 1e9)")]
-    OutOfRange {
-        /// Line of the value.
-        line: usize,
-        /// Its group code.
-        code: i32,
-        /// The value.
-        value: f64,
-    },
-    /// A section, block or polyline is not closed before the file ends (truncated file).
-    #[error("line {line}: {what} is not terminated before the end of the file (truncated?)")]
-    Unterminated {
-        /// Line where the unterminated item starts.
-        line: usize,
-        /// What it is (`section ENTITIES`, `block X`, …).
-        what: String,
-    },
-    /// The file has no `ENTITIES` section.
-    #[error("the file has no ENTITIES section")]
-    NoEntities,
-    /// An entity lacks a group it cannot do without.
-    #[error("line {line}: {entity} has no group {code} ({meaning})")]
-    MissingGroup {
-        /// Line of the entity.
-        line: usize,
-        /// Entity type.
-        entity: String,
-        /// The missing group code.
-        code: i32,
-        /// What the group means.
-        meaning: &'static str,
-    },
-    /// A spline whose data are inconsistent (degree, counts, knots, weights).
-    #[error("line {line}: invalid SPLINE: {reason}")]
-    InvalidSpline {
-        /// Line of the spline.
-        line: usize,
-        /// What is wrong.
-        reason: String,
-    },
-    /// Another inconsistent entity (negative counts, absurd array sizes, …).
-    #[error("line {line}: invalid {entity}: {reason}")]
-    InvalidEntity {
-        /// Line of the entity.
-        line: usize,
-        /// Entity type.
-        entity: String,
-        /// What is wrong.
-        reason: String,
-    },
-    /// An `INSERT` names a block the file does not define.
-    #[error("line {line}: INSERT of undefined block {name:?}")]
-    UnknownBlock {
-        /// Line of the INSERT.
-        line: usize,
-        /// The block name.
-        name: String,
-    },
-    /// Blocks insert each other deeper than the limit (or in a cycle).
-    #[error("line {line}: blocks nest deeper than {limit} levels at block {name:?} (cycle?)")]
-    BlockNestingTooDeep {
-        /// Line of the innermost INSERT.
-        line: usize,
-        /// The block being inserted.
-        name: String,
-        /// The depth limit.
-        limit: usize,
-    },
-    /// The drawing would produce more spans than [`DxfOptions::max_spans`].
-    #[error("the drawing needs more than {limit} spans (block explosion or too fine tolerance)")]
-    TooComplex {
-        /// The limit that was hit.
-        limit: usize,
-    },
-    /// The options are unusable (tolerances must be finite and positive).
-    #[error("invalid options: {0}")]
-    InvalidOptions(String),
-    /// The drawing yields no closed contour at all.
-    #[error("no closed contour in the drawing ({open} open chains, first: {first})")]
-    NothingClosed {
-        /// How many open chains there are.
-        open: usize,
-        /// The first open chain, described.
-        first: String,
-    },
-}
+/// Why a DXF file could not be imported: the CAD readers' shared [`CadError`](crate::CadError),
+/// whose shared and `DXF:` variants this reader returns. Line numbers are 1-based lines of the
+/// file.
+pub type DxfError = crate::CadError;
 
 /// Reads an ASCII DXF drawing into closed parts, reporting open chains and skipped entities.
 ///
@@ -214,12 +99,7 @@ pub fn read_dxf(bytes: &[u8], options: &DxfOptions) -> Result<DxfImport, DxfErro
             format!("nothing drawn in lines 1 to {lines}")
         }
     };
-    finish_import(pieces, None, &limits, warnings, dropped, nothing_drawn).map_err(|e| {
-        DxfError::NothingClosed {
-            open: e.open,
-            first: e.first,
-        }
-    })
+    finish_import(pieces, None, &limits, warnings, dropped, nothing_drawn)
 }
 
 fn check_options(options: &DxfOptions) -> Result<(), DxfError> {

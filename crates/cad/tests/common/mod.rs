@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use cutroute_geometry::{Contour, Point};
+use cutroute_geometry::{BoundingBox, Contour, Point};
 
 /// A file of the shared reference data; panics loudly when it is missing.
 pub fn shared_file(relative: &str) -> Vec<u8> {
@@ -102,45 +102,31 @@ pub fn distance_to_boundary(p: Point, polygon: &[Point]) -> f64 {
     best
 }
 
-/// Bounding box (min, max) of a polygon.
-pub fn bounds(polygon: &[Point]) -> (Point, Point) {
-    polygon.iter().fold(
-        (
-            Point::new(f64::INFINITY, f64::INFINITY),
-            Point::new(f64::NEG_INFINITY, f64::NEG_INFINITY),
-        ),
-        |(lo, hi), p| {
-            (
-                Point::new(lo.x.min(p.x), lo.y.min(p.y)),
-                Point::new(hi.x.max(p.x), hi.y.max(p.y)),
-            )
-        },
-    )
+/// Bounding box of a polygon.
+pub fn bounds(polygon: &[Point]) -> BoundingBox {
+    BoundingBox::from_points(polygon.iter().copied())
 }
 
 /// A flattened part: its material is inside the outer polygon and outside every hole.
 pub struct Solid {
     pub outer: Vec<Point>,
     pub holes: Vec<Vec<Point>>,
-    pub lo: Point,
-    pub hi: Point,
+    pub bounds: BoundingBox,
 }
 
 impl Solid {
     pub fn new(contours: &[Contour]) -> Self {
         let outer = polygon(&contours[0]);
-        let (lo, hi) = bounds(&outer);
         Self {
-            outer,
+            bounds: bounds(&outer),
             holes: contours[1..].iter().map(polygon).collect(),
-            lo,
-            hi,
+            outer,
         }
     }
 
     /// Whether `p` lies in the material farther than `tolerance` from every boundary.
     pub fn deeply_contains(&self, p: Point, tolerance: f64) -> bool {
-        if p.x < self.lo.x || p.x > self.hi.x || p.y < self.lo.y || p.y > self.hi.y {
+        if !self.bounds.contains_point(p) {
             return false;
         }
         inside(p, &self.outer)
@@ -166,7 +152,7 @@ impl Solid {
         }
         // An interior point: the middle of the first material interval on the horizontal line
         // through the bounding box centre (even-odd over outer and holes).
-        let y = (self.lo.y + self.hi.y) / 2.0 + 1e-3;
+        let y = (self.bounds.min.y + self.bounds.max.y) / 2.0 + 1e-3;
         let mut xs = Vec::new();
         for poly in std::iter::once(&self.outer).chain(self.holes.iter()) {
             let m = poly.len();
@@ -189,16 +175,18 @@ impl Solid {
 /// bounding boxes sorted by their left edge.
 pub fn overlapping_pairs(solids: &[Solid], tolerance: f64) -> Vec<(usize, usize)> {
     let mut order: Vec<usize> = (0..solids.len()).collect();
-    order.sort_by(|&a, &b| solids[a].lo.x.total_cmp(&solids[b].lo.x));
+    order.sort_by(|&a, &b| solids[a].bounds.min.x.total_cmp(&solids[b].bounds.min.x));
     let probes: Vec<Vec<Point>> = solids.iter().map(|s| s.probes(2.0)).collect();
     let mut pairs = Vec::new();
     for (k, &i) in order.iter().enumerate() {
         for &j in &order[k + 1..] {
             let (a, b) = (&solids[i], &solids[j]);
-            if b.lo.x >= a.hi.x - tolerance {
+            if b.bounds.min.x >= a.bounds.max.x - tolerance {
                 break;
             }
-            if b.lo.y >= a.hi.y - tolerance || a.lo.y >= b.hi.y - tolerance {
+            if b.bounds.min.y >= a.bounds.max.y - tolerance
+                || a.bounds.min.y >= b.bounds.max.y - tolerance
+            {
                 continue;
             }
             let hit = probes[i].iter().any(|&p| b.deeply_contains(p, tolerance))
@@ -235,7 +223,7 @@ fn on_sweep(angle: f64, start: f64, sweep: f64) -> bool {
 }
 
 /// Exact bounding box of a contour, arc extremes included.
-pub fn exact_bounds(contour: &Contour) -> (Point, Point) {
+pub fn exact_bounds(contour: &Contour) -> BoundingBox {
     let n = contour.vertices.len();
     let mut pts: Vec<Point> = contour.vertices.iter().map(|v| v.point).collect();
     for i in 0..n {

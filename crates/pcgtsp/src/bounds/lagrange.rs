@@ -500,13 +500,8 @@ mod tests {
 
     #[test]
     fn min_arborescence_matches_enumeration() {
-        let mut state = 12345u64;
-        let mut next = |bound: u64| {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 33) % bound
-        };
+        let mut rng = cutroute_geometry::SplitMix64::new(12345);
+        let mut next = |bound: u64| rng.below(bound);
         for case in 0..400 {
             let k = 2 + case % 5;
             let root = next(k as u64) as usize;

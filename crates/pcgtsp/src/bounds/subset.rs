@@ -692,27 +692,16 @@ impl SubsetBound {
 mod tests {
     use super::*;
     use crate::instance::Instance;
-
-    /// A small deterministic generator (tests must not depend on an RNG crate's stream).
-    struct Lcg(u64);
-    impl Lcg {
-        fn next(&mut self, bound: u64) -> u64 {
-            self.0 = self
-                .0
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (self.0 >> 33) % bound
-        }
-    }
+    use cutroute_geometry::SplitMix64;
 
     /// A random instance: `m` clusters of 1–3 nodes, asymmetric costs (some forbidden), random
     /// precedence pairs from a random topological order.
     fn random_instance(seed: u64, m: usize) -> Instance {
-        let mut rng = Lcg(seed);
+        let mut rng = SplitMix64::new(seed);
         let mut clusters = vec![vec![0usize]];
         let mut node_cluster = vec![0usize];
         for c in 1..m {
-            let size = 1 + rng.next(3) as usize;
+            let size = 1 + rng.below(3) as usize;
             let mut nodes = Vec::new();
             for _ in 0..size {
                 nodes.push(node_cluster.len());
@@ -724,21 +713,21 @@ mod tests {
         let mut cost = vec![0.0; n * n];
         for a in 0..n {
             for b in 0..n {
-                cost[a * n + b] = if a == b || rng.next(10) == 0 {
+                cost[a * n + b] = if a == b || rng.below(10) == 0 {
                     f64::INFINITY
                 } else {
-                    (30 + rng.next(40)) as f64
+                    (30 + rng.below(40)) as f64
                 };
             }
         }
         let mut order: Vec<usize> = (1..m).collect();
         for i in (1..order.len()).rev() {
-            order.swap(i, rng.next(i as u64 + 1) as usize);
+            order.swap(i, rng.below(i as u64 + 1) as usize);
         }
         let mut precedence = Vec::new();
         for i in 0..order.len() {
             for j in i + 1..order.len() {
-                if rng.next(5) == 0 {
+                if rng.below(5) == 0 {
                     precedence.push((order[i], order[j]));
                 }
             }

@@ -1,6 +1,7 @@
 //! Shared helpers for the integration tests: real data files, read loudly.
 #![allow(dead_code)]
 
+use cutroute_geometry::SplitMix64;
 use cutroute_pcgtsp::Instance;
 use std::path::PathBuf;
 
@@ -179,20 +180,6 @@ pub fn brute_force(instance: &Instance) -> Option<(f64, Vec<usize>)> {
     best
 }
 
-/// A small deterministic generator (tests must not depend on an RNG crate's stream).
-pub struct Lcg(pub u64);
-
-impl Lcg {
-    /// A number below `bound`.
-    pub fn next(&mut self, bound: u64) -> u64 {
-        self.0 = self
-            .0
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (self.0 >> 33) % bound
-    }
-}
-
 /// How [`random_instance`] draws: its stream's salt, the arc costs `cost_base + [0, cost_range)`,
 /// and each precedence pair's odds `1 / pair_odds`.
 #[derive(Clone, Copy)]
@@ -206,14 +193,14 @@ pub struct RandomShape {
 /// `m` clusters of 1–4 nodes (the depot has 1 or 2), integer asymmetric costs with about one
 /// arc in eight forbidden, and random precedence pairs consistent with a random order.
 pub fn random_instance(seed: u64, m: usize, shape: RandomShape) -> Instance {
-    let mut rng = Lcg(seed.wrapping_mul(7919).wrapping_add(shape.salt));
+    let mut rng = SplitMix64::new(seed.wrapping_mul(7919).wrapping_add(shape.salt));
     let mut clusters = Vec::new();
     let mut node_cluster = Vec::new();
     for c in 0..m {
         let size = if c == 0 {
-            1 + rng.next(2) as usize
+            1 + rng.below(2) as usize
         } else {
-            1 + rng.next(4) as usize
+            1 + rng.below(4) as usize
         };
         let nodes: Vec<usize> = (node_cluster.len()..node_cluster.len() + size).collect();
         node_cluster.extend(std::iter::repeat_n(c, size));
@@ -223,19 +210,19 @@ pub fn random_instance(seed: u64, m: usize, shape: RandomShape) -> Instance {
     let mut cost = vec![f64::INFINITY; n * n];
     for a in 0..n {
         for b in 0..n {
-            if a != b && rng.next(8) != 0 {
-                cost[a * n + b] = (shape.cost_base + rng.next(shape.cost_range)) as f64;
+            if a != b && rng.below(8) != 0 {
+                cost[a * n + b] = (shape.cost_base + rng.below(shape.cost_range)) as f64;
             }
         }
     }
     let mut order: Vec<usize> = (1..m).collect();
     for i in (1..order.len()).rev() {
-        order.swap(i, rng.next(i as u64 + 1) as usize);
+        order.swap(i, rng.below(i as u64 + 1) as usize);
     }
     let mut precedence = Vec::new();
     for i in 0..order.len() {
         for j in i + 1..order.len() {
-            if rng.next(shape.pair_odds) == 0 {
+            if rng.below(shape.pair_odds) == 0 {
                 precedence.push((order[i], order[j]));
             }
         }
