@@ -72,6 +72,28 @@ struct Descent {
     changed: bool,
 }
 
+/// An iteration under way ([`AlnsSolver::iterate_unit`]): its operators, its candidate and
+/// the candidate's cost, and where its local search is (`None`: not gated, or done).
+#[derive(Clone, Debug)]
+struct Iteration {
+    removal: usize,
+    insertion: usize,
+    candidate: Vec<usize>,
+    cost: f64,
+    improve: Option<Improve>,
+}
+
+/// Where an iteration's local search ([`AlnsSolver::improve`] in units) is: the next unit
+/// (0 the node-choice DP it starts with, 1 2-opt, 2 or-opt, 3 reinsertion, 4 block reversal
+/// when the round changed nothing, 5 the node-choice DP after the round) and whether the
+/// round's moves changed the tour.
+#[derive(Clone, Copy, Debug)]
+struct Improve {
+    deep_below: f64,
+    unit: u8,
+    changed: bool,
+}
+
 /// Anytime ALNS for PCGTSP / GTSP that can be advanced in slices (see [`AlnsSolver::step`]).
 ///
 /// The search trajectory depends only on the seed and the number of iterations: time only
@@ -102,6 +124,10 @@ pub struct AlnsSolver {
     /// The first tour's descent under way, a move family per [`AlnsSolver::step`] unit (on
     /// thousands of clusters it takes seconds: one piece would block Stop that long).
     descent: Option<Descent>,
+    /// The iteration under way, a destroy–repair or a move family per
+    /// [`AlnsSolver::step`] unit (on thousands of nodes one iteration's local search took
+    /// 0.4–0.6 s: one piece would block Stop that long).
+    iteration: Option<Iteration>,
     stop: Option<StopReason>,
     iterations: u64,
     improvements: u64,
@@ -179,6 +205,7 @@ impl AlnsSolver {
             elite: Vec::new(),
             started: false,
             descent: None,
+            iteration: None,
             stop: None,
             iterations: 0,
             improvements: 0,
@@ -189,8 +216,9 @@ impl AlnsSolver {
         }
     }
 
-    /// Searches for about `budget` of time (at least one iteration unless already finished) and
-    /// reports whether the search can go on.
+    /// Searches for about `budget` of time (at least one unit of work — a piece of the first
+    /// descent or of an iteration — unless already finished) and reports whether the search
+    /// can go on.
     pub fn step(&mut self, budget: Duration) -> SolverStatus {
         self.step_with(budget, &mut |_| {})
     }
@@ -204,16 +232,20 @@ impl AlnsSolver {
         let slice_start = Instant::now();
         let base = self.elapsed;
         loop {
-            if let Some(reason) = self.stop_reason() {
-                self.stop = Some(reason);
-                return SolverStatus::Finished;
+            // An iteration under way is finished first (as when it was one piece), unless the
+            // search was cancelled: the limits are checked between iterations.
+            if self.iteration.is_none() || self.stop.is_some() {
+                if let Some(reason) = self.stop_reason() {
+                    self.stop = Some(reason);
+                    return SolverStatus::Finished;
+                }
             }
             let improved = if !self.started {
                 self.start()
             } else if let Some(descent) = self.descent.take() {
                 self.descend(descent)
             } else {
-                self.iterate()
+                self.iterate_unit(base + slice_start.elapsed())
             };
             self.elapsed = base + slice_start.elapsed();
             if improved && self.best().is_some() {
@@ -221,6 +253,9 @@ impl AlnsSolver {
                 on_improvement(&self.progress());
             }
             if slice_start.elapsed() >= budget {
+                if self.iteration.is_some() {
+                    return SolverStatus::Running;
+                }
                 if let Some(reason) = self.stop_reason() {
                     self.stop = Some(reason);
                     return SolverStatus::Finished;
@@ -404,8 +439,76 @@ impl AlnsSolver {
         start * (end / start).powf_libm(frac.min(1.0))
     }
 
-    /// One destroy–repair–improve–accept iteration; returns whether the best tour improved.
+    /// One destroy–repair–improve–accept iteration in one piece; returns whether the best tour
+    /// improved.
+    #[cfg(test)]
     fn iterate(&mut self) -> bool {
+        loop {
+            let improved = self.iterate_unit(self.elapsed);
+            if self.iteration.is_none() {
+                return improved;
+            }
+        }
+    }
+
+    /// One unit of an iteration: the destroy–repair and node-choice DP that make the
+    /// candidate, one step of its local search (the loop of [`AlnsSolver::improve`], a move
+    /// family or a node-choice DP per unit, in the same order, so the iteration's result does
+    /// not depend on how its units fall into slices), or its acceptance. `elapsed` is the
+    /// search's time so far: the local search ends at the time limit between rounds, as
+    /// `improve` does. Returns whether the best tour improved.
+    fn iterate_unit(&mut self, elapsed: Duration) -> bool {
+        let Some(mut it) = self.iteration.take() else {
+            self.begin_iteration();
+            return false;
+        };
+        let Some(mut at) = it.improve else {
+            return self.accept(it);
+        };
+        let p = &self.problem;
+        match at.unit {
+            0 => it.cost = self.node_choice.optimise(p, &mut it.candidate),
+            1 => at.changed = self.local_search.two_opt(p, &mut it.candidate),
+            2 => at.changed |= self.local_search.or_opt(p, &mut it.candidate),
+            3 => at.changed |= self.local_search.reinsert(p, &mut it.candidate),
+            4 => {
+                let max_len = self.options.parameters.block_reverse_length;
+                if !at.changed
+                    && (it.cost > at.deep_below
+                        || !self
+                            .local_search
+                            .block_reverse(p, &mut it.candidate, max_len))
+                {
+                    debug_assert!(p.order_is_valid(&it.candidate));
+                    it.improve = None;
+                    self.iteration = Some(it);
+                    return false;
+                }
+            }
+            _ => {
+                it.cost = self.node_choice.optimise(p, &mut it.candidate);
+                if self
+                    .options
+                    .time_limit
+                    .is_some_and(|limit| elapsed >= limit)
+                {
+                    it.improve = None;
+                    self.iteration = Some(it);
+                    return false;
+                }
+                at.unit = 0;
+                at.changed = false;
+            }
+        }
+        at.unit += 1;
+        it.improve = Some(at);
+        self.iteration = Some(it);
+        false
+    }
+
+    /// The destroy–repair of an iteration and its node-choice DP; its local search follows
+    /// when the candidate passes the gate.
+    fn begin_iteration(&mut self) {
         self.iterations += 1;
         let params = self.options.parameters.clone();
         let p = &self.problem;
@@ -441,13 +544,33 @@ impl AlnsSolver {
             params.noise * arc_scale,
             &mut self.rng,
         );
-        let mut cost = self.node_choice.optimise(p, &mut candidate);
+        let cost = self.node_choice.optimise(p, &mut candidate);
         let gate = self.current_cost + params.local_search_gate * self.current_cost.abs();
-        if cost < gate || cost < self.best_cost {
-            let deep_below = self.best_cost + params.block_reverse_gate * self.best_cost.abs();
-            cost = self.improve(&mut candidate, deep_below);
-        }
+        let improve = (cost < gate || cost < self.best_cost).then(|| Improve {
+            deep_below: self.best_cost + params.block_reverse_gate * self.best_cost.abs(),
+            unit: 0,
+            changed: false,
+        });
+        self.iteration = Some(Iteration {
+            removal,
+            insertion,
+            candidate,
+            cost,
+            improve,
+        });
+    }
 
+    /// The acceptance of an iteration's candidate (annealing), the operators' scores and the
+    /// epoch's end; returns whether the best tour improved.
+    fn accept(&mut self, it: Iteration) -> bool {
+        let params = self.options.parameters.clone();
+        let Iteration {
+            removal,
+            insertion,
+            mut candidate,
+            cost,
+            ..
+        } = it;
         let eps = eps(&self.problem);
         let delta = cost - self.current_cost;
         let temperature = self.temperature();
@@ -598,6 +721,51 @@ mod tests {
             assert!(calls > 5, "{name}: {calls} units");
             assert_eq!(units.current, whole_first_tour(&instance, 5), "{name}");
             assert!(whole.best_cost <= last + 1e-9);
+        }
+    }
+
+    /// Iterations run in units (a destroy–repair, a move family, a node-choice DP, the
+    /// acceptance): stepped with no budget (one unit per call) the search ends with the very
+    /// tour, cost and counters of one long step, on a GTSP and a PCGTSP instance, and the
+    /// iterations did take several units each.
+    #[test]
+    fn iterations_in_units_equal_one_piece() {
+        for (set, name) in [("pcgtsplib", "ry48p.2"), ("industrial", "e1x_3")] {
+            let instance = instance(set, name);
+            let options = AlnsOptions {
+                seed: 11,
+                time_limit: None,
+                max_iterations: Some(400),
+                ..AlnsOptions::default()
+            };
+            let mut whole = AlnsSolver::new(&instance, options.clone()).unwrap();
+            assert_eq!(
+                whole.step(Duration::from_secs(3600)),
+                SolverStatus::Finished
+            );
+            let mut units = AlnsSolver::new(&instance, options).unwrap();
+            let mut calls = 0u64;
+            while units.step(Duration::ZERO) == SolverStatus::Running {
+                calls += 1;
+                if let Some((tour, cost)) = units.best() {
+                    let checked = check_tour(&instance, tour).unwrap();
+                    assert!((checked - cost).abs() <= 1e-6 * (1.0 + cost.abs()));
+                }
+            }
+            assert_eq!(units.iterations, 400, "{name}");
+            assert!(
+                calls > 2 * units.iterations,
+                "{name}: {calls} calls for {} iterations",
+                units.iterations
+            );
+            assert_eq!(units.best, whole.best, "{name}");
+            assert_eq!(units.best_cost, whole.best_cost, "{name}");
+            assert_eq!(units.current, whole.current, "{name}");
+            assert_eq!(
+                (units.improvements, units.restarts),
+                (whole.improvements, whole.restarts),
+                "{name}"
+            );
         }
     }
 

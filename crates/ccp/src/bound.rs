@@ -727,9 +727,18 @@ impl CcpLowerBound {
     /// the whole relaxation (which stays the bound where groups lose much at their borders).
     fn step_shared(&mut self, deadline: Instant) -> bool {
         self.turns += 1;
+        // A group in the middle of a stage keeps the groups' turns until that stage ends, and
+        // only then the group that has had the least time so far starts its next one: so at
+        // most one group holds a stage's matrices and exact search at a time (all of them at
+        // once held 1.6–2.8 GB on Nest02/Nest03). A group's stage ends by its own time share,
+        // whichever slices it runs in.
         let group = (0..self.groups.len())
-            .filter(|&g| self.groups_running[g])
-            .min_by_key(|&g| self.groups[g].elapsed());
+            .find(|&g| self.groups_running[g] && self.groups[g].stage.is_some())
+            .or_else(|| {
+                (0..self.groups.len())
+                    .filter(|&g| self.groups_running[g])
+                    .min_by_key(|&g| self.groups[g].elapsed())
+            });
         // With the ng-path bound the whole relaxation is the stronger one (the groups' exact
         // optima saturate within seconds at the loss on their borders): it gets three slices
         // of four, seven of eight once its bound is above the groups' sum; without it, one.
@@ -828,6 +837,10 @@ impl CcpLowerBound {
                     // With no piece left to split, the next stage reruns the same pieces
                     // with twice the time.
                     self.refine(&s.node_piece, Some(&marked));
+                    if !self.own.is_empty() {
+                        // A group's stage is over: the decomposition picks who goes next.
+                        return true;
+                    }
                 }
             }
             if Instant::now() >= deadline {
@@ -992,10 +1005,11 @@ impl CcpLowerBound {
             position_iterations: 0,
             ..ExactOptions::default()
         };
+        // Deferred: the start node's model and root bound are built in the stage's first
+        // slices, a piece each (`ExactSolver::new` built them here in one piece of up to
+        // 0.6 s on nested.dbs, which Stop had to wait for).
         let solver = if self.exact_whole() {
-            let solver = ExactSolver::new(&instance, options).ok()?;
-            self.best = self.best.max(solver.root_bound());
-            Some(solver)
+            Some(ExactSolver::deferred(&instance, options).ok()?)
         } else {
             None
         };
@@ -1070,6 +1084,16 @@ impl CcpLowerBound {
         let slice = deadline.saturating_duration_since(now);
         // With the ng-path bound beside it, the exact search (which cannot solve a relaxation
         // this large; its bounds stall early) gets every eighth slice.
+        // Until its model and root bound are built, one piece of them per slice (a step of
+        // no budget builds one and returns), whoever has the slice's turn.
+        if let Some(solver) = s.solver.as_mut().filter(|e| !e.runs_built()) {
+            let status = solver.step(Duration::ZERO);
+            s.exact_over = status != SolverStatus::Running;
+            let progress = solver.progress();
+            if progress.lower_bound.is_finite() {
+                self.best = self.best.max(progress.lower_bound);
+            }
+        }
         s.turns += 1;
         let exact_turn = !s.ng_running || s.turns.is_multiple_of(8);
         if let Some(solver) = s.solver.as_mut().filter(|_| !s.exact_over && exact_turn) {
@@ -1224,4 +1248,56 @@ fn spatial_groups(leaves: &[Leaf], size: usize) -> Vec<Vec<usize>> {
         todo.push(rest);
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use cutroute_geometry::{Contour, Part, Vertex};
+
+    fn grid_nest(columns: usize, rows: usize) -> Nest {
+        let square = |x: f64, y: f64| Part {
+            name: format!("square at {x},{y}"),
+            contours: vec![Contour::new(vec![
+                Vertex::line(x, y),
+                Vertex::line(x, y + 10.0),
+                Vertex::line(x + 10.0, y + 10.0),
+                Vertex::line(x + 10.0, y),
+            ])],
+        };
+        let parts = (0..columns * rows)
+            .map(|i| square(20.0 * (i % columns) as f64, 20.0 * (i / columns) as f64))
+            .collect();
+        Nest { sheet: None, parts }
+    }
+
+    /// The decomposition runs one group's stage at a time (the memory of a stage — its cost
+    /// matrix, the exact solver's model copies and DP — is held by one group only), in slices
+    /// of any length, and the groups still all get stages.
+    #[test]
+    fn one_group_at_a_time_holds_a_stage() {
+        let nest = grid_nest(4, 3);
+        let options = LowerBoundOptions {
+            start: Point::new(-10.0, -10.0),
+            group_size: 2,
+            decompose_above: 0,
+            first_stage: Duration::from_millis(20),
+            ..LowerBoundOptions::default()
+        };
+        let mut bound = CcpLowerBound::new(&nest, options).unwrap();
+        assert!(bound.group_count() >= 4);
+        for slice_us in [200u64, 3_000, 40_000].into_iter().cycle().take(300) {
+            if !bound.step(Duration::from_micros(slice_us)) {
+                break;
+            }
+            let holding = bound.groups.iter().filter(|g| g.stage.is_some()).count();
+            assert!(holding <= 1, "{holding} groups hold a stage at once");
+        }
+        assert!(
+            bound.groups.iter().all(|g| g.stages() >= 1),
+            "a group never finished a stage: {:?}",
+            bound.groups.iter().map(|g| g.stages()).collect::<Vec<_>>()
+        );
+        assert!(bound.group_sum() > 0.0);
+    }
 }

@@ -25,13 +25,9 @@ static ONE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
 /// (solver, input, what) whose steps are known to run longer than [`LONGEST_STEP_S`]: single
 /// pieces of work not yet split (measured in BENCHMARKS.md, "Time limits in the engine").
 /// Their wall-clock promise is still asserted unless they are in [`KNOWN_OVERRUNS`] too.
+/// (CCP is not listed: the interval relaxation's exact solver builds its model and root bound
+/// in steps of their own, `ExactSolver::deferred`, and its preparation runs in slices.)
 const LONG_STEPS: &[(SolverKind, &str, &str)] = &[
-    // The bound's first stage: pcgtsp's subset/lattice preparation of the relaxation.
-    (
-        SolverKind::Ccp,
-        "",
-        "the interval relaxation's first exact step",
-    ),
     // The exact solver's runs are built in steps (`ExactSolver::deferred`), but one start
     // node's model and its root bound (an assignment over every cluster) are one piece each.
     (SolverKind::Exact, "", "a start node's model or root bound"),
