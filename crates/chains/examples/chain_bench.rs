@@ -66,7 +66,8 @@ fn main() {
         let mut job = cutroute_engine::start_job(&request)
             .unwrap_or_else(|e| panic!("{path}: CCP refused: {e}"));
         let ccp_route = cutroute_engine::run_to_end(job.as_mut(), &mut |_| {})
-            .route
+            .route()
+            .cloned()
             .unwrap_or_else(|| panic!("{path}: CCP found no route"));
         for material in TABLE1_MATERIALS {
             let machine = material.priced(&MachineParameters::default());

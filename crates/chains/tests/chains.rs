@@ -330,7 +330,8 @@ fn tflex_nests_with_touching_parts_chain_validly() {
         };
         let mut job = cutroute_engine::start_job(&request).unwrap();
         let route = cutroute_engine::run_to_end(job.as_mut(), &mut |_| {})
-            .route
+            .route()
+            .cloned()
             .unwrap();
         assert_eq!((route.start, route.finish), (*start, *finish));
         for material in TABLE1_MATERIALS {

@@ -27,7 +27,8 @@ fn every_preset_reads_back_with_the_same_motion() {
     };
     let mut job = start_job(&request).expect("starts");
     let route = run_to_end(job.as_mut(), &mut |_| {})
-        .route
+        .route()
+        .cloned()
         .expect("a route");
     let toolpath = Toolpath::new(&route, nest).expect("toolpath");
     let machine = MachineParameters::default();

@@ -45,7 +45,8 @@ fn routed(relative: &str, solver: SolverKind, time_limit_s: f64) -> (Nest, Route
     };
     let mut job = start_job(&request).expect("starts");
     let route = run_to_end(job.as_mut(), &mut |_| {})
-        .route
+        .route()
+        .cloned()
         .expect("a route");
     route.validate(nest, 1e-6 * 10_000.0).expect("valid route");
     (nest.clone(), route)

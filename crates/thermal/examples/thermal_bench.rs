@@ -184,7 +184,8 @@ fn solve(
         }
     };
     let route = run_to_end(job.as_mut(), &mut |_| {})
-        .route
+        .route()
+        .cloned()
         .expect("CCP found a route");
     route
         .validate(nest, 1e-6 * scale(nest))
