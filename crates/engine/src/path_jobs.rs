@@ -12,7 +12,7 @@ use cutroute_protocol::{
 };
 use cutroute_segments::{
     Candidate, EnsembleKind, EnsembleReport, GsccpOptions, GsccpSearch, GsccpStage, PathHeat,
-    SccpOptions, SearchStatus,
+    SccpOptions,
 };
 use std::collections::HashMap;
 use web_time::{Duration, Instant};
@@ -393,10 +393,7 @@ impl Job for SegmentJob {
             ));
             return JobStatus::Running;
         }
-        match self.search.step(budget) {
-            SearchStatus::Running => JobStatus::Running,
-            SearchStatus::Finished => JobStatus::Done,
-        }
+        self.search.step(budget).into()
     }
 
     fn progress(&self) -> Progress {
