@@ -17,6 +17,7 @@ use cutroute_thermal::{path_route_pierces, HeatModel};
 use thiserror::Error;
 use web_time::{Duration, Instant};
 
+use crate::plan::PlanBuild;
 use crate::{CheckError, CutChain, EmbeddingError, PlanError, PlanGraph, PlanOptions};
 
 /// Options of [`solve_nest`].
@@ -147,9 +148,9 @@ pub fn solve_nest(nest: &Nest, options: &AoeSolveOptions) -> Result<AoeSolution,
 }
 
 /// [`solve_nest`] in resumable slices ([`AnytimeSolver`]), for callers that must stay
-/// responsive (the app's worker answers Stop between slices). On a 5,000-part sheet the whole
-/// solve took 12 s and the ordering's single rounds 4 s each, so every stage is cut into small
-/// units of work with a look at the clock between them: the plan graph, its components, each
+/// responsive (the app's worker answers Stop between slices). A 5,000-part sheet once took 12 s
+/// in one step, and its ordering rounds were single pieces of seconds, so every stage is cut
+/// into small units of work with a look at the clock between them: the plan graph, its components, each
 /// component's chains, each pick of the nearest-ready ordering, each move tried and each closed
 /// curve relaxed, and the two checks of the final route. The route does not depend on where the
 /// slices end. [`AoeSolving::stop_at`] ends the ordering at a deadline with its best so far (the
@@ -179,6 +180,7 @@ pub enum AoeStage {
 
 enum Stage {
     Plan,
+    Sweep(Box<PlanBuild>),
     Components(Box<PlanGraph>),
     Chains(Box<Chaining>),
     Ordering(Box<Orderings>),
@@ -232,8 +234,8 @@ enum OrderWork {
     Relax(Relax),
 }
 
-/// Units of work between looks at `stop` (a unit is one pick, one move tried or one curve
-/// relaxed: at most a few hundred microseconds on 5,000 components).
+/// Units of work between looks at `stop` (a unit is one pick, one move tried, one curve
+/// relaxed or one component's chains).
 const UNITS_PER_LOOK: usize = 16;
 
 impl AoeSolving {
@@ -257,7 +259,9 @@ impl AoeSolving {
     /// The stage under way.
     pub fn stage(&self) -> AoeStage {
         match self.stage {
-            Stage::Plan | Stage::Components(_) | Stage::Chains(_) => AoeStage::Building,
+            Stage::Plan | Stage::Sweep(_) | Stage::Components(_) | Stage::Chains(_) => {
+                AoeStage::Building
+            }
             Stage::Ordering(_) => AoeStage::Ordering,
             Stage::Check(..) => AoeStage::Checking,
             Stage::Done(_) => AoeStage::Done,
@@ -323,7 +327,14 @@ impl AoeSolving {
     ) -> Result<Stage, AoeSolveError> {
         let (nest, options) = (&self.nest, &self.options);
         Ok(match stage {
-            Stage::Plan => Stage::Components(Box::new(PlanGraph::from_nest(nest, &options.plan)?)),
+            Stage::Plan => Stage::Sweep(Box::new(PlanBuild::new(nest, &options.plan)?)),
+            Stage::Sweep(mut build) => {
+                if build.run(stop) {
+                    Stage::Components(Box::new(build.finish()?))
+                } else {
+                    Stage::Sweep(build)
+                }
+            }
             Stage::Components(plan) => {
                 let components = plan.components()?;
                 Stage::Chains(Box::new(Chaining {
