@@ -656,7 +656,7 @@ impl Sweep {
                 }
             }
             self.active.push(i);
-            if self.next % 256 == 0 && stop() {
+            if self.next.is_multiple_of(256) && stop() {
                 return self.next == self.order.len();
             }
         }

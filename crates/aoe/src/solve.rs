@@ -346,11 +346,11 @@ impl AoeSolving {
                 }))
             }
             Stage::Chains(mut chaining) => {
-                let mut units = 0;
+                let mut units = 0usize;
                 while chaining.visits.len() < chaining.components.len() {
                     chaining.add_next(options.start);
                     units += 1;
-                    if units % UNITS_PER_LOOK == 0 && stop() {
+                    if units.is_multiple_of(UNITS_PER_LOOK) && stop() {
                         return Ok(Stage::Chains(chaining));
                     }
                 }
@@ -833,7 +833,7 @@ impl NearestReady {
         let n = visits.len();
         while self.order.len() < n {
             self.pick(visits, after)?;
-            if self.order.len() % UNITS_PER_LOOK == 0 && self.order.len() < n && stop() {
+            if self.order.len().is_multiple_of(UNITS_PER_LOOK) && self.order.len() < n && stop() {
                 return Some(false);
             }
         }
@@ -935,7 +935,7 @@ impl Moves {
         stop: &dyn Fn() -> bool,
     ) -> bool {
         let n = order.len();
-        let mut units = 0;
+        let mut units = 0usize;
         loop {
             if self.i == n {
                 if !self.improved || self.pass + 1 >= MAX_MOVE_PASSES {
@@ -946,7 +946,7 @@ impl Moves {
             self.try_move(order, context, visits);
             self.i += 1;
             units += 1;
-            if units % UNITS_PER_LOOK == 0 && stop() {
+            if units.is_multiple_of(UNITS_PER_LOOK) && stop() {
                 return false;
             }
         }
@@ -1095,7 +1095,7 @@ impl Relax {
         finish: Option<Point>,
         stop: &dyn Fn() -> bool,
     ) -> Option<f64> {
-        let mut units = 0;
+        let mut units = 0usize;
         while self.sweep < MAX_RELAXATION_SWEEPS {
             if self.i == order.len() {
                 self.total += self.gain;
@@ -1128,7 +1128,7 @@ impl Relax {
                 }
             }
             units += 1;
-            if units % UNITS_PER_LOOK == 0 && stop() {
+            if units.is_multiple_of(UNITS_PER_LOOK) && stop() {
                 return None;
             }
         }
