@@ -286,7 +286,7 @@ impl AoeSolving {
     /// [`AoeSolving::stop_at`] cut the ordering short.
     pub fn step(&mut self, budget: Duration) -> Status {
         let slice_end = Instant::now().checked_add(budget);
-        let done = self.advance(&|| slice_end.is_none_or(|end| Instant::now() >= end));
+        let done = self.advance(&|| slice_end.is_some_and(|end| Instant::now() >= end));
         if !done {
             Status::Running
         } else if self.stopped {

@@ -274,7 +274,7 @@ impl Chaining {
         let done = self.groups.step_within(
             &self.nest,
             &self.options,
-            &|| slice_end.is_none_or(|end| Instant::now() >= end),
+            &|| slice_end.is_some_and(|end| Instant::now() >= end),
             &|| {
                 let over = deadline.is_some_and(|end| Instant::now() >= end);
                 aborted.set(aborted.get() || over);
