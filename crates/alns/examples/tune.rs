@@ -6,7 +6,7 @@
 
 use std::time::Duration;
 
-use cutroute_alns::{AlnsOptions, AlnsSolver, SolverStatus};
+use cutroute_alns::{AlnsOptions, AlnsSolver, Status};
 use cutroute_pcgtsp::{check_tour, Instance};
 
 fn main() {
@@ -52,7 +52,7 @@ fn main() {
                 p.best_cost,
                 p.iterations
             );
-        }) == SolverStatus::Running
+        }) == Status::Running
             && cpu_seconds() - start < seconds
         {}
         let (tour, cost) = solver.best().map(|(t, c)| (t.to_vec(), c)).unwrap();

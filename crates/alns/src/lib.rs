@@ -59,6 +59,7 @@ use std::time::Duration;
 
 use cutroute_pcgtsp::Instance;
 
+pub use cutroute_anytime::{AnytimeSolver, Bounds, Status};
 pub use solver::{AlnsBuilder, AlnsSolver};
 
 /// Why an instance cannot be searched.
@@ -224,15 +225,6 @@ impl Default for AlnsOptions {
     }
 }
 
-/// Whether [`AlnsSolver::step`] can be called again usefully.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum SolverStatus {
-    /// The search goes on.
-    Running,
-    /// A stop condition was met (see [`AlnsProgress::stop_reason`]).
-    Finished,
-}
-
 /// Why the search stopped.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum StopReason {
@@ -298,7 +290,10 @@ pub fn solve_until(
     cancelled: &dyn Fn() -> bool,
 ) -> Result<AlnsResult, AlnsError> {
     let mut solver = AlnsSolver::new(instance, options)?;
-    while solver.step_with(Duration::from_millis(5), on_improvement) == SolverStatus::Running {
+    while solver
+        .step_with(Duration::from_millis(5), on_improvement)
+        .is_running()
+    {
         if cancelled() {
             solver.cancel();
         }

@@ -10,7 +10,8 @@ use crate::local_search::{eps, LocalSearch};
 use crate::nodes::NodeChoice;
 use crate::operators::{Insertion, Operators, Removal, Selection, INSERTIONS, REMOVALS};
 use crate::problem::{Problem, ProblemBuild};
-use crate::{AlnsError, AlnsOptions, AlnsProgress, SolverStatus, StopReason};
+use crate::{AlnsError, AlnsOptions, AlnsProgress, StopReason};
+use cutroute_anytime::{AnytimeSolver, Bounds, Status};
 use cutroute_geometry::Xoshiro256 as Rng;
 
 /// Adaptive weights of one family of operators (Ropke & Pisinger's segment scheme).
@@ -218,8 +219,10 @@ impl AlnsSolver {
 
     /// Searches for about `budget` of time (at least one unit of work — a piece of the first
     /// descent or of an iteration — unless already finished) and reports whether the search
-    /// can go on.
-    pub fn step(&mut self, budget: Duration) -> SolverStatus {
+    /// can go on: once a stop condition holds, [`Status::Stopped`] for the time limit and
+    /// [`AlnsSolver::cancel`], else [`Status::Finished`] (proven optimal only when the instance
+    /// is too small to search).
+    pub fn step(&mut self, budget: Duration) -> Status {
         self.step_with(budget, &mut |_| {})
     }
 
@@ -228,7 +231,7 @@ impl AlnsSolver {
         &mut self,
         budget: Duration,
         on_improvement: &mut dyn FnMut(&AlnsProgress),
-    ) -> SolverStatus {
+    ) -> Status {
         let slice_start = Instant::now();
         let base = self.elapsed;
         loop {
@@ -237,7 +240,7 @@ impl AlnsSolver {
             if self.iteration.is_none() || self.stop.is_some() {
                 if let Some(reason) = self.stop_reason() {
                     self.stop = Some(reason);
-                    return SolverStatus::Finished;
+                    return stopped_status(reason);
                 }
             }
             let improved = if !self.started {
@@ -254,18 +257,18 @@ impl AlnsSolver {
             }
             if slice_start.elapsed() >= budget {
                 if self.iteration.is_some() {
-                    return SolverStatus::Running;
+                    return Status::Running;
                 }
                 if let Some(reason) = self.stop_reason() {
                     self.stop = Some(reason);
-                    return SolverStatus::Finished;
+                    return stopped_status(reason);
                 }
-                return SolverStatus::Running;
+                return Status::Running;
             }
         }
     }
 
-    /// Stops the search: later calls to `step` return [`SolverStatus::Finished`] at once.
+    /// Stops the search: later calls to `step` return [`Status::Stopped`] at once.
     pub fn cancel(&mut self) {
         if self.stop.is_none() {
             self.stop = Some(StopReason::Cancelled);
@@ -679,6 +682,40 @@ impl AlnsSolver {
     }
 }
 
+/// The status a stop condition gives.
+fn stopped_status(reason: StopReason) -> Status {
+    match reason {
+        StopReason::TimeLimit | StopReason::Cancelled => Status::Stopped,
+        StopReason::IterationLimit | StopReason::TargetReached => Status::Finished {
+            proven_optimal: false,
+        },
+        StopReason::Exhausted => Status::Finished {
+            proven_optimal: true,
+        },
+    }
+}
+
+/// The contract of every solver: the best tour (nodes, depot first) and its cost; no lower
+/// bound.
+impl AnytimeSolver for AlnsSolver {
+    type Solution = Vec<usize>;
+
+    fn step(&mut self, budget: Duration) -> Status {
+        AlnsSolver::step(self, budget)
+    }
+
+    fn best(&self) -> Option<Vec<usize>> {
+        AlnsSolver::best(self).map(|(tour, _)| tour.to_vec())
+    }
+
+    fn bounds(&self) -> Bounds {
+        Bounds {
+            upper: AlnsSolver::best(self).map(|(_, cost)| cost),
+            lower: None,
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -741,11 +778,13 @@ mod tests {
             let mut whole = AlnsSolver::new(&instance, options.clone()).unwrap();
             assert_eq!(
                 whole.step(Duration::from_secs(3600)),
-                SolverStatus::Finished
+                Status::Finished {
+                    proven_optimal: false
+                }
             );
             let mut units = AlnsSolver::new(&instance, options).unwrap();
             let mut calls = 0u64;
-            while units.step(Duration::ZERO) == SolverStatus::Running {
+            while units.step(Duration::ZERO) == Status::Running {
                 calls += 1;
                 if let Some((tour, cost)) = units.best() {
                     let checked = check_tour(&instance, tour).unwrap();
@@ -810,7 +849,7 @@ mod tests {
             };
             options.parameters.elite_size = 3;
             let mut solver = AlnsSolver::new(&instance, options).unwrap();
-            while solver.step(Duration::from_millis(50)) == SolverStatus::Running {}
+            while solver.step(Duration::from_millis(50)).is_running() {}
             let mut kicked = 0;
             for _ in 0..8 {
                 let restarts = solver.restarts;

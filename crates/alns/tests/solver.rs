@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use cutroute_alns::{
-    solve, AlnsError, AlnsOptions, AlnsParameters, AlnsSolver, SolverStatus, StopReason,
+    solve, AlnsError, AlnsOptions, AlnsParameters, AlnsSolver, Status, StopReason,
 };
 use cutroute_pcgtsp::{check_tour, Instance};
 
@@ -258,7 +258,7 @@ fn deterministic_for_a_seed_and_independent_of_slicing() {
     // Tiny slices, as a web worker would run it: same trajectory.
     let mut solver = AlnsSolver::new(&instance, options).unwrap();
     let mut slices = 0;
-    while solver.step(Duration::from_micros(1)) == SolverStatus::Running {
+    while solver.step(Duration::from_micros(1)) == Status::Running {
         slices += 1;
     }
     assert!(slices > 10);
@@ -292,15 +292,9 @@ fn honours_time_limit_and_cancel() {
     );
 
     let mut solver = AlnsSolver::new(&instance, options).unwrap();
-    assert_eq!(
-        solver.step(Duration::from_millis(20)),
-        SolverStatus::Running
-    );
+    assert_eq!(solver.step(Duration::from_millis(20)), Status::Running);
     solver.cancel();
-    assert_eq!(
-        solver.step(Duration::from_millis(20)),
-        SolverStatus::Finished
-    );
+    assert_eq!(solver.step(Duration::from_millis(20)), Status::Stopped);
     assert_eq!(solver.progress().stop_reason, Some(StopReason::Cancelled));
     let (tour, cost) = solver.best().unwrap();
     checked(&instance, tour, cost);
@@ -507,8 +501,8 @@ fn a_solver_built_in_pieces_searches_as_one_built_at_once() {
     };
     // A row block or a pivot per piece: many pieces on 100 clusters.
     assert!(pieces > 100, "{pieces} pieces");
-    while whole.step(Duration::from_secs(60)) == SolverStatus::Running {}
-    while pieced.step(Duration::from_secs(60)) == SolverStatus::Running {}
+    while whole.step(Duration::from_secs(60)) == Status::Running {}
+    while pieced.step(Duration::from_secs(60)) == Status::Running {}
     let (tour, cost) = pieced.best().unwrap();
     assert_eq!(whole.best(), Some((tour, cost)));
     checked(&instance, tour, cost);

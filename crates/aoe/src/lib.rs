@@ -54,8 +54,11 @@ pub use chain::{
     aoe_chain, split_cut_points, AoeChain, AoeError, AoeOptions, SplitRule, Transitions,
 };
 pub use check::{check_chain, check_route, CheckError};
+pub use cutroute_anytime::{run_to_end, AnytimeSolver, Bounds, Status};
 pub use embedding::{CutPoint, Embedding, EmbeddingError};
 pub use graph::{Dart, DualGraph, Faces, GraphError, PlaneGraph};
 pub use plan::{CutChain, DirectedEdge, PlanComponent, PlanError, PlanGraph, PlanOptions};
 pub use route::{oe_route, pierce_lower_bound, OeRoute};
-pub use solve::{solve_nest, AoeHeat, AoeSolution, AoeSolveError, AoeSolveOptions, AoeSolving};
+pub use solve::{
+    solve_nest, AoeHeat, AoeSolution, AoeSolveError, AoeSolveOptions, AoeSolving, AoeStage,
+};

@@ -119,28 +119,18 @@ impl PlanGraph {
     /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
     pub fn from_nest(nest: &Nest, options: &PlanOptions) -> Result<Self, PlanError> {
-        let tol = options.tolerance;
-        if !(tol.is_finite() && tol > 0.0) {
-            return Err(PlanError::BadTolerance(tol));
-        }
-        let mut spans: Vec<(Span, ContourRef)> = Vec::new();
-        for r in nest.contour_refs() {
-            let contour = nest.contour(r).expect("reference from the nest");
-            for span in contour.spans() {
-                let finite =
-                    span.start.is_finite() && span.end.is_finite() && span.bulge.is_finite();
-                if !finite {
-                    return Err(PlanError::NonFinite { contour: r });
-                }
-                if span.chord_length() > tol {
-                    spans.push((span, r));
-                }
-            }
-        }
-        if spans.is_empty() {
-            return Err(PlanError::Empty);
-        }
-        let params = split_parameters(&spans, tol);
+        let mut build = PlanBuild::new(nest, options)?;
+        while !build.run(&|| false) {}
+        build.finish()
+    }
+
+    /// The plan graph of the split spans.
+    fn from_split(
+        spans: &[(Span, ContourRef)],
+        params: Vec<Vec<f64>>,
+        tol: f64,
+        options: &PlanOptions,
+    ) -> Result<Self, PlanError> {
         let mut snapper = Snapper::new(tol);
         let mut pieces: Vec<Piece> = Vec::new();
         let mut by_ends: HashMap<(usize, usize), Vec<usize>> = HashMap::new();
@@ -324,19 +314,19 @@ impl PlanGraph {
                 component_of_edge[edge] = (c, local);
             }
         }
-        // Within components.
-        for (c, component) in components.iter().enumerate() {
-            let local: Vec<Vec<Dart>> = plan_chains
-                .iter()
-                .filter(|chain| component_of_edge[chain[0] / 2].0 == c)
-                .map(|chain| {
-                    chain
-                        .iter()
-                        .map(|&d| 2 * component_of_edge[d / 2].1 + d % 2)
-                        .collect()
-                })
-                .collect();
-            crate::check::check_route(&component.embedding, &local)?;
+        // Within components: each component's chains in route order (grouped in one pass: a
+        // filter over every chain per component is quadratic in the components).
+        let mut local: Vec<Vec<Vec<Dart>>> = vec![Vec::new(); components.len()];
+        for chain in &plan_chains {
+            local[component_of_edge[chain[0] / 2].0].push(
+                chain
+                    .iter()
+                    .map(|&d| 2 * component_of_edge[d / 2].1 + d % 2)
+                    .collect(),
+            );
+        }
+        for (component, local) in components.iter().zip(&local) {
+            crate::check::check_route(&component.embedding, local)?;
         }
         // Which face of component a holds component b (None: b lies in a's outer face). Only
         // a component whose box contains b's first vertex can hold b: an R-tree of the boxes
@@ -559,62 +549,147 @@ fn least(values: &[f64]) -> usize {
         .unwrap_or(0)
 }
 
-/// Split parameters of every span: 0, 1, and every point where another span crosses or
-/// touches it, sorted, with points closer than the tolerance merged.
-fn split_parameters(spans: &[(Span, ContourRef)], tol: f64) -> Vec<Vec<f64>> {
-    let mut params: Vec<Vec<f64>> = vec![vec![0.0, 1.0]; spans.len()];
-    let boxes: Vec<_> = spans
-        .iter()
-        .map(|(s, _)| s.bounding_box().expanded(tol))
-        .collect();
-    let mut order: Vec<usize> = (0..spans.len()).collect();
-    order.sort_by(|&a, &b| boxes[a].min.x.total_cmp(&boxes[b].min.x));
-    let mut active: Vec<usize> = Vec::new();
-    for &i in &order {
-        active.retain(|&j| boxes[j].max.x >= boxes[i].min.x);
-        for &j in &active {
-            if !boxes[i].intersects(&boxes[j]) {
-                continue;
-            }
-            let (si, sj) = (&spans[i].0, &spans[j].0);
-            for x in si.intersections(sj) {
-                params[i].push(x.t_self);
-                params[j].push(x.t_other);
-            }
-            for (a, b, target) in [(si, sj, i), (sj, si, j)] {
-                for p in [b.start, b.end] {
-                    let near = a.nearest_point(p);
-                    if near.distance <= tol {
-                        params[target].push(near.t);
-                    }
+/// [`PlanGraph::from_nest`] in resumable pieces: the spans gathered, then the sweep that finds
+/// where spans cross or touch (a unit of work per span: it meets the spans whose boxes overlap
+/// its own in x), then the graph assembled in one piece.
+pub(crate) struct PlanBuild {
+    tol: f64,
+    options: PlanOptions,
+    spans: Vec<(Span, ContourRef)>,
+    sweep: Sweep,
+}
+
+impl PlanBuild {
+    /// Gathers the parts' spans (refusing a bad tolerance, non-finite or empty input).
+    pub(crate) fn new(nest: &Nest, options: &PlanOptions) -> Result<Self, PlanError> {
+        let tol = options.tolerance;
+        if !(tol.is_finite() && tol > 0.0) {
+            return Err(PlanError::BadTolerance(tol));
+        }
+        let mut spans: Vec<(Span, ContourRef)> = Vec::new();
+        for r in nest.contour_refs() {
+            let contour = nest.contour(r).expect("reference from the nest");
+            for span in contour.spans() {
+                let finite =
+                    span.start.is_finite() && span.end.is_finite() && span.bulge.is_finite();
+                if !finite {
+                    return Err(PlanError::NonFinite { contour: r });
+                }
+                if span.chord_length() > tol {
+                    spans.push((span, r));
                 }
             }
         }
-        active.push(i);
+        if spans.is_empty() {
+            return Err(PlanError::Empty);
+        }
+        Ok(PlanBuild {
+            sweep: Sweep::new(&spans, tol),
+            tol,
+            options: options.clone(),
+            spans,
+        })
     }
-    for (k, ts) in params.iter_mut().enumerate() {
-        let span = &spans[k].0;
-        ts.retain(|t| t.is_finite());
-        ts.sort_by(f64::total_cmp);
-        let mut kept: Vec<f64> = Vec::with_capacity(ts.len());
-        for &t in ts.iter() {
-            let t = t.clamp(0.0, 1.0);
-            match kept.last() {
-                Some(&last) if span.point_at(last).distance(span.point_at(t)) <= tol => {
-                    if t == 1.0 {
-                        *kept.last_mut().expect("non-empty") = 1.0;
+
+    /// Sweeps until done (`true`) or `stop()` says so (`false`).
+    pub(crate) fn run(&mut self, stop: &dyn Fn() -> bool) -> bool {
+        self.sweep.run(&self.spans, self.tol, stop)
+    }
+
+    /// The graph, once the sweep is done.
+    pub(crate) fn finish(self) -> Result<PlanGraph, PlanError> {
+        let params = self.sweep.parameters(&self.spans, self.tol);
+        PlanGraph::from_split(&self.spans, params, self.tol, &self.options)
+    }
+}
+
+/// The split parameters of every span: 0, 1, and every point where another span crosses or
+/// touches it; found by a sweep over the spans' boxes in x.
+struct Sweep {
+    params: Vec<Vec<f64>>,
+    boxes: Vec<cutroute_geometry::BoundingBox>,
+    order: Vec<usize>,
+    active: Vec<usize>,
+    /// Spans of `order` swept so far.
+    next: usize,
+}
+
+impl Sweep {
+    fn new(spans: &[(Span, ContourRef)], tol: f64) -> Self {
+        let boxes: Vec<_> = spans
+            .iter()
+            .map(|(s, _)| s.bounding_box().expanded(tol))
+            .collect();
+        let mut order: Vec<usize> = (0..spans.len()).collect();
+        order.sort_by(|&a, &b| boxes[a].min.x.total_cmp(&boxes[b].min.x));
+        Sweep {
+            params: vec![vec![0.0, 1.0]; spans.len()],
+            boxes,
+            order,
+            active: Vec::new(),
+            next: 0,
+        }
+    }
+
+    /// Sweeps until every span is met (`true`) or `stop()` says so (`false`).
+    fn run(&mut self, spans: &[(Span, ContourRef)], tol: f64, stop: &dyn Fn() -> bool) -> bool {
+        let (boxes, params) = (&self.boxes, &mut self.params);
+        while let Some(&i) = self.order.get(self.next) {
+            self.next += 1;
+            self.active.retain(|&j| boxes[j].max.x >= boxes[i].min.x);
+            for &j in &self.active {
+                if !boxes[i].intersects(&boxes[j]) {
+                    continue;
+                }
+                let (si, sj) = (&spans[i].0, &spans[j].0);
+                for x in si.intersections(sj) {
+                    params[i].push(x.t_self);
+                    params[j].push(x.t_other);
+                }
+                for (a, b, target) in [(si, sj, i), (sj, si, j)] {
+                    for p in [b.start, b.end] {
+                        let near = a.nearest_point(p);
+                        if near.distance <= tol {
+                            params[target].push(near.t);
+                        }
                     }
                 }
-                _ => kept.push(t),
+            }
+            self.active.push(i);
+            if self.next.is_multiple_of(256) && stop() {
+                return self.next == self.order.len();
             }
         }
-        if kept.len() == 1 {
-            kept.push(1.0);
-        }
-        *kept.last_mut().expect("two parameters") = 1.0;
-        *ts = kept;
+        true
     }
-    params
+
+    /// The parameters found, sorted, with points closer than the tolerance merged.
+    fn parameters(self, spans: &[(Span, ContourRef)], tol: f64) -> Vec<Vec<f64>> {
+        let mut params = self.params;
+        for (k, ts) in params.iter_mut().enumerate() {
+            let span = &spans[k].0;
+            ts.retain(|t| t.is_finite());
+            ts.sort_by(f64::total_cmp);
+            let mut kept: Vec<f64> = Vec::with_capacity(ts.len());
+            for &t in ts.iter() {
+                let t = t.clamp(0.0, 1.0);
+                match kept.last() {
+                    Some(&last) if span.point_at(last).distance(span.point_at(t)) <= tol => {
+                        if t == 1.0 {
+                            *kept.last_mut().expect("non-empty") = 1.0;
+                        }
+                    }
+                    _ => kept.push(t),
+                }
+            }
+            if kept.len() == 1 {
+                kept.push(1.0);
+            }
+            *kept.last_mut().expect("two parameters") = 1.0;
+            *ts = kept;
+        }
+        params
+    }
 }
 
 /// Snaps points to vertices: a point within the tolerance of an existing vertex is that vertex.

@@ -8,13 +8,16 @@
 //! the only rule is containment: a component holding a contour that lies inside a contour of
 //! another component is cut first (the part it frees would otherwise fall with uncut edges).
 
+use cutroute_anytime::{AnytimeSolver, Bounds, Status};
 use cutroute_geometry::float::Libm;
 use cutroute_geometry::{
     BoundingBox, MachineParameters, Nest, PathRoute, PathRouteError, Point, Span, ToolOnPath,
 };
 use cutroute_thermal::{path_route_pierces, HeatModel};
 use thiserror::Error;
+use web_time::{Duration, Instant};
 
+use crate::plan::PlanBuild;
 use crate::{CheckError, CutChain, EmbeddingError, PlanError, PlanGraph, PlanOptions};
 
 /// Options of [`solve_nest`].
@@ -136,21 +139,68 @@ struct Opening {
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub fn solve_nest(nest: &Nest, options: &AoeSolveOptions) -> Result<AoeSolution, AoeSolveError> {
-    let mut solving = AoeSolving::new(nest, options)?;
-    loop {
-        if let Some(result) = solving.advance(nest, options, &|| false) {
-            return result;
-        }
-    }
+    let mut solving = AoeSolving::new(nest, options);
+    while !solving.advance(&|| false) {}
+    solving
+        .outcome
+        .take()
+        .expect("advance ended with an outcome")
 }
 
-/// [`solve_nest`] in resumable pieces, for callers that must stay responsive (the app's worker
-/// answers Stop between slices): [`AoeSolving::new`] builds the plan graph and the components'
-/// chains, [`AoeSolving::advance`] orders them — one start of the nearest-ready order or one
-/// round of moves per piece, `stop` asked after each — and checks the route. On 1,000
-/// components the ordering alone took seconds, a single step of the worker before. The result
-/// does not depend on where `stop` falls. Pass the same nest and options to every call.
+/// [`solve_nest`] in resumable slices ([`AnytimeSolver`]), for callers that must stay
+/// responsive (the app's worker answers Stop between slices). A 5,000-part sheet once took 12 s
+/// in one step, and its ordering rounds were single pieces of seconds, so every stage is cut
+/// into small units of work with a look at the clock between them: the plan graph, its components, each
+/// component's chains, each pick of the nearest-ready ordering, each move tried and each closed
+/// curve relaxed, and the two checks of the final route. The route does not depend on where the
+/// slices end. [`AoeSolving::stop_at`] ends the ordering at a deadline with its best so far (the
+/// plain inner-first area order at worst); the build and the checks always run to their end.
 pub struct AoeSolving {
+    nest: Nest,
+    options: AoeSolveOptions,
+    deadline: Option<Instant>,
+    stage: Stage,
+    /// Whether the deadline cut the ordering short.
+    stopped: bool,
+    outcome: Option<Result<AoeSolution, AoeSolveError>>,
+}
+
+/// Where [`AoeSolving`] is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AoeStage {
+    /// Building the plan graph, its components and their chains.
+    Building,
+    /// Ordering the components.
+    Ordering,
+    /// Checking the route of the best ordering.
+    Checking,
+    /// Done: [`AoeSolving::outcome`] holds the solution or the error.
+    Done,
+}
+
+enum Stage {
+    Plan,
+    Sweep(Box<PlanBuild>),
+    Components(Box<PlanGraph>),
+    Chains(Box<Chaining>),
+    Ordering(Box<Orderings>),
+    /// The route's chains, checked by the plan's checker; then the route by the nest's.
+    Check(Box<Orderings>, Option<(Vec<CutChain>, PathRoute)>),
+    /// The plan graph stays for [`AoeSolving::plan`] (none after a failure).
+    Done(Option<Box<PlanGraph>>),
+}
+
+/// The components' chains, one component per unit of work.
+struct Chaining {
+    plan: PlanGraph,
+    components: Vec<crate::PlanComponent>,
+    visits: Vec<Visit>,
+    contours_of: Vec<Vec<cutroute_geometry::ContourRef>>,
+    pierce_lower_bound: usize,
+}
+
+/// The orderings of the components and the best so far.
+struct Orderings {
     plan: PlanGraph,
     n: usize,
     visits: Vec<Visit>,
@@ -158,61 +208,283 @@ pub struct AoeSolving {
     after: Vec<Vec<usize>>,
     pierce_lower_bound: usize,
     unordered_idle_length: f64,
-    /// The best ordering so far: idle length (+ W·H with a heat penalty), visits (closed
-    /// curves placed), order.
+    /// The best ordering so far: its value (idle length, + W·H with a heat penalty), visits
+    /// (closed curves placed), order.
     best: (f64, Vec<Visit>, Vec<usize>),
     /// Whether the heat-priced ordering is still to try (with a heat penalty only).
     heated_start: bool,
     /// The starts of the ordering still to try (`choose_points` of each), next last.
     starts: Vec<bool>,
-    /// The start under way: its visits, order and rounds done.
-    ordering: Option<(Vec<Visit>, Vec<usize>, usize)>,
+    /// The start under way.
+    ordering: Option<Ordering>,
 }
 
+/// One start of the ordering: the nearest-ready order, then rounds of single-component moves
+/// and relaxation of the closed curves' points while they gain.
+struct Ordering {
+    placed: Vec<Visit>,
+    order: Vec<usize>,
+    rounds: usize,
+    work: OrderWork,
+}
+
+enum OrderWork {
+    Greedy(NearestReady),
+    Moves(Moves),
+    Relax(Relax),
+}
+
+/// Units of work between looks at `stop` (a unit is one pick, one move tried, one curve
+/// relaxed or one component's chains).
+const UNITS_PER_LOOK: usize = 16;
+
 impl AoeSolving {
-    /// Builds the plan graph, its components and their chains, and the precedence between
-    /// components.
-    pub fn new(nest: &Nest, options: &AoeSolveOptions) -> Result<Self, AoeSolveError> {
-        let plan = PlanGraph::from_nest(nest, &options.plan)?;
-        let components = plan.components()?;
-        let forest = nest.containment_forest();
-        let mut visits = Vec::with_capacity(components.len());
-        let mut pierce_lower_bound = 0;
-        let mut contours_of = Vec::with_capacity(components.len());
-        for component in &components {
-            pierce_lower_bound += crate::pierce_lower_bound(component.embedding.graph());
-            let chains = plan.component_chains(component);
-            let entry = chains
-                .first()
-                .and_then(|c| c.spans.first())
-                .map_or(options.start, |s| s.start);
-            let exit = chains
-                .last()
-                .and_then(|c| c.spans.last())
-                .map_or(entry, |s| s.end);
-            let inner_idle = chains
-                .windows(2)
-                .filter_map(|w| Some(w[0].spans.last()?.end.distance(w[1].spans.first()?.start)))
-                .sum();
-            let simple_cycle = chains.len() == 1
-                && (0..component.embedding.graph().vertex_count())
-                    .all(|v| component.embedding.graph().degree(v) == 2);
-            visits.push(Visit {
-                chains,
-                entry,
-                exit,
-                inner_idle,
-                opening: simple_cycle.then_some(Opening { span: 0, t: 0.0 }),
-            });
-            let mut contours: Vec<_> = component
-                .edges
-                .iter()
-                .flat_map(|&e| plan.edge_contours(e).iter().copied())
-                .collect();
-            contours.sort();
-            contours.dedup();
-            contours_of.push(contours);
+    /// Prepares the solve (no work yet: the plan graph is built by the first steps).
+    pub fn new(nest: &Nest, options: &AoeSolveOptions) -> Self {
+        AoeSolving {
+            nest: nest.clone(),
+            options: options.clone(),
+            deadline: None,
+            stage: Stage::Plan,
+            stopped: false,
+            outcome: None,
         }
+    }
+
+    /// Ends the ordering at `deadline` with its best order so far (a time limit).
+    pub fn stop_at(&mut self, deadline: Instant) {
+        self.deadline = Some(deadline);
+    }
+
+    /// The stage under way.
+    pub fn stage(&self) -> AoeStage {
+        match self.stage {
+            Stage::Plan | Stage::Sweep(_) | Stage::Components(_) | Stage::Chains(_) => {
+                AoeStage::Building
+            }
+            Stage::Ordering(_) => AoeStage::Ordering,
+            Stage::Check(..) => AoeStage::Checking,
+            Stage::Done(_) => AoeStage::Done,
+        }
+    }
+
+    /// The plan graph the route was made on, once done (for bounds measured on it).
+    pub fn plan(&self) -> Option<&PlanGraph> {
+        match &self.stage {
+            Stage::Done(plan) => plan.as_deref(),
+            _ => None,
+        }
+    }
+
+    /// The solution (checked by both checkers) or why there is none, once done.
+    pub fn outcome(&self) -> Option<&Result<AoeSolution, AoeSolveError>> {
+        self.outcome.as_ref()
+    }
+
+    /// Works for about `budget`: [`Status::Finished`] once the route is made and checked (or
+    /// failed: see [`AoeSolving::outcome`]), [`Status::Stopped`] when the deadline of
+    /// [`AoeSolving::stop_at`] cut the ordering short.
+    pub fn step(&mut self, budget: Duration) -> Status {
+        let slice_end = Instant::now().checked_add(budget);
+        let done = self.advance(&|| slice_end.is_some_and(|end| Instant::now() >= end));
+        if !done {
+            Status::Running
+        } else if self.stopped {
+            Status::Stopped
+        } else {
+            Status::Finished {
+                proven_optimal: false,
+            }
+        }
+    }
+
+    /// Works unit by unit until `stop()` says so (`false`: call again) or the outcome is set
+    /// (`true`).
+    fn advance(&mut self, stop: &dyn Fn() -> bool) -> bool {
+        loop {
+            if self.outcome.is_some() {
+                return true;
+            }
+            let stage = std::mem::replace(&mut self.stage, Stage::Done(None));
+            self.stage = match self.advance_stage(stage, stop) {
+                Ok(stage) => stage,
+                Err(e) => {
+                    self.outcome = Some(Err(e));
+                    return true;
+                }
+            };
+            if self.outcome.is_none() && stop() {
+                return false;
+            }
+        }
+    }
+
+    /// One piece of `stage` (a piece may stop early when `stop()` says so); the stage after it.
+    fn advance_stage(
+        &mut self,
+        stage: Stage,
+        stop: &dyn Fn() -> bool,
+    ) -> Result<Stage, AoeSolveError> {
+        let (nest, options) = (&self.nest, &self.options);
+        Ok(match stage {
+            Stage::Plan => Stage::Sweep(Box::new(PlanBuild::new(nest, &options.plan)?)),
+            Stage::Sweep(mut build) => {
+                if build.run(stop) {
+                    Stage::Components(Box::new(build.finish()?))
+                } else {
+                    Stage::Sweep(build)
+                }
+            }
+            Stage::Components(plan) => {
+                let components = plan.components()?;
+                Stage::Chains(Box::new(Chaining {
+                    plan: *plan,
+                    visits: Vec::with_capacity(components.len()),
+                    contours_of: Vec::with_capacity(components.len()),
+                    components,
+                    pierce_lower_bound: 0,
+                }))
+            }
+            Stage::Chains(mut chaining) => {
+                let mut units = 0usize;
+                while chaining.visits.len() < chaining.components.len() {
+                    chaining.add_next(options.start);
+                    units += 1;
+                    if units.is_multiple_of(UNITS_PER_LOOK) && stop() {
+                        return Ok(Stage::Chains(chaining));
+                    }
+                }
+                Stage::Ordering(Box::new(Orderings::new(*chaining, nest, options)))
+            }
+            Stage::Ordering(mut orderings) => {
+                let over = self.deadline.is_some_and(|end| Instant::now() >= end);
+                if over {
+                    self.stopped = orderings.cut_short(options);
+                    Stage::Check(orderings, None)
+                } else if orderings.advance(options, &|| {
+                    stop() || self.deadline.is_some_and(|end| Instant::now() >= end)
+                }) {
+                    Stage::Check(orderings, None)
+                } else {
+                    Stage::Ordering(orderings)
+                }
+            }
+            Stage::Check(mut orderings, None) => {
+                let (start, finish) = (options.start, options.finish);
+                let (_, visits, order) = std::mem::take(&mut orderings.best);
+                let chains: Vec<CutChain> = order
+                    .iter()
+                    .flat_map(|&c| visits[c].chains.iter().cloned())
+                    .collect();
+                orderings.plan.check_route(&chains)?;
+                let route = route_of(&visits, &order, start, finish);
+                Stage::Check(orderings, Some((chains, route)))
+            }
+            Stage::Check(orderings, Some((chains, route))) => {
+                let tolerance = (options.plan.tolerance * 10.0).max(1e-6);
+                if let Some(problem) = route.problems(nest, tolerance).into_iter().next() {
+                    return Err(AoeSolveError::Route(problem));
+                }
+                self.outcome = Some(Ok(AoeSolution {
+                    route,
+                    chains,
+                    components: orderings.n,
+                    pierce_lower_bound: orderings.pierce_lower_bound,
+                    unordered_idle_length: orderings.unordered_idle_length,
+                }));
+                Stage::Done(Some(Box::new(orderings.plan)))
+            }
+            Stage::Done(plan) => Stage::Done(plan),
+        })
+    }
+}
+
+/// The contract of every solver: the checked route once made (the orderings compete on an
+/// unchecked route, so none is offered before), its idle length (+ W·H with a heat penalty,
+/// the value the orderings minimise); no lower bound (the engine's `PlanBound` gives one).
+impl AnytimeSolver for AoeSolving {
+    type Solution = PathRoute;
+
+    fn step(&mut self, budget: Duration) -> Status {
+        AoeSolving::step(self, budget)
+    }
+
+    fn best(&self) -> Option<PathRoute> {
+        match &self.outcome {
+            Some(Ok(solution)) => Some(solution.route.clone()),
+            _ => None,
+        }
+    }
+
+    fn bounds(&self) -> Bounds {
+        let upper = match (&self.outcome, &self.stage) {
+            (Some(Ok(solution)), _) => {
+                let route = &solution.route;
+                Some(match self.options.heat {
+                    Some(heat) if heat.weight_mm > 0.0 => {
+                        route.idle_length()
+                            + heat.weight_mm
+                                * heat.model.load(&path_route_pierces(route, &heat.machine))
+                    }
+                    _ => route.idle_length(),
+                })
+            }
+            _ => None,
+        };
+        Bounds { upper, lower: None }
+    }
+}
+
+impl Chaining {
+    /// The chains and the entry and exit of the next component.
+    fn add_next(&mut self, start: Point) {
+        let (plan, component) = (&self.plan, &self.components[self.visits.len()]);
+        self.pierce_lower_bound += crate::pierce_lower_bound(component.embedding.graph());
+        let chains = plan.component_chains(component);
+        let entry = chains
+            .first()
+            .and_then(|c| c.spans.first())
+            .map_or(start, |s| s.start);
+        let exit = chains
+            .last()
+            .and_then(|c| c.spans.last())
+            .map_or(entry, |s| s.end);
+        let inner_idle = chains
+            .windows(2)
+            .filter_map(|w| Some(w[0].spans.last()?.end.distance(w[1].spans.first()?.start)))
+            .sum();
+        let simple_cycle = chains.len() == 1
+            && (0..component.embedding.graph().vertex_count())
+                .all(|v| component.embedding.graph().degree(v) == 2);
+        self.visits.push(Visit {
+            chains,
+            entry,
+            exit,
+            inner_idle,
+            opening: simple_cycle.then_some(Opening { span: 0, t: 0.0 }),
+        });
+        let mut contours: Vec<_> = component
+            .edges
+            .iter()
+            .flat_map(|&e| plan.edge_contours(e).iter().copied())
+            .collect();
+        contours.sort();
+        contours.dedup();
+        self.contours_of.push(contours);
+    }
+}
+
+impl Orderings {
+    /// The precedence between components and the plain inner-first (area) order.
+    fn new(chaining: Chaining, nest: &Nest, options: &AoeSolveOptions) -> Self {
+        let Chaining {
+            plan,
+            components,
+            visits,
+            contours_of,
+            pierce_lower_bound,
+        } = chaining;
+        let forest = nest.containment_forest();
         // before[b] lists the components that must be cut before b: those holding a contour
         // that lies inside one of b's contours (and is not itself b's).
         let n = components.len();
@@ -249,7 +521,7 @@ impl AoeSolving {
             }
         }
         let area_value = penalised(&visits, &area_order, options);
-        Ok(AoeSolving {
+        Orderings {
             plan,
             n,
             best: (area_value, visits.clone(), area_order),
@@ -262,17 +534,11 @@ impl AoeSolving {
             // Tried in the order true, then false.
             starts: vec![false, true],
             ordering: None,
-        })
+        }
     }
 
-    /// Works on the ordering piece by piece until `stop()` says so (`None`: call again) or the
-    /// route is made and checked.
-    pub fn advance(
-        &mut self,
-        nest: &Nest,
-        options: &AoeSolveOptions,
-        stop: &dyn Fn() -> bool,
-    ) -> Option<Result<AoeSolution, AoeSolveError>> {
+    /// Works on the orderings until `stop()` says so (`false`) or every start is done (`true`).
+    fn advance(&mut self, options: &AoeSolveOptions, stop: &dyn Fn() -> bool) -> bool {
         let (start, finish) = (options.start, options.finish);
         // Nearest ready component (closed curves entered at their nearest point), then rounds
         // of single-component moves and relaxation of the closed curves' points, while they
@@ -294,96 +560,94 @@ impl AoeSolving {
                     }
                 }
                 if stop() {
-                    return None;
+                    return false;
                 }
                 continue;
             }
-            match self.ordering.take() {
-                None => {
-                    let Some(choose_points) = self.starts.pop() else {
-                        break;
-                    };
-                    let mut placed = self.visits.clone();
+            let Some(mut ordering) = self.ordering.take() else {
+                let Some(choose_points) = self.starts.pop() else {
+                    return true;
+                };
+                let placed = self.visits.clone();
+                let greedy = NearestReady::new(&placed, &self.before, start, choose_points);
+                self.ordering = Some(Ordering {
+                    placed,
+                    order: Vec::new(),
+                    rounds: 0,
+                    work: OrderWork::Greedy(greedy),
+                });
+                continue;
+            };
+            let Ordering {
+                placed,
+                order,
+                rounds,
+                work,
+            } = &mut ordering;
+            match work {
+                OrderWork::Greedy(greedy) => match greedy.run(placed, &self.after, stop) {
                     // A containment cycle cannot come from a valid nest; the area order stays
                     // then.
-                    if let Some(order) = nearest_ready_order(
-                        &mut placed,
-                        &self.before,
-                        &self.after,
-                        start,
-                        choose_points,
-                    ) {
-                        self.ordering = Some((placed, order, 0));
+                    None => continue,
+                    Some(false) => {
+                        self.ordering = Some(ordering);
+                        return false;
                     }
+                    Some(true) => {
+                        *order = std::mem::take(&mut greedy.order);
+                        *work = OrderWork::Moves(Moves::new(order, placed));
+                    }
+                },
+                OrderWork::Moves(moves) => {
+                    let context = (&self.before[..], &self.after[..], start, finish);
+                    if !moves.run(order, context, placed, stop) {
+                        self.ordering = Some(ordering);
+                        return false;
+                    }
+                    *work = OrderWork::Relax(Relax::default());
                 }
-                Some((mut placed, order, rounds)) => {
-                    let order =
-                        improve_by_moves(order, &self.before, &self.after, &placed, start, finish);
-                    let settled = relax_openings(&mut placed, &order, start, finish) < 1e-6;
-                    if settled || rounds + 1 >= ORDER_ROUNDS {
-                        let value = penalised(&placed, &order, options);
+                OrderWork::Relax(relax) => {
+                    let Some(gain) = relax.run(placed, order, start, finish, stop) else {
+                        self.ordering = Some(ordering);
+                        return false;
+                    };
+                    if gain < 1e-6 || *rounds + 1 >= ORDER_ROUNDS {
+                        let value = penalised(placed, order, options);
                         if value < self.best.0 {
-                            self.best = (value, placed, order);
+                            self.best = (value, std::mem::take(placed), std::mem::take(order));
                         }
-                    } else {
-                        self.ordering = Some((placed, order, rounds + 1));
+                        if stop() {
+                            return false;
+                        }
+                        continue;
                     }
+                    *rounds += 1;
+                    *work = OrderWork::Moves(Moves::new(order, placed));
                 }
             }
+            self.ordering = Some(ordering);
             if stop() {
-                return None;
+                return false;
             }
         }
-        Some(self.route(nest, options))
     }
 
-    /// Ends the ordering now (a time limit): the route of the best ordering so far (the plain
-    /// inner-first area order at worst), checked as [`AoeSolving::advance`]'s is.
-    pub fn finish_now(
-        &mut self,
-        nest: &Nest,
-        options: &AoeSolveOptions,
-    ) -> Result<AoeSolution, AoeSolveError> {
-        if let Some((placed, order, _)) = self.ordering.take() {
-            let value = penalised(&placed, &order, options);
-            if value < self.best.0 {
-                self.best = (value, placed, order);
+    /// Ends the ordering now: the start under way competes with its order so far if it has a
+    /// whole one (its moves and relaxations keep every order whole). Whether anything was cut
+    /// short.
+    fn cut_short(&mut self, options: &AoeSolveOptions) -> bool {
+        let cut = self.ordering.is_some() || !self.starts.is_empty() || self.heated_start;
+        if let Some(ordering) = self.ordering.take() {
+            if !matches!(ordering.work, OrderWork::Greedy(_)) {
+                let value = penalised(&ordering.placed, &ordering.order, options);
+                if value < self.best.0 {
+                    self.best = (value, ordering.placed, ordering.order);
+                }
             }
         }
         self.starts.clear();
         self.heated_start = false;
-        self.route(nest, options)
-    }
-
-    /// The route of the best ordering, checked by the plan's and the nest's checkers.
-    fn route(
-        &mut self,
-        nest: &Nest,
-        options: &AoeSolveOptions,
-    ) -> Result<AoeSolution, AoeSolveError> {
-        let (start, finish) = (options.start, options.finish);
-        let (_, visits, order) = std::mem::take(&mut self.best);
-        let plan = &self.plan;
-        let n = self.n;
-        let pierce_lower_bound = self.pierce_lower_bound;
-        let unordered_idle_length = self.unordered_idle_length;
-        let chains: Vec<CutChain> = order
-            .iter()
-            .flat_map(|&c| visits[c].chains.iter().cloned())
-            .collect();
-        plan.check_route(&chains)?;
-        let route = route_of(&visits, &order, start, finish);
-        let tolerance = (options.plan.tolerance * 10.0).max(1e-6);
-        if let Some(problem) = route.problems(nest, tolerance).into_iter().next() {
-            return Err(AoeSolveError::Route(problem));
-        }
-        Ok(AoeSolution {
-            route,
-            chains,
-            components: n,
-            pierce_lower_bound,
-            unordered_idle_length,
-        })
+        cut
     }
 }
 
@@ -525,36 +789,64 @@ type Placed = (Opening, Point);
 const ORDER_ROUNDS: usize = 8;
 
 /// Nearest ready component first (with `choose_points`, a closed curve is measured to, and
-/// entered at, its nearest point; else at its chain's start); `None` when the precedence has a
-/// cycle.
-fn nearest_ready_order(
-    visits: &mut [Visit],
-    before: &[Vec<usize>],
-    after: &[Vec<usize>],
-    start: Point,
+/// entered at, its nearest point; else at its chain's start), one pick per unit of work.
+struct NearestReady {
+    waiting: Vec<usize>,
+    done: Vec<bool>,
+    order: Vec<usize>,
+    at: Point,
+    /// A closed curve's distance is at least its box's: the exact nearest point is needed only
+    /// for curves whose box is nearer than the best so far.
+    boxes: Vec<BoundingBox>,
     choose_points: bool,
-) -> Option<Vec<usize>> {
-    let n = visits.len();
-    let mut waiting: Vec<usize> = before.iter().map(Vec::len).collect();
-    let mut done = vec![false; n];
-    let mut order = Vec::with_capacity(n);
-    let mut at = start;
-    // A closed curve's distance is at least its box's: the exact nearest point is needed only
-    // for curves whose box is nearer than the best so far.
-    let boxes: Vec<BoundingBox> = visits
-        .iter()
-        .map(|v| {
-            v.chains[0]
-                .spans
+}
+
+impl NearestReady {
+    fn new(visits: &[Visit], before: &[Vec<usize>], start: Point, choose_points: bool) -> Self {
+        let n = visits.len();
+        NearestReady {
+            waiting: before.iter().map(Vec::len).collect(),
+            done: vec![false; n],
+            order: Vec::with_capacity(n),
+            at: start,
+            boxes: visits
                 .iter()
-                .fold(BoundingBox::EMPTY, |b, s| b.union(s.bounding_box()))
-        })
-        .collect();
-    while order.len() < n {
-        let mut ready: Vec<(f64, usize)> = (0..n)
-            .filter(|&c| !done[c] && waiting[c] == 0)
+                .map(|v| {
+                    v.chains[0]
+                        .spans
+                        .iter()
+                        .fold(BoundingBox::EMPTY, |b, s| b.union(s.bounding_box()))
+                })
+                .collect(),
+            choose_points,
+        }
+    }
+
+    /// Picks until the order is whole (`Some(true)`) or `stop()` says so (`Some(false)`);
+    /// `None` when the precedence has a cycle.
+    fn run(
+        &mut self,
+        visits: &mut [Visit],
+        after: &[Vec<usize>],
+        stop: &dyn Fn() -> bool,
+    ) -> Option<bool> {
+        let n = visits.len();
+        while self.order.len() < n {
+            self.pick(visits, after)?;
+            if self.order.len().is_multiple_of(UNITS_PER_LOOK) && self.order.len() < n && stop() {
+                return Some(false);
+            }
+        }
+        Some(true)
+    }
+
+    /// The next component; `None` when none is ready.
+    fn pick(&mut self, visits: &mut [Visit], after: &[Vec<usize>]) -> Option<()> {
+        let (at, choose_points) = (self.at, self.choose_points);
+        let mut ready: Vec<(f64, usize)> = (0..visits.len())
+            .filter(|&c| !self.done[c] && self.waiting[c] == 0)
             .map(|c| match visits[c].opening {
-                Some(_) if choose_points => (box_distance(&boxes[c], at), c),
+                Some(_) if choose_points => (box_distance(&self.boxes[c], at), c),
                 _ => (at.distance(visits[c].entry), c),
             })
             .collect();
@@ -586,14 +878,14 @@ fn nearest_ready_order(
             let visit = &mut visits[next];
             (visit.opening, visit.entry, visit.exit) = (Some(opening), point, point);
         }
-        done[next] = true;
-        order.push(next);
-        at = visits[next].exit;
+        self.done[next] = true;
+        self.order.push(next);
+        self.at = visits[next].exit;
         for &b in &after[next] {
-            waiting[b] -= 1;
+            self.waiting[b] -= 1;
         }
+        Some(())
     }
-    Some(order)
 }
 
 /// Or-opt with segments of one: move a component to the place that shortens the idle travel
@@ -601,97 +893,137 @@ fn nearest_ready_order(
 /// predecessors and before all its successors; passes until no move helps. Up to
 /// [`FULL_SCAN_COMPONENTS`] components every place is tried (O(n²) per pass); beyond, only the
 /// places next to the component's [`NEIGHBOURS`] nearest components, the order's ends
-/// included (O(n·k) per pass: a 5,000-part sheet took minutes with the full scan).
-fn improve_by_moves(
-    mut order: Vec<usize>,
-    before: &[Vec<usize>],
-    after: &[Vec<usize>],
-    visits: &[Visit],
-    start: Point,
-    finish: Option<Point>,
-) -> Vec<usize> {
-    let n = order.len();
-    let (entry, exit) = (|c: usize| visits[c].entry, |c: usize| visits[c].exit);
-    // The cost of putting `c` between `u` (an exit) and `v` (the next entry, if any).
-    let joint = |u: Point, c: usize, v: Option<Point>| {
-        u.distance(entry(c)) + v.map_or(0.0, |v| exit(c).distance(v) - u.distance(v))
-    };
-    let near = (n > FULL_SCAN_COMPONENTS).then(|| nearest_components(visits, NEIGHBOURS));
-    let mut pos = vec![0; n];
-    for (k, &x) in order.iter().enumerate() {
-        pos[x] = k;
+/// included (O(n·k) per pass: a 5,000-part sheet took minutes with the full scan). One move
+/// tried per unit of work.
+struct Moves {
+    near: Option<NearestComponents>,
+    pos: Vec<usize>,
+    places: Vec<usize>,
+    pass: usize,
+    /// The position whose move is tried next.
+    i: usize,
+    improved: bool,
+}
+
+/// Precedence (before, after), start and finish.
+type MoveContext<'a> = (&'a [Vec<usize>], &'a [Vec<usize>], Point, Option<Point>);
+
+impl Moves {
+    fn new(order: &[usize], visits: &[Visit]) -> Self {
+        let n = order.len();
+        let mut pos = vec![0; n];
+        for (k, &x) in order.iter().enumerate() {
+            pos[x] = k;
+        }
+        Moves {
+            near: (n > FULL_SCAN_COMPONENTS).then(|| nearest_components(visits, NEIGHBOURS)),
+            pos,
+            places: Vec::new(),
+            pass: 0,
+            i: 0,
+            improved: false,
+        }
     }
-    let mut places = Vec::new();
-    for _ in 0..MAX_MOVE_PASSES {
-        let mut improved = false;
-        for i in 0..n {
-            let c = order[i];
-            let p = if i == 0 { start } else { exit(order[i - 1]) };
-            let q = if i + 1 < n {
-                Some(entry(order[i + 1]))
+
+    /// Tries moves until no pass helps or [`MAX_MOVE_PASSES`] are done (`true`), or `stop()`
+    /// says so (`false`).
+    fn run(
+        &mut self,
+        order: &mut Vec<usize>,
+        context: MoveContext,
+        visits: &[Visit],
+        stop: &dyn Fn() -> bool,
+    ) -> bool {
+        let n = order.len();
+        let mut units = 0usize;
+        loop {
+            if self.i == n {
+                if !self.improved || self.pass + 1 >= MAX_MOVE_PASSES {
+                    return true;
+                }
+                (self.pass, self.i, self.improved) = (self.pass + 1, 0, false);
+            }
+            self.try_move(order, context, visits);
+            self.i += 1;
+            units += 1;
+            if units.is_multiple_of(UNITS_PER_LOOK) && stop() {
+                return false;
+            }
+        }
+    }
+
+    /// Moves the component at position `i` to its best place, if that shortens the route.
+    fn try_move(&mut self, order: &mut Vec<usize>, context: MoveContext, visits: &[Visit]) {
+        let (before, after, start, finish) = context;
+        let (n, i, pos) = (order.len(), self.i, &mut self.pos);
+        let (entry, exit) = (|c: usize| visits[c].entry, |c: usize| visits[c].exit);
+        // The cost of putting `c` between `u` (an exit) and `v` (the next entry, if any).
+        let joint = |u: Point, c: usize, v: Option<Point>| {
+            u.distance(entry(c)) + v.map_or(0.0, |v| exit(c).distance(v) - u.distance(v))
+        };
+        let c = order[i];
+        let p = if i == 0 { start } else { exit(order[i - 1]) };
+        let q = if i + 1 < n {
+            Some(entry(order[i + 1]))
+        } else {
+            finish
+        };
+        let saving = joint(p, c, q);
+        if saving <= 1e-9 {
+            return;
+        }
+        // Positions in the order without `c`.
+        let rest = |k: usize| if k < i { order[k] } else { order[k + 1] };
+        let rest_pos = |x: usize| if pos[x] < i { pos[x] } else { pos[x] - 1 };
+        let lo = before[c]
+            .iter()
+            .map(|&a| rest_pos(a) + 1)
+            .max()
+            .unwrap_or(0);
+        let hi = after[c]
+            .iter()
+            .map(|&b| rest_pos(b))
+            .min()
+            .unwrap_or(n - 1)
+            .min(n - 1);
+        let places = &mut self.places;
+        places.clear();
+        match &self.near {
+            None => places.extend(lo..=hi),
+            Some(near) => {
+                places.extend([lo, hi]);
+                // After a component whose exit is near c's entry, before one whose entry
+                // is near c's exit.
+                places.extend(near.entry_to_exits[c].iter().map(|&x| rest_pos(x) + 1));
+                places.extend(near.exit_to_entries[c].iter().map(|&x| rest_pos(x)));
+                places.retain(|&k| (lo..=hi).contains(&k));
+            }
+        }
+        let mut best = (saving - 1e-9, None);
+        for &k in places.iter() {
+            if k == i {
+                continue;
+            }
+            let u = if k == 0 { start } else { exit(rest(k - 1)) };
+            let v = if k < n - 1 {
+                Some(entry(rest(k)))
             } else {
                 finish
             };
-            let saving = joint(p, c, q);
-            if saving <= 1e-9 {
-                continue;
-            }
-            // Positions in the order without `c`.
-            let rest = |k: usize| if k < i { order[k] } else { order[k + 1] };
-            let rest_pos = |x: usize| if pos[x] < i { pos[x] } else { pos[x] - 1 };
-            let lo = before[c]
-                .iter()
-                .map(|&a| rest_pos(a) + 1)
-                .max()
-                .unwrap_or(0);
-            let hi = after[c]
-                .iter()
-                .map(|&b| rest_pos(b))
-                .min()
-                .unwrap_or(n - 1)
-                .min(n - 1);
-            places.clear();
-            match &near {
-                None => places.extend(lo..=hi),
-                Some(near) => {
-                    places.extend([lo, hi]);
-                    // After a component whose exit is near c's entry, before one whose entry
-                    // is near c's exit.
-                    places.extend(near.entry_to_exits[c].iter().map(|&x| rest_pos(x) + 1));
-                    places.extend(near.exit_to_entries[c].iter().map(|&x| rest_pos(x)));
-                    places.retain(|&k| (lo..=hi).contains(&k));
-                }
-            }
-            let mut best = (saving - 1e-9, None);
-            for &k in &places {
-                if k == i {
-                    continue;
-                }
-                let u = if k == 0 { start } else { exit(rest(k - 1)) };
-                let v = if k < n - 1 {
-                    Some(entry(rest(k)))
-                } else {
-                    finish
-                };
-                let cost = joint(u, c, v);
-                if cost < best.0 {
-                    best = (cost, Some(k));
-                }
-            }
-            if let (_, Some(k)) = best {
-                order.remove(i);
-                order.insert(k, c);
-                for (j, &x) in order.iter().enumerate().take(i.max(k) + 1).skip(i.min(k)) {
-                    pos[x] = j;
-                }
-                improved = true;
+            let cost = joint(u, c, v);
+            if cost < best.0 {
+                best = (cost, Some(k));
             }
         }
-        if !improved {
-            break;
+        if let (_, Some(k)) = best {
+            order.remove(i);
+            order.insert(k, c);
+            for (j, &x) in order.iter().enumerate().take(i.max(k) + 1).skip(i.min(k)) {
+                pos[x] = j;
+            }
+            self.improved = true;
         }
     }
-    order
 }
 
 /// Orders of up to this many components are improved by trying every place for every move.
@@ -742,17 +1074,40 @@ const MAX_MOVE_PASSES: usize = 50;
 
 /// Sweeps over the order moving each closed curve's point to the minimiser of
 /// `|previous exit, M| + |M, next entry|` on the curve, until a sweep gains less than 10⁻⁶ mm;
-/// returns the total gain.
-fn relax_openings(
-    visits: &mut [Visit],
-    order: &[usize],
-    start: Point,
-    finish: Option<Point>,
-) -> f64 {
-    let mut total = 0.0;
-    for _ in 0..MAX_RELAXATION_SWEEPS {
-        let mut gain = 0.0;
-        for (i, &c) in order.iter().enumerate() {
+/// one curve per unit of work.
+#[derive(Default)]
+struct Relax {
+    sweep: usize,
+    /// The position relaxed next.
+    i: usize,
+    /// The gain of the sweep under way, and of the sweeps before it.
+    gain: f64,
+    total: f64,
+}
+
+impl Relax {
+    /// Relaxes until done (`Some(total gain)`) or `stop()` says so (`None`).
+    fn run(
+        &mut self,
+        visits: &mut [Visit],
+        order: &[usize],
+        start: Point,
+        finish: Option<Point>,
+        stop: &dyn Fn() -> bool,
+    ) -> Option<f64> {
+        let mut units = 0usize;
+        while self.sweep < MAX_RELAXATION_SWEEPS {
+            if self.i == order.len() {
+                self.total += self.gain;
+                if self.gain < 1e-6 {
+                    break;
+                }
+                (self.sweep, self.i, self.gain) = (self.sweep + 1, 0, 0.0);
+                continue;
+            }
+            let i = self.i;
+            self.i += 1;
+            let c = order[i];
             if visits[c].opening.is_none() {
                 continue;
             }
@@ -764,23 +1119,21 @@ fn relax_openings(
             let b = order.get(i + 1).map(|&d| visits[d].entry).or(finish);
             let visit = &visits[c];
             let old = a.distance(visit.entry) + b.map_or(0.0, |b| visit.exit.distance(b));
-            let Some((span, t, point, value)) = best_point(&visit.chains[0].spans, a, b, old)
-            else {
-                continue;
-            };
-            if value < old - 1e-12 {
-                let visit = &mut visits[c];
-                (visit.opening, visit.entry, visit.exit) =
-                    (Some(Opening { span, t }), point, point);
-                gain += old - value;
+            if let Some((span, t, point, value)) = best_point(&visit.chains[0].spans, a, b, old) {
+                if value < old - 1e-12 {
+                    let visit = &mut visits[c];
+                    (visit.opening, visit.entry, visit.exit) =
+                        (Some(Opening { span, t }), point, point);
+                    self.gain += old - value;
+                }
+            }
+            units += 1;
+            if units.is_multiple_of(UNITS_PER_LOOK) && stop() {
+                return None;
             }
         }
-        total += gain;
-        if gain < 1e-6 {
-            break;
-        }
+        Some(self.total)
     }
-    total
 }
 
 const MAX_RELAXATION_SWEEPS: usize = 50;

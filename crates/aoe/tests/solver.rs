@@ -4,7 +4,11 @@
 mod common;
 
 use common::{hole, load_nest, part, rect, REAL_NESTS};
-use cutroute_aoe::{solve_nest, AoeSolveOptions, PlanGraph, PlanOptions, PlaneGraph};
+use std::time::{Duration, Instant};
+
+use cutroute_aoe::{
+    solve_nest, AoeSolveOptions, AoeSolving, PlanGraph, PlanOptions, PlaneGraph, Status,
+};
 use cutroute_geometry::{Nest, Point};
 
 /// `n × m` rectangles of `w × h` sharing their edges.
@@ -207,6 +211,80 @@ fn a_thousand_contour_sheet_gets_a_checked_route() {
     let plan = PlanGraph::from_nest(&nest, &options.plan).unwrap();
     plan.check_route(&solution.chains).unwrap();
     assert!(solution.components > 400);
+    assert!(solution.route.idle_length() <= solution.unordered_idle_length + 1e-9);
+}
+
+/// The engine's options for `nest`: the tolerance 10⁻⁶ of its width plus height.
+fn engine_options(nest: &Nest) -> AoeSolveOptions {
+    let b = nest.bounding_box();
+    let scale = (b.max.x - b.min.x).abs() + (b.max.y - b.min.y).abs();
+    AoeSolveOptions {
+        plan: PlanOptions {
+            tolerance: 1e-6 * scale.max(1.0),
+            ..PlanOptions::default()
+        },
+        ..AoeSolveOptions::default()
+    }
+}
+
+/// Stepped with a zero budget (a look at the clock after every few units of work: a pick, a
+/// move tried, a curve relaxed, a component's chains), the solver gives the route of one
+/// uninterrupted call: where the slices end changes nothing.
+#[test]
+fn slices_give_the_route_of_one_call() {
+    let mut nests: Vec<(String, Nest)> = REAL_NESTS
+        .iter()
+        .map(|name| (name.to_string(), load_nest(name)))
+        .collect();
+    nests.push(("grid".into(), grid(6, 4, 10.0, 5.0)));
+    nests.push((
+        "generated-1000".into(),
+        cutroute_geometry::generate_nest(1000, 1),
+    ));
+    for (name, nest) in nests {
+        let options = engine_options(&nest);
+        let whole = solve_nest(&nest, &options).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let mut solving = AoeSolving::new(&nest, &options);
+        let mut steps = 1;
+        let status = loop {
+            let status = solving.step(Duration::ZERO);
+            if status.is_done() {
+                break status;
+            }
+            steps += 1;
+        };
+        assert_eq!(
+            status,
+            Status::Finished {
+                proven_optimal: false
+            },
+            "{name}"
+        );
+        let sliced = solving.outcome().unwrap().as_ref().unwrap();
+        assert_eq!(sliced.route, whole.route, "{name}");
+        assert_eq!(sliced.chains, whole.chains, "{name}");
+        // Every stage in pieces: at least a step per 16 components' chains.
+        assert!(steps > sliced.components / 16 + 3, "{name}: {steps} steps");
+    }
+}
+
+/// A deadline already past ends the ordering at once: the route of the plain inner-first
+/// order at worst, still checked, and the status says it was stopped.
+#[test]
+fn a_past_deadline_stops_the_ordering_with_a_checked_route() {
+    let nest = cutroute_geometry::generate_nest(1000, 1);
+    let options = engine_options(&nest);
+    let mut solving = AoeSolving::new(&nest, &options);
+    solving.stop_at(Instant::now());
+    let status = cutroute_aoe::run_to_end(&mut solving, Duration::from_millis(40));
+    assert_eq!(status, Status::Stopped);
+    let solution = solving.outcome().unwrap().as_ref().unwrap();
+    let b = nest.bounding_box();
+    let tolerance = 1e-6 * ((b.max.x - b.min.x) + (b.max.y - b.min.y));
+    solution
+        .route
+        .validate(&nest, 10.0 * tolerance)
+        .unwrap_or_else(|e| panic!("{e}"));
     assert!(solution.route.idle_length() <= solution.unordered_idle_length + 1e-9);
 }
 

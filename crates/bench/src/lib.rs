@@ -107,7 +107,7 @@ pub fn run_heuristic_with_snapshots(
         });
         let progress = solver.progress();
         now = clock(&progress);
-        let finished = status == cutroute_alns::SolverStatus::Finished;
+        let finished = status.is_done();
         while next < order.len() && (finished || now >= limits[order[next]]) {
             let (tour, cost) = solver
                 .best()

@@ -7,7 +7,7 @@
 use std::time::{Duration, Instant};
 
 use cutroute_ccp::{build_pcgtsp, DiscretisationOptions};
-use cutroute_pcgtsp::{ExactOptions, ExactSolver, SolverStatus};
+use cutroute_pcgtsp::{ExactOptions, ExactSolver, Status};
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
@@ -52,14 +52,14 @@ fn main() {
         let status = solver.step(Duration::from_millis(100));
         let p = solver.progress();
         let now = t.elapsed().as_secs_f64();
-        if now - last_print >= 5.0 || status != SolverStatus::Running {
+        if now - last_print >= 5.0 || status != Status::Running {
             last_print = now;
             println!(
                 "{now:6.1} s  lb {:.1}  ub {:.1}  layer {}  states {}",
                 p.lower_bound, p.upper_bound, p.layer, p.live_states
             );
         }
-        if status != SolverStatus::Running || now > seconds + 30.0 {
+        if status != Status::Running || now > seconds + 30.0 {
             break;
         }
     }

@@ -82,7 +82,7 @@ use std::collections::HashMap;
 use std::sync::Arc;
 
 use cutroute_geometry::{BoundingBox, Contour, ContourRef, Nest, Point, Route, Span};
-use cutroute_pcgtsp::{ExactOptions, ExactSolver, Instance, SolverStatus};
+use cutroute_pcgtsp::{ExactOptions, ExactSolver, Instance, Status};
 use web_time::{Duration, Instant};
 
 use crate::{CcpError, NgPathBound};
@@ -1088,7 +1088,7 @@ impl CcpLowerBound {
         // no budget builds one and returns), whoever has the slice's turn.
         if let Some(solver) = s.solver.as_mut().filter(|e| !e.runs_built()) {
             let status = solver.step(Duration::ZERO);
-            s.exact_over = status != SolverStatus::Running;
+            s.exact_over = status != Status::Running;
             let progress = solver.progress();
             if progress.lower_bound.is_finite() {
                 self.best = self.best.max(progress.lower_bound);
@@ -1098,7 +1098,7 @@ impl CcpLowerBound {
         let exact_turn = !s.ng_running || s.turns.is_multiple_of(8);
         if let Some(solver) = s.solver.as_mut().filter(|_| !s.exact_over && exact_turn) {
             let status = solver.step(slice.max(Duration::from_millis(1)));
-            s.exact_over = status != SolverStatus::Running;
+            s.exact_over = status != Status::Running;
             let progress = solver.progress();
             if progress.lower_bound.is_finite() {
                 self.best = self.best.max(progress.lower_bound);

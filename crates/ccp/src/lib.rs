@@ -89,6 +89,7 @@ mod search;
 mod solver;
 
 pub use bound::{CcpLowerBound, LowerBoundOptions, MAX_RELAXATION_ENTRIES};
+pub use cutroute_anytime::{AnytimeSolver, Bounds, Status};
 pub use discrete::{
     build_pcgtsp, DiscreteInstance, DiscreteNode, DiscretisationOptions, PcgtspBuilder,
     MAX_DISCRETE_NODES,
@@ -97,7 +98,6 @@ pub use ngpath::NgPathBound;
 pub use route::{idle_length, route_certificates, route_metrics, ContourCertificate, RouteMetrics};
 pub use solver::{
     solve, solve_with_cancel, CcpOptions, CcpPhase, CcpProgress, CcpResult, CcpSolver, HeatPenalty,
-    SolverStatus,
 };
 
 use cutroute_geometry::{ContourRef, Nest};

@@ -3,6 +3,7 @@
 
 use std::time::Duration;
 
+use cutroute_anytime::{AnytimeSolver, Bounds, Status};
 use cutroute_geometry::{MachineParameters, Nest, Objective, Point, Route};
 use cutroute_thermal::HeatModel;
 use serde::{Deserialize, Serialize};
@@ -110,15 +111,6 @@ impl Default for CcpOptions {
     }
 }
 
-/// Whether the solver has more to do.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-pub enum SolverStatus {
-    /// `step` again to improve further.
-    Running,
-    /// Done: VNS ended, time ran out, or the run was cancelled.
-    Finished,
-}
-
 /// Where the solver is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum CcpPhase {
@@ -203,6 +195,8 @@ pub struct CcpSolver {
     /// per iteration of the step loop, across slices.
     full_relaxation_sweeps: Option<usize>,
     cancelled: bool,
+    /// The run ended at its time limit or by [`CcpSolver::cancel`], not at the VNS's end.
+    stopped: bool,
     /// The final route's pierce points were relaxed under the heat penalty.
     heat_relaxed: bool,
 }
@@ -298,17 +292,21 @@ impl CcpSolver {
             relaxation_sweeps: 0,
             full_relaxation_sweeps: None,
             cancelled: false,
+            stopped: false,
             heat_relaxed: false,
         })
     }
 
-    /// Stops the run: the next `step` returns `Finished` and the best route stays available.
+    /// Stops the run: the next `step` returns [`Status::Stopped`] and the best route stays
+    /// available.
     pub fn cancel(&mut self) {
         self.cancelled = true;
     }
 
-    /// Runs for about `budget` (checked between moves) and reports whether more is to be done.
-    pub fn step(&mut self, budget: Duration) -> SolverStatus {
+    /// Runs for about `budget` (checked between moves) and reports whether more is to be done:
+    /// [`Status::Finished`] when the VNS ended (never proven optimal), [`Status::Stopped`] at
+    /// the time limit or after [`CcpSolver::cancel`].
+    pub fn step(&mut self, budget: Duration) -> Status {
         let t0 = Instant::now();
         let result = self.step_inner(t0, budget);
         if !matches!(self.phase, CcpPhase::Start | CcpPhase::Relaxing)
@@ -332,29 +330,41 @@ impl CcpSolver {
         self.elapsed + t0.elapsed() >= self.options.time_limit
     }
 
-    /// Ends the slice: `Finished` when the run's time limit is reached (in any phase), else
+    /// Ends the slice: `Stopped` when the run's time limit is reached (in any phase), else
     /// `Running`.
-    fn end_slice(&mut self, t0: Instant) -> SolverStatus {
+    fn end_slice(&mut self, t0: Instant) -> Status {
         if self.time_is_up(t0) {
+            self.stopped = true;
             self.finish_run();
-            SolverStatus::Finished
+            Status::Stopped
         } else {
-            SolverStatus::Running
+            Status::Running
         }
     }
 
-    fn step_inner(&mut self, t0: Instant, budget: Duration) -> SolverStatus {
-        if self.cancelled {
+    /// The status of a run whose phase is `Done`.
+    fn done_status(&self) -> Status {
+        if self.stopped {
+            Status::Stopped
+        } else {
+            Status::Finished {
+                proven_optimal: false,
+            }
+        }
+    }
+
+    fn step_inner(&mut self, t0: Instant, budget: Duration) -> Status {
+        if self.cancelled && self.phase != CcpPhase::Done {
             if self.phase == CcpPhase::Start {
                 // Even a run cancelled at once reports a complete route.
                 self.search.construct(false);
             }
+            self.stopped = true;
             self.finish_run();
-            return SolverStatus::Finished;
         }
         loop {
             match self.phase {
-                CcpPhase::Done => return SolverStatus::Finished,
+                CcpPhase::Done => return self.done_status(),
                 CcpPhase::Start => {
                     self.search.construct(false);
                     self.phase = CcpPhase::Relaxing;
@@ -410,7 +420,7 @@ impl CcpSolver {
                         self.after_shake();
                     }
                     if self.phase == CcpPhase::Done {
-                        return SolverStatus::Finished;
+                        return self.done_status();
                     }
                     // Shake before the time check: a slice that ended here would otherwise
                     // resume with an empty queue and judge the same state twice, so the run
@@ -593,6 +603,27 @@ impl CcpSolver {
     }
 }
 
+/// The contract of every solver: the route with every contour restored, its idle length (the
+/// objective CCP-Relax minimises; the heat penalty is priced in the search, not in this bound).
+impl AnytimeSolver for CcpSolver {
+    type Solution = Route;
+
+    fn step(&mut self, budget: Duration) -> Status {
+        CcpSolver::step(self, budget)
+    }
+
+    fn best(&self) -> Option<Route> {
+        (!self.route.steps.is_empty()).then(|| self.route.clone())
+    }
+
+    fn bounds(&self) -> Bounds {
+        Bounds {
+            upper: (!self.route.steps.is_empty()).then(|| idle_length(&self.route)),
+            lower: None,
+        }
+    }
+}
+
 /// Runs CCP-Relax to the end (VNS finished or time limit), reporting progress after each slice.
 pub fn solve(
     nest: &Nest,
@@ -616,7 +647,7 @@ pub fn solve_with_cancel(
         }
         let status = solver.step(Duration::from_millis(100));
         on_progress(&solver.progress());
-        if status == SolverStatus::Finished {
+        if status.is_done() {
             return Ok(solver.result());
         }
     }

@@ -5,7 +5,7 @@ use std::time::Duration;
 
 use cutroute_ccp::{
     build_pcgtsp, containment_pairs, route_certificates, solve, CcpOptions, CcpSolver,
-    DiscretisationOptions, SolverStatus,
+    DiscretisationOptions, Status,
 };
 use cutroute_geometry::{generate_nest, Contour, Nest, Part, Point, Route, Vertex};
 
@@ -170,10 +170,7 @@ fn anytime_slices_report_valid_routes_and_cancel_stops() {
         last = p.best_idle_length;
     }
     solver.cancel();
-    assert_eq!(
-        solver.step(Duration::from_millis(20)),
-        SolverStatus::Finished
-    );
+    assert_eq!(solver.step(Duration::from_millis(20)), Status::Stopped);
     assert_valid(&nest, &solver.progress().route);
 }
 
@@ -374,7 +371,7 @@ fn a_spent_time_limit_ends_the_run_in_every_phase() {
         let mut solver = CcpSolver::new(&nest, options).unwrap();
         assert_eq!(
             solver.step(Duration::from_secs(3600)),
-            SolverStatus::Finished,
+            Status::Stopped,
             "a {limit_ms} ms run must end within one long slice"
         );
         let result = solver.result();
@@ -402,7 +399,7 @@ fn slice_length_does_not_change_the_route() {
     };
     let run = |slice: Duration| {
         let mut solver = CcpSolver::new(&nest, options.clone()).unwrap();
-        while solver.step(slice) == SolverStatus::Running {}
+        while solver.step(slice) == Status::Running {}
         solver.result()
     };
     let whole = run(Duration::from_secs(600));

@@ -60,12 +60,16 @@
 mod order;
 mod region;
 
+use cutroute_anytime::{AnytimeSolver, Bounds};
 use cutroute_geometry::float::Libm;
 use cutroute_geometry::{
     is_scrap_region, BoundingBox, ContainmentForest, Contour, ContourRef, CutStep, Entry,
     MachineParameters, Nest, Point, Route, RouteError,
 };
 use thiserror::Error;
+use web_time::{Duration, Instant};
+
+pub use cutroute_anytime::Status;
 
 use region::Region;
 
@@ -218,16 +222,111 @@ pub fn chain_route(
     route: &Route,
     options: &ChainOptions,
 ) -> Result<Chained, ChainError> {
-    let mut chaining = Chaining::new(nest, route, options)?;
-    while !chaining.step(nest, options, &|| false) {}
-    Ok(chaining.finish(nest, options))
+    let mut groups = Groups::new(nest, route, options)?;
+    while !groups.step_within(nest, options, &|| false, &|| false) {}
+    Ok(groups.finish(nest, options))
 }
 
 /// [`chain_route`] in resumable slices, so a caller that must stay responsive (the app's
 /// worker answers Stop between slices) can interleave: [`Chaining::new`], then
-/// [`Chaining::step`] until it returns `true`, then [`Chaining::finish`]. The unit of work is
-/// one group of close contours; pass the same `nest` and `options` to every call.
+/// [`Chaining::step`] (the [`AnytimeSolver`] contract) until it is done, then
+/// [`Chaining::finish`]. A slice ends between pieces of a group of close contours (a row of its
+/// distances, its order, one contour's refinement or link) and the next step resumes it: where
+/// slices end does not change the route. One group of a big scrap region can take seconds
+/// (seven.dbs: 20 s), so with [`Chaining::stop_at`] the group under way at that instant is
+/// given up ([`Status::Stopped`]) and the route keeps every group done before.
 pub struct Chaining {
+    nest: Nest,
+    options: ChainOptions,
+    deadline: Option<Instant>,
+    groups: Groups,
+    /// Set once the work is done: finished, or stopped at the deadline.
+    status: Status,
+}
+
+impl Chaining {
+    /// Checks the prices and the route (as [`chain_route`] does) and plans the work.
+    pub fn new(nest: &Nest, route: &Route, options: &ChainOptions) -> Result<Self, ChainError> {
+        Ok(Chaining {
+            groups: Groups::new(nest, route, options)?,
+            nest: nest.clone(),
+            options: options.clone(),
+            deadline: None,
+            status: Status::Running,
+        })
+    }
+
+    /// Gives up the group under way at `deadline` (a caller's time limit).
+    pub fn stop_at(&mut self, deadline: Instant) {
+        self.deadline = Some(deadline);
+    }
+
+    /// Tries groups of close contours for about `budget` (a slice ends between pieces of a
+    /// group): [`Status::Finished`] when every group is tried, [`Status::Stopped`] when the
+    /// deadline of [`Chaining::stop_at`] gave one up.
+    pub fn step(&mut self, budget: Duration) -> Status {
+        if self.status.is_done() {
+            return self.status;
+        }
+        let slice_end = Instant::now().checked_add(budget);
+        let deadline = self.deadline;
+        let aborted = std::cell::Cell::new(false);
+        let done = self.groups.step_within(
+            &self.nest,
+            &self.options,
+            &|| slice_end.is_some_and(|end| Instant::now() >= end),
+            &|| {
+                let over = deadline.is_some_and(|end| Instant::now() >= end);
+                aborted.set(aborted.get() || over);
+                over
+            },
+        );
+        if done {
+            self.status = if aborted.get() {
+                Status::Stopped
+            } else {
+                Status::Finished {
+                    proven_optimal: false,
+                }
+            };
+        }
+        if done {
+            self.status
+        } else {
+            Status::Running
+        }
+    }
+
+    /// The chained route and its report (all groups tried or not: the route is valid after
+    /// every group).
+    pub fn finish(self) -> Chained {
+        self.groups.finish(&self.nest, &self.options)
+    }
+}
+
+/// The contract of every solver: the route chained so far (valid after every group) and its
+/// cost at the options' prices; no lower bound.
+impl AnytimeSolver for Chaining {
+    type Solution = Route;
+
+    fn step(&mut self, budget: Duration) -> Status {
+        Chaining::step(self, budget)
+    }
+
+    fn best(&self) -> Option<Route> {
+        Some(self.groups.current.clone())
+    }
+
+    fn bounds(&self) -> Bounds {
+        Bounds {
+            upper: Some(self.groups.current_cost),
+            lower: None,
+        }
+    }
+}
+
+/// The work of [`Chaining`] on a nest and options held by the caller.
+struct Groups {
     original: Route,
     current: Route,
     current_cost: f64,
@@ -241,9 +340,9 @@ pub struct Chaining {
     work: Option<GroupWork>,
 }
 
-impl Chaining {
+impl Groups {
     /// Checks the prices and the route (as [`chain_route`] does) and plans the work.
-    pub fn new(nest: &Nest, route: &Route, options: &ChainOptions) -> Result<Self, ChainError> {
+    fn new(nest: &Nest, route: &Route, options: &ChainOptions) -> Result<Self, ChainError> {
         let m = &options.machine;
         let prices = [
             m.idle_price_per_metre,
@@ -273,7 +372,7 @@ impl Chaining {
         };
         let current_cost = current.cost(nest, m);
         let regions = scrap_regions(nest, &forest);
-        Ok(Chaining {
+        Ok(Groups {
             original: route.clone(),
             current,
             current_cost,
@@ -287,19 +386,10 @@ impl Chaining {
     }
 
     /// Tries groups of close contours until all are done (`true`) or `stop()` says so after a
-    /// piece of a group (`false`: call again; the group goes on from there).
-    pub fn step(&mut self, nest: &Nest, options: &ChainOptions, stop: &dyn Fn() -> bool) -> bool {
-        self.step_within(nest, options, stop, &|| false)
-    }
-
-    /// [`Chaining::step`] that also gives up when `abort()` says so, inside a group too (between
-    /// its contours): the group under way is left as it was, chaining ends (`true`) and the
-    /// route keeps every group done before. One group of a big scrap region can take seconds
-    /// (seven.dbs: 20 s), so a caller with a time limit passes its end here. `stop` ends a
-    /// slice between pieces of a group (a row of its distances, its order, one contour's
-    /// refinement or link) and the next call resumes it: where slices end does not change the
-    /// route.
-    pub fn step_within(
+    /// piece of a group (`false`: call again; the group goes on from there), or `abort()` says
+    /// so, inside a group too (between its contours): the group under way is left as it was,
+    /// chaining ends (`true`) and the route keeps every group done before.
+    fn step_within(
         &mut self,
         nest: &Nest,
         options: &ChainOptions,
@@ -375,9 +465,8 @@ impl Chaining {
         true
     }
 
-    /// The chained route and its report (all groups tried or not: the route is valid after
-    /// every group).
-    pub fn finish(self, nest: &Nest, options: &ChainOptions) -> Chained {
+    /// The chained route and its report.
+    fn finish(self, nest: &Nest, options: &ChainOptions) -> Chained {
         let m = &options.machine;
         let (route, current) = (self.original, self.current);
         let chains = current

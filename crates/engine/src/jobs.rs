@@ -1,6 +1,7 @@
 //! The solver jobs: each wraps one resumable solver (or two that cooperate) behind [`Job`].
 
 use cutroute_alns::{AlnsBuilder, AlnsOptions, AlnsSolver};
+use cutroute_anytime::AnytimeSolver;
 use cutroute_ccp::{CcpLowerBound, CcpOptions, CcpSolver, DiscreteInstance};
 use cutroute_chains::{ChainOptions, Chained, Chaining};
 use cutroute_geometry::{MachineParameters, Nest, Route};
@@ -78,7 +79,7 @@ impl Job for CcpJob {
             self.solver.cancel();
         }
         if !self.solver_done {
-            self.solver_done = self.solver.step(share) == cutroute_ccp::SolverStatus::Finished;
+            self.solver_done = self.solver.step(share).is_done();
         }
         if let Some(bound) = self.bound.as_mut().filter(|_| self.bound_running) {
             let state = self.solver.progress();
@@ -386,14 +387,8 @@ impl DiscreteJob {
     }
 
     fn best_tour(&self) -> Option<(Vec<usize>, f64)> {
-        let heuristic = self
-            .alns
-            .as_ref()
-            .and_then(|a| a.best().map(|(tour, cost)| (tour.to_vec(), cost)));
-        let exact = self.exact.as_ref().and_then(|e| {
-            let p = e.progress();
-            p.best_tour.map(|t| (t, p.upper_bound))
-        });
+        let heuristic = self.alns.as_ref().and_then(best_with_cost);
+        let exact = self.exact.as_ref().and_then(best_with_cost);
         match (heuristic, exact) {
             (Some(h), Some(e)) => Some(if e.1 < h.1 { e } else { h }),
             (h, e) => h.or(e),
@@ -407,7 +402,12 @@ const BUILD_TIMED_OUT: &str = "the time limit passed while the model was built";
 
 /// One slice of the heuristic; whether it has finished.
 fn alns_step(alns: &mut AlnsSolver, budget: Duration) -> bool {
-    alns.step(budget) == cutroute_alns::SolverStatus::Finished
+    alns.step(budget).is_done()
+}
+
+/// A solver's best solution with its objective (the upper bound).
+fn best_with_cost<S: AnytimeSolver>(solver: &S) -> Option<(S::Solution, f64)> {
+    Some((solver.best()?, solver.bounds().upper?))
 }
 
 impl Job for DiscreteJob {
@@ -441,7 +441,7 @@ impl Job for DiscreteJob {
         }
         let alns = self.alns.as_mut().expect("built");
         let Some(exact) = self.exact.as_mut() else {
-            if self.alns_done || alns.step(budget) == cutroute_alns::SolverStatus::Finished {
+            if self.alns_done || alns.step(budget).is_done() {
                 self.alns_done = true;
                 return JobStatus::Done;
             }
@@ -453,7 +453,7 @@ impl Job for DiscreteJob {
             } else {
                 budget / 4
             };
-            self.alns_done = alns.step(share) == cutroute_alns::SolverStatus::Finished;
+            self.alns_done = alns.step(share).is_done();
             if let Some((tour, cost)) = alns.best() {
                 if cost < self.offered_cost {
                     self.offered_cost = cost;
@@ -499,12 +499,8 @@ impl Job for DiscreteJob {
             let began = Instant::now();
             let status = exact.step(exact_share);
             self.exact_piece = self.exact_piece.max(began.elapsed());
-            match status {
-                cutroute_pcgtsp::SolverStatus::Running => {}
-                cutroute_pcgtsp::SolverStatus::Finished { proven_optimal } => {
-                    self.exact_done = Some(proven_optimal)
-                }
-                cutroute_pcgtsp::SolverStatus::Stopped => self.exact_done = Some(false),
+            if status.is_done() {
+                self.exact_done = Some(status.proven_optimal());
             }
         }
         // Once the exact search has ended there is nothing left to prove: stop the heuristic too.
@@ -651,7 +647,6 @@ impl Job for ChainJob {
         if self.chained.is_some() || self.failure.is_some() {
             return JobStatus::Done;
         }
-        let deadline = Instant::now() + budget;
         if !self.ccp_done {
             if self.ccp.step(budget) == JobStatus::Running {
                 return JobStatus::Running;
@@ -665,7 +660,12 @@ impl Job for ChainJob {
                 return JobStatus::Done;
             };
             match Chaining::new(&self.nest, &route, &self.options) {
-                Ok(chaining) => self.chaining = Some(chaining),
+                Ok(mut chaining) => {
+                    if let Some(end) = self.deadline {
+                        chaining.stop_at(end);
+                    }
+                    self.chaining = Some(chaining);
+                }
                 Err(e) => {
                     self.failure = Some(e.to_string());
                     return JobStatus::Done;
@@ -674,17 +674,11 @@ impl Job for ChainJob {
             return JobStatus::Running;
         }
         let chaining = self.chaining.as_mut().expect("set above");
-        let job_end = self.deadline;
-        if !chaining.step_within(
-            &self.nest,
-            &self.options,
-            &|| Instant::now() >= deadline,
-            &|| job_end.is_some_and(|end| Instant::now() >= end),
-        ) {
+        if chaining.step(budget).is_running() {
             return JobStatus::Running;
         }
         let chaining = self.chaining.take().expect("set above");
-        self.chained = Some(chaining.finish(&self.nest, &self.options));
+        self.chained = Some(chaining.finish());
         JobStatus::Done
     }
 

@@ -73,6 +73,16 @@ pub enum JobStatus {
     Done,
 }
 
+impl From<cutroute_anytime::Status> for JobStatus {
+    fn from(status: cutroute_anytime::Status) -> Self {
+        if status.is_running() {
+            JobStatus::Running
+        } else {
+            JobStatus::Done
+        }
+    }
+}
+
 /// A solver run that advances in slices.
 pub trait Job {
     /// Work for about `budget` (solvers check the clock every few hundred operations), then return.

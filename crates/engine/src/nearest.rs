@@ -3,6 +3,7 @@
 use cutroute_geometry::float::Libm;
 use std::collections::HashMap;
 
+use cutroute_anytime::{AnytimeSolver, Status};
 use cutroute_geometry::{ContourRef, CutStep, MachineParameters, Nest, Point, Route};
 use cutroute_protocol::{Bounds, JobId, Phase, Progress, Solution};
 use cutroute_thermal::{HeatModel, Pierce};
@@ -250,12 +251,34 @@ fn distance(a: Point, b: Point) -> f64 {
     (a.x - b.x).hypot_libm(a.y - b.y)
 }
 
-impl Job for NearestNeighbourJob {
-    fn step(&mut self, _budget: Duration) -> JobStatus {
+/// The contract of every solver: the greedy route in one step and its idle length.
+impl AnytimeSolver for NearestNeighbourJob {
+    type Solution = Route;
+
+    fn step(&mut self, _budget: Duration) -> Status {
         if self.route.is_none() {
             self.solve();
         }
-        JobStatus::Done
+        Status::Finished {
+            proven_optimal: false,
+        }
+    }
+
+    fn best(&self) -> Option<Route> {
+        self.route.clone()
+    }
+
+    fn bounds(&self) -> cutroute_anytime::Bounds {
+        cutroute_anytime::Bounds {
+            upper: self.route.as_ref().map(|_| self.idle_length),
+            lower: None,
+        }
+    }
+}
+
+impl Job for NearestNeighbourJob {
+    fn step(&mut self, budget: Duration) -> JobStatus {
+        AnytimeSolver::step(self, budget).into()
     }
 
     fn progress(&self) -> Progress {

@@ -4,7 +4,9 @@
 //! `params.objective`), a lower bound in the same unit, and the candidates weighed as
 //! `alternatives`.
 
-use cutroute_aoe::{AoeHeat, AoeSolution, AoeSolveOptions, AoeSolving, PlanGraph, PlanOptions};
+use cutroute_aoe::{
+    AoeHeat, AoeSolution, AoeSolveOptions, AoeSolving, AoeStage, PlanGraph, PlanOptions,
+};
 use cutroute_geometry::float::Libm;
 use cutroute_geometry::{BoundingBox, MachineParameters, Nest, Objective, PathRoute, Point, Span};
 use cutroute_protocol::{
@@ -13,7 +15,7 @@ use cutroute_protocol::{
 };
 use cutroute_segments::{
     Candidate, EnsembleKind, EnsembleReport, GsccpOptions, GsccpSearch, GsccpStage, PathHeat,
-    SccpOptions, SearchStatus,
+    SccpOptions,
 };
 use std::collections::HashMap;
 use web_time::{Duration, Instant};
@@ -200,6 +202,17 @@ impl PlanBound {
             },
         )
         .map_err(|e| e.to_string())?;
+        Self::from_plan(&plan, nest, start, finish, tolerance)
+    }
+
+    /// Measures `plan`, the plan graph of `nest` built with `tolerance` (mm).
+    pub fn from_plan(
+        plan: &PlanGraph,
+        nest: &Nest,
+        start: Point,
+        finish: Option<Point>,
+        tolerance: f64,
+    ) -> Result<Self, String> {
         let graph = plan.graph();
         let edges = graph.edge_count();
         let length: f64 = (0..edges)
@@ -394,10 +407,7 @@ impl Job for SegmentJob {
             ));
             return JobStatus::Running;
         }
-        match self.search.step(budget) {
-            SearchStatus::Running => JobStatus::Running,
-            SearchStatus::Finished => JobStatus::Done,
-        }
+        self.search.step(budget).into()
     }
 
     fn progress(&self) -> Progress {
@@ -462,10 +472,9 @@ impl Job for SegmentJob {
     }
 }
 
-/// Common-edge routes along AOE-chains (`cutroute-aoe`'s [`AoeSolving`]): the plan graph and
-/// linear-time chains per component in the first step, the ordering of the components in
-/// slices (a round of moves per piece), the plan bound in a step of its own. Its lower bound:
-/// the plan's length cut once and the trail pierce bound.
+/// Common-edge routes along AOE-chains (`cutroute-aoe`'s [`AoeSolving`], stepped in slices
+/// and stopped at the job's limit), then the plan bound on the solver's plan graph in a step of
+/// its own. Its lower bound: the plan's length cut once and the trail pierce bound.
 pub struct AoeJob {
     job_id: JobId,
     nest: Nest,
@@ -473,12 +482,7 @@ pub struct AoeJob {
     finish_bound: (Point, Option<Point>),
     machine: MachineParameters,
     objective: Objective,
-    /// The ordering under way (after the first step).
-    solving: Option<Box<AoeSolving>>,
-    /// The route, before its plan bound is measured.
-    solved: Option<AoeSolution>,
-    /// The job's wall-clock end: the ordering stops there with its best so far.
-    deadline: Option<Instant>,
+    solving: AoeSolving,
     outcome: Option<Result<(AoeSolution, Option<PlanBound>), String>>,
     started: Instant,
 }
@@ -487,38 +491,40 @@ impl AoeJob {
     /// The job of an `aoe` request on a nest.
     pub fn from_request(request: &JobRequest) -> Result<Self, EngineError> {
         let (nest, start, finish) = nest_of(request)?;
+        let options = AoeSolveOptions {
+            plan: PlanOptions {
+                tolerance: nest.check_tolerance(),
+                ..PlanOptions::default()
+            },
+            start,
+            finish,
+            // With a heat weight the orderings compete on idle + W·H (machine clock of
+            // `params.machine`), and a heat-priced greedy ordering joins them.
+            heat: request.params.thermal.penalised().then(|| {
+                let penalty =
+                    crate::thermal::heat_penalty(&request.params.thermal, request.params.objective);
+                AoeHeat {
+                    model: penalty.model,
+                    weight_mm: penalty.weight_mm(&request.params.machine),
+                    machine: request.params.machine,
+                }
+            }),
+        };
+        let mut solving = AoeSolving::new(nest, &options);
+        // The job's wall-clock end: the ordering stops there with its best so far.
+        if let Some(end) = Instant::now().checked_add(Duration::from_secs_f64(
+            request.params.time_limit_s.clamp(0.0, 1.0e7),
+        )) {
+            solving.stop_at(end);
+        }
         Ok(AoeJob {
             job_id: request.job_id,
             nest: nest.clone(),
-            options: AoeSolveOptions {
-                plan: PlanOptions {
-                    tolerance: nest.check_tolerance(),
-                    ..PlanOptions::default()
-                },
-                start,
-                finish,
-                // With a heat weight the orderings compete on idle + W·H (machine clock of
-                // `params.machine`), and a heat-priced greedy ordering joins them.
-                heat: request.params.thermal.penalised().then(|| {
-                    let penalty = crate::thermal::heat_penalty(
-                        &request.params.thermal,
-                        request.params.objective,
-                    );
-                    AoeHeat {
-                        model: penalty.model,
-                        weight_mm: penalty.weight_mm(&request.params.machine),
-                        machine: request.params.machine,
-                    }
-                }),
-            },
+            options,
             finish_bound: (start, finish),
             machine: request.params.machine,
             objective: request.params.objective,
-            solving: None,
-            solved: None,
-            deadline: Instant::now().checked_add(Duration::from_secs_f64(
-                request.params.time_limit_s.clamp(0.0, 1.0e7),
-            )),
+            solving,
             outcome: None,
             started: Instant::now(),
         })
@@ -535,42 +541,22 @@ impl Job for AoeJob {
         if self.outcome.is_some() {
             return JobStatus::Done;
         }
-        if let Some(solution) = self.solved.take() {
-            // The plan bound builds the plan graph again: a step of its own.
-            let (start, finish) = self.finish_bound;
-            let bound = PlanBound::new(&self.nest, start, finish, self.options.plan.tolerance).ok();
-            self.outcome = Some(Ok((solution, bound)));
-            return JobStatus::Done;
-        }
-        let Some(solving) = self.solving.as_mut() else {
-            match AoeSolving::new(&self.nest, &self.options) {
-                Ok(solving) => {
-                    self.solving = Some(Box::new(solving));
-                    return JobStatus::Running;
-                }
-                Err(e) => {
-                    self.outcome = Some(Err(e.to_string()));
-                    return JobStatus::Done;
-                }
-            }
-        };
-        let slice_end = Instant::now().checked_add(budget);
-        let advanced = if self.deadline.is_some_and(|end| Instant::now() >= end) {
-            Some(solving.finish_now(&self.nest, &self.options))
-        } else {
-            solving.advance(&self.nest, &self.options, &|| {
-                slice_end.is_some_and(|end| Instant::now() >= end)
-            })
-        };
-        match advanced {
-            None => JobStatus::Running,
-            Some(Ok(solution)) => {
-                self.solving = None;
-                self.solved = Some(solution);
+        match self.solving.outcome() {
+            None => {
+                // The route is made and checked in steps; the plan bound gets one of its own.
+                self.solving.step(budget);
                 JobStatus::Running
             }
+            Some(Ok(solution)) => {
+                let (start, finish) = self.finish_bound;
+                let tolerance = self.options.plan.tolerance;
+                let bound = self.solving.plan().and_then(|plan| {
+                    PlanBound::from_plan(plan, &self.nest, start, finish, tolerance).ok()
+                });
+                self.outcome = Some(Ok((solution.clone(), bound)));
+                JobStatus::Done
+            }
             Some(Err(e)) => {
-                self.solving = None;
                 self.outcome = Some(Err(e.to_string()));
                 JobStatus::Done
             }
@@ -583,9 +569,11 @@ impl Job for AoeJob {
             _ => None,
         };
         let phase = match &self.outcome {
-            None if self.solved.is_some() => Phase::CommonEdgeBound,
-            None if self.solving.is_some() => Phase::CommonEdgeOrdering,
-            None => Phase::CommonEdgeGraph,
+            None => match self.solving.stage() {
+                AoeStage::Building => Phase::CommonEdgeGraph,
+                AoeStage::Ordering | AoeStage::Checking => Phase::CommonEdgeOrdering,
+                AoeStage::Done => Phase::CommonEdgeBound,
+            },
             Some(Ok((solution, _))) => Phase::CommonEdgeDone {
                 chains: solution.chains.len(),
                 components: solution.components,

@@ -38,12 +38,6 @@ const LONG_STEPS: &[(SolverKind, &str, &str)] = &[
         "generated",
         "a move family of the ALNS's first descent",
     ),
-    // AoeSolving::new (plan graph, chains) and the final route checks.
-    (
-        SolverKind::Aoe,
-        "generated",
-        "the plan graph and the route checks",
-    ),
 ];
 
 /// (solver, input, what) that still overrun limit + 1 s: none listed; a run that overruns

@@ -14,7 +14,8 @@ use crate::heuristic::best_nodes;
 use crate::instance::Instance;
 use crate::model::Model;
 use crate::order::ClusterSet;
-use crate::solver::{ExactProgress, ExactResult, SolverError, SolverStatus};
+use crate::solver::{ExactProgress, ExactResult, SolverError};
+use cutroute_anytime::Status;
 use std::collections::{HashMap, VecDeque};
 use std::time::Duration;
 use web_time::Instant;
@@ -236,9 +237,9 @@ pub fn solve_bnb(instance: &Instance, options: &BnbOptions) -> Result<ExactResul
     };
     Ok(ExactResult {
         status: if stopped {
-            SolverStatus::Stopped
+            Status::Stopped
         } else {
-            SolverStatus::Finished {
+            Status::Finished {
                 proven_optimal: proven,
             }
         },

@@ -66,12 +66,11 @@ pub use bounds::completion::{position_bounds, PositionBounds};
 pub use bounds::lattice::count_ideals;
 pub use bounds::{root_bounds, RootBounds};
 pub use check::{check_tour, TourError};
+pub use cutroute_anytime::{AnytimeSolver, Bounds, Status};
 pub use instance::Instance;
 pub use order::{ClusterSet, OrderError, PrecedenceOrder};
 pub use parse::{ParseError, PcglnsResult, MAX_NODES, MAX_WEIGHT};
 pub use restricted::{
     restricted_bound, RestrictedBound, RestrictedBoundError, RestrictedBoundOptions,
 };
-pub use solver::{
-    solve, ExactOptions, ExactProgress, ExactResult, ExactSolver, SolverError, SolverStatus,
-};
+pub use solver::{solve, ExactOptions, ExactProgress, ExactResult, ExactSolver, SolverError};

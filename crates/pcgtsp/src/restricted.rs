@@ -20,7 +20,8 @@
 use crate::check::check_tour;
 use crate::instance::Instance;
 use crate::order::{OrderError, PrecedenceOrder};
-use crate::solver::{ExactOptions, ExactSolver, SolverStatus};
+use crate::solver::{ExactOptions, ExactSolver};
+use cutroute_anytime::Status;
 use std::time::Duration;
 use web_time::Instant;
 
@@ -302,7 +303,7 @@ pub fn restricted_bound(
         solver.offer_incumbent(&sub_guide, INF);
         let status = loop {
             let status = solver.step(Duration::from_millis(100));
-            if status != SolverStatus::Running {
+            if status != Status::Running {
                 break status;
             }
         };
@@ -317,7 +318,7 @@ pub fn restricted_bound(
             result.clusters = chosen.len();
             result.proven = matches!(
                 status,
-                SolverStatus::Finished {
+                Status::Finished {
                     proven_optimal: true
                 }
             );
@@ -326,7 +327,7 @@ pub fn restricted_bound(
         // paying (heavily constrained instances with many zero-cost arcs: the metric closure
         // erases their cost, and the time is better left to the exact search).
         let hopeless = result.rounds >= 2 && result.lower_bound < 0.8 * options.known_bound;
-        if !matches!(status, SolverStatus::Finished { .. })
+        if !matches!(status, Status::Finished { .. })
             || (!improved && result.rounds >= 2)
             || hopeless
         {

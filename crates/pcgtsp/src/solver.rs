@@ -1,5 +1,7 @@
 //! The exact solver: an anytime, resumable driver around the DP over order ideals.
 
+use cutroute_anytime::{AnytimeSolver, Bounds, Status};
+
 use crate::bounds::completion::{PositionBound, PositionBoundOptions};
 use crate::bounds::lagrange::{self, NodePenalties, PenaltyOptions};
 use crate::bounds::lattice::LatticeStore;
@@ -136,21 +138,6 @@ pub enum SolverError {
     TooManyNodes(usize),
 }
 
-/// What a call of [`ExactSolver::step`] ended with.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum SolverStatus {
-    /// Work remains; call `step` again.
-    Running,
-    /// The search is complete. `proven_optimal` is false if states were dropped for memory
-    /// (or the DP could not run), in which case the lower bound is the best proven one.
-    Finished {
-        /// Whether the incumbent is proven optimal.
-        proven_optimal: bool,
-    },
-    /// Stopped by the time limit, the gap tolerance or [`ExactSolver::cancel`].
-    Stopped,
-}
-
 /// A snapshot of the solver's state.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ExactProgress {
@@ -174,7 +161,7 @@ pub struct ExactProgress {
 #[derive(Clone, Debug, PartialEq)]
 pub struct ExactResult {
     /// The final status.
-    pub status: SolverStatus,
+    pub status: Status,
     /// The final progress snapshot (tour, bounds, time).
     pub progress: ExactProgress,
     /// DP states created over the whole run.
@@ -188,7 +175,7 @@ impl ExactResult {
     pub fn proven_optimal(&self) -> bool {
         matches!(
             self.status,
-            SolverStatus::Finished {
+            Status::Finished {
                 proven_optimal: true
             }
         )
@@ -486,7 +473,7 @@ enum Phase {
         engine: Option<Box<Engine>>,
     },
     Exact,
-    Done(SolverStatus),
+    Done(Status),
 }
 
 /// The least time the or-opt polish of a tour gets in a step, whatever the slice: on small
@@ -496,7 +483,7 @@ enum Phase {
 const POLISH_SLICE: Duration = Duration::from_millis(150);
 
 /// The anytime exact solver: construct, then call [`ExactSolver::step`] until it stops
-/// returning [`SolverStatus::Running`]; read [`ExactSolver::progress`] at any time; feed
+/// returning [`Status::Running`]; read [`ExactSolver::progress`] at any time; feed
 /// tours found elsewhere with [`ExactSolver::offer_incumbent`].
 pub struct ExactSolver {
     instance: Instance,
@@ -676,7 +663,7 @@ impl ExactSolver {
         }
         let lb = lb.max(self.external_bound);
         match self.phase {
-            Phase::Done(SolverStatus::Finished {
+            Phase::Done(Status::Finished {
                 proven_optimal: true,
             }) => ub,
             _ => lb.min(ub),
@@ -723,7 +710,7 @@ impl ExactSolver {
     }
 
     /// Does at most about `budget` of work and returns the status.
-    pub fn step(&mut self, budget: Duration) -> SolverStatus {
+    pub fn step(&mut self, budget: Duration) -> Status {
         if let Phase::Done(status) = self.phase {
             return status;
         }
@@ -752,7 +739,7 @@ impl ExactSolver {
             }
             if began.elapsed() >= deadline {
                 self.elapsed += began.elapsed();
-                return SolverStatus::Running;
+                return Status::Running;
             }
             if self.build_unit() {
                 continue;
@@ -760,7 +747,7 @@ impl ExactSolver {
             if self.bounds_meet_incumbent() {
                 // A bound (from outside, or a root bound) already meets the incumbent.
                 self.elapsed += began.elapsed();
-                let status = SolverStatus::Finished {
+                let status = Status::Finished {
                     proven_optimal: true,
                 };
                 self.phase = Phase::Done(status);
@@ -859,7 +846,7 @@ impl ExactSolver {
                                 .is_some_and(|b| b >= self.incumbent.upper_bound)
                         });
                         self.elapsed += began.elapsed();
-                        let status = SolverStatus::Finished {
+                        let status = Status::Finished {
                             proven_optimal: proven,
                         };
                         self.phase = Phase::Done(status);
@@ -906,7 +893,7 @@ impl ExactSolver {
                     if p.upper_bound.is_finite() && p.lower_bound >= p.upper_bound {
                         // Every live state is bounded by the incumbent: nothing can improve.
                         self.elapsed += began.elapsed();
-                        let status = SolverStatus::Finished {
+                        let status = Status::Finished {
                             proven_optimal: true,
                         };
                         self.phase = Phase::Done(status);
@@ -928,7 +915,7 @@ impl ExactSolver {
                         });
                         // Let the caller report progress after every layer.
                         self.elapsed += began.elapsed();
-                        return SolverStatus::Running;
+                        return Status::Running;
                     }
                 }
                 Phase::Done(status) => {
@@ -940,10 +927,10 @@ impl ExactSolver {
         }
     }
 
-    fn stop(&mut self, began: Instant) -> SolverStatus {
+    fn stop(&mut self, began: Instant) -> Status {
         self.elapsed += began.elapsed();
-        self.phase = Phase::Done(SolverStatus::Stopped);
-        SolverStatus::Stopped
+        self.phase = Phase::Done(Status::Stopped);
+        Status::Stopped
     }
 
     /// Local search on the incumbent (for the start node it begins with), until `deadline`.
@@ -965,6 +952,31 @@ impl ExactSolver {
     }
 }
 
+/// The contract of every solver: the best tour (0-based nodes from the depot) and its cost; the
+/// lower bound is the proven one ([`Status::Finished`]'s `proven_optimal` when they meet:
+/// finished without dropping states, or a bound reached the tour's cost; [`Status::Stopped`] by
+/// the time limit, the gap tolerance or [`ExactSolver::cancel`]).
+impl AnytimeSolver for ExactSolver {
+    type Solution = Vec<usize>;
+
+    fn step(&mut self, budget: Duration) -> Status {
+        ExactSolver::step(self, budget)
+    }
+
+    fn best(&self) -> Option<Vec<usize>> {
+        self.incumbent.tour.clone()
+    }
+
+    fn bounds(&self) -> Bounds {
+        let ub = self.incumbent.upper_bound;
+        let lb = self.lower_bound();
+        Bounds {
+            upper: ub.is_finite().then_some(ub),
+            lower: lb.is_finite().then_some(lb),
+        }
+    }
+}
+
 /// Runs the exact solver to completion (or its time limit), reporting progress at least every
 /// 200 ms and after every DP layer.
 pub fn solve(
@@ -978,7 +990,7 @@ pub fn solve(
         let status = solver.step(Duration::from_millis(100));
         let progress = solver.progress();
         on_progress(&progress);
-        if status != SolverStatus::Running {
+        if status != Status::Running {
             return Ok(ExactResult {
                 status,
                 progress,

@@ -5,7 +5,7 @@ mod common;
 
 use common::{brute_force, references};
 use cutroute_pcgtsp::{
-    check_tour, root_bounds, solve, ExactOptions, ExactSolver, Instance, SolverStatus,
+    check_tour, root_bounds, solve, ExactOptions, ExactSolver, Instance, Status,
 };
 use std::time::Duration;
 
@@ -79,7 +79,7 @@ fn bounds_are_built_in_slices_and_the_build_can_be_cancelled() {
     let mut solver = ExactSolver::new(&instance, options.clone()).unwrap();
     assert!(solver.offer_incumbent(&reference.pcglns_tour, reference.pcglns_cost));
     let mut steps = 0;
-    while solver.step(Duration::from_millis(1)) == SolverStatus::Running {
+    while solver.step(Duration::from_millis(1)) == Status::Running {
         steps += 1;
         assert!(solver.progress().lower_bound <= 3258.0);
     }
@@ -92,16 +92,10 @@ fn bounds_are_built_in_slices_and_the_build_can_be_cancelled() {
     // Cancelled in the middle of the build: stops with a valid bound.
     let mut cancelled = ExactSolver::new(&instance, options).unwrap();
     for _ in 0..3 {
-        assert_eq!(
-            cancelled.step(Duration::from_millis(1)),
-            SolverStatus::Running
-        );
+        assert_eq!(cancelled.step(Duration::from_millis(1)), Status::Running);
     }
     cancelled.cancel();
-    assert_eq!(
-        cancelled.step(Duration::from_secs(60)),
-        SolverStatus::Stopped
-    );
+    assert_eq!(cancelled.step(Duration::from_secs(60)), Status::Stopped);
     assert!(cancelled.progress().lower_bound <= 3258.0);
 }
 

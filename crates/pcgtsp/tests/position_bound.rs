@@ -6,7 +6,7 @@
 mod common;
 
 use common::{brute_force, references, trusted_optimum};
-use cutroute_pcgtsp::{position_bounds, solve, ExactOptions, ExactSolver, Instance, SolverStatus};
+use cutroute_pcgtsp::{position_bounds, solve, ExactOptions, ExactSolver, Instance, Status};
 use std::time::Duration;
 
 /// The instances of these tests: costs 0–39, each pair ordered with odds `1 / pair_odds`.
@@ -166,15 +166,15 @@ fn exact_solver_proves_rbg050c_from_the_published_tour() {
     };
     let mut solver = ExactSolver::new(&instance, options).unwrap();
     assert!(solver.offer_incumbent(&r.pcglns_tour, r.pcglns_cost));
-    let mut status = SolverStatus::Running;
-    while status == SolverStatus::Running {
+    let mut status = Status::Running;
+    while status == Status::Running {
         status = solver.step(Duration::from_millis(100));
         let p = solver.progress();
         assert!(p.lower_bound <= 378.0, "LB {} > 378", p.lower_bound);
     }
     assert_eq!(
         status,
-        SolverStatus::Finished {
+        Status::Finished {
             proven_optimal: true
         },
         "{:?}",

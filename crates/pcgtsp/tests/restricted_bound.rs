@@ -7,7 +7,7 @@ use common::{brute_force, references, trusted_optimum};
 use cutroute_geometry::SplitMix64;
 use cutroute_pcgtsp::{
     check_tour, restricted_bound, ExactOptions, ExactSolver, Instance, RestrictedBoundOptions,
-    SolverStatus,
+    Status,
 };
 use std::time::Duration;
 
@@ -216,7 +216,7 @@ fn external_restricted_bound_closes_the_gap_in_the_solver() {
             assert!(solver.offer_incumbent(&optimal_p43_4_tour(&instance), 66848.0));
             assert_eq!(
                 solver.step(Duration::from_millis(10)),
-                SolverStatus::Finished {
+                Status::Finished {
                     proven_optimal: true
                 }
             );

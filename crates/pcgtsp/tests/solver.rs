@@ -4,8 +4,7 @@ mod common;
 
 use common::{reference, references, trusted_optimum, Reference};
 use cutroute_pcgtsp::{
-    check_tour, root_bounds, solve, ExactOptions, ExactProgress, ExactSolver, Instance,
-    SolverStatus,
+    check_tour, root_bounds, solve, ExactOptions, ExactProgress, ExactSolver, Instance, Status,
 };
 use std::time::Duration;
 
@@ -198,14 +197,14 @@ fn anytime_api_steps_accepts_incumbents_and_cancels() {
         let status = solver.step(Duration::from_millis(5));
         steps += 1;
         check_progress(&instance, &r, &solver.progress());
-        if status != SolverStatus::Running {
+        if status != Status::Running {
             break status;
         }
     };
     assert!(steps > 1, "work must be split over several steps");
     assert_eq!(
         status,
-        SolverStatus::Finished {
+        Status::Finished {
             proven_optimal: true
         }
     );
@@ -215,10 +214,7 @@ fn anytime_api_steps_accepts_incumbents_and_cancels() {
 
     let mut cancelled = ExactSolver::new(&instance, ExactOptions::default()).unwrap();
     cancelled.cancel();
-    assert_eq!(
-        cancelled.step(Duration::from_secs(1)),
-        SolverStatus::Stopped
-    );
+    assert_eq!(cancelled.step(Duration::from_secs(1)), Status::Stopped);
     check_progress(&instance, &r, &cancelled.progress());
 }
 
@@ -314,12 +310,12 @@ fn a_deferred_solver_builds_its_runs_in_steps_and_proves_what_new_proves() {
             if deferred.root_bound() > f64::NEG_INFINITY {
                 break;
             }
-            assert_eq!(status, SolverStatus::Running, "{name}");
+            assert_eq!(status, Status::Running, "{name}");
             assert!(calls < 100, "{name}: runs never built");
         }
         assert!(calls >= 2, "{name}: model and root bound in separate steps");
         assert_eq!(deferred.root_bound(), whole.root_bound(), "{name}");
-        while deferred.step(Duration::from_millis(200)) == SolverStatus::Running {}
+        while deferred.step(Duration::from_millis(200)) == Status::Running {}
         let p = deferred.progress();
         check_progress(&instance, &r, &p);
         assert_eq!(p.upper_bound, opt, "{name}");

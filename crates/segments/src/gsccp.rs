@@ -4,13 +4,14 @@ use cutroute_geometry::float::Libm;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
-use cutroute_ccp::{CcpOptions, CcpSolver, SolverStatus};
+use cutroute_anytime::{AnytimeSolver, Bounds, Status};
+use cutroute_ccp::{CcpOptions, CcpSolver};
 use cutroute_geometry::{MachineParameters, Nest, Objective, PathRoute, PathRouteError, Route};
 use serde::{Deserialize, Serialize};
 use web_time::Instant;
 
 use crate::segment::{Ensemble, EnsembleKind};
-use crate::solver::{SccpOptions, SccpSearch, SearchStatus, SOLVE_SLICE};
+use crate::solver::{SccpOptions, SccpSearch, SOLVE_SLICE};
 use crate::SegmentError;
 
 /// Settings of [`solve_gsccp`].
@@ -92,6 +93,27 @@ pub struct GsccpResult {
     pub ccp_route: PathRoute,
 }
 
+/// The contract of every solver: the best checked path route so far and its value (time or
+/// cost by the options' objective); no lower bound.
+impl AnytimeSolver for GsccpSearch {
+    type Solution = PathRoute;
+
+    fn step(&mut self, budget: Duration) -> Status {
+        GsccpSearch::step(self, budget)
+    }
+
+    fn best(&self) -> Option<PathRoute> {
+        GsccpSearch::best(self).map(|c| c.route.clone())
+    }
+
+    fn bounds(&self) -> Bounds {
+        Bounds {
+            upper: GsccpSearch::best(self).map(|c| c.value),
+            lower: None,
+        }
+    }
+}
+
 /// Runs [`GsccpSearch`] to its end (the cancel flag is read between slices): CCP-Relax for its
 /// share of the time, then every ensemble of `options.kinds` seeded by its route, each route
 /// checked independently; returns the best by the objective with every ensemble's numbers. A
@@ -104,7 +126,7 @@ pub fn solve_gsccp(
     cancel: &AtomicBool,
 ) -> Result<GsccpResult, SegmentError> {
     let mut search = GsccpSearch::new(nest, options)?;
-    while search.step(SOLVE_SLICE) == SearchStatus::Running {
+    while search.step(SOLVE_SLICE).is_running() {
         if cancel.load(Ordering::Relaxed) {
             search.stop();
         }
@@ -189,6 +211,8 @@ pub struct GsccpSearch {
     next_snapshot: Instant,
     snapshot_idle: f64,
     failure: Option<SegmentError>,
+    /// [`GsccpSearch::stop`] ended the run before its end.
+    stopped: bool,
 }
 
 impl GsccpSearch {
@@ -230,6 +254,7 @@ impl GsccpSearch {
             next_snapshot: started,
             snapshot_idle: f64::INFINITY,
             failure: None,
+            stopped: false,
         })
     }
 
@@ -237,15 +262,15 @@ impl GsccpSearch {
     /// route are single pieces of work that may overrun the budget (measured on the real nests
     /// in `BENCHMARKS.md`); a step that does one returns right after it. While an ensemble's search improves, its best route is checked at
     /// most every 300 ms (and at most a tenth of the time) so [`GsccpSearch::best`] follows it.
-    pub fn step(&mut self, budget: Duration) -> SearchStatus {
+    pub fn step(&mut self, budget: Duration) -> Status {
         let slice_end = Instant::now() + budget;
         loop {
             let now = Instant::now();
             if matches!(self.stage, Stage::Finished) {
-                return SearchStatus::Finished;
+                return self.status();
             }
             if now >= slice_end {
-                return SearchStatus::Running;
+                return Status::Running;
             }
             let left = slice_end - now;
             match std::mem::replace(&mut self.stage, Stage::Finished) {
@@ -253,7 +278,7 @@ impl GsccpSearch {
                 // Ending a phase (a check over the whole nest) and building an ensemble (a
                 // plan graph) cannot be cut: each ends the step, so a step holds at most one.
                 Stage::Ccp(mut solver) => {
-                    if solver.step(left) == SolverStatus::Finished {
+                    if solver.step(left).is_done() {
                         self.ccp_done(&solver);
                         return self.status();
                     }
@@ -265,7 +290,7 @@ impl GsccpSearch {
                     return self.status();
                 }
                 Stage::Search(k, mut search, report) => {
-                    if search.step(left) == SearchStatus::Finished {
+                    if search.step(left).is_done() {
                         self.ensemble_done(k, &search, report);
                         return self.status();
                     }
@@ -280,11 +305,14 @@ impl GsccpSearch {
     /// running ensemble keeps its best route (checked), the ensembles not started are reported
     /// as not run.
     pub fn stop(&mut self) {
+        if !self.is_finished() {
+            self.stopped = true;
+        }
         match std::mem::replace(&mut self.stage, Stage::Finished) {
             Stage::Finished => {}
             Stage::Ccp(mut solver) => {
                 solver.cancel();
-                while solver.step(Duration::from_millis(10)) != SolverStatus::Finished {}
+                while solver.step(Duration::from_millis(10)).is_running() {}
                 self.ccp_done(&solver);
                 self.stage = Stage::Finished;
                 if self.failure.is_none() {
@@ -301,11 +329,15 @@ impl GsccpSearch {
         }
     }
 
-    fn status(&self) -> SearchStatus {
-        if self.is_finished() {
-            SearchStatus::Finished
+    fn status(&self) -> Status {
+        if !self.is_finished() {
+            Status::Running
+        } else if self.stopped {
+            Status::Stopped
         } else {
-            SearchStatus::Running
+            Status::Finished {
+                proven_optimal: false,
+            }
         }
     }
 

@@ -51,15 +51,14 @@ mod gsccp;
 mod segment;
 mod solver;
 
+pub use cutroute_anytime::{AnytimeSolver, Bounds, Status};
 pub use cutroute_geometry::Objective;
 pub use gsccp::{
     recut_length, solve_gsccp, Candidate, EnsembleReport, GsccpOptions, GsccpResult, GsccpSearch,
     GsccpStage,
 };
 pub use segment::{Ensemble, EnsembleKind, Segment};
-pub use solver::{
-    solve_sccp, PathHeat, SccpOptions, SccpSearch, SccpSolution, SearchStatus, SOLVE_SLICE,
-};
+pub use solver::{solve_sccp, PathHeat, SccpOptions, SccpSearch, SccpSolution, SOLVE_SLICE};
 
 use cutroute_geometry::{Contour, Nest, Part, Vertex};
 use thiserror::Error;

@@ -18,6 +18,7 @@ use std::collections::{BinaryHeap, HashMap};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
+use cutroute_anytime::{AnytimeSolver, Bounds, Status};
 use cutroute_ccp::HeatPenalty;
 use cutroute_geometry::{
     BoundingBox, ContourRef, MachineParameters, PathRoute, Point, Route, Span, SplitMix64,
@@ -602,25 +603,38 @@ pub fn solve_sccp(
             search.stop();
             break;
         }
-        if search.step(SOLVE_SLICE) != SearchStatus::Running {
+        if search.step(SOLVE_SLICE).is_done() {
             break;
         }
     }
     Ok(search.solution())
 }
 
+/// The contract of every solver: the best path route so far and its idle length (mm, the
+/// objective the search minimises; the heat penalty is priced inside the search); no lower
+/// bound.
+impl AnytimeSolver for SccpSearch {
+    type Solution = PathRoute;
+
+    fn step(&mut self, budget: Duration) -> Status {
+        SccpSearch::step(self, budget)
+    }
+
+    fn best(&self) -> Option<PathRoute> {
+        Some(self.best_route())
+    }
+
+    fn bounds(&self) -> Bounds {
+        Bounds {
+            upper: Some(self.best_idle_length()),
+            lower: None,
+        }
+    }
+}
+
 /// The slice [`solve_sccp`] and [`crate::solve_gsccp`] step their searches by between looks at
 /// the cancel flag.
 pub const SOLVE_SLICE: Duration = Duration::from_millis(20);
-
-/// What a step of a resumable search left behind.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum SearchStatus {
-    /// More work to do: call `step` again.
-    Running,
-    /// The search ended (local optimum confirmed by the shakes, time limit, or stopped).
-    Finished,
-}
 
 /// Units of work done between looks at the clock (each is one position of a pass: a few
 /// dozen distance evaluations, or one block move, O(segments)).
@@ -912,23 +926,36 @@ impl SccpSearch {
     }
 
     /// Works for about `budget` (the clock is read every few units of work, each far below a
-    /// millisecond on the real nests), then returns; ends at the time limit.
-    pub fn step(&mut self, budget: Duration) -> SearchStatus {
+    /// millisecond on the real nests), then returns; [`Status::Stopped`] at the time limit or
+    /// after [`SccpSearch::stop`], [`Status::Finished`] when the shakes confirmed the local
+    /// optimum.
+    pub fn step(&mut self, budget: Duration) -> Status {
         let slice_end = Instant::now() + budget;
         loop {
             for _ in 0..UNITS_PER_CLOCK_CHECK {
                 if matches!(self.stage, Stage::Finished) {
-                    return SearchStatus::Finished;
+                    return self.done_status();
                 }
                 self.unit();
             }
             let now = Instant::now();
             if now >= self.deadline {
                 self.stop();
-                return SearchStatus::Finished;
+                return self.done_status();
             }
             if now >= slice_end {
-                return SearchStatus::Running;
+                return Status::Running;
+            }
+        }
+    }
+
+    /// The status once the search has ended.
+    fn done_status(&self) -> Status {
+        if self.interrupted {
+            Status::Stopped
+        } else {
+            Status::Finished {
+                proven_optimal: false,
             }
         }
     }

@@ -19,7 +19,7 @@
 use cutroute_alns::{AlnsOptions, AlnsSolver};
 use cutroute_pcgtsp::{
     check_tour, count_ideals, restricted_bound, ExactOptions, ExactSolver, Instance,
-    RestrictedBoundOptions, SolverStatus,
+    RestrictedBoundOptions, Status,
 };
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
@@ -204,9 +204,8 @@ fn run(
         };
         let mut alns = AlnsSolver::new(instance, alns_options).expect("ALNS accepts the instance");
         while clock() < alns_seconds
-            && alns.step(Duration::from_millis(50)) == cutroute_alns::SolverStatus::Running
-        {
-        }
+            && alns.step(Duration::from_millis(50)) == cutroute_alns::Status::Running
+        {}
         best = alns.best().map(|(t, c)| (t.to_vec(), c));
     }
     // The solver's own beam search still runs after ALNS (unless `--no-heuristic`): with a
@@ -248,13 +247,13 @@ fn run(
             restricted_lb = Some(format!("{} ({})", bound.lower_bound, bound.clusters));
         }
     }
-    let mut status = SolverStatus::Running;
-    while status == SolverStatus::Running && clock() < limit {
+    let mut status = Status::Running;
+    while status == Status::Running && clock() < limit {
         status = solver.step(Duration::from_millis(100));
     }
     let proven = matches!(
         status,
-        SolverStatus::Finished {
+        Status::Finished {
             proven_optimal: true
         }
     );
