@@ -11,7 +11,7 @@ use crate::nodes::NodeChoice;
 use crate::operators::{Insertion, Operators, Removal, Selection, INSERTIONS, REMOVALS};
 use crate::problem::{Problem, ProblemBuild};
 use crate::{AlnsError, AlnsOptions, AlnsProgress, StopReason};
-use cutroute_anytime::{AnytimeSolver, Bounds, Status};
+use cutroute_anytime::{AnytimeSolver, Bounds, CostUnit, Status};
 use cutroute_geometry::Xoshiro256 as Rng;
 
 /// Adaptive weights of one family of operators (Ropke & Pisinger's segment scheme).
@@ -712,6 +712,7 @@ impl AnytimeSolver for AlnsSolver {
         Bounds {
             upper: AlnsSolver::best(self).map(|(_, cost)| cost),
             lower: None,
+            unit: CostUnit::TourCost,
         }
     }
 }

@@ -10,12 +10,12 @@
 //! a checked best solution it can hand over at any time).
 //!
 //! The trait is deliberately small: a solution in the solver's own type (a route, a path route
-//! or a tour) and bounds in the solver's own objective; the job engine turns those into the
-//! protocol's progress, with their units.
+//! or a tour) and [`Bounds`] in the solver's own objective, which say their [`CostUnit`]; the
+//! job engine turns those into the protocol's progress.
 //!
 //! ```
 //! use std::time::Duration;
-//! use cutroute_anytime::{AnytimeSolver, Bounds, Status};
+//! use cutroute_anytime::{AnytimeSolver, Bounds, CostUnit, Status};
 //!
 //! /// Counts to `n`, one number per unit of work; the best is the largest number reached.
 //! struct Count { n: u32, at: u32 }
@@ -33,7 +33,7 @@
 //!         Some(self.at)
 //!     }
 //!     fn bounds(&self) -> Bounds {
-//!         Bounds { upper: Some(f64::from(self.n - self.at)), lower: Some(0.0) }
+//!         Bounds { upper: Some(f64::from(self.n - self.at)), lower: Some(0.0), unit: CostUnit::TourCost }
 //!     }
 //! }
 //!
@@ -47,6 +47,7 @@
 #![no_std]
 
 use core::time::Duration;
+use serde::{Deserialize, Serialize};
 
 /// What a call of [`AnytimeSolver::step`] left behind.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -83,14 +84,68 @@ impl Status {
     }
 }
 
-/// The bounds so far, in the solver's own objective (idle millimetres, seconds or cost, as the
-/// solver minimises). `None`: no bound known yet.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+/// What a solver's bounds measure. The solver that computes a bound says its unit, so no reader
+/// (the engine, the CLI, the page's chart) has to work it out from the solver or the problem.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum CostUnit {
+    /// Idle (tool-off) travel, mm: the solvers of routes of whole contours (with a heat weight,
+    /// idle plus the weighted heat load, in mm).
+    #[default]
+    IdleMm,
+    /// Machining time, s, under the machine's model (formula 1.2).
+    Seconds,
+    /// Cost under the machine's prices (formula 1.3).
+    Cost,
+    /// The arc weights of a PCGTSP instance (a tour's cost, in the instance's own unit).
+    TourCost,
+}
+
+/// The bounds so far: the cost of the best solution and a proven lower bound on the optimum,
+/// both in `unit`. `None`: not known yet.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Bounds {
-    /// The objective of the best solution so far.
+    /// The cost of the best solution so far, if any.
     pub upper: Option<f64>,
-    /// A proven lower bound on the optimum, if the solver computes one.
+    /// A proven lower bound on the optimal cost, if the solver computes one.
     pub lower: Option<f64>,
+    /// What both measure.
+    pub unit: CostUnit,
+}
+
+impl Bounds {
+    /// No bound yet, in `unit`.
+    pub fn unknown(unit: CostUnit) -> Self {
+        Self {
+            upper: None,
+            lower: None,
+            unit,
+        }
+    }
+
+    /// Bounds on idle length, mm.
+    pub fn idle_mm(upper: Option<f64>, lower: Option<f64>) -> Self {
+        Self {
+            upper,
+            lower,
+            unit: CostUnit::IdleMm,
+        }
+    }
+
+    /// The same values in another unit: for a caller that knows the solver's objective means
+    /// something else to its user (a discretised nest's tour cost is idle length).
+    pub fn in_unit(self, unit: CostUnit) -> Self {
+        Self { unit, ..self }
+    }
+
+    /// The relative gap `(upper − lower) / upper`, clamped at 0 (0 when `upper` is 0), when
+    /// both are known.
+    pub fn gap(&self) -> Option<f64> {
+        match (self.upper, self.lower) {
+            (Some(ub), Some(lb)) if ub > 0.0 => Some(((ub - lb) / ub).max(0.0)),
+            (Some(_), Some(_)) => Some(0.0),
+            _ => None,
+        }
+    }
 }
 
 /// A solver that works in resumable slices and has a best solution at any time.

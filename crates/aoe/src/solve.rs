@@ -8,7 +8,7 @@
 //! the only rule is containment: a component holding a contour that lies inside a contour of
 //! another component is cut first (the part it frees would otherwise fall with uncut edges).
 
-use cutroute_anytime::{AnytimeSolver, Bounds, Status};
+use cutroute_anytime::{AnytimeSolver, Bounds, CostUnit, Status};
 use cutroute_geometry::float::Libm;
 use cutroute_geometry::{
     BoundingBox, MachineParameters, Nest, PathRoute, PathRouteError, Point, Span, ToolOnPath,
@@ -431,7 +431,11 @@ impl AnytimeSolver for AoeSolving {
             }
             _ => None,
         };
-        Bounds { upper, lower: None }
+        Bounds {
+            upper,
+            lower: None,
+            unit: CostUnit::IdleMm,
+        }
     }
 }
 

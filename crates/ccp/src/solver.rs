@@ -3,7 +3,7 @@
 
 use std::time::Duration;
 
-use cutroute_anytime::{AnytimeSolver, Bounds, Status};
+use cutroute_anytime::{AnytimeSolver, Bounds, CostUnit, Status};
 use cutroute_geometry::{MachineParameters, Nest, Objective, Point, Route};
 use cutroute_thermal::HeatModel;
 use serde::{Deserialize, Serialize};
@@ -620,6 +620,7 @@ impl AnytimeSolver for CcpSolver {
         Bounds {
             upper: (!self.route.steps.is_empty()).then(|| idle_length(&self.route)),
             lower: None,
+            unit: CostUnit::IdleMm,
         }
     }
 }

@@ -60,7 +60,7 @@
 mod order;
 mod region;
 
-use cutroute_anytime::{AnytimeSolver, Bounds};
+use cutroute_anytime::{AnytimeSolver, Bounds, CostUnit};
 use cutroute_geometry::float::Libm;
 use cutroute_geometry::{
     is_scrap_region, BoundingBox, ContainmentForest, Contour, ContourRef, CutStep, Entry,
@@ -321,6 +321,7 @@ impl AnytimeSolver for Chaining {
         Bounds {
             upper: Some(self.groups.current_cost),
             lower: None,
+            unit: CostUnit::Cost,
         }
     }
 }

@@ -268,11 +268,8 @@ impl AnytimeSolver for NearestNeighbourJob {
         self.route.clone()
     }
 
-    fn bounds(&self) -> cutroute_anytime::Bounds {
-        cutroute_anytime::Bounds {
-            upper: self.route.as_ref().map(|_| self.idle_length),
-            lower: None,
-        }
+    fn bounds(&self) -> Bounds {
+        Bounds::idle_mm(self.route.as_ref().map(|_| self.idle_length), None)
     }
 }
 

@@ -10,8 +10,8 @@ use cutroute_aoe::{
 use cutroute_geometry::float::Libm;
 use cutroute_geometry::{BoundingBox, MachineParameters, Nest, Objective, PathRoute, Point, Span};
 use cutroute_protocol::{
-    Bounds, CostUnit, Ensemble, JobId, JobRequest, Phase, Problem, Progress, RouteSummary,
-    Solution, SolverKind,
+    Bounds, Ensemble, JobId, JobRequest, Phase, Problem, Progress, RouteSummary, Solution,
+    SolverKind,
 };
 use cutroute_segments::{
     Candidate, EnsembleKind, EnsembleReport, GsccpOptions, GsccpSearch, GsccpStage, PathHeat,
@@ -458,7 +458,7 @@ impl Job for SegmentJob {
                     )
                 }),
                 lower: lower_bound,
-                unit: CostUnit::of_objective(self.objective),
+                unit: self.objective.unit(),
             },
             phase: segments_phase(&self.search),
             solution: best.map(|c| Solution::PathRoute(c.route.clone())),
@@ -599,7 +599,7 @@ impl Job for AoeJob {
                 lower: solved
                     .and_then(|(_, b)| b.as_ref())
                     .map(|b| b.trail_route(self.objective, &self.machine)),
-                unit: CostUnit::of_objective(self.objective),
+                unit: self.objective.unit(),
             },
             phase,
             solution: route.cloned().map(Solution::PathRoute),

@@ -14,9 +14,7 @@ use cutroute_geometry::{
     Contour, MachineParameters, Nest, Objective, Part, PathRoute, PathRouteError, Point, Span,
     SplitMix64,
 };
-use cutroute_protocol::{
-    CostUnit, JobRequest, Problem, Progress, Solution, SolverKind, SolverParams,
-};
+use cutroute_protocol::{JobRequest, Problem, Progress, Solution, SolverKind, SolverParams};
 use web_time::{Duration, Instant};
 
 const NEST01: &str = "nests/tflex/Nest01.tfnesting";
@@ -109,7 +107,7 @@ fn check_progress(
     assert!(lb > 0.0 && lb <= ub, "{what}: lb {lb} ub {ub}");
     assert_eq!(
         progress.bounds.unit,
-        CostUnit::of_objective(params.objective),
+        params.objective.unit(),
         "{what}: the bounds are in the objective's unit"
     );
     // The idle bound (mm) holds for the route, and the chosen candidate carries it.

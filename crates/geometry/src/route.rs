@@ -172,6 +172,14 @@ pub enum Objective {
 }
 
 impl Objective {
+    /// The unit of this objective's value (bounds on it say so).
+    pub fn unit(self) -> cutroute_anytime::CostUnit {
+        match self {
+            Objective::Time => cutroute_anytime::CostUnit::Seconds,
+            Objective::Cost => cutroute_anytime::CostUnit::Cost,
+        }
+    }
+
     /// The objective's value for a route of these lengths (mm) and pierces.
     pub fn value(
         self,

@@ -1,6 +1,6 @@
 //! The exact solver: an anytime, resumable driver around the DP over order ideals.
 
-use cutroute_anytime::{AnytimeSolver, Bounds, Status};
+use cutroute_anytime::{AnytimeSolver, Bounds, CostUnit, Status};
 
 use crate::bounds::completion::{PositionBound, PositionBoundOptions};
 use crate::bounds::lagrange::{self, NodePenalties, PenaltyOptions};
@@ -973,6 +973,7 @@ impl AnytimeSolver for ExactSolver {
         Bounds {
             upper: ub.is_finite().then_some(ub),
             lower: lb.is_finite().then_some(lb),
+            unit: CostUnit::TourCost,
         }
     }
 }

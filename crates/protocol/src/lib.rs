@@ -34,10 +34,11 @@ mod profile;
 mod solution;
 mod thermal;
 
+pub use cutroute_anytime::{Bounds, CostUnit};
 pub use open_error::{OpenError, OpenErrorKind, SourceLocation};
 pub use phase::{CcpStage, Ensemble, KerfNote, KerfSource, Phase, ThermalNote};
 pub use profile::{MachineProfile, ProfileError};
-pub use solution::{Bounds, CostUnit, Solution};
+pub use solution::Solution;
 pub use thermal::ThermalSettings;
 // The thermal types a `Progress` carries, so the UI needs no second import path.
 pub use cutroute_thermal::{HeatModel, RuleCounts, RuleSet, Violation};
@@ -665,8 +666,8 @@ mod tests {
 
     #[test]
     fn the_objective_names_the_unit_of_path_route_bounds() {
-        assert_eq!(CostUnit::of_objective(Objective::Time), CostUnit::Seconds);
-        assert_eq!(CostUnit::of_objective(Objective::Cost), CostUnit::Cost);
+        assert_eq!(Objective::Time.unit(), CostUnit::Seconds);
+        assert_eq!(Objective::Cost.unit(), CostUnit::Cost);
         assert_eq!(Bounds::default().unit, CostUnit::IdleMm);
         assert_eq!(Bounds::idle_mm(Some(4.0), Some(3.0)).gap(), Some(0.25));
         assert_eq!(Bounds::unknown(CostUnit::Cost).gap(), None);

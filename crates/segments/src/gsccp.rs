@@ -110,6 +110,7 @@ impl AnytimeSolver for GsccpSearch {
         Bounds {
             upper: GsccpSearch::best(self).map(|c| c.value),
             lower: None,
+            unit: self.options.objective.unit(),
         }
     }
 }

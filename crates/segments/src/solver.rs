@@ -18,7 +18,7 @@ use std::collections::{BinaryHeap, HashMap};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
-use cutroute_anytime::{AnytimeSolver, Bounds, Status};
+use cutroute_anytime::{AnytimeSolver, Bounds, CostUnit, Status};
 use cutroute_ccp::HeatPenalty;
 use cutroute_geometry::{
     BoundingBox, ContourRef, MachineParameters, PathRoute, Point, Route, Span, SplitMix64,
@@ -628,6 +628,7 @@ impl AnytimeSolver for SccpSearch {
         Bounds {
             upper: Some(self.best_idle_length()),
             lower: None,
+            unit: CostUnit::IdleMm,
         }
     }
 }
