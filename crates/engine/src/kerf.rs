@@ -14,6 +14,13 @@
 //! two full routes: its route is never longer than the idealised order with leads attached and
 //! relaxed, and so never longer than that order with leads attached.
 //!
+//! The exact solver is the exception: it searches the discretised full-route model itself
+//! ([`crate::FullRouteModel`]: candidate entries with their leads fitted, idle legs from M* to
+//! the next M), and the job keeps its route as found, with its lower bound and optimality
+//! proof, which are about that model (see the module `full_route`). Neither the idealised run
+//! nor the relaxation is added: either could give a route off the candidates, below the
+//! discretised optimum, and the bound would then no longer be below the route reported.
+//!
 //! With `leads_after` the job runs the solver on the nest only and attaches leads (no
 //! relaxation): the "solve, then attach leads" route of the benchmark.
 
@@ -23,6 +30,8 @@ use cutroute_geometry::{
 use cutroute_protocol::{JobRequest, KerfNote, KerfSource, Phase, Problem, Progress, SolverKind};
 use web_time::{Duration, Instant};
 
+use crate::full_route::{FullRouteBuilder, FullRouteJob, Modelling};
+use crate::thermal::ThermalJob;
 use crate::{EngineError, Job, JobStatus};
 
 /// Sweeps of [`LeadFitter::relax`] over a finished route, and the entries it tries round each
@@ -107,6 +116,8 @@ struct Candidate {
 /// they are relaxed step by step (every stage in slices, so a cancel is seen and no step runs
 /// long).
 enum Stage {
+    /// The exact solver's full-route model is built (its candidates' leads fitted).
+    Modelling(Box<ExactModelling>),
     Solving,
     Attaching(Attach),
     Relaxing {
@@ -119,6 +130,15 @@ enum Stage {
         dirty: Vec<bool>,
     },
     Finished(Option<Result<Route, Vec<LeadError>>>),
+}
+
+/// The full-route model under construction and the request its exact job will run.
+struct ExactModelling {
+    builder: FullRouteBuilder,
+    /// The idealised request (its time limit shortened like every inner job's).
+    request: JobRequest,
+    /// When the request arrived: the build counts against the limit.
+    started: Instant,
 }
 
 /// Leads attached to a solver's route, one step at a time (a chained route all at once: its
@@ -227,7 +247,12 @@ impl KerfJob {
             solver: solver.name(),
             message,
         };
-        let Problem::Nest { nest, .. } = &request.problem else {
+        let Problem::Nest {
+            nest,
+            start: route_start,
+            finish: route_finish,
+        } = &request.problem
+        else {
             return Err(EngineError::UnsupportedProblem {
                 solver: solver.name(),
                 problem: "a PCGTSP instance with kerf and leads",
@@ -235,7 +260,7 @@ impl KerfJob {
         };
         if !supports_kerf(solver) {
             return Err(refused(
-                "does not cut with kerf and leads yet (nearest, ccp, heuristic and chain do)"
+                "does not cut with kerf and leads yet (nearest, ccp, heuristic, exact and chain do)"
                     .into(),
             ));
         }
@@ -254,7 +279,37 @@ impl KerfJob {
         let mut candidates = Vec::new();
         let after = request.params.leads_after;
         let chained = solver == SolverKind::Chain;
-        if chained {
+        let exact = solver == SolverKind::Exact && !after;
+        if exact {
+            // A heat penalty or a rule repair changes the route after the search: the bound
+            // would no longer be about it.
+            if request.params.thermal.penalised() || request.params.thermal.hard {
+                return Err(refused(
+                    "with kerf and leads, exact searches the full-route model and cannot price \
+                     heat or repair rules; use heuristic"
+                        .into(),
+                ));
+            }
+            let builder = FullRouteBuilder::new(
+                nest,
+                settings,
+                request.params.discretisation_step_mm,
+                *route_start,
+                *route_finish,
+            )
+            .map_err(refused)?;
+            candidates.push(Candidate::new(
+                KerfSource::FullRoute,
+                Box::new(Modelling {
+                    job_id: request.job_id,
+                }),
+            ));
+            candidates[0].stage = Stage::Modelling(Box::new(ExactModelling {
+                builder,
+                request: idealised.clone(),
+                started,
+            }));
+        } else if chained {
             // Links routed round the equidistants keep kerf/2 from every contour.
             let equidistants = LeadFitter::with_forest(nest, &forest, settings).kerf_nest();
             let mut over_equidistants = idealised.clone();
@@ -276,7 +331,7 @@ impl KerfJob {
                 start(&over_curves)?,
             ));
         }
-        if !chained {
+        if !chained && !exact {
             candidates.push(Candidate::new(KerfSource::Idealised, start(&idealised)?));
         }
         Ok(KerfJob {
@@ -315,6 +370,30 @@ impl KerfJob {
         loop {
             let stage = std::mem::replace(&mut candidate.stage, Stage::Finished(None));
             candidate.stage = match stage {
+                Stage::Modelling(mut modelling) => match modelling.builder.advance(until) {
+                    None => Stage::Modelling(modelling),
+                    Some(Err(errors)) => Stage::Finished(Some(Err(errors))),
+                    Some(Ok(model)) => match exact_job(&self.nest, model, &modelling) {
+                        Some(job) => {
+                            candidate.job = job;
+                            Stage::Solving
+                        }
+                        None => Stage::Finished(None),
+                    },
+                },
+                // The exact solver's routes carry their leads already.
+                Stage::Solving if candidate.source == KerfSource::FullRoute => {
+                    let status = candidate.job.step(budget);
+                    if let Some(route) = candidate.job.progress().route {
+                        candidate.fitted = Some((route.clone(), Ok(route)));
+                    }
+                    if status == JobStatus::Done {
+                        Stage::Finished(candidate.fitted.take().map(|(_, fitted)| fitted))
+                    } else {
+                        candidate.stage = Stage::Solving;
+                        return;
+                    }
+                }
                 Stage::Solving => {
                     let status = candidate.job.step(budget);
                     let route = candidate.job.progress().route;
@@ -428,7 +507,12 @@ impl Candidate {
 impl Job for KerfJob {
     fn step(&mut self, budget: Duration) -> JobStatus {
         let solving: Vec<usize> = (0..self.candidates.len())
-            .filter(|&i| matches!(self.candidates[i].stage, Stage::Solving))
+            .filter(|&i| {
+                matches!(
+                    self.candidates[i].stage,
+                    Stage::Solving | Stage::Modelling(_)
+                )
+            })
             .collect();
         // Leads are finished one candidate at a time, every attachment before any relaxation,
         // so the first full route is there as soon as one solver has ended (a stop at the
@@ -477,6 +561,7 @@ impl Job for KerfJob {
                 Stage::Finished(last) => last.clone(),
                 Stage::Relaxing { route, .. } => Some(Ok(route.clone())),
                 Stage::Solving | Stage::Attaching(_) => c.fitted.as_ref().map(|(_, r)| r.clone()),
+                Stage::Modelling(_) => None,
             })
             .collect();
         // The shorter full route (the first candidate, the curves', on a tie).
@@ -528,10 +613,17 @@ impl Job for KerfJob {
         let slowest = inner.iter().map(|p| p.elapsed_s).fold(0.0, f64::max);
         let mut progress = inner.swap_remove(index);
         // The inner bounds, certificates and optimality proof are about the idealised (or the
-        // curve) nest, not the full route: none of them is reported for it.
+        // curve) nest, not the full route: none of them is reported for it. The exact
+        // solver's are about the discretised full route, whose tour the route is: they stay
+        // (the bound no higher than the route's idle length, which the tour's cost equals but
+        // for rounding).
+        let full_route = self.candidates[index].source == KerfSource::FullRoute;
         progress.upper_bound = route.as_ref().map(Route::idle_length);
-        progress.lower_bound = None;
-        progress.proven_optimal = false;
+        progress.lower_bound = match (full_route, progress.lower_bound, progress.upper_bound) {
+            (true, Some(lower), Some(upper)) => Some(lower.min(upper)),
+            _ => None,
+        };
+        progress.proven_optimal = full_route && route.is_some() && progress.proven_optimal;
         progress.tour = None;
         progress.certified = Vec::new();
         progress.route = route;
@@ -545,6 +637,36 @@ impl Job for KerfJob {
         };
         progress
     }
+}
+
+/// The exact job over a built full-route model, inside its thermal job (which reports H and
+/// checks the rules; penalties and repairs are refused with leads); `None` when the search
+/// refuses the instance.
+fn exact_job(
+    nest: &Nest,
+    model: crate::FullRouteModel,
+    modelling: &ExactModelling,
+) -> Option<Box<dyn Job>> {
+    let params = &modelling.request.params;
+    let limit = Duration::from_secs_f64(params.time_limit_s.clamp(0.0, 1.0e7));
+    let job = FullRouteJob::new(
+        modelling.request.job_id,
+        nest.clone(),
+        model,
+        limit,
+        modelling.started,
+        params.seed,
+    )
+    .ok()?;
+    Some(Box::new(ThermalJob::new(
+        Box::new(job),
+        SolverKind::Exact,
+        nest.clone(),
+        params.machine,
+        params.objective,
+        params.thermal,
+        limit,
+    )))
 }
 
 /// The tool-on links of a route (steps entered without a pierce).

@@ -31,6 +31,7 @@
 //! ```
 #![deny(missing_docs)]
 
+mod full_route;
 mod jobs;
 mod kerf;
 mod located;
@@ -43,6 +44,7 @@ mod thermal;
 use cutroute_protocol::{JobRequest, Problem, Progress, SolverKind};
 use web_time::Duration;
 
+pub use full_route::{build_full_route_model, FullRouteBuilder, FullRouteJob, FullRouteModel};
 pub use jobs::{ccp_options, CcpJob, ChainJob, DiscreteJob, DiscreteMode};
 pub use kerf::{fit_leads, supports_kerf, validate_kerf, KerfJob};
 pub use nearest::NearestNeighbourJob;

@@ -728,9 +728,10 @@ impl<'a> LeadFitter<'a> {
         self.forest.depth(r).is_some_and(|d| d % 2 == 1)
     }
 
-    /// Leads with the entry at arc length `s` of the equidistant, trying the variants of each
-    /// lead in order.
-    fn fit_at(&self, r: ContourRef, eq: &Contour, s: f64) -> Result<StepLeads, LeadProblem> {
+    /// Leads with the entry at arc length `s` of `eq` (contour `r`'s equidistant), trying the
+    /// variants of each lead in order; the rule the last variant broke when none fits. The
+    /// full-route discretisation places its candidates with it (one entry per position).
+    pub fn fit_at(&self, r: ContourRef, eq: &Contour, s: f64) -> Result<StepLeads, LeadProblem> {
         self.fit_at_linked(r, eq, s, false, false)
             .map_err(|(_, problem)| problem)
     }
