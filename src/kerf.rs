@@ -197,6 +197,18 @@ pub fn KerfPanel(settings: RwSignal<KerfSettings>) -> impl IntoView {
                     }
                 />
             </label>
+            <label class="param" title=tr("Pierce parts' outer contours at the sheet's border where a straight lead from it reaches the contour (the nest needs a sheet)", "Врезка внешних контуров деталей с кромки листа, где прямой подвод от неё доходит до контура (нужен лист)")>
+                <span>{tr("Edge piercing", "Врезка с кромки листа")}</span>
+                <input
+                    id="kerf-edge-pierce"
+                    type="checkbox"
+                    prop:checked=move || settings.with(|k| k.edge_pierce)
+                    on:change=move |ev| {
+                        let on = event_target_checked(&ev);
+                        settings.update(|k| k.edge_pierce = on);
+                    }
+                />
+            </label>
         </details>
     }
 }

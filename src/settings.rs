@@ -309,6 +309,7 @@ impl Settings {
                         self.kerf.tabs = tabs;
                     }
                 }
+                "edge_pierce" => self.kerf.edge_pierce = value == "1",
                 "sample" if crate::app::SAMPLES.iter().any(|(f, ..)| *f == value) => {
                     // The address bar follows the page, so a reload brings the query of the
                     // sample shown beside a remembered local file: that keeps the reminder;
@@ -420,6 +421,9 @@ impl Settings {
                 k.tabs.count,
                 k.tabs.width
             ));
+            if k.edge_pierce {
+                query.push_str("&edge_pierce=1");
+            }
         }
         let t = &self.thermal;
         if *t != ThermalSettings::default() {
@@ -588,6 +592,7 @@ mod tests {
                     count: 3,
                     width: 1.5,
                 },
+                edge_pierce: true,
             },
             ..Settings::default()
         };

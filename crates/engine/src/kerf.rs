@@ -45,6 +45,14 @@ const RELAX_POSITIONS: usize = 24;
 const FIT_RESERVE_SHARE: f64 = 0.25;
 const FIT_RESERVE_MAX_S: f64 = 2.0;
 
+/// How long past the request's limit the job may run to finish its first route with leads (the
+/// CLI's and the page's promise is the limit + 1 s): then it ends with what it has.
+const OVERRUN_LIMIT: Duration = Duration::from_secs(1);
+
+/// A solver is stopped this much earlier than the time its final route's leads are expected
+/// to take (from the leads attached so far) would allow, for the estimate's noise.
+const ATTACH_MARGIN: f64 = 1.5;
+
 /// Whether the kerf job can wrap `solver`'s job ([`SolverKind::cuts_with_kerf`], which the page
 /// asks before it sends a job).
 pub fn supports_kerf(solver: SolverKind) -> bool {
@@ -152,6 +160,8 @@ struct Attach {
     route: Route,
     steps: Vec<CutStep>,
     errors: Vec<LeadError>,
+    /// Time spent attaching so far.
+    spent: Duration,
 }
 
 impl Attach {
@@ -166,6 +176,7 @@ impl Attach {
             },
             steps: Vec::with_capacity(from.steps.len()),
             errors: Vec::new(),
+            spent: Duration::ZERO,
             from,
         }
     }
@@ -173,6 +184,23 @@ impl Attach {
     /// Attaches steps until `until`; the route with leads (or every contour without room)
     /// once every step is done.
     fn advance(
+        &mut self,
+        fitter: &LeadFitter<'_>,
+        until: Instant,
+    ) -> Option<Result<Route, Vec<LeadError>>> {
+        let began = Instant::now();
+        let result = self.advance_until(fitter, until);
+        self.spent += began.elapsed();
+        result
+    }
+
+    /// The time per step attached so far (`None` before a few steps are done).
+    fn step_cost(&self) -> Option<Duration> {
+        let done = (self.steps.len() + self.errors.len()) as u32;
+        (done >= 8).then(|| self.spent / done)
+    }
+
+    fn advance_until(
         &mut self,
         fitter: &LeadFitter<'_>,
         until: Instant,
@@ -229,8 +257,12 @@ pub struct KerfJob {
     /// Which candidate the next slice starts with (they take turns).
     turn: usize,
     /// The request's time limit from the job's start: relaxing stops there (every relaxed
-    /// route is valid; attaching, which validity needs, does not stop).
+    /// route is valid; attaching, which validity needs, goes on until a route has its leads,
+    /// for at most [`OVERRUN_LIMIT`] more).
     deadline: Option<Instant>,
+    /// The time one step's leads took to attach, as measured on the routes attached so far: a
+    /// solver is stopped when its final route's leads would not be ready by the deadline.
+    step_cost: Option<Duration>,
 }
 
 impl KerfJob {
@@ -343,6 +375,7 @@ impl KerfJob {
             candidates,
             turn: 0,
             deadline: started.checked_add(Duration::from_secs_f64(limit.clamp(0.0, 1.0e7))),
+            step_cost: None,
         })
     }
 
@@ -366,6 +399,13 @@ impl KerfJob {
             pass: 0,
             next: 0,
         };
+        // The time the final route's leads are expected to take: the solver stops that much
+        // before the deadline, so its route has them by the limit.
+        let reserve = self.step_cost.map_or(Duration::ZERO, |cost| {
+            (cost * self.nest.contour_count() as u32).mul_f64(ATTACH_MARGIN)
+        });
+        let cut_solver = deadline.is_some_and(|end| Instant::now() + reserve >= end);
+        let mut step_cost = self.step_cost;
         let candidate = &mut self.candidates[i];
         loop {
             let stage = std::mem::replace(&mut candidate.stage, Stage::Finished(None));
@@ -395,7 +435,13 @@ impl KerfJob {
                     }
                 }
                 Stage::Solving => {
-                    let status = candidate.job.step(budget);
+                    // Past the point where the leads would still be attached by the deadline,
+                    // the solver's route so far is its last (when it has one).
+                    let status = if cut_solver && candidate.job.progress().route.is_some() {
+                        JobStatus::Done
+                    } else {
+                        candidate.job.step(budget)
+                    };
                     let route = candidate.job.progress().route;
                     let fitted_from = candidate.fitted.as_ref().map(|(from, _)| from);
                     let pending_from = candidate.pending.as_ref().map(|a| &a.from);
@@ -429,20 +475,27 @@ impl KerfJob {
                             budget
                         };
                         if let Some(pending) = candidate.pending.as_mut() {
-                            if let Some(result) = pending.advance(&fitter, Instant::now() + spare) {
+                            let result = pending.advance(&fitter, Instant::now() + spare);
+                            step_cost = pending.step_cost().or(step_cost);
+                            if let Some(result) = result {
                                 let from = candidate.pending.take().expect("pending").from;
                                 candidate.fitted = Some((from, result));
                             }
                         }
                         candidate.stage = Stage::Solving;
+                        self.step_cost = step_cost;
                         return;
                     }
                 }
-                Stage::Attaching(mut attach) => match attach.advance(&fitter, until) {
-                    None => Stage::Attaching(attach),
-                    Some(Ok(route)) if relax => relaxing(route),
-                    Some(result) => Stage::Finished(Some(result)),
-                },
+                Stage::Attaching(mut attach) => {
+                    let result = attach.advance(&fitter, until);
+                    step_cost = attach.step_cost().or(step_cost);
+                    match result {
+                        None => Stage::Attaching(attach),
+                        Some(Ok(route)) if relax => relaxing(route),
+                        Some(result) => Stage::Finished(Some(result)),
+                    }
+                }
                 Stage::Relaxing {
                     mut route,
                     mut pass,
@@ -486,6 +539,7 @@ impl KerfJob {
                 Stage::Attaching(_) | Stage::Relaxing { .. }
             );
             if !working || Instant::now() >= until {
+                self.step_cost = step_cost;
                 return;
             }
         }
@@ -504,8 +558,43 @@ impl Candidate {
     }
 }
 
+impl KerfJob {
+    /// Whether some candidate has a full route (its leads all fitted).
+    fn has_full_route(&self) -> bool {
+        self.candidates.iter().any(|c| match &c.stage {
+            Stage::Finished(Some(Ok(_))) | Stage::Relaxing { .. } => true,
+            _ => matches!(c.fitted, Some((_, Ok(_)))),
+        })
+    }
+
+    /// At the deadline with a full route, or [`OVERRUN_LIMIT`] past it, every unfinished
+    /// candidate ends with the full route it has (relaxed as far as it got); whether it did.
+    fn end_at_deadline(&mut self) -> bool {
+        let Some(deadline) = self.deadline else {
+            return false;
+        };
+        let now = Instant::now();
+        if now < deadline || (!self.has_full_route() && now < deadline + OVERRUN_LIMIT) {
+            return false;
+        }
+        for c in &mut self.candidates {
+            let last = match std::mem::replace(&mut c.stage, Stage::Finished(None)) {
+                Stage::Relaxing { route, .. } => Some(Ok(route)),
+                Stage::Finished(last) => last,
+                Stage::Modelling(_) => None,
+                Stage::Solving | Stage::Attaching(_) => c.fitted.as_ref().map(|(_, r)| r.clone()),
+            };
+            c.stage = Stage::Finished(last);
+        }
+        true
+    }
+}
+
 impl Job for KerfJob {
     fn step(&mut self, budget: Duration) -> JobStatus {
+        if self.end_at_deadline() {
+            return JobStatus::Done;
+        }
         let solving: Vec<usize> = (0..self.candidates.len())
             .filter(|&i| {
                 matches!(

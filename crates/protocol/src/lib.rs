@@ -652,6 +652,7 @@ mod tests {
                 from: Point::new(0.0, 3.0),
                 to: Point::new(0.0, 4.5),
             }],
+            edge_pierce: true,
         });
         let route = Route {
             start: Point::default(),
@@ -689,6 +690,7 @@ mod tests {
                 count: 2,
                 width: 1.5,
             },
+            edge_pierce: true,
         };
         request.params.leads_after = true;
         let message = ToWorker::Start(request.clone());
