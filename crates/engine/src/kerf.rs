@@ -162,6 +162,8 @@ struct Attach {
     errors: Vec<LeadError>,
     /// Time spent attaching so far.
     spent: Duration,
+    /// Steps of a chained route once its leads are attached (all at once).
+    chained_done: usize,
 }
 
 impl Attach {
@@ -177,6 +179,7 @@ impl Attach {
             steps: Vec::with_capacity(from.steps.len()),
             errors: Vec::new(),
             spent: Duration::ZERO,
+            chained_done: 0,
             from,
         }
     }
@@ -191,12 +194,15 @@ impl Attach {
         let began = Instant::now();
         let result = self.advance_until(fitter, until);
         self.spent += began.elapsed();
+        if self.chained && result.is_some() {
+            self.chained_done = self.from.steps.len();
+        }
         result
     }
 
     /// The time per step attached so far (`None` before a few steps are done).
     fn step_cost(&self) -> Option<Duration> {
-        let done = (self.steps.len() + self.errors.len()) as u32;
+        let done = (self.steps.len() + self.errors.len()).max(self.chained_done) as u32;
         (done >= 8).then(|| self.spent / done)
     }
 
@@ -559,22 +565,14 @@ impl Candidate {
 }
 
 impl KerfJob {
-    /// Whether some candidate has a full route (its leads all fitted).
-    fn has_full_route(&self) -> bool {
-        self.candidates.iter().any(|c| match &c.stage {
-            Stage::Finished(Some(Ok(_))) | Stage::Relaxing { .. } => true,
-            _ => matches!(c.fitted, Some((_, Ok(_)))),
-        })
-    }
-
-    /// At the deadline with a full route, or [`OVERRUN_LIMIT`] past it, every unfinished
-    /// candidate ends with the full route it has (relaxed as far as it got); whether it did.
+    /// [`OVERRUN_LIMIT`] past the deadline every unfinished candidate ends with the full route
+    /// it has (relaxed as far as it got); whether that time has come. (At the deadline the
+    /// solvers are cut and their last routes get their leads; relaxing stops.)
     fn end_at_deadline(&mut self) -> bool {
         let Some(deadline) = self.deadline else {
             return false;
         };
-        let now = Instant::now();
-        if now < deadline || (!self.has_full_route() && now < deadline + OVERRUN_LIMIT) {
+        if Instant::now() < deadline + OVERRUN_LIMIT {
             return false;
         }
         for c in &mut self.candidates {
