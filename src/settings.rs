@@ -41,11 +41,14 @@ pub enum Layer {
     Equidistants,
     /// Pierce points M and switch-off points M* of the full cutting route.
     PierceRegions,
+    /// The outlines of the pierce region G_M and the switch-off region G_M*: each contour's
+    /// offsets at d₁ and d₂ on its scrap side.
+    Regions,
 }
 
 impl Layer {
     /// Every layer, in the order the panel lists them.
-    pub const ALL: [Layer; 14] = [
+    pub const ALL: [Layer; 15] = [
         Layer::Hatch,
         Layer::Arrows,
         Layer::Candidates,
@@ -60,6 +63,7 @@ impl Layer {
         Layer::Leads,
         Layer::Equidistants,
         Layer::PierceRegions,
+        Layer::Regions,
     ];
 
     /// Stable short name (element ids, CSS classes).
@@ -79,6 +83,7 @@ impl Layer {
             Layer::Leads => "leads",
             Layer::Equidistants => "equidistants",
             Layer::PierceRegions => "pierce-regions",
+            Layer::Regions => "regions",
         }
     }
 
@@ -99,6 +104,10 @@ impl Layer {
             Layer::Leads => ("Lead-ins and lead-outs", "Подводы и отводы"),
             Layer::Equidistants => ("Equidistants (kerf)", "Эквидистанты (ширина реза)"),
             Layer::PierceRegions => ("Pierce and switch-off points", "Точки врезки и выключения"),
+            Layer::Regions => (
+                "Pierce and switch-off regions",
+                "Области врезки и выключения",
+            ),
         };
         lang.pick(en, ru)
     }
