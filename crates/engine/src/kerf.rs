@@ -406,10 +406,14 @@ impl KerfJob {
             next: 0,
         };
         // The time the final route's leads are expected to take: the solver stops that much
-        // before the deadline, so its route has them by the limit.
-        let reserve = self.step_cost.map_or(Duration::ZERO, |cost| {
-            (cost * self.nest.contour_count() as u32).mul_f64(ATTACH_MARGIN)
-        });
+        // before the deadline, so its route has them by the limit. Not chain cutting: its
+        // route before the chaining has no links, so it runs to the deadline.
+        let reserve = match self.step_cost {
+            Some(cost) if !chained => {
+                (cost * self.nest.contour_count() as u32).mul_f64(ATTACH_MARGIN)
+            }
+            _ => Duration::ZERO,
+        };
         let cut_solver = deadline.is_some_and(|end| Instant::now() + reserve >= end);
         let mut step_cost = self.step_cost;
         let candidate = &mut self.candidates[i];
