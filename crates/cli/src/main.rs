@@ -560,9 +560,15 @@ fn bounded_job_run(
     make_job: impl FnOnce(&JobRequest) -> Result<Option<Box<dyn Job>>, String> + Send + 'static,
 ) -> Result<JobRun, Failure> {
     let time_limit_s = request.params.time_limit_s;
-    // A kerf job keeps its leads' time inside the limit (it stops its solvers when the final
-    // route's leads would not be ready by then): the grace is every job's.
-    let grace = GRACE;
+    // A kerf job keeps its leads' time inside the limit where it can (it stops its solvers
+    // when the final route's leads would not be ready by then) and ends by itself at most
+    // `OVERRUN_LIMIT` past it: a route whose leads are still being fitted is waited for that
+    // long, and no longer (the limit + 1 s promise, report included).
+    let grace = if request.params.kerf.is_idealised() {
+        GRACE
+    } else {
+        cutroute_engine::OVERRUN_LIMIT + std::time::Duration::from_millis(50)
+    };
     let display = stdio::ProgressDisplay::new(as_json);
     let mut shown = display.clone();
     let outcome = run_bounded(time_limit_s, grace, move |watch| {

@@ -45,9 +45,10 @@ const RELAX_POSITIONS: usize = 24;
 const FIT_RESERVE_SHARE: f64 = 0.25;
 const FIT_RESERVE_MAX_S: f64 = 2.0;
 
-/// How long past the request's limit the job may run to finish its first route with leads (the
-/// CLI's and the page's promise is the limit + 1 s): then it ends with what it has.
-const OVERRUN_LIMIT: Duration = Duration::from_secs(1);
+/// How long past the request's limit the job may run to give its solvers' last routes their
+/// leads (the CLI's promise is the limit + 1 s, its report included): then it ends with what
+/// it has.
+pub const OVERRUN_LIMIT: Duration = Duration::from_millis(700);
 
 /// A solver is stopped this much earlier than the time its final route's leads are expected
 /// to take (from the leads attached so far) would allow, for the estimate's noise.

@@ -46,7 +46,7 @@ use web_time::Duration;
 
 pub use full_route::{build_full_route_model, FullRouteBuilder, FullRouteJob, FullRouteModel};
 pub use jobs::{ccp_options, CcpJob, ChainJob, DiscreteJob, DiscreteMode};
-pub use kerf::{fit_leads, supports_kerf, validate_kerf, KerfJob};
+pub use kerf::{fit_leads, supports_kerf, validate_kerf, KerfJob, OVERRUN_LIMIT};
 pub use nearest::NearestNeighbourJob;
 pub use open::{format_name, OpenError};
 pub use open_files::{
