@@ -2,7 +2,9 @@
 //! and d₂, lead shapes and lengths, overcut and tabs (sent in every job request as
 //! `SolverParams::kerf`; the engine's kerf job returns the route with its leads), and the
 //! drawing's layers of it: one lead path per step (lead-in and lead-out), the equidistants the
-//! tool centre runs on, and the pierce (M) and switch-off (M*) points. The cuts themselves
+//! tool centre runs on, the pierce (M) and switch-off (M*) points, and the outlines of the
+//! pierce and switch-off regions G_M and G_M* (each contour's offsets at d₁ and d₂ on its
+//! scrap side, where M and M* may lie beyond). The cuts themselves
 //! (along the equidistants, tabs left as gaps) and the animation come from the route's
 //! `Toolpath`, which follows lead-in → contour → lead-out.
 
@@ -49,6 +51,29 @@ pub fn equidistants_path(nest: &Nest, route: &Route) -> String {
     d
 }
 
+/// Path data of the outlines of the pierce region G_M and the switch-off region G_M*: for each
+/// step with leads, its contour's offsets at the d₁ and d₂ the leads were placed under, on the
+/// contour's scrap side (a clearance of 0, or an offset that closes up, draws nothing).
+pub fn region_paths(nest: &Nest, route: &Route) -> (String, String) {
+    let (mut pierce, mut switch_off) = (String::new(), String::new());
+    for step in &route.steps {
+        let (Some(leads), Some(contour)) = (&step.leads, nest.contour(step.contour)) else {
+            continue;
+        };
+        for (distance, d) in [
+            (leads.pierce_clearance, &mut pierce),
+            (leads.switch_off_clearance, &mut switch_off),
+        ] {
+            if distance > 0.0 {
+                if let Ok(outline) = equidistant(contour, distance) {
+                    contour_path(&outline, d);
+                }
+            }
+        }
+    }
+    (pierce, switch_off)
+}
+
 /// Lead-in and lead-out lengths of a route, mm (0 without leads).
 pub fn lead_lengths(route: &Route) -> (f64, f64) {
     route
@@ -83,6 +108,12 @@ pub fn LeadLayers(
             nest.with(|n| n.as_ref().map(|n| equidistants_path(n, r)))
         })
     };
+    let regions = Memo::new(move |_| {
+        route.with(|r| {
+            let r = r.as_ref()?;
+            nest.with(|n| n.as_ref().map(|n| region_paths(n, r)))
+        })
+    });
     let marks = move || {
         let size = extent.get() / 300.0;
         route.with(|r| {
@@ -110,6 +141,10 @@ pub fn LeadLayers(
         <path class="equidistants" d=equidistants />
         <g class="leads">{leads}</g>
         <g class="pierce-regions">{marks}</g>
+        <g class="regions">
+            <path class="region-pierce" d=move || regions.get().map(|r| r.0) />
+            <path class="region-switch-off" d=move || regions.get().map(|r| r.1) />
+        </g>
     }
 }
 
@@ -194,6 +229,18 @@ pub fn KerfPanel(settings: RwSignal<KerfSettings>) -> impl IntoView {
                         if let Some(tabs) = parse_tabs(&event_target_value(&ev)) {
                             settings.update(|k| k.tabs = tabs);
                         }
+                    }
+                />
+            </label>
+            <label class="param" title=tr("Pierce parts' outer contours at the sheet's border where a straight lead from it reaches the contour (the nest needs a sheet)", "Врезка внешних контуров деталей с кромки листа, где прямой подвод от неё доходит до контура (нужен лист)")>
+                <span>{tr("Edge piercing", "Врезка с кромки листа")}</span>
+                <input
+                    id="kerf-edge-pierce"
+                    type="checkbox"
+                    prop:checked=move || settings.with(|k| k.edge_pierce)
+                    on:change=move |ev| {
+                        let on = event_target_checked(&ev);
+                        settings.update(|k| k.edge_pierce = on);
                     }
                 />
             </label>

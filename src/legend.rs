@@ -35,6 +35,8 @@ pub fn DrawingLegend() -> impl IntoView {
                 {item("pierce", "pierce point", "точка врезки")}
                 {item("lead", "lead-in and lead-out", "подвод и отвод")}
                 {item("equidistants", "equidistant (kerf/2)", "эквидистанта (половина ширины реза)")}
+                {item("region-pierce", "pierce region G_M (d₁)", "область врезки G_M (d₁)")}
+                {item("region-switch-off", "switch-off region G_M* (d₂)", "область выключения G_M* (d₂)")}
                 {item("start-marker", "start", "начало")}
                 {item("finish-marker", "finish", "конец")}
             </ul>

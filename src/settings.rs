@@ -41,11 +41,14 @@ pub enum Layer {
     Equidistants,
     /// Pierce points M and switch-off points M* of the full cutting route.
     PierceRegions,
+    /// The outlines of the pierce region G_M and the switch-off region G_M*: each contour's
+    /// offsets at d₁ and d₂ on its scrap side.
+    Regions,
 }
 
 impl Layer {
     /// Every layer, in the order the panel lists them.
-    pub const ALL: [Layer; 14] = [
+    pub const ALL: [Layer; 15] = [
         Layer::Hatch,
         Layer::Arrows,
         Layer::Candidates,
@@ -60,6 +63,7 @@ impl Layer {
         Layer::Leads,
         Layer::Equidistants,
         Layer::PierceRegions,
+        Layer::Regions,
     ];
 
     /// Stable short name (element ids, CSS classes).
@@ -79,6 +83,7 @@ impl Layer {
             Layer::Leads => "leads",
             Layer::Equidistants => "equidistants",
             Layer::PierceRegions => "pierce-regions",
+            Layer::Regions => "regions",
         }
     }
 
@@ -99,6 +104,10 @@ impl Layer {
             Layer::Leads => ("Lead-ins and lead-outs", "Подводы и отводы"),
             Layer::Equidistants => ("Equidistants (kerf)", "Эквидистанты (ширина реза)"),
             Layer::PierceRegions => ("Pierce and switch-off points", "Точки врезки и выключения"),
+            Layer::Regions => (
+                "Pierce and switch-off regions",
+                "Области врезки и выключения",
+            ),
         };
         lang.pick(en, ru)
     }
@@ -309,6 +318,7 @@ impl Settings {
                         self.kerf.tabs = tabs;
                     }
                 }
+                "edge_pierce" => self.kerf.edge_pierce = value == "1",
                 "sample" if crate::app::SAMPLES.iter().any(|(f, ..)| *f == value) => {
                     // The address bar follows the page, so a reload brings the query of the
                     // sample shown beside a remembered local file: that keeps the reminder;
@@ -420,6 +430,9 @@ impl Settings {
                 k.tabs.count,
                 k.tabs.width
             ));
+            if k.edge_pierce {
+                query.push_str("&edge_pierce=1");
+            }
         }
         let t = &self.thermal;
         if *t != ThermalSettings::default() {
@@ -588,6 +601,7 @@ mod tests {
                     count: 3,
                     width: 1.5,
                 },
+                edge_pierce: true,
             },
             ..Settings::default()
         };

@@ -134,6 +134,12 @@ fn phase_ru(phase: &Phase) -> String {
                 phase_ru(base)
             ),
             KerfNote::Leads {
+                source: KerfSource::FullRoute,
+            } => format!(
+                "{} · подводы выбраны среди кандидатов модели полного маршрута",
+                phase_ru(base)
+            ),
+            KerfNote::Leads {
                 source: KerfSource::Idealised,
             } => format!(
                 "{} · подводы добавлены к идеализированному порядку",

@@ -87,6 +87,24 @@ test('kerf and an arc lead-in: leads drawn and animated, G-code reads back with 
   const drawnArcs = ds.filter((d) => /^M[-\d.]+ [-\d.]+A/.test(d)).length;
   assert.ok(drawnArcs > 0, 'arc lead-ins drawn');
   assert.ok((await page.getAttribute('#nest-view path.equidistants', 'd')).length > 0, 'equidistants drawn');
+  // The outlines of the pierce region G_M (d₁ = 5) and the switch-off region G_M* (d₂ = 1): at
+  // most one closed subpath per step (a contour's offset; holes too small for one draw none),
+  // each in a style of its own, toggled like the other layers.
+  const subpaths = (d) => (d.match(/M/g) ?? []).length;
+  const regionPierce = await page.getAttribute('#nest-view g.regions path.region-pierce', 'd');
+  const regionSwitchOff = await page.getAttribute('#nest-view g.regions path.region-switch-off', 'd');
+  assert.ok(subpaths(regionPierce) > 0 && subpaths(regionPierce) <= steps, 'G_M outlines drawn');
+  assert.ok(subpaths(regionSwitchOff) > 0 && subpaths(regionSwitchOff) <= steps, 'G_M* outlines drawn');
+  const strokeOf = (selector) => page.evaluate((s) => getComputedStyle(document.querySelector(s)).stroke, selector);
+  const strokes = new Set([await strokeOf('#nest-view path.region-pierce'), await strokeOf('#nest-view path.region-switch-off'),
+    await strokeOf('#nest-view path.equidistants'), await strokeOf('#nest-view path.lead')]);
+  assert.equal(strokes.size, 4, 'regions, equidistants and leads each in their own colour');
+  const regionsDisplay = () => page.evaluate(() => getComputedStyle(document.querySelector('#nest-view g.regions')).display);
+  assert.notEqual(await regionsDisplay(), 'none');
+  await page.uncheck('#layer-regions');
+  assert.equal(await regionsDisplay(), 'none', 'the regions layer hides');
+  await page.check('#layer-regions');
+  assert.notEqual(await regionsDisplay(), 'none');
   assert.equal(await page.locator('#nest-view .pierce-regions circle.pierce-m').count(), steps);
   assert.equal(await page.locator('#nest-view .pierce-regions rect.switch-off-m').count(), steps);
   // Leads are drawn in a style of their own.

@@ -2,8 +2,8 @@
 //! switch-off clearances d₁ and d₂, lead-ins, lead-outs, overcut and micro-joints (tabs). The defaults are the
 //! idealised model, under which nothing here changes a route or a report.
 //!
-//! With leads on, the contour solvers (nearest, ccp, heuristic, discrete) and chain cutting
-//! optimise the full route in the engine's kerf job (`cutroute_engine::KerfJob`, the app's
+//! With leads on, the contour solvers (nearest, ccp, heuristic, discrete, exact) and chain
+//! cutting optimise the full route in the engine's kerf job (`cutroute_engine::KerfJob`, the app's
 //! code path): the settings travel in the request, and the job's routes come with their leads
 //! (chains with a lead-in at each chain's start and a lead-out at its end).
 //! `--leads-after` instead solves the idealised route and attaches leads to it (the
@@ -49,6 +49,11 @@ pub struct KerfArgs {
     /// Solve the idealised route, then attach leads (instead of optimising with them).
     #[arg(long)]
     leads_after: bool,
+    /// Pierce parts' outer contours at the sheet's border where the border is within the
+    /// lead-in's reach plus d₁ of the entry and a straight lead from it keeps kerf/2 from every
+    /// contour (the pierce takes `--edge-pierce-time`). Needs a nest with a sheet.
+    #[arg(long)]
+    edge_pierce: bool,
 }
 
 /// The parsed full-route settings.
@@ -111,6 +116,7 @@ impl KerfArgs {
             ),
             overcut: length("overcut", self.overcut)?,
             tabs: tabs(self.tabs.as_deref())?,
+            edge_pierce: self.edge_pierce,
         };
         Ok(Kerf {
             settings,
@@ -143,10 +149,10 @@ impl Kerf {
         }
         if !matches!(
             solver,
-            "nearest" | "ccp" | "heuristic" | "discrete" | "chain"
+            "nearest" | "ccp" | "heuristic" | "discrete" | "exact" | "chain"
         ) {
             return Err(format!(
-                "--solver {solver} does not cut with kerf and leads yet (nearest, ccp, heuristic, discrete and chain do)"
+                "--solver {solver} does not cut with kerf and leads yet (nearest, ccp, heuristic, discrete, exact and chain do)"
             ));
         }
         request.params.kerf = self.settings;
@@ -201,7 +207,11 @@ impl Kerf {
             "overcut": s.overcut,
             "tabs": { "per_part": s.tabs.count, "width": s.tabs.width },
             "optimised_with_leads": !self.after,
+            "edge_pierce": s.edge_pierce,
         });
+        if s.edge_pierce {
+            report["edge_pierces"] = json!(route.edge_pierce_count());
+        }
         let leads = || route.steps.iter().filter_map(|s| s.leads.as_ref());
         let by_job = match phase {
             Some(Phase::Kerf {
@@ -239,6 +249,9 @@ impl Kerf {
                 fields.remove("pierce");
             }
             step["entry"] = json!([l.entry.x, l.entry.y]);
+            if l.edge_pierce && cut.is_pierced() {
+                step["edge_pierce"] = json!(true);
+            }
             step["lead_in"] = json!(triples(&l.lead_in));
             step["lead_out"] = json!(triples(&l.lead_out));
             if !linked_out {

@@ -196,6 +196,9 @@ struct MachineArgs {
     /// A RouteManager task JSON whose speeds and pierce time are the defaults.
     #[arg(long)]
     task: Option<PathBuf>,
+    /// Time of one pierce at the sheet's edge (`--edge-pierce`), s; default: the pierce time.
+    #[arg(long, value_name = "S")]
+    edge_pierce_time: Option<f64>,
     /// What gsccp minimises when it picks an ensemble, and the unit of the path-route
     /// solvers' (sccp, gsccp, aoe) bounds: time or cost.
     #[arg(long, default_value = "time", value_parser = ["time", "cost"])]
@@ -205,12 +208,20 @@ struct MachineArgs {
 impl MachineArgs {
     /// The time and cost model on top of `base` (defaults or the profile), and the objective.
     fn parse(&self, base: MachineParameters) -> Result<(MachineParameters, Objective), String> {
-        let machine = machine_parameters(
+        let mut machine = machine_parameters(
             base,
             self.cost.as_deref(),
             self.speeds.as_deref(),
             self.task.as_deref(),
         )?;
+        if let Some(time) = self.edge_pierce_time {
+            if !(time.is_finite() && time >= 0.0) {
+                return Err(format!(
+                    "--edge-pierce-time {time}: must be finite and non-negative"
+                ));
+            }
+            machine.edge_pierce_time = Some(time);
+        }
         let objective = match self.objective.as_str() {
             "cost" => Objective::Cost,
             _ => Objective::Time,
@@ -453,11 +464,6 @@ const KEPT_ROUTES: usize = 8;
 /// best state it published and exits (the promise is limit + 1 s, report included).
 const GRACE: std::time::Duration = std::time::Duration::from_millis(300);
 
-/// How long past its limit a kerf job may take to fit the leads of its first route: leads are
-/// part of the answer, and a route without them is none (on `nested.dbs` in a debug build
-/// under load, attaching every contour's leads takes about half a second).
-const LEADS_GRACE: std::time::Duration = std::time::Duration::from_secs(30);
-
 /// What the CLI's main thread and the solver's thread share.
 #[derive(Default)]
 struct Watch {
@@ -691,12 +697,14 @@ struct FinishedRun {
 /// The run of the request's job on the solver's thread, bounded by [`run_bounded`].
 fn bounded_job_run(request: JobRequest, as_json: bool) -> Result<FinishedRun, Failure> {
     let time_limit_s = request.params.time_limit_s;
-    // A kerf job stopped before its first route with leads keeps stepping until it has one
-    // (see `run_job`); the grace lets it.
+    // A kerf job keeps its leads' time inside the limit where it can (it stops its solvers
+    // when the final route's leads would not be ready by then) and ends by itself at most
+    // `OVERRUN_LIMIT` past it: a route whose leads are still being fitted is waited for that
+    // long, and no longer (the limit + 1 s promise, report included).
     let grace = if request.params.kerf.is_idealised() {
         GRACE
     } else {
-        LEADS_GRACE
+        cutroute_engine::OVERRUN_LIMIT + std::time::Duration::from_millis(50)
     };
     let display = stdio::ProgressDisplay::new(as_json);
     let mut shown = display.clone();
@@ -1395,13 +1403,16 @@ fn route_report(
     let idle_length = route.idle_length();
     let cut_length = route.cut_length(nest);
     let pierces = route.pierce_count();
+    // Edge pierces (`--edge-pierce`) take the machine's edge-pierce time.
+    let time_s = machine.time(cut_length, idle_length, 0)
+        + machine.pierce_seconds(pierces, route.edge_pierce_count());
     Ok(json!({
         "solver": solver,
         "idle_length": idle_length,
         "cut_length": cut_length,
         "link_length": route.link_length(),
         "pierces": pierces,
-        "time_s": machine.time(cut_length, idle_length, pierces),
+        "time_s": time_s,
         "cost": machine.cost(cut_length, idle_length, pierces),
         "machine": machine_json(machine),
         "route": route.steps.iter().map(|s| {

@@ -413,3 +413,85 @@ fn controller_compensation_writes_a_program_that_reads_back_as_the_route() {
     let (ok, _, err) = cutroute(&["convert", &file, &out_s, "--kerf-compensation", "g42"]);
     assert!(!ok && err.contains("--kerf-compensation"), "{err}");
 }
+
+#[test]
+fn exact_with_leads_reports_its_model_bound_below_its_route() {
+    let file = data("nests/dbs-json/E1X_6_01.dbs.json");
+    let mut args = vec![
+        "solve",
+        &file,
+        "--solver",
+        "exact",
+        "--time-limit",
+        "10",
+        "--json",
+    ];
+    args.extend(PLASMA);
+    let report = json(&args);
+    let idle = report["idle_length"].as_f64().unwrap();
+    assert!((legs(&report) - idle).abs() < 1e-6 * idle.max(1.0));
+    for step in report["route"].as_array().unwrap() {
+        assert!(step.get("lead_in").is_some() && step.get("switch_off").is_some());
+    }
+    let lb = report["lb"]
+        .as_f64()
+        .expect("a bound of the full-route model");
+    assert!(lb > 0.0 && lb <= idle, "bound {lb} vs route {idle}");
+}
+
+#[test]
+fn edge_pierces_sit_on_the_sheet_border_and_take_the_edge_pierce_time() {
+    // test1: a 2000 × 1000 sheet.
+    let file = data("nests/dbs-json/test1.dbs.json");
+    let mut args = vec![
+        "solve",
+        &file,
+        "--solver",
+        "nearest",
+        "--json",
+        "--edge-pierce",
+        "--edge-pierce-time",
+        "2",
+    ];
+    args.extend(PLASMA);
+    let report = json(&args);
+    let edge: Vec<&Value> = report["route"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|s| s.get("edge_pierce").is_some())
+        .collect();
+    assert_eq!(
+        report["edge_pierces"].as_u64().unwrap() as usize,
+        edge.len()
+    );
+    // Nearest is deterministic: one part of test1 lies within the edge reach of the border.
+    assert!(!edge.is_empty());
+    for step in &edge {
+        let (x, y) = point(&step["pierce"]);
+        let to_border = x
+            .abs()
+            .min((x - 2000.0).abs())
+            .min(y.abs())
+            .min((y - 1000.0).abs());
+        assert!(to_border < 1e-6, "edge pierce ({x}, {y}) off the border");
+        assert_eq!(
+            step["lead_in"].as_array().unwrap().len(),
+            2,
+            "a straight lead"
+        );
+    }
+    // Time: cut at 10 mm/s, idle at 500 mm/s, 7 s a pierce in the sheet, 2 s at its edge.
+    let (cut, idle) = (
+        report["cut_length"].as_f64().unwrap(),
+        report["idle_length"].as_f64().unwrap(),
+    );
+    let pierces = report["pierces"].as_u64().unwrap() as f64;
+    let expected =
+        cut / 10.0 + idle / 500.0 + 7.0 * (pierces - edge.len() as f64) + 2.0 * edge.len() as f64;
+    let time = report["time_s"].as_f64().unwrap();
+    assert!(
+        (time - expected).abs() < 1e-6 * expected,
+        "{time} vs {expected}"
+    );
+}

@@ -48,6 +48,7 @@ fn main() {
         lead_out: LeadSpec::new(LeadShape::Line, 2.0),
         overcut: 0.0,
         tabs: TabSpec::default(),
+        edge_pierce: false,
     };
     let machine = MachineParameters::default();
     let here = PathBuf::from(env!("CARGO_MANIFEST_DIR"));

@@ -14,6 +14,13 @@
 //! two full routes: its route is never longer than the idealised order with leads attached and
 //! relaxed, and so never longer than that order with leads attached.
 //!
+//! The exact solver is the exception: it searches the discretised full-route model itself
+//! ([`crate::FullRouteModel`]: candidate entries with their leads fitted, idle legs from M* to
+//! the next M), and the job keeps its route as found, with its lower bound and optimality
+//! proof, which are about that model (see the module `full_route`). Neither the idealised run
+//! nor the relaxation is added: either could give a route off the candidates, below the
+//! discretised optimum, and the bound would then no longer be below the route reported.
+//!
 //! With `leads_after` the job runs the solver on the nest only and attaches leads (no
 //! relaxation): the "solve, then attach leads" route of the benchmark.
 
@@ -25,6 +32,8 @@ use cutroute_protocol::{
 };
 use web_time::{Duration, Instant};
 
+use crate::full_route::{FullRouteBuilder, FullRouteJob, Modelling};
+use crate::thermal::ThermalJob;
 use crate::{EngineError, Job, JobStatus, Refusal};
 
 /// Sweeps of [`LeadFitter::relax`] over a finished route, and the entries it tries round each
@@ -37,6 +46,15 @@ const RELAX_POSITIONS: usize = 24;
 /// so the final full route is there by the limit (the CLI stops a job at it).
 const FIT_RESERVE_SHARE: f64 = 0.25;
 const FIT_RESERVE_MAX_S: f64 = 2.0;
+
+/// How long past the request's limit the job may run to give its solvers' last routes their
+/// leads (the CLI's promise is the limit + 1 s, its report included): then it ends with what
+/// it has.
+pub const OVERRUN_LIMIT: Duration = Duration::from_millis(700);
+
+/// A solver is stopped this much earlier than the time its final route's leads are expected
+/// to take (from the leads attached so far) would allow, for the estimate's noise.
+const ATTACH_MARGIN: f64 = 1.5;
 
 /// Whether the kerf job can wrap `solver`'s job ([`SolverKind::cuts_with_kerf`], which the page
 /// asks before it sends a job).
@@ -109,6 +127,8 @@ struct Candidate {
 /// they are relaxed step by step (every stage in slices, so a cancel is seen and no step runs
 /// long).
 enum Stage {
+    /// The exact solver's full-route model is built (its candidates' leads fitted).
+    Modelling(Box<ExactModelling>),
     Solving,
     Attaching(Attach),
     Relaxing {
@@ -123,6 +143,15 @@ enum Stage {
     Finished(Option<Result<Route, Vec<LeadError>>>),
 }
 
+/// The full-route model under construction and the request its exact job will run.
+struct ExactModelling {
+    builder: FullRouteBuilder,
+    /// The idealised request (its time limit shortened like every inner job's).
+    request: JobRequest,
+    /// When the request arrived: the build counts against the limit.
+    started: Instant,
+}
+
 /// Leads attached to a solver's route, one step at a time (a chained route all at once: its
 /// links tie neighbouring steps' leads together).
 struct Attach {
@@ -134,6 +163,10 @@ struct Attach {
     route: Route,
     steps: Vec<CutStep>,
     errors: Vec<LeadError>,
+    /// Time spent attaching so far.
+    spent: Duration,
+    /// Steps of a chained route once its leads are attached (all at once).
+    chained_done: usize,
 }
 
 impl Attach {
@@ -148,6 +181,8 @@ impl Attach {
             },
             steps: Vec::with_capacity(from.steps.len()),
             errors: Vec::new(),
+            spent: Duration::ZERO,
+            chained_done: 0,
             from,
         }
     }
@@ -155,6 +190,26 @@ impl Attach {
     /// Attaches steps until `until`; the route with leads (or every contour without room)
     /// once every step is done.
     fn advance(
+        &mut self,
+        fitter: &LeadFitter<'_>,
+        until: Instant,
+    ) -> Option<Result<Route, Vec<LeadError>>> {
+        let began = Instant::now();
+        let result = self.advance_until(fitter, until);
+        self.spent += began.elapsed();
+        if self.chained && result.is_some() {
+            self.chained_done = self.from.steps.len();
+        }
+        result
+    }
+
+    /// The time per step attached so far (`None` before a few steps are done).
+    fn step_cost(&self) -> Option<Duration> {
+        let done = (self.steps.len() + self.errors.len()).max(self.chained_done) as u32;
+        (done >= 8).then(|| self.spent / done)
+    }
+
+    fn advance_until(
         &mut self,
         fitter: &LeadFitter<'_>,
         until: Instant,
@@ -211,8 +266,12 @@ pub struct KerfJob {
     /// Which candidate the next slice starts with (they take turns).
     turn: usize,
     /// The request's time limit from the job's start: relaxing stops there (every relaxed
-    /// route is valid; attaching, which validity needs, does not stop).
+    /// route is valid; attaching, which validity needs, goes on until a route has its leads,
+    /// for at most [`OVERRUN_LIMIT`] more).
     deadline: Option<Instant>,
+    /// The time one step's leads took to attach, as measured on the routes attached so far: a
+    /// solver is stopped when its final route's leads would not be ready by the deadline.
+    step_cost: Option<Duration>,
 }
 
 impl KerfJob {
@@ -229,7 +288,12 @@ impl KerfJob {
             solver: solver.name(),
             reason,
         };
-        let Problem::Nest { nest, .. } = &request.problem else {
+        let Problem::Nest {
+            nest,
+            start: route_start,
+            finish: route_finish,
+        } = &request.problem
+        else {
             return Err(EngineError::UnsupportedProblem {
                 solver: solver.name(),
                 problem: "a PCGTSP instance with kerf and leads",
@@ -253,7 +317,37 @@ impl KerfJob {
         let mut candidates = Vec::new();
         let after = request.params.leads_after;
         let chained = solver == SolverKind::Chain;
-        if chained {
+        let exact = solver == SolverKind::Exact && !after;
+        if exact {
+            // A heat penalty or a rule repair changes the route after the search: the bound
+            // would no longer be about it.
+            if request.params.thermal.penalised() || request.params.thermal.hard {
+                return Err(refused(
+                    "with kerf and leads, exact searches the full-route model and cannot price \
+                     heat or repair rules; use heuristic"
+                        .into(),
+                ));
+            }
+            let builder = FullRouteBuilder::new(
+                nest,
+                settings,
+                request.params.discretisation_step_mm,
+                *route_start,
+                *route_finish,
+            )
+            .map_err(refused)?;
+            candidates.push(Candidate::new(
+                KerfSource::FullRoute,
+                Box::new(Modelling {
+                    job_id: request.job_id,
+                }),
+            ));
+            candidates[0].stage = Stage::Modelling(Box::new(ExactModelling {
+                builder,
+                request: idealised.clone(),
+                started,
+            }));
+        } else if chained {
             // Links routed round the equidistants keep kerf/2 from every contour.
             let equidistants = LeadFitter::with_forest(nest, &forest, settings).kerf_nest();
             let mut over_equidistants = idealised.clone();
@@ -275,7 +369,7 @@ impl KerfJob {
                 start(&over_curves)?,
             ));
         }
-        if !chained {
+        if !chained && !exact {
             candidates.push(Candidate::new(KerfSource::Idealised, start(&idealised)?));
         }
         Ok(KerfJob {
@@ -287,6 +381,7 @@ impl KerfJob {
             candidates,
             turn: 0,
             deadline: started.checked_add(Duration::from_secs_f64(limit.clamp(0.0, 1.0e7))),
+            step_cost: None,
         })
     }
 
@@ -310,12 +405,58 @@ impl KerfJob {
             pass: 0,
             next: 0,
         };
+        // The time the final route's leads are expected to take: the solver stops that much
+        // before the deadline, so its route has them by the limit. Not chain cutting: its
+        // route before the chaining has no links, so it runs to the deadline.
+        let reserve = match self.step_cost {
+            Some(cost) if !chained => {
+                (cost * self.nest.contour_count() as u32).mul_f64(ATTACH_MARGIN)
+            }
+            _ => Duration::ZERO,
+        };
+        let cut_solver = deadline.is_some_and(|end| Instant::now() + reserve >= end);
+        let mut step_cost = self.step_cost;
         let candidate = &mut self.candidates[i];
         loop {
             let stage = std::mem::replace(&mut candidate.stage, Stage::Finished(None));
             candidate.stage = match stage {
-                Stage::Solving => {
+                Stage::Modelling(mut modelling) => match modelling.builder.advance(until) {
+                    None => Stage::Modelling(modelling),
+                    Some(Err(errors)) => Stage::Finished(Some(Err(errors))),
+                    Some(Ok(model)) => match exact_job(&self.nest, model, &modelling) {
+                        Some(job) => {
+                            candidate.job = job;
+                            Stage::Solving
+                        }
+                        None => Stage::Finished(None),
+                    },
+                },
+                // The exact solver's routes carry their leads already.
+                Stage::Solving if candidate.source == KerfSource::FullRoute => {
                     let status = candidate.job.step(budget);
+                    if let Some(route) = candidate
+                        .job
+                        .progress()
+                        .solution
+                        .and_then(Solution::into_route)
+                    {
+                        candidate.fitted = Some((route.clone(), Ok(route)));
+                    }
+                    if status == JobStatus::Done {
+                        Stage::Finished(candidate.fitted.take().map(|(_, fitted)| fitted))
+                    } else {
+                        candidate.stage = Stage::Solving;
+                        return;
+                    }
+                }
+                Stage::Solving => {
+                    // Past the point where the leads would still be attached by the deadline,
+                    // the solver's route so far is its last (when it has one).
+                    let status = if cut_solver && candidate.job.progress().route().is_some() {
+                        JobStatus::Done
+                    } else {
+                        candidate.job.step(budget)
+                    };
                     let route = candidate
                         .job
                         .progress()
@@ -353,20 +494,27 @@ impl KerfJob {
                             budget
                         };
                         if let Some(pending) = candidate.pending.as_mut() {
-                            if let Some(result) = pending.advance(&fitter, Instant::now() + spare) {
+                            let result = pending.advance(&fitter, Instant::now() + spare);
+                            step_cost = pending.step_cost().or(step_cost);
+                            if let Some(result) = result {
                                 let from = candidate.pending.take().expect("pending").from;
                                 candidate.fitted = Some((from, result));
                             }
                         }
                         candidate.stage = Stage::Solving;
+                        self.step_cost = step_cost;
                         return;
                     }
                 }
-                Stage::Attaching(mut attach) => match attach.advance(&fitter, until) {
-                    None => Stage::Attaching(attach),
-                    Some(Ok(route)) if relax => relaxing(route),
-                    Some(result) => Stage::Finished(Some(result)),
-                },
+                Stage::Attaching(mut attach) => {
+                    let result = attach.advance(&fitter, until);
+                    step_cost = attach.step_cost().or(step_cost);
+                    match result {
+                        None => Stage::Attaching(attach),
+                        Some(Ok(route)) if relax => relaxing(route),
+                        Some(result) => Stage::Finished(Some(result)),
+                    }
+                }
                 Stage::Relaxing {
                     mut route,
                     mut pass,
@@ -410,6 +558,7 @@ impl KerfJob {
                 Stage::Attaching(_) | Stage::Relaxing { .. }
             );
             if !working || Instant::now() >= until {
+                self.step_cost = step_cost;
                 return;
             }
         }
@@ -428,10 +577,42 @@ impl Candidate {
     }
 }
 
+impl KerfJob {
+    /// [`OVERRUN_LIMIT`] past the deadline every unfinished candidate ends with the full route
+    /// it has (relaxed as far as it got); whether that time has come. (At the deadline the
+    /// solvers are cut and their last routes get their leads; relaxing stops.)
+    fn end_at_deadline(&mut self) -> bool {
+        let Some(deadline) = self.deadline else {
+            return false;
+        };
+        if Instant::now() < deadline + OVERRUN_LIMIT {
+            return false;
+        }
+        for c in &mut self.candidates {
+            let last = match std::mem::replace(&mut c.stage, Stage::Finished(None)) {
+                Stage::Relaxing { route, .. } => Some(Ok(route)),
+                Stage::Finished(last) => last,
+                Stage::Modelling(_) => None,
+                Stage::Solving | Stage::Attaching(_) => c.fitted.as_ref().map(|(_, r)| r.clone()),
+            };
+            c.stage = Stage::Finished(last);
+        }
+        true
+    }
+}
+
 impl Job for KerfJob {
     fn step(&mut self, budget: Duration) -> JobStatus {
+        if self.end_at_deadline() {
+            return JobStatus::Done;
+        }
         let solving: Vec<usize> = (0..self.candidates.len())
-            .filter(|&i| matches!(self.candidates[i].stage, Stage::Solving))
+            .filter(|&i| {
+                matches!(
+                    self.candidates[i].stage,
+                    Stage::Solving | Stage::Modelling(_)
+                )
+            })
             .collect();
         // Leads are finished one candidate at a time, every attachment before any relaxation,
         // so the first full route is there as soon as one solver has ended (a stop at the
@@ -480,6 +661,7 @@ impl Job for KerfJob {
                 Stage::Finished(last) => last.clone(),
                 Stage::Relaxing { route, .. } => Some(Ok(route.clone())),
                 Stage::Solving | Stage::Attaching(_) => c.fitted.as_ref().map(|(_, r)| r.clone()),
+                Stage::Modelling(_) => None,
             })
             .collect();
         // The shorter full route (the first candidate, the curves', on a tie).
@@ -530,9 +712,18 @@ impl Job for KerfJob {
         let slowest = inner.iter().map(|p| p.elapsed_s).fold(0.0, f64::max);
         let mut progress = inner.swap_remove(index);
         // The inner bounds, certificates and optimality proof are about the idealised (or the
-        // curve) nest, not the full route: none of them is reported for it.
-        progress.bounds = Bounds::idle_mm(route.as_ref().map(Route::idle_length), None);
-        progress.proven_optimal = false;
+        // curve) nest, not the full route: none of them is reported for it. The exact
+        // solver's are about the discretised full route, whose tour the route is: they stay
+        // (the bound no higher than the route's idle length, which the tour's cost equals but
+        // for rounding).
+        let full_route = self.candidates[index].source == KerfSource::FullRoute;
+        let upper = route.as_ref().map(Route::idle_length);
+        let lower = match (full_route, progress.bounds.lower, upper) {
+            (true, Some(lower), Some(upper)) => Some(lower.min(upper)),
+            _ => None,
+        };
+        progress.bounds = Bounds::idle_mm(upper, lower);
+        progress.proven_optimal = full_route && route.is_some() && progress.proven_optimal;
         progress.certified = Vec::new();
         progress.solution = route.map(Solution::Route);
         if done {
@@ -545,6 +736,36 @@ impl Job for KerfJob {
         };
         progress
     }
+}
+
+/// The exact job over a built full-route model, inside its thermal job (which reports H and
+/// checks the rules; penalties and repairs are refused with leads); `None` when the search
+/// refuses the instance.
+fn exact_job(
+    nest: &Nest,
+    model: crate::FullRouteModel,
+    modelling: &ExactModelling,
+) -> Option<Box<dyn Job>> {
+    let params = &modelling.request.params;
+    let limit = Duration::from_secs_f64(params.time_limit_s.clamp(0.0, 1.0e7));
+    let job = FullRouteJob::new(
+        modelling.request.job_id,
+        nest.clone(),
+        model,
+        limit,
+        modelling.started,
+        params.seed,
+    )
+    .ok()?;
+    Some(Box::new(ThermalJob::new(
+        Box::new(job),
+        SolverKind::Exact,
+        nest.clone(),
+        params.machine,
+        params.objective,
+        params.thermal,
+        limit,
+    )))
 }
 
 /// The tool-on links of a route (steps entered without a pierce).

@@ -31,6 +31,7 @@
 //! ```
 #![deny(missing_docs)]
 
+mod full_route;
 mod jobs;
 mod kerf;
 mod located;
@@ -43,8 +44,9 @@ mod thermal;
 use cutroute_protocol::{JobRequest, Problem, Progress, SolverKind};
 use web_time::Duration;
 
+pub use full_route::{build_full_route_model, FullRouteBuilder, FullRouteJob, FullRouteModel};
 pub use jobs::{ccp_options, CcpJob, ChainJob, DiscreteJob, DiscreteMode};
-pub use kerf::{fit_leads, supports_kerf, validate_kerf, KerfJob};
+pub use kerf::{fit_leads, supports_kerf, validate_kerf, KerfJob, OVERRUN_LIMIT};
 pub use nearest::NearestNeighbourJob;
 pub use open::{format_name, OpenError};
 pub use open_files::{
@@ -139,7 +141,7 @@ pub enum Refusal {
     #[error("{0}")]
     Thermal(#[from] cutroute_thermal::ThermalError),
     /// The solver has no model of the full cutting route (kerf, leads).
-    #[error("does not cut with kerf and leads yet (nearest, ccp, heuristic and chain do)")]
+    #[error("does not cut with kerf and leads yet (nearest, ccp, heuristic, exact and chain do)")]
     NoFullRouteModel,
     /// A setting the solver cannot run with, in words (thermal weight, kerf lengths).
     #[error("{0}")]

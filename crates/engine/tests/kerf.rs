@@ -35,6 +35,7 @@ fn plasma() -> KerfSettings {
         lead_out: LeadSpec::new(LeadShape::Line, 2.0),
         overcut: 0.0,
         tabs: TabSpec::default(),
+        edge_pierce: false,
     }
 }
 

@@ -718,6 +718,8 @@ impl ReadLeads {
             pierce_clearance: 0.0,
             switch_off_clearance: 0.0,
             tabs,
+            // The format has no edge-pierce mark; with d₁ 0 a border pierce is in G_M anyway.
+            edge_pierce: false,
         });
     }
 }

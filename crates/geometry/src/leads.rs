@@ -30,6 +30,7 @@
 //!     lead_out: LeadSpec::new(LeadShape::Line, 3.0),
 //!     overcut: 0.0,
 //!     tabs: Default::default(),
+//!     edge_pierce: false,
 //! };
 //! let fitter = LeadFitter::new(&nest, settings);
 //! let r = ContourRef { part: 0, contour: 0 };
@@ -294,6 +295,14 @@ pub struct KerfSettings {
     /// Micro-joints in the outer contour of every part.
     #[serde(default)]
     pub tabs: TabSpec,
+    /// Edge piercing: a part's outer contour that lies in the sheet's own scrap (not in a
+    /// hole) may be pierced at the sheet's border, where piercing is quicker and deforms
+    /// less. Where the border is within [`KerfSettings::edge_reach`] of an entry, the lead-in
+    /// is a straight line from the border's nearest point to the entry, used when it keeps
+    /// kerf/2 from every contour; its pierce is priced at the machine's edge-pierce time.
+    /// Needs a nest with a sheet. Off by default (the idealised and published runs).
+    #[serde(default)]
+    pub edge_pierce: bool,
 }
 
 impl KerfSettings {
@@ -306,6 +315,13 @@ impl KerfSettings {
             && self.lead_out.shape == LeadShape::None
             && self.overcut == 0.0
             && self.tabs.count == 0
+            && !self.edge_pierce
+    }
+
+    /// The longest edge lead-in, mm: the asked lead-in's longest chain plus d₁, as far as the
+    /// asked lead and its pierce region would reach from the entry anyway.
+    pub fn edge_reach(&self) -> f64 {
+        self.lead_in.longest_chain() + self.pierce_clearance
     }
 }
 
@@ -340,6 +356,10 @@ pub struct StepLeads {
     /// Micro-joints of the cut, in cut order.
     #[serde(default)]
     pub tabs: Vec<Tab>,
+    /// M lies on the sheet's border (an edge pierce, see [`KerfSettings::edge_pierce`]): the
+    /// checker holds it to the border instead of G_M.
+    #[serde(default)]
+    pub edge_pierce: bool,
 }
 
 /// Spans of a vertex chain (each vertex's bulge shapes the span to the next; the last vertex
@@ -550,6 +570,15 @@ pub enum LeadProblem {
         /// Its distance to the nearest contour.
         distance: f64,
     },
+    /// An edge pierce whose M is not on the sheet's border, or whose contour is not a part's
+    /// outer contour in the sheet's scrap (or the nest has no sheet).
+    #[error("edge pierce point ({x}, {y}) is not on the sheet's border")]
+    EdgePierceOffBorder {
+        /// M, x.
+        x: f64,
+        /// M, y.
+        y: f64,
+    },
     /// The entry (or exit) is not on the equidistant.
     #[error("the entry ({x}, {y}) is {distance} mm off the equidistant")]
     EntryOffEquidistant {
@@ -728,9 +757,10 @@ impl<'a> LeadFitter<'a> {
         self.forest.depth(r).is_some_and(|d| d % 2 == 1)
     }
 
-    /// Leads with the entry at arc length `s` of the equidistant, trying the variants of each
-    /// lead in order.
-    fn fit_at(&self, r: ContourRef, eq: &Contour, s: f64) -> Result<StepLeads, LeadProblem> {
+    /// Leads with the entry at arc length `s` of `eq` (contour `r`'s equidistant), trying the
+    /// variants of each lead in order; the rule the last variant broke when none fits. The
+    /// full-route discretisation places its candidates with it (one entry per position).
+    pub fn fit_at(&self, r: ContourRef, eq: &Contour, s: f64) -> Result<StepLeads, LeadProblem> {
         self.fit_at_linked(r, eq, s, false, false)
             .map_err(|(_, problem)| problem)
     }
@@ -755,8 +785,16 @@ impl<'a> LeadFitter<'a> {
             self.settings.overcut
         };
         let (exit, exit_tangent) = frame_at(eq, (s + overcut).rem_euclid(perimeter));
+        let edge_lead = if linked_in {
+            None
+        } else {
+            self.edge_lead_in(r, entry)
+        };
+        let edge_pierce = edge_lead.is_some();
         let lead_in = if linked_in {
             vec![vertex(entry)]
+        } else if let Some(chain) = edge_lead {
+            chain
         } else {
             self.first_fitting(
                 r,
@@ -793,7 +831,35 @@ impl<'a> LeadFitter<'a> {
             pierce_clearance: self.settings.pierce_clearance,
             switch_off_clearance: self.settings.switch_off_clearance,
             tabs,
+            edge_pierce,
         })
+    }
+
+    /// The border of the sheet when contour `r` may be pierced at it: edge piercing on, `r` a
+    /// part's outer contour in the sheet's own scrap (a root of the containment forest).
+    fn edge_border(&self, r: ContourRef) -> Option<&'a Contour> {
+        if self.forest.parent(r).is_some() || self.is_hole(r) {
+            return None;
+        }
+        self.nest.sheet.as_ref()?.contours.first()
+    }
+
+    /// An edge lead-in to `entry` of contour `r`: the straight line from the nearest point of
+    /// the sheet's border, when edge piercing is on, `r` may be pierced at the border, the line
+    /// is no longer than [`KerfSettings::edge_reach`] and it keeps kerf/2 from every contour.
+    fn edge_lead_in(&self, r: ContourRef, entry: Point) -> Option<Vec<Vertex>> {
+        if !self.settings.edge_pierce {
+            return None;
+        }
+        let at = self.edge_border(r)?.nearest_point(entry)?.point;
+        if !(at.distance(entry) <= self.settings.edge_reach()) {
+            return None;
+        }
+        let chain = vec![vertex(at), vertex(entry)];
+        // Linked: M is held to the border, not to G_M; the line to every contour's kerf.
+        self.chain_problem_linked(r, &chain, true, true)
+            .is_none()
+            .then_some(chain)
     }
 
     /// The first chain that breaks no rule, else the problem of the last one tried.
@@ -863,6 +929,7 @@ impl<'a> LeadFitter<'a> {
             pierce_clearance: self.settings.pierce_clearance,
             switch_off_clearance: self.settings.switch_off_clearance,
             tabs: Vec::new(),
+            edge_pierce: false,
         })
     }
 
@@ -1121,7 +1188,14 @@ impl<'a> LeadFitter<'a> {
         // variants included), so M lies within `lead_in` of P and M* within `lead_out` of it:
         // an entry whose legs cannot beat the best even so is not fitted (the result is the
         // same, the fits are the cost).
-        let lead_in = self.settings.lead_in.longest_chain();
+        let lead_in = if self.settings.edge_pierce {
+            self.settings
+                .lead_in
+                .longest_chain()
+                .max(self.settings.edge_reach())
+        } else {
+            self.settings.lead_in.longest_chain()
+        };
         let lead_out = self.settings.lead_out.longest_chain() + self.settings.overcut;
         let perimeter = eq.perimeter();
         let mut best = (legs(current), None);
@@ -1196,7 +1270,21 @@ impl<'a> LeadFitter<'a> {
                 distance: f64::NAN,
             }),
         }
-        problems.extend(self.chain_problem_linked(r, &leads.lead_in, true, linked_in));
+        // An edge pierce's M is on the sheet's border, outside G_M; its lead is held to the
+        // kerf like every other.
+        let edge = leads.edge_pierce && !linked_in;
+        if edge {
+            let on_border = self
+                .edge_border(r)
+                .is_some_and(|border| border.distance_to(leads.pierce) <= 1e-6);
+            if !on_border {
+                problems.push(LeadProblem::EdgePierceOffBorder {
+                    x: leads.pierce.x,
+                    y: leads.pierce.y,
+                });
+            }
+        }
+        problems.extend(self.chain_problem_linked(r, &leads.lead_in, true, linked_in || edge));
         problems.extend(self.chain_problem_linked(r, &leads.lead_out, false, linked_out));
         if !leads.tabs.is_empty() {
             problems.extend(self.tab_problems(r, leads));

@@ -128,6 +128,10 @@ pub struct MachineParameters {
     pub cut_price_per_metre: f64,
     /// Price of one pierce C_pt.
     pub pierce_price: f64,
+    /// Time of one pierce at the sheet's edge, s (`None`: the pierce time, so runs without
+    /// edge piercing, and old profiles, are unchanged).
+    #[serde(default)]
+    pub edge_pierce_time: Option<f64>,
 }
 
 impl Default for MachineParameters {
@@ -141,6 +145,7 @@ impl Default for MachineParameters {
             idle_price_per_metre: 0.1,
             cut_price_per_metre: 1.0,
             pierce_price: 0.5,
+            edge_pierce_time: None,
         }
     }
 }
@@ -151,6 +156,17 @@ impl MachineParameters {
         cut_length / self.cut_speed
             + idle_length / self.idle_speed
             + pierces as f64 * self.pierce_time
+    }
+
+    /// Time of one pierce at the sheet's edge, s: `edge_pierce_time`, else the pierce time.
+    pub fn edge_pierce_seconds(&self) -> f64 {
+        self.edge_pierce_time.unwrap_or(self.pierce_time)
+    }
+
+    /// Time of `pierces` pierces of which `edge` are at the sheet's edge, s.
+    pub fn pierce_seconds(&self, pierces: usize, edge: usize) -> f64 {
+        let edge = edge.min(pierces);
+        (pierces - edge) as f64 * self.pierce_time + edge as f64 * self.edge_pierce_seconds()
     }
 
     /// Cost `F = L_on·C_on + L_off·C_off + N·C_pt`, lengths in millimetres (prices per metre).
@@ -401,6 +417,15 @@ impl Route {
     pub fn pierce_count(&self) -> usize {
         self.steps.iter().filter(|s| s.is_pierced()).count()
             + self.steps.iter().map(|s| s.tabs().len()).sum::<usize>()
+    }
+
+    /// The pierces of [`Route::pierce_count`] made at the sheet's edge (edge-pierced steps;
+    /// the pierces after tabs are in the sheet).
+    pub fn edge_pierce_count(&self) -> usize {
+        self.steps
+            .iter()
+            .filter(|s| s.is_pierced() && s.leads.as_ref().is_some_and(|l| l.edge_pierce))
+            .count()
     }
 
     /// Total cut length: the perimeters of the contours cut (with leads: the equidistants,

@@ -18,6 +18,7 @@ fn settings(count: usize, width: f64) -> KerfSettings {
         lead_out: LeadSpec::new(LeadShape::Line, 2.0),
         overcut: 1.0,
         tabs: TabSpec { count, width },
+        edge_pierce: false,
     }
 }
 

@@ -231,17 +231,19 @@ impl SolverKind {
 
     /// Whether the solver has a full-route model (kerf, pierce regions, leads, tabs): nearest,
     /// ccp and heuristic route whole contours through pierce points, which the pierce curves
-    /// carry over, and chain runs over the equidistants with leads at its chains' ends. The
-    /// exact solver's bounds are about the idealised nest, so with leads it would prove
-    /// nothing; the path solvers (sccp, gsccp, aoe) cut pieces of contours, shared edges among
-    /// them, and have no full-route model yet.
+    /// carry over, and chain runs over the equidistants with leads at its chains' ends. Exact
+    /// searches the discretised full-route model (candidate entries with their leads, idle
+    /// legs from M* to the next M), so its bounds are about that model. The path solvers
+    /// (sccp, gsccp, aoe) cut pieces of contours, shared edges among them, and have no
+    /// full-route model yet.
     pub fn cuts_with_kerf(self) -> bool {
         match self {
             SolverKind::NearestNeighbour
             | SolverKind::Ccp
             | SolverKind::Heuristic
+            | SolverKind::Exact
             | SolverKind::Chain => true,
-            SolverKind::Exact | SolverKind::Sccp | SolverKind::Gsccp | SolverKind::Aoe => false,
+            SolverKind::Sccp | SolverKind::Gsccp | SolverKind::Aoe => false,
         }
     }
 
@@ -699,6 +701,7 @@ mod tests {
                 from: Point::new(0.0, 3.0),
                 to: Point::new(0.0, 4.5),
             }],
+            edge_pierce: true,
         });
         let route = Route {
             start: Point::default(),
@@ -736,6 +739,7 @@ mod tests {
                 count: 2,
                 width: 1.5,
             },
+            edge_pierce: true,
         };
         request.params.leads_after = true;
         let message = ToWorker::Start(request.clone());

@@ -80,6 +80,9 @@ pub enum ThermalNote {
 pub enum KerfSource {
     /// The solver's route over the pierce curves, leads fitted and moved along the equidistants.
     PierceCurves,
+    /// The exact solver's route over the discretised full-route model: candidate entries with
+    /// their leads fitted, idle legs from M* to the next M; its bounds are about that model.
+    FullRoute,
     /// The solver's idealised route with leads attached (and, unless asked for the plain
     /// "after" route, moved along the equidistants).
     Idealised,
@@ -359,6 +362,12 @@ impl fmt::Display for Phase {
                 KerfNote::Leads {
                     source: KerfSource::PierceCurves,
                 } => write!(f, "{base} · leads optimised over the pierce curves"),
+                KerfNote::Leads {
+                    source: KerfSource::FullRoute,
+                } => write!(
+                    f,
+                    "{base} · leads chosen among the full-route model's candidates"
+                ),
                 KerfNote::Leads {
                     source: KerfSource::Idealised,
                 } => write!(f, "{base} · leads attached to the idealised order"),

@@ -1,0 +1,248 @@
+//! The exact solver with kerf and leads (issue #17): it searches the discretised full-route
+//! model, its routes pass the independent checker, and its lower bound is below the route it
+//! reports and below the brute-force optimum of that model.
+
+use std::path::PathBuf;
+
+use cutroute_engine::{build_full_route_model, open_document, run_to_end, start_job};
+use cutroute_geometry::{
+    Contour, KerfSettings, LeadShape, LeadSpec, Nest, Part, Point, Route, TabSpec, Vertex,
+};
+use cutroute_pcgtsp::Instance;
+use cutroute_protocol::{
+    JobRequest, KerfNote, KerfSource, Phase, Problem, Progress, SolverKind, SolverParams,
+};
+
+fn nest_problem(relative: &str) -> Problem {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../data")
+        .join(relative);
+    let bytes = std::fs::read(&path).expect("test file");
+    open_document(relative, &bytes).expect("opens").problem
+}
+
+fn nest_of(problem: &Problem) -> &Nest {
+    match problem {
+        Problem::Nest { nest, .. } => nest,
+        Problem::PcgtspText { .. } => panic!("a nest"),
+    }
+}
+
+/// Kerf 2, d₁ 5, d₂ 1, an 8 mm arc lead-in and a 2 mm line lead-out (the issue's plasma).
+fn plasma() -> KerfSettings {
+    KerfSettings {
+        kerf: 2.0,
+        pierce_clearance: 5.0,
+        switch_off_clearance: 1.0,
+        lead_in: LeadSpec::new(LeadShape::Arc, 8.0),
+        lead_out: LeadSpec::new(LeadShape::Line, 2.0),
+        overcut: 0.0,
+        tabs: TabSpec::default(),
+        edge_pierce: false,
+    }
+}
+
+fn exact_request(problem: &Problem, step: f64, limit: f64) -> JobRequest {
+    JobRequest {
+        job_id: 3,
+        problem: problem.clone(),
+        solver: SolverKind::Exact,
+        params: SolverParams {
+            time_limit_s: limit,
+            kerf: plasma(),
+            discretisation_step_mm: step,
+            ..SolverParams::default()
+        },
+    }
+}
+
+/// Runs the job; every progress with a route has leads on each step, an upper bound equal to
+/// its idle length and no lower bound above it.
+fn run(request: &JobRequest) -> Progress {
+    let mut job = start_job(request).expect("starts");
+    run_to_end(job.as_mut(), &mut |p| {
+        if let Some(route) = p.route() {
+            assert!(route.steps.iter().all(|s| s.leads.is_some()));
+            assert_eq!(p.bounds.upper, Some(route.idle_length()));
+        }
+        if let (Some(lower), Some(upper)) = (p.bounds.lower, p.bounds.upper) {
+            assert!(lower <= upper, "lower bound {lower} > route {upper}");
+        }
+        assert!(matches!(p.phase, Phase::Kerf { .. }), "{:?}", p.phase);
+    })
+}
+
+fn checked(problem: &Problem, progress: &Progress) -> Route {
+    let nest = nest_of(problem);
+    let route = progress.route().cloned().expect("a route");
+    let problems = route.problems(nest, &nest.containment_forest(), 1e-6);
+    assert!(problems.is_empty(), "{:?}", problems.first());
+    assert!(route.steps.iter().all(|s| s.leads.is_some()));
+    route
+}
+
+fn square(x: f64, y: f64, side: f64) -> Contour {
+    Contour::new(vec![
+        Vertex::line(x, y),
+        Vertex::line(x, y + side),
+        Vertex::line(x + side, y + side),
+        Vertex::line(x + side, y),
+    ])
+}
+
+/// Four contours: a plate with a square hole (the hole first), a square and a disc.
+fn tiny_nest() -> Nest {
+    let mut nest = Nest {
+        sheet: None,
+        parts: vec![
+            Part {
+                name: "plate".into(),
+                contours: vec![square(0.0, 0.0, 80.0), square(25.0, 25.0, 30.0)],
+            },
+            Part {
+                name: "square".into(),
+                contours: vec![square(110.0, 0.0, 40.0)],
+            },
+            Part {
+                name: "disc".into(),
+                contours: vec![Contour::circle(Point::new(130.0, 90.0), 15.0, true)],
+            },
+        ],
+    };
+    nest.normalize_orientation();
+    nest
+}
+
+/// The optimum of a PCGTSP instance by dynamic programming over the sets of visited clusters
+/// (Held–Karp with precedence), independent of the solver's code.
+fn brute_force(instance: &Instance) -> f64 {
+    let clusters = instance.clusters.len() - 1; // cluster 0 is the depot
+    let bit = |c: usize| 1usize << (c - 1);
+    let mut before = vec![0usize; clusters + 1];
+    for &(a, b) in &instance.precedence {
+        before[b] |= bit(a);
+    }
+    let n = instance.node_count;
+    let full = (1usize << clusters) - 1;
+    let mut dp = vec![vec![f64::INFINITY; n]; full + 1];
+    for c in 1..=clusters {
+        if before[c] == 0 {
+            for &v in &instance.clusters[c] {
+                dp[bit(c)][v] = instance.arc_cost(0, v);
+            }
+        }
+    }
+    for mask in 1..=full {
+        for c in 1..=clusters {
+            if mask & bit(c) == 0 {
+                continue;
+            }
+            for &v in &instance.clusters[c] {
+                let here = dp[mask][v];
+                if !here.is_finite() {
+                    continue;
+                }
+                for d in 1..=clusters {
+                    if mask & bit(d) != 0 || before[d] & !mask != 0 {
+                        continue;
+                    }
+                    for &w in &instance.clusters[d] {
+                        let next = here + instance.arc_cost(v, w);
+                        let slot = &mut dp[mask | bit(d)][w];
+                        if next < *slot {
+                            *slot = next;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    (0..n)
+        .map(|v| dp[full][v] + instance.arc_cost(v, 0))
+        .fold(f64::INFINITY, f64::min)
+}
+
+#[test]
+fn exact_with_leads_is_bounded_by_the_brute_force_optimum_of_its_model() {
+    let nest = tiny_nest();
+    let problem = Problem::Nest {
+        nest: nest.clone(),
+        start: Point::new(-10.0, -10.0),
+        finish: None,
+    };
+    let step = 40.0;
+    let model = build_full_route_model(&nest, plasma(), step, Point::new(-10.0, -10.0), None)
+        .expect("a valid step")
+        .expect("every contour has room");
+    assert!(
+        model.instance.node_count > 4 * 4,
+        "several candidates per contour"
+    );
+    // The hole before its plate.
+    assert!(!model.instance.precedence.is_empty());
+    let optimum = brute_force(&model.instance);
+    assert!(optimum.is_finite());
+    let progress = run(&exact_request(&problem, step, 10.0));
+    let route = checked(&problem, &progress);
+    let lower = progress.bounds.lower.expect("a lower bound");
+    // The route is a tour of the model: never below its optimum; the bound never above it.
+    assert!(route.idle_length() >= optimum - 1e-6);
+    assert!(lower <= optimum + 1e-9, "bound {lower} > optimum {optimum}");
+    assert!(lower <= route.idle_length());
+    // Four contours are proven within the limit, and then the route is the optimum.
+    assert!(progress.proven_optimal, "{:?}", progress.phase);
+    assert!((route.idle_length() - optimum).abs() < 1e-6);
+    assert!(matches!(
+        progress.phase,
+        Phase::Kerf {
+            note: KerfNote::Leads {
+                source: KerfSource::FullRoute
+            },
+            ..
+        }
+    ));
+}
+
+#[test]
+fn exact_with_leads_gives_checked_routes_on_small_nests() {
+    for file in ["nests/dbs-json/E1X_6_01.dbs.json", "nests/dbs/seven.dbs"] {
+        let problem = nest_problem(file);
+        // Time for a bound on a loaded machine (the exact search's share of the slices).
+        let progress = run(&exact_request(&problem, 50.0, 10.0));
+        let route = checked(&problem, &progress);
+        assert_eq!(
+            route.steps.len(),
+            nest_of(&problem).contour_count(),
+            "{file}"
+        );
+        let lower = progress.bounds.lower.expect("a lower bound");
+        assert!(lower <= route.idle_length(), "{file}");
+    }
+}
+
+#[test]
+fn exact_with_leads_names_contours_without_room() {
+    // ring.dbs: a 4 mm ring, no room inside for an 8 mm lead-in at kerf 2 and d₁ 5.
+    let problem = nest_problem("nests/dbs/ring.dbs");
+    let progress = run(&exact_request(&problem, 50.0, 2.0));
+    assert!(progress.route().is_none());
+    assert!(
+        matches!(
+            &progress.phase,
+            Phase::Kerf {
+                note: KerfNote::NoRoom { contours, .. },
+                ..
+            } if !contours.is_empty()
+        ),
+        "{:?}",
+        progress.phase
+    );
+}
+
+#[test]
+fn exact_with_leads_refuses_a_heat_penalty() {
+    let problem = nest_problem("nests/dbs-json/E1X_6_01.dbs.json");
+    let mut request = exact_request(&problem, 50.0, 1.0);
+    request.params.thermal.weight = 1.0;
+    assert!(start_job(&request).is_err());
+}
