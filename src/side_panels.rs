@@ -10,7 +10,7 @@ use crate::job_status::JobStatusList;
 use crate::settings::Layer;
 use crate::state::{Page, ViewSettings};
 use crate::stats::{AlternativesTable, StatsPanel};
-use crate::thermal::{ThermalPanel, ThermalStats, ThermalView};
+use crate::thermal::{ThermalPanel, ThermalStats};
 
 /// The aside beside the drawing.
 #[component]
@@ -18,7 +18,6 @@ pub fn SidePanels() -> impl IntoView {
     let page = expect_context::<Page>();
     let (job, shown, machine) = (page.job, page.shown, page.machine);
     let language = use_language();
-    let thermal_view = expect_context::<ThermalView>();
     let alternatives = Signal::derive(move || {
         job.progress.with(|p| {
             p.as_ref()
@@ -32,7 +31,7 @@ pub fn SidePanels() -> impl IntoView {
             <JobStatusList />
             <StatsPanel nest=shown.nest route=shown.route paths=shown.paths machine=machine.machine />
             <crate::kerf::LeadStats route=shown.route />
-            <crate::profiles::ProfilesPanel machine=machine.machine kerf=machine.kerf choice=machine.gcode />
+            <crate::profiles::ProfilesPanel />
             <crate::kerf::KerfPanel settings=machine.kerf />
             <ThermalPanel settings=machine.thermal />
             <ThermalStats progress=job.progress />
@@ -44,12 +43,7 @@ pub fn SidePanels() -> impl IntoView {
             />
             <LayerPanel />
             <crate::legend::DrawingLegend />
-            <ComparePanel
-                kept=page.document.kept
-                keep=move |_| page.keep(thermal_view)
-                can_keep=Signal::derive(move || shown.has_route())
-                objective=Signal::from(page.solver.objective)
-            />
+            <ComparePanel />
         </aside>
     }
 }

@@ -6,15 +6,13 @@ use leptos::prelude::*;
 use crate::app::SAMPLES;
 use crate::export::ExportMenu;
 use crate::i18n::tr;
-use crate::state::{DocumentState, MachineSettings, Page, Shown, ViewSettings};
+use crate::state::{DocumentState, Page, ViewSettings};
 
 /// The page's header.
 #[component]
 pub fn Toolbar(initial_sample: String, lecture_url: String) -> impl IntoView {
     let page = expect_context::<Page>();
     let document = page.document;
-    let shown = expect_context::<Shown>();
-    let machine = expect_context::<MachineSettings>();
     view! {
         <header class="toolbar">
             <h1>"cutroute"</h1>
@@ -24,15 +22,7 @@ pub fn Toolbar(initial_sample: String, lecture_url: String) -> impl IntoView {
                 document=document.document
                 open=Callback::new(move |sheet| document.open_sheet(sheet))
             />
-            <ExportMenu
-                file_name=Signal::derive(move || document.file_name())
-                nest=shown.nest
-                route=shown.route
-                paths=shown.paths
-                toolpath=shown.toolpath
-                machine=machine.machine
-                choice=machine.gcode
-            />
+            <ExportMenu />
             <crate::gallery::LectureGallery
                 list_url=lecture_url
                 pick=Callback::new(move |(url, query): (String, String)| page.pick_lecture(url, &query))
