@@ -281,16 +281,56 @@ pub fn format_clock(seconds: f64) -> String {
 #[component]
 pub fn AnimationControls(animation: Animation) -> impl IntoView {
     let Animation {
+        timeline, playing, ..
+    } = animation;
+    let absent = move || timeline.with(Option::is_none);
+    let language = use_language();
+    let play_pause = move || {
+        if playing.get() {
+            language.pick("Pause", "Пауза")
+        } else {
+            language.pick("Play", "Пуск анимации")
+        }
+    };
+    view! {
+        <div class="animation" role="group" aria-label=tr("Animation of the route", "Анимация маршрута")>
+            <StepButton animation=animation forward=false />
+            <button
+                id="anim-play"
+                aria-label=play_pause
+                title=play_pause
+                disabled=absent
+                on:click=move |_| animation.toggle()
+            >
+                {play_pause}
+            </button>
+            <StepButton animation=animation forward=true />
+            <TimeControls animation=animation />
+            <ContourCounter animation=animation />
+        </div>
+    }
+}
+
+/// The piece ("contour" or "path") in the page's language; both are masculine in Russian.
+fn piece_word(lang: Lang, piece: &'static str) -> &'static str {
+    match (lang, piece) {
+        (Lang::En, p) => p,
+        (Lang::Ru, "path") => "путь",
+        (Lang::Ru, _) => "контур",
+    }
+}
+
+/// The button to the previous or the next pierce.
+#[component]
+fn StepButton(animation: Animation, forward: bool) -> impl IntoView {
+    let Animation {
         timeline,
         time,
-        playing,
-        speed,
         piece,
+        ..
     } = animation;
-    let total = move || timeline.with(|t| t.as_ref().map_or(0.0, Timeline::total));
-    let shown = move || time.get().unwrap_or(0.0);
-    let absent = move || timeline.with(Option::is_none);
-    let step = move |forward: bool| {
+    let language = use_language();
+    let step = move || {
         let t = time.get_untracked().unwrap_or(0.0);
         let target = timeline.with_untracked(|tl| {
             tl.as_ref().map(|tl| {
@@ -305,124 +345,121 @@ pub fn AnimationControls(animation: Animation) -> impl IntoView {
             animation.seek(target);
         }
     };
-    let language = use_language();
-    // The piece ("contour" or "path") in the page's language; both are masculine in Russian.
-    let piece_word = move || match (language.get(), piece.get()) {
-        (Lang::En, p) => p,
-        (Lang::Ru, "path") => "путь",
-        (Lang::Ru, _) => "контур",
+    let name = move || match (language.get(), forward) {
+        (Lang::En, false) => format!("Previous {}", piece.get()),
+        (Lang::En, true) => format!("Next {}", piece.get()),
+        (Lang::Ru, false) => format!("Предыдущий {}", piece_word(Lang::Ru, piece.get())),
+        (Lang::Ru, true) => format!("Следующий {}", piece_word(Lang::Ru, piece.get())),
     };
+    let (id, text) = if forward {
+        ("anim-next", tr("Next ›", "Вперёд ›"))
+    } else {
+        ("anim-prev", tr("‹ Prev", "‹ Назад"))
+    };
+    view! {
+        <button
+            id=id
+            title=name
+            aria-label=name
+            disabled=move || timeline.with(Option::is_none)
+            on:click=move |_| step()
+        >
+            {text}
+        </button>
+    }
+}
+
+/// The machine-time slider, the speed and the clock.
+#[component]
+fn TimeControls(animation: Animation) -> impl IntoView {
+    let Animation {
+        timeline,
+        time,
+        speed,
+        ..
+    } = animation;
+    let total = move || timeline.with(|t| t.as_ref().map_or(0.0, Timeline::total));
+    let shown = move || time.get().unwrap_or(0.0);
+    view! {
+        <label class="scrub">
+            <span class="visually-hidden">{tr("Machine time", "Время работы станка")}</span>
+            <input
+                id="anim-scrub"
+                type="range"
+                min="0"
+                step="any"
+                aria-label=tr("Machine time", "Время работы станка")
+                disabled=move || timeline.with(Option::is_none)
+                max=move || total().to_string()
+                prop:value=move || shown().to_string()
+                on:input=move |ev| {
+                    if let Ok(v) = event_target_value(&ev).parse::<f64>() {
+                        animation.seek(v);
+                    }
+                }
+            />
+        </label>
+        <label>
+            {tr("Speed ", "Скорость ")}
+            <select
+                id="anim-speed"
+                aria-label=tr("Animation speed (machine time)", "Скорость анимации (по времени станка)")
+                prop:value=move || speed.get().to_string()
+                on:change=move |ev| {
+                    if let Ok(v) = event_target_value(&ev).parse::<u32>() {
+                        speed.set(v);
+                    }
+                }
+            >
+                {SPEEDS
+                    .iter()
+                    .map(|s| {
+                        view! {
+                            <option value=s.to_string() selected=*s == DEFAULT_SPEED>
+                                {format!("×{s}")}
+                            </option>
+                        }
+                    })
+                    .collect_view()}
+            </select>
+        </label>
+        <output
+            id="anim-clock"
+            aria-label=tr("Machine time", "Время работы станка")
+            data-time=move || format!("{:.3}", shown())
+            data-total=move || format!("{:.3}", total())
+        >
+            {move || format!("{} / {}", format_clock(shown()), format_clock(total()))}
+        </output>
+    }
+}
+
+/// Which contour (or tool-on path) the head is at, of how many.
+#[component]
+fn ContourCounter(animation: Animation) -> impl IntoView {
+    let Animation {
+        timeline,
+        time,
+        piece,
+        ..
+    } = animation;
+    let language = use_language();
     let contour_text = move || {
         let t = time.get()?;
-        let of = language.pick("of", "из");
+        let lang = language.get();
+        let of = lang.pick("of", "из");
         timeline.with(|tl| {
             tl.as_ref().map(|tl| {
                 format!(
                     "{} {} {of} {}",
-                    piece_word(),
+                    piece_word(lang, piece.get()),
                     tl.contours_begun(t),
                     tl.pierces.len()
                 )
             })
         })
     };
-    let previous = move || match language.get() {
-        Lang::En => format!("Previous {}", piece.get()),
-        Lang::Ru => format!("Предыдущий {}", piece_word()),
-    };
-    let next = move || match language.get() {
-        Lang::En => format!("Next {}", piece.get()),
-        Lang::Ru => format!("Следующий {}", piece_word()),
-    };
-    let play_pause = move || {
-        if playing.get() {
-            language.pick("Pause", "Пауза")
-        } else {
-            language.pick("Play", "Пуск анимации")
-        }
-    };
-    view! {
-        <div class="animation" role="group" aria-label=tr("Animation of the route", "Анимация маршрута")>
-            <button
-                id="anim-prev"
-                title=previous
-                aria-label=previous
-                disabled=absent
-                on:click=move |_| step(false)
-            >
-                {tr("‹ Prev", "‹ Назад")}
-            </button>
-            <button
-                id="anim-play"
-                aria-label=play_pause
-                title=play_pause
-                disabled=absent
-                on:click=move |_| animation.toggle()
-            >
-                {play_pause}
-            </button>
-            <button
-                id="anim-next"
-                title=next
-                aria-label=next
-                disabled=absent
-                on:click=move |_| step(true)
-            >
-                {tr("Next ›", "Вперёд ›")}
-            </button>
-            <label class="scrub">
-                <span class="visually-hidden">{tr("Machine time", "Время работы станка")}</span>
-                <input
-                    id="anim-scrub"
-                    type="range"
-                    min="0"
-                    step="any"
-                    aria-label=tr("Machine time", "Время работы станка")
-                    disabled=absent
-                    max=move || total().to_string()
-                    prop:value=move || shown().to_string()
-                    on:input=move |ev| {
-                        if let Ok(v) = event_target_value(&ev).parse::<f64>() {
-                            animation.seek(v);
-                        }
-                    }
-                />
-            </label>
-            <label>
-                {tr("Speed ", "Скорость ")}
-                <select
-                    id="anim-speed"
-                    aria-label=tr("Animation speed (machine time)", "Скорость анимации (по времени станка)")
-                    prop:value=move || speed.get().to_string()
-                    on:change=move |ev| {
-                        if let Ok(v) = event_target_value(&ev).parse::<u32>() {
-                            speed.set(v);
-                        }
-                    }
-                >
-                    {SPEEDS
-                        .iter()
-                        .map(|s| {
-                            view! {
-                                <option value=s.to_string() selected=*s == DEFAULT_SPEED>
-                                    {format!("×{s}")}
-                                </option>
-                            }
-                        })
-                        .collect_view()}
-                </select>
-            </label>
-            <output
-                id="anim-clock"
-                aria-label=tr("Machine time", "Время работы станка")
-                data-time=move || format!("{:.3}", shown())
-                data-total=move || format!("{:.3}", total())
-            >
-                {move || format!("{} / {}", format_clock(shown()), format_clock(total()))}
-            </output>
-            <span id="anim-contour" class="muted">{contour_text}</span>
-        </div>
-    }
+    view! { <span id="anim-contour" class="muted">{contour_text}</span> }
 }
 
 /// The travelled route and the tool head, in an `<svg>` of their own stacked on the view (same

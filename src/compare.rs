@@ -8,7 +8,9 @@ use leptos::prelude::*;
 
 use crate::drawing::{idle_path, path_route_idle_path};
 use crate::i18n::{tr, use_language, Lang};
+use crate::state::Page;
 use crate::stats::{path_route_figures, route_figures, Figures};
+use crate::thermal::ThermalView;
 
 /// A kept result.
 #[derive(Clone, Debug, PartialEq)]
@@ -98,21 +100,19 @@ impl Kept {
 
 /// The list of kept results with a Keep button.
 #[component]
-pub fn ComparePanel(
-    kept: RwSignal<Vec<Kept>>,
-    keep: impl Fn(web_sys::MouseEvent) + 'static,
-    can_keep: Signal<bool>,
-    objective: Signal<Objective>,
-) -> impl IntoView {
-    let language = use_language();
-    let best = move || {
+pub fn ComparePanel() -> impl IntoView {
+    let page = expect_context::<Page>();
+    let thermal = expect_context::<ThermalView>();
+    let kept = page.document.kept;
+    let objective = page.solver.objective;
+    let best = Signal::derive(move || {
         let objective = objective.get();
         kept.with(|k| {
             k.iter()
                 .map(|e| e.value(objective))
                 .fold(f64::INFINITY, f64::min)
         })
-    };
+    });
     view! {
         <section class="compare" aria-label=tr("Compare results", "Сравнение результатов")>
             <h2>{tr("Compare", "Сравнение")}</h2>
@@ -122,8 +122,8 @@ pub fn ComparePanel(
                     "Keep the route shown to compare it with later ones",
                     "Сохранить показанный маршрут, чтобы сравнить его с последующими",
                 )
-                disabled=move || !can_keep.get()
-                on:click=keep
+                disabled=move || !page.shown.has_route()
+                on:click=move |_| page.keep(thermal)
             >
                 {tr("Keep this result", "Сохранить результат")}
             </button>
@@ -135,82 +135,102 @@ pub fn ComparePanel(
                 {tr("Clear", "Очистить")}
             </button>
             <table id="compare-table">
-                <thead>
-                    <tr>
-                        <th scope="col">"#"</th>
-                        <th scope="col">{tr("Solver", "Решатель")}</th>
-                        <th scope="col">{tr("Idle, mm", "Хол. ход, мм")}</th>
-                        <th scope="col" id="compare-by">{move || match language.get() {
-                            Lang::En => format!("vs best ({})", objective.get().name()),
-                            Lang::Ru => format!(
-                                "к лучшему ({})",
-                                match objective.get() {
-                                    Objective::Time => "время",
-                                    Objective::Cost => "стоимость",
-                                }
-                            ),
-                        }}</th>
-                        <th scope="col">{tr("Time, s", "Время, с")}</th>
-                        <th scope="col">{tr("Cost", "Стоимость")}</th>
-                        <th scope="col" title=tr("Thermal load H under the heat panel's σ and τ", "Тепловая нагрузка H при σ и τ из тепловой панели")>"H"</th>
-                        <th scope="col">{tr("Pierces", "Врезки")}</th>
-                        <th scope="col">{tr("Overlay", "Наложить")}</th>
-                    </tr>
-                </thead>
+                <CompareHead objective=objective />
                 <tbody>
                     <For
                         each=move || kept.get()
                         key=|e| (e.id, e.overlay)
-                        children=move |e: Kept| {
-                            let id = e.id;
-                            let (time_s, cost) = (e.time_s, e.cost);
-                            let value = move || match objective.get() {
-                                Objective::Time => time_s,
-                                Objective::Cost => cost,
-                            };
-                            let excess = move || {
-                                let b = best();
-                                if b > 0.0 {
-                                    format!("+{:.1} %", (value() / b - 1.0) * 100.0)
-                                } else {
-                                    "—".into()
-                                }
-                            };
-                            view! {
-                                <tr class="kept" data-id=id>
-                                    <td>{id}</td>
-                                    <td>{tr(e.label.0, e.label.1)}</td>
-                                    <td class="kept-idle">{format!("{:.1}", e.idle_length)}</td>
-                                    <td>{excess}</td>
-                                    <td class="kept-time">{format!("{:.1}", e.time_s)}</td>
-                                    <td class="kept-cost">{format!("{:.2}", e.cost)}</td>
-                                    <td class="kept-heat">{e.heat.map_or_else(|| "—".into(), |h| format!("{h:.4}"))}</td>
-                                    <td class="kept-pierces">{e.pierces}</td>
-                                    <td>
-                                        <input
-                                            type="checkbox"
-                                            class="kept-overlay"
-                                            aria-label=move || match language.get() {
-                                                Lang::En => format!("Overlay result {id} on the drawing"),
-                                                Lang::Ru => format!("Наложить результат {id} на чертёж"),
-                                            }
-                                            prop:checked=e.overlay
-                                            on:change=move |ev| {
-                                                let on = event_target_checked(&ev);
-                                                kept.update(|k| {
-                                                    if let Some(x) = k.iter_mut().find(|x| x.id == id) {
-                                                        x.overlay = on;
-                                                    }
-                                                });
-                                            }
-                                        />
-                                    </td>
-                                </tr>
-                            }
-                        }
+                        children=move |entry: Kept| view! { <KeptRow entry=entry kept=kept objective=objective best=best /> }
                     />
                 </tbody>
             </table>
         </section>
+    }
+}
+
+/// The table's head; the column of excess names the objective.
+#[component]
+fn CompareHead(objective: RwSignal<Objective>) -> impl IntoView {
+    let language = use_language();
+    view! {
+        <thead>
+            <tr>
+                <th scope="col">"#"</th>
+                <th scope="col">{tr("Solver", "Решатель")}</th>
+                <th scope="col">{tr("Idle, mm", "Хол. ход, мм")}</th>
+                <th scope="col" id="compare-by">{move || match language.get() {
+                    Lang::En => format!("vs best ({})", objective.get().name()),
+                    Lang::Ru => format!(
+                        "к лучшему ({})",
+                        match objective.get() {
+                            Objective::Time => "время",
+                            Objective::Cost => "стоимость",
+                        }
+                    ),
+                }}</th>
+                <th scope="col">{tr("Time, s", "Время, с")}</th>
+                <th scope="col">{tr("Cost", "Стоимость")}</th>
+                <th scope="col" title=tr("Thermal load H under the heat panel's σ and τ", "Тепловая нагрузка H при σ и τ из тепловой панели")>"H"</th>
+                <th scope="col">{tr("Pierces", "Врезки")}</th>
+                <th scope="col">{tr("Overlay", "Наложить")}</th>
+            </tr>
+        </thead>
+    }
+}
+
+/// A kept result's row: its figures, how far it is above the best, and its overlay switch.
+#[component]
+fn KeptRow(
+    entry: Kept,
+    kept: RwSignal<Vec<Kept>>,
+    objective: RwSignal<Objective>,
+    best: Signal<f64>,
+) -> impl IntoView {
+    let language = use_language();
+    let e = entry;
+    let id = e.id;
+    let (time_s, cost) = (e.time_s, e.cost);
+    let value = move || match objective.get() {
+        Objective::Time => time_s,
+        Objective::Cost => cost,
+    };
+    let excess = move || {
+        let b = best.get();
+        if b > 0.0 {
+            format!("+{:.1} %", (value() / b - 1.0) * 100.0)
+        } else {
+            "—".into()
+        }
+    };
+    view! {
+        <tr class="kept" data-id=id>
+            <td>{id}</td>
+            <td>{tr(e.label.0, e.label.1)}</td>
+            <td class="kept-idle">{format!("{:.1}", e.idle_length)}</td>
+            <td>{excess}</td>
+            <td class="kept-time">{format!("{:.1}", e.time_s)}</td>
+            <td class="kept-cost">{format!("{:.2}", e.cost)}</td>
+            <td class="kept-heat">{e.heat.map_or_else(|| "—".into(), |h| format!("{h:.4}"))}</td>
+            <td class="kept-pierces">{e.pierces}</td>
+            <td>
+                <input
+                    type="checkbox"
+                    class="kept-overlay"
+                    aria-label=move || match language.get() {
+                        Lang::En => format!("Overlay result {id} on the drawing"),
+                        Lang::Ru => format!("Наложить результат {id} на чертёж"),
+                    }
+                    prop:checked=e.overlay
+                    on:change=move |ev| {
+                        let on = event_target_checked(&ev);
+                        kept.update(|k| {
+                            if let Some(x) = k.iter_mut().find(|x| x.id == id) {
+                                x.overlay = on;
+                            }
+                        });
+                    }
+                />
+            </td>
+        </tr>
     }
 }

@@ -24,6 +24,7 @@ use leptos::prelude::*;
 use wasm_bindgen::JsCast;
 
 use crate::i18n::{tr, use_language, Lang};
+use crate::state::{DocumentState, MachineSettings, Shown};
 
 /// Styles inlined into an exported SVG so it looks like the view without the page's CSS.
 const SVG_STYLE: &str = ".sheet{fill:#e9e6df;stroke:#6b6b70}.part{fill:#c9d6e8;fill-rule:evenodd;stroke:#2b4a73}\
@@ -301,9 +302,9 @@ pub fn save(download: &Download) -> Result<(), String> {
 /// A saved file's name, or why the export failed (in English: the writers' words).
 type ExportOutcome = Result<String, String>;
 
-/// The export menu for the nest and route shown.
-#[component]
-pub fn ExportMenu(
+/// What the export menu exports (the nest and route shown) and what it said last.
+#[derive(Clone, Copy)]
+struct Exports {
     file_name: Signal<Option<String>>,
     nest: Signal<Option<Nest>>,
     route: Signal<Option<Route>>,
@@ -312,228 +313,120 @@ pub fn ExportMenu(
     machine: RwSignal<MachineParameters>,
     /// The G-code panel's choice, shared with the machine profiles (`profiles.rs`).
     choice: RwSignal<GcodeChoice>,
-) -> impl IntoView {
-    let language = use_language();
-    let message = RwSignal::new(None::<ExportOutcome>);
-    let run = move |make: Exporter| {
-        let Some(nest) = nest.get_untracked() else {
+    /// The last file saved, or why the export failed.
+    message: RwSignal<Option<ExportOutcome>>,
+    /// The first lines of the G-code.
+    preview: RwSignal<String>,
+}
+
+impl Exports {
+    /// The shown nest and route, from context.
+    fn new() -> Self {
+        let shown = expect_context::<Shown>();
+        let document = expect_context::<DocumentState>();
+        let machine = expect_context::<MachineSettings>();
+        Self {
+            file_name: Signal::derive(move || document.file_name()),
+            nest: shown.nest,
+            route: shown.route,
+            paths: shown.paths,
+            toolpath: shown.toolpath,
+            machine: machine.machine,
+            choice: machine.gcode,
+            message: RwSignal::new(None),
+            preview: RwSignal::new(String::new()),
+        }
+    }
+
+    fn stem(&self) -> String {
+        stem(&self.file_name.get_untracked().unwrap_or_default())
+    }
+
+    /// Saves what `make` writes of the nest and route.
+    fn run(&self, make: Exporter) {
+        let Some(nest) = self.nest.get_untracked() else {
             return;
         };
-        let stem = stem(&file_name.get_untracked().unwrap_or_default());
-        let route = route.get_untracked();
-        let outcome = make(&stem, &nest, route.as_ref()).and_then(|d| {
+        let route = self.route.get_untracked();
+        let outcome = make(&self.stem(), &nest, route.as_ref()).and_then(|d| {
             save(&d)?;
             Ok(d.name)
         });
-        message.set(Some(outcome));
-    };
-    let no_nest = move || nest.with(Option::is_none);
-    let no_route = move || route.with(Option::is_none) && paths.with(Option::is_none);
-    let is_paths = move || paths.with(Option::is_some);
-    let preview = RwSignal::new(String::new());
-    let make_gcode = move || -> Result<Download, String> {
-        let nest = nest.get_untracked().ok_or("no nest")?;
-        let route = route.get_untracked();
-        let paths = paths.get_untracked();
-        let options = machine.with_untracked(|m| choice.with_untracked(|c| c.options(m)));
+        self.message.set(Some(outcome));
+    }
+
+    fn no_nest(&self) -> bool {
+        self.nest.with(Option::is_none)
+    }
+
+    fn no_route(&self) -> bool {
+        self.route.with(Option::is_none) && self.paths.with(Option::is_none)
+    }
+
+    fn is_paths(&self) -> bool {
+        self.paths.with(Option::is_some)
+    }
+
+    /// The G-code program of the route shown, as the panel sets it.
+    fn gcode(&self) -> Result<Download, String> {
+        let nest = self.nest.get_untracked().ok_or("no nest")?;
+        let route = self.route.get_untracked();
+        let paths = self.paths.get_untracked();
+        let choice = self.choice;
+        let options = self
+            .machine
+            .with_untracked(|m| choice.with_untracked(|c| c.options(m)));
         gcode(
-            &stem(&file_name.get_untracked().unwrap_or_default()),
+            &self.stem(),
             &nest,
             route.as_ref(),
             paths.as_ref(),
             &options,
         )
-    };
-    let show_preview = move || match make_gcode() {
-        Ok(d) => preview.set(
-            String::from_utf8_lossy(&d.bytes)
-                .lines()
-                .take(PREVIEW_LINES)
-                .collect::<Vec<_>>()
-                .join("\n"),
-        ),
-        Err(e) => preview.set(format!(
-            "{}: {e}",
-            language.get_untracked().pick("no G-code", "G-кода нет")
-        )),
-    };
+    }
+
+    fn show_preview(&self, lang: Lang) {
+        match self.gcode() {
+            Ok(d) => self.preview.set(
+                String::from_utf8_lossy(&d.bytes)
+                    .lines()
+                    .take(PREVIEW_LINES)
+                    .collect::<Vec<_>>()
+                    .join("\n"),
+            ),
+            Err(e) => self
+                .preview
+                .set(format!("{}: {e}", lang.pick("no G-code", "G-кода нет"))),
+        }
+    }
+
+    /// Saves the G-code program, previewing it.
+    fn save_gcode(&self, lang: Lang) {
+        self.show_preview(lang);
+        let outcome = self.gcode().and_then(|d| {
+            save(&d)?;
+            Ok(d.name)
+        });
+        self.message.set(Some(outcome));
+    }
+}
+
+/// The export menu for the nest and route shown.
+#[component]
+pub fn ExportMenu() -> impl IntoView {
+    let language = use_language();
+    let exports = Exports::new();
     view! {
         <details class="export">
             <summary>{tr("Export", "Экспорт")}</summary>
-            <div class="export-buttons" role="group" aria-label=tr("Export", "Экспорт")>
-                <button
-                    id="export-result"
-                    title=move || {
-                        if is_paths() {
-                            language.pick(RESULT_JSON_CANNOT_HOLD_PATHS, RESULT_JSON_CANNOT_HOLD_PATHS_RU)
-                        } else {
-                            language.pick(
-                                "The route in RouteManager's result format (rm-result.json)",
-                                "Маршрут в формате результата RouteManager (rm-result.json)",
-                            )
-                        }
-                    }
-                    disabled=move || route.with(Option::is_none)
-                    on:click=move |_| {
-                        run(&|stem, nest, route| {
-                            let route = route.ok_or("no route yet")?;
-                            machine.with_untracked(|m| result_json(stem, nest, route, m))
-                        })
-                    }
-                >
-                    {tr("Result JSON", "JSON результата")}
-                </button>
-                <button
-                    id="export-geometry"
-                    title=tr("The nest as geometry JSON (dbs.json)", "Раскрой в JSON геометрии (dbs.json)")
-                    disabled=no_nest
-                    on:click=move |_| run(&|stem, nest, _| geometry_json(stem, nest))
-                >
-                    {tr("Geometry JSON", "JSON геометрии")}
-                </button>
-                <button
-                    id="export-dbs"
-                    title=tr("The nest as binary DBS", "Раскрой в двоичном формате DBS")
-                    disabled=no_nest
-                    on:click=move |_| run(&|stem, nest, _| dbs(stem, nest))
-                >
-                    "DBS"
-                </button>
-                <button
-                    id="export-svg"
-                    title=tr("The drawing as shown (current zoom and layers)", "Чертёж как на экране (текущий масштаб и слои)")
-                    disabled=no_nest
-                    on:click=move |_| run(&|stem, _, _| current_view_svg(stem, "nest-view"))
-                >
-                    {tr("SVG of the view", "SVG вида")}
-                </button>
-                <button
-                    id="export-html"
-                    title=tr(
-                        "A single HTML file that shows and animates the route, no server needed",
-                        "Один HTML-файл, который показывает и анимирует маршрут, без сервера",
-                    )
-                    disabled=no_route
-                    on:click=move |_| {
-                        run(&|stem, nest, route| {
-                            if let (Some(p), Some(t)) = (paths.get_untracked(), toolpath.get_untracked()) {
-                                return Ok(machine.with_untracked(|m| standalone_html_of_paths(stem, nest, &p, &t, m)));
-                            }
-                            let route = route.ok_or("no route yet")?;
-                            machine.with_untracked(|m| standalone_html(stem, nest, route, m))
-                        })
-                    }
-                >
-                    {tr("Standalone HTML", "Отдельная HTML-страница")}
-                </button>
-            </div>
+            <FileExportButtons exports=exports />
             {move || {
-                is_paths()
+                exports.is_paths()
                     .then(|| view! { <p id="export-result-note" class="note">{tr(RESULT_JSON_CANNOT_HOLD_PATHS, RESULT_JSON_CANNOT_HOLD_PATHS_RU)}</p> })
             }}
-            <fieldset class="gcode">
-                <legend>{tr("G-code", "G-код")}</legend>
-                <crate::profiles::PresetPicker choice=choice machine=machine />
-                <label title=tr(
-                    "G90: positions; G91: increments from the previous point",
-                    "G90: абсолютные координаты; G91: приращения от предыдущей точки",
-                )>
-                    {tr("Coordinates ", "Координаты ")}
-                    <select
-                        id="gcode-distance"
-                        prop:value=move || if choice.with(|c| c.incremental) { "incremental" } else { "absolute" }
-                        on:change=move |ev| {
-                            let incremental = event_target_value(&ev) == "incremental";
-                            choice.update(|c| c.incremental = incremental);
-                        }
-                    >
-                        <option value="absolute">{tr("absolute (G90)", "абсолютные (G90)")}</option>
-                        <option value="incremental">{tr("incremental (G91)", "в приращениях (G91)")}</option>
-                    </select>
-                </label>
-                <label title=tr("How arcs are written", "Как записываются дуги")>
-                    {tr("Arcs ", "Дуги ")}
-                    <select
-                        id="gcode-arcs"
-                        prop:value=move || choice.with(|c| c.arcs.clone())
-                        on:change=move |ev| {
-                            let arcs = event_target_value(&ev);
-                            choice.update(|c| c.arcs = arcs);
-                        }
-                    >
-                        <option value="ij">{tr("G02/G03 with I, J", "G02/G03 с I, J")}</option>
-                        <option value="r">{tr("G02/G03 with R", "G02/G03 с R")}</option>
-                        <option value="lines">{tr("G01 chords only", "только хорды G01")}</option>
-                    </select>
-                </label>
-                <label title=tr("Line that switches the torch on", "Строка включения резака")>
-                    {tr("Torch on ", "Включение резака ")}
-                    <input
-                        id="gcode-torch-on"
-                        type="text"
-                        size="8"
-                        prop:value=move || choice.with(|c| c.torch_on.clone())
-                        on:change=move |ev| {
-                            let v = event_target_value(&ev);
-                            choice.update(|c| c.torch_on = v);
-                        }
-                    />
-                </label>
-                <label title=tr("Line that switches the torch off", "Строка выключения резака")>
-                    {tr("Torch off ", "Выключение резака ")}
-                    <input
-                        id="gcode-torch-off"
-                        type="text"
-                        size="8"
-                        prop:value=move || choice.with(|c| c.torch_off.clone())
-                        on:change=move |ev| {
-                            let v = event_target_value(&ev);
-                            choice.update(|c| c.torch_off = v);
-                        }
-                    />
-                </label>
-                <label title=tr(
-                    "Dwell after the torch is switched on (G04), seconds",
-                    "Выдержка после включения резака (G04), секунды",
-                )>
-                    {tr("Pierce dwell, s ", "Выдержка на врезку, с ")}
-                    <input
-                        id="gcode-dwell"
-                        type="number"
-                        min="0"
-                        step="any"
-                        prop:value=move || choice.with(|c| c.dwell_s.to_string())
-                        on:change=move |ev| {
-                            if let Ok(v) = event_target_value(&ev).parse::<f64>() {
-                                if v >= 0.0 && v.is_finite() {
-                                    choice.update(|c| c.dwell_s = v);
-                                }
-                            }
-                        }
-                    />
-                </label>
-                <crate::profiles::HeaderFooterFields choice=choice />
-                <button id="gcode-preview-button" disabled=no_route on:click=move |_| show_preview()>
-                    {tr("Preview", "Просмотр")}
-                </button>
-                <button
-                    id="export-gcode"
-                    disabled=no_route
-                    on:click=move |_| {
-                        show_preview();
-                        let outcome = make_gcode().and_then(|d| {
-                            save(&d)?;
-                            Ok(d.name)
-                        });
-                        message.set(Some(outcome));
-                    }
-                >
-                    {tr("G-code", "G-код")}
-                </button>
-                <pre id="gcode-preview" aria-label=tr("First lines of the G-code", "Первые строки G-кода")>{move || preview.get()}</pre>
-            </fieldset>
+            <GcodeExport exports=exports />
             <p id="export-status" class="muted" aria-live="polite">
-                {move || message.get().map(|outcome| match (outcome, language.get()) {
+                {move || exports.message.get().map(|outcome| match (outcome, language.get()) {
                     (Ok(name), Lang::En) => format!("saved {name}"),
                     (Ok(name), Lang::Ru) => format!("сохранено: {name}"),
                     (Err(e), Lang::En) => format!("export failed: {e}"),
@@ -541,6 +434,224 @@ pub fn ExportMenu(
                 })}
             </p>
         </details>
+    }
+}
+
+/// The buttons that save the route or the nest as a file.
+#[component]
+fn FileExportButtons(exports: Exports) -> impl IntoView {
+    let language = use_language();
+    let Exports {
+        route,
+        paths,
+        toolpath,
+        machine,
+        ..
+    } = exports;
+    let no_nest = move || exports.no_nest();
+    view! {
+        <div class="export-buttons" role="group" aria-label=tr("Export", "Экспорт")>
+            <button
+                id="export-result"
+                title=move || {
+                    if exports.is_paths() {
+                        language.pick(RESULT_JSON_CANNOT_HOLD_PATHS, RESULT_JSON_CANNOT_HOLD_PATHS_RU)
+                    } else {
+                        language.pick(
+                            "The route in RouteManager's result format (rm-result.json)",
+                            "Маршрут в формате результата RouteManager (rm-result.json)",
+                        )
+                    }
+                }
+                disabled=move || route.with(Option::is_none)
+                on:click=move |_| {
+                    exports.run(&|stem, nest, route| {
+                        let route = route.ok_or("no route yet")?;
+                        machine.with_untracked(|m| result_json(stem, nest, route, m))
+                    })
+                }
+            >
+                {tr("Result JSON", "JSON результата")}
+            </button>
+            <button
+                id="export-geometry"
+                title=tr("The nest as geometry JSON (dbs.json)", "Раскрой в JSON геометрии (dbs.json)")
+                disabled=no_nest
+                on:click=move |_| exports.run(&|stem, nest, _| geometry_json(stem, nest))
+            >
+                {tr("Geometry JSON", "JSON геометрии")}
+            </button>
+            <button
+                id="export-dbs"
+                title=tr("The nest as binary DBS", "Раскрой в двоичном формате DBS")
+                disabled=no_nest
+                on:click=move |_| exports.run(&|stem, nest, _| dbs(stem, nest))
+            >
+                "DBS"
+            </button>
+            <button
+                id="export-svg"
+                title=tr("The drawing as shown (current zoom and layers)", "Чертёж как на экране (текущий масштаб и слои)")
+                disabled=no_nest
+                on:click=move |_| exports.run(&|stem, _, _| current_view_svg(stem, "nest-view"))
+            >
+                {tr("SVG of the view", "SVG вида")}
+            </button>
+            <button
+                id="export-html"
+                title=tr(
+                    "A single HTML file that shows and animates the route, no server needed",
+                    "Один HTML-файл, который показывает и анимирует маршрут, без сервера",
+                )
+                disabled=move || exports.no_route()
+                on:click=move |_| {
+                    exports.run(&|stem, nest, route| {
+                        if let (Some(p), Some(t)) = (paths.get_untracked(), toolpath.get_untracked()) {
+                            return Ok(machine.with_untracked(|m| standalone_html_of_paths(stem, nest, &p, &t, m)));
+                        }
+                        let route = route.ok_or("no route yet")?;
+                        machine.with_untracked(|m| standalone_html(stem, nest, route, m))
+                    })
+                }
+            >
+                {tr("Standalone HTML", "Отдельная HTML-страница")}
+            </button>
+        </div>
+    }
+}
+
+/// The G-code panel: dialect, format, preview and save.
+#[component]
+fn GcodeExport(exports: Exports) -> impl IntoView {
+    let language = use_language();
+    let Exports {
+        choice, machine, ..
+    } = exports;
+    let no_route = move || exports.no_route();
+    view! {
+        <fieldset class="gcode">
+            <legend>{tr("G-code", "G-код")}</legend>
+            <crate::profiles::PresetPicker choice=choice machine=machine />
+            <GcodeFormatFields choice=choice />
+            <crate::profiles::HeaderFooterFields choice=choice />
+            <button
+                id="gcode-preview-button"
+                disabled=no_route
+                on:click=move |_| exports.show_preview(language.get_untracked())
+            >
+                {tr("Preview", "Просмотр")}
+            </button>
+            <button
+                id="export-gcode"
+                disabled=no_route
+                on:click=move |_| exports.save_gcode(language.get_untracked())
+            >
+                {tr("G-code", "G-код")}
+            </button>
+            <pre id="gcode-preview" aria-label=tr("First lines of the G-code", "Первые строки G-кода")>{move || exports.preview.get()}</pre>
+        </fieldset>
+    }
+}
+
+/// How the program writes coordinates and arcs, switches the torch and dwells on a pierce.
+#[component]
+fn GcodeFormatFields(choice: RwSignal<GcodeChoice>) -> impl IntoView {
+    let text_field = move |id: &'static str,
+                           label: (&'static str, &'static str),
+                           tip: (&'static str, &'static str),
+                           get: fn(&GcodeChoice) -> String,
+                           set: fn(&mut GcodeChoice, String)| {
+        view! {
+            <label title=tr(tip.0, tip.1)>
+                {tr(label.0, label.1)}
+                <input
+                    id=id
+                    type="text"
+                    size="8"
+                    prop:value=move || choice.with(get)
+                    on:change=move |ev| {
+                        let v = event_target_value(&ev);
+                        choice.update(|c| set(c, v));
+                    }
+                />
+            </label>
+        }
+    };
+    view! {
+        <GcodeFormatPickers choice=choice />
+        {text_field(
+            "gcode-torch-on",
+            ("Torch on ", "Включение резака "),
+            ("Line that switches the torch on", "Строка включения резака"),
+            |c| c.torch_on.clone(),
+            |c, v| c.torch_on = v,
+        )}
+        {text_field(
+            "gcode-torch-off",
+            ("Torch off ", "Выключение резака "),
+            ("Line that switches the torch off", "Строка выключения резака"),
+            |c| c.torch_off.clone(),
+            |c, v| c.torch_off = v,
+        )}
+        <label title=tr(
+            "Dwell after the torch is switched on (G04), seconds",
+            "Выдержка после включения резака (G04), секунды",
+        )>
+            {tr("Pierce dwell, s ", "Выдержка на врезку, с ")}
+            <input
+                id="gcode-dwell"
+                type="number"
+                min="0"
+                step="any"
+                prop:value=move || choice.with(|c| c.dwell_s.to_string())
+                on:change=move |ev| {
+                    if let Ok(v) = event_target_value(&ev).parse::<f64>() {
+                        if v >= 0.0 && v.is_finite() {
+                            choice.update(|c| c.dwell_s = v);
+                        }
+                    }
+                }
+            />
+        </label>
+    }
+}
+
+/// Absolute or incremental coordinates, and how arcs are written.
+#[component]
+fn GcodeFormatPickers(choice: RwSignal<GcodeChoice>) -> impl IntoView {
+    view! {
+        <label title=tr(
+            "G90: positions; G91: increments from the previous point",
+            "G90: абсолютные координаты; G91: приращения от предыдущей точки",
+        )>
+            {tr("Coordinates ", "Координаты ")}
+            <select
+                id="gcode-distance"
+                prop:value=move || if choice.with(|c| c.incremental) { "incremental" } else { "absolute" }
+                on:change=move |ev| {
+                    let incremental = event_target_value(&ev) == "incremental";
+                    choice.update(|c| c.incremental = incremental);
+                }
+            >
+                <option value="absolute">{tr("absolute (G90)", "абсолютные (G90)")}</option>
+                <option value="incremental">{tr("incremental (G91)", "в приращениях (G91)")}</option>
+            </select>
+        </label>
+        <label title=tr("How arcs are written", "Как записываются дуги")>
+            {tr("Arcs ", "Дуги ")}
+            <select
+                id="gcode-arcs"
+                prop:value=move || choice.with(|c| c.arcs.clone())
+                on:change=move |ev| {
+                    let arcs = event_target_value(&ev);
+                    choice.update(|c| c.arcs = arcs);
+                }
+            >
+                <option value="ij">{tr("G02/G03 with I, J", "G02/G03 с I, J")}</option>
+                <option value="r">{tr("G02/G03 with R", "G02/G03 с R")}</option>
+                <option value="lines">{tr("G01 chords only", "только хорды G01")}</option>
+            </select>
+        </label>
     }
 }
 

@@ -10,7 +10,8 @@ use cutroute_protocol::MachineProfile;
 use leptos::prelude::*;
 
 use crate::export::{save, Download, GcodeChoice};
-use crate::i18n::{tr, use_language};
+use crate::i18n::{tr, use_language, Lang};
+use crate::state::MachineSettings;
 
 /// Local-storage key of the saved profiles.
 const STORAGE_KEY: &str = "cutroute.profiles";
@@ -81,66 +82,98 @@ pub fn parse_profile(text: &str) -> Result<MachineProfile, String> {
     Ok(profile)
 }
 
-/// The panel of named machine profiles, beside the machine parameters.
-#[component]
-pub fn ProfilesPanel(
-    machine: RwSignal<MachineParameters>,
-    kerf: RwSignal<KerfSettings>,
-    choice: RwSignal<GcodeChoice>,
-) -> impl IntoView {
-    let language = use_language();
-    let profiles = RwSignal::new(stored());
-    let name = RwSignal::new(
-        profiles.with_untracked(|p| p.first().map(|p| p.name.clone()).unwrap_or_default()),
-    );
-    let status = RwSignal::new(String::new());
-    let apply = move |profile: &MachineProfile| match from_profile(profile) {
-        Ok((m, k, c)) => {
-            machine.set(m);
-            kerf.set(k);
-            choice.set(c);
-            name.set(profile.name.clone());
-            true
+/// The stored profiles, the one named in the panel, and what the panel said last.
+#[derive(Clone, Copy)]
+struct Profiles {
+    all: RwSignal<Vec<MachineProfile>>,
+    /// The profile's name in the panel.
+    name: RwSignal<String>,
+    status: RwSignal<String>,
+    machine: MachineSettings,
+}
+
+impl Profiles {
+    /// The profiles stored in the browser; the first is named.
+    fn new(machine: MachineSettings) -> Self {
+        let all = RwSignal::new(stored());
+        let name = RwSignal::new(
+            all.with_untracked(|p| p.first().map(|p| p.name.clone()).unwrap_or_default()),
+        );
+        Self {
+            all,
+            name,
+            status: RwSignal::new(String::new()),
+            machine,
         }
-        Err(e) => {
-            status.set(e);
-            false
+    }
+
+    /// Sets the machine, kerf and G-code settings from `profile`; false (and said) when it
+    /// holds values the page refuses.
+    fn apply(&self, profile: &MachineProfile) -> bool {
+        match from_profile(profile) {
+            Ok((m, k, c)) => {
+                self.machine.machine.set(m);
+                self.machine.kerf.set(k);
+                self.machine.gcode.set(c);
+                self.name.set(profile.name.clone());
+                true
+            }
+            Err(e) => {
+                self.status.set(e);
+                false
+            }
         }
-    };
-    let current = move || {
-        let n = name.get_untracked();
+    }
+
+    /// The panel's settings as a profile of the name given.
+    fn current(&self) -> MachineProfile {
+        let n = self.name.get_untracked();
         let n = if n.trim().is_empty() {
             "machine".to_string()
         } else {
             n.trim().to_string()
         };
+        let MachineSettings {
+            machine,
+            kerf,
+            gcode,
+            ..
+        } = self.machine;
         machine.with_untracked(|m| {
-            kerf.with_untracked(|k| choice.with_untracked(|c| profile_of(&n, m, k, c)))
+            kerf.with_untracked(|k| gcode.with_untracked(|c| profile_of(&n, m, k, c)))
         })
-    };
-    let keep = move |profile: MachineProfile| {
-        profiles.update(|all| {
+    }
+
+    /// Stores `profile`, replacing one of its name.
+    fn keep(&self, profile: MachineProfile) {
+        self.all.update(|all| {
             all.retain(|p| p.name != profile.name);
             all.push(profile);
             all.sort_by(|a, b| a.name.cmp(&b.name));
         });
-        profiles.with_untracked(|all| store(all));
-    };
-    let save_profile = move |_| {
-        let profile = current();
+        self.all.with_untracked(|all| store(all));
+    }
+
+    fn save(&self, lang: Lang) {
+        let profile = self.current();
         let saved = profile.name.clone();
-        keep(profile);
-        name.set(saved.clone());
-        status.set(format!("{} {saved}", language.pick("saved", "сохранён")));
-    };
-    let delete = move |_| {
-        let n = name.get_untracked();
-        profiles.update(|all| all.retain(|p| p.name != n));
-        profiles.with_untracked(|all| store(all));
-        status.set(format!("{} {n}", language.pick("deleted", "удалён")));
-    };
-    let export = move |_| {
-        let profile = current();
+        self.keep(profile);
+        self.name.set(saved.clone());
+        self.status
+            .set(format!("{} {saved}", lang.pick("saved", "сохранён")));
+    }
+
+    fn delete(&self, lang: Lang) {
+        let n = self.name.get_untracked();
+        self.all.update(|all| all.retain(|p| p.name != n));
+        self.all.with_untracked(|all| store(all));
+        self.status
+            .set(format!("{} {n}", lang.pick("deleted", "удалён")));
+    }
+
+    /// Downloads the panel's settings as a profile file.
+    fn export(&self, lang: Lang) {
+        let profile = self.current();
         let outcome = serde_json::to_string_pretty(&profile)
             .map_err(|e| e.to_string())
             .and_then(|text| {
@@ -152,36 +185,43 @@ pub fn ProfilesPanel(
                 save(&download)?;
                 Ok(download.name)
             });
-        status.set(match outcome {
-            Ok(file) => format!("{} {file}", language.pick("saved", "сохранён")),
+        self.status.set(match outcome {
+            Ok(file) => format!("{} {file}", lang.pick("saved", "сохранён")),
             Err(e) => e,
         });
-    };
-    let import = move |ev: leptos::ev::Event| {
-        let input: web_sys::HtmlInputElement = event_target(&ev);
-        let Some(file) = input.files().and_then(|f| f.item(0)) else {
-            return;
-        };
-        input.set_value("");
+    }
+
+    /// Reads a profile file: applied, then stored.
+    fn import(&self, file: web_sys::File, lang: Lang) {
+        let this = *self;
         leptos::task::spawn_local(async move {
             let text = crate::app::read_file(&file)
                 .await
                 .and_then(|bytes| String::from_utf8(bytes).map_err(|e| e.to_string()));
             match text.and_then(|t| parse_profile(&t)) {
                 Ok(profile) => {
-                    if apply(&profile) {
-                        status.set(format!(
+                    if this.apply(&profile) {
+                        this.status.set(format!(
                             "{} {}",
-                            language.pick("imported", "загружен"),
+                            lang.pick("imported", "загружен"),
                             profile.name
                         ));
-                        keep(profile);
+                        this.keep(profile);
                     }
                 }
-                Err(e) => status.set(format!("{}: {e}", file.name())),
+                Err(e) => this.status.set(format!("{}: {e}", file.name())),
             }
         });
-    };
+    }
+}
+
+/// The panel of named machine profiles, beside the machine parameters.
+#[component]
+pub fn ProfilesPanel() -> impl IntoView {
+    let profiles = Profiles::new(expect_context::<MachineSettings>());
+    let Profiles {
+        all, name, status, ..
+    } = profiles;
     view! {
         <details id="profiles" class="profiles">
             <summary>{tr("Machine profiles", "Профили станков")}</summary>
@@ -192,14 +232,14 @@ pub fn ProfilesPanel(
                     prop:value=move || name.get()
                     on:change=move |ev| {
                         let chosen = event_target_value(&ev);
-                        if let Some(p) = profiles.with_untracked(|all| all.iter().find(|p| p.name == chosen).cloned()) {
-                            apply(&p);
+                        if let Some(p) = all.with_untracked(|all| all.iter().find(|p| p.name == chosen).cloned()) {
+                            profiles.apply(&p);
                         }
                     }
                 >
                     <option value="">"—"</option>
                     {move || {
-                        profiles
+                        all
                             .get()
                             .into_iter()
                             .map(|p| view! { <option value=p.name.clone()>{p.name.clone()}</option> })
@@ -216,46 +256,63 @@ pub fn ProfilesPanel(
                     on:change=move |ev| name.set(event_target_value(&ev))
                 />
             </label>
-            <div class="profile-buttons">
-                <button
-                    id="profile-save"
-                    type="button"
-                    title=tr(
-                        "Remember the machine parameters and G-code settings under this name",
-                        "Запомнить параметры станка и настройки G-кода под этим названием",
-                    )
-                    on:click=save_profile
-                >
-                    {tr("Save", "Сохранить")}
-                </button>
-                <button id="profile-delete" type="button" on:click=delete>
-                    {tr("Delete", "Удалить")}
-                </button>
-                <button
-                    id="profile-export"
-                    type="button"
-                    title=tr(
-                        "Download the profile as JSON (the CLI reads it: cutroute solve --profile FILE)",
-                        "Скачать профиль в JSON (его читает и программа командной строки cutroute, ключ --profile)",
-                    )
-                    on:click=export
-                >
-                    {tr("Export JSON", "Экспорт JSON")}
-                </button>
-                <label class="file-button">
-                    {tr("Import JSON… ", "Импорт JSON… ")}
-                    <input
-                        id="profile-import"
-                        type="file"
-                        accept=".json,application/json"
-                        on:change=import
-                    />
-                </label>
-            </div>
+            <ProfileButtons profiles=profiles />
             <p id="profile-status" class="muted" role="status" aria-live="polite">
                 {move || status.get()}
             </p>
         </details>
+    }
+}
+
+/// Save, delete, export and import a profile.
+#[component]
+fn ProfileButtons(profiles: Profiles) -> impl IntoView {
+    let language = use_language();
+    let import = move |ev: leptos::ev::Event| {
+        let input: web_sys::HtmlInputElement = event_target(&ev);
+        let Some(file) = input.files().and_then(|f| f.item(0)) else {
+            return;
+        };
+        input.set_value("");
+        profiles.import(file, language.get_untracked());
+    };
+    view! {
+        <div class="profile-buttons">
+            <button
+                id="profile-save"
+                type="button"
+                title=tr(
+                    "Remember the machine parameters and G-code settings under this name",
+                    "Запомнить параметры станка и настройки G-кода под этим названием",
+                )
+                on:click=move |_| profiles.save(language.get_untracked())
+            >
+                {tr("Save", "Сохранить")}
+            </button>
+            <button id="profile-delete" type="button" on:click=move |_| profiles.delete(language.get_untracked())>
+                {tr("Delete", "Удалить")}
+            </button>
+            <button
+                id="profile-export"
+                type="button"
+                title=tr(
+                    "Download the profile as JSON (the CLI reads it: cutroute solve --profile FILE)",
+                    "Скачать профиль в JSON (его читает и программа командной строки cutroute, ключ --profile)",
+                )
+                on:click=move |_| profiles.export(language.get_untracked())
+            >
+                {tr("Export JSON", "Экспорт JSON")}
+            </button>
+            <label class="file-button">
+                {tr("Import JSON… ", "Импорт JSON… ")}
+                <input
+                    id="profile-import"
+                    type="file"
+                    accept=".json,application/json"
+                    on:change=import
+                />
+            </label>
+        </div>
     }
 }
 
