@@ -186,14 +186,6 @@ impl DocumentState {
             })
     }
 
-    /// Whether the document is a PCGTSP instance (its bounds are a tour's cost).
-    pub fn is_instance(&self) -> bool {
-        self.document.with(|d| {
-            d.as_ref()
-                .is_some_and(|d| matches!(d.problem, Problem::PcgtspText { .. }))
-        })
-    }
-
     /// Whether the document is a PCGTSP instance, read without tracking.
     pub fn is_instance_untracked(&self) -> bool {
         self.document.with_untracked(|d| {

@@ -625,23 +625,24 @@ impl SolverJob {
         let mut extra = serde_json::Map::new();
         match self {
             SolverJob::Engine(_) => {}
-            SolverJob::Aoe(job) => {
-                let (solution, _) = match job.outcome() {
-                    Some(Ok(solved)) => solved,
-                    Some(Err(e)) => {
-                        return Err(Failure::Solver {
-                            solver: solver.name(),
-                            message: e.clone(),
-                        })
-                    }
-                    None => return Err(Failure::Message("the aoe job did not run".into())),
-                };
-                extra.insert(
-                    "pierce_lower_bound".into(),
-                    json!(solution.pierce_lower_bound),
-                );
-                extra.insert("components".into(), json!(solution.components));
-            }
+            SolverJob::Aoe(job) => match job.outcome() {
+                Some(Ok((solution, _))) => {
+                    extra.insert(
+                        "pierce_lower_bound".into(),
+                        json!(solution.pierce_lower_bound),
+                    );
+                    extra.insert("components".into(), json!(solution.components));
+                }
+                Some(Err(e)) => {
+                    return Err(Failure::Solver {
+                        solver: solver.name(),
+                        message: e.clone(),
+                    })
+                }
+                // Stopped before its route was made (the job runs in slices): no extras, and
+                // the report says what the run has, or that it found no route by the limit.
+                None => {}
+            },
             SolverJob::Segments(job) => {
                 let result = job.search().result().map_err(|e| Failure::Segments {
                     solver: solver.name(),

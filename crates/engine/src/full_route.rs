@@ -31,7 +31,7 @@ use cutroute_pcgtsp::Instance;
 use cutroute_protocol::{CostUnit, Phase, Progress, Solution};
 use web_time::{Duration, Instant};
 
-use crate::{DiscreteJob, DiscreteMode, Job, JobStatus};
+use crate::{DiscreteJob, DiscreteMode, Job, JobStatus, Refusal};
 
 /// Fewest entry positions tried round each equidistant (small contours get this many even
 /// when their perimeter is shorter than the step).
@@ -107,9 +107,11 @@ impl FullRouteBuilder {
         step: f64,
         start: Point,
         finish: Option<Point>,
-    ) -> Result<FullRouteBuilder, String> {
+    ) -> Result<FullRouteBuilder, Refusal> {
         if !(step > 0.0 && step.is_finite()) {
-            return Err(format!("discretisation step {step}: must be positive"));
+            return Err(Refusal::Settings(format!(
+                "discretisation step {step}: must be positive"
+            )));
         }
         Ok(FullRouteBuilder {
             forest: nest.containment_forest(),
@@ -253,7 +255,7 @@ pub fn build_full_route_model(
     step: f64,
     start: Point,
     finish: Option<Point>,
-) -> Result<Result<FullRouteModel, Vec<LeadError>>, String> {
+) -> Result<Result<FullRouteModel, Vec<LeadError>>, Refusal> {
     let mut builder = FullRouteBuilder::new(nest, settings, step, start, finish)?;
     loop {
         if let Some(model) = builder.advance(Instant::now()) {
@@ -279,7 +281,7 @@ impl FullRouteJob {
         time_limit: Duration,
         started: Instant,
         seed: u64,
-    ) -> Result<FullRouteJob, String> {
+    ) -> Result<FullRouteJob, Refusal> {
         let search = DiscreteJob::new(
             job_id,
             model.instance.clone(),
