@@ -685,6 +685,7 @@ mod tests {
                 ToolOnPath {
                     pierce: p(0.0, 0.0),
                     spans: vec![Span::line(p(0.0, 0.0), p(10.0, 0.0))],
+                    leads: None,
                 },
                 ToolOnPath {
                     pierce: p(20.0, 0.0),
@@ -692,6 +693,7 @@ mod tests {
                         Span::line(p(20.0, 0.0), p(20.0, 10.0)),
                         Span::line(p(20.0, 10.0), p(30.0, 10.0)),
                     ],
+                    leads: None,
                 },
             ],
             finish: None,

@@ -647,6 +647,7 @@ mod tests {
                 p(10.0, 0.0),
                 p(0.0, 0.0),
             ]),
+            leads: None,
         };
         let edge_then_c = ToolOnPath {
             pierce: p(10.0, 0.0),
@@ -664,6 +665,7 @@ mod tests {
                 p(40.0, 10.0),
                 p(35.0, 10.0),
             ]),
+            leads: None,
         };
         let route = PathRoute {
             start: p(0.0, -10.0),

@@ -398,6 +398,7 @@ fn route_of(visits: &[Visit], order: &[usize], start: Point, finish: Option<Poin
                 paths.push(ToolOnPath {
                     pierce: visit.entry,
                     spans: opened(spans, opening, visit.entry),
+                    leads: None,
                 });
             }
             None => paths.extend(
@@ -408,6 +409,7 @@ fn route_of(visits: &[Visit], order: &[usize], start: Point, finish: Option<Poin
                     .map(|c| ToolOnPath {
                         pierce: c.spans[0].start,
                         spans: c.spans.clone(),
+                        leads: None,
                     }),
             ),
         }

@@ -16,6 +16,9 @@
 //!
 //! With `leads_after` the job runs the solver on the nest only and attaches leads (no
 //! relaxation): the "solve, then attach leads" route of the benchmark.
+//!
+//! The path solvers (sccp, gsccp, aoe) run on the nest of equidistants instead, with leads at
+//! their paths' ends (module `kerf_paths`).
 
 use cutroute_geometry::{
     ContainmentForest, CutStep, KerfSettings, LeadError, LeadFitter, Nest, Route,
@@ -23,6 +26,7 @@ use cutroute_geometry::{
 use cutroute_protocol::{JobRequest, KerfNote, KerfSource, Phase, Problem, Progress, SolverKind};
 use web_time::{Duration, Instant};
 
+use crate::kerf_paths::PathLeadsRun;
 use crate::{EngineError, Job, JobStatus};
 
 /// Sweeps of [`LeadFitter::relax`] over a finished route, and the entries it tries round each
@@ -211,6 +215,8 @@ pub struct KerfJob {
     /// The request's time limit from the job's start: relaxing stops there (every relaxed
     /// route is valid; attaching, which validity needs, does not stop).
     deadline: Option<Instant>,
+    /// A path solver's run over the equidistants (sccp, gsccp, aoe): the job is that run.
+    paths: Option<PathLeadsRun>,
 }
 
 impl KerfJob {
@@ -235,7 +241,7 @@ impl KerfJob {
         };
         if !supports_kerf(solver) {
             return Err(refused(
-                "does not cut with kerf and leads yet (nearest, ccp, heuristic and chain do)"
+                "does not cut with kerf and leads yet (nearest, ccp, heuristic, chain, sccp, gsccp and aoe do)"
                     .into(),
             ));
         }
@@ -250,6 +256,34 @@ impl KerfJob {
         if limit.is_finite() && limit > 0.0 {
             idealised.params.time_limit_s =
                 limit - (limit * FIT_RESERVE_SHARE).min(FIT_RESERVE_MAX_S);
+        }
+        if solver.gives_path_route() {
+            // Cut on the equidistants: the solver's paths are the tool centre's; leads at
+            // their ends (`leads_after` changes nothing: nothing is relaxed).
+            let equidistants = LeadFitter::with_forest(nest, &forest, settings).kerf_nest();
+            let mut over_equidistants = idealised.clone();
+            if let Problem::Nest { nest, .. } = &mut over_equidistants.problem {
+                *nest = equidistants;
+            }
+            let run = PathLeadsRun::new(
+                nest.clone(),
+                forest.clone(),
+                settings,
+                request.params.machine,
+                request.params.objective,
+                start(&over_equidistants)?,
+            );
+            return Ok(KerfJob {
+                nest: nest.clone(),
+                forest,
+                settings,
+                relax: false,
+                chained: false,
+                candidates: Vec::new(),
+                turn: 0,
+                deadline: None,
+                paths: Some(run),
+            });
         }
         let mut candidates = Vec::new();
         let after = request.params.leads_after;
@@ -288,6 +322,7 @@ impl KerfJob {
             candidates,
             turn: 0,
             deadline: started.checked_add(Duration::from_secs_f64(limit.clamp(0.0, 1.0e7))),
+            paths: None,
         })
     }
 
@@ -427,6 +462,9 @@ impl Candidate {
 
 impl Job for KerfJob {
     fn step(&mut self, budget: Duration) -> JobStatus {
+        if let Some(paths) = self.paths.as_mut() {
+            return paths.step(budget);
+        }
         let solving: Vec<usize> = (0..self.candidates.len())
             .filter(|&i| matches!(self.candidates[i].stage, Stage::Solving))
             .collect();
@@ -466,6 +504,9 @@ impl Job for KerfJob {
     }
 
     fn progress(&self) -> Progress {
+        if let Some(paths) = &self.paths {
+            return paths.progress();
+        }
         let done = self.done();
         let mut inner: Vec<Progress> = self.candidates.iter().map(|c| c.job.progress()).collect();
         // Each candidate's full route: the finished one, the one being relaxed, or the last
@@ -552,7 +593,7 @@ fn links(route: &Route) -> usize {
     route.steps.iter().filter(|s| !s.is_pierced()).count()
 }
 
-fn no_room(errors: &[LeadError]) -> KerfNote {
+pub(crate) fn no_room(errors: &[LeadError]) -> KerfNote {
     let contours = errors
         .iter()
         .map(|e| match e {

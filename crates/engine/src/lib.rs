@@ -33,6 +33,7 @@
 
 mod jobs;
 mod kerf;
+mod kerf_paths;
 mod located;
 mod nearest;
 mod open;

@@ -230,15 +230,18 @@ impl SolverKind {
     /// ccp and heuristic route whole contours through pierce points, which the pierce curves
     /// carry over, and chain runs over the equidistants with leads at its chains' ends. The
     /// exact solver's bounds are about the idealised nest, so with leads it would prove
-    /// nothing; the path solvers (sccp, gsccp, aoe) cut pieces of contours, shared edges among
-    /// them, and have no full-route model yet.
+    /// nothing. The path solvers (sccp, gsccp, aoe) run over the equidistants at kerf/2, with
+    /// a lead-in at each path's start and a lead-out at its end.
     pub fn cuts_with_kerf(self) -> bool {
         match self {
             SolverKind::NearestNeighbour
             | SolverKind::Ccp
             | SolverKind::Heuristic
-            | SolverKind::Chain => true,
-            SolverKind::Exact | SolverKind::Sccp | SolverKind::Gsccp | SolverKind::Aoe => false,
+            | SolverKind::Chain
+            | SolverKind::Sccp
+            | SolverKind::Gsccp
+            | SolverKind::Aoe => true,
+            SolverKind::Exact => false,
         }
     }
 
@@ -526,6 +529,7 @@ mod tests {
                     end: Point::new(40.0, 40.0),
                     bulge: 0.0,
                 }],
+                leads: None,
             }],
             finish: None,
         };
@@ -588,6 +592,7 @@ mod tests {
                         end: Point::new(10.0, 0.0),
                         bulge: 0.5,
                     }],
+                    leads: None,
                 }],
                 finish: Some(Point::new(1.0, 1.0)),
             }),

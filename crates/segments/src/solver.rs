@@ -540,6 +540,7 @@ impl Search {
                 ToolOnPath {
                     pierce: entry_point(segment, place[s]),
                     spans,
+                    leads: None,
                 }
             })
             .collect();
