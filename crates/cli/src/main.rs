@@ -371,10 +371,9 @@ fn main() -> ExitCode {
             };
             let input = (file.as_path(), sheet.index());
             let report = match solver.as_str() {
-                "sccp" | "gsccp" | "aoe" if kerf.is_on() => Err(Failure::Error(format!(
-                    "--solver {solver} does not cut with kerf and leads yet"
-                ))),
-                "sccp" | "gsccp" | "aoe" => Ok(solve_path(input, &solver, params, json, &thermal)?),
+                "sccp" | "gsccp" | "aoe" => {
+                    Ok(solve_path(input, &solver, params, json, &thermal, &kerf)?)
+                }
                 _ => solve(input, &solver, params, json, &thermal, &kerf),
             }?;
             Ok(write_report(&report, json, out.as_deref())?)
@@ -471,6 +470,7 @@ fn run_job(job: &mut dyn Job, watch: &Watch, on_progress: &mut dyn FnMut(&Progre
         // part of the answer, so a stop waits for them (the main thread still reports what
         // was published at the grace's end).
         let fitting_leads = progress.route.is_none()
+            && progress.path_route.is_none()
             && matches!(
                 progress.phase,
                 cutroute_protocol::Phase::Kerf {
@@ -943,8 +943,11 @@ fn convert(
             (name, ..) => solved(&document, name.unwrap_or("ccp"), params.clone(), kerf),
         }
         .and_then(|routed| match routed {
-            Routed::Paths(_) if kerf.is_on() => {
-                Err("path routes (sccp, gsccp, aoe) do not cut with kerf and leads yet".into())
+            // A solved path route has its leads from the job; a file's own has none.
+            Routed::Paths(paths)
+                if kerf.is_on() && paths.paths.iter().any(|p| p.leads.is_none()) =>
+            {
+                Err("a file's own path route gets no leads: solve it with --solver sccp, gsccp or aoe".into())
             }
             routed => Ok(routed),
         })
@@ -1243,6 +1246,7 @@ fn solve_path(
     params: SolverParams,
     as_json: bool,
     thermal: &thermal::Thermal,
+    kerf: &kerf::Kerf,
 ) -> Result<Value, String> {
     let document = open(input)?;
     let Problem::Nest { nest, .. } = &document.problem else {
@@ -1255,19 +1259,32 @@ fn solve_path(
     let time_limit_s = params.time_limit_s;
     let objective = params.objective;
     thermal.warn_unpriced(solver);
-    let request = JobRequest {
-        job_id: 1,
-        problem: document.problem.clone(),
-        solver,
-        params,
-    };
+    let request = kerf.request(
+        JobRequest {
+            job_id: 1,
+            problem: document.problem.clone(),
+            solver,
+            params,
+        },
+        solver_name,
+    )?;
+    let with_leads = kerf.is_on();
     let started = std::time::Instant::now();
     let display = stdio::ProgressDisplay::new(as_json);
     let mut shown = display.clone();
-    let outcome = run_bounded(time_limit_s, GRACE, move |watch| {
+    // As `bounded_job_run`: a kerf job stopped before its first route with leads keeps
+    // stepping until it has one.
+    let grace = if with_leads { LEADS_GRACE } else { GRACE };
+    let outcome = run_bounded(time_limit_s, grace, move |watch| {
         let mut on_progress = |p: &Progress| shown.show(p);
         let mut extra = serde_json::Map::new();
-        let progress = if solver == SolverKind::Aoe {
+        let progress = if with_leads {
+            // The engine's kerf job (the page's code path): the solver over the equidistants,
+            // leads at every path's ends; its ensembles are about the nest without leads.
+            let mut job = start_job(&request)
+                .map_err(|e| format!("--solver {}: {e}", request.solver.name()))?;
+            run_job(job.as_mut(), watch, &mut on_progress).last
+        } else if solver == SolverKind::Aoe {
             let mut job =
                 AoeJob::from_request(&request).map_err(|e| format!("--solver aoe: {e}"))?;
             let progress = run_job(&mut job, watch, &mut on_progress).last;
@@ -1342,6 +1359,7 @@ fn solve_path(
             stopped.unwrap_or("")
         )
     })?;
+    kerf.refused(Some(&progress))?;
     let solver_route = progress
         .path_route
         .as_ref()
@@ -1352,6 +1370,13 @@ fn solve_path(
         Ok(repaired) => (repaired, None),
         Err(e) => (None, Some(e)),
     };
+    if with_leads && repaired.is_some() {
+        return Err(
+            "the rule repair's route (whole contours, standard cutting) gets no leads yet: \
+             solve without --kerf or without the hard rules"
+                .into(),
+        );
+    }
     let route = repaired.as_ref().unwrap_or(solver_route);
     let (ub, lb, phase) = match &repaired {
         None => (
@@ -1413,6 +1438,7 @@ fn solve_path(
         fields.extend(extra);
     }
     thermal.report_paths(&mut report, nest, route, &machine, objective)?;
+    kerf.report_paths(&mut report, route);
     Ok(report)
 }
 
