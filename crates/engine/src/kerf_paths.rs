@@ -9,12 +9,13 @@
 //!
 //! Common edges (aoe; sccp's chains) exist on the kerf nest only where equidistants coincide:
 //! parts spaced by exactly the kerf. Parts spaced closer (touching parts among them) have
-//! equidistants that cross each other: the solver cuts them, and the checker reports every
-//! cut that comes closer than kerf/2 to a neighbour (`PathRouteError::CutTooClose`).
+//! equidistants that cross each other: no cut keeps kerf/2 from both, so such a route is
+//! refused and the contours its kerf would burn into are named as contours without room (the
+//! checker reports such cuts as `PathRouteError::CutTooClose`).
 
 use cutroute_geometry::{
-    ContainmentForest, KerfSettings, LeadError, LeadFitter, MachineParameters, Nest, Objective,
-    PathRoute, ToolOnPath,
+    ContainmentForest, KerfSettings, LeadError, LeadFitter, LeadProblem, MachineParameters, Nest,
+    Objective, PathRoute, PathRouteError, ToolOnPath,
 };
 use cutroute_protocol::{KerfNote, KerfSource, Phase, Progress};
 use web_time::{Duration, Instant};
@@ -130,6 +131,7 @@ impl PathLeadsRun {
         if let Some(pending) = self.pending.as_mut() {
             if let Some(result) = pending.advance(&fitter, until.max(Instant::now())) {
                 let from = self.pending.take().expect("pending").from;
+                let result = result.and_then(|route| self.clear_of_parts(route));
                 self.fitted = Some((from, result));
             }
         }
@@ -138,6 +140,36 @@ impl PathLeadsRun {
         } else {
             JobStatus::Done
         }
+    }
+
+    /// `route` if its cuts keep kerf/2 from every contour; else the contours its kerf would
+    /// burn into (parts spaced closer than the kerf, touching ones among them), as contours
+    /// without room.
+    fn clear_of_parts(&self, route: PathRoute) -> Result<PathRoute, Vec<LeadError>> {
+        let close = route.clearance_problems(
+            &self.nest,
+            self.settings.kerf / 2.0,
+            self.nest.check_tolerance(),
+        );
+        if close.is_empty() {
+            return Ok(route);
+        }
+        Err(close
+            .into_iter()
+            .filter_map(|p| match p {
+                PathRouteError::CutTooClose {
+                    contour,
+                    x,
+                    y,
+                    distance,
+                    ..
+                } => Some(LeadError::NoFit {
+                    contour,
+                    reason: LeadProblem::LeadTooClose { x, y, distance },
+                }),
+                _ => None,
+            })
+            .collect())
     }
 
     pub(crate) fn progress(&self) -> Progress {

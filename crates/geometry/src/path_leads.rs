@@ -149,6 +149,13 @@ impl LeadFitter<'_> {
             .collect()
     }
 
+    /// How far `p` lies off the equidistant of contour `r`, mm (by its distance to `r`).
+    fn off_equidistant(&self, r: ContourRef, p: Point) -> f64 {
+        self.nest().contour(r).map_or(f64::NAN, |c| {
+            (c.distance_to(p) - self.settings().kerf / 2.0).abs()
+        })
+    }
+
     /// The nearest contour to `p` (for naming a contour where a lead found no room).
     fn nearest_contour(&self, p: Point) -> ContourRef {
         self.nest()
@@ -164,8 +171,11 @@ impl LeadFitter<'_> {
             )
     }
 
-    /// The contour among `candidates` whose equidistant `path` cuts once round, from its start
-    /// back to it, and that equidistant.
+    /// The contour whose equidistant `path` cuts once round, from its start back to it, and
+    /// that equidistant: one of `candidates` (contours whose equidistant passes through the
+    /// start), or a contour the path runs round itself (the kerf nest keeps a contour's own
+    /// shape where its equidistant would change which contour holds which: the path is then
+    /// moved onto the equidistant).
     fn whole_loop(
         &self,
         path: &ToolOnPath,
@@ -176,17 +186,35 @@ impl LeadFitter<'_> {
             return None;
         }
         let length: f64 = path.spans.iter().map(Span::length).sum();
-        candidates.iter().find_map(|&r| {
-            let eq = self.equidistant(r).ok()?;
-            let perimeter = eq.perimeter();
-            let round = (length - perimeter).abs() <= 1e-6 * perimeter.max(1.0)
+        let runs_round = |target: &Contour| {
+            let perimeter = target.perimeter();
+            (length - perimeter).abs() <= 1e-6 * perimeter.max(1.0)
                 && path.spans.iter().all(|s| {
                     [s.point_at(0.5), s.end]
                         .iter()
-                        .all(|&p| eq.distance_to(p) <= ON_EQUIDISTANT)
-                });
-            round.then_some((r, eq))
-        })
+                        .all(|&p| target.distance_to(p) <= ON_EQUIDISTANT)
+                })
+        };
+        let on_contour = self.nest().contour_refs().filter(|&r| {
+            self.box_of(r)
+                .is_some_and(|b| b.expanded(ON_EQUIDISTANT).contains_point(first.start))
+                && self
+                    .nest()
+                    .contour(r)
+                    .is_some_and(|c| c.distance_to(first.start) <= ON_EQUIDISTANT)
+        });
+        candidates
+            .iter()
+            .copied()
+            .find_map(|r| {
+                let eq = self.equidistant(r).ok()?;
+                runs_round(&eq).then_some((r, eq))
+            })
+            .or_else(|| {
+                on_contour
+                    .filter(|&r| self.nest().contour(r).is_some_and(|c| runs_round(c)))
+                    .find_map(|r| Some((r, self.equidistant(r).ok()?)))
+            })
     }
 
     /// A lead-in (`lead_in`) ending at `at` where the cut leaves along `tangent`, or a lead-out
@@ -205,12 +233,13 @@ impl LeadFitter<'_> {
             self.settings().lead_out
         };
         let Some(&named) = candidates.first() else {
+            let contour = self.nearest_contour(at);
             return Err(LeadError::NoFit {
-                contour: self.nearest_contour(at),
+                contour,
                 reason: LeadProblem::EntryOffEquidistant {
                     x: at.x,
                     y: at.y,
-                    distance: f64::NAN,
+                    distance: self.off_equidistant(contour, at),
                 },
             });
         };
@@ -349,10 +378,7 @@ impl LeadFitter<'_> {
                 vec![LeadProblem::EntryOffEquidistant {
                     x: at.x,
                     y: at.y,
-                    distance: self
-                        .nest()
-                        .contour(self.nearest_contour(at))
-                        .map_or(f64::NAN, |c| c.distance_to(at)),
+                    distance: self.off_equidistant(self.nearest_contour(at), at),
                 }]
             })
         };

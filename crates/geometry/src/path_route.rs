@@ -197,10 +197,12 @@ pub enum PathRouteError {
     },
     /// With leads: a tool-on span comes closer than kerf/2 to a contour, so the kerf burns
     /// into it (parts spaced narrower than the kerf, or a cut off the equidistants).
-    #[error("span {span} of path {path} comes {distance} mm from a contour at ({x}, {y}), closer than half the kerf")]
+    #[error("span {span} of path {path} comes {distance} mm from contour {contour:?} at ({x}, {y}), closer than half the kerf")]
     CutTooClose {
         /// Index of the path.
         path: usize,
+        /// The contour it comes too close to.
+        contour: ContourRef,
         /// Index of the span in the path.
         span: usize,
         /// Where, x.
@@ -504,8 +506,14 @@ impl PathRoute {
     }
 
     /// Every tool-on span (leads aside: their checker samples them) closer than `half` less
-    /// `tolerance` to a contour of `nest`; one per path.
-    fn clearance_problems(&self, nest: &Nest, half: f64, tolerance: f64) -> Vec<PathRouteError> {
+    /// `tolerance` to a contour of `nest`, one per path: a cut whose kerf burns into a part.
+    pub fn clearance_problems(
+        &self,
+        nest: &Nest,
+        half: f64,
+        tolerance: f64,
+    ) -> Vec<PathRouteError> {
+        let refs: Vec<ContourRef> = nest.contour_refs().collect();
         let contours: Vec<Vec<Span>> = nest
             .contour_refs()
             .map(|r| nest.contour(r).map_or(Vec::new(), |c| c.spans().collect()))
@@ -532,6 +540,7 @@ impl PathRoute {
                         let at = span.nearest_point(other.nearest_point(span.point_at(0.5)).point);
                         problems.push(PathRouteError::CutTooClose {
                             path: p,
+                            contour: refs[e.contour],
                             span: s,
                             x: at.point.x,
                             y: at.point.y,
