@@ -134,6 +134,11 @@ impl LeadFitter<'_> {
     /// The contours of the nest whose equidistant at kerf/2 passes through `p` (several where
     /// equidistants coincide: parts spaced by the kerf).
     pub fn contours_on_equidistant(&self, p: Point) -> Vec<ContourRef> {
+        self.contours_near_equidistant(p, ON_EQUIDISTANT)
+    }
+
+    /// [`LeadFitter::contours_on_equidistant`] within `tolerance` mm.
+    fn contours_near_equidistant(&self, p: Point, tolerance: f64) -> Vec<ContourRef> {
         let half = self.settings().kerf / 2.0;
         self.nest()
             .contour_refs()
@@ -144,7 +149,7 @@ impl LeadFitter<'_> {
             .filter(|&r| {
                 self.nest()
                     .contour(r)
-                    .is_some_and(|c| (c.distance_to(p) - half).abs() <= ON_EQUIDISTANT)
+                    .is_some_and(|c| (c.distance_to(p) - half).abs() <= tolerance)
             })
             .collect()
     }
@@ -180,28 +185,29 @@ impl LeadFitter<'_> {
         &self,
         path: &ToolOnPath,
         candidates: &[ContourRef],
+        tolerance: f64,
     ) -> Option<(ContourRef, Contour)> {
         let (first, last) = (path.spans.first()?, path.spans.last()?);
-        if first.start.distance(last.end) > ON_EQUIDISTANT {
+        if first.start.distance(last.end) > tolerance {
             return None;
         }
         let length: f64 = path.spans.iter().map(Span::length).sum();
         let runs_round = |target: &Contour| {
             let perimeter = target.perimeter();
-            (length - perimeter).abs() <= 1e-6 * perimeter.max(1.0)
+            (length - perimeter).abs() <= 1e-6 * perimeter.max(1.0) + tolerance
                 && path.spans.iter().all(|s| {
                     [s.point_at(0.5), s.end]
                         .iter()
-                        .all(|&p| target.distance_to(p) <= ON_EQUIDISTANT)
+                        .all(|&p| target.distance_to(p) <= tolerance)
                 })
         };
         let on_contour = self.nest().contour_refs().filter(|&r| {
             self.box_of(r)
-                .is_some_and(|b| b.expanded(ON_EQUIDISTANT).contains_point(first.start))
+                .is_some_and(|b| b.expanded(tolerance).contains_point(first.start))
                 && self
                     .nest()
                     .contour(r)
-                    .is_some_and(|c| c.distance_to(first.start) <= ON_EQUIDISTANT)
+                    .is_some_and(|c| c.distance_to(first.start) <= tolerance)
         });
         candidates
             .iter()
@@ -273,9 +279,12 @@ impl LeadFitter<'_> {
         let (Some(first), Some(last)) = (path.spans.first(), path.spans.last()) else {
             return Ok(path.clone());
         };
-        let start = first.start;
-        let at_start = self.contours_on_equidistant(start);
-        if let Some((r, eq)) = self.whole_loop(path, &at_start) {
+        // The solver's points on the equidistants are exact to its own tolerance (segment
+        // cutting splits spans at computed points): within the nest's check tolerance they
+        // count as on an equidistant and are moved onto it.
+        let snap = self.nest().check_tolerance().max(ON_EQUIDISTANT);
+        let at_start = self.contours_near_equidistant(first.start, snap);
+        if let Some((r, eq)) = self.whole_loop(path, &at_start, snap) {
             let leads = self.fit_on(r, &eq, path.pierce)?;
             let spans = opened_at(&eq, leads.entry, MIN_PIECE);
             let exit = spans.last().map_or(leads.entry, |s| s.end);
@@ -303,14 +312,26 @@ impl LeadFitter<'_> {
                 }),
             });
         }
-        let lead_in = self.fit_path_end(&at_start, start, first.tangent_at(0.0), true)?;
-        let end = last.end;
-        let at_end = self.contours_on_equidistant(end);
-        let lead_out = self.fit_path_end(&at_end, end, last.tangent_at(1.0), false)?;
+        let onto = |p: Point, candidates: &[ContourRef]| {
+            candidates
+                .first()
+                .and_then(|&r| self.equidistant(r).ok())
+                .and_then(|eq| eq.nearest_point(p))
+                .map_or(p, |q| q.point)
+        };
+        let at_end = self.contours_near_equidistant(last.end, snap);
+        let mut spans = path.spans.clone();
+        let start = onto(first.start, &at_start);
+        let end = onto(last.end, &at_end);
+        spans[0].start = start;
+        let n = spans.len();
+        spans[n - 1].end = end;
+        let lead_in = self.fit_path_end(&at_start, start, spans[0].tangent_at(0.0), true)?;
+        let lead_out = self.fit_path_end(&at_end, end, spans[n - 1].tangent_at(1.0), false)?;
         let settings = self.settings();
         Ok(ToolOnPath {
             pierce: lead_in[0].point,
-            spans: path.spans.clone(),
+            spans,
             leads: Some(PathLeads {
                 entry: start,
                 switch_off: lead_out.last().map_or(end, |v| v.point),

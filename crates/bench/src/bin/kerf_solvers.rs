@@ -124,6 +124,8 @@ fn run(problem: &Problem, nest: &Nest, solver: SolverKind, kerf: KerfSettings, l
             seconds,
         };
     }
+    // Why, on stderr: the table has no room for the reasons.
+    eprintln!("{} {}: {}", solver.name(), kerf.kerf, progress.phase);
     Run {
         checker: if no_room > 0 { "no room" } else { "no route" }.into(),
         idle: None,
