@@ -218,7 +218,7 @@ impl LeadFitter<'_> {
             })
             .or_else(|| {
                 on_contour
-                    .filter(|&r| self.nest().contour(r).is_some_and(|c| runs_round(c)))
+                    .filter(|&r| self.nest().contour(r).is_some_and(&runs_round))
                     .find_map(|r| Some((r, self.equidistant(r).ok()?)))
             })
     }
@@ -558,7 +558,7 @@ mod tests {
         );
         // A lead not joined to its pierce point.
         let mut loose = good.clone();
-        loose.paths[1].pierce = loose.paths[1].pierce + Point::new(0.5, 0.0);
+        loose.paths[1].pierce += Point::new(0.5, 0.0);
         assert!(matches!(
             first_lead(&loose),
             Some(PathRouteError::Lead(PathLeadError {
