@@ -126,10 +126,10 @@ test('kerf and an arc lead-in: leads drawn and animated, G-code reads back with 
 
   await screenshot(page, 'kerf.png');
 
-  // A path solver cuts on the equidistants with leads at each path's ends: aoe on nested.dbs
+  // A path solver cuts on the equidistants with leads at each path's ends: sccp on nested.dbs
   // (its parts apart, so one path per contour) draws every path's leads and M/M* points.
-  await runSolver(page, 'aoe', 3);
-  assert.match(await page.textContent('#phase'), /leads/, 'the aoe job says it fitted leads');
+  await runSolver(page, 'sccp', 3);
+  assert.match(await page.textContent('#phase'), /leads/, 'the sccp job says it fitted leads');
   assert.equal(Number(await page.textContent('#pierces')), steps, 'one pierce per contour');
   assert.equal(await page.locator('#nest-view .leads path.lead').count(), steps);
   assert.equal(await page.locator('#nest-view .pierce-regions circle.pierce-m').count(), steps);

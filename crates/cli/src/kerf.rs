@@ -281,9 +281,20 @@ impl Kerf {
         if let Some(paths) = report["route"]["paths"].as_array_mut() {
             for (path, p) in paths.iter_mut().zip(&route.paths) {
                 let Some(l) = &p.leads else { continue };
+                let triples = |chain: &[Vertex]| {
+                    chain
+                        .iter()
+                        .map(|v| [v.point.x, v.point.y, v.bulge])
+                        .collect::<Vec<_>>()
+                };
                 path["pierce"] = json!([p.pierce.x, p.pierce.y]);
                 path["entry"] = json!([l.entry.x, l.entry.y]);
+                path["lead_in"] = json!(triples(&l.lead_in));
+                path["lead_out"] = json!(triples(&l.lead_out));
                 path["switch_off"] = json!([l.switch_off.x, l.switch_off.y]);
+                if let Some(fields) = path.as_object_mut() {
+                    fields.remove("leads");
+                }
             }
         }
         report["lead_in_length"] = json!(leads().map(PathLeads::lead_in_length).sum::<f64>());

@@ -500,26 +500,19 @@ mod tests {
     }
 
     #[test]
-    fn json_carries_the_leads_beside_pierce_and_spans() {
+    fn json_carries_the_leads_and_reads_back() {
         let route = with_leads(&plates(), plasma()).expect("room");
         let json = serde_json::to_value(&route).expect("serialises");
-        let path = &json["paths"][0];
-        for field in [
-            "pierce",
-            "entry",
-            "lead_in",
-            "lead_out",
-            "switch_off",
-            "spans",
-        ] {
-            assert!(path.get(field).is_some(), "{field} missing in {path}");
+        let leads = &json["paths"][0]["leads"];
+        for field in ["entry", "lead_in", "lead_out", "switch_off"] {
+            assert!(leads.get(field).is_some(), "{field} missing in {leads}");
         }
-        assert_eq!(path["lead_in"][0].as_array().map(Vec::len), Some(3));
+        assert_eq!(leads["lead_in"][0].as_array().map(Vec::len), Some(3));
         let back: PathRoute = serde_json::from_value(json).expect("reads back");
         assert_eq!(back, route);
-        // A path route without leads still reads as one.
+        // A path route written before leads still reads.
         let plain: PathRoute = serde_json::from_str(
-            r#"{"start":[0,0],"paths":[{"pierce":[0,0],"spans":[]}],"finish":null}"#,
+            r#"{"start":{"x":0,"y":0},"paths":[{"pierce":{"x":0,"y":0},"spans":[]}],"finish":null}"#,
         )
         .expect("reads");
         assert!(plain.paths[0].leads.is_none());

@@ -21,8 +21,7 @@ use crate::{
 /// One pierce's worth of cutting: the torch pierces at `pierce` and cuts `spans` in order.
 /// With [`PathLeads`] (the full cutting route: kerf, pierce regions, leads) the torch pierces at
 /// `pierce` = M, runs the lead-in to the entry where the spans start (on an equidistant), cuts
-/// them, and runs the lead-out to the switch-off point M*; in JSON the leads' fields (`entry`,
-/// `lead_in`, `lead_out`, `switch_off`, …) sit beside `pierce` and `spans`.
+/// them, and runs the lead-out to the switch-off point M*.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct ToolOnPath {
     /// Where the torch pierces; without leads the first span starts here.
@@ -30,8 +29,9 @@ pub struct ToolOnPath {
     /// The spans in cutting direction, each starting where the previous one ends.
     pub spans: Vec<Span>,
     /// The lead-in, the entry, the lead-out and the switch-off point, when the route is the
-    /// full cutting route.
-    #[serde(flatten)]
+    /// full cutting route. (Always written, even as `null`, and never flattened: the worker's
+    /// binary codec needs every field in place.)
+    #[serde(default)]
     pub leads: Option<PathLeads>,
 }
 
