@@ -722,6 +722,7 @@ mod tests {
                 ToolOnPath {
                     pierce: p(0.0, 0.0),
                     spans: vec![Span::line(p(0.0, 0.0), p(10.0, 0.0))],
+                    leads: None,
                 },
                 ToolOnPath {
                     pierce: p(20.0, 0.0),
@@ -729,6 +730,7 @@ mod tests {
                         Span::line(p(20.0, 0.0), p(20.0, 10.0)),
                         Span::line(p(20.0, 10.0), p(30.0, 10.0)),
                     ],
+                    leads: None,
                 },
             ],
             finish: None,

@@ -239,14 +239,36 @@ impl ContourGrid {
 /// The toolpath of a path route over `nest`, with the tool-on pieces that follow no contour
 /// (links between parts through scrap) marked as links, as chain cutting's links are, so the
 /// drawing, the animation and the exports show them apart.
+///
+/// With kerf and leads (the paths carry [`cutroute_geometry::PathLeads`]) the paths run on the
+/// equidistants: those are the contours a piece follows, and the leads are no links (as a
+/// contour route's leads are not).
 pub fn path_route_toolpath(route: &PathRoute, nest: &Nest) -> Toolpath {
     let mut toolpath = Toolpath::from_path_route(route);
-    let Some(grid) = ContourGrid::new(nest, ON_CONTOUR_TOLERANCE_MM) else {
+    let kerf_nest = route
+        .paths
+        .iter()
+        .find_map(|p| p.leads.as_ref())
+        .map(|l| cutroute_geometry::LeadFitter::new(nest, l.rules()).kerf_nest());
+    let Some(grid) = ContourGrid::new(kerf_nest.as_ref().unwrap_or(nest), ON_CONTOUR_TOLERANCE_MM)
+    else {
         return toolpath;
     };
+    let is_lead = |step: usize, span: &Span| {
+        route
+            .paths
+            .get(step)
+            .and_then(|p| p.leads.as_ref())
+            .is_some_and(|l| {
+                cutroute_geometry::chain_spans(&l.lead_in)
+                    .chain(cutroute_geometry::chain_spans(&l.lead_out))
+                    .any(|s| s.start == span.start && s.end == span.end)
+            })
+    };
     for m in &mut toolpath.moves {
-        if let ToolMove::Cut { span, link, .. } = m {
-            *link = !grid.on_contour(span.point_at(0.5), ON_CONTOUR_TOLERANCE_MM);
+        if let ToolMove::Cut { span, link, step } = m {
+            *link = !is_lead(*step, span)
+                && !grid.on_contour(span.point_at(0.5), ON_CONTOUR_TOLERANCE_MM);
         }
     }
     toolpath
@@ -608,6 +630,38 @@ mod tests {
         assert!(arrows.contains("L11.000 0.000") || arrows.contains("L10.000 1.000"));
     }
 
+    #[test]
+    fn path_route_leads_and_cuts_on_the_equidistants_are_no_links() {
+        let (nest, _) = common_edge_route();
+        // Parts A and C only (apart): their paths over the kerf nest, with leads.
+        let nest = Nest {
+            sheet: None,
+            parts: vec![nest.parts[0].clone(), nest.parts[2].clone()],
+        };
+        let settings = cutroute_geometry::KerfSettings {
+            kerf: 0.2,
+            pierce_clearance: 1.0,
+            switch_off_clearance: 0.5,
+            lead_in: cutroute_geometry::LeadSpec::new(cutroute_geometry::LeadShape::Arc, 2.0),
+            lead_out: cutroute_geometry::LeadSpec::new(cutroute_geometry::LeadShape::Line, 1.0),
+            ..Default::default()
+        };
+        let fitter = cutroute_geometry::LeadFitter::new(&nest, settings);
+        let kerf_nest = fitter.kerf_nest();
+        let route = Route::innermost_first(&kerf_nest, Point::new(-5.0, -5.0), None);
+        let paths = PathRoute::from_route(&route, &kerf_nest).unwrap();
+        let paths = fitter.attach_paths(&paths).unwrap();
+        let toolpath = path_route_toolpath(&paths, &nest);
+        assert!(toolpath
+            .moves
+            .iter()
+            .all(|m| !matches!(m, ToolMove::Cut { link: true, .. })));
+        // The leads are in the drawing's lead layer and the animation's toolpath.
+        assert_eq!(crate::kerf::path_lead_paths(&paths).len(), 2);
+        let leads: f64 = paths.paths.iter().map(|p| p.leads_length()).sum();
+        assert!((toolpath.cut_length() - paths.cut_length()).abs() < 1e-9 && leads > 0.0);
+    }
+
     /// Parts A = [0,10]², B = [10,20]×[0,10] sharing the edge x = 10, C = [30,40]×[0,10] apart;
     /// a path route cutting A∪B's outline, then the common edge, a link through scrap over to C
     /// and C's outline.
@@ -647,6 +701,7 @@ mod tests {
                 p(10.0, 0.0),
                 p(0.0, 0.0),
             ]),
+            leads: None,
         };
         let edge_then_c = ToolOnPath {
             pierce: p(10.0, 0.0),
@@ -664,6 +719,7 @@ mod tests {
                 p(40.0, 10.0),
                 p(35.0, 10.0),
             ]),
+            leads: None,
         };
         let route = PathRoute {
             start: p(0.0, -10.0),

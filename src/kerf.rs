@@ -10,13 +10,26 @@
 
 use std::fmt::Write;
 
-use cutroute_geometry::{chain_spans, equidistant, KerfSettings, LeadShape, Nest, Route};
+use cutroute_geometry::{
+    chain_spans, equidistant, KerfSettings, LeadShape, Nest, PathRoute, Route, Vertex,
+};
 use leptos::prelude::*;
 
 use crate::drawing::{contour_path, push_span};
 use crate::fields::{setting_field, Accept};
 use crate::i18n::tr;
 use crate::settings::{parse_tabs, shape_from_name, shape_name};
+
+/// Path data of a lead-in and a lead-out, the lead-out as a second subpath.
+fn leads_d(lead_in: &[Vertex], lead_out: &[Vertex]) -> String {
+    let mut d = String::new();
+    for chain in [lead_in, lead_out] {
+        let Some(first) = chain.first() else { continue };
+        let _ = write!(d, "M{:.3} {:.3}", first.point.x, first.point.y);
+        chain_spans(chain).for_each(|span| push_span(&span, &mut d));
+    }
+    d
+}
 
 /// Path data of each step's leads (lead-in, then lead-out as a second subpath), one entry per
 /// step that has leads.
@@ -25,15 +38,18 @@ pub fn lead_paths(route: &Route) -> Vec<String> {
         .steps
         .iter()
         .filter_map(|s| s.leads.as_ref())
-        .map(|leads| {
-            let mut d = String::new();
-            for chain in [&leads.lead_in, &leads.lead_out] {
-                let Some(first) = chain.first() else { continue };
-                let _ = write!(d, "M{:.3} {:.3}", first.point.x, first.point.y);
-                chain_spans(chain).for_each(|span| push_span(&span, &mut d));
-            }
-            d
-        })
+        .map(|leads| leads_d(&leads.lead_in, &leads.lead_out))
+        .collect()
+}
+
+/// Path data of each tool-on path's leads (sccp, gsccp, aoe with kerf), one entry per path
+/// that has leads.
+pub fn path_lead_paths(route: &PathRoute) -> Vec<String> {
+    route
+        .paths
+        .iter()
+        .filter_map(|p| p.leads.as_ref())
+        .map(|leads| leads_d(&leads.lead_in, &leads.lead_out))
         .collect()
 }
 
@@ -85,22 +101,21 @@ pub fn lead_lengths(route: &Route) -> (f64, f64) {
         })
 }
 
-/// The lead layers of the drawing: leads, equidistants, pierce and switch-off points.
+/// The lead layers of the drawing: leads, equidistants, pierce and switch-off points, of a
+/// contour route or of a path route (whose cuts are the equidistants themselves).
 #[component]
 pub fn LeadLayers(
     nest: Signal<Option<Nest>>,
     route: Signal<Option<Route>>,
+    paths: Signal<Option<PathRoute>>,
     extent: Signal<f64>,
 ) -> impl IntoView {
     let leads = move || {
-        route.with(|r| {
-            r.as_ref().map(|r| {
-                lead_paths(r)
-                    .into_iter()
-                    .map(|d| view! { <path class="lead" d=d /> })
-                    .collect_view()
-            })
-        })
+        let mut ds = route.with(|r| r.as_ref().map(lead_paths).unwrap_or_default());
+        ds.extend(paths.with(|p| p.as_ref().map(path_lead_paths).unwrap_or_default()));
+        ds.into_iter()
+            .map(|d| view! { <path class="lead" d=d /> })
+            .collect_view()
     };
     let equidistants = move || {
         route.with(|r| {
@@ -116,26 +131,35 @@ pub fn LeadLayers(
     });
     let marks = move || {
         let size = extent.get() / 300.0;
-        route.with(|r| {
-            r.as_ref().map(|r| {
-                r.steps
+        // M and M* of every step (contour route) or path (path route) with leads.
+        let mut points: Vec<_> = route.with(|r| {
+            r.iter()
+                .flat_map(|r| r.steps.iter().filter_map(|s| s.leads.as_ref()))
+                .map(|l| (l.pierce, l.switch_off))
+                .collect()
+        });
+        paths.with(|p| {
+            points.extend(p.iter().flat_map(|p| {
+                p.paths
                     .iter()
-                    .filter_map(|s| s.leads.as_ref())
-                    .map(|l| {
-                        view! {
-                            <circle class="pierce-m" cx=l.pierce.x cy=l.pierce.y r=size />
-                            <rect
-                                class="switch-off-m"
-                                x=l.switch_off.x - size
-                                y=l.switch_off.y - size
-                                width=2.0 * size
-                                height=2.0 * size
-                            />
-                        }
-                    })
-                    .collect_view()
+                    .filter_map(|path| Some((path.pierce, path.leads.as_ref()?.switch_off)))
+            }))
+        });
+        points
+            .into_iter()
+            .map(|(m, off)| {
+                view! {
+                    <circle class="pierce-m" cx=m.x cy=m.y r=size />
+                    <rect
+                        class="switch-off-m"
+                        x=off.x - size
+                        y=off.y - size
+                        width=2.0 * size
+                        height=2.0 * size
+                    />
+                }
             })
-        })
+            .collect_view()
     };
     view! {
         <path class="equidistants" d=equidistants />

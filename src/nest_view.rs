@@ -294,7 +294,7 @@ fn RouteLayers(extent: Memo<f64>) -> impl IntoView {
     };
     view! {
         <g class="route">
-            <crate::kerf::LeadLayers nest=nest route=route extent=Signal::from(extent) />
+            <crate::kerf::LeadLayers nest=nest route=route paths=paths extent=Signal::from(extent) />
             <path class="cut" d=cuts />
             <g class="tool-on-paths">{tool_on_paths}</g>
             <path class="link" d=links />

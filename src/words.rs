@@ -151,6 +151,12 @@ fn phase_ru(phase: &Phase) -> String {
                 "{} · подводы на концах цепочек, перемычек заменено врезками: {links_broken}",
                 phase_ru(base)
             ),
+            KerfNote::Leads {
+                source: KerfSource::Paths,
+            } => format!(
+                "{} · подводы на концах путей, резка по эквидистантам",
+                phase_ru(base)
+            ),
             // The contours by number, not the engine's English reasons.
             KerfNote::NoRoom { contours, .. } => format!(
                 "{} · нет места для подводов у контуров ({}): {}",

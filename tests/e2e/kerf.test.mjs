@@ -144,14 +144,14 @@ test('kerf and an arc lead-in: leads drawn and animated, G-code reads back with 
 
   await screenshot(page, 'kerf.png');
 
-  // A solver without a full-route model is refused by the page, in its language, and the
-  // route with leads stays on screen.
-  await page.selectOption('#solver', 'aoe');
-  await page.click('#start');
-  await page.waitForFunction(() => /^failed/.test(document.querySelector('#job-status')?.textContent ?? ''),
-    null, { timeout: 10000 });
-  assert.match(await page.textContent('#job-status'), /aoe solver does not cut with kerf and leads yet/);
+  // A path solver cuts on the equidistants with leads at each path's ends: sccp on nested.dbs
+  // (its parts apart, so one path per contour) draws every path's leads and M/M* points.
+  await runSolver(page, 'sccp', 3);
+  assert.match(await page.textContent('#phase'), /leads/, 'the sccp job says it fitted leads');
+  assert.equal(Number(await page.textContent('#pierces')), steps, 'one pierce per contour');
   assert.equal(await page.locator('#nest-view .leads path.lead').count(), steps);
+  assert.equal(await page.locator('#nest-view .pierce-regions circle.pierce-m').count(), steps);
+  assert.equal(await page.locator('#nest-view .pierce-regions rect.switch-off-m').count(), steps);
   assert.deepEqual(errors, []);
   await context.close();
 });

@@ -666,6 +666,7 @@ fn route_of(visits: &[Visit], order: &[usize], start: Point, finish: Option<Poin
                 paths.push(ToolOnPath {
                     pierce: visit.entry,
                     spans: opened(spans, opening, visit.entry),
+                    leads: None,
                 });
             }
             None => paths.extend(
@@ -676,6 +677,7 @@ fn route_of(visits: &[Visit], order: &[usize], start: Point, finish: Option<Poin
                     .map(|c| ToolOnPath {
                         pierce: c.spans[0].start,
                         spans: c.spans.clone(),
+                        leads: None,
                     }),
             ),
         }

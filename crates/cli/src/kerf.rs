@@ -10,7 +10,8 @@
 //! comparison of the benchmark). This module parses the flags and writes the report.
 
 use cutroute_geometry::{
-    KerfSettings, LeadError, LeadShape, LeadSpec, Nest, Route, StepLeads, TabSpec, Vertex,
+    KerfSettings, LeadError, LeadShape, LeadSpec, Nest, PathLeads, PathRoute, Route, StepLeads,
+    TabSpec, Vertex,
 };
 use cutroute_protocol::{JobRequest, KerfNote, KerfSource, Phase, Progress};
 use serde_json::{json, Value};
@@ -147,12 +148,10 @@ impl Kerf {
         if !self.is_on() {
             return Ok(request);
         }
-        if !matches!(
-            solver,
-            "nearest" | "ccp" | "heuristic" | "discrete" | "exact" | "chain"
-        ) {
+        // The engine's word on which solvers have a full-route model (today: every one).
+        if !request.solver.cuts_with_kerf() {
             return Err(format!(
-                "--solver {solver} does not cut with kerf and leads yet (nearest, ccp, heuristic, discrete, exact and chain do)"
+                "--solver {solver} does not cut with kerf and leads yet"
             ));
         }
         request.params.kerf = self.settings;
@@ -266,6 +265,51 @@ impl Kerf {
                     .collect::<Vec<_>>());
             }
         }
+    }
+}
+
+impl Kerf {
+    /// Adds the full-route fields to a path report: `start`, `finish`, the settings and the
+    /// lead lengths; each path of the report's `route` carries its `pierce` (M), `entry` and
+    /// `switch_off` as [x, y], `lead_in` and `lead_out` as [x, y, bulge] vertices.
+    pub fn report_paths(&self, report: &mut Value, route: &PathRoute) {
+        report["start"] = json!([route.start.x, route.start.y]);
+        if let Some(finish) = route.finish {
+            report["finish"] = json!([finish.x, finish.y]);
+        }
+        if !self.is_on() {
+            return;
+        }
+        let s = &self.settings;
+        report["kerf"] = json!({
+            "kerf": s.kerf,
+            "pierce_clearance": s.pierce_clearance,
+            "switch_off_clearance": s.switch_off_clearance,
+            "optimised_with_leads": true,
+        });
+        let leads = || route.paths.iter().filter_map(|p| p.leads.as_ref());
+        // The form: points as [x, y] (the route's serde form is {x, y}).
+        if let Some(paths) = report["route"]["paths"].as_array_mut() {
+            for (path, p) in paths.iter_mut().zip(&route.paths) {
+                let Some(l) = &p.leads else { continue };
+                let triples = |chain: &[Vertex]| {
+                    chain
+                        .iter()
+                        .map(|v| [v.point.x, v.point.y, v.bulge])
+                        .collect::<Vec<_>>()
+                };
+                path["pierce"] = json!([p.pierce.x, p.pierce.y]);
+                path["entry"] = json!([l.entry.x, l.entry.y]);
+                path["lead_in"] = json!(triples(&l.lead_in));
+                path["lead_out"] = json!(triples(&l.lead_out));
+                path["switch_off"] = json!([l.switch_off.x, l.switch_off.y]);
+                if let Some(fields) = path.as_object_mut() {
+                    fields.remove("leads");
+                }
+            }
+        }
+        report["lead_in_length"] = json!(leads().map(PathLeads::lead_in_length).sum::<f64>());
+        report["lead_out_length"] = json!(leads().map(PathLeads::lead_out_length).sum::<f64>());
     }
 }
 

@@ -501,7 +501,7 @@ fn run_job(job: &mut dyn Job, watch: &Watch, on_progress: &mut dyn FnMut(&Progre
         // A kerf job between its solver's end and its first route with leads: the leads are
         // part of the answer, so a stop waits for them (the main thread still reports what
         // was published at the grace's end).
-        let fitting_leads = progress.route().is_none()
+        let fitting_leads = progress.solution.is_none()
             && matches!(
                 progress.phase,
                 cutroute_protocol::Phase::Kerf {
@@ -597,6 +597,11 @@ impl SolverJob {
             source: e,
         };
         Ok(match request.solver {
+            // With kerf and leads every solver runs in the engine's kerf job (the page's code
+            // path): a path solver over the equidistants, leads at every path's ends.
+            _ if !request.params.kerf.is_idealised() => {
+                SolverJob::Engine(start_job(request).map_err(refused)?)
+            }
             SolverKind::Aoe => {
                 SolverJob::Aoe(Box::new(AoeJob::from_request(request).map_err(refused)?))
             }
@@ -1110,8 +1115,11 @@ fn convert_document(
             (name, ..) => solved(document, name.unwrap_or("ccp"), params.clone(), kerf),
         }
         .and_then(|routed| match routed {
-            Routed::Paths(_) if kerf.is_on() => {
-                Err("path routes (sccp, gsccp, aoe) do not cut with kerf and leads yet".into())
+            // A solved path route has its leads from the job; a file's own has none.
+            Routed::Paths(paths)
+                if kerf.is_on() && paths.paths.iter().any(|p| p.leads.is_none()) =>
+            {
+                Err("a file's own path route gets no leads: solve it with --solver sccp, gsccp or aoe".into())
             }
             routed => Ok(routed),
         })
@@ -1249,11 +1257,6 @@ fn solve(
     kerf: &kerf::Kerf,
 ) -> Result<Value, Failure> {
     let solver = solver_kind(solver_name)?;
-    if solver.gives_path_route() && kerf.is_on() {
-        return Err(Failure::Message(format!(
-            "--solver {solver_name} does not cut with kerf and leads yet"
-        )));
-    }
     let document = open(input)?;
     if solver.gives_path_route() && matches!(document.problem, Problem::PcgtspText { .. }) {
         return Err(Failure::Message(format!(
@@ -1292,6 +1295,7 @@ fn solve(
                 machine: &machine,
                 objective,
                 thermal,
+                kerf,
                 started,
             };
             report.of(nest, finished)?
@@ -1448,6 +1452,8 @@ struct PathReport<'a> {
     machine: &'a MachineParameters,
     objective: Objective,
     thermal: &'a thermal::Thermal,
+    /// The full route's settings: the job's paths carry their leads, printed per path.
+    kerf: &'a kerf::Kerf,
     /// When the run started (the report's `elapsed_s` runs to the report).
     started: std::time::Instant,
 }
@@ -1470,6 +1476,7 @@ impl PathReport<'_> {
                 stopped.unwrap_or("")
             )
         })?;
+        self.kerf.refused(Some(&progress))?;
         let solver_route = progress
             .path_route()
             .ok_or_else(|| format!("the solver found no route ({})", progress.phase))?;
@@ -1484,6 +1491,13 @@ impl PathReport<'_> {
                 Ok(repaired) => (repaired, None),
                 Err(e) => (None, Some(e)),
             };
+        if self.kerf.is_on() && repaired.is_some() {
+            return Err(Failure::Message(
+                "the rule repair's route (whole contours, standard cutting) gets no leads yet: \
+                 solve without --kerf or without the hard rules"
+                    .into(),
+            ));
+        }
         let route = repaired.as_ref().unwrap_or(solver_route);
         let (ub, lb, phase) = match &repaired {
             None => (
@@ -1546,6 +1560,7 @@ impl PathReport<'_> {
         }
         self.thermal
             .report_paths(&mut report, nest, route, machine, objective)?;
+        self.kerf.report_paths(&mut report, route);
         Ok(report)
     }
 }

@@ -210,12 +210,35 @@ fn the_defaults_keep_the_idealised_report() {
 }
 
 #[test]
-fn path_solvers_and_bad_flags_are_refused_with_leads() {
+fn path_solvers_print_leads_per_path_and_bad_flags_are_refused() {
     let file = data("nests/dbs-json/E1X_6_01.dbs.json");
-    let mut args = vec!["solve", &file, "--solver", "aoe"];
-    args.extend(PLASMA);
-    let (ok, _, err) = cutroute(&args);
-    assert!(!ok && err.contains("kerf"), "{err}");
+    for solver in ["sccp", "aoe"] {
+        let mut args = vec!["solve", &file, "--solver", solver, "--json"];
+        args.extend(PLASMA);
+        let report = json(&args);
+        assert!(report.get("kerf").is_some(), "{solver}");
+        let paths = report["route"]["paths"].as_array().expect("paths");
+        assert_eq!(paths.len() as f64, report["pierces"].as_f64().unwrap());
+        for path in paths {
+            for field in ["pierce", "entry", "lead_in", "lead_out", "switch_off"] {
+                assert!(path.get(field).is_some(), "{solver}: {field} in {path}");
+            }
+            let lead_in = path["lead_in"].as_array().unwrap();
+            assert_eq!(point(&lead_in[0]), point(&path["pierce"]), "{solver}");
+            assert_eq!(
+                point(&lead_in[lead_in.len() - 1]),
+                point(&path["entry"]),
+                "{solver}"
+            );
+            let lead_out = path["lead_out"].as_array().unwrap();
+            assert_eq!(
+                point(&lead_out[lead_out.len() - 1]),
+                point(&path["switch_off"]),
+                "{solver}"
+            );
+        }
+        assert!(report["lead_in_length"].as_f64().unwrap() > 0.0, "{solver}");
+    }
     let (ok, _, err) = cutroute(&["solve", &file, "--lead-in", "spiral"]);
     assert!(!ok && err.contains("--lead-in"), "{err}");
     let (ok, _, err) = cutroute(&["solve", &file, "--kerf=-1"]);

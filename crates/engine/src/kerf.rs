@@ -23,6 +23,9 @@
 //!
 //! With `leads_after` the job runs the solver on the nest only and attaches leads (no
 //! relaxation): the "solve, then attach leads" route of the benchmark.
+//!
+//! The path solvers (sccp, gsccp, aoe) run on the nest of equidistants instead, with leads at
+//! their paths' ends (module `kerf_paths`).
 
 use cutroute_geometry::{
     ContainmentForest, CutStep, KerfSettings, LeadError, LeadFitter, Nest, Route,
@@ -33,6 +36,7 @@ use cutroute_protocol::{
 use web_time::{Duration, Instant};
 
 use crate::full_route::{FullRouteBuilder, FullRouteJob, Modelling};
+use crate::kerf_paths::PathLeadsRun;
 use crate::thermal::ThermalJob;
 use crate::{EngineError, Job, JobStatus, Refusal};
 
@@ -272,6 +276,8 @@ pub struct KerfJob {
     /// The time one step's leads took to attach, as measured on the routes attached so far: a
     /// solver is stopped when its final route's leads would not be ready by the deadline.
     step_cost: Option<Duration>,
+    /// A path solver's run over the equidistants (sccp, gsccp, aoe): the job is that run.
+    paths: Option<PathLeadsRun>,
 }
 
 impl KerfJob {
@@ -313,6 +319,35 @@ impl KerfJob {
         if limit.is_finite() && limit > 0.0 {
             idealised.params.time_limit_s =
                 limit - (limit * FIT_RESERVE_SHARE).min(FIT_RESERVE_MAX_S);
+        }
+        if solver.gives_path_route() {
+            // Cut on the equidistants: the solver's paths are the tool centre's; leads at
+            // their ends (`leads_after` changes nothing: nothing is relaxed).
+            let equidistants = LeadFitter::with_forest(nest, &forest, settings).kerf_nest();
+            let mut over_equidistants = idealised.clone();
+            if let Problem::Nest { nest, .. } = &mut over_equidistants.problem {
+                *nest = equidistants;
+            }
+            let run = PathLeadsRun::new(
+                nest.clone(),
+                forest.clone(),
+                settings,
+                request.params.machine,
+                request.params.objective,
+                start(&over_equidistants)?,
+            );
+            return Ok(KerfJob {
+                nest: nest.clone(),
+                forest,
+                settings,
+                relax: false,
+                chained: false,
+                candidates: Vec::new(),
+                turn: 0,
+                deadline: None,
+                step_cost: None,
+                paths: Some(run),
+            });
         }
         let mut candidates = Vec::new();
         let after = request.params.leads_after;
@@ -382,6 +417,7 @@ impl KerfJob {
             turn: 0,
             deadline: started.checked_add(Duration::from_secs_f64(limit.clamp(0.0, 1.0e7))),
             step_cost: None,
+            paths: None,
         })
     }
 
@@ -603,6 +639,9 @@ impl KerfJob {
 
 impl Job for KerfJob {
     fn step(&mut self, budget: Duration) -> JobStatus {
+        if let Some(paths) = self.paths.as_mut() {
+            return paths.step(budget);
+        }
         if self.end_at_deadline() {
             return JobStatus::Done;
         }
@@ -650,6 +689,9 @@ impl Job for KerfJob {
     }
 
     fn progress(&self) -> Progress {
+        if let Some(paths) = &self.paths {
+            return paths.progress();
+        }
         let done = self.done();
         let mut inner: Vec<Progress> = self.candidates.iter().map(|c| c.job.progress()).collect();
         // Each candidate's full route: the finished one, the one being relaxed, or the last
@@ -773,7 +815,7 @@ fn links(route: &Route) -> usize {
     route.steps.iter().filter(|s| !s.is_pierced()).count()
 }
 
-fn no_room(errors: &[LeadError]) -> KerfNote {
+pub(crate) fn no_room(errors: &[LeadError]) -> KerfNote {
     let contours = errors
         .iter()
         .map(|e| match e {

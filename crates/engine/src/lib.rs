@@ -34,6 +34,7 @@
 mod full_route;
 mod jobs;
 mod kerf;
+mod kerf_paths;
 mod located;
 mod nearest;
 mod open;

@@ -192,14 +192,97 @@ fn chain_gives_a_checked_chained_route_with_leads() {
 }
 
 #[test]
-fn solvers_without_a_full_route_model_are_refused_and_bad_settings_too() {
-    let problem = nest_problem("nests/dbs-json/E1X_6_01.dbs.json");
-    for solver in [SolverKind::Aoe, SolverKind::Sccp, SolverKind::Gsccp] {
-        let refused = start_job(&request(&problem, solver, plasma(), false));
-        assert!(
-            matches!(refused, Err(EngineError::SolverRefused { .. })),
-            "{solver:?}"
+fn path_solvers_give_checked_path_routes_with_leads() {
+    for file in ["nests/dbs-json/E1X_6_01.dbs.json", "nests/dbs/nested.dbs"] {
+        let problem = nest_problem(file);
+        let nest = nest_of(&problem);
+        for solver in [SolverKind::Sccp, SolverKind::Gsccp, SolverKind::Aoe] {
+            let mut job = start_job(&request(&problem, solver, plasma(), false)).expect("starts");
+            let progress = run_to_end(job.as_mut(), &mut |p| {
+                // Every route a progress shows is a full route: leads on every path.
+                if let Some(route) = p.path_route() {
+                    assert!(route.paths.iter().all(|p| p.leads.is_some()));
+                }
+            });
+            assert!(
+                matches!(
+                    &progress.phase,
+                    Phase::Kerf {
+                        note: KerfNote::Leads {
+                            source: KerfSource::Paths
+                        },
+                        ..
+                    }
+                ),
+                "{file} {solver:?}: {}",
+                progress.phase
+            );
+            let route = progress.path_route().cloned().expect("a route");
+            assert_eq!(
+                route.pierce_count(),
+                nest.contour_count(),
+                "{file} {solver:?}"
+            );
+            let problems: Vec<_> = route
+                .problems(nest, nest.check_tolerance())
+                .into_iter()
+                .filter(|p| !matches!(p, cutroute_geometry::PathRouteError::Overlap { .. }))
+                .collect();
+            assert_eq!(problems, Vec::new(), "{file} {solver:?}");
+            // The reported objective counts the leads as cut.
+            let machine = cutroute_geometry::MachineParameters::default();
+            let leads: f64 = route.paths.iter().map(|p| p.leads_length()).sum();
+            assert!(leads > 0.0);
+            assert!(
+                (progress.bounds.upper.unwrap()
+                    - machine.time(
+                        route.cut_length(),
+                        route.idle_length(),
+                        route.pierce_count()
+                    ))
+                .abs()
+                    < 1e-6
+            );
+        }
+    }
+}
+
+#[test]
+fn a_path_solver_names_the_contour_without_room() {
+    // ring.dbs: a 4 mm ring whose hole has no room for kerf 2 and d₁ 5.
+    let problem = nest_problem("nests/dbs/ring.dbs");
+    for solver in [SolverKind::Sccp, SolverKind::Aoe] {
+        let progress = run_to_end(
+            start_job(&request(&problem, solver, plasma(), false))
+                .expect("starts")
+                .as_mut(),
+            &mut |_| {},
         );
+        assert!(progress.path_route().is_none(), "{solver:?}");
+        assert!(
+            matches!(
+                &progress.phase,
+                Phase::Kerf { note: KerfNote::NoRoom { contours, .. }, .. } if !contours.is_empty()
+            ),
+            "{solver:?}: {}",
+            progress.phase
+        );
+    }
+}
+
+#[test]
+fn every_solver_starts_with_kerf_and_bad_settings_are_refused() {
+    let problem = nest_problem("nests/dbs-json/E1X_6_01.dbs.json");
+    // Every solver has a full-route model now; one without would be refused here.
+    for solver in SolverKind::ALL {
+        let started = start_job(&request(&problem, solver, plasma(), false));
+        assert_eq!(
+            started.is_ok(),
+            solver.cuts_with_kerf(),
+            "{solver:?}: {:?}",
+            started.err()
+        );
+        assert!(solver.cuts_with_kerf(), "{solver:?}");
     }
     let bad = KerfSettings {
         kerf: f64::NAN,

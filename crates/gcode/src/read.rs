@@ -230,6 +230,7 @@ impl Program {
                 Motion::TorchOn { at, .. } => paths.push(ToolOnPath {
                     pierce: at,
                     spans: Vec::new(),
+                    leads: None,
                 }),
                 Motion::Feed {
                     span,

@@ -1,10 +1,12 @@
 //! Routes with kerf and leads written as G-code and read back: the program cuts on the
 //! equidistants with the leads, and reads back with the same lengths and pierces.
 
-use cutroute_gcode::{read_gcode, route_gcode, ArcOutput, DistanceMode, GcodeOptions, ReadOptions};
+use cutroute_gcode::{
+    path_route_gcode, read_gcode, route_gcode, ArcOutput, DistanceMode, GcodeOptions, ReadOptions,
+};
 use cutroute_geometry::{
-    generate_nest, KerfSettings, LeadFitter, LeadShape, LeadSpec, Nest, Point, Route, TabSpec,
-    Toolpath,
+    chain_spans, generate_nest, KerfSettings, LeadFitter, LeadShape, LeadSpec, Nest, PathRoute,
+    Point, Route, TabSpec, Toolpath,
 };
 
 /// A generated nest and its baseline route (innermost first) with leads fitted under `settings`,
@@ -221,4 +223,81 @@ fn controller_compensation_reads_back_as_the_route() {
         route_gcode(&nest, &with_arcs, &options),
         Err(cutroute_gcode::GcodeError::CompensationNeedsLineLeads { .. })
     ));
+}
+
+/// A path route (segment cutting's form) over the kerf nest of a generated nest, with leads
+/// at every path's ends, checked.
+fn path_routed(contours: usize, seed: u64, settings: KerfSettings) -> (Nest, PathRoute) {
+    let nest = generate_nest(contours, seed);
+    let fitter = LeadFitter::new(&nest, settings);
+    let kerf_nest = fitter.kerf_nest();
+    let origin = Point::new(0.0, 0.0);
+    let route = Route::innermost_first(&kerf_nest, origin, Some(origin));
+    let paths = PathRoute::from_route(&route, &kerf_nest).unwrap();
+    let paths = fitter.attach_paths(&paths).unwrap();
+    assert_eq!(paths.problems(&nest, 1e-6), Vec::new());
+    (nest, paths)
+}
+
+#[test]
+fn a_path_route_with_leads_reads_back_with_the_same_lengths_pierces_and_leads() {
+    let settings = KerfSettings {
+        kerf: 2.0,
+        pierce_clearance: 2.0,
+        switch_off_clearance: 1.0,
+        lead_in: LeadSpec::new(LeadShape::Arc, 4.0),
+        lead_out: LeadSpec::new(LeadShape::Line, 2.0),
+        ..KerfSettings::default()
+    };
+    let (_, route) = path_routed(40, 11, settings);
+    for arcs in [ArcOutput::CentreOffsets, ArcOutput::Radius] {
+        let options = GcodeOptions {
+            arcs,
+            decimals: 6,
+            ..GcodeOptions::default()
+        };
+        let text = path_route_gcode(&route, &options).unwrap();
+        let program = read_gcode(
+            &text,
+            &ReadOptions {
+                start: route.start,
+                ..ReadOptions::default()
+            },
+        )
+        .unwrap();
+        let what = format!("{arcs:?}");
+        assert_eq!(program.pierce_count(), route.pierce_count(), "{what}");
+        assert!(
+            (program.cut_length() - route.cut_length()).abs() < 1e-3,
+            "{what}: cut {} vs {}",
+            program.cut_length(),
+            route.cut_length()
+        );
+        assert!(
+            (program.idle_length() - route.idle_length()).abs() < 1e-3,
+            "{what}"
+        );
+        // Read back as paths: each pierces at M, starts with the lead-in's spans (the same
+        // lengths), ends with the lead-out's at M*.
+        let back = program.path_route();
+        assert_eq!(back.paths.len(), route.paths.len(), "{what}");
+        for (read, written) in back.paths.iter().zip(&route.paths) {
+            let leads = written.leads.as_ref().unwrap();
+            assert!(read.pierce.distance(written.pierce) < 1e-5, "{what}");
+            assert!(read.end().distance(leads.switch_off) < 1e-5, "{what}");
+            let lead_in: Vec<f64> = chain_spans(&leads.lead_in).map(|s| s.length()).collect();
+            let lead_out: Vec<f64> = chain_spans(&leads.lead_out)
+                .map(|s| s.length())
+                .filter(|&l| l > 1e-9)
+                .collect();
+            assert!(!lead_in.is_empty() && !lead_out.is_empty(), "{what}");
+            for (span, length) in read.spans.iter().zip(&lead_in) {
+                assert!((span.length() - length).abs() < 1e-4, "{what}: lead-in");
+            }
+            for (span, length) in read.spans.iter().rev().zip(lead_out.iter().rev()) {
+                assert!((span.length() - length).abs() < 1e-4, "{what}: lead-out");
+            }
+            assert!((read.length() - written.length()).abs() < 1e-3, "{what}");
+        }
+    }
 }

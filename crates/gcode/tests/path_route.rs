@@ -24,10 +24,12 @@ fn two_paths() -> PathRoute {
             },
             Span::line(p(30.0, 0.0), p(20.0, 0.0)),
         ],
+        leads: None,
     };
     let second = ToolOnPath {
         pierce: p(40.0, 0.0),
         spans: vec![Span::line(p(40.0, 0.0), p(40.0, 25.0))],
+        leads: None,
     };
     PathRoute {
         start: p(-5.0, -5.0),

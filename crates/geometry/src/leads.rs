@@ -492,7 +492,7 @@ pub fn opened_at(contour: &Contour, at: Point, min_piece: f64) -> Vec<Span> {
     out
 }
 
-mod vertex_triples {
+pub(crate) mod vertex_triples {
     //! Lead vertices as `[x, y, bulge]` triples, the JSON form.
     use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
@@ -642,7 +642,7 @@ impl<'a> LeadFitter<'a> {
         }
     }
 
-    fn box_of(&self, r: ContourRef) -> Option<&BoundingBox> {
+    pub(crate) fn box_of(&self, r: ContourRef) -> Option<&BoundingBox> {
         let boxes = self.boxes.get_or_init(|| {
             self.nest
                 .parts
@@ -698,8 +698,23 @@ impl<'a> LeadFitter<'a> {
     }
 
     /// The nest the fitter fits leads in.
-    pub(crate) fn nest(&self) -> &'a Nest {
+    pub fn nest(&self) -> &'a Nest {
         self.nest
+    }
+
+    /// This fitter with the settings paths are fitted under: no overcut and no tabs (a path's
+    /// cut is the solver's, not a contour round and on).
+    pub fn for_paths(&self) -> LeadFitter<'a> {
+        LeadFitter {
+            nest: self.nest,
+            forest: self.forest.clone(),
+            settings: KerfSettings {
+                overcut: 0.0,
+                tabs: TabSpec::default(),
+                ..self.settings
+            },
+            boxes: self.boxes.clone(),
+        }
     }
 
     /// The nest's containment forest.
@@ -880,7 +895,7 @@ impl<'a> LeadFitter<'a> {
     }
 
     /// The asked lead, then shorter ones, then (lines) turned ones, then a line for an arc.
-    fn variants(&self, spec: LeadSpec) -> impl Iterator<Item = LeadSpec> {
+    pub(crate) fn variants(&self, spec: LeadSpec) -> impl Iterator<Item = LeadSpec> {
         let mut out = vec![spec];
         if spec.shape != LeadShape::None {
             out.extend([0.75, 0.5].map(|f| spec.scaled(f)));
@@ -935,7 +950,12 @@ impl<'a> LeadFitter<'a> {
 
     /// The first rule a lead chain breaks: its free end (M for a lead-in, M* for a lead-out)
     /// must lie in the region, and every span must keep kerf/2 from every contour.
-    fn chain_problem(&self, r: ContourRef, chain: &[Vertex], lead_in: bool) -> Option<LeadProblem> {
+    pub(crate) fn chain_problem(
+        &self,
+        r: ContourRef,
+        chain: &[Vertex],
+        lead_in: bool,
+    ) -> Option<LeadProblem> {
         self.chain_problem_linked(r, chain, lead_in, false)
     }
 
@@ -1328,7 +1348,7 @@ impl<'a> LeadFitter<'a> {
     }
 }
 
-fn vertex(p: Point) -> Vertex {
+pub(crate) fn vertex(p: Point) -> Vertex {
     Vertex::arc(p.x, p.y, 0.0)
 }
 
@@ -1343,7 +1363,7 @@ fn frame_at(eq: &Contour, s: f64) -> (Point, Point) {
 
 /// The lead-in chain from M to `entry`, where the cut leaves in direction `tangent`; the
 /// scrap side is the left of the tangent.
-fn lead_in_chain(spec: LeadSpec, entry: Point, tangent: Point) -> Vec<Vertex> {
+pub(crate) fn lead_in_chain(spec: LeadSpec, entry: Point, tangent: Point) -> Vec<Vertex> {
     let normal = tangent.rotated_quarter();
     match spec.shape {
         LeadShape::None => vec![vertex(entry)],
@@ -1372,7 +1392,7 @@ fn lead_in_chain(spec: LeadSpec, entry: Point, tangent: Point) -> Vec<Vertex> {
 }
 
 /// The lead-out chain from `exit`, where the cut arrives in direction `tangent`, to M*.
-fn lead_out_chain(spec: LeadSpec, exit: Point, tangent: Point) -> Vec<Vertex> {
+pub(crate) fn lead_out_chain(spec: LeadSpec, exit: Point, tangent: Point) -> Vec<Vertex> {
     let normal = tangent.rotated_quarter();
     match spec.shape {
         LeadShape::None => vec![vertex(exit)],

@@ -81,6 +81,7 @@ mod forest;
 mod generator;
 mod kerf;
 mod leads;
+mod path_leads;
 mod path_route;
 mod point;
 mod rng;
@@ -103,7 +104,8 @@ pub use leads::{
     chain_spans, opened_at, place_tabs, KerfSettings, LeadError, LeadFitter, LeadProblem,
     LeadShape, LeadSpec, StepLeads, Tab, TabSpec,
 };
-pub use path_route::{PathRoute, PathRouteError, ToolOnPath};
+pub use path_leads::PathLeads;
+pub use path_route::{PathLeadError, PathRoute, PathRouteError, ToolOnPath};
 pub use rng::{SplitMix64, Xoshiro256};
 pub use route::{
     in_scrap_region, is_scrap_region, ContourRef, CutStep, Entry, MachineParameters, Objective,

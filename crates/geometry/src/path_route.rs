@@ -14,28 +14,63 @@ use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use crate::{
-    BoundingBox, ContainmentForest, ContourRef, MachineParameters, Nest, Point, Route, RouteError,
-    Span,
+    BoundingBox, ContainmentForest, ContourRef, LeadFitter, LeadProblem, MachineParameters, Nest,
+    PathLeads, Point, Route, RouteError, Span,
 };
 
 /// One pierce's worth of cutting: the torch pierces at `pierce` and cuts `spans` in order.
+/// With [`PathLeads`] (the full cutting route: kerf, pierce regions, leads) the torch pierces at
+/// `pierce` = M, runs the lead-in to the entry where the spans start (on an equidistant), cuts
+/// them, and runs the lead-out to the switch-off point M*.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct ToolOnPath {
-    /// Where the torch pierces; the first span starts here.
+    /// Where the torch pierces; without leads the first span starts here.
     pub pierce: Point,
     /// The spans in cutting direction, each starting where the previous one ends.
     pub spans: Vec<Span>,
+    /// The lead-in, the entry, the lead-out and the switch-off point, when the route is the
+    /// full cutting route. (Always written, even as `null`, and never flattened: the worker's
+    /// binary codec needs every field in place.)
+    #[serde(default)]
+    pub leads: Option<PathLeads>,
 }
 
 impl ToolOnPath {
-    /// Where the torch switches off: the end of the last span (the pierce point if empty).
-    pub fn end(&self) -> Point {
-        self.spans.last().map_or(self.pierce, |s| s.end)
+    /// The path's spans from `pierce`, without leads.
+    pub fn new(pierce: Point, spans: Vec<Span>) -> ToolOnPath {
+        ToolOnPath {
+            pierce,
+            spans,
+            leads: None,
+        }
     }
 
-    /// Tool-on length of the path, mm.
+    /// Where the cut of the spans starts: the entry with leads, else the pierce point.
+    pub fn cut_start(&self) -> Point {
+        self.leads.as_ref().map_or(self.pierce, |l| l.entry)
+    }
+
+    /// Where the spans end: the exit with leads, the switch-off point without (the pierce
+    /// point if empty).
+    pub fn end(&self) -> Point {
+        self.spans.last().map_or(self.cut_start(), |s| s.end)
+    }
+
+    /// Where the torch switches off: M* with leads, else the end of the spans.
+    pub fn switch_off(&self) -> Point {
+        self.leads.as_ref().map_or(self.end(), |l| l.switch_off)
+    }
+
+    /// Length of the lead-in and lead-out, mm (0 without leads).
+    pub fn leads_length(&self) -> f64 {
+        self.leads
+            .as_ref()
+            .map_or(0.0, |l| l.lead_in_length() + l.lead_out_length())
+    }
+
+    /// Tool-on length of the path, leads included, mm.
     pub fn length(&self) -> f64 {
-        self.spans.iter().map(|s| s.length()).sum()
+        self.spans.iter().map(|s| s.length()).sum::<f64>() + self.leads_length()
     }
 }
 
@@ -142,6 +177,41 @@ pub enum PathRouteError {
         /// Its y.
         y: f64,
     },
+    /// With leads: a lead of a path breaks a rule of the model (M ∉ G_M, M* ∉ G_M*, a lead
+    /// closer than kerf/2 to a contour, an entry or exit off the equidistants, chains not
+    /// joined).
+    #[error(transparent)]
+    Lead(#[from] PathLeadError),
+    /// With leads on other paths: this path has none, or was fitted under other kerf or
+    /// clearances.
+    #[error("path {path} has no leads, or leads under other kerf rules than the route's first")]
+    LeadsMismatch {
+        /// Index of the path.
+        path: usize,
+    },
+    /// With leads: the contour has no equidistant at kerf/2, so no cut keeps the kerf off it.
+    #[error("contour {contour:?} has no equidistant at half the kerf")]
+    NoEquidistant {
+        /// The contour.
+        contour: ContourRef,
+    },
+    /// With leads: a tool-on span comes closer than kerf/2 to a contour, so the kerf burns
+    /// into it (parts spaced narrower than the kerf, or a cut off the equidistants).
+    #[error("span {span} of path {path} comes {distance} mm from contour {contour:?} at ({x}, {y}), closer than half the kerf")]
+    CutTooClose {
+        /// Index of the path.
+        path: usize,
+        /// The contour it comes too close to.
+        contour: ContourRef,
+        /// Index of the span in the path.
+        span: usize,
+        /// Where, x.
+        x: f64,
+        /// Where, y.
+        y: f64,
+        /// The distance, mm.
+        distance: f64,
+    },
     /// A contour's boundary is completed before that of a contour inside it: the outer piece
     /// would drop (or move) before the inner one is cut out.
     #[error("contour {outer:?} is completed (path {outer_path}) before contour {inner:?} inside it (path {inner_path})")]
@@ -155,6 +225,16 @@ pub enum PathRouteError {
         /// Path that completes it.
         outer_path: usize,
     },
+}
+
+/// With leads (the full cutting route): a path's lead breaks a rule of the model.
+#[derive(Clone, Debug, PartialEq, Error)]
+#[error("path {path}: {problem}")]
+pub struct PathLeadError {
+    /// Index of the path.
+    pub path: usize,
+    /// The rule broken.
+    pub problem: LeadProblem,
 }
 
 /// R-tree entry: the box of one span of a contour.
@@ -307,10 +387,7 @@ impl PathRoute {
                 _ => false,
             };
             if !linked {
-                paths.push(ToolOnPath {
-                    pierce: cut.pierce_point,
-                    spans: Vec::new(),
-                });
+                paths.push(ToolOnPath::new(cut.pierce_point, Vec::new()));
             }
             let path = paths.last_mut().expect("a path was just ensured");
             let Some(entry) = contour.nearest_point(cut.pierce_point) else {
@@ -347,7 +424,7 @@ impl PathRoute {
         let mut at = self.start;
         for p in &self.paths {
             moves.push((at, p.pierce));
-            at = p.end();
+            at = p.switch_off();
         }
         if let Some(finish) = self.finish {
             moves.push((at, finish));
@@ -360,7 +437,7 @@ impl PathRoute {
         self.idle_moves().iter().map(|(a, b)| a.distance(*b)).sum()
     }
 
-    /// Total tool-on length (contours and pieces through scrap alike), mm.
+    /// Total tool-on length (contours, pieces through scrap and leads alike), mm.
     pub fn cut_length(&self) -> f64 {
         self.paths.iter().map(|p| p.length()).sum()
     }
@@ -388,7 +465,98 @@ impl PathRoute {
     /// - every tool-on piece that lies on no contour crosses no contour and lies in scrap (an
     ///   even number of part contours around it: outside every part, or in a hole);
     /// - when a contour's boundary is completed, every contour inside it is already complete.
+    ///
+    /// With leads on its paths (the full cutting route) the cut is checked against the nest of
+    /// equidistants at kerf/2 ([`LeadFitter::kerf_nest`]: every contour's equidistant covered
+    /// exactly once, precedence, pieces through scrap) and every path's leads against the
+    /// nest ([`LeadFitter::path_lead_problems`]: M ∈ G_M, M* ∈ G_M*, leads at least kerf/2
+    /// from every contour, entry and exit on the equidistants); every tool-on span keeps
+    /// kerf/2 from every contour; every contour has an equidistant; every path has leads under
+    /// the same rules.
     pub fn problems(&self, nest: &Nest, tolerance: f64) -> Vec<PathRouteError> {
+        let Some(rules) = self
+            .paths
+            .iter()
+            .find_map(|p| p.leads.as_ref())
+            .map(PathLeads::rules)
+        else {
+            return self.cut_problems(nest, tolerance);
+        };
+        let forest = nest.containment_forest();
+        let fitter = LeadFitter::with_forest(nest, &forest, rules);
+        let mut problems: Vec<PathRouteError> = nest
+            .contour_refs()
+            .filter(|&r| fitter.equidistant(r).is_err())
+            .map(|contour| PathRouteError::NoEquidistant { contour })
+            .collect();
+        problems.extend(self.cut_problems(&fitter.kerf_nest(), tolerance));
+        for (p, path) in self.paths.iter().enumerate() {
+            match &path.leads {
+                Some(leads) if leads.rules() == rules => problems.extend(
+                    fitter
+                        .path_lead_problems(path, leads, tolerance)
+                        .into_iter()
+                        .map(|problem| PathLeadError { path: p, problem }.into()),
+                ),
+                _ => problems.push(PathRouteError::LeadsMismatch { path: p }),
+            }
+        }
+        problems.extend(self.clearance_problems(nest, rules.kerf / 2.0, tolerance));
+        problems
+    }
+
+    /// Every tool-on span (leads aside: their checker samples them) closer than `half` less
+    /// `tolerance` to a contour of `nest`, one per path: a cut whose kerf burns into a part.
+    pub fn clearance_problems(
+        &self,
+        nest: &Nest,
+        half: f64,
+        tolerance: f64,
+    ) -> Vec<PathRouteError> {
+        let refs: Vec<ContourRef> = nest.contour_refs().collect();
+        let contours: Vec<Vec<Span>> = nest
+            .contour_refs()
+            .map(|r| nest.contour(r).map_or(Vec::new(), |c| c.spans().collect()))
+            .collect();
+        let mut entries = Vec::new();
+        for (c, spans) in contours.iter().enumerate() {
+            for (s, span) in spans.iter().enumerate() {
+                entries.push(SpanEntry {
+                    envelope: aabb(&span.bounding_box()),
+                    contour: c,
+                    span: s,
+                });
+            }
+        }
+        let tree = RTree::bulk_load(entries);
+        let mut problems = Vec::new();
+        'paths: for (p, path) in self.paths.iter().enumerate() {
+            for (s, span) in path.spans.iter().enumerate() {
+                let reach = aabb(&span.bounding_box().expanded(half));
+                for e in tree.locate_in_envelope_intersecting(&reach) {
+                    let other = &contours[e.contour][e.span];
+                    let distance = span.distance_to_span(other);
+                    if distance < half - tolerance {
+                        let at = span.nearest_point(other.nearest_point(span.point_at(0.5)).point);
+                        problems.push(PathRouteError::CutTooClose {
+                            path: p,
+                            contour: refs[e.contour],
+                            span: s,
+                            x: at.point.x,
+                            y: at.point.y,
+                            distance,
+                        });
+                        continue 'paths;
+                    }
+                }
+            }
+        }
+        problems
+    }
+
+    /// The checks of [`PathRoute::problems`] on the cut itself (the spans against `nest`'s
+    /// contours: contiguity, coverage, pieces through scrap, precedence).
+    fn cut_problems(&self, nest: &Nest, tolerance: f64) -> Vec<PathRouteError> {
         let mut problems = Vec::new();
         let refs: Vec<ContourRef> = nest.contour_refs().collect();
         let contours: Vec<Vec<Span>> = refs
@@ -421,7 +589,7 @@ impl PathRoute {
                 });
                 continue;
             }
-            let mut at = path.pierce;
+            let mut at = path.cut_start();
             for (s, span) in path.spans.iter().enumerate() {
                 if !(span.start.is_finite() && span.end.is_finite() && span.bulge.is_finite()) {
                     problems.push(PathRouteError::NonFinite { path: p, span: s });
@@ -682,6 +850,7 @@ mod tests {
                 .windows(2)
                 .map(|w| Span::line(p(w[0].0, w[0].1), p(w[1].0, w[1].1)))
                 .collect(),
+            leads: None,
         }
     }
 
@@ -906,10 +1075,12 @@ mod tests {
                         Span::line(p(11.0, 0.0), p(10.0, 0.0)),
                         Span::line(p(10.0, 0.0), p(10.0, 10.0)),
                     ],
+                    leads: None,
                 },
                 ToolOnPath {
                     pierce: p(5.0, 5.0),
                     spans: vec![],
+                    leads: None,
                 },
             ],
             finish: None,
@@ -1040,10 +1211,12 @@ mod tests {
                 ToolOnPath {
                     pierce: spans[0].start,
                     spans: vec![first],
+                    leads: None,
                 },
                 ToolOnPath {
                     pierce: spans[1].end,
                     spans: vec![spans[1].reversed(), second.reversed()],
+                    leads: None,
                 },
             ],
             finish: None,
@@ -1124,7 +1297,7 @@ mod tests {
             prop_assert!(problems.iter().any(|e| matches!(e, PathRouteError::Gap { length, .. } if (length - victim.length()).abs() < 1e-6)), "{:?}", problems);
             let mut repeated = route.clone();
             // First, so that no contour's completion moves.
-            repeated.paths.insert(0, ToolOnPath { pierce: victim.start, spans: vec![victim] });
+            repeated.paths.insert(0, ToolOnPath { pierce: victim.start, spans: vec![victim], leads: None });
             let problems = repeated.problems(&nest, TOL);
             prop_assert!(problems.iter().all(|e| matches!(e, PathRouteError::Overlap { .. })), "{:?}", problems);
             let doubled: f64 = problems.iter().map(|e| match e { PathRouteError::Overlap { length, .. } => *length, _ => 0.0 }).sum();

@@ -194,7 +194,8 @@ impl Toolpath {
     }
 
     /// The toolpath of a segment-cutting route: per path an idle move (when the head is not
-    /// there already), a pierce, and the path's spans as cuts; the path's index is the move's
+    /// there already), a pierce, and the path's spans (with leads: lead-in, spans, lead-out)
+    /// as cuts; the path's index is the move's
     /// step. Pieces through scrap are cuts like the rest (`link: false`: telling them apart
     /// needs the nest, see [`PathRoute::problems`]).
     pub fn from_path_route(route: &PathRoute) -> Toolpath {
@@ -211,7 +212,10 @@ impl Toolpath {
                 at: path.pierce,
                 step,
             });
-            for &span in &path.spans {
+            // With leads: the lead-in, the spans, the lead-out, torch on throughout.
+            let lead_in = path.leads.iter().flat_map(|l| chain_spans(&l.lead_in));
+            let lead_out = path.leads.iter().flat_map(|l| chain_spans(&l.lead_out));
+            for span in lead_in.chain(path.spans.iter().copied()).chain(lead_out) {
                 if span.length() > MIN_PIECE_LENGTH {
                     moves.push(ToolMove::Cut {
                         step,
@@ -220,7 +224,7 @@ impl Toolpath {
                     });
                 }
             }
-            at = path.end();
+            at = path.switch_off();
         }
         if let Some(finish) = route.finish {
             if at != finish {

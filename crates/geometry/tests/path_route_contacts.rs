@@ -63,6 +63,7 @@ fn cutting_the_arc_twice_is_still_an_overlap() {
     route.paths.push(ToolOnPath {
         pierce: piece.start,
         spans: vec![piece],
+        leads: None,
     });
     let problems = route.problems(&nest, 0.01);
     assert!(
@@ -115,10 +116,12 @@ fn an_arc_bulging_a_rounding_error_across_a_line_is_covered_by_the_line() {
             ToolOnPath {
                 pierce: spans[0].start,
                 spans,
+                leads: None,
             },
             ToolOnPath {
                 pierce: corners[0],
                 spans: rest,
+                leads: None,
             },
         ],
         ..full

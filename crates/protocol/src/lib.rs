@@ -234,16 +234,19 @@ impl SolverKind {
     /// carry over, and chain runs over the equidistants with leads at its chains' ends. Exact
     /// searches the discretised full-route model (candidate entries with their leads, idle
     /// legs from M* to the next M), so its bounds are about that model. The path solvers
-    /// (sccp, gsccp, aoe) cut pieces of contours, shared edges among them, and have no
-    /// full-route model yet.
+    /// (sccp, gsccp, aoe) run over the equidistants at kerf/2, with a lead-in at each path's
+    /// start and a lead-out at its end. Every solver has one; the match makes a new solver
+    /// decide.
     pub fn cuts_with_kerf(self) -> bool {
         match self {
             SolverKind::NearestNeighbour
             | SolverKind::Ccp
             | SolverKind::Heuristic
             | SolverKind::Exact
-            | SolverKind::Chain => true,
-            SolverKind::Sccp | SolverKind::Gsccp | SolverKind::Aoe => false,
+            | SolverKind::Chain
+            | SolverKind::Sccp
+            | SolverKind::Gsccp
+            | SolverKind::Aoe => true,
         }
     }
 
@@ -532,6 +535,7 @@ mod tests {
                     end: Point::new(40.0, 40.0),
                     bulge: 0.0,
                 }],
+                leads: None,
             }],
             finish: None,
         };
@@ -583,6 +587,7 @@ mod tests {
                             end: Point::new(10.0, 0.0),
                             bulge: 0.5,
                         }],
+                        leads: None,
                     }],
                     finish: Some(Point::new(1.0, 1.0)),
                 }),

@@ -93,6 +93,9 @@ pub enum KerfSource {
         /// Links of the solver's route that became pierces.
         links_broken: usize,
     },
+    /// A path solver's route (sccp, gsccp, aoe) over the equidistants: a lead-in at each
+    /// path's start and a lead-out at its end.
+    Paths,
 }
 
 /// What a kerf job (the full cutting route: kerf, leads, tabs) did to the route of the solver
@@ -376,6 +379,12 @@ impl fmt::Display for Phase {
                 } => write!(
                     f,
                     "{base} · leads at the chains' ends, {links_broken} link(s) broken into pierces"
+                ),
+                KerfNote::Leads {
+                    source: KerfSource::Paths,
+                } => write!(
+                    f,
+                    "{base} · leads at the paths' ends, cut on the equidistants"
                 ),
                 KerfNote::NoRoom { errors, .. } => write!(
                     f,

@@ -541,6 +541,7 @@ impl Search {
                 ToolOnPath {
                     pierce: entry_point(segment, place[s]),
                     spans,
+                    leads: None,
                 }
             })
             .collect();
