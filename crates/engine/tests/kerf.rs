@@ -4,7 +4,7 @@
 
 use std::path::PathBuf;
 
-use cutroute_engine::{open_document, run_to_end, start_job, EngineError};
+use cutroute_engine::{open_document, run_to_end, start_job};
 use cutroute_geometry::{KerfSettings, LeadShape, LeadSpec, Nest, Route, TabSpec};
 use cutroute_protocol::{
     JobRequest, KerfNote, KerfSource, Phase, Problem, Progress, Solution, SolverKind, SolverParams,
