@@ -307,12 +307,16 @@ enum Failure {
         #[source]
         source: cutroute_segments::SegmentError,
     },
-    /// A solver ended with an error it reports in words (AOE's job).
-    #[error("--solver {solver}: {message}")]
-    Solver {
+    /// AOE's job failed.
+    #[error("--solver {solver}: {source}")]
+    Aoe {
         solver: &'static str,
-        message: String,
+        #[source]
+        source: cutroute_aoe::AoeSolveError,
     },
+    /// The heat model or a rule check refused the route.
+    #[error(transparent)]
+    Thermal(#[from] cutroute_thermal::ThermalError),
 }
 
 impl From<String> for Failure {
@@ -639,9 +643,9 @@ impl SolverJob {
                     extra.insert("components".into(), json!(solution.components));
                 }
                 Some(Err(e)) => {
-                    return Err(Failure::Solver {
+                    return Err(Failure::Aoe {
                         solver: solver.name(),
-                        message: e.clone(),
+                        source: e.clone(),
                     })
                 }
                 // Stopped before its route was made (the job runs in slices): no extras, and
