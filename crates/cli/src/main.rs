@@ -1481,9 +1481,18 @@ impl PathReport<'_> {
             )
         })?;
         self.kerf.refused(Some(&progress))?;
+        // Stopped by the limit while it still had no route (AOE building its plan graph): the
+        // limit is what to change, so the message names it.
         let solver_route = progress
             .path_route()
-            .ok_or_else(|| format!("the solver found no route ({})", progress.phase))?;
+            .ok_or_else(|| match finished.run.stopped {
+                Some(why) => format!(
+                    "--time-limit {time_limit_s}: the {solver_name} solver found no route before \
+                     it was stopped ({why}; {})",
+                    progress.phase
+                ),
+                None => format!("the solver found no route ({})", progress.phase),
+            })?;
         // Hard rules: a route whose contour route breaks them is replaced by that route
         // repaired (standard cutting). Its ub is its own objective; AOE's lb assumed edges cut
         // once.
