@@ -77,7 +77,7 @@ pub struct AoeSolution {
 }
 
 /// Why [`solve_nest`] failed.
-#[derive(Debug, Error)]
+#[derive(Clone, Debug, Error)]
 pub enum AoeSolveError {
     /// The plan graph could not be built.
     #[error("cannot build the plan graph: {0}")]

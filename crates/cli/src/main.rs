@@ -307,12 +307,16 @@ enum Failure {
         #[source]
         source: cutroute_segments::SegmentError,
     },
-    /// A solver ended with an error it reports in words (AOE's job).
-    #[error("--solver {solver}: {message}")]
-    Solver {
+    /// AOE's job failed.
+    #[error("--solver {solver}: {source}")]
+    Aoe {
         solver: &'static str,
-        message: String,
+        #[source]
+        source: cutroute_aoe::AoeSolveError,
     },
+    /// The heat model or a rule check refused the route.
+    #[error(transparent)]
+    Thermal(#[from] cutroute_thermal::ThermalError),
 }
 
 impl From<String> for Failure {
@@ -639,9 +643,9 @@ impl SolverJob {
                     extra.insert("components".into(), json!(solution.components));
                 }
                 Some(Err(e)) => {
-                    return Err(Failure::Solver {
+                    return Err(Failure::Aoe {
                         solver: solver.name(),
-                        message: e.clone(),
+                        source: e.clone(),
                     })
                 }
                 // Stopped before its route was made (the job runs in slices): no extras, and
@@ -1477,9 +1481,18 @@ impl PathReport<'_> {
             )
         })?;
         self.kerf.refused(Some(&progress))?;
+        // Stopped by the limit while it still had no route (AOE building its plan graph): the
+        // limit is what to change, so the message names it.
         let solver_route = progress
             .path_route()
-            .ok_or_else(|| format!("the solver found no route ({})", progress.phase))?;
+            .ok_or_else(|| match finished.run.stopped {
+                Some(why) => format!(
+                    "--time-limit {time_limit_s}: the {solver_name} solver found no route before \
+                     it was stopped ({why}; {})",
+                    progress.phase
+                ),
+                None => format!("the solver found no route ({})", progress.phase),
+            })?;
         // Hard rules: a route whose contour route breaks them is replaced by that route
         // repaired (standard cutting). Its ub is its own objective; AOE's lb assumed edges cut
         // once.

@@ -2,10 +2,10 @@
 //! rules as a check or as a hard repair, and the report's `heat`, `rule_violations` and
 //! per-step `t`.
 
-use cutroute_engine::enforce_thermal_rules;
+use cutroute_engine::{enforce_thermal_rules, PathRepairError};
 use cutroute_geometry::{MachineParameters, Nest, Objective, Route};
 use cutroute_protocol::{SolverKind, ThermalSettings};
-use cutroute_thermal::{check_rules, route_pierces, HeatModel, RuleParams, RuleSet};
+use cutroute_thermal::{check_rules, route_pierces, HeatModel, RuleParams, RuleSet, ThermalError};
 use serde_json::{json, Value};
 
 /// The thermal flags of `solve`.
@@ -114,7 +114,7 @@ impl Thermal {
         route: Route,
         machine: &MachineParameters,
         objective: Objective,
-    ) -> Result<Route, String> {
+    ) -> Result<Route, ThermalError> {
         if !self.hard {
             return Ok(route);
         }
@@ -134,7 +134,7 @@ impl Thermal {
         route: &cutroute_geometry::PathRoute,
         machine: &MachineParameters,
         objective: Objective,
-    ) -> Result<Option<cutroute_geometry::PathRoute>, String> {
+    ) -> Result<Option<cutroute_geometry::PathRoute>, PathRepairError> {
         if !self.hard {
             return Ok(None);
         }
@@ -155,7 +155,7 @@ impl Thermal {
         route: &cutroute_geometry::PathRoute,
         machine: &MachineParameters,
         objective: Objective,
-    ) -> Result<(), String> {
+    ) -> Result<(), ThermalError> {
         let pierces = cutroute_thermal::path_route_pierces(route, machine);
         let settings = ThermalSettings {
             rules: self.rules,
@@ -191,11 +191,9 @@ impl Thermal {
         route: &Route,
         machine: &MachineParameters,
         objective: Objective,
-    ) -> Result<(), String> {
-        let pierces = route_pierces(route, nest, machine).map_err(|e| e.to_string())?;
-        let counts = check_rules(nest, route, self.rules, &RuleParams::default())
-            .map_err(|e| e.to_string())?
-            .counts();
+    ) -> Result<(), ThermalError> {
+        let pierces = route_pierces(route, nest, machine)?;
+        let counts = check_rules(nest, route, self.rules, &RuleParams::default())?.counts();
         report["heat"] = json!(self.model.load(&pierces));
         report["thermal"] = json!({
             "sigma_mm": self.model.sigma_mm,

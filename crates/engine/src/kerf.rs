@@ -66,9 +66,25 @@ pub fn supports_kerf(solver: SolverKind) -> bool {
     solver.cuts_with_kerf()
 }
 
+/// A kerf setting [`validate_kerf`] refuses.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum KerfSettingsError {
+    /// A length is negative, infinite or NaN.
+    #[error("{name} {value}: must be finite and non-negative")]
+    BadLength {
+        /// The setting, in words.
+        name: &'static str,
+        /// Its value.
+        value: f64,
+    },
+    /// Tabs are asked for with no width.
+    #[error("tabs need a positive width")]
+    TabWidth,
+}
+
 /// Checks the settings a request carries: every length finite and non-negative, and d₂ < d₁
 /// when d₁ is set (the model's 0 ≤ d₂ < d₁).
-pub fn validate_kerf(settings: &KerfSettings) -> Result<(), String> {
+pub fn validate_kerf(settings: &KerfSettings) -> Result<(), KerfSettingsError> {
     let lengths = [
         ("kerf", settings.kerf),
         ("pierce clearance", settings.pierce_clearance),
@@ -80,11 +96,11 @@ pub fn validate_kerf(settings: &KerfSettings) -> Result<(), String> {
     ];
     for (name, value) in lengths {
         if !(value.is_finite() && value >= 0.0) {
-            return Err(format!("{name} {value}: must be finite and non-negative"));
+            return Err(KerfSettingsError::BadLength { name, value });
         }
     }
     if settings.tabs.count > 0 && settings.tabs.width <= 0.0 {
-        return Err("tabs need a positive width".into());
+        return Err(KerfSettingsError::TabWidth);
     }
     Ok(())
 }
@@ -309,7 +325,7 @@ impl KerfJob {
             return Err(refused(Refusal::NoFullRouteModel));
         }
         let settings = request.params.kerf;
-        validate_kerf(&settings).map_err(|message| refused(Refusal::Settings(message)))?;
+        validate_kerf(&settings).map_err(|e| refused(e.into()))?;
         let forest = nest.containment_forest();
         // The inner requests are idealised: the kerf is this job's.
         let mut idealised = request.clone();

@@ -47,18 +47,20 @@ use web_time::Duration;
 
 pub use full_route::{build_full_route_model, FullRouteBuilder, FullRouteJob, FullRouteModel};
 pub use jobs::{ccp_options, CcpJob, ChainJob, DiscreteJob, DiscreteMode};
-pub use kerf::{fit_leads, supports_kerf, validate_kerf, KerfJob, OVERRUN_LIMIT};
+pub use kerf::{
+    fit_leads, supports_kerf, validate_kerf, KerfJob, KerfSettingsError, OVERRUN_LIMIT,
+};
 pub use nearest::NearestNeighbourJob;
 pub use open::{format_name, OpenError};
 pub use open_files::{
     is_pcglns_result, open_document, open_gcode, open_gcode_with, open_sheet, open_together,
     task_instance, POINT_TOLERANCE_MM,
 };
-pub use path_jobs::{idle_tree_bound, AoeJob, PlanBound, SegmentJob};
+pub use path_jobs::{idle_tree_bound, AoeJob, PlanBound, PlanBoundError, SegmentJob};
 pub use thermal::{
     check_path_rules, enforce_thermal_rules, enforce_thermal_rules_on_paths, heat_penalty,
-    measure_path_route, measure_route, path_contour_route, price_consecutive_heat, ThermalJob,
-    ThermalMeasure,
+    measure_path_route, measure_route, path_contour_route, price_consecutive_heat, PathRepairError,
+    ThermalJob, ThermalMeasure,
 };
 
 /// How long one [`Job::step`] may run before it returns, so cancel requests are seen quickly.
@@ -141,6 +143,9 @@ pub enum Refusal {
     /// The heat model's σ or τ is out of range.
     #[error("{0}")]
     Thermal(#[from] cutroute_thermal::ThermalError),
+    /// A kerf or lead length is out of range.
+    #[error("{0}")]
+    Kerf(#[from] kerf::KerfSettingsError),
     /// The solver has no model of the full cutting route (kerf, leads).
     #[error("does not cut with kerf and leads yet (nearest, ccp, heuristic, exact and chain do)")]
     NoFullRouteModel,

@@ -5,7 +5,8 @@
 //! `alternatives`.
 
 use cutroute_aoe::{
-    AoeHeat, AoeSolution, AoeSolveOptions, AoeSolving, AoeStage, PlanGraph, PlanOptions,
+    AoeHeat, AoeSolution, AoeSolveError, AoeSolveOptions, AoeSolving, AoeStage, EmbeddingError,
+    PlanError, PlanGraph, PlanOptions,
 };
 use cutroute_geometry::float::Libm;
 use cutroute_geometry::{BoundingBox, MachineParameters, Nest, Objective, PathRoute, Point, Span};
@@ -21,6 +22,17 @@ use std::collections::HashMap;
 use web_time::{Duration, Instant};
 
 use crate::{EngineError, Job, JobStatus};
+
+/// Why a [`PlanBound`] could not be measured: the nest gives no plane graph.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum PlanBoundError {
+    /// The plan graph could not be built.
+    #[error(transparent)]
+    Plan(#[from] PlanError),
+    /// A component of the plan graph could not be embedded.
+    #[error(transparent)]
+    Embedding(#[from] EmbeddingError),
+}
 
 /// What every route of a plan must at least cut and pierce, from the nest's plane graph
 /// (`cutroute-aoe`'s [`PlanGraph`]: contours split at touchings and crossings, common edges
@@ -193,15 +205,14 @@ impl PlanBound {
         start: Point,
         finish: Option<Point>,
         tolerance: f64,
-    ) -> Result<Self, String> {
+    ) -> Result<Self, PlanBoundError> {
         let plan = PlanGraph::from_nest(
             nest,
             &PlanOptions {
                 tolerance,
                 ..PlanOptions::default()
             },
-        )
-        .map_err(|e| e.to_string())?;
+        )?;
         Self::from_plan(&plan, nest, start, finish, tolerance)
     }
 
@@ -212,14 +223,14 @@ impl PlanBound {
         start: Point,
         finish: Option<Point>,
         tolerance: f64,
-    ) -> Result<Self, String> {
+    ) -> Result<Self, PlanBoundError> {
         let graph = plan.graph();
         let edges = graph.edge_count();
         let length: f64 = (0..edges)
             .flat_map(|e| plan.edge_spans(e).iter())
             .map(|s| s.length())
             .sum();
-        let components = plan.components().map_err(|e| e.to_string())?;
+        let components = plan.components()?;
         let trail_pierces = components
             .iter()
             .map(|c| cutroute_aoe::pierce_lower_bound(c.embedding.graph()))
@@ -327,7 +338,7 @@ pub struct SegmentJob {
     machine: MachineParameters,
     objective: Objective,
     tolerance: f64,
-    bound: Option<Result<PlanBound, String>>,
+    bound: Option<Result<PlanBound, PlanBoundError>>,
     started: Instant,
 }
 
@@ -390,7 +401,7 @@ impl SegmentJob {
     }
 
     /// The plan graph's bound, once the first step has measured it (`Err`: no plane graph).
-    pub fn plan_bound(&self) -> Option<&Result<PlanBound, String>> {
+    pub fn plan_bound(&self) -> Option<&Result<PlanBound, PlanBoundError>> {
         self.bound.as_ref()
     }
 }
@@ -483,7 +494,7 @@ pub struct AoeJob {
     machine: MachineParameters,
     objective: Objective,
     solving: AoeSolving,
-    outcome: Option<Result<(AoeSolution, Option<PlanBound>), String>>,
+    outcome: Option<Result<(AoeSolution, Option<PlanBound>), AoeSolveError>>,
     started: Instant,
 }
 
@@ -531,7 +542,7 @@ impl AoeJob {
     }
 
     /// The solution and the plan bound, once the job has run (`Err`: why it failed).
-    pub fn outcome(&self) -> Option<&Result<(AoeSolution, Option<PlanBound>), String>> {
+    pub fn outcome(&self) -> Option<&Result<(AoeSolution, Option<PlanBound>), AoeSolveError>> {
         self.outcome.as_ref()
     }
 }
@@ -557,7 +568,7 @@ impl Job for AoeJob {
                 JobStatus::Done
             }
             Some(Err(e)) => {
-                self.outcome = Some(Err(e.to_string()));
+                self.outcome = Some(Err(e.clone()));
                 JobStatus::Done
             }
         }

@@ -25,12 +25,14 @@
 use std::cell::RefCell;
 
 use cutroute_ccp::HeatPenalty;
-use cutroute_geometry::{MachineParameters, Nest, Objective, PathRoute, Route};
+use cutroute_geometry::{
+    MachineParameters, Nest, Objective, PathRoute, PathRouteError, Route, RouteError,
+};
 use cutroute_protocol::{Phase, Progress, Solution, SolverKind, ThermalNote, ThermalSettings};
 use cutroute_thermal::{
     admissible_pierce_points, check_rules, contour_route_of_paths, enforce_rules,
     path_route_pierces, relax_pierce_points, route_pierces, HeatModel, RuleCheck, RuleCounts,
-    RuleParams, RuleRepair, Violation,
+    RuleParams, RuleRepair, ThermalError, Violation,
 };
 use web_time::{Duration, Instant};
 
@@ -49,6 +51,21 @@ const LIVE_RULES_MAX_CONTOURS: usize = 1_000;
 /// promise is limit + 1 s, and the inner job ends at its limit.
 pub const FINAL_CHECK_GRACE: Duration = Duration::from_millis(800);
 
+/// Why a path route's hard-rule repair failed: the thermal crate refused, or the repaired
+/// contour route could not be cut as standard cutting.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum PathRepairError {
+    /// The rule check, the repair or the heat relaxation refused.
+    #[error(transparent)]
+    Thermal(#[from] ThermalError),
+    /// The repaired contour route does not fit the nest as tool-on paths.
+    #[error(transparent)]
+    Route(#[from] RouteError),
+    /// The repaired route, as tool-on paths, fails the path checker.
+    #[error("the repaired route fails the checker: {0}")]
+    FailsChecker(#[source] PathRouteError),
+}
+
 /// The final route's rule check: the check, the route it checks (a path route's contour
 /// route), and the progress's (route, path route) it reports on.
 type FinalCheck = (RuleCheck, Route, (Option<Route>, Option<PathRoute>));
@@ -61,7 +78,7 @@ enum RepairWork {
     /// repaired route is cut as standard cutting.
     Rules { repair: RuleRepair, path: bool },
     /// The repair could not start (reported as the repair's failure).
-    Failed(String),
+    Failed(ThermalError),
 }
 
 /// A measure (H, or the rule check) of a route that is not the final one runs only when at
@@ -81,10 +98,8 @@ pub fn enforce_thermal_rules(
     settings: &ThermalSettings,
     machine: &MachineParameters,
     objective: Objective,
-) -> Result<Route, String> {
-    let route = enforce_rules(nest, &route, settings.rules, &RuleParams::default())
-        .map_err(|e| e.to_string())?
-        .route;
+) -> Result<Route, ThermalError> {
+    let route = enforce_rules(nest, &route, settings.rules, &RuleParams::default())?.route;
     relax_repaired(nest, route, settings, machine, objective)
 }
 
@@ -96,14 +111,14 @@ fn relax_repaired(
     settings: &ThermalSettings,
     machine: &MachineParameters,
     objective: Objective,
-) -> Result<Route, String> {
+) -> Result<Route, ThermalError> {
     if !settings.penalised() {
         return Ok(route);
     }
-    let model = settings.model().map_err(|e| e.to_string())?;
+    let model = settings.model()?;
     let params = RuleParams::default();
     let candidates = if settings.rules.part {
-        Some(admissible_pierce_points(nest, &route, &params).map_err(|e| e.to_string())?)
+        Some(admissible_pierce_points(nest, &route, &params)?)
     } else {
         None
     };
@@ -117,7 +132,6 @@ fn relax_repaired(
         RELAX_PASSES,
         candidates.as_deref(),
     )
-    .map_err(|e| e.to_string())
 }
 
 /// Hard rules on a route of tool-on paths: `Ok(None)` when its contour route
@@ -131,10 +145,9 @@ pub fn enforce_thermal_rules_on_paths(
     settings: &ThermalSettings,
     machine: &MachineParameters,
     objective: Objective,
-) -> Result<Option<PathRoute>, String> {
+) -> Result<Option<PathRoute>, PathRepairError> {
     let contours = path_contour_route(nest, path_route);
-    let report = check_rules(nest, &contours, settings.rules, &RuleParams::default())
-        .map_err(|e| e.to_string())?;
+    let report = check_rules(nest, &contours, settings.rules, &RuleParams::default())?;
     if report.violations.is_empty() {
         return Ok(None);
     }
@@ -144,8 +157,8 @@ pub fn enforce_thermal_rules_on_paths(
 
 /// A repaired contour route as a route of tool-on paths (standard cutting: whole contours,
 /// common edges cut twice), or why it fails the path checker.
-fn cut_as_standard(nest: &Nest, route: &Route) -> Result<PathRoute, String> {
-    let paths = PathRoute::from_route(route, nest).map_err(|e| e.to_string())?;
+fn cut_as_standard(nest: &Nest, route: &Route) -> Result<PathRoute, PathRepairError> {
+    let paths = PathRoute::from_route(route, nest)?;
     // The repaired route must pass the path checker as the solver's did (pieces cut twice
     // allowed); when it does not, the repair fails and the caller keeps the solver's route.
     if let Some(problem) = paths
@@ -153,7 +166,7 @@ fn cut_as_standard(nest: &Nest, route: &Route) -> Result<PathRoute, String> {
         .into_iter()
         .find(|p| !matches!(p, cutroute_geometry::PathRouteError::Overlap { .. }))
     {
-        return Err(format!("the repaired route fails the checker: {problem}"));
+        return Err(PathRepairError::FailsChecker(problem));
     }
     Ok(paths)
 }
@@ -163,14 +176,13 @@ pub fn check_path_rules(
     nest: &Nest,
     path_route: &PathRoute,
     settings: &ThermalSettings,
-) -> Result<cutroute_thermal::RuleReport, String> {
+) -> Result<cutroute_thermal::RuleReport, ThermalError> {
     check_rules(
         nest,
         &path_contour_route(nest, path_route),
         settings.rules,
         &RuleParams::default(),
     )
-    .map_err(|e| e.to_string())
 }
 
 /// Adds to every arc between two candidate pierce points of `discrete` the heat term H would
@@ -241,11 +253,10 @@ pub fn measure_route(
     route: &Route,
     settings: &ThermalSettings,
     machine: &MachineParameters,
-) -> Result<ThermalMeasure, String> {
+) -> Result<ThermalMeasure, ThermalError> {
     let heat = measure_heat(nest, route, settings, machine)?;
     let (counts, violations) = if settings.rules.any() {
-        let report = check_rules(nest, route, settings.rules, &RuleParams::default())
-            .map_err(|e| e.to_string())?;
+        let report = check_rules(nest, route, settings.rules, &RuleParams::default())?;
         (Some(report.counts()), report.violations)
     } else {
         (None, Vec::new())
@@ -262,9 +273,9 @@ fn measure_heat(
     route: &Route,
     settings: &ThermalSettings,
     machine: &MachineParameters,
-) -> Result<f64, String> {
-    let model = settings.model().map_err(|e| e.to_string())?;
-    let pierces = route_pierces(route, nest, machine).map_err(|e| e.to_string())?;
+) -> Result<f64, ThermalError> {
+    let model = settings.model()?;
+    let pierces = route_pierces(route, nest, machine)?;
     Ok(model.load(&pierces))
 }
 
@@ -273,8 +284,8 @@ pub fn measure_path_route(
     route: &PathRoute,
     settings: &ThermalSettings,
     machine: &MachineParameters,
-) -> Result<f64, String> {
-    let model = settings.model().map_err(|e| e.to_string())?;
+) -> Result<f64, ThermalError> {
+    let model = settings.model()?;
     Ok(model.load(&path_route_pierces(route, machine)))
 }
 
@@ -319,9 +330,9 @@ pub struct ThermalJob {
     settings: ThermalSettings,
     done: bool,
     /// The repaired final route, or why the repair failed (the solver's route is then kept).
-    repaired: Option<Result<Route, String>>,
+    repaired: Option<Result<Route, ThermalError>>,
     /// The same for a path route: its contour route repaired, as standard cutting.
-    repaired_path: Option<Result<PathRoute, String>>,
+    repaired_path: Option<Result<PathRoute, PathRepairError>>,
     /// The hard-rule repair under way, a piece per step (about a second on Nest02/03).
     repair_work: Option<RepairWork>,
     /// The final route's rule check under way: the check, the (contour) route it checks, and
@@ -382,7 +393,7 @@ impl ThermalJob {
             self.repair_work = Some(
                 match RuleCheck::new(self.settings.rules, RuleParams::default()) {
                     Ok(check) => RepairWork::PathCheck { contours, check },
-                    Err(e) => RepairWork::Failed(e.to_string()),
+                    Err(e) => RepairWork::Failed(e),
                 },
             );
             return;
@@ -397,31 +408,24 @@ impl ThermalJob {
                         repair,
                         path: false,
                     },
-                    Err(e) => RepairWork::Failed(e.to_string()),
+                    Err(e) => RepairWork::Failed(e),
                 },
             );
             return;
         }
         // Not hard: the discrete solvers' pierce points relaxed on the heat weight.
-        self.repaired = Some(
-            self.settings
-                .model()
-                .map_err(|e| e.to_string())
-                .and_then(|model| {
-                    let weight_mm =
-                        heat_penalty(&self.settings, self.objective).weight_mm(&self.machine);
-                    relax_pierce_points(
-                        &self.nest,
-                        &route,
-                        &self.machine,
-                        &model,
-                        weight_mm,
-                        RELAX_PASSES,
-                        None,
-                    )
-                    .map_err(|e| e.to_string())
-                }),
-        );
+        self.repaired = Some(self.settings.model().and_then(|model| {
+            let weight_mm = heat_penalty(&self.settings, self.objective).weight_mm(&self.machine);
+            relax_pierce_points(
+                &self.nest,
+                &route,
+                &self.machine,
+                &model,
+                weight_mm,
+                RELAX_PASSES,
+                None,
+            )
+        }));
     }
 
     /// Works on the repair under way for about `budget`; true when it is over (its result is
@@ -442,10 +446,10 @@ impl ThermalJob {
                 Ok(Some(_)) => {
                     match RuleRepair::new(&contours, self.settings.rules, RuleParams::default()) {
                         Ok(repair) => RepairWork::Rules { repair, path: true },
-                        Err(e) => RepairWork::Failed(e.to_string()),
+                        Err(e) => RepairWork::Failed(e),
                     }
                 }
-                Err(e) => RepairWork::Failed(e.to_string()),
+                Err(e) => RepairWork::Failed(e),
             },
             RepairWork::Rules { mut repair, path } => match repair.advance(nest, budget) {
                 Ok(None) => RepairWork::Rules { repair, path },
@@ -458,18 +462,21 @@ impl ThermalJob {
                         self.objective,
                     );
                     if path {
-                        self.repaired_path =
-                            Some(route.and_then(|route| cut_as_standard(nest, &route)));
+                        self.repaired_path = Some(
+                            route
+                                .map_err(PathRepairError::from)
+                                .and_then(|route| cut_as_standard(nest, &route)),
+                        );
                     } else {
                         self.repaired = Some(route);
                     }
                     return true;
                 }
-                Err(e) => RepairWork::Failed(e.to_string()),
+                Err(e) => RepairWork::Failed(e),
             },
             RepairWork::Failed(e) => {
                 if self.base_is_path() {
-                    self.repaired_path = Some(Err(e));
+                    self.repaired_path = Some(Err(e.into()));
                 } else {
                     self.repaired = Some(Err(e));
                 }
@@ -682,7 +689,9 @@ impl ThermalJob {
                 Err(e) => {
                     progress.phase = thermal_phase(
                         std::mem::take(&mut progress.phase),
-                        ThermalNote::RepairFailed { error: e.clone() },
+                        ThermalNote::RepairFailed {
+                            error: e.to_string(),
+                        },
                     )
                 }
             }

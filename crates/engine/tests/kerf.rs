@@ -4,7 +4,9 @@
 
 use std::path::PathBuf;
 
-use cutroute_engine::{open_document, run_to_end, start_job};
+use cutroute_engine::{
+    open_document, run_to_end, start_job, validate_kerf, EngineError, KerfSettingsError, Refusal,
+};
 use cutroute_geometry::{KerfSettings, LeadShape, LeadSpec, Nest, Route, TabSpec};
 use cutroute_protocol::{
     JobRequest, KerfNote, KerfSource, Phase, Problem, Progress, Solution, SolverKind, SolverParams,
@@ -308,4 +310,50 @@ fn idealised_settings_leave_the_job_as_it_was() {
         .and_then(Solution::into_route)
         .expect("a route");
     assert!(route.steps.iter().all(|s| s.leads.is_none()));
+}
+
+#[test]
+fn out_of_range_kerf_settings_are_refused_by_name() {
+    let negative = KerfSettings {
+        lead_in: LeadSpec {
+            length: -1.0,
+            ..plasma().lead_in
+        },
+        ..plasma()
+    };
+    assert_eq!(
+        validate_kerf(&negative),
+        Err(KerfSettingsError::BadLength {
+            name: "lead-in length",
+            value: -1.0
+        })
+    );
+    let no_width = KerfSettings {
+        tabs: TabSpec {
+            count: 2,
+            width: 0.0,
+        },
+        ..plasma()
+    };
+    assert_eq!(validate_kerf(&no_width), Err(KerfSettingsError::TabWidth));
+    assert_eq!(validate_kerf(&plasma()), Ok(()));
+    // The job's refusal keeps the typed reason and the same words.
+    let problem = nest_problem("nests/dbs-json/E1X_6_01.dbs.json");
+    let refused = start_job(&request(&problem, SolverKind::Ccp, negative, false))
+        .err()
+        .expect("refused");
+    assert_eq!(
+        refused,
+        EngineError::SolverRefused {
+            solver: "ccp",
+            reason: Refusal::Kerf(KerfSettingsError::BadLength {
+                name: "lead-in length",
+                value: -1.0
+            }),
+        }
+    );
+    assert_eq!(
+        refused.to_string(),
+        "ccp: lead-in length -1: must be finite and non-negative"
+    );
 }
