@@ -110,28 +110,6 @@ fn discrete_exact_job_bound_never_exceeds_the_discrete_optimum() {
     }
 }
 
-/// On seven.dbs (50 contours) the job's bound stays below its own route.
-#[test]
-fn discrete_exact_job_on_seven_reports_a_bound_below_its_route() {
-    let (name, bytes) = data("nests/dbs/seven.dbs");
-    let document = open_document(&name, &bytes).expect("opens");
-    let request = JobRequest {
-        job_id: 4,
-        problem: document.problem.clone(),
-        solver: SolverKind::Exact,
-        params: SolverParams {
-            time_limit_s: 3.0,
-            discretisation_step_mm: 25.0,
-            ..SolverParams::default()
-        },
-    };
-    let mut job = start_job(&request).expect("starts");
-    let result = run_to_end(job.as_mut(), &mut |_| {});
-    let idle = check_route(&document.problem, &result);
-    let lb = result.bounds.lower.expect("a lower bound");
-    assert!(lb > 0.0 && lb <= idle, "bound {lb} vs route {idle}");
-}
-
 /// On nested.dbs (87 contours, 70 innermost: the bound runs the decomposition by spatial
 /// groups) the job's bound stays below its own route.
 #[test]
