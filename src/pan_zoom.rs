@@ -19,32 +19,26 @@
 use std::collections::HashMap;
 use std::time::Duration;
 
-use cutroute_geometry::{BoundingBox, Point};
+use cutroute_geometry::BoundingBox;
 use leptos::prelude::*;
 use wasm_bindgen::JsCast;
 use web_sys::{KeyboardEvent, PointerEvent, SvgGraphicsElement, WheelEvent};
 
-/// The SVG `viewBox` attribute `"x y width height"` of a view: a box in the drawing's flipped
-/// frame (y down), as [`PanZoom`] keeps it.
-pub fn view_box_attribute(view: &BoundingBox) -> String {
-    format!(
-        "{} {} {} {}",
-        view.min.x,
-        view.min.y,
-        view.width(),
-        view.height()
-    )
-}
+/// An SVG `viewBox` `[x, y, width, height]` in the drawing's flipped frame (y down). Boxes of
+/// the model are geometry's `BoundingBox`; `fitted_view` is where one becomes the other.
+pub type ViewBox = [f64; 4];
 
-/// The view (a box in the drawing's flipped frame, y down) that shows `bounds` (model
-/// coordinates, y up) with a margin of 3 % of its longer side (at least 1 mm). The drawing's
-/// group flips y, so the view spans [−max.y, −min.y].
-pub fn fitted_view(bounds: BoundingBox) -> BoundingBox {
-    let margin = (bounds.width().max(bounds.height()) * 0.03).max(1.0);
-    BoundingBox::from_corners(
-        Point::new(bounds.min.x - margin, -bounds.max.y - margin),
-        Point::new(bounds.max.x + margin, -bounds.min.y + margin),
-    )
+/// The view box that shows `bounds` (model coordinates, y up) with a margin of 3 % of its longer
+/// side (at least 1 mm). The drawing's group flips y, so the box spans [−max.y, −min.y].
+pub fn fitted_view(bounds: BoundingBox) -> ViewBox {
+    let (width, height) = (bounds.width(), bounds.height());
+    let margin = (width.max(height) * 0.03).max(1.0);
+    [
+        bounds.min.x - margin,
+        -bounds.max.y - margin,
+        width + 2.0 * margin,
+        height + 2.0 * margin,
+    ]
 }
 
 /// Zoom factor of one key press.
@@ -54,27 +48,16 @@ const KEY_PAN: f64 = 0.1;
 /// A wheel gesture ends when no wheel event came for this long; the view box is then committed.
 pub const WHEEL_SETTLE_MS: u64 = 150;
 
-/// `view` moved by `(dx, dy)` drawing units, its size kept.
-fn panned(view: BoundingBox, dx: f64, dy: f64) -> BoundingBox {
-    BoundingBox::from_corners(
-        Point::new(view.min.x + dx, view.min.y + dy),
-        Point::new(view.max.x + dx, view.max.y + dy),
-    )
-}
-
 /// Scale `view` by `factor` (> 1 zooms out) keeping the drawing point `(ux, uy)` fixed.
-pub fn zoom_about(view: BoundingBox, factor: f64, ux: f64, uy: f64) -> BoundingBox {
+pub fn zoom_about(view: ViewBox, factor: f64, ux: f64, uy: f64) -> ViewBox {
+    let [x, y, w, h] = view;
     let factor = factor.clamp(1e-3, 1e3);
-    BoundingBox::from_corners(
-        Point::new(
-            ux - (ux - view.min.x) * factor,
-            uy - (uy - view.min.y) * factor,
-        ),
-        Point::new(
-            ux + (view.max.x - ux) * factor,
-            uy + (view.max.y - uy) * factor,
-        ),
-    )
+    [
+        ux - (ux - x) * factor,
+        uy - (uy - y) * factor,
+        w * factor,
+        h * factor,
+    ]
 }
 
 /// The CSS transform of the `<svg>` element (origin at its centre) that makes the picture drawn
@@ -84,10 +67,11 @@ pub fn zoom_about(view: BoundingBox, factor: f64, ux: f64, uy: f64) -> BoundingB
 /// and `preserveAspectRatio="xMidYMid meet"` puts each box's centre at the element's centre `O`,
 /// so a drawing point `p` shown at `O + a (p − c₀)` must move to `O + a k (p − c)` (`c₀`, `c` the
 /// boxes' centres, `k = committed width / live width`): that is `t = a k (c₀ − c)`.
-pub fn gesture_transform(a: f64, committed: BoundingBox, live: BoundingBox) -> (f64, f64, f64) {
-    let k = committed.width() / live.width();
-    let (c0, c) = (committed.centre(), live.centre());
-    (a * k * (c0.x - c.x), a * k * (c0.y - c.y), k)
+pub fn gesture_transform(a: f64, committed: ViewBox, live: ViewBox) -> (f64, f64, f64) {
+    let k = committed[2] / live[2];
+    let centre = |v: ViewBox| (v[0] + v[2] / 2.0, v[1] + v[3] / 2.0);
+    let (c0, c) = (centre(committed), centre(live));
+    (a * k * (c0.0 - c.0), a * k * (c0.1 - c.1), k)
 }
 
 /// Screen ↔ drawing mapping of a live view box, from the screen matrix of the committed one.
@@ -103,12 +87,14 @@ struct LiveMapping {
 
 impl LiveMapping {
     /// The mapping, given the committed view's screen matrix `screen = a · user + (e, f)`.
-    fn new(a: f64, e: f64, f: f64, committed: BoundingBox, live: BoundingBox) -> Self {
-        let (c0, c) = (committed.centre(), live.centre());
+    fn new(a: f64, e: f64, f: f64, committed: ViewBox, live: ViewBox) -> Self {
         Self {
-            scale: a * committed.width() / live.width(),
-            screen_centre: (a * c0.x + e, a * c0.y + f),
-            live_centre: (c.x, c.y),
+            scale: a * committed[2] / live[2],
+            screen_centre: (
+                a * (committed[0] + committed[2] / 2.0) + e,
+                a * (committed[1] + committed[3] / 2.0) + f,
+            ),
+            live_centre: (live[0] + live[2] / 2.0, live[1] + live[3] / 2.0),
         }
     }
 
@@ -130,8 +116,8 @@ struct Gesture {
     followers: Vec<web_sys::Element>,
     /// `screen = a · user + (e, f)` for the committed view box.
     ctm: (f64, f64, f64),
-    committed: BoundingBox,
-    live: BoundingBox,
+    committed: ViewBox,
+    live: ViewBox,
 }
 
 impl Gesture {
@@ -145,9 +131,9 @@ impl Gesture {
 #[derive(Clone, Copy)]
 pub struct PanZoom {
     /// The committed view box (the SVG `viewBox`), `None` = fit the whole drawing.
-    pub view: RwSignal<Option<BoundingBox>>,
+    pub view: RwSignal<Option<ViewBox>>,
     /// The fitted view box, used when `view` is `None`.
-    pub fit: Signal<Option<BoundingBox>>,
+    pub fit: Signal<Option<ViewBox>>,
     gesture: StoredValue<Option<Gesture>, LocalStorage>,
     /// Commits the view when the wheel has been quiet for [`WHEEL_SETTLE_MS`].
     wheel_timer: StoredValue<Option<TimeoutHandle>>,
@@ -156,7 +142,7 @@ pub struct PanZoom {
 
 impl PanZoom {
     /// State for one view.
-    pub fn new(fit: Signal<Option<BoundingBox>>) -> Self {
+    pub fn new(fit: Signal<Option<ViewBox>>) -> Self {
         Self {
             view: RwSignal::new(None),
             fit,
@@ -167,11 +153,11 @@ impl PanZoom {
     }
 
     /// The committed view box to render.
-    pub fn current(&self) -> Option<BoundingBox> {
+    pub fn current(&self) -> Option<ViewBox> {
         self.view.get().or_else(|| self.fit.get())
     }
 
-    fn committed_untracked(&self) -> Option<BoundingBox> {
+    fn committed_untracked(&self) -> Option<ViewBox> {
         self.view
             .get_untracked()
             .or_else(|| self.fit.get_untracked())
@@ -185,7 +171,7 @@ impl PanZoom {
 
     /// The live view and its screen mapping, starting a gesture on `ev`'s `<svg>` if none is
     /// under way.
-    fn gesture_view<E: AsRef<web_sys::Event>>(&self, ev: &E) -> Option<(BoundingBox, LiveMapping)> {
+    fn gesture_view<E: AsRef<web_sys::Event>>(&self, ev: &E) -> Option<(ViewBox, LiveMapping)> {
         let running = self
             .gesture
             .with_value(|g| g.as_ref().map(|g| (g.live, g.mapping())));
@@ -196,7 +182,7 @@ impl PanZoom {
         let svg = target_svg(ev)?;
         let m = svg.get_screen_ctm()?;
         let (a, e, f) = (f64::from(m.a()), f64::from(m.e()), f64::from(m.f()));
-        if a == 0.0 || !a.is_finite() || committed.width() == 0.0 {
+        if a == 0.0 || !a.is_finite() || committed[2] == 0.0 {
             return None;
         }
         // Hit-testing thousands of paths on every move is wasted work mid-gesture.
@@ -218,7 +204,7 @@ impl PanZoom {
     }
 
     /// Shows `live` during a gesture: a transform of the `<svg>`, no `viewBox` change.
-    fn show_live(&self, live: BoundingBox) {
+    fn show_live(&self, live: ViewBox) {
         self.gesture.update_value(|g| {
             if let Some(g) = g {
                 g.live = live;
@@ -233,7 +219,7 @@ impl PanZoom {
     }
 
     /// Ends the gesture under way, if any, undoing its transform; returns its live view.
-    fn end_gesture(&self) -> Option<BoundingBox> {
+    fn end_gesture(&self) -> Option<ViewBox> {
         if let Some(timer) = self.wheel_timer.try_update_value(Option::take).flatten() {
             timer.clear();
         }
@@ -322,11 +308,13 @@ impl PanZoom {
                 zoom_about(view, d_before / d_now, ux, uy)
             }
         } else {
-            panned(
-                view,
-                -(now.0 - before.0) / mapping.scale,
-                -(now.1 - before.1) / mapping.scale,
-            )
+            let [x, y, w, h] = view;
+            [
+                x - (now.0 - before.0) / mapping.scale,
+                y - (now.1 - before.1) / mapping.scale,
+                w,
+                h,
+            ]
         };
         self.pointers.update_value(|p| {
             p.insert(id, now);
@@ -356,15 +344,15 @@ impl PanZoom {
         let Some(view) = self.committed_untracked() else {
             return;
         };
-        let (w, h) = (view.width(), view.height());
-        let centre = view.centre();
+        let [x, y, w, h] = view;
+        let (cx, cy) = (x + w / 2.0, y + h / 2.0);
         let next = match ev.key().as_str() {
-            "+" | "=" => Some(zoom_about(view, 1.0 / KEY_ZOOM, centre.x, centre.y)),
-            "-" | "_" => Some(zoom_about(view, KEY_ZOOM, centre.x, centre.y)),
-            "ArrowLeft" => Some(panned(view, -w * KEY_PAN, 0.0)),
-            "ArrowRight" => Some(panned(view, w * KEY_PAN, 0.0)),
-            "ArrowUp" => Some(panned(view, 0.0, -h * KEY_PAN)),
-            "ArrowDown" => Some(panned(view, 0.0, h * KEY_PAN)),
+            "+" | "=" => Some(zoom_about(view, 1.0 / KEY_ZOOM, cx, cy)),
+            "-" | "_" => Some(zoom_about(view, KEY_ZOOM, cx, cy)),
+            "ArrowLeft" => Some([x - w * KEY_PAN, y, w, h]),
+            "ArrowRight" => Some([x + w * KEY_PAN, y, w, h]),
+            "ArrowUp" => Some([x, y - h * KEY_PAN, w, h]),
+            "ArrowDown" => Some([x, y + h * KEY_PAN, w, h]),
             "0" => {
                 ev.prevent_default();
                 self.reset();
@@ -388,47 +376,33 @@ fn target_svg<E: AsRef<web_sys::Event>>(ev: &E) -> Option<SvgGraphicsElement> {
 
 #[cfg(test)]
 mod tests {
-    use super::{fitted_view, gesture_transform, zoom_about, LiveMapping};
+    use super::{fitted_view, gesture_transform, zoom_about, LiveMapping, ViewBox};
     use cutroute_geometry::{BoundingBox, Point};
-
-    /// A view from its SVG `viewBox` numbers `[x, y, width, height]`.
-    fn vb([x, y, w, h]: [f64; 4]) -> BoundingBox {
-        BoundingBox::from_corners(Point::new(x, y), Point::new(x + w, y + h))
-    }
-
-    /// A view's SVG `viewBox` numbers.
-    fn xywh(v: BoundingBox) -> [f64; 4] {
-        [v.min.x, v.min.y, v.width(), v.height()]
-    }
 
     #[test]
     fn the_fitted_view_flips_y_and_keeps_a_margin() {
         // A 100 × 50 box whose top edge is at y = 60: 3 mm margin, y flipped.
         let bounds = BoundingBox::from_corners(Point::new(10.0, 10.0), Point::new(110.0, 60.0));
-        assert_eq!(xywh(fitted_view(bounds)), [7.0, -63.0, 106.0, 56.0]);
+        assert_eq!(fitted_view(bounds), [7.0, -63.0, 106.0, 56.0]);
         // A tiny box still gets a 1 mm margin.
         let dot = BoundingBox::from_corners(Point::new(0.0, 0.0), Point::new(2.0, 1.0));
-        let view: BoundingBox = fitted_view(dot);
-        assert_eq!(xywh(view), [-1.0, -2.0, 4.0, 3.0]);
+        let view: ViewBox = fitted_view(dot);
+        assert_eq!(view, [-1.0, -2.0, 4.0, 3.0]);
     }
 
     #[test]
     fn zoom_keeps_the_anchor_point_fixed() {
-        let view = vb([0.0, 0.0, 100.0, 50.0]);
+        let view = [0.0, 0.0, 100.0, 50.0];
         let zoomed = zoom_about(view, 0.5, 20.0, 10.0);
-        assert_eq!(xywh(zoomed), [10.0, 5.0, 50.0, 25.0]);
+        assert_eq!(zoomed, [10.0, 5.0, 50.0, 25.0]);
         // The anchor sits at the same relative place in both boxes.
-        let rel = |v: BoundingBox| {
-            let [x, y, w, h] = xywh(v);
-            ((20.0 - x) / w, (10.0 - y) / h)
-        };
+        let rel = |v: [f64; 4]| ((20.0 - v[0]) / v[2], (10.0 - v[1]) / v[3]);
         assert_eq!(rel(view), rel(zoomed));
     }
 
     /// Screen point of drawing point `p` when `view` is the viewBox of an 800 × 500 px viewport
     /// at (40, 60), `xMidYMid meet` (what the browser does).
-    fn screen(view: BoundingBox, p: (f64, f64)) -> (f64, f64) {
-        let view = xywh(view);
+    fn screen(view: [f64; 4], p: (f64, f64)) -> (f64, f64) {
         let (vw, vh) = (800.0, 500.0);
         let a = (vw / view[2]).min(vh / view[3]);
         let e = 40.0 + (vw - a * view[2]) / 2.0 - a * view[0];
@@ -443,14 +417,14 @@ mod tests {
     #[test]
     fn the_gesture_transform_shows_the_live_view() {
         // Committed box taller than the viewport's aspect, so "meet" letterboxes it.
-        let committed = vb([-20.0, -310.0, 400.0, 300.0]);
+        let committed = [-20.0, -310.0, 400.0, 300.0];
         let a = screen(committed, (1.0, 0.0)).0 - screen(committed, (0.0, 0.0)).0;
         // The element's centre, the CSS transform origin.
         let origin = (40.0 + 400.0, 60.0 + 250.0);
         let lives = [
             zoom_about(committed, 0.37, 55.0, -120.0),
             zoom_about(committed, 2.5, 300.0, -20.0),
-            vb([-20.0 + 33.0, -310.0 - 71.0, 400.0, 300.0]),
+            [committed[0] + 33.0, committed[1] - 71.0, 400.0, 300.0],
         ];
         for live in lives {
             let (tx, ty, k) = gesture_transform(a, committed, live);
@@ -467,7 +441,7 @@ mod tests {
 
     #[test]
     fn the_live_mapping_inverts_the_live_view_and_zoom_stays_under_the_cursor() {
-        let committed = vb([-20.0, -310.0, 400.0, 300.0]);
+        let committed = [-20.0, -310.0, 400.0, 300.0];
         // The committed view's screen matrix, as getScreenCTM reports it.
         let (e, f) = screen(committed, (0.0, 0.0));
         let a = screen(committed, (1.0, 0.0)).0 - e;
