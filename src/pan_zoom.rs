@@ -25,7 +25,9 @@ use wasm_bindgen::JsCast;
 use web_sys::{KeyboardEvent, PointerEvent, SvgGraphicsElement, WheelEvent};
 
 /// An SVG `viewBox` `[x, y, width, height]` in the drawing's flipped frame (y down). Boxes of
-/// the model are geometry's `BoundingBox`; `fitted_view` is where one becomes the other.
+/// the model are geometry's `BoundingBox`; `fitted_view` is where one becomes the other. The
+/// view keeps its width and height as numbers of their own (not `max − min`): a pan must leave
+/// the zoom exactly as it was.
 pub type ViewBox = [f64; 4];
 
 /// The view box that shows `bounds` (model coordinates, y up) with a margin of 3 % of its longer
