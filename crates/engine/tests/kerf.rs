@@ -2,44 +2,17 @@
 //! its route with leads, every final route passes the independent checker, its route is never
 //! longer than the idealised order with leads attached, and contours without room are named.
 
-use std::path::PathBuf;
+mod common;
+
+use common::{nest_of, nest_problem, plasma};
 
 use cutroute_engine::{
-    open_document, run_to_end, start_job, validate_kerf, EngineError, KerfSettingsError, Refusal,
+    run_to_end, start_job, validate_kerf, EngineError, KerfSettingsError, Refusal,
 };
-use cutroute_geometry::{KerfSettings, LeadShape, LeadSpec, Nest, Route, TabSpec};
+use cutroute_geometry::{KerfSettings, LeadSpec, Route, TabSpec};
 use cutroute_protocol::{
     JobRequest, KerfNote, KerfSource, Phase, Problem, Progress, Solution, SolverKind, SolverParams,
 };
-
-fn nest_problem(relative: &str) -> Problem {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../data")
-        .join(relative);
-    let bytes = std::fs::read(&path).expect("test file");
-    open_document(relative, &bytes).expect("opens").problem
-}
-
-fn nest_of(problem: &Problem) -> &Nest {
-    match problem {
-        Problem::Nest { nest, .. } => nest,
-        Problem::PcgtspText { .. } => panic!("a nest"),
-    }
-}
-
-/// Kerf 2, d₁ 5, d₂ 1, an 8 mm arc lead-in and a 2 mm line lead-out (the plasma).
-fn plasma() -> KerfSettings {
-    KerfSettings {
-        kerf: 2.0,
-        pierce_clearance: 5.0,
-        switch_off_clearance: 1.0,
-        lead_in: LeadSpec::new(LeadShape::Arc, 8.0),
-        lead_out: LeadSpec::new(LeadShape::Line, 2.0),
-        overcut: 0.0,
-        tabs: TabSpec::default(),
-        edge_pierce: false,
-    }
-}
 
 fn request(problem: &Problem, solver: SolverKind, kerf: KerfSettings, after: bool) -> JobRequest {
     JobRequest {

@@ -2,45 +2,16 @@
 //! model, its routes pass the independent checker, and its lower bound is below the route it
 //! reports and below the brute-force optimum of that model.
 
-use std::path::PathBuf;
+mod common;
 
-use cutroute_engine::{build_full_route_model, open_document, run_to_end, start_job};
-use cutroute_geometry::{
-    Contour, KerfSettings, LeadShape, LeadSpec, Nest, Part, Point, Route, TabSpec, Vertex,
-};
+use common::{nest_of, nest_problem, plasma};
+
+use cutroute_engine::{build_full_route_model, run_to_end, start_job};
+use cutroute_geometry::{Contour, Nest, Part, Point, Route, Vertex};
 use cutroute_pcgtsp::Instance;
 use cutroute_protocol::{
     JobRequest, KerfNote, KerfSource, Phase, Problem, Progress, SolverKind, SolverParams,
 };
-
-fn nest_problem(relative: &str) -> Problem {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../data")
-        .join(relative);
-    let bytes = std::fs::read(&path).expect("test file");
-    open_document(relative, &bytes).expect("opens").problem
-}
-
-fn nest_of(problem: &Problem) -> &Nest {
-    match problem {
-        Problem::Nest { nest, .. } => nest,
-        Problem::PcgtspText { .. } => panic!("a nest"),
-    }
-}
-
-/// Kerf 2, d₁ 5, d₂ 1, an 8 mm arc lead-in and a 2 mm line lead-out (the plasma).
-fn plasma() -> KerfSettings {
-    KerfSettings {
-        kerf: 2.0,
-        pierce_clearance: 5.0,
-        switch_off_clearance: 1.0,
-        lead_in: LeadSpec::new(LeadShape::Arc, 8.0),
-        lead_out: LeadSpec::new(LeadShape::Line, 2.0),
-        overcut: 0.0,
-        tabs: TabSpec::default(),
-        edge_pierce: false,
-    }
-}
 
 fn exact_request(problem: &Problem, step: f64, limit: f64) -> JobRequest {
     JobRequest {

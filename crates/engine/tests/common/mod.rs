@@ -4,6 +4,7 @@
 
 use std::path::PathBuf;
 
+use cutroute_geometry::{KerfSettings, LeadShape, LeadSpec, Nest, TabSpec};
 use cutroute_protocol::{Problem, Progress};
 
 /// The name and bytes of a file under `data/`; panics naming the file when it is missing.
@@ -33,4 +34,34 @@ pub fn check_route(problem: &Problem, result: &Progress) -> f64 {
         "reported {reported} vs recomputed {idle}"
     );
     idle
+}
+
+/// The problem of a nest file under `data/`, opened by the engine.
+pub fn nest_problem(relative: &str) -> Problem {
+    let (name, bytes) = data(relative);
+    cutroute_engine::open_document(&name, &bytes)
+        .expect("opens")
+        .problem
+}
+
+/// The nest of a nest problem.
+pub fn nest_of(problem: &Problem) -> &Nest {
+    match problem {
+        Problem::Nest { nest, .. } => nest,
+        Problem::PcgtspText { .. } => panic!("a nest"),
+    }
+}
+
+/// Kerf 2, d₁ 5, d₂ 1, an 8 mm arc lead-in and a 2 mm line lead-out (issue #17's plasma).
+pub fn plasma() -> KerfSettings {
+    KerfSettings {
+        kerf: 2.0,
+        pierce_clearance: 5.0,
+        switch_off_clearance: 1.0,
+        lead_in: LeadSpec::new(LeadShape::Arc, 8.0),
+        lead_out: LeadSpec::new(LeadShape::Line, 2.0),
+        overcut: 0.0,
+        tabs: TabSpec::default(),
+        edge_pierce: false,
+    }
 }
