@@ -319,6 +319,7 @@ impl Settings {
                     }
                 }
                 "edge_pierce" => self.kerf.edge_pierce = value == "1",
+                "kerf_pierce" => self.kerf.kerf_pierce = value == "1",
                 "sample" if crate::app::SAMPLES.iter().any(|(f, ..)| *f == value) => {
                     // The address bar follows the page, so a reload brings the query of the
                     // sample shown beside a remembered local file: that keeps the reminder;
@@ -432,6 +433,9 @@ impl Settings {
             ));
             if k.edge_pierce {
                 query.push_str("&edge_pierce=1");
+            }
+            if k.kerf_pierce {
+                query.push_str("&kerf_pierce=1");
             }
         }
         let t = &self.thermal;
@@ -602,6 +606,7 @@ mod tests {
                     width: 1.5,
                 },
                 edge_pierce: true,
+                kerf_pierce: true,
             },
             ..Settings::default()
         };

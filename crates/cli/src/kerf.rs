@@ -55,6 +55,11 @@ pub struct KerfArgs {
     /// contour (the pierce takes `--edge-pierce-time`). Needs a nest with a sheet.
     #[arg(long)]
     edge_pierce: bool,
+    /// Pierce in the open kerf of a contour cut earlier, where the entry is within the same
+    /// reach of it and that saves time (the pierce takes `--edge-pierce-time`): for machines
+    /// and materials that allow it.
+    #[arg(long)]
+    kerf_pierce: bool,
 }
 
 /// The parsed full-route settings.
@@ -118,6 +123,7 @@ impl KerfArgs {
             overcut: length("overcut", self.overcut)?,
             tabs: tabs(self.tabs.as_deref())?,
             edge_pierce: self.edge_pierce,
+            kerf_pierce: self.kerf_pierce,
         };
         Ok(Kerf {
             settings,
@@ -207,9 +213,13 @@ impl Kerf {
             "tabs": { "per_part": s.tabs.count, "width": s.tabs.width },
             "optimised_with_leads": !self.after,
             "edge_pierce": s.edge_pierce,
+            "kerf_pierce": s.kerf_pierce,
         });
         if s.edge_pierce {
             report["edge_pierces"] = json!(route.edge_pierce_count());
+        }
+        if s.kerf_pierce {
+            report["kerf_pierces"] = json!(route.kerf_pierce_count());
         }
         let leads = || route.steps.iter().filter_map(|s| s.leads.as_ref());
         let by_job = match phase {
@@ -250,6 +260,10 @@ impl Kerf {
             step["entry"] = json!([l.entry.x, l.entry.y]);
             if l.edge_pierce && cut.is_pierced() {
                 step["edge_pierce"] = json!(true);
+            }
+            if let Some(kerf_of) = l.kerf_pierce.filter(|_| cut.is_pierced()) {
+                // In the open kerf of this contour, cut before: [part, contour].
+                step["kerf_pierce"] = json!([kerf_of.part, kerf_of.contour]);
             }
             step["lead_in"] = json!(triples(&l.lead_in));
             step["lead_out"] = json!(triples(&l.lead_out));

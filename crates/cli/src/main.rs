@@ -1412,9 +1412,13 @@ fn route_report(
     let idle_length = route.idle_length();
     let cut_length = route.cut_length(nest);
     let pierces = route.pierce_count();
-    // Edge pierces (`--edge-pierce`) take the machine's edge-pierce time.
+    // Edge and kerf pierces (`--edge-pierce`, `--kerf-pierce`) take the machine's edge-pierce
+    // time.
     let time_s = machine.time(cut_length, idle_length, 0)
-        + machine.pierce_seconds(pierces, route.edge_pierce_count());
+        + machine.pierce_seconds(
+            pierces,
+            route.edge_pierce_count() + route.kerf_pierce_count(),
+        );
     Ok(json!({
         "solver": solver,
         "idle_length": idle_length,

@@ -518,3 +518,78 @@ fn edge_pierces_sit_on_the_sheet_border_and_take_the_edge_pierce_time() {
         "{time} vs {expected}"
     );
 }
+
+#[test]
+fn kerf_pierces_sit_in_a_kerf_cut_before_and_save_time() {
+    // nested.dbs with nearest (deterministic): the same order with and without kerf piercing.
+    let file = data("nests/dbs/nested.dbs");
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            "solve",
+            &file,
+            "--solver",
+            "nearest",
+            "--json",
+            "--edge-pierce-time",
+            "2",
+        ];
+        args.extend(PLASMA);
+        args.extend(extra);
+        json(&args)
+    };
+    let plain = run(&[]);
+    let report = run(&["--kerf-pierce"]);
+    assert!(
+        report["final_route_rejected"].is_null(),
+        "the checker passed it"
+    );
+    assert!(plain.get("kerf_pierces").is_none());
+    let route = report["route"].as_array().unwrap();
+    let kerf: Vec<(usize, &Value)> = route
+        .iter()
+        .enumerate()
+        .filter(|(_, s)| s.get("kerf_pierce").is_some())
+        .collect();
+    assert_eq!(
+        report["kerf_pierces"].as_u64().unwrap() as usize,
+        kerf.len()
+    );
+    assert!(
+        kerf.len() >= 5,
+        "nested.dbs packs parts within reach: {}",
+        kerf.len()
+    );
+    let cut_before = |k: usize, of: &Value| route[..k].iter().any(|s| s["contour"] == *of);
+    for &(k, step) in &kerf {
+        assert!(cut_before(k, &step["kerf_pierce"]), "step {k}: {step}");
+        assert_eq!(
+            step["lead_in"].as_array().unwrap().len(),
+            2,
+            "a straight lead"
+        );
+    }
+    // The order is nearest's either way; the quick pierces save more than the idle they add.
+    let order = |steps: &[Value]| {
+        steps
+            .iter()
+            .map(|s| s["contour"].clone())
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(order(route), order(plain["route"].as_array().unwrap()));
+    let time = |r: &Value| r["time_s"].as_f64().unwrap();
+    assert!(
+        time(&report) < time(&plain) - 4.0 * kerf.len() as f64,
+        "{} vs {}",
+        time(&report),
+        time(&plain)
+    );
+    // Time: cut at 10 mm/s, idle at 500 mm/s, 7 s a pierce in the sheet, 2 s in a kerf.
+    let (cut, idle) = (
+        report["cut_length"].as_f64().unwrap(),
+        report["idle_length"].as_f64().unwrap(),
+    );
+    let pierces = report["pierces"].as_u64().unwrap() as f64;
+    let expected =
+        cut / 10.0 + idle / 500.0 + 7.0 * (pierces - kerf.len() as f64) + 2.0 * kerf.len() as f64;
+    assert!((time(&report) - expected).abs() < 1e-6 * expected);
+}

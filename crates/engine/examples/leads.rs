@@ -49,6 +49,7 @@ fn main() {
         overcut: 0.0,
         tabs: TabSpec::default(),
         edge_pierce: false,
+        kerf_pierce: false,
     };
     let machine = MachineParameters::default();
     let here = PathBuf::from(env!("CARGO_MANIFEST_DIR"));

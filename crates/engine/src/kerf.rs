@@ -28,7 +28,7 @@
 //! their paths' ends (module `kerf_paths`).
 
 use cutroute_geometry::{
-    ContainmentForest, CutStep, KerfSettings, LeadError, LeadFitter, Nest, Route,
+    ContainmentForest, CutStep, KerfSettings, LeadError, LeadFitter, MachineParameters, Nest, Route,
 };
 use cutroute_protocol::{
     Bounds, JobRequest, KerfNote, KerfSource, Phase, Problem, Progress, Solution, SolverKind,
@@ -141,6 +141,8 @@ struct Candidate {
     fitted: Option<(Route, Result<Route, Vec<LeadError>>)>,
     /// A newer route of the running solver whose leads are being fitted step by step.
     pending: Option<Attach>,
+    /// Whether its finished route has had its kerf pierces placed (once).
+    kerf_pierced: bool,
 }
 
 /// Where a candidate is: its solver runs, then its final route gets leads step by step, then
@@ -294,6 +296,8 @@ pub struct KerfJob {
     step_cost: Option<Duration>,
     /// A path solver's run over the equidistants (sccp, gsccp, aoe): the job is that run.
     paths: Option<PathLeadsRun>,
+    /// The machine: whether a kerf pierce pays off is a matter of its pierce times.
+    machine: MachineParameters,
 }
 
 impl KerfJob {
@@ -363,6 +367,7 @@ impl KerfJob {
                 deadline: None,
                 step_cost: None,
                 paths: Some(run),
+                machine: request.params.machine,
             });
         }
         let mut candidates = Vec::new();
@@ -434,6 +439,7 @@ impl KerfJob {
             deadline: started.checked_add(Duration::from_secs_f64(limit.clamp(0.0, 1.0e7))),
             step_cost: None,
             paths: None,
+            machine: request.params.machine,
         })
     }
 
@@ -605,6 +611,14 @@ impl KerfJob {
                 }
                 finished @ Stage::Finished(_) => finished,
             };
+            // A finished full route gets its kerf pierces once (with edge piercing on): the
+            // order and the leads are final, and each move only saves time.
+            if let Stage::Finished(Some(Ok(route))) = &mut candidate.stage {
+                if !candidate.kerf_pierced {
+                    candidate.kerf_pierced = true;
+                    fitter.pierce_into_kerfs(route, &self.machine);
+                }
+            }
             let working = matches!(
                 candidate.stage,
                 Stage::Attaching(_) | Stage::Relaxing { .. }
@@ -625,6 +639,7 @@ impl Candidate {
             stage: Stage::Solving,
             fitted: None,
             pending: None,
+            kerf_pierced: false,
         }
     }
 }

@@ -720,6 +720,7 @@ impl ReadLeads {
             tabs,
             // The format has no edge-pierce mark; with d₁ 0 a border pierce is in G_M anyway.
             edge_pierce: false,
+            kerf_pierce: None,
         });
     }
 }

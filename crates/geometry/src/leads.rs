@@ -31,6 +31,7 @@
 //!     overcut: 0.0,
 //!     tabs: Default::default(),
 //!     edge_pierce: false,
+//!     kerf_pierce: false,
 //! };
 //! let fitter = LeadFitter::new(&nest, settings);
 //! let r = ContourRef { part: 0, contour: 0 };
@@ -49,7 +50,8 @@ use thiserror::Error;
 
 use crate::kerf::{equidistant, OffsetError};
 use crate::{
-    BoundingBox, ContainmentForest, Contour, ContourRef, CutStep, Nest, Point, Route, Span, Vertex,
+    BoundingBox, ContainmentForest, Contour, ContourRef, CutStep, MachineParameters, Nest, Point,
+    Route, Span, Vertex,
 };
 
 /// The shape of a lead-in or lead-out.
@@ -303,6 +305,11 @@ pub struct KerfSettings {
     /// Needs a nest with a sheet. Off by default (the idealised and published runs).
     #[serde(default)]
     pub edge_pierce: bool,
+    /// Kerf piercing, where the technology allows it: a step may be pierced in the open kerf
+    /// of a contour cut earlier in the route, as at an edge ([`LeadFitter::pierce_into_kerfs`];
+    /// needs a kerf; priced at the machine's edge-pierce time). Off by default.
+    #[serde(default)]
+    pub kerf_pierce: bool,
 }
 
 impl KerfSettings {
@@ -316,6 +323,7 @@ impl KerfSettings {
             && self.overcut == 0.0
             && self.tabs.count == 0
             && !self.edge_pierce
+            && !self.kerf_pierce
     }
 
     /// The longest edge lead-in, mm: the asked lead-in's longest chain plus d₁, as far as the
@@ -360,6 +368,11 @@ pub struct StepLeads {
     /// checker holds it to the border instead of G_M.
     #[serde(default)]
     pub edge_pierce: bool,
+    /// M lies in the open kerf of this contour, cut earlier in the route (a kerf pierce, see
+    /// [`LeadFitter::pierce_into_kerfs`]): the checker holds it to that contour's cut
+    /// equidistant, outside its tabs, instead of G_M. Priced like an edge pierce.
+    #[serde(default)]
+    pub kerf_pierce: Option<ContourRef>,
 }
 
 /// Spans of a vertex chain (each vertex's bulge shapes the span to the next; the last vertex
@@ -574,6 +587,15 @@ pub enum LeadProblem {
     /// outer contour in the sheet's scrap (or the nest has no sheet).
     #[error("edge pierce point ({x}, {y}) is not on the sheet's border")]
     EdgePierceOffBorder {
+        /// M, x.
+        x: f64,
+        /// M, y.
+        y: f64,
+    },
+    /// A kerf pierce whose M is not in the open kerf of the contour it names: off that
+    /// contour's equidistant, in one of its tabs, or with no kerf at all.
+    #[error("kerf pierce point ({x}, {y}) is not in the open kerf of the contour it names")]
+    KerfPierceOffKerf {
         /// M, x.
         x: f64,
         /// M, y.
@@ -847,6 +869,7 @@ impl<'a> LeadFitter<'a> {
             switch_off_clearance: self.settings.switch_off_clearance,
             tabs,
             edge_pierce,
+            kerf_pierce: None,
         })
     }
 
@@ -945,6 +968,7 @@ impl<'a> LeadFitter<'a> {
             switch_off_clearance: self.settings.switch_off_clearance,
             tabs: Vec::new(),
             edge_pierce: false,
+            kerf_pierce: None,
         })
     }
 
@@ -1290,9 +1314,11 @@ impl<'a> LeadFitter<'a> {
                 distance: f64::NAN,
             }),
         }
-        // An edge pierce's M is on the sheet's border, outside G_M; its lead is held to the
-        // kerf like every other.
+        // An edge pierce's M is on the sheet's border, a kerf pierce's in a cut kerf (checked
+        // by the route, which knows what was cut before): both outside G_M; their leads are
+        // held to the kerf like every other.
         let edge = leads.edge_pierce && !linked_in;
+        let quick = (leads.edge_pierce || leads.kerf_pierce.is_some()) && !linked_in;
         if edge {
             let on_border = self
                 .edge_border(r)
@@ -1304,7 +1330,7 @@ impl<'a> LeadFitter<'a> {
                 });
             }
         }
-        problems.extend(self.chain_problem_linked(r, &leads.lead_in, true, linked_in || edge));
+        problems.extend(self.chain_problem_linked(r, &leads.lead_in, true, linked_in || quick));
         problems.extend(self.chain_problem_linked(r, &leads.lead_out, false, linked_out));
         if !leads.tabs.is_empty() {
             problems.extend(self.tab_problems(r, leads));
@@ -1346,6 +1372,125 @@ impl<'a> LeadFitter<'a> {
         }
         problems
     }
+}
+
+impl LeadFitter<'_> {
+    /// Kerf piercing ([`KerfSettings::kerf_pierce`], with a kerf): each pierced step of `route` (a route
+    /// with leads) whose entry lies within [`KerfSettings::edge_reach`] of the equidistant of
+    /// a contour cut earlier is pierced there instead, in that contour's open kerf (no
+    /// material to burn through, like the sheet's edge), by a straight lead-in from the
+    /// kerf's nearest point that keeps kerf/2 from every contour. A step moves only when that
+    /// saves time under `machine`: the edge-pierce time against the pierce time, plus the
+    /// change in its idle leg. Steps already pierced at the border, and points in a tab's
+    /// gap, are left alone. The order and every other element stay. Returns how many steps
+    /// moved.
+    pub fn pierce_into_kerfs(&self, route: &mut Route, machine: &MachineParameters) -> usize {
+        if !self.settings.kerf_pierce || self.settings.kerf <= 0.0 {
+            return 0;
+        }
+        // As far as the lead and its pierce region would reach from the entry anyway.
+        let reach = self.settings.edge_reach();
+        let half = self.settings.kerf / 2.0;
+        let mut equidistants: std::collections::HashMap<ContourRef, Option<Contour>> =
+            Default::default();
+        let mut moved = 0;
+        for i in 0..route.steps.len() {
+            let step = &route.steps[i];
+            let Some(leads) = step.leads.as_ref().filter(|_| step.is_pierced()) else {
+                continue;
+            };
+            if leads.edge_pierce || leads.kerf_pierce.is_some() {
+                continue;
+            }
+            let before = if i == 0 {
+                route.start
+            } else {
+                route.steps[i - 1].switch_off_point()
+            };
+            let seconds = |m: Point, pierce: f64| before.distance(m) / machine.idle_speed + pierce;
+            let mut best = (seconds(leads.pierce, machine.pierce_time), None);
+            for earlier in &route.steps[..i] {
+                let (kerf_of, Some(cut)) = (earlier.contour, earlier.leads.as_ref()) else {
+                    continue;
+                };
+                let near = self
+                    .box_of(kerf_of)
+                    .is_some_and(|b| b.expanded(half + reach).contains_point(leads.entry));
+                if kerf_of == step.contour || !near {
+                    continue;
+                }
+                let eq = equidistants
+                    .entry(kerf_of)
+                    .or_insert_with(|| self.equidistant(kerf_of).ok());
+                let Some(at) = eq.as_ref().and_then(|eq| eq.nearest_point(leads.entry)) else {
+                    continue;
+                };
+                let at = at.point;
+                let time = seconds(at, machine.edge_pierce_seconds());
+                if !(at.distance(leads.entry) <= reach) || time >= best.0 - 1e-9 {
+                    continue;
+                }
+                let chain = vec![vertex(at), vertex(leads.entry)];
+                let open = eq
+                    .as_ref()
+                    .is_some_and(|eq| in_open_kerf(eq, cut, at, half));
+                if open
+                    && self
+                        .chain_problem_linked(step.contour, &chain, true, true)
+                        .is_none()
+                {
+                    best = (time, Some((kerf_of, chain)));
+                }
+            }
+            if let (_, Some((kerf_of, chain))) = best {
+                let leads = route.steps[i].leads.as_mut().expect("checked above");
+                leads.pierce = chain[0].point;
+                leads.lead_in = chain;
+                leads.kerf_pierce = Some(kerf_of);
+                moved += 1;
+            }
+        }
+        moved
+    }
+
+    /// Whether `pierce` lies in the open kerf that the cut `cut` of contour `kerf_of` leaves:
+    /// on its equidistant, outside its tabs' gaps (the route checker's test of a kerf pierce).
+    pub fn kerf_pierce_problem(
+        &self,
+        kerf_of: ContourRef,
+        cut: &StepLeads,
+        pierce: Point,
+    ) -> Option<LeadProblem> {
+        let off = LeadProblem::KerfPierceOffKerf {
+            x: pierce.x,
+            y: pierce.y,
+        };
+        let half = self.settings.kerf / 2.0;
+        if !(half > 0.0) {
+            return Some(off);
+        }
+        let Ok(eq) = self.equidistant(kerf_of) else {
+            return Some(off);
+        };
+        let on = eq.distance_to(pierce) <= 1e-6 && in_open_kerf(&eq, cut, pierce, half);
+        (!on).then_some(off)
+    }
+}
+
+/// Whether `at` (on `eq`, the equidistant that the cut `cut` runs on) lies outside every tab
+/// gap of that cut, with `half` (kerf/2) to spare: a tab is material left standing.
+fn in_open_kerf(eq: &Contour, cut: &StepLeads, at: Point, half: f64) -> bool {
+    if cut.tabs.is_empty() {
+        return true;
+    }
+    let position = |p: Point| eq.nearest_point(p).map(|n| eq.length_at(n.position));
+    let (Some(s), Some(entry)) = (position(at), position(cut.entry)) else {
+        return false;
+    };
+    let along = (s - entry).rem_euclid(eq.perimeter().max(1e-12));
+    cut.tabs
+        .iter()
+        .all(|t| along <= t.start - half || along >= t.end + half)
 }
 
 pub(crate) fn vertex(p: Point) -> Vertex {

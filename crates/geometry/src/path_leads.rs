@@ -96,6 +96,7 @@ impl PathLeads {
             tabs: Vec::new(),
             // A path's leads are fitted in G_M (edge piercing is for whole contours).
             edge_pierce: false,
+            kerf_pierce: None,
         }
     }
 
@@ -115,6 +116,7 @@ impl PathLeads {
             tabs: Vec::new(),
             // A path's leads are fitted in G_M (edge piercing is for whole contours).
             edge_pierce: false,
+            kerf_pierce: None,
         }
     }
 }

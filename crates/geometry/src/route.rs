@@ -258,6 +258,17 @@ pub enum RouteError {
         /// The tolerance exceeded.
         tolerance: f64,
     },
+    /// A step is pierced in the kerf of a contour that is not cut before it (or not cut with
+    /// leads).
+    #[error("step {step} on contour {contour:?} is pierced in the kerf of {kerf_of:?}, which is not cut before it")]
+    KerfPierceBeforeCut {
+        /// Index of the step.
+        step: usize,
+        /// Its contour.
+        contour: ContourRef,
+        /// The contour whose kerf it names.
+        kerf_of: ContourRef,
+    },
     /// A contour is cut after a contour that contains it.
     #[error("contour {inner:?} (step {inner_step}) lies inside {outer:?} (step {outer_step}) but is cut after it")]
     PrecedenceViolated {
@@ -428,6 +439,15 @@ impl Route {
             .count()
     }
 
+    /// The pierces of [`Route::pierce_count`] made in the open kerf of a contour cut earlier
+    /// (kerf-pierced steps; priced like edge pierces).
+    pub fn kerf_pierce_count(&self) -> usize {
+        self.steps
+            .iter()
+            .filter(|s| s.is_pierced() && s.leads.as_ref().is_some_and(|l| l.kerf_pierce.is_some()))
+            .count()
+    }
+
     /// Total cut length: the perimeters of the contours cut (with leads: the equidistants,
     /// overcuts and leads) plus the tool-on links, mm. Unknown contours count 0 (see
     /// [`Route::validate`]).
@@ -504,6 +524,31 @@ impl Route {
                             problem,
                         }),
                 );
+                // A kerf pierce needs its kerf cut before: the contours cut so far are those
+                // with a step already.
+                if let Some(kerf_of) = leads.kerf_pierce.filter(|_| !linked_in) {
+                    let cut_at = forest
+                        .index_of(kerf_of)
+                        .and_then(|k| step_of[k])
+                        .filter(|&j| j < step);
+                    let cut = cut_at.and_then(|j| self.steps[j].leads.as_ref());
+                    match cut {
+                        None => problems.push(RouteError::KerfPierceBeforeCut {
+                            step,
+                            contour: s.contour,
+                            kerf_of,
+                        }),
+                        Some(cut) => problems.extend(
+                            fitter
+                                .kerf_pierce_problem(kerf_of, cut, leads.pierce)
+                                .map(|problem| RouteError::Lead {
+                                    step,
+                                    contour: s.contour,
+                                    problem,
+                                }),
+                        ),
+                    }
+                }
             }
             let distance = contour.distance_to(s.pierce_point);
             if !(distance <= tolerance) {

@@ -26,6 +26,7 @@ fn plasma_edge() -> KerfSettings {
         overcut: 0.0,
         tabs: TabSpec::default(),
         edge_pierce: true,
+        kerf_pierce: false,
     }
 }
 

@@ -19,6 +19,7 @@ fn settings(count: usize, width: f64) -> KerfSettings {
         overcut: 1.0,
         tabs: TabSpec { count, width },
         edge_pierce: false,
+        kerf_pierce: false,
     }
 }
 

@@ -707,6 +707,10 @@ mod tests {
                 to: Point::new(0.0, 4.5),
             }],
             edge_pierce: true,
+            kerf_pierce: Some(ContourRef {
+                part: 1,
+                contour: 0,
+            }),
         });
         let route = Route {
             start: Point::default(),
@@ -745,6 +749,7 @@ mod tests {
                 width: 1.5,
             },
             edge_pierce: true,
+            kerf_pierce: true,
         };
         request.params.leads_after = true;
         let message = ToWorker::Start(request.clone());

@@ -63,5 +63,6 @@ pub fn plasma() -> KerfSettings {
         overcut: 0.0,
         tabs: TabSpec::default(),
         edge_pierce: false,
+        kerf_pierce: false,
     }
 }
