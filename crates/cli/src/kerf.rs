@@ -10,8 +10,8 @@
 //! comparison of the benchmark). This module parses the flags and writes the report.
 
 use cutroute_geometry::{
-    KerfSettings, LeadError, LeadShape, LeadSpec, Nest, PathLeads, PathRoute, Route, StepLeads,
-    TabSpec, Vertex,
+    KerfSettings, LeadError, LeadShape, LeadSpec, Nest, PathLeads, PathRoute, Point, Route,
+    StepLeads, TabSpec, Vertex,
 };
 use cutroute_protocol::{JobRequest, KerfNote, KerfSource, Phase, Progress};
 use serde_json::{json, Value};
@@ -193,15 +193,21 @@ impl Kerf {
         }
     }
 
+    /// The fields every report states, `start` and `finish` (where there is one); whether
+    /// the full-route fields follow (a kerf or leads are on).
+    fn report_head(&self, report: &mut Value, start: Point, finish: Option<Point>) -> bool {
+        report["start"] = json!([start.x, start.y]);
+        if let Some(finish) = finish {
+            report["finish"] = json!([finish.x, finish.y]);
+        }
+        self.is_on()
+    }
+
     /// Adds the full-route fields to a nest report: `start`, `finish`, the settings, the lead
     /// lengths, and per step `pierce` (M), `entry`, `lead_in`, `lead_out`, `switch_off`.
     /// `phase` is the job's last phase: its kerf note counts the chain links the job broke.
     pub fn report(&self, report: &mut Value, route: &Route, phase: Option<&Phase>) {
-        report["start"] = json!([route.start.x, route.start.y]);
-        if let Some(finish) = route.finish {
-            report["finish"] = json!([finish.x, finish.y]);
-        }
-        if !self.is_on() {
+        if !self.report_head(report, route.start, route.finish) {
             return;
         }
         let s = &self.settings;
@@ -287,11 +293,7 @@ impl Kerf {
     /// lead lengths; each path of the report's `route` carries its `pierce` (M), `entry` and
     /// `switch_off` as [x, y], `lead_in` and `lead_out` as [x, y, bulge] vertices.
     pub fn report_paths(&self, report: &mut Value, route: &PathRoute) {
-        report["start"] = json!([route.start.x, route.start.y]);
-        if let Some(finish) = route.finish {
-            report["finish"] = json!([finish.x, finish.y]);
-        }
-        if !self.is_on() {
+        if !self.report_head(report, route.start, route.finish) {
             return;
         }
         let s = &self.settings;
