@@ -123,10 +123,11 @@ impl PathLeadsRun {
     pub(crate) fn step(&mut self, budget: Duration) -> JobStatus {
         let started = Instant::now();
         if let Some(equidistants) = self.equidistants.take() {
-            // A cut may lie a tolerance off its equidistant, so an equidistant closer than
-            // kerf/2 by twice the tolerance has no cut that keeps kerf/2.
+            // Routes are refused closer than kerf/2 less the tolerance, and a cut may lie a
+            // tolerance off its equidistant: an equidistant closer than kerf/2 less twice the
+            // tolerance has no cut that passes.
             self.crowded = self.too_close(
-                equidistants_as_cuts(&equidistants),
+                &equidistants_as_cuts(&equidistants),
                 2.0 * self.nest.check_tolerance(),
             );
             if !self.crowded.is_empty() {
@@ -179,7 +180,7 @@ impl PathLeadsRun {
     /// burn into (parts spaced closer than the kerf, touching ones among them), as contours
     /// without room.
     fn clear_of_parts(&self, route: PathRoute) -> Result<PathRoute, Vec<LeadError>> {
-        let close = self.too_close(route.clone(), self.nest.check_tolerance());
+        let close = self.too_close(&route, self.nest.check_tolerance());
         if close.is_empty() {
             Ok(route)
         } else {
@@ -189,7 +190,7 @@ impl PathLeadsRun {
 
     /// The contours that `cuts` come closer to than kerf/2 less `tolerance`, each once, as
     /// contours without room.
-    fn too_close(&self, cuts: PathRoute, tolerance: f64) -> Vec<LeadError> {
+    fn too_close(&self, cuts: &PathRoute, tolerance: f64) -> Vec<LeadError> {
         let mut named = std::collections::HashSet::new();
         cuts.clearance_problems(&self.nest, self.settings.kerf / 2.0, tolerance)
             .into_iter()
