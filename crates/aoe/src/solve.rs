@@ -381,9 +381,28 @@ impl AoeSolving {
                 Stage::Check(orderings, Some((chains, route)))
             }
             Stage::Check(orderings, Some((chains, route))) => {
+                // Ten times the plan's tolerance: merged copies of a common edge agree within
+                // it (ends snapped within the tolerance, midpoints within eight times it).
                 let tolerance = (options.plan.tolerance * 10.0).max(1e-6);
-                if let Some(problem) = route.problems(nest, tolerance).into_iter().next() {
+                let (overlaps, others): (Vec<_>, Vec<_>) = route
+                    .problems(nest, tolerance)
+                    .into_iter()
+                    .partition(|p| matches!(p, PathRouteError::Overlap { .. }));
+                if let Some(problem) = others.into_iter().next() {
                     return Err(AoeSolveError::Route(problem));
+                }
+                // But two cuts that far apart are not one piece cut twice: the plan kept them
+                // apart, as it keeps the equidistants of parts spaced a little wider than the
+                // kerf. A piece is cut twice when the cuts agree within the plan's tolerance.
+                if !overlaps.is_empty() {
+                    let close = options.plan.tolerance.max(1e-6);
+                    if let Some(problem) = route
+                        .problems(nest, close)
+                        .into_iter()
+                        .find(|p| matches!(p, PathRouteError::Overlap { .. }))
+                    {
+                        return Err(AoeSolveError::Route(problem));
+                    }
                 }
                 self.outcome = Some(Ok(AoeSolution {
                     route,

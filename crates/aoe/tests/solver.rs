@@ -314,3 +314,19 @@ fn fewest_pierces(graph: &PlaneGraph) -> usize {
     }
     odd.values().map(|&k| (k / 2).max(1)).sum()
 }
+
+#[test]
+fn parts_spaced_a_little_more_than_the_tolerance_are_cut_apart() {
+    // Two squares 0.005 mm apart, planned at 0.001 mm: their facing edges are two edges of the
+    // plan, two cuts 0.005 mm apart (as parts spaced by the kerf plus a small margin give on
+    // the nest of equidistants). Neither is cut twice.
+    let nest = Nest {
+        sheet: None,
+        parts: vec![
+            part(vec![rect(0.0, 0.0, 10.0, 10.0)]),
+            part(vec![rect(10.005, 0.0, 20.005, 10.0)]),
+        ],
+    };
+    let solution = check(&nest, &AoeSolveOptions::default());
+    assert!((solution.route.cut_length() - 80.0).abs() < 1e-6);
+}

@@ -346,11 +346,12 @@ impl KerfJob {
             let equidistants = LeadFitter::with_forest(nest, &forest, settings).kerf_nest();
             let mut over_equidistants = idealised.clone();
             if let Problem::Nest { nest, .. } = &mut over_equidistants.problem {
-                *nest = equidistants;
+                *nest = equidistants.clone();
             }
             let run = PathLeadsRun::new(
                 nest.clone(),
                 forest.clone(),
+                equidistants,
                 settings,
                 request.params.machine,
                 request.params.objective,

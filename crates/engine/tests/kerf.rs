@@ -246,6 +246,67 @@ fn a_path_solver_names_the_contour_without_room() {
 }
 
 #[test]
+fn aoe_cuts_seven_on_the_equidistants_with_plasma_settings() {
+    // seven.dbs's equidistants at kerf 2 have runs of spans of 0.002-0.02 mm near corners, and
+    // aoe's own check once refused its route there (a cut along such a run was taken for a cut
+    // through material).
+    let problem = nest_problem("nests/dbs/seven.dbs");
+    let nest = nest_of(&problem);
+    let mut job = start_job(&request(&problem, SolverKind::Aoe, plasma(), false)).expect("starts");
+    let progress = run_to_end(job.as_mut(), &mut |_| {});
+    let route = progress
+        .path_route()
+        .unwrap_or_else(|| panic!("no route: {}", progress.phase));
+    assert!(route.paths.iter().all(|p| p.leads.is_some()));
+    // Every problem, overlaps included: aoe cuts each piece of an equidistant once.
+    assert_eq!(route.problems(nest, nest.check_tolerance()), Vec::new());
+    assert!(route.pierce_count() <= nest.contour_count());
+}
+
+#[test]
+fn parts_closer_than_the_kerf_are_named_before_a_path_solver_runs() {
+    // T-FLEX Nest02 places parts touching each other: no cut on their equidistants keeps
+    // kerf/2 from both, whatever the solver, so each names the same contours without room.
+    let problem = nest_problem("nests/tflex/Nest02.tfnesting");
+    let nest = nest_of(&problem);
+    let settings = plasma();
+    let mut named = Vec::new();
+    for solver in [SolverKind::Sccp, SolverKind::Gsccp, SolverKind::Aoe] {
+        let mut job = start_job(&request(&problem, solver, settings, false)).expect("starts");
+        let progress = run_to_end(job.as_mut(), &mut |_| {});
+        assert!(progress.path_route().is_none(), "{solver:?}");
+        let Phase::Kerf {
+            note: KerfNote::NoRoom { contours, .. },
+            ..
+        } = &progress.phase
+        else {
+            panic!("{solver:?}: {}", progress.phase);
+        };
+        assert!(!contours.is_empty(), "{solver:?}");
+        named.push(contours.clone());
+    }
+    assert!(named.windows(2).all(|w| w[0] == w[1]));
+    // Each named contour (the first few: all pairs of spans are slow in a debug build) comes
+    // closer than the kerf to another contour.
+    let tolerance = nest.check_tolerance();
+    let all: Vec<_> = nest.contour_refs().collect();
+    for &(part, contour) in named[0].iter().take(4) {
+        let me = cutroute_geometry::ContourRef { part, contour };
+        let spans: Vec<_> = nest.contour(me).expect("named").spans().collect();
+        let nearest = all
+            .iter()
+            .filter(|&&r| r != me)
+            .flat_map(|&r| nest.contour(r).expect("listed").spans().collect::<Vec<_>>())
+            .flat_map(|o| spans.iter().map(move |s| s.distance_to_span(&o)))
+            .fold(f64::INFINITY, f64::min);
+        assert!(
+            nearest < settings.kerf + 2.0 * tolerance,
+            "{me:?}: {nearest} mm from its nearest neighbour"
+        );
+    }
+}
+
+#[test]
 fn every_solver_starts_with_kerf_and_bad_settings_are_refused() {
     let problem = nest_problem("nests/dbs-json/E1X_6_01.dbs.json");
     // Every solver has a full-route model now; one without would be refused here.

@@ -262,16 +262,34 @@ struct Overlap {
     b: f64,
     ra: f64,
     rb: f64,
-    /// The route span runs along the contour span ([`same_carrier`]) rather than touching it.
-    along: bool,
+    /// How the route span lies on the piece.
+    contact: Contact,
 }
 
-/// Sub-intervals of `on` that lie on `other` within `tolerance`: the candidates are the ends of
-/// `on` and the projections of `other`'s ends; a piece between candidates lies on `other` when
-/// its ends and three interior points do (two distinct circles or lines share at most two
-/// points). The ends matter for short pieces: next to `other`'s end, interior points of a piece
-/// up to 4/3 of `tolerance` long are within `tolerance` of `other` although the piece is not on it.
-fn pieces_on(on: &Span, other: &Span, tolerance: f64) -> Vec<(f64, f64)> {
+/// How a cut lies on a piece of contour.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Contact {
+    /// It runs along the piece ([`same_carrier`]): a second such cut is an overlap.
+    Along,
+    /// It touches the piece within the tolerance over the piece's length (a tangent touch, or
+    /// an arc bulging a rounding error across a line): the piece is cut, and a second cut of
+    /// it is not reported.
+    Touch,
+    /// The piece is no longer than the tolerance, so which way it runs cannot be told, but it
+    /// lies within the tolerance of the cut: it counts as cut (finely discretised contours,
+    /// such as offsets near corners, have runs of such spans, and a run longer than the
+    /// tolerance would otherwise be a gap although the cut runs along it), and neither as a
+    /// second cut nor as the moment its contour completes.
+    Within,
+}
+
+/// Sub-intervals of `on` that lie on `other` within `tolerance`, each with whether it is longer
+/// than `tolerance`: the candidates are the ends of `on` and the projections of `other`'s ends;
+/// a piece between candidates lies on `other` when its ends and three interior points do (two
+/// distinct circles or lines share at most two points). A piece no longer than `tolerance` is
+/// kept apart: next to `other`'s end, every point of a piece up to 4/3 of `tolerance` long is
+/// within `tolerance` of `other` although the piece need not run along it.
+fn pieces_on(on: &Span, other: &Span, tolerance: f64) -> Vec<(f64, f64, bool)> {
     let mut cuts = vec![0.0, 1.0];
     for p in [other.start, other.end] {
         let q = on.nearest_point(p);
@@ -281,19 +299,20 @@ fn pieces_on(on: &Span, other: &Span, tolerance: f64) -> Vec<(f64, f64)> {
     }
     cuts.sort_by(f64::total_cmp);
     let length = on.length();
-    let mut pieces: Vec<(f64, f64)> = Vec::new();
+    let mut pieces: Vec<(f64, f64, bool)> = Vec::new();
     for w in cuts.windows(2) {
         let (a, b) = (w[0], w[1]);
-        if !((b - a) * length > tolerance) {
+        if !((b - a) * length > 0.0) {
             continue;
         }
+        let long = (b - a) * length > tolerance;
         let lies = [0.0, 0.25, 0.5, 0.75, 1.0]
             .iter()
             .all(|f| other.distance_to(on.point_at(a + (b - a) * f)) <= tolerance);
         if lies {
             match pieces.last_mut() {
-                Some(last) if last.1 >= a => last.1 = b,
-                _ => pieces.push((a, b)),
+                Some(last) if last.1 >= a && last.2 == long => last.1 = b,
+                _ => pieces.push((a, b, long)),
             }
         }
     }
@@ -325,7 +344,7 @@ fn overlaps(contour_span: &Span, route_span: &Span, tolerance: f64) -> Vec<Overl
     let along = same_carrier(contour_span, route_span, tolerance);
     pieces_on(contour_span, route_span, tolerance)
         .into_iter()
-        .map(|(a, b)| {
+        .map(|(a, b, long)| {
             // The nearest point's parameter (clamped, compared with the span's ends), not
             // `Span::parameter_of`: that one once wrapped a point at an arc's start to 2π/φ.
             let ta = route_span.nearest_point(contour_span.point_at(a)).t;
@@ -335,15 +354,18 @@ fn overlaps(contour_span: &Span, route_span: &Span, tolerance: f64) -> Vec<Overl
                 b,
                 ra: ta.min(tb),
                 rb: ta.max(tb),
-                along,
+                contact: match (long, along) {
+                    (false, _) => Contact::Within,
+                    (true, true) => Contact::Along,
+                    (true, false) => Contact::Touch,
+                },
             }
         })
         .collect()
 }
 
-/// A piece `(a, b)` of a contour span cut at a moment, and whether the cut ran along it
-/// ([`same_carrier`]) rather than touching it.
-type Coverage = (f64, f64, Moment, bool);
+/// A piece `(a, b)` of a contour span cut at a moment, and how the cut lies on it.
+type Coverage = (f64, f64, Moment, Contact);
 
 /// When a piece of contour is cut: path, span within the path, and parameter on that span.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -620,7 +642,7 @@ impl PathRoute {
                                 span: s,
                                 t: o.rb,
                             },
-                            o.along,
+                            o.contact,
                         ));
                         on_route.push((o.ra, o.rb));
                     }
@@ -643,16 +665,16 @@ impl PathRoute {
         let mut completed: Vec<Option<Moment>> = vec![None; refs.len()];
         for (c, spans) in contours.iter().enumerate() {
             let lengths: Vec<f64> = spans.iter().map(|s| s.length()).collect();
-            let mut intervals: Vec<(f64, f64, Moment, Point, bool)> = Vec::new();
+            let mut intervals: Vec<(f64, f64, Moment, Point, Contact)> = Vec::new();
             let mut offset = 0.0;
             for (s, pieces) in covered[c].iter().enumerate() {
-                for &(a, b, m, along) in pieces {
+                for &(a, b, m, contact) in pieces {
                     intervals.push((
                         offset + a * lengths[s],
                         offset + b * lengths[s],
                         m,
                         spans[s].point_at(a),
-                        along,
+                        contact,
                     ));
                 }
                 offset += lengths[s];
@@ -666,7 +688,7 @@ impl PathRoute {
             };
             let (mut reach, mut along_reach) = (0.0, 0.0);
             let mut last: Option<Moment> = None;
-            for &(a, b, m, pa, along) in &intervals {
+            for &(a, b, m, pa, contact) in &intervals {
                 if a - reach > tolerance {
                     let p = point_at_length(reach);
                     problems.push(PathRouteError::Gap {
@@ -676,7 +698,7 @@ impl PathRoute {
                         length: a - reach,
                     });
                 }
-                if along {
+                if contact == Contact::Along {
                     if along_reach - a > tolerance {
                         let to = point_at_length(f64::min(along_reach, b));
                         problems.push(PathRouteError::Overlap {
@@ -691,7 +713,7 @@ impl PathRoute {
                     along_reach = f64::max(along_reach, b);
                 }
                 reach = f64::max(reach, b);
-                if last.is_none_or(|l| m.is_after(&l)) {
+                if contact != Contact::Within && last.is_none_or(|l| m.is_after(&l)) {
                     last = Some(m);
                 }
             }
@@ -1053,6 +1075,76 @@ mod tests {
             };
             assert!((length - 10.0).abs() < 1e-9 && (x - 10.0).abs() < 1e-9);
         }
+    }
+
+    /// A clockwise 10 × 10 square whose top edge starts with a run of `n` collinear spans of
+    /// `step` mm each (finely discretised geometry: offsets give such runs near corners).
+    fn square_with_fine_run(n: usize, step: f64) -> Nest {
+        let mut vertices = vec![Vertex::line(0.0, 0.0)];
+        vertices.extend((0..n).map(|i| Vertex::line(i as f64 * step, 10.0)));
+        vertices.push(Vertex::line(10.0, 10.0));
+        vertices.push(Vertex::line(10.0, 0.0));
+        Nest {
+            sheet: None,
+            parts: vec![part(vec![Contour::new(vertices)])],
+        }
+    }
+
+    #[test]
+    fn runs_of_spans_shorter_than_the_tolerance_are_covered_by_the_cut_along_them() {
+        // 0.004 mm of spans of 0.0004 mm each, checked at 0.001 mm: no single span is long
+        // enough to tell its direction, but every one lies on the cut. The contour cut as
+        // itself, and cut with the run as one straight span, cut it exactly once.
+        let tolerance = 1e-3;
+        let nest = square_with_fine_run(11, 4e-4);
+        let itself = PathRoute::from_route(
+            &Route {
+                start: p(0.0, 0.0),
+                steps: vec![step(0, 0, p(0.0, 0.0))],
+                finish: None,
+            },
+            &nest,
+        )
+        .unwrap();
+        assert_eq!(itself.problems(&nest, tolerance), vec![]);
+        let merged = PathRoute {
+            start: p(0.0, 0.0),
+            paths: vec![polyline(&[
+                (0.0, 0.0),
+                (0.0, 10.0),
+                (0.004, 10.0),
+                (10.0, 10.0),
+                (10.0, 0.0),
+                (0.0, 0.0),
+            ])],
+            finish: None,
+        };
+        assert_eq!(merged.problems(&nest, tolerance), vec![]);
+    }
+
+    #[test]
+    fn a_run_of_short_spans_left_uncut_is_a_gap() {
+        // The same run, with the cut stopping before it and starting again after it: the
+        // uncut 0.004 mm (less what lies within the tolerance of the two cut ends) is a gap.
+        let tolerance = 1e-3;
+        let nest = square_with_fine_run(11, 4e-4);
+        let route = PathRoute {
+            start: p(0.0, 0.0),
+            paths: vec![polyline(&[
+                (0.004, 10.0),
+                (10.0, 10.0),
+                (10.0, 0.0),
+                (0.0, 0.0),
+                (0.0, 10.0),
+            ])],
+            finish: None,
+        };
+        // One path from the run's end round to its start: the run itself is never cut.
+        let problems = route.problems(&nest, tolerance);
+        assert!(
+            problems.iter().any(|e| matches!(e, PathRouteError::Gap { length, .. } if *length >= 0.004 - 2.0 * tolerance - 1e-9)),
+            "{problems:?}"
+        );
     }
 
     #[test]
