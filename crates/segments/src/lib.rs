@@ -54,8 +54,8 @@ mod solver;
 pub use cutroute_anytime::{AnytimeSolver, Bounds, Status};
 pub use cutroute_geometry::Objective;
 pub use gsccp::{
-    recut_length, solve_gsccp, Candidate, EnsembleReport, GsccpOptions, GsccpResult, GsccpSearch,
-    GsccpStage,
+    recut_length, solve_gsccp, Candidate, EnsembleFailure, EnsembleReport, GsccpOptions,
+    GsccpResult, GsccpSearch, GsccpStage,
 };
 pub use segment::{Ensemble, EnsembleKind, Segment};
 pub use solver::{solve_sccp, PathHeat, SccpOptions, SccpSearch, SccpSolution, SOLVE_SLICE};
