@@ -82,7 +82,7 @@ pub fn NestView() -> impl IntoView {
         </svg>
         // A second SVG stacked on the view: its own layer, so an animation frame repaints and
         // rasters the tool head only, not the nest (src/animation.rs).
-        <AnimationOverlay animation=animation scale=view_width view_box=Signal::derive(view_box) />
+        <AnimationOverlay scale=view_width view_box=Signal::derive(view_box) />
         </div>
     }
 }
