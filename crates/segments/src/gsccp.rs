@@ -251,8 +251,7 @@ impl GsccpSearch {
                 heat: options.sccp.heat.map(|h| h.penalty),
                 ..CcpOptions::default()
             },
-        )
-        .map_err(|e| SegmentError::Ccp(e.to_string()))?;
+        )?;
         Ok(GsccpSearch {
             nest: nest.clone(),
             options: options.clone(),
@@ -483,7 +482,7 @@ impl GsccpSearch {
         let route = solver.result().route;
         match PathRoute::from_route(&route, &self.nest) {
             Err(e) => {
-                self.failure = Some(SegmentError::Ccp(e.to_string()));
+                self.failure = Some(SegmentError::CcpRoute(e));
                 self.stage = Stage::Finished;
             }
             Ok(path) => {
