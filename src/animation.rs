@@ -468,74 +468,17 @@ fn ContourCounter(animation: Animation) -> impl IntoView {
 ///
 /// The paths are created once per route; per frame only the dash of `#anim-current` and the
 /// head's transform change; `#anim-done`'s dash and `#anim-current`'s path data change when the
-/// head leaves a chunk. Nothing here re-renders the route as the time advances. Being a separate element (its own paint layer
-/// and compositing layer, `style/base.css`), a frame repaints and rasters only this overlay:
-/// inside the view's SVG the same change made Chromium repaint thousands of labels and pierce
-/// marks and re-raster the route's single big paths under the head, ~50–130 ms a frame at
-/// 5,000 contours. Pan/zoom gestures move it with the view (`data-follows-gesture`,
-/// `src/pan_zoom.rs`).
+/// head leaves a chunk. Nothing here re-renders the route as the time advances. Being a
+/// separate element (its own paint layer and compositing layer, `style/base.css`), a frame
+/// repaints and rasters only this overlay: inside the view's SVG the same change made Chromium
+/// repaint thousands of labels and pierce marks and re-raster the route's single big paths
+/// under the head, ~50–130 ms a frame at 5,000 contours. Pan/zoom gestures move it with the
+/// view (`data-follows-gesture`, `src/pan_zoom.rs`).
 #[component]
-pub fn AnimationOverlay(
-    animation: Animation,
-    scale: Signal<f64>,
-    view_box: Signal<Option<String>>,
-) -> impl IntoView {
-    let Animation { timeline, time, .. } = animation;
-    // One frame's state, computed once and read by every attribute below; the head is shown at
-    // the route's start before the animation is first used.
-    let frame = Memo::new(move |_| {
-        let t = time.get().unwrap_or(0.0);
-        timeline.with(|tl| tl.as_ref().map(|tl| tl.frame_at(t)))
-    });
-    let revealed = Memo::new(move |_| time.get().is_some());
-    // The chunk under the head while the travelled route is shown, and the length of the
-    // chunks fully travelled: both change a few times a second at most.
-    let current = Memo::new(move |_| {
-        if revealed.get() {
-            frame.with(|f| f.and_then(|f| f.chunk))
-        } else {
-            None
-        }
-    });
-    let finished = Memo::new(move |_| {
-        let (k, travelled) = frame.with(|f| f.and_then(|f| Some((f.chunk?, f.chunk_travelled))))?;
-        timeline.with(|tl| {
-            let chunk = tl.as_ref()?.travel.chunks.get(k)?;
-            Some(if travelled >= chunk.length {
-                chunk.start + chunk.length
-            } else {
-                chunk.start
-            })
-        })
-    });
-    let route_length = Memo::new(move |_| {
-        timeline.with(|tl| {
-            tl.as_ref()
-                .map(|tl| tl.travel.length())
-                .filter(|&l| l > 0.0)
-        })
-    });
-    let route_d = move || timeline.with(|tl| tl.as_ref().map(|tl| tl.travel.d.clone()));
-    // The chunk under the head, unless already drawn whole by `#anim-done`. A chunk of a lone
-    // pierce has no length: not drawn (a zero pathLength is invalid).
-    let partial = Memo::new(move |_| {
-        let k = current.get()?;
-        let done = finished.get()?;
-        timeline.with(|tl| {
-            let chunk = tl.as_ref()?.travel.chunks.get(k)?;
-            (chunk.length > 0.0 && done <= chunk.start).then_some(k)
-        })
-    });
-    let partial_length = Memo::new(move |_| {
-        let k = partial.get()?;
-        timeline.with(|tl| tl.as_ref()?.travel.chunks.get(k).map(|c| c.length))
-    });
-    let partial_d = move || {
-        let k = partial.get()?;
-        timeline.with(|tl| tl.as_ref()?.travel.chunks.get(k).map(|c| c.d.clone()))
-    };
-    let head_state = move || frame.get().map(|f| f.state);
-    let head_shown = Memo::new(move |_| frame.with(Option::is_some));
+pub fn AnimationOverlay(scale: Signal<f64>, view_box: Signal<Option<String>>) -> impl IntoView {
+    let animation = expect_context::<Animation>();
+    let timeline = animation.timeline;
+    let frame = OverlayFrame::new(animation);
     view! {
         <svg
             id="anim-overlay"
@@ -547,10 +490,120 @@ pub fn AnimationOverlay(
             data-follows-gesture=""
             data-chunks=move || timeline.with(|tl| tl.as_ref().map(|tl| tl.travel.chunks.len()))
         >
-        <g transform="scale(1,-1)">
+            <g transform="scale(1,-1)">
+                <TravelledRoute timeline=timeline frame=frame scale=scale />
+                <ToolHead frame=frame.frame scale=scale />
+            </g>
+        </svg>
+    }
+}
+
+/// What the overlay shows at the animation's time, each part a memo computed once per frame
+/// and read by every attribute that needs it. Only `frame` changes every frame; the chunk
+/// under the head and the length travelled in whole chunks change a few times a second.
+#[derive(Clone, Copy)]
+struct OverlayFrame {
+    /// The head and the chunk under it (at the route's start before the animation is used).
+    frame: Memo<Option<Frame>>,
+    /// The chunk under the head while the travelled route is shown.
+    current: Memo<Option<usize>>,
+    /// The route length of the chunks fully travelled.
+    finished: Memo<Option<f64>>,
+    /// The whole route's length, when positive.
+    route_length: Memo<Option<f64>>,
+    /// The chunk under the head, unless already drawn whole by `#anim-done`. A chunk of a
+    /// lone pierce has no length: not drawn (a zero pathLength is invalid).
+    partial: Memo<Option<usize>>,
+    /// That chunk's length.
+    partial_length: Memo<Option<f64>>,
+}
+
+impl OverlayFrame {
+    fn new(animation: Animation) -> Self {
+        let Animation { timeline, time, .. } = animation;
+        let frame = Memo::new(move |_| {
+            let t = time.get().unwrap_or(0.0);
+            timeline.with(|tl| tl.as_ref().map(|tl| tl.frame_at(t)))
+        });
+        let revealed = Memo::new(move |_| time.get().is_some());
+        let current = Memo::new(move |_| {
+            revealed
+                .get()
+                .then(|| frame.with(|f| f.and_then(|f| f.chunk)))
+                .flatten()
+        });
+        // A chunk's start along the route and its length.
+        let chunk = move |k: usize| {
+            timeline.with(|tl| {
+                tl.as_ref()?
+                    .travel
+                    .chunks
+                    .get(k)
+                    .map(|c| (c.start, c.length))
+            })
+        };
+        let finished = Memo::new(move |_| {
+            let (k, travelled) =
+                frame.with(|f| f.and_then(|f| Some((f.chunk?, f.chunk_travelled))))?;
+            let (start, length) = chunk(k)?;
+            Some(if travelled >= length {
+                start + length
+            } else {
+                start
+            })
+        });
+        let route_length = Memo::new(move |_| {
+            timeline.with(|tl| {
+                tl.as_ref()
+                    .map(|tl| tl.travel.length())
+                    .filter(|&l| l > 0.0)
+            })
+        });
+        let partial = Memo::new(move |_| {
+            let (k, done) = (current.get()?, finished.get()?);
+            let (start, length) = chunk(k)?;
+            (length > 0.0 && done <= start).then_some(k)
+        });
+        let partial_length = Memo::new(move |_| chunk(partial.get()?).map(|(_, length)| length));
+        Self {
+            frame,
+            current,
+            finished,
+            route_length,
+            partial,
+            partial_length,
+        }
+    }
+}
+
+/// The route travelled so far: the chunks fully travelled (the whole route revealed by a dash
+/// that changes only when the head leaves a chunk), and the travelled part of the chunk under
+/// the head (the only path a frame changes).
+#[component]
+fn TravelledRoute(
+    timeline: Memo<Option<Timeline>>,
+    frame: OverlayFrame,
+    scale: Signal<f64>,
+) -> impl IntoView {
+    let OverlayFrame {
+        current,
+        finished,
+        route_length,
+        partial,
+        partial_length,
+        ..
+    } = frame;
+    let route_d = move || timeline.with(|tl| tl.as_ref().map(|tl| tl.travel.d.clone()));
+    let partial_d = move || {
+        let k = partial.get()?;
+        timeline.with(|tl| tl.as_ref()?.travel.chunks.get(k).map(|c| c.d.clone()))
+    };
+    // A dash of `done` along a path of `length` (the gap longer than the path).
+    let dash = |done: f64, length: f64| format!("{done} {}", length * 2.0 + 1.0);
+    // (`#anim-done` is hidden before the first chunk is done: a dash of length 0 shows as a dot.)
+    let done_shown = move || current.get().is_some() && finished.get().is_some_and(|d| d > 0.0);
+    view! {
         <g class="travelled" stroke-width=move || scale.get() / 250.0>
-            // The chunks fully travelled: the whole route revealed by a dash that changes only
-            // when the head leaves a chunk.
             <path
                 id="anim-done"
                 class="done"
@@ -558,57 +611,49 @@ pub fn AnimationOverlay(
                 pathLength=move || route_length.get()
                 stroke-dasharray=move || {
                     let length = route_length.get()?;
-                    Some(format!("{} {}", finished.get()?, length * 2.0 + 1.0))
+                    Some(dash(finished.get()?, length))
                 }
-                // (Hidden before the first chunk is done: a dash of length 0 shows as a dot.)
-                visibility=move || {
-                    if current.get().is_some() && finished.get().is_some_and(|d| d > 0.0) {
-                        "visible"
-                    } else {
-                        "hidden"
-                    }
-                }
+                visibility=move || if done_shown() { "visible" } else { "hidden" }
             />
-            // The travelled part of the chunk under the head: the only path a frame changes.
             <path
                 id="anim-current"
                 class="done"
                 d=partial_d
                 pathLength=move || partial_length.get()
+                // (The frame is read only while a chunk is partly travelled: no work per
+                // frame otherwise.)
                 stroke-dasharray=move || {
                     let length = partial_length.get()?;
-                    let travelled = frame.get()?.chunk_travelled;
-                    Some(format!("{travelled} {}", length * 2.0 + 1.0))
+                    Some(dash(frame.frame.get()?.chunk_travelled, length))
                 }
                 visibility=move || if partial.get().is_some() { "visible" } else { "hidden" }
             />
         </g>
-        {move || {
-            head_shown.get().then(|| {
-                view! {
-                    <circle
-                        id="tool-head"
-                        class=move || {
-                            if head_state().is_some_and(|s| s.tool_on) {
-                                "tool-head on"
-                            } else {
-                                "tool-head"
-                            }
-                        }
-                        r=move || scale.get() / 120.0
-                        transform=move || {
-                            head_state()
-                                .map(|s| format!("translate({} {})", s.position.x, s.position.y))
-                        }
-                        data-machine-time=move || {
-                            format!("{:.3}", frame.get().map_or(0.0, |f| f.time))
-                        }
-                    />
-                }
-            })
-        }}
-        </g>
-        </svg>
+    }
+}
+
+/// The tool head at the frame's position, lit while the tool is on; `data-machine-time` is
+/// the frame's clock time for checks by tools.
+#[component]
+fn ToolHead(frame: Memo<Option<Frame>>, scale: Signal<f64>) -> impl IntoView {
+    let head_shown = Memo::new(move |_| frame.with(Option::is_some));
+    let head_state = move || frame.get().map(|f| f.state);
+    move || {
+        head_shown.get().then(|| {
+            view! {
+                <circle
+                    id="tool-head"
+                    class=move || {
+                        if head_state().is_some_and(|s| s.tool_on) { "tool-head on" } else { "tool-head" }
+                    }
+                    r=move || scale.get() / 120.0
+                    transform=move || {
+                        head_state().map(|s| format!("translate({} {})", s.position.x, s.position.y))
+                    }
+                    data-machine-time=move || format!("{:.3}", frame.get().map_or(0.0, |f| f.time))
+                />
+            }
+        })
     }
 }
 

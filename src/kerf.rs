@@ -16,9 +16,10 @@ use cutroute_geometry::{
 use leptos::prelude::*;
 
 use crate::drawing::{contour_path, push_span};
-use crate::fields::{setting_field, Accept};
+use crate::fields::{setting_field, Accept, Words};
 use crate::i18n::tr;
 use crate::settings::{parse_tabs, shape_from_name, shape_name};
+use crate::state::MachineSettings;
 
 /// Path data of a lead-in and a lead-out, the lead-out as a second subpath.
 fn leads_d(lead_in: &[Vertex], lead_out: &[Vertex]) -> String {
@@ -174,62 +175,11 @@ pub fn LeadLayers(
 
 /// The full-route settings, beside the machine parameters.
 #[component]
-pub fn KerfPanel(settings: RwSignal<KerfSettings>) -> impl IntoView {
-    use crate::fields::Words;
-    let number = move |id: &'static str,
-                       label: Words,
-                       tip: Words,
-                       get: fn(&KerfSettings) -> f64,
-                       set: fn(&mut KerfSettings, f64)| {
-        setting_field(
-            settings,
-            id,
-            label,
-            ("mm", "мм"),
-            Some(tip),
-            Accept::NonNegative,
-            get,
-            set,
-        )
-    };
-    let shape = move |id: &'static str,
-                      label: Words,
-                      get: fn(&KerfSettings) -> LeadShape,
-                      set: fn(&mut KerfSettings, LeadShape)| {
-        let options: [(LeadShape, Words); 4] = [
-            (LeadShape::None, ("none", "нет")),
-            (LeadShape::Line, ("line", "прямая")),
-            (LeadShape::Arc, ("arc", "дуга")),
-            (LeadShape::LineArc, ("line + arc", "прямая + дуга")),
-        ];
-        view! {
-            <label class="param">
-                <span>{tr(label.0, label.1)}</span>
-                <select
-                    id=id
-                    prop:value=move || shape_name(get(&settings.get()))
-                    on:change=move |ev| {
-                        if let Some(s) = shape_from_name(&event_target_value(&ev)) {
-                            settings.update(|k| set(k, s));
-                        }
-                    }
-                >
-                    {options
-                        .into_iter()
-                        .map(|(s, words)| {
-                            view! {
-                                <option
-                                    value=shape_name(s)
-                                    selected=move || get(&settings.get()) == s
-                                >
-                                    {tr(words.0, words.1)}
-                                </option>
-                            }
-                        })
-                        .collect_view()}
-                </select>
-            </label>
-        }
+pub fn KerfPanel() -> impl IntoView {
+    let settings = expect_context::<MachineSettings>().kerf;
+    let number = |id, label, tip, get, set| length_field(settings, id, label, tip, get, set);
+    let shape = |id, label, get, set| {
+        view! { <LeadShapeSelect settings=settings id=id label=label get=get set=set /> }
     };
     view! {
         <details class="machine kerf">
@@ -242,33 +192,111 @@ pub fn KerfPanel(settings: RwSignal<KerfSettings>) -> impl IntoView {
             {shape("lead-out-shape", ("Lead-out", "Отвод"), |k| k.lead_out.shape, |k, s| k.lead_out.shape = s)}
             {number("lead-out-length", ("Lead-out length", "Длина отвода"), ("Length of the lead-out from the contour to the switch-off point", "Длина отвода от контура до точки выключения"), |k| k.lead_out.length, |k, v| k.lead_out.length = v)}
             {number("kerf-overcut", ("Overcut", "Перебег"), ("How far the cut runs on past the entry before the lead-out", "На сколько рез заходит за точку входа перед отводом"), |k| k.overcut, |k, v| k.overcut = v)}
-            <label class="param" title=tr("Micro-joints: N uncut gaps of WIDTH mm in the outer contour of every part (0:0 for none)", "Микроперемычки: N непрорезанных промежутков шириной W мм во внешнем контуре каждой детали (0:0 — нет)")>
-                <span>{tr("Tabs N:width", "Перемычки N:ширина")}</span>
-                <input
-                    id="kerf-tabs"
-                    type="text"
-                    inputmode="decimal"
-                    prop:value=move || settings.with(|k| format!("{}:{}", k.tabs.count, k.tabs.width))
-                    on:change=move |ev| {
-                        if let Some(tabs) = parse_tabs(&event_target_value(&ev)) {
-                            settings.update(|k| k.tabs = tabs);
-                        }
-                    }
-                />
-            </label>
-            <label class="param" title=tr("Pierce parts' outer contours at the sheet's border where a straight lead from it reaches the contour (the nest needs a sheet)", "Врезка внешних контуров деталей с кромки листа, где прямой подвод от неё доходит до контура (нужен лист)")>
-                <span>{tr("Edge piercing", "Врезка с кромки листа")}</span>
-                <input
-                    id="kerf-edge-pierce"
-                    type="checkbox"
-                    prop:checked=move || settings.with(|k| k.edge_pierce)
-                    on:change=move |ev| {
-                        let on = event_target_checked(&ev);
-                        settings.update(|k| k.edge_pierce = on);
-                    }
-                />
-            </label>
+            <TabsField settings=settings />
+            <EdgePierceField settings=settings />
         </details>
+    }
+}
+
+/// A length of the kerf settings in mm (non-negative), with its tip.
+fn length_field(
+    settings: RwSignal<KerfSettings>,
+    id: &'static str,
+    label: Words,
+    tip: Words,
+    get: fn(&KerfSettings) -> f64,
+    set: fn(&mut KerfSettings, f64),
+) -> impl IntoView {
+    let unit = ("mm", "мм");
+    setting_field(
+        settings,
+        id,
+        label,
+        unit,
+        Some(tip),
+        Accept::NonNegative,
+        get,
+        set,
+    )
+}
+
+/// The shape of a lead-in or lead-out.
+#[component]
+fn LeadShapeSelect(
+    settings: RwSignal<KerfSettings>,
+    id: &'static str,
+    label: Words,
+    get: fn(&KerfSettings) -> LeadShape,
+    set: fn(&mut KerfSettings, LeadShape),
+) -> impl IntoView {
+    let options: [(LeadShape, Words); 4] = [
+        (LeadShape::None, ("none", "нет")),
+        (LeadShape::Line, ("line", "прямая")),
+        (LeadShape::Arc, ("arc", "дуга")),
+        (LeadShape::LineArc, ("line + arc", "прямая + дуга")),
+    ];
+    let option = move |(s, words): (LeadShape, Words)| {
+        view! {
+            <option value=shape_name(s) selected=move || get(&settings.get()) == s>
+                {tr(words.0, words.1)}
+            </option>
+        }
+    };
+    view! {
+        <label class="param">
+            <span>{tr(label.0, label.1)}</span>
+            <select
+                id=id
+                prop:value=move || shape_name(get(&settings.get()))
+                on:change=move |ev| {
+                    if let Some(s) = shape_from_name(&event_target_value(&ev)) {
+                        settings.update(|k| set(k, s));
+                    }
+                }
+            >
+                {options.into_iter().map(option).collect_view()}
+            </select>
+        </label>
+    }
+}
+
+/// Micro-joints as "N:width".
+#[component]
+fn TabsField(settings: RwSignal<KerfSettings>) -> impl IntoView {
+    view! {
+        <label class="param" title=tr("Micro-joints: N uncut gaps of WIDTH mm in the outer contour of every part (0:0 for none)", "Микроперемычки: N непрорезанных промежутков шириной W мм во внешнем контуре каждой детали (0:0 — нет)")>
+            <span>{tr("Tabs N:width", "Перемычки N:ширина")}</span>
+            <input
+                id="kerf-tabs"
+                type="text"
+                inputmode="decimal"
+                prop:value=move || settings.with(|k| format!("{}:{}", k.tabs.count, k.tabs.width))
+                on:change=move |ev| {
+                    if let Some(tabs) = parse_tabs(&event_target_value(&ev)) {
+                        settings.update(|k| k.tabs = tabs);
+                    }
+                }
+            />
+        </label>
+    }
+}
+
+/// Piercing outer contours from the sheet's edge.
+#[component]
+fn EdgePierceField(settings: RwSignal<KerfSettings>) -> impl IntoView {
+    view! {
+        <label class="param" title=tr("Pierce parts' outer contours at the sheet's border where a straight lead from it reaches the contour (the nest needs a sheet)", "Врезка внешних контуров деталей с кромки листа, где прямой подвод от неё доходит до контура (нужен лист)")>
+            <span>{tr("Edge piercing", "Врезка с кромки листа")}</span>
+            <input
+                id="kerf-edge-pierce"
+                type="checkbox"
+                prop:checked=move || settings.with(|k| k.edge_pierce)
+                on:change=move |ev| {
+                    let on = event_target_checked(&ev);
+                    settings.update(|k| k.edge_pierce = on);
+                }
+            />
+        </label>
     }
 }
 

@@ -1,7 +1,7 @@
 //! The drawing: sheet, parts and the route's layers, y axis up, with pan and zoom, and the
 //! animation's overlay stacked on it.
 
-use cutroute_geometry::Point;
+use cutroute_geometry::{Point, Viewport};
 use leptos::prelude::*;
 
 use crate::animation::{Animation, AnimationOverlay};
@@ -10,7 +10,7 @@ use crate::drawing::{
     link_path, nest_bounds, path_route_idle_path, toolpath_bounds,
 };
 use crate::i18n::{tr, use_language, Lang};
-use crate::pan_zoom::{fitted_view, PanZoom, ViewBox};
+use crate::pan_zoom::{fitted_view, view_box_attribute, PanZoom};
 use crate::state::{DocumentState, Shown, SolverSettings, ViewSettings};
 use crate::thermal::{HeatMapLayer, ThermalView, ViolationMarks};
 
@@ -26,7 +26,7 @@ pub fn NestView() -> impl IntoView {
     let thermal = expect_context::<ThermalView>();
     let fit = drawing_fit();
     // Size of the drawing: fixed-size marks (arrows, dots, numbers) scale with it.
-    let extent = Memo::new(move |_| fit.get().map_or(100.0, |f| f[2].max(f[3])));
+    let extent = Memo::new(move |_| fit.get().map_or(100.0, |f| f.longer_side()));
     let pan_zoom = PanZoom::new(fit);
     // A new drawing starts fitted, with the animation rewound.
     Effect::new(move |_| {
@@ -35,13 +35,8 @@ pub fn NestView() -> impl IntoView {
         animation.playing.set(false);
         animation.time.set(None);
     });
-    let view_box = move || {
-        pan_zoom
-            .current()
-            .map(|[x, y, w, h]| format!("{x} {y} {w} {h}"))
-    };
-    let view_width =
-        Signal::derive(move || pan_zoom.current().map_or(100.0, |[_, _, w, h]| w.max(h)));
+    let view_box = move || pan_zoom.current().map(view_box_attribute);
+    let view_width = Signal::derive(move || pan_zoom.current().map_or(100.0, |v| v.longer_side()));
     let classes = move || {
         hidden_layers.with(|hidden| {
             let mut c = String::from("nest");
@@ -87,14 +82,14 @@ pub fn NestView() -> impl IntoView {
         </svg>
         // A second SVG stacked on the view: its own layer, so an animation frame repaints and
         // rasters the tool head only, not the nest (src/animation.rs).
-        <AnimationOverlay animation=animation scale=view_width view_box=Signal::derive(view_box) />
+        <AnimationOverlay scale=view_width view_box=Signal::derive(view_box) />
         </div>
     }
 }
 
 /// The box the drawing fits at first: the nest's; for a nest with nothing to draw (a G-code
 /// program of open paths), the box of the head's moves.
-fn drawing_fit() -> Signal<Option<ViewBox>> {
+fn drawing_fit() -> Signal<Option<Viewport>> {
     let Shown { nest, paths, .. } = expect_context::<Shown>();
     let animation = expect_context::<Animation>();
     let fit = Memo::new(move |_| {

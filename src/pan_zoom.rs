@@ -19,28 +19,26 @@
 use std::collections::HashMap;
 use std::time::Duration;
 
-use cutroute_geometry::BoundingBox;
+use cutroute_geometry::{BoundingBox, Point, Viewport};
 use leptos::prelude::*;
 use wasm_bindgen::JsCast;
 use web_sys::{KeyboardEvent, PointerEvent, SvgGraphicsElement, WheelEvent};
 
-/// An SVG `viewBox` `[x, y, width, height]` in the drawing's flipped frame (y down). Boxes of
-/// the model are geometry's `BoundingBox`; `fitted_view` is where one becomes the other. The
-/// view keeps its width and height as numbers of their own (not `max − min`): a pan must leave
-/// the zoom exactly as it was.
-pub type ViewBox = [f64; 4];
-
 /// The view box that shows `bounds` (model coordinates, y up) with a margin of 3 % of its longer
-/// side (at least 1 mm). The drawing's group flips y, so the box spans [−max.y, −min.y].
-pub fn fitted_view(bounds: BoundingBox) -> ViewBox {
-    let (width, height) = (bounds.width(), bounds.height());
-    let margin = (width.max(height) * 0.03).max(1.0);
-    [
-        bounds.min.x - margin,
-        -bounds.max.y - margin,
-        width + 2.0 * margin,
-        height + 2.0 * margin,
-    ]
+/// side (at least 1 mm). The SVG `viewBox` is in the drawing's flipped frame (y down: the
+/// drawing's group flips y), so the box spans [−max.y, −min.y].
+pub fn fitted_view(bounds: BoundingBox) -> Viewport {
+    let margin = (bounds.width().max(bounds.height()) * 0.03).max(1.0);
+    let flipped = BoundingBox::from_corners(
+        Point::new(bounds.min.x, -bounds.max.y),
+        Point::new(bounds.max.x, -bounds.min.y),
+    );
+    Viewport::fitting(&flipped, margin)
+}
+
+/// The `viewBox` attribute of a view.
+pub fn view_box_attribute(view: Viewport) -> String {
+    format!("{} {} {} {}", view.x, view.y, view.width, view.height)
 }
 
 /// Zoom factor of one key press.
@@ -50,18 +48,6 @@ const KEY_PAN: f64 = 0.1;
 /// A wheel gesture ends when no wheel event came for this long; the view box is then committed.
 pub const WHEEL_SETTLE_MS: u64 = 150;
 
-/// Scale `view` by `factor` (> 1 zooms out) keeping the drawing point `(ux, uy)` fixed.
-pub fn zoom_about(view: ViewBox, factor: f64, ux: f64, uy: f64) -> ViewBox {
-    let [x, y, w, h] = view;
-    let factor = factor.clamp(1e-3, 1e3);
-    [
-        ux - (ux - x) * factor,
-        uy - (uy - y) * factor,
-        w * factor,
-        h * factor,
-    ]
-}
-
 /// The CSS transform of the `<svg>` element (origin at its centre) that makes the picture drawn
 /// for the `committed` view box look as the `live` one would: `(tx, ty, k)` for
 /// `translate(tx px, ty px) scale(k)`. `a` is the committed view's screen pixels per drawing
@@ -69,11 +55,10 @@ pub fn zoom_about(view: ViewBox, factor: f64, ux: f64, uy: f64) -> ViewBox {
 /// and `preserveAspectRatio="xMidYMid meet"` puts each box's centre at the element's centre `O`,
 /// so a drawing point `p` shown at `O + a (p − c₀)` must move to `O + a k (p − c)` (`c₀`, `c` the
 /// boxes' centres, `k = committed width / live width`): that is `t = a k (c₀ − c)`.
-pub fn gesture_transform(a: f64, committed: ViewBox, live: ViewBox) -> (f64, f64, f64) {
-    let k = committed[2] / live[2];
-    let centre = |v: ViewBox| (v[0] + v[2] / 2.0, v[1] + v[3] / 2.0);
-    let (c0, c) = (centre(committed), centre(live));
-    (a * k * (c0.0 - c.0), a * k * (c0.1 - c.1), k)
+pub fn gesture_transform(a: f64, committed: Viewport, live: Viewport) -> (f64, f64, f64) {
+    let k = committed.width / live.width;
+    let (c0, c) = (committed.centre(), live.centre());
+    (a * k * (c0.x - c.x), a * k * (c0.y - c.y), k)
 }
 
 /// Screen ↔ drawing mapping of a live view box, from the screen matrix of the committed one.
@@ -82,29 +67,27 @@ struct LiveMapping {
     /// Screen pixels per drawing unit in the live view.
     scale: f64,
     /// Screen point of the committed view's centre (also the live view's centre).
-    screen_centre: (f64, f64),
+    screen_centre: Point,
     /// Drawing point at the centre of the live view.
-    live_centre: (f64, f64),
+    live_centre: Point,
 }
 
 impl LiveMapping {
     /// The mapping, given the committed view's screen matrix `screen = a · user + (e, f)`.
-    fn new(a: f64, e: f64, f: f64, committed: ViewBox, live: ViewBox) -> Self {
+    fn new(a: f64, e: f64, f: f64, committed: Viewport, live: Viewport) -> Self {
+        let centre = committed.centre();
         Self {
-            scale: a * committed[2] / live[2],
-            screen_centre: (
-                a * (committed[0] + committed[2] / 2.0) + e,
-                a * (committed[1] + committed[3] / 2.0) + f,
-            ),
-            live_centre: (live[0] + live[2] / 2.0, live[1] + live[3] / 2.0),
+            scale: a * committed.width / live.width,
+            screen_centre: Point::new(a * centre.x + e, a * centre.y + f),
+            live_centre: live.centre(),
         }
     }
 
     /// The drawing point under a screen point.
-    fn drawing_at(self, client_x: f64, client_y: f64) -> (f64, f64) {
-        (
-            self.live_centre.0 + (client_x - self.screen_centre.0) / self.scale,
-            self.live_centre.1 + (client_y - self.screen_centre.1) / self.scale,
+    fn drawing_at(self, client_x: f64, client_y: f64) -> Point {
+        Point::new(
+            self.live_centre.x + (client_x - self.screen_centre.x) / self.scale,
+            self.live_centre.y + (client_y - self.screen_centre.y) / self.scale,
         )
     }
 }
@@ -118,8 +101,8 @@ struct Gesture {
     followers: Vec<web_sys::Element>,
     /// `screen = a · user + (e, f)` for the committed view box.
     ctm: (f64, f64, f64),
-    committed: ViewBox,
-    live: ViewBox,
+    committed: Viewport,
+    live: Viewport,
 }
 
 impl Gesture {
@@ -133,9 +116,9 @@ impl Gesture {
 #[derive(Clone, Copy)]
 pub struct PanZoom {
     /// The committed view box (the SVG `viewBox`), `None` = fit the whole drawing.
-    pub view: RwSignal<Option<ViewBox>>,
+    pub view: RwSignal<Option<Viewport>>,
     /// The fitted view box, used when `view` is `None`.
-    pub fit: Signal<Option<ViewBox>>,
+    pub fit: Signal<Option<Viewport>>,
     gesture: StoredValue<Option<Gesture>, LocalStorage>,
     /// Commits the view when the wheel has been quiet for [`WHEEL_SETTLE_MS`].
     wheel_timer: StoredValue<Option<TimeoutHandle>>,
@@ -144,7 +127,7 @@ pub struct PanZoom {
 
 impl PanZoom {
     /// State for one view.
-    pub fn new(fit: Signal<Option<ViewBox>>) -> Self {
+    pub fn new(fit: Signal<Option<Viewport>>) -> Self {
         Self {
             view: RwSignal::new(None),
             fit,
@@ -155,11 +138,11 @@ impl PanZoom {
     }
 
     /// The committed view box to render.
-    pub fn current(&self) -> Option<ViewBox> {
+    pub fn current(&self) -> Option<Viewport> {
         self.view.get().or_else(|| self.fit.get())
     }
 
-    fn committed_untracked(&self) -> Option<ViewBox> {
+    fn committed_untracked(&self) -> Option<Viewport> {
         self.view
             .get_untracked()
             .or_else(|| self.fit.get_untracked())
@@ -173,7 +156,7 @@ impl PanZoom {
 
     /// The live view and its screen mapping, starting a gesture on `ev`'s `<svg>` if none is
     /// under way.
-    fn gesture_view<E: AsRef<web_sys::Event>>(&self, ev: &E) -> Option<(ViewBox, LiveMapping)> {
+    fn gesture_view<E: AsRef<web_sys::Event>>(&self, ev: &E) -> Option<(Viewport, LiveMapping)> {
         let running = self
             .gesture
             .with_value(|g| g.as_ref().map(|g| (g.live, g.mapping())));
@@ -184,7 +167,7 @@ impl PanZoom {
         let svg = target_svg(ev)?;
         let m = svg.get_screen_ctm()?;
         let (a, e, f) = (f64::from(m.a()), f64::from(m.e()), f64::from(m.f()));
-        if a == 0.0 || !a.is_finite() || committed[2] == 0.0 {
+        if a == 0.0 || !a.is_finite() || committed.width == 0.0 {
             return None;
         }
         // Hit-testing thousands of paths on every move is wasted work mid-gesture.
@@ -206,7 +189,7 @@ impl PanZoom {
     }
 
     /// Shows `live` during a gesture: a transform of the `<svg>`, no `viewBox` change.
-    fn show_live(&self, live: ViewBox) {
+    fn show_live(&self, live: Viewport) {
         self.gesture.update_value(|g| {
             if let Some(g) = g {
                 g.live = live;
@@ -221,7 +204,7 @@ impl PanZoom {
     }
 
     /// Ends the gesture under way, if any, undoing its transform; returns its live view.
-    fn end_gesture(&self) -> Option<ViewBox> {
+    fn end_gesture(&self) -> Option<Viewport> {
         if let Some(timer) = self.wheel_timer.try_update_value(Option::take).flatten() {
             timer.clear();
         }
@@ -247,10 +230,10 @@ impl PanZoom {
         let Some((live, mapping)) = self.gesture_view(&ev) else {
             return;
         };
-        let (ux, uy) = mapping.drawing_at(f64::from(ev.client_x()), f64::from(ev.client_y()));
+        let anchor = mapping.drawing_at(f64::from(ev.client_x()), f64::from(ev.client_y()));
         // deltaMode 1 = lines: scale them to pixels so mice and touchpads feel alike.
         let delta = ev.delta_y() * if ev.delta_mode() == 1 { 16.0 } else { 1.0 };
-        self.show_live(zoom_about(live, (delta * 0.0015).exp(), ux, uy));
+        self.show_live(live.zoomed_about((delta * 0.0015).exp(), anchor));
         let this = *self;
         let timer = set_timeout_with_handle(
             move || this.commit(),
@@ -306,17 +289,13 @@ impl PanZoom {
                 view
             } else {
                 let mid = ((now.0 + other.0) / 2.0, (now.1 + other.1) / 2.0);
-                let (ux, uy) = mapping.drawing_at(mid.0, mid.1);
-                zoom_about(view, d_before / d_now, ux, uy)
+                view.zoomed_about(d_before / d_now, mapping.drawing_at(mid.0, mid.1))
             }
         } else {
-            let [x, y, w, h] = view;
-            [
-                x - (now.0 - before.0) / mapping.scale,
-                y - (now.1 - before.1) / mapping.scale,
-                w,
-                h,
-            ]
+            view.panned(Point::new(
+                -(now.0 - before.0) / mapping.scale,
+                -(now.1 - before.1) / mapping.scale,
+            ))
         };
         self.pointers.update_value(|p| {
             p.insert(id, now);
@@ -346,15 +325,14 @@ impl PanZoom {
         let Some(view) = self.committed_untracked() else {
             return;
         };
-        let [x, y, w, h] = view;
-        let (cx, cy) = (x + w / 2.0, y + h / 2.0);
+        let (w, h) = (view.width, view.height);
         let next = match ev.key().as_str() {
-            "+" | "=" => Some(zoom_about(view, 1.0 / KEY_ZOOM, cx, cy)),
-            "-" | "_" => Some(zoom_about(view, KEY_ZOOM, cx, cy)),
-            "ArrowLeft" => Some([x - w * KEY_PAN, y, w, h]),
-            "ArrowRight" => Some([x + w * KEY_PAN, y, w, h]),
-            "ArrowUp" => Some([x, y - h * KEY_PAN, w, h]),
-            "ArrowDown" => Some([x, y + h * KEY_PAN, w, h]),
+            "+" | "=" => Some(view.zoomed_about(1.0 / KEY_ZOOM, view.centre())),
+            "-" | "_" => Some(view.zoomed_about(KEY_ZOOM, view.centre())),
+            "ArrowLeft" => Some(view.panned(Point::new(-w * KEY_PAN, 0.0))),
+            "ArrowRight" => Some(view.panned(Point::new(w * KEY_PAN, 0.0))),
+            "ArrowUp" => Some(view.panned(Point::new(0.0, -h * KEY_PAN))),
+            "ArrowDown" => Some(view.panned(Point::new(0.0, h * KEY_PAN))),
             "0" => {
                 ev.prevent_default();
                 self.reset();
@@ -378,37 +356,38 @@ fn target_svg<E: AsRef<web_sys::Event>>(ev: &E) -> Option<SvgGraphicsElement> {
 
 #[cfg(test)]
 mod tests {
-    use super::{fitted_view, gesture_transform, zoom_about, LiveMapping, ViewBox};
+    use super::{fitted_view, gesture_transform, view_box_attribute, LiveMapping, Viewport};
     use cutroute_geometry::{BoundingBox, Point};
 
     #[test]
     fn the_fitted_view_flips_y_and_keeps_a_margin() {
         // A 100 × 50 box whose top edge is at y = 60: 3 mm margin, y flipped.
         let bounds = BoundingBox::from_corners(Point::new(10.0, 10.0), Point::new(110.0, 60.0));
-        assert_eq!(fitted_view(bounds), [7.0, -63.0, 106.0, 56.0]);
+        assert_eq!(fitted_view(bounds), Viewport::new(7.0, -63.0, 106.0, 56.0));
         // A tiny box still gets a 1 mm margin.
         let dot = BoundingBox::from_corners(Point::new(0.0, 0.0), Point::new(2.0, 1.0));
-        let view: ViewBox = fitted_view(dot);
-        assert_eq!(view, [-1.0, -2.0, 4.0, 3.0]);
+        let view: Viewport = fitted_view(dot);
+        assert_eq!(view, Viewport::new(-1.0, -2.0, 4.0, 3.0));
+        assert_eq!(view_box_attribute(view), "-1 -2 4 3");
     }
 
     #[test]
     fn zoom_keeps_the_anchor_point_fixed() {
-        let view = [0.0, 0.0, 100.0, 50.0];
-        let zoomed = zoom_about(view, 0.5, 20.0, 10.0);
-        assert_eq!(zoomed, [10.0, 5.0, 50.0, 25.0]);
+        let view = Viewport::new(0.0, 0.0, 100.0, 50.0);
+        let zoomed = view.zoomed_about(0.5, Point::new(20.0, 10.0));
+        assert_eq!(zoomed, Viewport::new(10.0, 5.0, 50.0, 25.0));
         // The anchor sits at the same relative place in both boxes.
-        let rel = |v: [f64; 4]| ((20.0 - v[0]) / v[2], (10.0 - v[1]) / v[3]);
+        let rel = |v: Viewport| ((20.0 - v.x) / v.width, (10.0 - v.y) / v.height);
         assert_eq!(rel(view), rel(zoomed));
     }
 
     /// Screen point of drawing point `p` when `view` is the viewBox of an 800 × 500 px viewport
     /// at (40, 60), `xMidYMid meet` (what the browser does).
-    fn screen(view: [f64; 4], p: (f64, f64)) -> (f64, f64) {
+    fn screen(view: Viewport, p: (f64, f64)) -> (f64, f64) {
         let (vw, vh) = (800.0, 500.0);
-        let a = (vw / view[2]).min(vh / view[3]);
-        let e = 40.0 + (vw - a * view[2]) / 2.0 - a * view[0];
-        let f = 60.0 + (vh - a * view[3]) / 2.0 - a * view[1];
+        let a = (vw / view.width).min(vh / view.height);
+        let e = 40.0 + (vw - a * view.width) / 2.0 - a * view.x;
+        let f = 60.0 + (vh - a * view.height) / 2.0 - a * view.y;
         (a * p.0 + e, a * p.1 + f)
     }
 
@@ -419,14 +398,14 @@ mod tests {
     #[test]
     fn the_gesture_transform_shows_the_live_view() {
         // Committed box taller than the viewport's aspect, so "meet" letterboxes it.
-        let committed = [-20.0, -310.0, 400.0, 300.0];
+        let committed = Viewport::new(-20.0, -310.0, 400.0, 300.0);
         let a = screen(committed, (1.0, 0.0)).0 - screen(committed, (0.0, 0.0)).0;
         // The element's centre, the CSS transform origin.
         let origin = (40.0 + 400.0, 60.0 + 250.0);
         let lives = [
-            zoom_about(committed, 0.37, 55.0, -120.0),
-            zoom_about(committed, 2.5, 300.0, -20.0),
-            [committed[0] + 33.0, committed[1] - 71.0, 400.0, 300.0],
+            committed.zoomed_about(0.37, Point::new(55.0, -120.0)),
+            committed.zoomed_about(2.5, Point::new(300.0, -20.0)),
+            Viewport::new(committed.x + 33.0, committed.y - 71.0, 400.0, 300.0),
         ];
         for live in lives {
             let (tx, ty, k) = gesture_transform(a, committed, live);
@@ -443,7 +422,7 @@ mod tests {
 
     #[test]
     fn the_live_mapping_inverts_the_live_view_and_zoom_stays_under_the_cursor() {
-        let committed = [-20.0, -310.0, 400.0, 300.0];
+        let committed = Viewport::new(-20.0, -310.0, 400.0, 300.0);
         // The committed view's screen matrix, as getScreenCTM reports it.
         let (e, f) = screen(committed, (0.0, 0.0));
         let a = screen(committed, (1.0, 0.0)).0 - e;
@@ -451,10 +430,11 @@ mod tests {
         let cursor = (500.0, 200.0);
         for step in 0..20 {
             let mapping = LiveMapping::new(a, e, f, committed, live);
-            let (ux, uy) = mapping.drawing_at(cursor.0, cursor.1);
+            let anchor = mapping.drawing_at(cursor.0, cursor.1);
+            let (ux, uy) = (anchor.x, anchor.y);
             assert!(close(screen(live, (ux, uy)), cursor), "step {step}");
             let factor = if step < 10 { 0.8 } else { 1.3 };
-            live = zoom_about(live, factor, ux, uy);
+            live = live.zoomed_about(factor, anchor);
             // The drawing point under the cursor is the same after the zoom.
             assert!(close(screen(live, (ux, uy)), cursor), "step {step}");
         }

@@ -32,9 +32,9 @@ pub fn SidePanels() -> impl IntoView {
             <StatsPanel nest=shown.nest route=shown.route paths=shown.paths machine=machine.machine />
             <crate::kerf::LeadStats route=shown.route />
             <crate::profiles::ProfilesPanel />
-            <crate::kerf::KerfPanel settings=machine.kerf />
-            <ThermalPanel settings=machine.thermal />
-            <ThermalStats progress=job.progress />
+            <crate::kerf::KerfPanel />
+            <ThermalPanel />
+            <ThermalStats />
             <AlternativesTable alternatives=alternatives />
             <BoundsChart
                 samples=job.chart_samples

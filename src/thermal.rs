@@ -17,6 +17,7 @@ use crate::drawing::{contour_path, heat_frame, nest_bounds};
 use crate::fields::{setting_field, Accept};
 use crate::i18n::{tr, use_language, Lang};
 use crate::settings::Layer;
+use crate::state::{JobState, MachineSettings};
 
 /// Cells of the heat map along the drawing's longer side: fine enough to show each source's
 /// σ-wide spot on a sheet of a few metres, coarse enough to redraw every animation frame.
@@ -67,7 +68,8 @@ impl ThermalView {
 
 /// The material's heat model and the shop rules, beside the machine parameters.
 #[component]
-pub fn ThermalPanel(settings: RwSignal<ThermalSettings>) -> impl IntoView {
+pub fn ThermalPanel() -> impl IntoView {
+    let settings = expect_context::<MachineSettings>().thermal;
     // Labels, units and tips as (English, Russian).
     use crate::fields::Words;
     let number = move |id: &'static str,
@@ -182,9 +184,36 @@ fn kind_word(kind: &'static str, lang: Lang) -> &'static str {
 
 /// H and the rule violations of the job's route.
 #[component]
-pub fn ThermalStats(progress: RwSignal<Option<Progress>>) -> impl IntoView {
-    let language = use_language();
+pub fn ThermalStats() -> impl IntoView {
+    let progress = expect_context::<JobState>().progress;
+    view! {
+        <dl class="thermal-stats">
+            <HeatFigure progress=progress />
+            <RuleCounts progress=progress />
+        </dl>
+        <ViolationList progress=progress />
+    }
+}
+
+/// H, rounded; `data-value` keeps it unrounded for checks by tools.
+#[component]
+fn HeatFigure(progress: RwSignal<Option<Progress>>) -> impl IntoView {
     let heat = move || progress.with(|p| p.as_ref().and_then(|p| p.heat));
+    view! {
+        <dt title=tr(
+            "Thermal load: Σ over pairs of pierces of exp(−d²/2σ²)·exp(−Δt/τ) on the machine clock",
+            "Тепловая нагрузка: Σ по парам врезок exp(−d²/2σ²)·exp(−Δt/τ) по часам станка",
+        )>{tr("Heat H", "Нагрев H")}</dt>
+        <dd id="heat" data-value=move || heat().map(|h| format!("{h:e}")).unwrap_or_default()>
+            {move || heat().map(|h| format!("{h:.4}")).unwrap_or_else(|| "—".into())}
+        </dd>
+    }
+}
+
+/// How many violations of each checked rule the route has.
+#[component]
+fn RuleCounts(progress: RwSignal<Option<Progress>>) -> impl IntoView {
+    let language = use_language();
     let counts = move || progress.with(|p| p.as_ref().and_then(|p| p.rule_counts));
     let count = move |pick: fn(&cutroute_protocol::RuleCounts) -> Option<usize>| {
         move || {
@@ -194,76 +223,81 @@ pub fn ThermalStats(progress: RwSignal<Option<Progress>>) -> impl IntoView {
                 .unwrap_or_default()
         }
     };
+    let text = move || match counts() {
+        None => language
+            .pick("— (no rule checked)", "— (правила не проверялись)")
+            .to_string(),
+        Some(c) => [("part", c.part), ("sheet", c.sheet), ("islands", c.islands)]
+            .into_iter()
+            .filter_map(|(name, n)| n.map(|n| format!("{} {n}", kind_word(name, language.get()))))
+            .collect::<Vec<_>>()
+            .join(" · "),
+    };
     view! {
-        <dl class="thermal-stats">
-            <dt title=tr(
-                "Thermal load: Σ over pairs of pierces of exp(−d²/2σ²)·exp(−Δt/τ) on the machine clock",
-                "Тепловая нагрузка: Σ по парам врезок exp(−d²/2σ²)·exp(−Δt/τ) по часам станка",
-            )>{tr("Heat H", "Нагрев H")}</dt>
-            // `data-value` keeps the unrounded H for checks by tools.
-            <dd id="heat" data-value=move || heat().map(|h| format!("{h:e}")).unwrap_or_default()>
-                {move || heat().map(|h| format!("{h:.4}")).unwrap_or_else(|| "—".into())}
-            </dd>
-            <dt>{tr("Rule violations", "Нарушения правил")}</dt>
-            <dd
-                id="rule-counts"
-                data-part=count(|c| c.part)
-                data-sheet=count(|c| c.sheet)
-                data-islands=count(|c| c.islands)
+        <dt>{tr("Rule violations", "Нарушения правил")}</dt>
+        <dd
+            id="rule-counts"
+            data-part=count(|c| c.part)
+            data-sheet=count(|c| c.sheet)
+            data-islands=count(|c| c.islands)
+        >
+            {text}
+        </dd>
+    }
+}
+
+/// Each violation, with the cut and the contour it is at.
+#[component]
+fn ViolationList(progress: RwSignal<Option<Progress>>) -> impl IntoView {
+    let language = use_language();
+    let item = move |v: &Violation| {
+        let (step, contour) = violation_place(v);
+        let kind = violation_kind(v);
+        view! {
+            <li
+                class=format!("violation-item {kind}")
+                data-kind=kind
+                data-step=step
+                data-part=contour.part
+                data-contour=contour.contour
             >
-                {move || match counts() {
-                    None => language.pick("— (no rule checked)", "— (правила не проверялись)").to_string(),
-                    Some(c) => [("part", c.part), ("sheet", c.sheet), ("islands", c.islands)]
-                        .into_iter()
-                        .filter_map(|(name, n)| n.map(|n| format!("{} {n}", kind_word(name, language.get()))))
-                        .collect::<Vec<_>>()
-                        .join(" · "),
-                }}
-            </dd>
-        </dl>
+                {violation_line(v, language.get())}
+            </li>
+        }
+    };
+    let items = move || {
+        progress.with(|p| {
+            p.as_ref()
+                .map(|p| p.violations.iter().map(item).collect_view())
+        })
+    };
+    view! {
         <ol id="violations" class="violations" aria-label=tr("Rule violations", "Нарушения правил")>
-            {move || {
-                progress.with(|p| {
-                    p.as_ref()
-                        .map(|p| {
-                            p.violations
-                                .iter()
-                                .map(|v| {
-                                    let (step, contour) = violation_place(v);
-                                    let kind = violation_kind(v);
-                                    view! {
-                                        <li
-                                            class=format!("violation-item {kind}")
-                                            data-kind=kind
-                                            data-step=step
-                                            data-part=contour.part
-                                            data-contour=contour.contour
-                                        >
-                                            {match language.get() {
-                                                Lang::En => format!(
-                                                    "{kind}: cut {}, part {} contour {} — {}",
-                                                    step + 1,
-                                                    contour.part + 1,
-                                                    contour.contour,
-                                                    violation_text(v, Lang::En)
-                                                ),
-                                                Lang::Ru => format!(
-                                                    "{}: рез {}, деталь {} контур {} — {}",
-                                                    kind_word(kind, Lang::Ru),
-                                                    step + 1,
-                                                    contour.part + 1,
-                                                    contour.contour,
-                                                    violation_text(v, Lang::Ru)
-                                                ),
-                                            }}
-                                        </li>
-                                    }
-                                })
-                                .collect_view()
-                        })
-                })
-            }}
+            {items}
         </ol>
+    }
+}
+
+/// One violation in words: its kind, the cut, the contour, and what is wrong.
+fn violation_line(v: &Violation, lang: Lang) -> String {
+    let (step, contour) = violation_place(v);
+    let kind = violation_kind(v);
+    match lang {
+        Lang::En => format!(
+            "{kind}: cut {}, part {} contour {} — {}",
+            step + 1,
+            contour.part + 1,
+            contour.contour,
+            violation_text(v, Lang::En)
+        ),
+        Lang::Ru => format!(
+            "{}: рез {}, деталь {} контур {} — {}",
+            kind_word(kind, Lang::Ru),
+            step + 1,
+            contour.part + 1,
+            contour.contour,
+            violation_text(v, Lang::Ru)
+        ),
     }
 }
 

@@ -224,7 +224,8 @@ fn check_options(options: &SvgOptions) -> Result<(), SvgError> {
 /// One piece of a subpath in the element's own user space.
 #[derive(Clone, Debug)]
 enum Segment {
-    Line(Point, Point),
+    /// A straight piece (`L`, `H`, `V`, `Z`, polyline edges): geometry's span with bulge 0.
+    Line(Span),
     /// A Bézier curve by its control points (3 for quadratic, 4 for cubic).
     Bezier(Vec<Point>),
     /// An elliptic arc `center + u·cos t + v·sin t`, `t` from `t0` to `t1`.
@@ -570,8 +571,8 @@ impl<'a, 'input> Reader<'a, 'input, '_> {
         let mut spans: Vec<Span> = Vec::new();
         for segment in subpath.segments {
             match segment {
-                Segment::Line(a, b) => {
-                    let (a, b) = (to_model.apply(a), to_model.apply(b));
+                Segment::Line(line) => {
+                    let (a, b) = (to_model.apply(line.start), to_model.apply(line.end));
                     if a != b {
                         self.budget = self.budget.checked_sub(1).ok_or(too_complex.clone())?;
                         spans.push(Span::line(a, b));
@@ -645,7 +646,7 @@ fn polyline(points: &[Point]) -> Subpath {
     Subpath {
         segments: points
             .windows(2)
-            .map(|w| Segment::Line(w[0], w[1]))
+            .map(|w| Segment::Line(Span::line(w[0], w[1])))
             .collect(),
         closed: false,
     }
@@ -657,7 +658,7 @@ fn close(subpath: &mut Subpath, start: Option<Point>) {
     let end = subpath.segments.last().map(segment_end);
     if let Some(end) = end {
         if end != start {
-            subpath.segments.push(Segment::Line(end, start));
+            subpath.segments.push(Segment::Line(Span::line(end, start)));
         }
     }
     subpath.closed = true;
@@ -665,7 +666,7 @@ fn close(subpath: &mut Subpath, start: Option<Point>) {
 
 fn segment_end(s: &Segment) -> Point {
     match s {
-        Segment::Line(_, b) => *b,
+        Segment::Line(line) => line.end,
         Segment::Bezier(c) => c[c.len() - 1],
         Segment::Elliptic(arc) => arc.point_at(arc.t1),
     }
@@ -698,7 +699,7 @@ fn rounded_rect(x: f64, y: f64, w: f64, h: f64, rx: f64, ry: f64) -> Subpath {
     let mut segments = Vec::new();
     let line = |a: Point, b: Point, segments: &mut Vec<Segment>| {
         if a != b {
-            segments.push(Segment::Line(a, b));
+            segments.push(Segment::Line(Span::line(a, b)));
         }
     };
     // Clockwise on screen (y down): top edge, top-right corner, right edge, …
@@ -1003,7 +1004,7 @@ fn parse_path(d: &str) -> Result<Vec<Subpath>, (usize, String)> {
             }
             b'L' => {
                 let p = at(&mut s, base)?;
-                current.segments.push(Segment::Line(pen, p));
+                current.segments.push(Segment::Line(Span::line(pen, p)));
                 pen = p;
             }
             b'H' | b'V' => {
@@ -1015,7 +1016,7 @@ fn parse_path(d: &str) -> Result<Vec<Subpath>, (usize, String)> {
                 } else {
                     Point::new(pen.x, if relative { pen.y + v } else { v })
                 };
-                current.segments.push(Segment::Line(pen, p));
+                current.segments.push(Segment::Line(Span::line(pen, p)));
                 pen = p;
             }
             b'C' | b'S' => {
@@ -1094,10 +1095,10 @@ fn endpoint_arc(
     to: Point,
 ) -> Segment {
     if from == to {
-        return Segment::Line(from, to);
+        return Segment::Line(Span::line(from, to));
     }
     if rx == 0.0 || ry == 0.0 {
-        return Segment::Line(from, to);
+        return Segment::Line(Span::line(from, to));
     }
     let (sin, cos) = rotation_deg.to_radians().sin_cos_libm();
     let dx = (from.x - to.x) / 2.0;
@@ -1123,7 +1124,7 @@ fn endpoint_arc(
     }
     if !(rx.is_finite() && ry.is_finite() && k.is_finite()) {
         // Radii far below the chord (1e-300) overflow the scaling: the arc is the chord.
-        return Segment::Line(from, to);
+        return Segment::Line(Span::line(from, to));
     }
     let cx1 = k * rx * y1 / ry;
     let cy1 = -k * ry * x1 / rx;
@@ -1142,7 +1143,7 @@ fn endpoint_arc(
         delta -= std::f64::consts::TAU;
     }
     if !delta.is_finite() || !center.x.is_finite() || !center.y.is_finite() {
-        return Segment::Line(from, to);
+        return Segment::Line(Span::line(from, to));
     }
     Segment::Elliptic(EllipticArc {
         center,

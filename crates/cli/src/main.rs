@@ -675,7 +675,7 @@ impl SolverJob {
                             "recut_length": r.recut_length,
                             "time_s": finite(r.time_s),
                             "cost": finite(r.cost),
-                            "failure": r.failure,
+                            "failure": r.failure.as_ref().map(ToString::to_string),
                         }))
                         .collect::<Vec<_>>()),
                 );
@@ -1637,9 +1637,10 @@ mod tests {
     #[test]
     fn an_engine_refusal_keeps_its_words_and_its_source() {
         use cutroute_engine::{EngineError, Refusal};
+        use cutroute_protocol::ThermalSettingsError;
         let refusal = || EngineError::SolverRefused {
             solver: "exact",
-            reason: Refusal::Settings("thermal weight must be finite".into()),
+            reason: Refusal::ThermalSettings(ThermalSettingsError::Weight(-1.0)),
         };
         let failure = Failure::Engine {
             solver: "exact",
@@ -1647,7 +1648,7 @@ mod tests {
         };
         assert_eq!(
             failure.to_string(),
-            "--solver exact: exact: thermal weight must be finite"
+            "--solver exact: exact: thermal weight -1: must be finite and non-negative"
         );
         let source = std::error::Error::source(&failure).expect("a source");
         assert_eq!(source.downcast_ref::<EngineError>(), Some(&refusal()));

@@ -109,9 +109,7 @@ impl FullRouteBuilder {
         finish: Option<Point>,
     ) -> Result<FullRouteBuilder, Refusal> {
         if !(step > 0.0 && step.is_finite()) {
-            return Err(Refusal::Settings(format!(
-                "discretisation step {step}: must be positive"
-            )));
+            return Err(Refusal::DiscretisationStep(step));
         }
         Ok(FullRouteBuilder {
             forest: nest.containment_forest(),

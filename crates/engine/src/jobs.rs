@@ -3,7 +3,7 @@
 use cutroute_alns::{AlnsBuilder, AlnsOptions, AlnsSolver};
 use cutroute_anytime::AnytimeSolver;
 use cutroute_ccp::{CcpLowerBound, CcpOptions, CcpSolver, DiscreteInstance};
-use cutroute_chains::{ChainOptions, Chained, Chaining};
+use cutroute_chains::{ChainError, ChainOptions, Chained, Chaining};
 use cutroute_geometry::{MachineParameters, Nest, Route};
 use cutroute_pcgtsp::{ExactOptions, ExactSolver, Instance};
 use cutroute_protocol::{Bounds, CcpStage, CostUnit, JobId, Phase, Progress, Solution};
@@ -198,11 +198,20 @@ pub struct DiscreteJob {
     bound_running: bool,
     offered_route_cost: f64,
     started: Instant,
-    /// Why the job ended without a search (a solver refused the instance, or the build
-    /// outlasted the limit), in words for the phase.
-    failure: Option<String>,
-    /// The error of the solver that refused the instance, for [`DiscreteJob::new`].
-    refusal: Option<Refusal>,
+    /// Why the job ended without a search.
+    failure: Option<DiscreteFailure>,
+}
+
+/// Why a discrete job ended without a search; its words are the phase's reason.
+#[derive(Clone, Debug, thiserror::Error)]
+enum DiscreteFailure {
+    /// A solver refused the instance (its error, for [`DiscreteJob::new`]).
+    #[error("{0}")]
+    Refused(#[from] Refusal),
+    /// The time limit passed while the model was built (the phase says it as
+    /// [`Phase::BuildTimedOut`]).
+    #[error("the time limit passed while the model was built")]
+    BuildTimedOut,
 }
 
 impl DiscreteJob {
@@ -223,7 +232,7 @@ impl DiscreteJob {
         job.instance = Some(instance);
         job.discrete = discrete;
         while !job.build(Duration::MAX) {
-            if let Some(refusal) = job.refusal.take() {
+            if let Some(DiscreteFailure::Refused(refusal)) = job.failure.take() {
                 return Err(refusal);
             }
         }
@@ -274,7 +283,6 @@ impl DiscreteJob {
             offered_route_cost: f64::INFINITY,
             started,
             failure: None,
-            refusal: None,
         }
     }
 
@@ -382,8 +390,7 @@ impl DiscreteJob {
 
     /// A solver refused the instance: the job ends, its phase saying why.
     fn refuse(&mut self, refusal: Refusal) {
-        self.failure = Some(refusal.to_string());
-        self.refusal = Some(refusal);
+        self.failure = Some(refusal.into());
     }
 
     fn best_tour(&self) -> Option<(Vec<usize>, f64)> {
@@ -395,10 +402,6 @@ impl DiscreteJob {
         }
     }
 }
-
-/// Why a discrete job ends when its limit passes before the model is built (the phase says
-/// it as [`Phase::BuildTimedOut`]).
-const BUILD_TIMED_OUT: &str = "the time limit passed while the model was built";
 
 /// One slice of the heuristic; whether it has finished.
 fn alns_step(alns: &mut AlnsSolver, budget: Duration) -> bool {
@@ -423,7 +426,7 @@ impl Job for DiscreteJob {
             let preparing = self.alns_builder.is_some();
             return if self.failure.is_some() || (over && self.alns.is_none() && !preparing) {
                 if self.failure.is_none() {
-                    self.failure = Some(BUILD_TIMED_OUT.into());
+                    self.failure = Some(DiscreteFailure::BuildTimedOut);
                 }
                 JobStatus::Done
             } else {
@@ -519,9 +522,11 @@ impl Job for DiscreteJob {
         };
         let proven_optimal = self.exact_done == Some(true);
         let phase = match (&exact, self.exact_done) {
-            _ if self.failure.as_deref() == Some(BUILD_TIMED_OUT) => Phase::BuildTimedOut,
+            _ if matches!(self.failure, Some(DiscreteFailure::BuildTimedOut)) => {
+                Phase::BuildTimedOut
+            }
             _ if self.failure.is_some() => Phase::Stopped {
-                reason: self.failure.clone(),
+                reason: self.failure.as_ref().map(ToString::to_string),
             },
             (_, Some(true)) => Phase::ProvenOptimal,
             (_, Some(false)) => Phase::Stopped { reason: None },
@@ -606,7 +611,7 @@ pub struct ChainJob {
     /// Chain cutting under way, in slices of close-contour groups (Stop stays responsive).
     chaining: Option<Chaining>,
     chained: Option<Chained>,
-    failure: Option<String>,
+    failure: Option<ChainFailure>,
     /// Whether CCP-Relax has ended (its last step, `Chaining::new` and the groups each take
     /// steps of their own: together they ran 2 s on a thousand contours).
     ccp_done: bool,
@@ -656,7 +661,7 @@ impl Job for ChainJob {
         }
         if self.chaining.is_none() {
             let Some(route) = self.ccp.progress().solution.and_then(Solution::into_route) else {
-                self.failure = Some("CCP found no route to chain".into());
+                self.failure = Some(ChainFailure::NoCcpRoute);
                 return JobStatus::Done;
             };
             match Chaining::new(&self.nest, &route, &self.options) {
@@ -667,7 +672,7 @@ impl Job for ChainJob {
                     self.chaining = Some(chaining);
                 }
                 Err(e) => {
-                    self.failure = Some(e.to_string());
+                    self.failure = Some(e.into());
                     return JobStatus::Done;
                 }
             }
@@ -711,6 +716,17 @@ impl Job for ChainJob {
         }
         progress
     }
+}
+
+/// Why a chain job ended without chaining; its words are the phase's error.
+#[derive(Debug, thiserror::Error)]
+enum ChainFailure {
+    /// CCP-Relax ended without a route.
+    #[error("CCP found no route to chain")]
+    NoCcpRoute,
+    /// Chain cutting refused CCP's route.
+    #[error("{0}")]
+    Chaining(#[from] ChainError),
 }
 
 /// CCP-Relax's step in the protocol's words.

@@ -379,11 +379,7 @@ impl KerfJob {
             // A heat penalty or a rule repair changes the route after the search: the bound
             // would no longer be about it.
             if request.params.thermal.penalised() || request.params.thermal.hard {
-                return Err(refused(Refusal::Settings(
-                    "with kerf and leads, exact searches the full-route model and cannot price \
-                     heat or repair rules; use heuristic"
-                        .into(),
-                )));
+                return Err(refused(Refusal::ExactWithHeat));
             }
             let builder = FullRouteBuilder::new(
                 nest,

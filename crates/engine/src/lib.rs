@@ -149,9 +149,18 @@ pub enum Refusal {
     /// The solver has no model of the full cutting route (kerf, leads).
     #[error("does not cut with kerf and leads yet (nearest, ccp, heuristic, exact and chain do)")]
     NoFullRouteModel,
-    /// A setting the solver cannot run with, in words (thermal weight, kerf lengths).
+    /// The thermal settings are out of range.
     #[error("{0}")]
-    Settings(String),
+    ThermalSettings(#[from] cutroute_protocol::ThermalSettingsError),
+    /// The discretisation step of the full-route model is not a positive number.
+    #[error("discretisation step {0}: must be positive")]
+    DiscretisationStep(f64),
+    /// With kerf and leads, exact searches the full-route model, which has no heat terms.
+    #[error(
+        "with kerf and leads, exact searches the full-route model and cannot price heat or \
+         repair rules; use heuristic"
+    )]
+    ExactWithHeat,
 }
 
 /// Most kept (innermost) contours for which the discrete exact job bounds at the
@@ -198,9 +207,9 @@ pub fn start_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
     params
         .thermal
         .validate()
-        .map_err(|message| EngineError::SolverRefused {
+        .map_err(|e| EngineError::SolverRefused {
             solver: request.solver.name(),
-            reason: Refusal::Settings(message),
+            reason: e.into(),
         })?;
     let inner = match heated_job(request)? {
         Some(job) => job,

@@ -300,7 +300,7 @@ fn report_summary(report: &EnsembleReport) -> RouteSummary {
         time_s: report.time_s,
         cost: report.cost,
         chosen: false,
-        failure: report.failure.clone(),
+        failure: report.failure.as_ref().map(ToString::to_string),
         idle_lower_bound: None,
     }
 }

@@ -90,6 +90,7 @@ mod span;
 mod toolpath;
 mod transform;
 mod types;
+mod viewport;
 
 pub use bbox::BoundingBox;
 pub use chain_leads::ChainedLeads;
@@ -115,3 +116,4 @@ pub use span::{tan_half_arg, Span, SpanIntersection, SpanProjection};
 pub use toolpath::{ToolClock, ToolMove, ToolState, Toolpath};
 pub use transform::Transform;
 pub use types::{Contour, Nest, Part, Point, Vertex};
+pub use viewport::Viewport;

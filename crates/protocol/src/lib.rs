@@ -39,7 +39,7 @@ pub use open_error::{OpenError, OpenErrorKind, SourceLocation};
 pub use phase::{CcpStage, Ensemble, KerfNote, KerfSource, Phase, ThermalNote};
 pub use profile::{MachineProfile, ProfileError};
 pub use solution::Solution;
-pub use thermal::ThermalSettings;
+pub use thermal::{ThermalSettings, ThermalSettingsError};
 // The thermal types a `Progress` carries, so the UI needs no second import path.
 pub use cutroute_thermal::{HeatModel, RuleCounts, RuleSet, Violation};
 
@@ -413,7 +413,10 @@ pub struct RouteSummary {
     pub cost: f64,
     /// Whether this is the route the solver returned.
     pub chosen: bool,
-    /// Why the candidate gave no route, if it did not.
+    /// Why the candidate gave no route, if it did not, in words. A message, not the solver's
+    /// error type: the summary crosses to the page (postMessage) and the CLI's JSON, where only
+    /// the words are shown; the typed error with its source stays in the solver crate
+    /// (`cutroute_segments::EnsembleFailure`).
     pub failure: Option<String>,
     /// The solver's proven lower bound on the idle length (mm) of every route it can return
     /// ([`Progress::idle_lower_bound`]), on the chosen candidate; `None` elsewhere.

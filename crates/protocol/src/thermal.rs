@@ -39,6 +39,17 @@ impl Default for ThermalSettings {
     }
 }
 
+/// A thermal setting out of range, named in plain words.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum ThermalSettingsError {
+    /// σ or τ is not finite and positive: the heat model's own error.
+    #[error("thermal σ/τ: {0}")]
+    Model(#[from] cutroute_thermal::ThermalError),
+    /// The heat penalty's weight is negative or not finite.
+    #[error("thermal weight {0}: must be finite and non-negative")]
+    Weight(f64),
+}
+
 impl ThermalSettings {
     /// The heat model, checked (σ and τ finite and positive).
     pub fn model(&self) -> Result<HeatModel, cutroute_thermal::ThermalError> {
@@ -47,13 +58,10 @@ impl ThermalSettings {
 
     /// Checks every setting: σ, τ as [`ThermalSettings::model`], the weight finite and
     /// non-negative. An error names the setting in plain words.
-    pub fn validate(&self) -> Result<(), String> {
-        self.model().map_err(|e| format!("thermal σ/τ: {e}"))?;
+    pub fn validate(&self) -> Result<(), ThermalSettingsError> {
+        self.model()?;
         if !(self.weight >= 0.0 && self.weight.is_finite()) {
-            return Err(format!(
-                "thermal weight {}: must be finite and non-negative",
-                self.weight
-            ));
+            return Err(ThermalSettingsError::Weight(self.weight));
         }
         Ok(())
     }
@@ -95,5 +103,26 @@ mod tests {
             ..settings
         };
         assert!(negative.validate().is_err());
+    }
+
+    #[test]
+    fn settings_errors_name_the_setting_and_keep_the_model_error_as_source() {
+        use std::error::Error;
+        let bad = ThermalSettings {
+            tau_s: 0.0,
+            ..ThermalSettings::default()
+        };
+        let err = bad.validate().unwrap_err();
+        assert!(matches!(err, ThermalSettingsError::Model(_)), "{err:?}");
+        assert!(err.to_string().starts_with("thermal σ/τ: invalid"), "{err}");
+        assert!(err.source().is_some());
+        let negative = ThermalSettings {
+            weight: -1.0,
+            ..ThermalSettings::default()
+        };
+        assert_eq!(
+            negative.validate().unwrap_err().to_string(),
+            "thermal weight -1: must be finite and non-negative"
+        );
     }
 }

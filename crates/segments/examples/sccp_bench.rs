@@ -142,7 +142,7 @@ fn main() {
         );
         for r in &result.reports {
             let note = match &r.failure {
-                Some(f) => f.clone(),
+                Some(f) => f.to_string(),
                 None if Some(r.kind) == result.best => format!("**best** ({wall:.1} s wall)"),
                 None => String::new(),
             };

@@ -7,7 +7,6 @@ use std::time::Duration;
 use cutroute_anytime::{AnytimeSolver, Bounds, Status};
 use cutroute_ccp::{CcpOptions, CcpSolver};
 use cutroute_geometry::{MachineParameters, Nest, Objective, PathRoute, PathRouteError, Route};
-use serde::{Deserialize, Serialize};
 use web_time::Instant;
 
 use crate::segment::{Ensemble, EnsembleKind};
@@ -54,8 +53,9 @@ impl Default for GsccpOptions {
     }
 }
 
-/// The numbers of one ensemble's route.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+/// The numbers of one ensemble's route. (Not serialised: its failure is a typed error; the
+/// engine's `RouteSummary` carries the numbers and the failure's words to the page.)
+#[derive(Clone, Debug, PartialEq)]
 pub struct EnsembleReport {
     /// Which ensemble.
     pub kind: EnsembleKind,
@@ -75,7 +75,21 @@ pub struct EnsembleReport {
     /// both sides (counted in `cut_length`, time and cost alike).
     pub recut_length: f64,
     /// Why the ensemble gave no route (could not be built, or its route failed the check).
-    pub failure: Option<String>,
+    pub failure: Option<EnsembleFailure>,
+}
+
+/// Why an ensemble gave no route.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum EnsembleFailure {
+    /// The ensemble or its search could not be built.
+    #[error("{0}")]
+    Build(#[from] SegmentError),
+    /// Its route failed the independent check (other than by cutting an edge twice).
+    #[error("the route fails the check: {0}")]
+    FailsCheck(#[source] PathRouteError),
+    /// The run was stopped before the ensemble's turn.
+    #[error("not run: the run was stopped first")]
+    NotRun,
 }
 
 /// The outcome of [`solve_gsccp`].
@@ -237,8 +251,7 @@ impl GsccpSearch {
                 heat: options.sccp.heat.map(|h| h.penalty),
                 ..CcpOptions::default()
             },
-        )
-        .map_err(|e| SegmentError::Ccp(e.to_string()))?;
+        )?;
         Ok(GsccpSearch {
             nest: nest.clone(),
             options: options.clone(),
@@ -417,7 +430,10 @@ impl GsccpSearch {
                     format!(
                         "{}: {}",
                         r.kind.name(),
-                        r.failure.clone().unwrap_or_default()
+                        r.failure
+                            .as_ref()
+                            .map(ToString::to_string)
+                            .unwrap_or_default()
                     )
                 })
                 .collect();
@@ -466,7 +482,7 @@ impl GsccpSearch {
         let route = solver.result().route;
         match PathRoute::from_route(&route, &self.nest) {
             Err(e) => {
-                self.failure = Some(SegmentError::Ccp(e.to_string()));
+                self.failure = Some(SegmentError::CcpRoute(e));
                 self.stage = Stage::Finished;
             }
             Ok(path) => {
@@ -525,7 +541,7 @@ impl GsccpSearch {
         });
         match search {
             Err(e) => {
-                report.failure = Some(e.to_string());
+                report.failure = Some(e.into());
                 self.reports.push(report);
                 self.stage = Stage::Build(k + 1);
             }
@@ -597,7 +613,7 @@ impl GsccpSearch {
         // Cutting a piece of contour twice wastes time but harms nothing: such routes compete
         // with their true cost. Anything else disqualifies.
         match self.checked(&route) {
-            Err(problem) => report.failure = Some(format!("the route fails the check: {problem}")),
+            Err(problem) => report.failure = Some(EnsembleFailure::FailsCheck(problem)),
             Ok((value, recut)) => {
                 report.recut_length = recut;
                 self.offer(Candidate {
@@ -623,7 +639,7 @@ impl GsccpSearch {
                 time_s: f64::NAN,
                 cost: f64::NAN,
                 recut_length: 0.0,
-                failure: Some("not run: the run was stopped first".into()),
+                failure: Some(EnsembleFailure::NotRun),
             });
         }
     }

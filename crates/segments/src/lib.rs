@@ -54,8 +54,8 @@ mod solver;
 pub use cutroute_anytime::{AnytimeSolver, Bounds, Status};
 pub use cutroute_geometry::Objective;
 pub use gsccp::{
-    recut_length, solve_gsccp, Candidate, EnsembleReport, GsccpOptions, GsccpResult, GsccpSearch,
-    GsccpStage,
+    recut_length, solve_gsccp, Candidate, EnsembleFailure, EnsembleReport, GsccpOptions,
+    GsccpResult, GsccpSearch, GsccpStage,
 };
 pub use segment::{Ensemble, EnsembleKind, Segment};
 pub use solver::{solve_sccp, PathHeat, SccpOptions, SccpSearch, SccpSolution, SOLVE_SLICE};
@@ -92,7 +92,10 @@ pub fn rectangle_grid(columns: usize, rows: usize, width: f64, height: f64) -> N
 pub enum SegmentError {
     /// The nest gives no plane graph (needed by the chain and junction ensembles).
     #[error("the nest gives no plane graph: {0}")]
-    Plan(String),
+    Plan(#[from] cutroute_aoe::PlanError),
+    /// The plane graph cannot be ranked into chains or components.
+    #[error("the nest gives no plane graph: {0}")]
+    Embedding(#[from] cutroute_aoe::EmbeddingError),
     /// The precedence rules of an ensemble contradict each other.
     #[error("the {} ensemble's precedence has a cycle through segment {segment}", kind.name())]
     CyclicPrecedence {
@@ -117,11 +120,52 @@ pub enum SegmentError {
     },
     /// CCP-Relax, which seeds the orders, failed.
     #[error("CCP-Relax failed: {0}")]
-    Ccp(String),
+    Ccp(#[from] cutroute_ccp::CcpError),
+    /// CCP-Relax's route is not a valid route of the nest.
+    #[error("CCP-Relax failed: {0}")]
+    CcpRoute(#[source] cutroute_geometry::RouteError),
     /// An option is out of range.
     #[error("invalid option: {0}")]
     InvalidOption(String),
     /// No ensemble gave a route that passed the check.
     #[error("no ensemble gave a valid route ({0})")]
     NoRoute(String),
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use cutroute_geometry::{ContourRef, RouteError};
+    use std::error::Error as _;
+
+    /// The words stay those of the string the variants once held; the failing crate's error
+    /// is kept as the source.
+    #[test]
+    fn segment_errors_keep_their_words_and_their_source() {
+        let route = RouteError::NotCut {
+            contour: ContourRef {
+                part: 0,
+                contour: 1,
+            },
+        };
+        let error = SegmentError::CcpRoute(route.clone());
+        assert_eq!(error.to_string(), format!("CCP-Relax failed: {route}"));
+        let source = error.source().expect("a source");
+        assert_eq!(source.downcast_ref::<RouteError>(), Some(&route));
+        let failure = EnsembleFailure::FailsCheck(cutroute_geometry::PathRouteError::EmptyPath {
+            path: 2,
+            x: 1.0,
+            y: 0.5,
+        });
+        assert!(failure
+            .to_string()
+            .starts_with("the route fails the check: "));
+        assert!(failure.source().is_some());
+        let from_build = EnsembleFailure::from(error.clone());
+        assert_eq!(from_build.to_string(), error.to_string());
+        assert_eq!(
+            EnsembleFailure::NotRun.to_string(),
+            "not run: the run was stopped first"
+        );
+    }
 }

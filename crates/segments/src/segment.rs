@@ -264,7 +264,7 @@ fn plan(nest: &Nest, tolerance: f64) -> Result<PlanGraph, SegmentError> {
         tolerance,
         ..PlanOptions::default()
     };
-    PlanGraph::from_nest(nest, &options).map_err(|e| SegmentError::Plan(e.to_string()))
+    Ok(PlanGraph::from_nest(nest, &options)?)
 }
 
 /// Connected piece of the plan graph each edge belongs to.
@@ -290,9 +290,7 @@ fn edge_components(plan: &PlanGraph) -> Vec<usize> {
 
 fn chains(nest: &Nest, tolerance: f64) -> Result<Ensemble, SegmentError> {
     let plan = plan(nest, tolerance)?;
-    let route = plan
-        .route()
-        .map_err(|e| SegmentError::Plan(e.to_string()))?;
+    let route = plan.route()?;
     let component = edge_components(&plan);
     let mut segments = Vec::with_capacity(route.len());
     let mut precedence = Vec::new();
@@ -323,9 +321,7 @@ fn chains(nest: &Nest, tolerance: f64) -> Result<Ensemble, SegmentError> {
 
 fn junctions(nest: &Nest, tolerance: f64) -> Result<Ensemble, SegmentError> {
     let plan = plan(nest, tolerance)?;
-    let components = plan
-        .components()
-        .map_err(|e| SegmentError::Plan(e.to_string()))?;
+    let components = plan.components()?;
     let edge_count = plan.graph().edge_count();
     let segments: Vec<Segment> = (0..edge_count)
         .map(|e| {
