@@ -3,7 +3,9 @@
 //! burns eats into that contour's part. One index and one test serve both route checkers
 //! ([`crate::Route::problems`] on each step's cut, [`crate::PathRoute::problems`] on every
 //! tool-on span) and the kerf job's refusal of nests whose parts sit closer than the kerf
-//! ([`kerf_overlaps`]).
+//! ([`kerf_overlaps`]). A step's cut is held off every *other* contour (its own is the offset's
+//! business, tested by the offset's properties); a path's span names no contour, so it is held
+//! off every contour.
 //!
 //! A cut that keeps kerf/2 (less the tolerance) from every contour also never runs through
 //! material: every point of an equidistant lies kerf/2 from its own contour on the scrap side,
@@ -154,8 +156,7 @@ pub struct KerfOverlap {
     pub distance: f64,
     /// The least it may be: kerf/2, mm.
     pub required: f64,
-    /// The gap between the two contours themselves, mm (less than the kerf; 0 for a cut too
-    /// close to its own contour).
+    /// The gap between the two contours themselves, mm (less than the kerf).
     pub gap: f64,
     /// A point of the cut near where it comes closest to `other`.
     pub at: Point,
@@ -163,9 +164,9 @@ pub struct KerfOverlap {
 
 /// The contours each cut of `cuts` (contour, its tool-on spans) comes closer than
 /// `half − tolerance` to, as [`KerfOverlap`]s with the least distance per pair. Each unordered
-/// pair of contours is reported once, in the direction first found; a cut too close to its own
-/// contour (an equidistant off by more than the tolerance) is a pair of one contour. Pairs in
-/// `seen` are skipped, and the reported ones added to it.
+/// pair of contours is reported once, in the direction first found. Pairs in `seen` are skipped
+/// (a caller marks `(contour, contour)` to leave the contour's own out), and the reported ones
+/// added to it.
 pub(crate) fn cut_overlaps<'a>(
     index: &ContourSpans,
     contour: ContourRef,
@@ -255,11 +256,14 @@ impl std::fmt::Display for PartsTooClose {
             if i > 0 {
                 write!(f, "; ")?;
             }
-            write!(
-                f,
-                "{:?} and {:?} {:.3} mm apart near ({:.3}, {:.3})",
-                p.contour, p.other, p.gap, p.at.x, p.at.y
-            )?;
+            write!(f, "{:?} and {:?} ", p.contour, p.other)?;
+            // Touching parts are the common case (nests packed without spacing).
+            if p.gap < 5e-4 {
+                write!(f, "touch")?;
+            } else {
+                write!(f, "{:.3} mm apart", p.gap)?;
+            }
+            write!(f, " near ({:.3}, {:.3})", p.at.x, p.at.y)?;
         }
         if self.pairs.len() > PAIRS_NAMED {
             write!(f, "; and {} more", self.pairs.len() - PAIRS_NAMED)?;

@@ -287,7 +287,7 @@ pub enum RouteError {
     /// The cut of a step on its equidistant (the overcut included, the tabs' gaps not) comes
     /// closer than kerf/2 to a contour: the kerf eats into that contour's part (parts closer
     /// than the kerf). Reported once per pair of contours, at the first step that cuts one of
-    /// them; `other` is `contour` itself when the equidistant strays from its own contour.
+    /// them.
     #[error("the cut of contour {contour:?} (step {step}) comes {distance} mm from contour {other:?} near ({x}, {y}), closer than kerf/2 = {required} mm (the contours are {gap} mm apart)")]
     KerfOverlap {
         /// Index of the step.
@@ -489,8 +489,8 @@ impl Route {
     /// region (children of the sheet or of one hole) without crossing any contour or leaving
     /// that region. With leads, each step's elements are checked by
     /// [`LeadFitter::problems_linked`], and its cut on the equidistant keeps kerf/2 (less
-    /// `tolerance`) from every contour, its own included ([`RouteError::KerfOverlap`], the
-    /// test [`PathRoute::problems`](crate::PathRoute::problems) holds every tool-on span to).
+    /// `tolerance`) from every other contour ([`RouteError::KerfOverlap`], the test
+    /// [`PathRoute::problems`](crate::PathRoute::problems) holds every tool-on span to).
     pub fn problems(
         &self,
         nest: &Nest,
@@ -574,15 +574,15 @@ impl Route {
                 check_link(self, step, nest, forest, tolerance, &mut problems);
             }
         }
-        problems.extend(self.kerf_overlaps(nest, tolerance));
+        problems.extend(self.kerf_overlap_problems(nest, tolerance));
         problems
     }
 
     /// The steps whose cut on the equidistant comes closer than kerf/2 (less `tolerance`) to
-    /// a contour, once per pair of contours (see [`RouteError::KerfOverlap`]). Steps without
+    /// another contour, once per pair of contours (see [`RouteError::KerfOverlap`]). Steps without
     /// leads (the idealised model: no kerf) and contours without an equidistant (reported as
-    /// the entry off the equidistant) are not checked here.
-    fn kerf_overlaps(&self, nest: &Nest, tolerance: f64) -> Vec<RouteError> {
+    /// the entry off the equidistant) are not checked here. Part of [`Route::problems`].
+    pub fn kerf_overlap_problems(&self, nest: &Nest, tolerance: f64) -> Vec<RouteError> {
         let mut index: Option<ContourSpans> = None;
         let mut seen = std::collections::BTreeSet::new();
         let mut problems = Vec::new();
@@ -602,6 +602,10 @@ impl Route {
                 .flatten()
                 .collect();
             let index = index.get_or_insert_with(|| ContourSpans::new(nest));
+            // Its own contour is kept kerf/2 off by the offset itself (to the offset's
+            // precision, which can be 1e-4 mm on files' runs of tiny segments, where the
+            // offset's cleanup moves vertices): the pairs here are neighbours.
+            seen.insert((s.contour, s.contour));
             problems.extend(
                 cut_overlaps(index, s.contour, &cut, leads.offset, tolerance, &mut seen)
                     .into_iter()
