@@ -28,7 +28,8 @@
 //! their paths' ends (module `kerf_paths`).
 
 use cutroute_geometry::{
-    ContainmentForest, CutStep, KerfSettings, LeadError, LeadFitter, Nest, Route,
+    kerf_overlaps, ContainmentForest, CutStep, KerfSettings, LeadError, LeadFitter, Nest,
+    PartsTooClose, Route,
 };
 use cutroute_protocol::{
     Bounds, JobRequest, KerfNote, KerfSource, Phase, Problem, Progress, Solution, SolverKind,
@@ -326,6 +327,18 @@ impl KerfJob {
         }
         let settings = request.params.kerf;
         validate_kerf(&settings).map_err(|e| refused(e.into()))?;
+        // Parts closer than the kerf: every solver's cut there would eat into a neighbour, and
+        // the route checkers reject it; say so now, with the pairs, rather than after a search.
+        let pairs = kerf_overlaps(nest, settings.kerf / 2.0, nest.check_tolerance());
+        if !pairs.is_empty() {
+            return Err(refused(
+                PartsTooClose {
+                    kerf: settings.kerf,
+                    pairs,
+                }
+                .into(),
+            ));
+        }
         let forest = nest.containment_forest();
         // The inner requests are idealised: the kerf is this job's.
         let mut idealised = request.clone();

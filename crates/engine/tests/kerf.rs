@@ -330,3 +330,104 @@ fn out_of_range_kerf_settings_are_refused_by_name() {
         "ccp: lead-in length -1: must be finite and non-negative"
     );
 }
+
+/// The least distance between two contours, span against span (independent of the kerf
+/// check's index).
+fn brute_gap(a: &cutroute_geometry::Contour, b: &cutroute_geometry::Contour) -> f64 {
+    a.spans()
+        .flat_map(|x| b.spans().map(move |y| x.distance_to_span(&y)))
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// T-FLEX Nest01's parts touch: no cut on the equidistants keeps kerf/2 off its neighbour (the
+/// checkers reject every such route), so every solver's kerf job is refused up front, with
+/// the pairs of contours and their gaps, under plasma and laser alike.
+#[test]
+fn parts_closer_than_the_kerf_are_refused_up_front_naming_the_pairs() {
+    let problem = nest_problem("nests/tflex/Nest01.tfnesting");
+    let nest = nest_of(&problem);
+    let laser = KerfSettings {
+        kerf: 0.2,
+        pierce_clearance: 1.0,
+        switch_off_clearance: 0.5,
+        ..plasma()
+    };
+    for kerf in [plasma(), laser] {
+        for solver in SolverKind::ALL {
+            let started = start_job(&request(&problem, solver, kerf, false));
+            let Err(EngineError::SolverRefused {
+                reason: Refusal::PartsTooClose(refusal),
+                ..
+            }) = started
+            else {
+                panic!("{solver:?} kerf {}: {:?}", kerf.kerf, started.err());
+            };
+            assert_eq!(refusal.kerf, kerf.kerf);
+            assert!(!refusal.pairs.is_empty());
+            for pair in &refusal.pairs {
+                assert_ne!(pair.contour, pair.other);
+                let (a, b) = (
+                    nest.contour(pair.contour).unwrap(),
+                    nest.contour(pair.other).unwrap(),
+                );
+                let gap = brute_gap(a, b);
+                assert!((gap - pair.gap).abs() < 1e-9, "{pair:?} vs {gap}");
+                assert!(gap < kerf.kerf, "{pair:?}");
+            }
+            let words = refusal.to_string();
+            assert!(
+                words.contains("parts closer than the kerf") && words.contains("ContourRef"),
+                "{words}"
+            );
+        }
+    }
+}
+
+/// A nest whose parts are 1 mm apart is refused with kerf 2 and cut with kerf 0.2; the route
+/// cut then passes the checker, which holds each cut kerf/2 from every contour.
+#[test]
+fn a_nest_is_refused_only_where_its_gaps_are_narrower_than_the_kerf() {
+    use cutroute_geometry::{Contour, Nest, Part, Point, Vertex};
+    let square = |x: f64| Part {
+        name: format!("at {x}"),
+        contours: vec![Contour::new(vec![
+            Vertex::line(x, 0.0),
+            Vertex::line(x, 40.0),
+            Vertex::line(x + 40.0, 40.0),
+            Vertex::line(x + 40.0, 0.0),
+        ])],
+    };
+    let problem = Problem::Nest {
+        nest: Nest {
+            sheet: None,
+            parts: vec![square(0.0), square(41.0), square(90.0)],
+        },
+        start: Point::new(-50.0, -50.0),
+        finish: None,
+    };
+    for solver in [
+        SolverKind::NearestNeighbour,
+        SolverKind::Ccp,
+        SolverKind::Chain,
+    ] {
+        let refused = start_job(&request(&problem, solver, plasma(), false)).err();
+        let Some(EngineError::SolverRefused {
+            reason: Refusal::PartsTooClose(refusal),
+            ..
+        }) = refused
+        else {
+            panic!("{solver:?}: {refused:?}");
+        };
+        // Only the first two sit closer than 2 mm; the third is 9 mm away.
+        assert_eq!(refusal.pairs.len(), 1, "{refusal}");
+        assert!((refusal.pairs[0].gap - 1.0).abs() < 1e-9);
+        let laser = KerfSettings {
+            kerf: 0.2,
+            pierce_clearance: 1.0,
+            switch_off_clearance: 0.5,
+            ..plasma()
+        };
+        let progress = run(&request(&problem, solver, laser, false));
+        checked(&problem, &progress);
+    }
+}
