@@ -200,8 +200,49 @@ pub enum JobFailure {
     WorkerStopped,
     /// The engine refused the job (its English words).
     Engine(String),
+    /// Kerf and leads are on, and the nest's parts sit closer than the kerf (the pairs).
+    PartsTooClose(cutroute_geometry::PartsTooClose),
     /// Kerf and leads are on, and the solver has no full-route model.
     NoKerfModel { solver: &'static str },
+}
+
+/// How many pairs the page names before it counts the rest (as the engine's message does).
+const PAIRS_NAMED: usize = 8;
+
+/// The refusal of a nest whose parts sit closer than the kerf, in Russian: each pair by part
+/// (from 1) and contour, as the phase names contours without room.
+fn parts_too_close_ru(refusal: &cutroute_geometry::PartsTooClose) -> String {
+    let named =
+        |r: cutroute_geometry::ContourRef| format!("деталь {} контур {}", r.part + 1, r.contour);
+    let mut pairs: Vec<String> = refusal
+        .pairs
+        .iter()
+        .take(PAIRS_NAMED)
+        .map(|p| {
+            let gap = if p.gap < 5e-4 {
+                "касаются".to_string()
+            } else {
+                format!("в {:.3} мм друг от друга", p.gap)
+            };
+            format!(
+                "{} и {} {gap} около ({:.3}, {:.3})",
+                named(p.contour),
+                named(p.other),
+                p.at.x,
+                p.at.y
+            )
+        })
+        .collect();
+    if refusal.pairs.len() > PAIRS_NAMED {
+        pairs.push(format!("и ещё {}", refusal.pairs.len() - PAIRS_NAMED));
+    }
+    format!(
+        "детали ближе друг к другу, чем ширина реза {} мм: рез по эквидистанте задел бы соседнюю \
+         деталь; пар контуров: {}: {}",
+        refusal.kerf,
+        refusal.pairs.len(),
+        pairs.join("; ")
+    )
 }
 
 impl JobFailure {
@@ -233,6 +274,8 @@ impl JobFailure {
             ),
             (JobFailure::WorkerStopped, Lang::En) => "the solver stopped unexpectedly".into(),
             (JobFailure::WorkerStopped, Lang::Ru) => "решатель неожиданно остановился".into(),
+            (JobFailure::PartsTooClose(refusal), Lang::En) => refusal.to_string(),
+            (JobFailure::PartsTooClose(refusal), Lang::Ru) => parts_too_close_ru(refusal),
             (JobFailure::Engine(message), Lang::En) => message.clone(),
             (JobFailure::Engine(message), Lang::Ru) => format!("задача не запущена: {message}"),
         }
@@ -423,5 +466,56 @@ pub fn preset_text(lang: Lang, preset: cutroute_gcode::GcodePreset) -> String {
             }
         }
         .to_string(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use cutroute_geometry::{ContourRef, KerfOverlap, PartsTooClose, Point};
+
+    fn refusal(pairs: usize) -> PartsTooClose {
+        PartsTooClose {
+            kerf: 2.0,
+            pairs: (0..pairs)
+                .map(|i| KerfOverlap {
+                    contour: ContourRef {
+                        part: i,
+                        contour: 0,
+                    },
+                    other: ContourRef {
+                        part: i + 1,
+                        contour: 0,
+                    },
+                    distance: 0.0,
+                    required: 1.0,
+                    gap: if i == 0 { 0.0 } else { 0.25 },
+                    at: Point::new(501.0, 0.0),
+                })
+                .collect(),
+        }
+    }
+
+    /// The refusal of parts closer than the kerf names every pair by part and contour in
+    /// Russian, with no English word; in English it is the engine's message.
+    #[test]
+    fn parts_too_close_is_worded_in_each_language() {
+        let failure = JobFailure::PartsTooClose(refusal(10));
+        assert_eq!(failure.text(Lang::En), refusal(10).to_string());
+        let ru = failure.text(Lang::Ru);
+        assert!(
+            ru.contains("ширина реза 2 мм") && ru.contains("пар контуров: 10"),
+            "{ru}"
+        );
+        assert!(
+            ru.contains("деталь 1 контур 0 и деталь 2 контур 0 касаются около (501.000, 0.000)"),
+            "{ru}"
+        );
+        assert!(
+            ru.contains("деталь 2 контур 0 и деталь 3 контур 0 в 0.250 мм"),
+            "{ru}"
+        );
+        assert!(ru.ends_with("и ещё 2"), "{ru}");
+        assert!(!ru.chars().any(|c| c.is_ascii_alphabetic()), "{ru}");
     }
 }

@@ -238,9 +238,15 @@ impl JobState {
                 self.apply(Some(self.merged(last)));
                 self.status.set(JobStatus::Cancelled);
             }
-            FromWorker::Failed { job_id, message } if self.runs_job(job_id) => {
-                self.status
-                    .set(JobStatus::Failed(JobFailure::Engine(message)));
+            FromWorker::Failed {
+                job_id,
+                message,
+                parts_too_close,
+            } if self.runs_job(job_id) => {
+                self.status.set(JobStatus::Failed(match parts_too_close {
+                    Some(refusal) => JobFailure::PartsTooClose(refusal),
+                    None => JobFailure::Engine(message),
+                }));
             }
             _ => {}
         }

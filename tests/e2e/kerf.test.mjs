@@ -9,7 +9,7 @@ import assert from 'node:assert/strict';
 import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
-import { watchErrors, useApp, screenshot, cli, runSolver, setNumber } from './harness.mjs';
+import { watchErrors, useApp, screenshot, cli, cliError, projectRoot, runSolver, setNumber } from './harness.mjs';
 
 const app = useApp(before, after);
 
@@ -152,6 +152,44 @@ test('kerf and an arc lead-in: leads drawn and animated, G-code reads back with 
   assert.equal(await page.locator('#nest-view .leads path.lead').count(), steps);
   assert.equal(await page.locator('#nest-view .pierce-regions circle.pierce-m').count(), steps);
   assert.equal(await page.locator('#nest-view .pierce-regions rect.switch-off-m').count(), steps);
+  assert.deepEqual(errors, []);
+  await context.close();
+});
+
+// Parts closer than the kerf (T-FLEX Nest01: five parts touching in a row): the engine refuses
+// the job before any solver runs, and the page words the refusal in its language, naming each
+// pair of contours by part and contour as the CLI's oracle does by index.
+test('a nest whose parts touch is refused with kerf, the pairs named in Russian', async () => {
+  const file = path.join(projectRoot, 'data', 'nests', 'tflex', 'Nest01.tfnesting');
+  // The oracle: the CLI refuses the same nest and settings, naming the pairs.
+  const oracle = cliError(file, 'solve', file, '--solver', 'ccp', '--time-limit', '1', '--kerf', '2',
+    '--pierce-clearance', '5', '--switch-off-clearance', '1', '--lead-in', 'arc');
+  assert.equal(oracle.status, 1);
+  const named = oracle.message.match(/(\d+) pair\(s\) of contours: ContourRef \{ part: 0, contour: 0 \} and ContourRef \{ part: 1, contour: 0 \} touch/);
+  assert.ok(named, oracle.message);
+
+  const context = await app.browser.newContext({ locale: 'ru-RU', viewport: { width: 1280, height: 800 } });
+  const page = await context.newPage();
+  const errors = watchErrors(page);
+  await page.goto(app.baseUrl);
+  await page.setInputFiles('#file-input', file);
+  await page.waitForFunction(() => (document.querySelector('#file-name')?.textContent ?? '').includes('Nest01'),
+    null, { timeout: 30000 });
+  await page.click('details.kerf summary');
+  await setNumber(page, '#kerf-width', 2);
+  await setNumber(page, '#kerf-d1', 5);
+  await setNumber(page, '#kerf-d2', 1);
+  await page.selectOption('#solver', 'ccp');
+  await page.fill('#time-limit', '1');
+  await page.dispatchEvent('#time-limit', 'change');
+  await page.click('#start');
+  await page.waitForFunction(() => /^ошибка/.test(document.querySelector('#job-status')?.textContent ?? ''),
+    null, { timeout: 30000 });
+  const status = await page.textContent('#job-status');
+  assert.match(status, /детали ближе друг к другу, чем ширина реза 2 мм/, status);
+  assert.match(status, new RegExp(`пар контуров: ${named[1]}: деталь 1 контур 0 и деталь 2 контур 0 касаются около`), status);
+  assert.doesNotMatch(status, /[A-Za-z]{2,}/, 'no English word in the Russian refusal');
+  assert.equal(await page.locator('#nest-view .leads path.lead').count(), 0, 'no route drawn');
   assert.deepEqual(errors, []);
   await context.close();
 });

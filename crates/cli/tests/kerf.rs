@@ -593,3 +593,31 @@ fn kerf_pierces_sit_in_a_kerf_cut_before_and_save_time() {
         cut / 10.0 + idle / 500.0 + 7.0 * (pierces - kerf.len() as f64) + 2.0 * kerf.len() as f64;
     assert!((time(&report) - expected).abs() < 1e-6 * expected);
 }
+
+/// T-FLEX Nest01's five parts touch in a row: with any kerf no cut on the equidistants keeps
+/// kerf/2 off its neighbour, so `solve` refuses up front (exit 1, no route printed), naming
+/// each touching pair and where — for plasma and laser alike.
+#[test]
+fn parts_closer_than_the_kerf_are_refused_naming_the_pairs() {
+    let file = data("nests/tflex/Nest01.tfnesting");
+    for solver in ["nearest", "ccp", "chain"] {
+        for machine in [&PLASMA[..], &LASER[..]] {
+            let mut args = vec!["solve", &file, "--solver", solver, "--time-limit", "0.3"];
+            args.extend(machine);
+            let (ok, out, err) = cutroute(&args);
+            assert!(!ok && out.is_empty(), "{solver}: {out}");
+            assert!(err.contains("parts closer than the kerf of"), "{err}");
+            assert!(err.contains("4 pair(s) of contours"), "{err}");
+            assert!(
+                err.contains(
+                    "ContourRef { part: 0, contour: 0 } and ContourRef { part: 1, contour: 0 } \
+                     touch near ("
+                ),
+                "{err}"
+            );
+        }
+    }
+    // Without kerf the same nest is cut as ever.
+    let (ok, _, err) = cutroute(&["solve", &file, "--solver", "ccp", "--time-limit", "0.3"]);
+    assert!(ok, "{err}");
+}

@@ -28,7 +28,8 @@
 //! their paths' ends (module `kerf_paths`).
 
 use cutroute_geometry::{
-    ContainmentForest, CutStep, KerfSettings, LeadError, LeadFitter, MachineParameters, Nest, Route,
+    kerf_overlaps, ContainmentForest, CutStep, KerfSettings, LeadError, LeadFitter,
+    MachineParameters, Nest, PartsTooClose, Route,
 };
 use cutroute_protocol::{
     Bounds, JobRequest, KerfNote, KerfSource, Phase, Problem, Progress, Solution, SolverKind,
@@ -330,6 +331,18 @@ impl KerfJob {
         }
         let settings = request.params.kerf;
         validate_kerf(&settings).map_err(|e| refused(e.into()))?;
+        // Parts closer than the kerf: every solver's cut there would eat into a neighbour, and
+        // the route checkers reject it; say so now, with the pairs, rather than after a search.
+        let pairs = kerf_overlaps(nest, settings.kerf / 2.0, nest.check_tolerance());
+        if !pairs.is_empty() {
+            return Err(refused(
+                PartsTooClose {
+                    kerf: settings.kerf,
+                    pairs,
+                }
+                .into(),
+            ));
+        }
         let forest = nest.containment_forest();
         // The inner requests are idealised: the kerf is this job's.
         let mut idealised = request.clone();
@@ -346,12 +359,11 @@ impl KerfJob {
             let equidistants = LeadFitter::with_forest(nest, &forest, settings).kerf_nest();
             let mut over_equidistants = idealised.clone();
             if let Problem::Nest { nest, .. } = &mut over_equidistants.problem {
-                *nest = equidistants.clone();
+                *nest = equidistants;
             }
             let run = PathLeadsRun::new(
                 nest.clone(),
                 forest.clone(),
-                equidistants,
                 settings,
                 request.params.machine,
                 request.params.objective,

@@ -10,18 +10,15 @@
 //! Common edges (aoe; sccp's chains) exist on the kerf nest only where equidistants coincide:
 //! parts spaced by exactly the kerf. Parts spaced closer (touching parts among them) have
 //! equidistants that cross each other: no cut keeps kerf/2 from both, since every route must
-//! cut every equidistant whole. So before the solver runs, the equidistants themselves are
-//! checked against the nest: the contours their kerf would burn into are named as contours
-//! without room (the checker reports such cuts as `PathRouteError::CutTooClose`) and no
-//! solver runs. Besides saving the solve, this names them for every path solver alike: aoe's
-//! own check refuses its route where crossing equidistants run nearly tangent (T-FLEX Nest02
-//! and Nest03), so it had no route to name them from. Each route the solver gives is checked
-//! the same way once its leads are fitted (a cut within the tolerance of an equidistant may
-//! come a little closer than the equidistant itself).
+//! cut every equidistant whole. [`crate::KerfJob`] refuses such a nest before any solver runs
+//! (`Refusal::PartsTooClose`). Each route the solver gives is still checked against the nest
+//! once its leads are fitted (a cut within the tolerance of an equidistant may come a little
+//! closer than the equidistant itself): the contours it would burn into are named as contours
+//! without room (the checker reports such cuts as `PathRouteError::CutTooClose`).
 
 use cutroute_geometry::{
     ContainmentForest, KerfSettings, LeadError, LeadFitter, LeadProblem, MachineParameters, Nest,
-    Objective, PathRoute, PathRouteError, Point, Span, ToolOnPath,
+    Objective, PathRoute, PathRouteError, ToolOnPath,
 };
 use cutroute_protocol::{Bounds, KerfNote, KerfSource, Phase, Progress, Solution};
 use web_time::{Duration, Instant};
@@ -78,11 +75,6 @@ impl Attach {
 pub(crate) struct PathLeadsRun {
     nest: Nest,
     forest: ContainmentForest,
-    /// [`LeadFitter::kerf_nest`] of `nest`, until its check before the solver's first step.
-    equidistants: Option<Nest>,
-    /// The contours the equidistants' kerf burns into (parts spaced closer than the kerf):
-    /// when any, no solver runs.
-    crowded: Vec<LeadError>,
     settings: KerfSettings,
     machine: MachineParameters,
     objective: Objective,
@@ -95,11 +87,10 @@ pub(crate) struct PathLeadsRun {
 }
 
 impl PathLeadsRun {
-    /// `job` is the solver's job over `equidistants`, `LeadFitter::kerf_nest` of `nest`.
+    /// `job` is the solver's job over `LeadFitter::kerf_nest` of `nest`.
     pub(crate) fn new(
         nest: Nest,
         forest: ContainmentForest,
-        equidistants: Nest,
         settings: KerfSettings,
         machine: MachineParameters,
         objective: Objective,
@@ -108,8 +99,6 @@ impl PathLeadsRun {
         PathLeadsRun {
             nest,
             forest,
-            equidistants: Some(equidistants),
-            crowded: Vec::new(),
             settings,
             machine,
             objective,
@@ -122,22 +111,6 @@ impl PathLeadsRun {
 
     pub(crate) fn step(&mut self, budget: Duration) -> JobStatus {
         let started = Instant::now();
-        if let Some(equidistants) = self.equidistants.take() {
-            // Routes are refused closer than kerf/2 less the tolerance, and a cut may lie a
-            // tolerance off its equidistant: an equidistant closer than kerf/2 less twice the
-            // tolerance has no cut that passes.
-            self.crowded = self.too_close(
-                &equidistants_as_cuts(&equidistants),
-                2.0 * self.nest.check_tolerance(),
-            );
-            if !self.crowded.is_empty() {
-                self.solving = false;
-                return JobStatus::Done;
-            }
-        }
-        if !self.crowded.is_empty() {
-            return JobStatus::Done;
-        }
         let fitter = LeadFitter::with_forest(&self.nest, &self.forest, self.settings).for_paths();
         if self.solving {
             // The solver gets most of the slice; its newer routes get their leads in the rest.
@@ -212,11 +185,7 @@ impl PathLeadsRun {
 
     pub(crate) fn progress(&self) -> Progress {
         let mut progress = self.job.progress();
-        let fitted = if self.crowded.is_empty() {
-            self.fitted.as_ref().map(|(_, r)| r.as_ref())
-        } else {
-            Some(Err(&self.crowded))
-        };
+        let fitted = self.fitted.as_ref().map(|(_, r)| r.as_ref());
         let (note, route) = match fitted {
             Some(Ok(route)) => (
                 KerfNote::Leads {
@@ -255,24 +224,5 @@ impl PathLeadsRun {
             note,
         };
         progress
-    }
-}
-
-/// Every equidistant of `equidistants` as one closed cut: what every route over them cuts.
-fn equidistants_as_cuts(equidistants: &Nest) -> PathRoute {
-    PathRoute {
-        start: Point::default(),
-        paths: equidistants
-            .contour_refs()
-            .filter_map(|r| equidistants.contour(r))
-            .map(|c| {
-                let spans: Vec<Span> = c.spans().collect();
-                ToolOnPath::new(
-                    spans.first().map_or_else(Point::default, |s| s.start),
-                    spans,
-                )
-            })
-            .collect(),
-        finish: None,
     }
 }

@@ -146,6 +146,10 @@ pub enum Refusal {
     /// A kerf or lead length is out of range.
     #[error("{0}")]
     Kerf(#[from] kerf::KerfSettingsError),
+    /// Parts sit closer than the kerf: no cut on the equidistants keeps kerf/2 off its
+    /// neighbour, so the full cutting route has no admissible route (the pairs and their gaps).
+    #[error("{0}")]
+    PartsTooClose(#[from] cutroute_geometry::PartsTooClose),
     /// The solver has no model of the full cutting route (kerf, leads).
     #[error("does not cut with kerf and leads yet (nearest, ccp, heuristic, exact and chain do)")]
     NoFullRouteModel,

@@ -264,49 +264,6 @@ fn aoe_cuts_seven_on_the_equidistants_with_plasma_settings() {
 }
 
 #[test]
-fn parts_closer_than_the_kerf_are_named_before_a_path_solver_runs() {
-    // T-FLEX Nest02 places parts touching each other: no cut on their equidistants keeps
-    // kerf/2 from both, whatever the solver, so each names the same contours without room.
-    let problem = nest_problem("nests/tflex/Nest02.tfnesting");
-    let nest = nest_of(&problem);
-    let settings = plasma();
-    let mut named = Vec::new();
-    for solver in [SolverKind::Sccp, SolverKind::Gsccp, SolverKind::Aoe] {
-        let mut job = start_job(&request(&problem, solver, settings, false)).expect("starts");
-        let progress = run_to_end(job.as_mut(), &mut |_| {});
-        assert!(progress.path_route().is_none(), "{solver:?}");
-        let Phase::Kerf {
-            note: KerfNote::NoRoom { contours, .. },
-            ..
-        } = &progress.phase
-        else {
-            panic!("{solver:?}: {}", progress.phase);
-        };
-        assert!(!contours.is_empty(), "{solver:?}");
-        named.push(contours.clone());
-    }
-    assert!(named.windows(2).all(|w| w[0] == w[1]));
-    // Each named contour (the first few: all pairs of spans are slow in a debug build) comes
-    // closer than the kerf to another contour.
-    let tolerance = nest.check_tolerance();
-    let all: Vec<_> = nest.contour_refs().collect();
-    for &(part, contour) in named[0].iter().take(4) {
-        let me = cutroute_geometry::ContourRef { part, contour };
-        let spans: Vec<_> = nest.contour(me).expect("named").spans().collect();
-        let nearest = all
-            .iter()
-            .filter(|&&r| r != me)
-            .flat_map(|&r| nest.contour(r).expect("listed").spans().collect::<Vec<_>>())
-            .flat_map(|o| spans.iter().map(move |s| s.distance_to_span(&o)))
-            .fold(f64::INFINITY, f64::min);
-        assert!(
-            nearest < settings.kerf + 2.0 * tolerance,
-            "{me:?}: {nearest} mm from its nearest neighbour"
-        );
-    }
-}
-
-#[test]
 fn every_solver_starts_with_kerf_and_bad_settings_are_refused() {
     let problem = nest_problem("nests/dbs-json/E1X_6_01.dbs.json");
     // Every solver has a full-route model now; one without would be refused here.
@@ -390,4 +347,105 @@ fn out_of_range_kerf_settings_are_refused_by_name() {
         refused.to_string(),
         "ccp: lead-in length -1: must be finite and non-negative"
     );
+}
+
+/// The least distance between two contours, span against span (independent of the kerf
+/// check's index).
+fn brute_gap(a: &cutroute_geometry::Contour, b: &cutroute_geometry::Contour) -> f64 {
+    a.spans()
+        .flat_map(|x| b.spans().map(move |y| x.distance_to_span(&y)))
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// T-FLEX Nest01's parts touch: no cut on the equidistants keeps kerf/2 off its neighbour (the
+/// checkers reject every such route), so every solver's kerf job is refused up front, with
+/// the pairs of contours and their gaps, under plasma and laser alike.
+#[test]
+fn parts_closer_than_the_kerf_are_refused_up_front_naming_the_pairs() {
+    let problem = nest_problem("nests/tflex/Nest01.tfnesting");
+    let nest = nest_of(&problem);
+    let laser = KerfSettings {
+        kerf: 0.2,
+        pierce_clearance: 1.0,
+        switch_off_clearance: 0.5,
+        ..plasma()
+    };
+    for kerf in [plasma(), laser] {
+        for solver in SolverKind::ALL {
+            let started = start_job(&request(&problem, solver, kerf, false));
+            let Err(EngineError::SolverRefused {
+                reason: Refusal::PartsTooClose(refusal),
+                ..
+            }) = started
+            else {
+                panic!("{solver:?} kerf {}: {:?}", kerf.kerf, started.err());
+            };
+            assert_eq!(refusal.kerf, kerf.kerf);
+            assert!(!refusal.pairs.is_empty());
+            for pair in &refusal.pairs {
+                assert_ne!(pair.contour, pair.other);
+                let (a, b) = (
+                    nest.contour(pair.contour).unwrap(),
+                    nest.contour(pair.other).unwrap(),
+                );
+                let gap = brute_gap(a, b);
+                assert!((gap - pair.gap).abs() < 1e-9, "{pair:?} vs {gap}");
+                assert!(gap < kerf.kerf, "{pair:?}");
+            }
+            let words = refusal.to_string();
+            assert!(
+                words.contains("parts closer than the kerf") && words.contains("ContourRef"),
+                "{words}"
+            );
+        }
+    }
+}
+
+/// A nest whose parts are 1 mm apart is refused with kerf 2 and cut with kerf 0.2; the route
+/// cut then passes the checker, which holds each cut kerf/2 from every contour.
+#[test]
+fn a_nest_is_refused_only_where_its_gaps_are_narrower_than_the_kerf() {
+    use cutroute_geometry::{Contour, Nest, Part, Point, Vertex};
+    let square = |x: f64| Part {
+        name: format!("at {x}"),
+        contours: vec![Contour::new(vec![
+            Vertex::line(x, 0.0),
+            Vertex::line(x, 40.0),
+            Vertex::line(x + 40.0, 40.0),
+            Vertex::line(x + 40.0, 0.0),
+        ])],
+    };
+    let problem = Problem::Nest {
+        nest: Nest {
+            sheet: None,
+            parts: vec![square(0.0), square(41.0), square(90.0)],
+        },
+        start: Point::new(-50.0, -50.0),
+        finish: None,
+    };
+    for solver in [
+        SolverKind::NearestNeighbour,
+        SolverKind::Ccp,
+        SolverKind::Chain,
+    ] {
+        let refused = start_job(&request(&problem, solver, plasma(), false)).err();
+        let Some(EngineError::SolverRefused {
+            reason: Refusal::PartsTooClose(refusal),
+            ..
+        }) = refused
+        else {
+            panic!("{solver:?}: {refused:?}");
+        };
+        // Only the first two sit closer than 2 mm; the third is 9 mm away.
+        assert_eq!(refusal.pairs.len(), 1, "{refusal}");
+        assert!((refusal.pairs[0].gap - 1.0).abs() < 1e-9);
+        let laser = KerfSettings {
+            kerf: 0.2,
+            pierce_clearance: 1.0,
+            switch_off_clearance: 0.5,
+            ..plasma()
+        };
+        let progress = run(&request(&problem, solver, laser, false));
+        checked(&problem, &progress);
+    }
 }

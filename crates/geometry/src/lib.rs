@@ -23,7 +23,8 @@
 //! - The full cutting route (issue #17): [`equidistant`] (exact offsets at kerf/2), the pierce
 //!   and switch-off regions ([`in_clear_scrap`]), lead-ins and lead-outs ([`LeadSpec`]) fitted
 //!   by [`LeadFitter`] into [`StepLeads`] on a [`CutStep`]; [`KerfSettings::default`] is the
-//!   idealised model.
+//!   idealised model; [`kerf_overlaps`]: parts closer than the kerf, where no cut keeps kerf/2
+//!   off its neighbour.
 //! - [`generate_nest`]: deterministic synthetic nests of up to tens of thousands of contours.
 //!
 //! Sign conventions: [`Contour::signed_area`] is positive for counter-clockwise contours (the
@@ -80,6 +81,7 @@ pub mod float;
 mod forest;
 mod generator;
 mod kerf;
+mod kerf_clearance;
 mod leads;
 mod path_leads;
 mod path_route;
@@ -101,6 +103,7 @@ pub use domain::{DomainError, NestDomainError, MAX_BULGE, MAX_COORDINATE, MIN_CO
 pub use forest::ContainmentForest;
 pub use generator::generate_nest;
 pub use kerf::{clearance, equidistant, in_clear_scrap, OffsetError};
+pub use kerf_clearance::{kerf_overlaps, ContourSpans, KerfOverlap, PartsTooClose, TooClose};
 pub use leads::{
     chain_spans, opened_at, place_tabs, KerfSettings, LeadError, LeadFitter, LeadProblem,
     LeadShape, LeadSpec, StepLeads, Tab, TabSpec,

@@ -14,8 +14,8 @@ use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use crate::{
-    BoundingBox, ContainmentForest, ContourRef, LeadFitter, LeadProblem, MachineParameters, Nest,
-    PathLeads, Point, Route, RouteError, Span,
+    BoundingBox, ContainmentForest, ContourRef, ContourSpans, LeadFitter, LeadProblem,
+    MachineParameters, Nest, PathLeads, Point, Route, RouteError, Span,
 };
 
 /// One pierce's worth of cutting: the torch pierces at `pierce` and cuts `spans` in order.
@@ -529,48 +529,31 @@ impl PathRoute {
 
     /// Every tool-on span (leads aside: their checker samples them) closer than `half` less
     /// `tolerance` to a contour of `nest`, one per path: a cut whose kerf burns into a part.
+    /// The same test as [`Route::problems`]'s on each step's cut ([`ContourSpans::too_close`]).
     pub fn clearance_problems(
         &self,
         nest: &Nest,
         half: f64,
         tolerance: f64,
     ) -> Vec<PathRouteError> {
-        let refs: Vec<ContourRef> = nest.contour_refs().collect();
-        let contours: Vec<Vec<Span>> = nest
-            .contour_refs()
-            .map(|r| nest.contour(r).map_or(Vec::new(), |c| c.spans().collect()))
-            .collect();
-        let mut entries = Vec::new();
-        for (c, spans) in contours.iter().enumerate() {
-            for (s, span) in spans.iter().enumerate() {
-                entries.push(SpanEntry {
-                    envelope: aabb(&span.bounding_box()),
-                    contour: c,
-                    span: s,
-                });
-            }
-        }
-        let tree = RTree::bulk_load(entries);
+        let index = ContourSpans::new(nest);
         let mut problems = Vec::new();
-        'paths: for (p, path) in self.paths.iter().enumerate() {
-            for (s, span) in path.spans.iter().enumerate() {
-                let reach = aabb(&span.bounding_box().expanded(half));
-                for e in tree.locate_in_envelope_intersecting(&reach) {
-                    let other = &contours[e.contour][e.span];
-                    let distance = span.distance_to_span(other);
-                    if distance < half - tolerance {
-                        let at = span.nearest_point(other.nearest_point(span.point_at(0.5)).point);
-                        problems.push(PathRouteError::CutTooClose {
-                            path: p,
-                            contour: refs[e.contour],
-                            span: s,
-                            x: at.point.x,
-                            y: at.point.y,
-                            distance,
-                        });
-                        continue 'paths;
-                    }
-                }
+        for (p, path) in self.paths.iter().enumerate() {
+            let first = path.spans.iter().enumerate().find_map(|(s, span)| {
+                index
+                    .too_close(span, half, tolerance)
+                    .next()
+                    .map(|hit| (s, hit))
+            });
+            if let Some((s, hit)) = first {
+                problems.push(PathRouteError::CutTooClose {
+                    path: p,
+                    contour: hit.contour,
+                    span: s,
+                    x: hit.at.x,
+                    y: hit.at.y,
+                    distance: hit.distance,
+                });
             }
         }
         problems

@@ -3,7 +3,10 @@
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
-use crate::{ContainmentForest, Contour, LeadFitter, LeadProblem, Nest, Point, StepLeads};
+use crate::kerf_clearance::cut_overlaps;
+use crate::{
+    ContainmentForest, Contour, ContourSpans, LeadFitter, LeadProblem, Nest, Point, Span, StepLeads,
+};
 
 /// Identifies one contour of a nest: `part` indexes `Nest::parts`, `contour` that part's contours.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
@@ -292,6 +295,29 @@ pub enum RouteError {
         /// What is wrong.
         problem: LeadProblem,
     },
+    /// The cut of a step on its equidistant (the overcut included, the tabs' gaps not) comes
+    /// closer than kerf/2 to a contour: the kerf eats into that contour's part (parts closer
+    /// than the kerf). Reported once per pair of contours, at the first step that cuts one of
+    /// them.
+    #[error("the cut of contour {contour:?} (step {step}) comes {distance} mm from contour {other:?} near ({x}, {y}), closer than kerf/2 = {required} mm (the contours are {gap} mm apart)")]
+    KerfOverlap {
+        /// Index of the step.
+        step: usize,
+        /// The contour it cuts.
+        contour: ContourRef,
+        /// The contour its kerf eats into.
+        other: ContourRef,
+        /// The least distance from the cut to `other`, mm.
+        distance: f64,
+        /// kerf/2, mm.
+        required: f64,
+        /// The gap between the two contours themselves, mm.
+        gap: f64,
+        /// A point of the cut near where it comes closest, x.
+        x: f64,
+        /// Its y.
+        y: f64,
+    },
     /// The first step is entered by a link, but there is no previous cut to link from.
     #[error("step 0 is entered by a tool-on link, but no contour was cut before it")]
     LinkWithoutPrevious,
@@ -481,7 +507,10 @@ impl Route {
     /// each pierce point within `tolerance` mm of its contour, inner contours cut before
     /// every contour containing them, and every tool-on link joining two siblings of one scrap
     /// region (children of the sheet or of one hole) without crossing any contour or leaving
-    /// that region.
+    /// that region. With leads, each step's elements are checked by
+    /// [`LeadFitter::problems_linked`], and its cut on the equidistant keeps kerf/2 (less
+    /// `tolerance`) from every other contour ([`RouteError::KerfOverlap`], the test
+    /// [`PathRoute::problems`](crate::PathRoute::problems) holds every tool-on span to).
     pub fn problems(
         &self,
         nest: &Nest,
@@ -589,6 +618,53 @@ impl Route {
             if let Entry::Link(_) = self.steps[step].entry {
                 check_link(self, step, nest, forest, tolerance, &mut problems);
             }
+        }
+        problems.extend(self.kerf_overlap_problems(nest, tolerance));
+        problems
+    }
+
+    /// The steps whose cut on the equidistant comes closer than kerf/2 (less `tolerance`) to
+    /// another contour, once per pair of contours (see [`RouteError::KerfOverlap`]). Steps without
+    /// leads (the idealised model: no kerf) and contours without an equidistant (reported as
+    /// the entry off the equidistant) are not checked here. Part of [`Route::problems`].
+    pub fn kerf_overlap_problems(&self, nest: &Nest, tolerance: f64) -> Vec<RouteError> {
+        let mut index: Option<ContourSpans> = None;
+        let mut seen = std::collections::BTreeSet::new();
+        let mut problems = Vec::new();
+        for (step, s) in self.steps.iter().enumerate() {
+            let Some(leads) = s.leads.as_ref().filter(|l| l.offset > 0.0) else {
+                continue;
+            };
+            let Some(eq) = nest
+                .contour(s.contour)
+                .and_then(|c| crate::equidistant(c, leads.offset).ok())
+            else {
+                continue;
+            };
+            let cut: Vec<Span> = leads
+                .equidistant_pieces(&eq, 0.0)
+                .into_iter()
+                .flatten()
+                .collect();
+            let index = index.get_or_insert_with(|| ContourSpans::new(nest));
+            // Its own contour is kept kerf/2 off by the offset itself (to the offset's
+            // precision, which can be 1e-4 mm on files' runs of tiny segments, where the
+            // offset's cleanup moves vertices): the pairs here are neighbours.
+            seen.insert((s.contour, s.contour));
+            problems.extend(
+                cut_overlaps(index, s.contour, &cut, leads.offset, tolerance, &mut seen)
+                    .into_iter()
+                    .map(|o| RouteError::KerfOverlap {
+                        step,
+                        contour: o.contour,
+                        other: o.other,
+                        distance: o.distance,
+                        required: o.required,
+                        gap: o.gap,
+                        x: o.at.x,
+                        y: o.at.y,
+                    }),
+            );
         }
         problems
     }

@@ -163,6 +163,11 @@ pub enum FromWorker {
         job_id: JobId,
         /// What went wrong, in plain words.
         message: String,
+        /// When the job was refused because parts sit closer than the kerf: the pairs, so
+        /// the page can word them in its language. (Always written, even as `null`: the
+        /// worker's binary codec cannot skip fields.)
+        #[serde(default)]
+        parts_too_close: Option<cutroute_geometry::PartsTooClose>,
     },
 }
 

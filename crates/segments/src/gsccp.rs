@@ -482,7 +482,7 @@ impl GsccpSearch {
         let route = solver.result().route;
         match PathRoute::from_route(&route, &self.nest) {
             Err(e) => {
-                self.failure = Some(SegmentError::CcpRoute(e));
+                self.failure = Some(SegmentError::CcpRoute(Box::new(e)));
                 self.stage = Stage::Finished;
             }
             Ok(path) => {

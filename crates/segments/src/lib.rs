@@ -121,9 +121,10 @@ pub enum SegmentError {
     /// CCP-Relax, which seeds the orders, failed.
     #[error("CCP-Relax failed: {0}")]
     Ccp(#[from] cutroute_ccp::CcpError),
-    /// CCP-Relax's route is not a valid route of the nest.
+    /// CCP-Relax's route is not a valid route of the nest (boxed: a route error is large and
+    /// this one is rare).
     #[error("CCP-Relax failed: {0}")]
-    CcpRoute(#[source] cutroute_geometry::RouteError),
+    CcpRoute(#[source] Box<cutroute_geometry::RouteError>),
     /// An option is out of range.
     #[error("invalid option: {0}")]
     InvalidOption(String),
@@ -148,10 +149,13 @@ mod tests {
                 contour: 1,
             },
         };
-        let error = SegmentError::CcpRoute(route.clone());
+        let error = SegmentError::CcpRoute(Box::new(route.clone()));
         assert_eq!(error.to_string(), format!("CCP-Relax failed: {route}"));
         let source = error.source().expect("a source");
-        assert_eq!(source.downcast_ref::<RouteError>(), Some(&route));
+        assert_eq!(
+            source.downcast_ref::<Box<RouteError>>().map(|b| &**b),
+            Some(&route)
+        );
         let failure = EnsembleFailure::FailsCheck(cutroute_geometry::PathRouteError::EmptyPath {
             path: 2,
             x: 1.0,

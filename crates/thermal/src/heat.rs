@@ -144,7 +144,7 @@ pub fn route_pierces(
     nest: &Nest,
     machine: &MachineParameters,
 ) -> Result<Vec<Pierce>, ThermalError> {
-    let toolpath = Toolpath::new(route, nest).map_err(ThermalError::Route)?;
+    let toolpath = Toolpath::new(route, nest).map_err(|e| ThermalError::Route(Box::new(e)))?;
     Ok(step_times(&toolpath, machine, route.steps.len())
         .into_iter()
         .zip(&route.steps)

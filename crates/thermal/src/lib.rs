@@ -96,7 +96,7 @@ pub enum ThermalError {
     UnknownRule(String),
     /// The route does not fit the nest.
     #[error(transparent)]
-    Route(cutroute_geometry::RouteError),
+    Route(Box<cutroute_geometry::RouteError>),
     /// [`RuleRepair::advance`] was called again after it returned its result.
     #[error("the rule repair has already returned its result")]
     RepairFinished,

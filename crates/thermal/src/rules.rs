@@ -418,12 +418,12 @@ impl RuleCheck {
 fn check_steps(route: &Route, nest: &Nest) -> Result<(), ThermalError> {
     for (step, s) in route.steps.iter().enumerate() {
         if nest.contour(s.contour).is_none() {
-            return Err(ThermalError::Route(
+            return Err(ThermalError::Route(Box::new(
                 cutroute_geometry::RouteError::UnknownContour {
                     step,
                     contour: s.contour,
                 },
-            ));
+            )));
         }
     }
     Ok(())

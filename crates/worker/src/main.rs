@@ -12,7 +12,8 @@ mod web {
     use std::collections::HashMap;
 
     use cutroute_engine::{
-        open_sheet, open_together, start_job, Job, JobStatus, OpenError, DEFAULT_SLICE,
+        open_sheet, open_together, start_job, EngineError, Job, JobStatus, OpenError, Refusal,
+        DEFAULT_SLICE,
     };
     use cutroute_protocol::{Document, FromWorker, JobId, ToWorker};
     use gloo_worker::{HandlerId, Worker, WorkerScope};
@@ -126,6 +127,13 @@ mod web {
                         FromWorker::Failed {
                             job_id: request.job_id,
                             message: error.to_string(),
+                            parts_too_close: match error {
+                                EngineError::SolverRefused {
+                                    reason: Refusal::PartsTooClose(pairs),
+                                    ..
+                                } => Some(pairs),
+                                _ => None,
+                            },
                         },
                     ),
                 },
