@@ -193,7 +193,8 @@ pub fn KerfPanel() -> impl IntoView {
             {number("lead-out-length", ("Lead-out length", "Длина отвода"), ("Length of the lead-out from the contour to the switch-off point", "Длина отвода от контура до точки выключения"), |k| k.lead_out.length, |k, v| k.lead_out.length = v)}
             {number("kerf-overcut", ("Overcut", "Перебег"), ("How far the cut runs on past the entry before the lead-out", "На сколько рез заходит за точку входа перед отводом"), |k| k.overcut, |k, v| k.overcut = v)}
             <TabsField settings=settings />
-            <EdgePierceField settings=settings />
+            {switch_field(settings, "kerf-edge-pierce", ("Edge piercing", "Врезка с кромки листа"), ("Pierce parts' outer contours at the sheet's border where a straight lead from it reaches the contour (the nest needs a sheet)", "Врезка внешних контуров деталей с кромки листа, где прямой подвод от неё доходит до контура (нужен лист)"), |k| k.edge_pierce, |k, on| k.edge_pierce = on)}
+            {switch_field(settings, "kerf-kerf-pierce", ("Kerf piercing", "Врезка в прорезь"), ("Pierce in the open kerf of a contour cut earlier, where a straight lead from it reaches the contour and that saves time (for machines and materials that allow it; priced at the edge-pierce time)", "Врезка в открытую прорезь ранее вырезанного контура, где прямой подвод от неё доходит до контура и это экономит время (если станок и материал позволяют; время — как врезки с кромки)"), |k| k.kerf_pierce, |k, on| k.kerf_pierce = on)}
         </details>
     }
 }
@@ -281,19 +282,25 @@ fn TabsField(settings: RwSignal<KerfSettings>) -> impl IntoView {
     }
 }
 
-/// Piercing outer contours from the sheet's edge.
-#[component]
-fn EdgePierceField(settings: RwSignal<KerfSettings>) -> impl IntoView {
+/// A yes/no setting of the full route (edge piercing, kerf piercing).
+fn switch_field(
+    settings: RwSignal<KerfSettings>,
+    id: &'static str,
+    label: Words,
+    tip: Words,
+    get: fn(&KerfSettings) -> bool,
+    set: fn(&mut KerfSettings, bool),
+) -> impl IntoView {
     view! {
-        <label class="param" title=tr("Pierce parts' outer contours at the sheet's border where a straight lead from it reaches the contour (the nest needs a sheet)", "Врезка внешних контуров деталей с кромки листа, где прямой подвод от неё доходит до контура (нужен лист)")>
-            <span>{tr("Edge piercing", "Врезка с кромки листа")}</span>
+        <label class="param" title=tr(tip.0, tip.1)>
+            <span>{tr(label.0, label.1)}</span>
             <input
-                id="kerf-edge-pierce"
+                id=id
                 type="checkbox"
-                prop:checked=move || settings.with(|k| k.edge_pierce)
+                prop:checked=move || settings.with(get)
                 on:change=move |ev| {
                     let on = event_target_checked(&ev);
-                    settings.update(|k| k.edge_pierce = on);
+                    settings.update(|k| set(k, on));
                 }
             />
         </label>
@@ -306,6 +313,9 @@ pub fn LeadStats(route: Signal<Option<Route>>) -> impl IntoView {
     let language = crate::i18n::use_language();
     let lengths = move || route.with(|r| r.as_ref().map(lead_lengths));
     let mm = move || language.pick("mm", "мм");
+    // Pierces at the sheet's edge and in a cut kerf: quicker ones (`--edge-pierce-time`).
+    let edge = move || route.with(|r| r.as_ref().map_or(0, Route::edge_pierce_count));
+    let kerf = move || route.with(|r| r.as_ref().map_or(0, Route::kerf_pierce_count));
     let has_leads = move || {
         route.with(|r| {
             r.as_ref()
@@ -322,6 +332,12 @@ pub fn LeadStats(route: Signal<Option<Route>>) -> impl IntoView {
                 <dt>{tr("Lead-outs", "Отводы")}</dt>
                 <dd id="lead-out-length" data-mm=move || lengths().map(|l| format!("{:.3}", l.1))>
                     {move || lengths().map(|l| format!("{:.1} {}", l.1, mm())).unwrap_or_default()}
+                </dd>
+                <dt>{tr("Edge / kerf pierces", "Врезки с кромки / в прорезь")}</dt>
+                <dd id="quick-pierces">
+                    <span id="edge-pierces">{edge}</span>
+                    " / "
+                    <span id="kerf-pierces">{kerf}</span>
                 </dd>
             </dl>
         </Show>

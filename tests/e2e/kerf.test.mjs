@@ -193,3 +193,32 @@ test('a nest whose parts touch is refused with kerf, the pairs named in Russian'
   assert.deepEqual(errors, []);
   await context.close();
 });
+
+// Kerf piercing from a link: the switch is on, nearest (deterministic) on nested.dbs places as
+// many pierces in a kerf cut before as the CLI does with the same settings, and the stats say so.
+test('kerf piercing rides the link, and the page places the kerf pierces the CLI places', async () => {
+  const file = path.join(projectRoot, 'data', 'nests', 'dbs', 'nested.dbs');
+  const oracle = cli('solve', file, '--solver', 'nearest', '--json', '--kerf', '2', '--pierce-clearance', '5',
+    '--switch-off-clearance', '1', '--lead-in', 'arc', '--lead-in-length', '8', '--lead-out', 'line',
+    '--lead-out-length', '2', '--kerf-pierce');
+  assert.ok(oracle.kerf_pierces > 0, JSON.stringify(oracle.kerf_pierces));
+
+  const context = await app.browser.newContext({ viewport: { width: 1280, height: 800 } });
+  const page = await context.newPage();
+  const errors = watchErrors(page);
+  await page.goto(`${app.baseUrl}?sample=nested.dbs&kerf=2&d1=5&d2=1&lead_in_length=8&lead_out_length=2`
+    + '&lead_in=arc&lead_out=line&tabs=0:0&kerf_pierce=1');
+  await page.waitForFunction(() => (document.querySelector('#file-name')?.textContent ?? '').includes('nested'),
+    null, { timeout: 20000 });
+  assert.ok(await page.isChecked('#kerf-kerf-pierce'), 'the link turns kerf piercing on');
+  assert.ok(!(await page.isChecked('#kerf-edge-pierce')));
+  assert.match(await page.inputValue('#share-link'), /kerf_pierce=1/);
+  await runSolver(page, 'nearest', 5);
+  assert.equal(Number(await page.textContent('#kerf-pierces')), oracle.kerf_pierces, 'kerf pierces as the CLI');
+  assert.equal(Number(await page.textContent('#edge-pierces')), 0);
+  assert.equal(Number(await page.textContent('#pierces')), oracle.pierces);
+  const idle = Number(await page.getAttribute('#idle-length', 'data-mm'));
+  assert.ok(Math.abs(idle - oracle.idle_length) < 1e-6 * oracle.idle_length, `idle ${idle} vs ${oracle.idle_length}`);
+  assert.deepEqual(errors, []);
+  await context.close();
+});
