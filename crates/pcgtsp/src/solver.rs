@@ -12,7 +12,7 @@ use crate::dp::{Dp, DpStatus, Incumbent};
 use crate::heuristic;
 use crate::instance::Instance;
 use crate::keys::{on_keyed, ByWidth, Keyed};
-use crate::model::Model;
+use crate::model::{Model, ModelBuilder};
 use crate::order::{OrderError, PrecedenceOrder};
 use crate::prepare::{LatticeLimits, Preparation, STRONG_SUBSET_SHARE};
 use std::rc::Rc;
@@ -491,6 +491,8 @@ pub struct ExactSolver {
     runs: Vec<Run>,
     /// Start nodes whose run is still to be built (reversed: next is last).
     unbuilt: Vec<usize>,
+    /// The model being built, a piece per [`ExactSolver::build_unit`].
+    building: Option<ModelBuilder>,
     /// The model built last, its root bound not yet computed.
     unbounded: Option<Model>,
     current_run: usize,
@@ -506,14 +508,15 @@ impl ExactSolver {
     /// Prepares the solver (preprocessing and root bounds; no search yet).
     pub fn new(instance: &Instance, options: ExactOptions) -> Result<ExactSolver, SolverError> {
         let mut solver = ExactSolver::deferred(instance, options)?;
-        while solver.build_unit() {}
+        while solver.build_unit(&|| false) {}
         Ok(solver)
     }
 
     /// Like [`ExactSolver::new`] but cheap: the instance is checked here and each start
     /// node's model and root bound are built later, each in a [`ExactSolver::step`] of its own
     /// (on thousands of nodes each takes seconds, which a caller answering Stop between steps
-    /// cannot wait for). Until they are built, [`ExactSolver::root_bound`] is −∞.
+    /// cannot wait for; a model is built in pieces itself, [`ModelBuilder`]). Until they are
+    /// built, [`ExactSolver::root_bound`] is −∞.
     pub fn deferred(
         instance: &Instance,
         options: ExactOptions,
@@ -538,6 +541,7 @@ impl ExactSolver {
             options,
             runs: Vec::new(),
             unbuilt,
+            building: None,
             unbounded: None,
             current_run: 0,
             incumbent: Incumbent {
@@ -554,12 +558,13 @@ impl ExactSolver {
     /// Whether every start node's run (model and root bound) is built (always, but for a
     /// [`ExactSolver::deferred`] solver before its first steps).
     pub fn runs_built(&self) -> bool {
-        self.unbuilt.is_empty() && self.unbounded.is_none()
+        self.unbuilt.is_empty() && self.building.is_none() && self.unbounded.is_none()
     }
 
-    /// Builds one piece of the runs: the next start node's model, or its root bound. Returns
-    /// whether it did anything (false once all are built).
-    fn build_unit(&mut self) -> bool {
+    /// Builds one piece of the runs: pieces of the next start node's model until `pause()`
+    /// (at least one), or its root bound. Returns whether it did anything (false once all are
+    /// built).
+    fn build_unit(&mut self, pause: &dyn Fn() -> bool) -> bool {
         if let Some(model) = self.unbounded.take() {
             let depot = model.depot;
             let root_bound = model.round_bound(ResidualBounder::default().compute(
@@ -584,16 +589,29 @@ impl ExactSolver {
             });
             return true;
         }
+        if let Some(builder) = self.building.as_mut() {
+            let t = Instant::now();
+            if let Some(model) = builder.advance(&self.instance, pause) {
+                let start = model.start;
+                debug_log(|| {
+                    format!(
+                        "model of start node {start} built (last piece {:?})",
+                        t.elapsed()
+                    )
+                });
+                self.building = None;
+                self.unbounded = Some(model);
+            }
+            return true;
+        }
         let Some(start) = self.unbuilt.pop() else {
             return false;
         };
-        let t = Instant::now();
         // Checked in `deferred`: the order is a partial order, so the model builds.
-        match Model::new(&self.instance, start) {
-            Ok(model) => self.unbounded = Some(model),
+        match ModelBuilder::new(&self.instance, start) {
+            Ok(builder) => self.building = Some(builder),
             Err(e) => debug_log(|| format!("start node {start}: no model ({e})")),
         }
-        debug_log(|| format!("model of start node {start} built in {:?}", t.elapsed()));
         true
     }
 
@@ -733,7 +751,8 @@ impl ExactSolver {
             }
             // The runs of a deferred solver: one model or root bound per piece, at least one
             // per step whatever its budget (so tiny slices still advance).
-            if !built_one && self.build_unit() {
+            let pause = || began.elapsed() >= deadline;
+            if !built_one && self.build_unit(&pause) {
                 built_one = true;
                 continue;
             }
@@ -741,7 +760,7 @@ impl ExactSolver {
                 self.elapsed += began.elapsed();
                 return Status::Running;
             }
-            if self.build_unit() {
+            if self.build_unit(&pause) {
                 continue;
             }
             if self.bounds_meet_incumbent() {
