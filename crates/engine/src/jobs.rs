@@ -230,6 +230,22 @@ impl DiscreteJob {
         Ok(job)
     }
 
+    /// A job on an instance like [`DiscreteJob::new`], but its solvers are made in its first
+    /// steps (on a big instance that is seconds: [`DiscreteJob::new`] is one piece); a solver
+    /// that refuses the instance ends the job there, its phase saying why.
+    pub fn unbuilt(
+        job_id: JobId,
+        instance: Instance,
+        mode: DiscreteMode,
+        time_limit: Duration,
+        started: Instant,
+        seed: u64,
+    ) -> Self {
+        let mut job = Self::pending(job_id, mode, time_limit, started, seed);
+        job.instance = Some(instance);
+        job
+    }
+
     /// A job on the discretisation `builder` is building (one step fills rows of its matrix).
     pub fn building(
         job_id: JobId,
