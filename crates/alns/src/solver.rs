@@ -95,6 +95,12 @@ struct Improve {
     changed: bool,
 }
 
+/// How the first tour is built: cheapest insertion, without noise.
+const FIRST_INSERTION: Insertion = Insertion {
+    selection: Selection::Cheapest,
+    noisy: false,
+};
+
 /// Anytime ALNS for PCGTSP / GTSP that can be advanced in slices (see [`AlnsSolver::step`]).
 ///
 /// The search trajectory depends only on the seed and the number of iterations: time only
@@ -122,6 +128,10 @@ pub struct AlnsSolver {
     /// The best distinct epoch results, cheapest first: restart points after a stagnant epoch.
     elite: Vec<(Vec<usize>, f64)>,
     started: bool,
+    /// The first tour under way (cheapest insertion a cluster per [`AlnsSolver::step`] unit,
+    /// finished before any limit is checked, as when it was one piece: the search always has
+    /// a tour once started).
+    first: Option<Vec<usize>>,
     /// The first tour's descent under way, a move family per [`AlnsSolver::step`] unit (on
     /// thousands of clusters it takes seconds: one piece would block Stop that long).
     descent: Option<Descent>,
@@ -205,6 +215,7 @@ impl AlnsSolver {
             epoch_improved: false,
             elite: Vec::new(),
             started: false,
+            first: None,
             descent: None,
             iteration: None,
             stop: None,
@@ -235,9 +246,9 @@ impl AlnsSolver {
         let slice_start = Instant::now();
         let base = self.elapsed;
         loop {
-            // An iteration under way is finished first (as when it was one piece), unless the
-            // search was cancelled: the limits are checked between iterations.
-            if self.iteration.is_none() || self.stop.is_some() {
+            // An iteration or the first tour under way is finished first (as when it was one
+            // piece), unless the search was cancelled: the limits are checked between them.
+            if (self.iteration.is_none() && self.first.is_none()) || self.stop.is_some() {
                 if let Some(reason) = self.stop_reason() {
                     self.stop = Some(reason);
                     return stopped_status(reason);
@@ -245,6 +256,8 @@ impl AlnsSolver {
             }
             let improved = if !self.started {
                 self.start()
+            } else if let Some(tour) = self.first.take() {
+                self.build_first(tour)
             } else if let Some(descent) = self.descent.take() {
                 self.descend(descent)
             } else {
@@ -256,7 +269,7 @@ impl AlnsSolver {
                 on_improvement(&self.progress());
             }
             if slice_start.elapsed() >= budget {
-                if self.iteration.is_some() {
+                if self.iteration.is_some() || self.first.is_some() {
                     return Status::Running;
                 }
                 if let Some(reason) = self.stop_reason() {
@@ -324,19 +337,33 @@ impl AlnsSolver {
         None
     }
 
-    /// Builds the first tour by cheapest insertion from the depot and starts its descent
-    /// ([`AlnsSolver::descend`], the same moves as [`AlnsSolver::improve`] with no depth
-    /// gate). The tour is the best from here on: every unit of the descent keeps it valid.
+    /// Starts the first tour: cheapest insertion from the depot, a cluster per unit
+    /// ([`AlnsSolver::build_first`]), then its descent ([`AlnsSolver::descend`], the same
+    /// moves as [`AlnsSolver::improve`] with no depth gate). The tour is the best from its
+    /// node-choice DP on: every unit of the descent keeps it valid.
     fn start(&mut self) -> bool {
         self.started = true;
         let p = &self.problem;
         let mut tour = Vec::with_capacity(p.m);
         self.operators.destroy_all(p, &mut tour);
-        let how = Insertion {
-            selection: Selection::Cheapest,
-            noisy: false,
-        };
-        self.operators.repair(p, &mut tour, how, 0.0, &mut self.rng);
+        self.operators
+            .begin_repair(p, &tour, FIRST_INSERTION, 0.0, &mut self.rng);
+        self.first = Some(tour);
+        false
+    }
+
+    /// One unit of the first tour's cheapest insertion: the next cluster inserted, or (when
+    /// all are) its node-choice DP, after which the tour is the best and its descent starts
+    /// ([`AlnsSolver::descend`]). Returns whether the best improved.
+    fn build_first(&mut self, mut tour: Vec<usize>) -> bool {
+        let p = &self.problem;
+        if self
+            .operators
+            .insert_one(p, &mut tour, FIRST_INSERTION, 0.0, &mut self.rng)
+        {
+            self.first = Some(tour);
+            return false;
+        }
         let cost = self.node_choice.optimise(p, &mut tour);
         self.publish_first(tour, cost);
         self.descent = Some(Descent::default());
@@ -742,9 +769,25 @@ mod tests {
             let mut whole = AlnsSolver::new(&instance, options.clone()).unwrap();
             whole.step(Duration::from_secs(3600));
             let mut units = AlnsSolver::new(&instance, options).unwrap();
+            // The first tour's insertion: a cluster per unit, no tour before it is whole.
+            let mut insertions = 0;
+            while units.first.is_some() || !units.started {
+                assert!(units.best().is_none(), "{name}: a tour before the first");
+                units.step(Duration::ZERO);
+                insertions += 1;
+            }
+            // The start, a unit per cluster but the depot's, and the node-choice DP.
+            let expected = 1 + (instance.clusters.len() - 1) + 1;
+            assert_eq!(insertions, expected, "{name}: a unit per cluster");
             let mut calls = 0;
             let mut last = f64::INFINITY;
-            while units.descent.is_some() || !units.started {
+            while units.descent.is_some() {
+                let (tour, cost) = units.best().expect("a tour from the insertion's end");
+                let checked = check_tour(&instance, tour).unwrap();
+                assert!(
+                    (checked - cost).abs() <= 1e-6 * (1.0 + cost.abs()),
+                    "{name}"
+                );
                 units.step(Duration::ZERO);
                 calls += 1;
                 let (tour, cost) = units.best().expect("a tour from the first unit");
