@@ -71,6 +71,36 @@ impl<const N: usize> Adaptive<N> {
 struct Descent {
     unit: u8,
     changed: bool,
+    /// Where the unit's move family paused.
+    family: FamilyAt,
+}
+
+/// Where a move family paused at a slice's end ([`run_family`]): whether it is under way, and
+/// the reinsertion's position.
+#[derive(Clone, Copy, Debug, Default)]
+struct FamilyAt {
+    partial: bool,
+    reinsert: Option<(usize, usize)>,
+}
+
+/// Runs move family `family` (0 2-opt, 1 or-opt, 2 reinsertion, 3 block reversal of segments
+/// up to `max_len`) on `tour` until `pause()`: whether it improved the tour, and whether it is
+/// finished (else it goes on from `at` in the next call, with the result of one call).
+fn run_family(
+    search: &mut LocalSearch,
+    p: &Problem,
+    tour: &mut [usize],
+    family: u8,
+    max_len: usize,
+    at: &mut FamilyAt,
+    pause: &dyn Fn() -> bool,
+) -> (bool, bool) {
+    match family {
+        0 => search.two_opt_until(p, tour, pause),
+        1 => search.or_opt_until(p, tour, pause),
+        2 => search.reinsert_until(p, tour, &mut at.reinsert, pause),
+        _ => search.block_reverse_until(p, tour, max_len, pause),
+    }
 }
 
 /// An iteration under way ([`AlnsSolver::iterate_unit`]): its operators, its candidate and
@@ -93,6 +123,8 @@ struct Improve {
     deep_below: f64,
     unit: u8,
     changed: bool,
+    /// Where the unit's move family paused.
+    family: FamilyAt,
 }
 
 /// How the first tour is built: cheapest insertion, without noise.
@@ -245,6 +277,9 @@ impl AlnsSolver {
     ) -> Status {
         let slice_start = Instant::now();
         let base = self.elapsed;
+        // A move family pauses at the slice's end (and goes on in the next unit).
+        let slice_end = slice_start.checked_add(budget);
+        let pause = || slice_end.is_some_and(|end| Instant::now() >= end);
         loop {
             // An iteration or the first tour under way is finished first (as when it was one
             // piece), unless the search was cancelled: the limits are checked between them.
@@ -259,9 +294,9 @@ impl AlnsSolver {
             } else if let Some(tour) = self.first.take() {
                 self.build_first(tour)
             } else if let Some(descent) = self.descent.take() {
-                self.descend(descent)
+                self.descend(descent, &pause)
             } else {
-                self.iterate_unit(base + slice_start.elapsed())
+                self.iterate_unit(base + slice_start.elapsed(), &pause)
             };
             self.elapsed = base + slice_start.elapsed();
             if improved && self.best().is_some() {
@@ -385,21 +420,62 @@ impl AlnsSolver {
     /// [`AlnsSolver::improve`] (with `deep_below` infinite) in the same order, so the tour it
     /// ends with does not depend on how the units fall into slices; a time limit ends it
     /// between units as it ended `improve` between rounds. Returns whether the best improved.
-    fn descend(&mut self, mut descent: Descent) -> bool {
+    fn descend(&mut self, mut descent: Descent, pause: &dyn Fn() -> bool) -> bool {
         let p = &self.problem;
         let mut tour = std::mem::take(&mut self.current);
         let mut improved = false;
+        let max_len = self.options.parameters.block_reverse_length;
         match descent.unit {
-            0 => descent.changed = self.local_search.two_opt(p, &mut tour),
-            1 => descent.changed |= self.local_search.or_opt(p, &mut tour),
-            2 => descent.changed |= self.local_search.reinsert(p, &mut tour),
-            3 => {
-                let max_len = self.options.parameters.block_reverse_length;
-                if !descent.changed && !self.local_search.block_reverse(p, &mut tour, max_len) {
-                    // A local optimum: the descent is over.
-                    debug_assert!(p.order_is_valid(&tour));
+            0..=2 => {
+                if descent.unit == 0 && !descent.family.partial {
+                    descent.changed = false;
+                }
+                let family = &mut descent.family;
+                let (better, finished) = run_family(
+                    &mut self.local_search,
+                    p,
+                    &mut tour,
+                    descent.unit,
+                    max_len,
+                    family,
+                    pause,
+                );
+                descent.changed |= better;
+                if !finished {
+                    family.partial = true;
                     self.current = tour;
+                    self.descent = Some(descent);
                     return false;
+                }
+                descent.family = FamilyAt::default();
+            }
+            3 => {
+                // Block reversal only after a round that changed nothing (or to finish it).
+                if !descent.changed || descent.family.partial {
+                    let family = &mut descent.family;
+                    let (better, finished) = run_family(
+                        &mut self.local_search,
+                        p,
+                        &mut tour,
+                        3,
+                        max_len,
+                        family,
+                        pause,
+                    );
+                    descent.changed |= better;
+                    if !finished {
+                        family.partial = true;
+                        self.current = tour;
+                        self.descent = Some(descent);
+                        return false;
+                    }
+                    descent.family = FamilyAt::default();
+                    if !descent.changed {
+                        // A local optimum: the descent is over.
+                        debug_assert!(p.order_is_valid(&tour));
+                        self.current = tour;
+                        return false;
+                    }
                 }
             }
             _ => {
@@ -474,7 +550,7 @@ impl AlnsSolver {
     #[cfg(test)]
     fn iterate(&mut self) -> bool {
         loop {
-            let improved = self.iterate_unit(self.elapsed);
+            let improved = self.iterate_unit(self.elapsed, &|| false);
             if self.iteration.is_none() {
                 return improved;
             }
@@ -487,7 +563,7 @@ impl AlnsSolver {
     /// not depend on how its units fall into slices), or its acceptance. `elapsed` is the
     /// search's time so far: the local search ends at the time limit between rounds, as
     /// `improve` does. Returns whether the best tour improved.
-    fn iterate_unit(&mut self, elapsed: Duration) -> bool {
+    fn iterate_unit(&mut self, elapsed: Duration, pause: &dyn Fn() -> bool) -> bool {
         let Some(mut it) = self.iteration.take() else {
             self.begin_iteration();
             return false;
@@ -496,23 +572,63 @@ impl AlnsSolver {
             return self.accept(it);
         };
         let p = &self.problem;
+        let max_len = self.options.parameters.block_reverse_length;
         match at.unit {
             0 => it.cost = self.node_choice.optimise(p, &mut it.candidate),
-            1 => at.changed = self.local_search.two_opt(p, &mut it.candidate),
-            2 => at.changed |= self.local_search.or_opt(p, &mut it.candidate),
-            3 => at.changed |= self.local_search.reinsert(p, &mut it.candidate),
-            4 => {
-                let max_len = self.options.parameters.block_reverse_length;
-                if !at.changed
-                    && (it.cost > at.deep_below
-                        || !self
-                            .local_search
-                            .block_reverse(p, &mut it.candidate, max_len))
-                {
-                    debug_assert!(p.order_is_valid(&it.candidate));
-                    it.improve = None;
+            1..=3 => {
+                if at.unit == 1 && !at.family.partial {
+                    at.changed = false;
+                }
+                let family = &mut at.family;
+                let (better, finished) = run_family(
+                    &mut self.local_search,
+                    p,
+                    &mut it.candidate,
+                    at.unit - 1,
+                    max_len,
+                    family,
+                    pause,
+                );
+                at.changed |= better;
+                if !finished {
+                    family.partial = true;
+                    it.improve = Some(at);
                     self.iteration = Some(it);
                     return false;
+                }
+                at.family = FamilyAt::default();
+            }
+            4 => {
+                // Block reversal only after a round that changed nothing and on a candidate
+                // about as good as the best (or to finish it).
+                if !at.changed || at.family.partial {
+                    let gated = !at.family.partial && it.cost > at.deep_below;
+                    if !gated {
+                        let family = &mut at.family;
+                        let (better, finished) = run_family(
+                            &mut self.local_search,
+                            p,
+                            &mut it.candidate,
+                            3,
+                            max_len,
+                            family,
+                            pause,
+                        );
+                        at.changed |= better;
+                        if !finished {
+                            family.partial = true;
+                            it.improve = Some(at);
+                            self.iteration = Some(it);
+                            return false;
+                        }
+                        at.family = FamilyAt::default();
+                    }
+                    if !at.changed {
+                        debug_assert!(p.order_is_valid(&it.candidate));
+                        it.improve = None;
+                        self.iteration = Some(it);
+                        return false;
+                    }
                 }
             }
             _ => {
@@ -580,6 +696,7 @@ impl AlnsSolver {
             deep_below: self.best_cost + params.block_reverse_gate * self.best_cost.abs(),
             unit: 0,
             changed: false,
+            family: FamilyAt::default(),
         });
         self.iteration = Some(Iteration {
             removal,
