@@ -555,11 +555,20 @@ impl ExactSolver {
         instance: &Instance,
         options: ExactOptions,
     ) -> Result<ExactSolver, SolverError> {
+        ExactSolver::deferred_owned(instance.clone(), options)
+    }
+
+    /// [`ExactSolver::deferred`] on an instance it keeps (a caller that copied it in pieces
+    /// saves the copy `deferred` makes: hundreds of MB on a big discretisation).
+    pub fn deferred_owned(
+        instance: Instance,
+        options: ExactOptions,
+    ) -> Result<ExactSolver, SolverError> {
         if instance.node_count > u16::MAX as usize {
             return Err(SolverError::TooManyNodes(instance.node_count));
         }
         // The only way a model fails: the precedence pairs are no partial order.
-        PrecedenceOrder::new(instance)?;
+        PrecedenceOrder::new(&instance)?;
         let phase = if options.heuristic {
             Phase::Heuristic {
                 beam: 0,
@@ -571,7 +580,7 @@ impl ExactSolver {
         let mut unbuilt = instance.clusters[instance.depot].clone();
         unbuilt.reverse();
         Ok(ExactSolver {
-            instance: instance.clone(),
+            instance,
             options,
             runs: Vec::new(),
             unbuilt,
