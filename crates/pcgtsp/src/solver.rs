@@ -2,7 +2,7 @@
 
 use cutroute_anytime::{AnytimeSolver, Bounds, CostUnit, Status};
 
-use crate::bounds::completion::{PositionBound, PositionBoundOptions};
+use crate::bounds::completion::{PositionAscent, PositionBound, PositionBoundOptions};
 use crate::bounds::lagrange::{ArborescenceAscent, NodePenalties, PenaltyAscent, PenaltyOptions};
 use crate::bounds::lattice::LatticeStore;
 use crate::bounds::residual::ResidualBounder;
@@ -284,6 +284,10 @@ struct Run {
     /// incumbent's cost and the arborescence bound's options.
     penalty_ascent: Option<(Option<PenaltyAscent>, f64, PenaltyOptions)>,
     arborescence: Option<ArborescenceAscent>,
+    /// Whether the position bound was considered (after the Lagrangian bounds); its ascent
+    /// then runs in `position_ascent`, slices of its own.
+    position_checked: bool,
+    position_ascent: Option<PositionAscent>,
     root_bound: f64,
     engine: Option<Engine>,
     finished_bound: Option<f64>,
@@ -342,25 +346,32 @@ impl Run {
             self.prepared = Some(store);
             return;
         }
+        if !self.position_checked {
+            self.position_checked = true;
+            if let Some(root) = store.root_bound() {
+                self.root_bound = self.root_bound.max(self.model.round_bound(root));
+            }
+            if let Some(subset) = &self.subset {
+                self.root_bound = self
+                    .root_bound
+                    .max(self.model.round_bound(subset.root_bound));
+            }
+            let strong_subset = self.subset.as_ref().is_some_and(|s| {
+                s.tracked_count() == self.model.m
+                    || s.root_bound >= STRONG_SUBSET_SHARE * upper_bound
+            });
+            if store.root_bound().is_none() && !strong_subset && self.root_bound < upper_bound {
+                // Neither the lattice nor a strong subset bound (exact, or within 15 % of the
+                // incumbent, as on the industrial orders) sees precedence per state: add the
+                // position bound (on e1x_4, ec_2, … its root stays 17–35 % below the subset's).
+                self.build_position_bound(options, upper_bound);
+            }
+        }
+        if !self.advance_position(deadline) {
+            self.prepared = Some(store);
+            return;
+        }
         self.preparation = None;
-        if let Some(root) = store.root_bound() {
-            self.root_bound = self.root_bound.max(self.model.round_bound(root));
-        }
-        if let Some(subset) = &self.subset {
-            self.root_bound = self
-                .root_bound
-                .max(self.model.round_bound(subset.root_bound));
-        }
-        let strong_subset = self.subset.as_ref().is_some_and(|s| {
-            s.tracked_count() == self.model.m || s.root_bound >= STRONG_SUBSET_SHARE * upper_bound
-        });
-        if store.root_bound().is_none() && !strong_subset && self.root_bound < upper_bound {
-            // Neither the lattice nor a strong subset bound (exact, or within 15 % of the
-            // incumbent, as on the industrial orders) sees precedence per state: add the
-            // position bound (on e1x_4, ec_2, … its root stays 17–35 % below the subset's).
-            self.build_position_bound(options, upper_bound);
-            debug_log(|| format!("position bound after {:?}", began.elapsed()));
-        }
         debug_log(|| {
             format!(
                 "bounds built (last slice {:?}): lattice root {:?}, subset root {:?} ({} of {} clusters tracked)",
@@ -454,8 +465,7 @@ impl Run {
         if options.position_iterations == 0 || self.model.m > 256 {
             return;
         }
-        let began = Instant::now();
-        let position = PositionBound::build(
+        self.position_ascent = PositionAscent::new(
             &self.model,
             upper_bound,
             PositionBoundOptions {
@@ -465,18 +475,29 @@ impl Run {
                 known_bound: self.root_bound,
             },
         );
-        if let Some(p) = &position {
-            self.root_bound = self.root_bound.max(self.model.round_bound(p.root_bound));
-            debug_log(|| {
-                format!(
-                    "position bound in {:?}: root {} ({} iterations)",
-                    began.elapsed(),
-                    p.root_bound,
-                    p.iterations
-                )
-            });
-        }
-        self.position = position.map(Rc::new);
+    }
+
+    /// Iterations of the position bound's ascent until `deadline` (at least one); whether it
+    /// is done (or there is none).
+    fn advance_position(&mut self, deadline: Instant) -> bool {
+        let Some(ascent) = self.position_ascent.as_mut() else {
+            return true;
+        };
+        let Some(position) = ascent.advance(&self.model, &|| Instant::now() >= deadline) else {
+            return false;
+        };
+        self.position_ascent = None;
+        self.root_bound = self
+            .root_bound
+            .max(self.model.round_bound(position.root_bound));
+        debug_log(|| {
+            format!(
+                "position bound: root {} ({} iterations)",
+                position.root_bound, position.iterations
+            )
+        });
+        self.position = Some(Rc::new(position));
+        true
     }
 
     /// A new DP engine with every bound this run has.
@@ -627,6 +648,8 @@ impl ExactSolver {
                 penalties_built: false,
                 penalty_ascent: None,
                 arborescence: None,
+                position_checked: false,
+                position_ascent: None,
                 root_bound,
                 engine: None,
                 finished_bound: None,
