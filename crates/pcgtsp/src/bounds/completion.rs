@@ -572,8 +572,16 @@ mod tests {
                 }
             };
             assert_eq!(format!("{sliced:?}"), format!("{whole:?}"), "{name}");
-            assert!(whole.iterations > 10, "{name}: {} iterations", whole.iterations);
-            assert_eq!(pieces, whole.iterations + 1, "{name}: a piece per iteration");
+            assert!(
+                whole.iterations > 10,
+                "{name}: {} iterations",
+                whole.iterations
+            );
+            assert_eq!(
+                pieces,
+                whole.iterations + 1,
+                "{name}: a piece per iteration"
+            );
         }
     }
 }
