@@ -30,9 +30,10 @@ enum Stage {
 }
 
 /// A [`Model`] built in resumable pieces: on a discretised nest of thousands of nodes its
-/// tables are several passes over an n × n matrix (0.7 s on 5,000 nodes), longer than the
-/// page may wait for Stop. [`ModelBuilder::advance`] works until asked to pause, always doing
-/// at least one piece; the model is the one [`Model::new`] builds, however the pieces fall.
+/// tables are several passes over an n × n matrix (a piece of 0.72 s in the exact job on
+/// nested.dbs at 25 mm), longer than the page may wait for Stop. [`ModelBuilder::advance`]
+/// works until asked to pause, always doing at least one piece; the model is the one
+/// [`Model::new`] builds, however the pieces fall.
 #[derive(Clone, Debug)]
 pub(crate) struct ModelBuilder {
     stage: Stage,
