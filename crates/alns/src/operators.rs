@@ -228,6 +228,21 @@ impl Operators {
         noise: f64,
         rng: &mut Rng,
     ) {
+        self.begin_repair(p, t, how, noise, rng);
+        while self.insert_one(p, t, how, noise, rng) {}
+    }
+
+    /// The first part of [`Operators::repair`]: every pending cluster's best insertion. Then
+    /// [`Operators::insert_one`] inserts them one at a time (a repair in resumable units: the
+    /// first tour of Nest03's 460 clusters took 0.6–1.5 s in one piece).
+    pub(crate) fn begin_repair(
+        &mut self,
+        p: &Problem,
+        t: &[usize],
+        how: Insertion,
+        noise: f64,
+        rng: &mut Rng,
+    ) {
         let noise = if how.noisy { noise } else { 0.0 };
         self.candidate.clear();
         self.candidate.resize(p.m, NO_CANDIDATE);
@@ -253,8 +268,25 @@ impl Operators {
                 self.nearest[c] = best;
             }
         }
-        let mut pending = pending;
-        while !pending.is_empty() {
+        self.pending = pending;
+    }
+
+    /// Inserts the next pending cluster of a repair begun by [`Operators::begin_repair`] (with
+    /// the same `how` and `noise`); whether one was left to insert.
+    pub(crate) fn insert_one(
+        &mut self,
+        p: &Problem,
+        t: &mut Vec<usize>,
+        how: Insertion,
+        noise: f64,
+        rng: &mut Rng,
+    ) -> bool {
+        let noise = if how.noisy { noise } else { 0.0 };
+        let mut pending = std::mem::take(&mut self.pending);
+        if pending.is_empty() {
+            return false;
+        }
+        {
             let pick = match how.selection {
                 Selection::Random => pending.len() - 1,
                 Selection::Cheapest => arg_best(&pending, |c| -self.candidate[c].delta),
@@ -323,6 +355,7 @@ impl Operators {
             }
         }
         self.pending = pending;
+        true
     }
 
     /// Sets `candidate[c].lo ..= candidate[c].hi` of every pending cluster `c` to its feasible

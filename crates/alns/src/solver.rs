@@ -71,6 +71,36 @@ impl<const N: usize> Adaptive<N> {
 struct Descent {
     unit: u8,
     changed: bool,
+    /// Where the unit's move family paused.
+    family: FamilyAt,
+}
+
+/// Where a move family paused at a slice's end ([`run_family`]): whether it is under way, and
+/// the reinsertion's position.
+#[derive(Clone, Copy, Debug, Default)]
+struct FamilyAt {
+    partial: bool,
+    reinsert: Option<(usize, usize)>,
+}
+
+/// Runs move family `family` (0 2-opt, 1 or-opt, 2 reinsertion, 3 block reversal of segments
+/// up to `max_len`) on `tour` until `pause()`: whether it improved the tour, and whether it is
+/// finished (else it goes on from `at` in the next call, with the result of one call).
+fn run_family(
+    search: &mut LocalSearch,
+    p: &Problem,
+    tour: &mut [usize],
+    family: u8,
+    max_len: usize,
+    at: &mut FamilyAt,
+    pause: &dyn Fn() -> bool,
+) -> (bool, bool) {
+    match family {
+        0 => search.two_opt_until(p, tour, pause),
+        1 => search.or_opt_until(p, tour, pause),
+        2 => search.reinsert_until(p, tour, &mut at.reinsert, pause),
+        _ => search.block_reverse_until(p, tour, max_len, pause),
+    }
 }
 
 /// An iteration under way ([`AlnsSolver::iterate_unit`]): its operators, its candidate and
@@ -93,7 +123,15 @@ struct Improve {
     deep_below: f64,
     unit: u8,
     changed: bool,
+    /// Where the unit's move family paused.
+    family: FamilyAt,
 }
+
+/// How the first tour is built: cheapest insertion, without noise.
+const FIRST_INSERTION: Insertion = Insertion {
+    selection: Selection::Cheapest,
+    noisy: false,
+};
 
 /// Anytime ALNS for PCGTSP / GTSP that can be advanced in slices (see [`AlnsSolver::step`]).
 ///
@@ -122,6 +160,10 @@ pub struct AlnsSolver {
     /// The best distinct epoch results, cheapest first: restart points after a stagnant epoch.
     elite: Vec<(Vec<usize>, f64)>,
     started: bool,
+    /// The first tour under way (cheapest insertion a cluster per [`AlnsSolver::step`] unit,
+    /// finished before any limit is checked, as when it was one piece: the search always has
+    /// a tour once started).
+    first: Option<Vec<usize>>,
     /// The first tour's descent under way, a move family per [`AlnsSolver::step`] unit (on
     /// thousands of clusters it takes seconds: one piece would block Stop that long).
     descent: Option<Descent>,
@@ -205,6 +247,7 @@ impl AlnsSolver {
             epoch_improved: false,
             elite: Vec::new(),
             started: false,
+            first: None,
             descent: None,
             iteration: None,
             stop: None,
@@ -234,10 +277,13 @@ impl AlnsSolver {
     ) -> Status {
         let slice_start = Instant::now();
         let base = self.elapsed;
+        // A move family pauses at the slice's end (and goes on in the next unit).
+        let slice_end = slice_start.checked_add(budget);
+        let pause = || slice_end.is_some_and(|end| Instant::now() >= end);
         loop {
-            // An iteration under way is finished first (as when it was one piece), unless the
-            // search was cancelled: the limits are checked between iterations.
-            if self.iteration.is_none() || self.stop.is_some() {
+            // An iteration or the first tour under way is finished first (as when it was one
+            // piece), unless the search was cancelled: the limits are checked between them.
+            if (self.iteration.is_none() && self.first.is_none()) || self.stop.is_some() {
                 if let Some(reason) = self.stop_reason() {
                     self.stop = Some(reason);
                     return stopped_status(reason);
@@ -245,10 +291,12 @@ impl AlnsSolver {
             }
             let improved = if !self.started {
                 self.start()
+            } else if let Some(tour) = self.first.take() {
+                self.build_first(tour)
             } else if let Some(descent) = self.descent.take() {
-                self.descend(descent)
+                self.descend(descent, &pause)
             } else {
-                self.iterate_unit(base + slice_start.elapsed())
+                self.iterate_unit(base + slice_start.elapsed(), &pause)
             };
             self.elapsed = base + slice_start.elapsed();
             if improved && self.best().is_some() {
@@ -256,7 +304,7 @@ impl AlnsSolver {
                 on_improvement(&self.progress());
             }
             if slice_start.elapsed() >= budget {
-                if self.iteration.is_some() {
+                if self.iteration.is_some() || self.first.is_some() {
                     return Status::Running;
                 }
                 if let Some(reason) = self.stop_reason() {
@@ -324,19 +372,33 @@ impl AlnsSolver {
         None
     }
 
-    /// Builds the first tour by cheapest insertion from the depot and starts its descent
-    /// ([`AlnsSolver::descend`], the same moves as [`AlnsSolver::improve`] with no depth
-    /// gate). The tour is the best from here on: every unit of the descent keeps it valid.
+    /// Starts the first tour: cheapest insertion from the depot, a cluster per unit
+    /// ([`AlnsSolver::build_first`]), then its descent ([`AlnsSolver::descend`], the same
+    /// moves as [`AlnsSolver::improve`] with no depth gate). The tour is the best from its
+    /// node-choice DP on: every unit of the descent keeps it valid.
     fn start(&mut self) -> bool {
         self.started = true;
         let p = &self.problem;
         let mut tour = Vec::with_capacity(p.m);
         self.operators.destroy_all(p, &mut tour);
-        let how = Insertion {
-            selection: Selection::Cheapest,
-            noisy: false,
-        };
-        self.operators.repair(p, &mut tour, how, 0.0, &mut self.rng);
+        self.operators
+            .begin_repair(p, &tour, FIRST_INSERTION, 0.0, &mut self.rng);
+        self.first = Some(tour);
+        false
+    }
+
+    /// One unit of the first tour's cheapest insertion: the next cluster inserted, or (when
+    /// all are) its node-choice DP, after which the tour is the best and its descent starts
+    /// ([`AlnsSolver::descend`]). Returns whether the best improved.
+    fn build_first(&mut self, mut tour: Vec<usize>) -> bool {
+        let p = &self.problem;
+        if self
+            .operators
+            .insert_one(p, &mut tour, FIRST_INSERTION, 0.0, &mut self.rng)
+        {
+            self.first = Some(tour);
+            return false;
+        }
         let cost = self.node_choice.optimise(p, &mut tour);
         self.publish_first(tour, cost);
         self.descent = Some(Descent::default());
@@ -358,21 +420,62 @@ impl AlnsSolver {
     /// [`AlnsSolver::improve`] (with `deep_below` infinite) in the same order, so the tour it
     /// ends with does not depend on how the units fall into slices; a time limit ends it
     /// between units as it ended `improve` between rounds. Returns whether the best improved.
-    fn descend(&mut self, mut descent: Descent) -> bool {
+    fn descend(&mut self, mut descent: Descent, pause: &dyn Fn() -> bool) -> bool {
         let p = &self.problem;
         let mut tour = std::mem::take(&mut self.current);
         let mut improved = false;
+        let max_len = self.options.parameters.block_reverse_length;
         match descent.unit {
-            0 => descent.changed = self.local_search.two_opt(p, &mut tour),
-            1 => descent.changed |= self.local_search.or_opt(p, &mut tour),
-            2 => descent.changed |= self.local_search.reinsert(p, &mut tour),
-            3 => {
-                let max_len = self.options.parameters.block_reverse_length;
-                if !descent.changed && !self.local_search.block_reverse(p, &mut tour, max_len) {
-                    // A local optimum: the descent is over.
-                    debug_assert!(p.order_is_valid(&tour));
+            0..=2 => {
+                if descent.unit == 0 && !descent.family.partial {
+                    descent.changed = false;
+                }
+                let family = &mut descent.family;
+                let (better, finished) = run_family(
+                    &mut self.local_search,
+                    p,
+                    &mut tour,
+                    descent.unit,
+                    max_len,
+                    family,
+                    pause,
+                );
+                descent.changed |= better;
+                if !finished {
+                    family.partial = true;
                     self.current = tour;
+                    self.descent = Some(descent);
                     return false;
+                }
+                descent.family = FamilyAt::default();
+            }
+            3 => {
+                // Block reversal only after a round that changed nothing (or to finish it).
+                if !descent.changed || descent.family.partial {
+                    let family = &mut descent.family;
+                    let (better, finished) = run_family(
+                        &mut self.local_search,
+                        p,
+                        &mut tour,
+                        3,
+                        max_len,
+                        family,
+                        pause,
+                    );
+                    descent.changed |= better;
+                    if !finished {
+                        family.partial = true;
+                        self.current = tour;
+                        self.descent = Some(descent);
+                        return false;
+                    }
+                    descent.family = FamilyAt::default();
+                    if !descent.changed {
+                        // A local optimum: the descent is over.
+                        debug_assert!(p.order_is_valid(&tour));
+                        self.current = tour;
+                        return false;
+                    }
                 }
             }
             _ => {
@@ -447,7 +550,7 @@ impl AlnsSolver {
     #[cfg(test)]
     fn iterate(&mut self) -> bool {
         loop {
-            let improved = self.iterate_unit(self.elapsed);
+            let improved = self.iterate_unit(self.elapsed, &|| false);
             if self.iteration.is_none() {
                 return improved;
             }
@@ -460,7 +563,7 @@ impl AlnsSolver {
     /// not depend on how its units fall into slices), or its acceptance. `elapsed` is the
     /// search's time so far: the local search ends at the time limit between rounds, as
     /// `improve` does. Returns whether the best tour improved.
-    fn iterate_unit(&mut self, elapsed: Duration) -> bool {
+    fn iterate_unit(&mut self, elapsed: Duration, pause: &dyn Fn() -> bool) -> bool {
         let Some(mut it) = self.iteration.take() else {
             self.begin_iteration();
             return false;
@@ -469,23 +572,63 @@ impl AlnsSolver {
             return self.accept(it);
         };
         let p = &self.problem;
+        let max_len = self.options.parameters.block_reverse_length;
         match at.unit {
             0 => it.cost = self.node_choice.optimise(p, &mut it.candidate),
-            1 => at.changed = self.local_search.two_opt(p, &mut it.candidate),
-            2 => at.changed |= self.local_search.or_opt(p, &mut it.candidate),
-            3 => at.changed |= self.local_search.reinsert(p, &mut it.candidate),
-            4 => {
-                let max_len = self.options.parameters.block_reverse_length;
-                if !at.changed
-                    && (it.cost > at.deep_below
-                        || !self
-                            .local_search
-                            .block_reverse(p, &mut it.candidate, max_len))
-                {
-                    debug_assert!(p.order_is_valid(&it.candidate));
-                    it.improve = None;
+            1..=3 => {
+                if at.unit == 1 && !at.family.partial {
+                    at.changed = false;
+                }
+                let family = &mut at.family;
+                let (better, finished) = run_family(
+                    &mut self.local_search,
+                    p,
+                    &mut it.candidate,
+                    at.unit - 1,
+                    max_len,
+                    family,
+                    pause,
+                );
+                at.changed |= better;
+                if !finished {
+                    family.partial = true;
+                    it.improve = Some(at);
                     self.iteration = Some(it);
                     return false;
+                }
+                at.family = FamilyAt::default();
+            }
+            4 => {
+                // Block reversal only after a round that changed nothing and on a candidate
+                // about as good as the best (or to finish it).
+                if !at.changed || at.family.partial {
+                    let gated = !at.family.partial && it.cost > at.deep_below;
+                    if !gated {
+                        let family = &mut at.family;
+                        let (better, finished) = run_family(
+                            &mut self.local_search,
+                            p,
+                            &mut it.candidate,
+                            3,
+                            max_len,
+                            family,
+                            pause,
+                        );
+                        at.changed |= better;
+                        if !finished {
+                            family.partial = true;
+                            it.improve = Some(at);
+                            self.iteration = Some(it);
+                            return false;
+                        }
+                        at.family = FamilyAt::default();
+                    }
+                    if !at.changed {
+                        debug_assert!(p.order_is_valid(&it.candidate));
+                        it.improve = None;
+                        self.iteration = Some(it);
+                        return false;
+                    }
                 }
             }
             _ => {
@@ -553,6 +696,7 @@ impl AlnsSolver {
             deep_below: self.best_cost + params.block_reverse_gate * self.best_cost.abs(),
             unit: 0,
             changed: false,
+            family: FamilyAt::default(),
         });
         self.iteration = Some(Iteration {
             removal,
@@ -742,9 +886,25 @@ mod tests {
             let mut whole = AlnsSolver::new(&instance, options.clone()).unwrap();
             whole.step(Duration::from_secs(3600));
             let mut units = AlnsSolver::new(&instance, options).unwrap();
+            // The first tour's insertion: a cluster per unit, no tour before it is whole.
+            let mut insertions = 0;
+            while units.first.is_some() || !units.started {
+                assert!(units.best().is_none(), "{name}: a tour before the first");
+                units.step(Duration::ZERO);
+                insertions += 1;
+            }
+            // The start, a unit per cluster but the depot's, and the node-choice DP.
+            let expected = 1 + (instance.clusters.len() - 1) + 1;
+            assert_eq!(insertions, expected, "{name}: a unit per cluster");
             let mut calls = 0;
             let mut last = f64::INFINITY;
-            while units.descent.is_some() || !units.started {
+            while units.descent.is_some() {
+                let (tour, cost) = units.best().expect("a tour from the insertion's end");
+                let checked = check_tour(&instance, tour).unwrap();
+                assert!(
+                    (checked - cost).abs() <= 1e-6 * (1.0 + cost.abs()),
+                    "{name}"
+                );
                 units.step(Duration::ZERO);
                 calls += 1;
                 let (tour, cost) = units.best().expect("a tour from the first unit");

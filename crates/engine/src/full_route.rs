@@ -83,8 +83,9 @@ impl FullRouteModel {
     }
 }
 
-/// Builds a [`FullRouteModel`] in slices: the leads of one contour's candidates per call of
-/// [`FullRouteBuilder::advance`] until the time is up, then the cost matrix.
+/// Builds a [`FullRouteModel`] in slices: the leads of one contour's candidates at a time
+/// until [`FullRouteBuilder::advance`]'s time is up, then the cost matrix a row at a time (on
+/// Nest02 its 5,000 × 5,000 legs were a piece of seconds, longer than Stop may wait).
 pub struct FullRouteBuilder {
     nest: Nest,
     forest: ContainmentForest,
@@ -96,6 +97,16 @@ pub struct FullRouteBuilder {
     /// The candidates of `refs[..candidates.len()]`.
     candidates: Vec<Vec<StepLeads>>,
     errors: Vec<LeadError>,
+    /// The matrix under way, once every candidate is placed.
+    matrix: Option<Matrix>,
+}
+
+/// The full-route instance's nodes and clusters, and its cost matrix's rows so far.
+struct Matrix {
+    nodes: Vec<Option<(ContourRef, StepLeads)>>,
+    clusters: Vec<Vec<usize>>,
+    node_cluster: Vec<usize>,
+    cost: Vec<f64>,
 }
 
 impl FullRouteBuilder {
@@ -121,6 +132,7 @@ impl FullRouteBuilder {
             finish,
             candidates: Vec::new(),
             errors: Vec::new(),
+            matrix: None,
         })
     }
 
@@ -129,29 +141,61 @@ impl FullRouteBuilder {
         (self.candidates.len() + self.errors.len(), self.refs.len())
     }
 
-    /// Places candidates until `until`; the model (or every contour where no lead fits) once
-    /// all are placed.
+    /// Places candidates, then fills the matrix, until `until` (at least a contour or a row
+    /// per call); the model (or every contour where no lead fits) once all is built.
     pub fn advance(&mut self, until: Instant) -> Option<Result<FullRouteModel, Vec<LeadError>>> {
-        let fitter = LeadFitter::with_forest(&self.nest, &self.forest, self.settings);
-        loop {
-            let done = self.candidates.len() + self.errors.len();
-            let Some(&r) = self.refs.get(done) else {
-                break;
-            };
-            match self.candidates_of(&fitter, r) {
-                Ok(c) => self.candidates.push(c),
-                Err(e) => {
-                    // Keeps `candidates` aligned with `refs` while errors are collected.
-                    self.candidates.push(Vec::new());
-                    self.errors.push(e);
+        if self.matrix.is_none() {
+            let fitter = LeadFitter::with_forest(&self.nest, &self.forest, self.settings);
+            loop {
+                let done = self.candidates.len() + self.errors.len();
+                let Some(&r) = self.refs.get(done) else {
+                    break;
+                };
+                match self.candidates_of(&fitter, r) {
+                    Ok(c) => self.candidates.push(c),
+                    Err(e) => {
+                        // Keeps `candidates` aligned with `refs` while errors are collected.
+                        self.candidates.push(Vec::new());
+                        self.errors.push(e);
+                    }
+                }
+                if Instant::now() >= until && done + 1 < self.refs.len() {
+                    return None;
                 }
             }
-            if Instant::now() >= until && done + 1 < self.refs.len() {
+            if !self.errors.is_empty() {
+                return Some(Err(std::mem::take(&mut self.errors)));
+            }
+            self.matrix = Some(self.nodes());
+            if Instant::now() >= until {
                 return None;
             }
         }
-        if !self.errors.is_empty() {
-            return Some(Err(std::mem::take(&mut self.errors)));
+        let matrix = self.matrix.as_mut().expect("set above");
+        let n = matrix.nodes.len();
+        loop {
+            let a = matrix.cost.len() / n;
+            if a == n {
+                break;
+            }
+            let from = matrix.nodes[a]
+                .as_ref()
+                .map_or(self.start, |(_, l)| l.switch_off);
+            for b in 0..n {
+                matrix
+                    .cost
+                    .push(if matrix.node_cluster[a] == matrix.node_cluster[b] {
+                        f64::INFINITY
+                    } else {
+                        match &matrix.nodes[b] {
+                            Some((_, l)) => from.distance(l.pierce),
+                            None => self.finish.map_or(0.0, |f| from.distance(f)),
+                        }
+                    });
+            }
+            if a + 1 < n && Instant::now() >= until {
+                return None;
+            }
         }
         Some(Ok(self.model()))
     }
@@ -184,7 +228,8 @@ impl FullRouteBuilder {
         Ok(found)
     }
 
-    fn model(&mut self) -> FullRouteModel {
+    /// The instance's nodes (the start, then every contour's candidates) and clusters.
+    fn nodes(&mut self) -> Matrix {
         let mut nodes: Vec<Option<(ContourRef, StepLeads)>> = vec![None];
         let mut clusters = vec![vec![0usize]];
         let mut node_cluster = vec![0usize];
@@ -203,20 +248,23 @@ impl FullRouteBuilder {
             clusters.push(cluster);
         }
         let n = nodes.len();
-        let mut cost = Vec::with_capacity(n * n);
-        for a in 0..n {
-            let from = nodes[a].as_ref().map_or(self.start, |(_, l)| l.switch_off);
-            for b in 0..n {
-                cost.push(if node_cluster[a] == node_cluster[b] {
-                    f64::INFINITY
-                } else {
-                    match &nodes[b] {
-                        Some((_, l)) => from.distance(l.pierce),
-                        None => self.finish.map_or(0.0, |f| from.distance(f)),
-                    }
-                });
-            }
+        Matrix {
+            nodes,
+            clusters,
+            node_cluster,
+            cost: Vec::with_capacity(n * n),
         }
+    }
+
+    /// The model of the complete matrix.
+    fn model(&mut self) -> FullRouteModel {
+        let Matrix {
+            nodes,
+            clusters,
+            node_cluster,
+            cost,
+        } = self.matrix.take().expect("the matrix is complete");
+        let n = nodes.len();
         let index: std::collections::HashMap<ContourRef, usize> = self
             .refs
             .iter()
@@ -271,29 +319,36 @@ pub struct FullRouteJob {
 }
 
 impl FullRouteJob {
-    /// The exact job on `model` of `nest`, ended `time_limit` after `started`.
+    /// The exact job on `model` of `nest`, ended `time_limit` after `started`. Its solvers are
+    /// made in its first steps (made here, they were one piece of seconds on Nest02); one that
+    /// refuses the instance ends the job without a route, its phase saying why.
     pub fn new(
         job_id: u64,
         nest: Nest,
-        model: FullRouteModel,
+        mut model: FullRouteModel,
         time_limit: Duration,
         started: Instant,
         seed: u64,
-    ) -> Result<FullRouteJob, Refusal> {
-        let search = DiscreteJob::new(
+    ) -> FullRouteJob {
+        // The search takes the cost matrix (hundreds of MB on a big nest: no copy); the model
+        // keeps the clusters its routes are read with.
+        let instance = Instance {
+            cost: std::mem::take(&mut model.instance.cost),
+            ..model.instance.clone()
+        };
+        let search = DiscreteJob::unbuilt(
             job_id,
-            model.instance.clone(),
-            None,
+            instance,
             DiscreteMode::Exact,
             time_limit,
             started,
             seed,
-        )?;
-        Ok(FullRouteJob {
+        );
+        FullRouteJob {
             nest,
             model,
             search,
-        })
+        }
     }
 }
 

@@ -187,6 +187,8 @@ pub struct DiscreteJob {
     /// The heuristic being prepared, a piece per step (seconds on a big discretisation).
     alns_builder: Option<AlnsBuilder>,
     alns_done: bool,
+    /// The exact solver's copy of the instance, being made (a slice of rows per step).
+    exact_instance: Option<Instance>,
     exact: Option<ExactSolver>,
     exact_done: Option<bool>,
     /// The longest single piece of the exact solver so far (its making, then its steps): a
@@ -239,6 +241,22 @@ impl DiscreteJob {
         Ok(job)
     }
 
+    /// A job on an instance like [`DiscreteJob::new`], but its solvers are made in its first
+    /// steps (on a big instance that is seconds: [`DiscreteJob::new`] is one piece); a solver
+    /// that refuses the instance ends the job there, its phase saying why.
+    pub fn unbuilt(
+        job_id: JobId,
+        instance: Instance,
+        mode: DiscreteMode,
+        time_limit: Duration,
+        started: Instant,
+        seed: u64,
+    ) -> Self {
+        let mut job = Self::pending(job_id, mode, time_limit, started, seed);
+        job.instance = Some(instance);
+        job
+    }
+
     /// A job on the discretisation `builder` is building (one step fills rows of its matrix).
     pub fn building(
         job_id: JobId,
@@ -274,6 +292,7 @@ impl DiscreteJob {
             alns: None,
             alns_builder: None,
             alns_done: false,
+            exact_instance: None,
             exact: None,
             exact_done: None,
             exact_piece: Duration::ZERO,
@@ -368,7 +387,14 @@ impl DiscreteJob {
             }
             return false;
         }
-        if self.mode == DiscreteMode::Exact && self.exact.is_none() {
+        if self.mode == DiscreteMode::Exact && self.exact.is_none() && self.exact_done.is_none() {
+            if Instant::now() >= self.deadline {
+                // The limit passed before the exact solver was made (its instance copy on a
+                // big discretisation): the heuristic's tour is the answer.
+                self.exact_instance = None;
+                self.exact_done = Some(false);
+                return true;
+            }
             // ALNS supplies the incumbents here, so the exact solver's own beam search (which
             // ate the whole budget on nests of 50-90 contours, leaving only the root assignment
             // bound) is switched off: the time goes to the bounds.
@@ -377,8 +403,34 @@ impl DiscreteJob {
                 heuristic: false,
                 ..ExactOptions::default()
             };
+            // The solver keeps its own instance, copied here a slice of rows at a time (on a
+            // 7,000-node discretisation one copy was a step of 0.5 s).
+            let n = instance.node_count;
+            let copy = self.exact_instance.get_or_insert_with(|| Instance {
+                name: instance.name.clone(),
+                node_count: n,
+                cost: Vec::with_capacity(n * n),
+                clusters: instance.clusters.clone(),
+                node_cluster: instance.node_cluster.clone(),
+                precedence: instance.precedence.clone(),
+                depot: instance.depot,
+            });
+            let copying = Instant::now();
+            while copy.cost.len() < n * n {
+                let row = copy.cost.len() / n;
+                let end = (row + 64).min(n);
+                copy.cost
+                    .extend_from_slice(&instance.cost[row * n..end * n]);
+                if copying.elapsed() >= budget {
+                    break;
+                }
+            }
+            if copy.cost.len() < n * n {
+                return false;
+            }
+            let copy = self.exact_instance.take().expect("copied above");
             let made = Instant::now();
-            match ExactSolver::deferred(instance, options) {
+            match ExactSolver::deferred_owned(copy, options) {
                 Ok(exact) => self.exact = Some(exact),
                 Err(e) => self.refuse(e.into()),
             }
@@ -403,6 +455,10 @@ impl DiscreteJob {
     }
 }
 
+/// How long past its limit a discrete job still finishes the heuristic's preparation (its
+/// first tour comes after, within the limit + 1 s promise).
+const LATEST_PREPARATION: Duration = Duration::from_millis(600);
+
 /// One slice of the heuristic; whether it has finished.
 fn alns_step(alns: &mut AlnsSolver, budget: Duration) -> bool {
     alns.step(budget).is_done()
@@ -421,9 +477,13 @@ impl Job for DiscreteJob {
         if !self.build(budget) {
             // A build past the limit ends the job (no solver yet: no tour to keep). The
             // heuristic's own preparation, once started, is finished (it is one pass over the
-            // matrix, bounded, and then gives the first tour), as when it was one step.
-            let over = Instant::now() >= self.deadline + self.first_tour_allowance;
-            let preparing = self.alns_builder.is_some();
+            // matrix, bounded, and then gives the first tour), as when it was one step ...
+            let now = Instant::now();
+            let over = now >= self.deadline + self.first_tour_allowance;
+            // ... unless it is still under way this late: the first tour would come after the
+            // limit + 1 s promise (a 25 mm discretisation of Nest02: the preparation alone
+            // ran 3 s past a 5 s limit).
+            let preparing = self.alns_builder.is_some() && now < self.deadline + LATEST_PREPARATION;
             return if self.failure.is_some() || (over && self.alns.is_none() && !preparing) {
                 if self.failure.is_none() {
                     self.failure = Some(DiscreteFailure::BuildTimedOut);

@@ -490,13 +490,10 @@ impl KerfJob {
                 Stage::Modelling(mut modelling) => match modelling.builder.advance(until) {
                     None => Stage::Modelling(modelling),
                     Some(Err(errors)) => Stage::Finished(Some(Err(errors))),
-                    Some(Ok(model)) => match exact_job(&self.nest, model, &modelling) {
-                        Some(job) => {
-                            candidate.job = job;
-                            Stage::Solving
-                        }
-                        None => Stage::Finished(None),
-                    },
+                    Some(Ok(model)) => {
+                        candidate.job = exact_job(&self.nest, model, &modelling);
+                        Stage::Solving
+                    }
                 },
                 // The exact solver's routes carry their leads already.
                 Stage::Solving if candidate.source == KerfSource::FullRoute => {
@@ -821,13 +818,13 @@ impl Job for KerfJob {
 }
 
 /// The exact job over a built full-route model, inside its thermal job (which reports H and
-/// checks the rules; penalties and repairs are refused with leads); `None` when the search
-/// refuses the instance.
+/// checks the rules; penalties and repairs are refused with leads). A search that refuses
+/// the instance ends in its first steps without a route.
 fn exact_job(
     nest: &Nest,
     model: crate::FullRouteModel,
     modelling: &ExactModelling,
-) -> Option<Box<dyn Job>> {
+) -> Box<dyn Job> {
     let params = &modelling.request.params;
     let limit = Duration::from_secs_f64(params.time_limit_s.clamp(0.0, 1.0e7));
     let job = FullRouteJob::new(
@@ -837,9 +834,8 @@ fn exact_job(
         limit,
         modelling.started,
         params.seed,
-    )
-    .ok()?;
-    Some(Box::new(ThermalJob::new(
+    );
+    Box::new(ThermalJob::new(
         Box::new(job),
         SolverKind::Exact,
         nest.clone(),
@@ -847,7 +843,7 @@ fn exact_job(
         params.objective,
         params.thermal,
         limit,
-    )))
+    ))
 }
 
 /// The tool-on links of a route (steps entered without a pierce).

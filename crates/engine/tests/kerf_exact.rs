@@ -217,3 +217,32 @@ fn exact_with_leads_refuses_a_heat_penalty() {
     request.params.thermal.weight = 1.0;
     assert!(start_job(&request).is_err());
 }
+
+/// The full-route model built a contour or a matrix row per call (each call's time already
+/// up) is the model built in one call, on a real nest.
+#[test]
+fn the_full_route_model_in_pieces_equals_the_model_in_one_piece() {
+    let problem = nest_problem("nests/dbs/seven.dbs");
+    let nest = nest_of(&problem);
+    let start = Point::new(0.0, 0.0);
+    let mut whole = cutroute_engine::FullRouteBuilder::new(nest, plasma(), 50.0, start, None)
+        .expect("a positive step");
+    let far = web_time::Instant::now() + std::time::Duration::from_secs(3600);
+    let whole = whole
+        .advance(far)
+        .expect("built in one call")
+        .expect("leads fit on seven.dbs");
+    let mut pieces = 0;
+    let mut builder = cutroute_engine::FullRouteBuilder::new(nest, plasma(), 50.0, start, None)
+        .expect("a positive step");
+    let sliced = loop {
+        pieces += 1;
+        if let Some(model) = builder.advance(web_time::Instant::now()) {
+            break model.expect("leads fit on seven.dbs");
+        }
+    };
+    assert_eq!(sliced.instance, whole.instance);
+    assert_eq!(sliced.nodes, whole.nodes);
+    let n = whole.instance.node_count;
+    assert!(pieces > n, "{pieces} calls for {n} nodes: a row per call");
+}

@@ -24,21 +24,10 @@ static ONE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
 
 /// (solver, input, what) whose steps are known to run longer than [`LONGEST_STEP_S`]: single
 /// pieces of work not yet split (measured in BENCHMARKS.md, "Time limits in the engine").
-/// Their wall-clock promise is still asserted unless they are in [`KNOWN_OVERRUNS`] too.
-/// (CCP is not listed: the interval relaxation's exact solver builds its model and root bound
-/// in steps of their own, `ExactSolver::deferred`, and its preparation runs in slices.)
-const LONG_STEPS: &[(SolverKind, &str, &str)] = &[
-    // The exact solver's runs are built in steps (`ExactSolver::deferred`), but one start
-    // node's model and its root bound (an assignment over every cluster) are one piece each.
-    (SolverKind::Exact, "", "a start node's model or root bound"),
-    // The ALNS's first descent runs a move family per step; on hundreds of clusters one
-    // family is still a piece of 0.5–1.5 s.
-    (
-        SolverKind::Heuristic,
-        "generated",
-        "a move family of the ALNS's first descent",
-    ),
-];
+/// Their wall-clock promise is still asserted unless they are in [`KNOWN_OVERRUNS`] too. None
+/// listed: the exact solver's model, Lagrangian bounds and instance copy and the ALNS's first
+/// tour and move families all run in slices now, so every solver's steps are checked.
+const LONG_STEPS: &[(SolverKind, &str, &str)] = &[];
 
 /// (solver, input, what) that still overrun limit + 1 s: none listed; a run that overruns
 /// fails the test.

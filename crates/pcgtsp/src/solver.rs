@@ -2,8 +2,8 @@
 
 use cutroute_anytime::{AnytimeSolver, Bounds, CostUnit, Status};
 
-use crate::bounds::completion::{PositionBound, PositionBoundOptions};
-use crate::bounds::lagrange::{self, NodePenalties, PenaltyOptions};
+use crate::bounds::completion::{PositionAscent, PositionBound, PositionBoundOptions};
+use crate::bounds::lagrange::{ArborescenceAscent, NodePenalties, PenaltyAscent, PenaltyOptions};
 use crate::bounds::lattice::LatticeStore;
 use crate::bounds::residual::ResidualBounder;
 use crate::bounds::subset::SubsetBound;
@@ -12,7 +12,7 @@ use crate::dp::{Dp, DpStatus, Incumbent};
 use crate::heuristic;
 use crate::instance::Instance;
 use crate::keys::{on_keyed, ByWidth, Keyed};
-use crate::model::Model;
+use crate::model::{Model, ModelBuilder};
 use crate::order::{OrderError, PrecedenceOrder};
 use crate::prepare::{LatticeLimits, Preparation, STRONG_SUBSET_SHARE};
 use std::rc::Rc;
@@ -272,11 +272,22 @@ struct Run {
     penalties: Option<Rc<NodePenalties>>,
     /// The position-indexed completion bound (when the run has no lattice).
     position: Option<Rc<PositionBound>>,
-    /// The prepared lattice store while the Lagrangian bounds are still to be built: they
-    /// take a step of their own (0.4–1.1 s on ESC78), the position bound the next.
+    /// The prepared lattice store while the Lagrangian bounds are still to be built: the node
+    /// penalties take a step of their own, the arborescence bound's ascent slices of its own
+    /// (together 0.4–1.1 s on ESC78, 0.7 s on seven.dbs's full-route model), the position
+    /// bound the next step.
     prepared: Option<LatticeStore>,
-    /// Whether the Lagrangian bounds of `prepared` are built.
+    /// Whether the Lagrangian bounds of `prepared` are built (the arborescence bound's ascent
+    /// then runs in `arborescence`, a slice per call, before the position bound).
     penalties_built: bool,
+    /// The node penalties' ascent under way (`None` inside: an infeasible root), with the
+    /// incumbent's cost and the arborescence bound's options.
+    penalty_ascent: Option<(Option<PenaltyAscent>, f64, PenaltyOptions)>,
+    arborescence: Option<ArborescenceAscent>,
+    /// Whether the position bound was considered (after the Lagrangian bounds); its ascent
+    /// then runs in `position_ascent`, slices of its own.
+    position_checked: bool,
+    position_ascent: Option<PositionAscent>,
     root_bound: f64,
     engine: Option<Engine>,
     finished_bound: Option<f64>,
@@ -326,30 +337,41 @@ impl Run {
             self.penalties_built = true;
             if store.root_bound().is_none() {
                 // Without the lattice the DP bounds its states by assignments: strengthen them.
-                self.build_penalties(instance, options, upper_bound);
+                self.build_penalties(options, upper_bound);
             }
             self.prepared = Some(store);
             return;
         }
+        if !self.advance_penalties(instance, deadline) || !self.advance_arborescence(deadline) {
+            self.prepared = Some(store);
+            return;
+        }
+        if !self.position_checked {
+            self.position_checked = true;
+            if let Some(root) = store.root_bound() {
+                self.root_bound = self.root_bound.max(self.model.round_bound(root));
+            }
+            if let Some(subset) = &self.subset {
+                self.root_bound = self
+                    .root_bound
+                    .max(self.model.round_bound(subset.root_bound));
+            }
+            let strong_subset = self.subset.as_ref().is_some_and(|s| {
+                s.tracked_count() == self.model.m
+                    || s.root_bound >= STRONG_SUBSET_SHARE * upper_bound
+            });
+            if store.root_bound().is_none() && !strong_subset && self.root_bound < upper_bound {
+                // Neither the lattice nor a strong subset bound (exact, or within 15 % of the
+                // incumbent, as on the industrial orders) sees precedence per state: add the
+                // position bound (on e1x_4, ec_2, … its root stays 17–35 % below the subset's).
+                self.build_position_bound(options, upper_bound);
+            }
+        }
+        if !self.advance_position(deadline) {
+            self.prepared = Some(store);
+            return;
+        }
         self.preparation = None;
-        if let Some(root) = store.root_bound() {
-            self.root_bound = self.root_bound.max(self.model.round_bound(root));
-        }
-        if let Some(subset) = &self.subset {
-            self.root_bound = self
-                .root_bound
-                .max(self.model.round_bound(subset.root_bound));
-        }
-        let strong_subset = self.subset.as_ref().is_some_and(|s| {
-            s.tracked_count() == self.model.m || s.root_bound >= STRONG_SUBSET_SHARE * upper_bound
-        });
-        if store.root_bound().is_none() && !strong_subset && self.root_bound < upper_bound {
-            // Neither the lattice nor a strong subset bound (exact, or within 15 % of the
-            // incumbent, as on the industrial orders) sees precedence per state: add the
-            // position bound (on e1x_4, ec_2, … its root stays 17–35 % below the subset's).
-            self.build_position_bound(options, upper_bound);
-            debug_log(|| format!("position bound after {:?}", began.elapsed()));
-        }
         debug_log(|| {
             format!(
                 "bounds built (last slice {:?}): lattice root {:?}, subset root {:?} ({} of {} clusters tracked)",
@@ -365,54 +387,77 @@ impl Run {
 
     /// The Lagrangian bounds (`lagrange.rs`): node penalties for the per-state assignment
     /// bounds, and the Held–Karp style arborescence bound at the root.
-    fn build_penalties(&mut self, instance: &Instance, options: &ExactOptions, upper_bound: f64) {
+    fn build_penalties(&mut self, options: &ExactOptions, upper_bound: f64) {
         if options.penalty_iterations == 0 || self.model.m > 256 {
             return;
         }
-        let began = Instant::now();
         let work = options.effective_penalty_work();
-        let penalties = lagrange::optimise(
-            instance,
+        let ascent = PenaltyAscent::new(
             &self.model,
             upper_bound,
             PenaltyOptions {
                 iterations: options.penalty_iterations,
                 work,
             },
-        )
-        .map(Rc::new);
+        );
+        let arborescence = PenaltyOptions {
+            iterations: 4 * options.penalty_iterations,
+            work: 4.0 * work,
+        };
+        self.penalty_ascent = Some((ascent, upper_bound, arborescence));
+    }
+
+    /// Iterations of the node penalties' ascent until `deadline` (at least one), then the
+    /// arborescence bound's ascent is set up from them; whether they are done (or there are
+    /// none).
+    fn advance_penalties(&mut self, instance: &Instance, deadline: Instant) -> bool {
+        let Some((ascent, upper_bound, arborescence)) = self.penalty_ascent.as_mut() else {
+            return true;
+        };
+        let (upper_bound, arborescence) = (*upper_bound, *arborescence);
+        let penalties = match ascent {
+            Some(ascent) => {
+                match ascent.advance(instance, &self.model, &|| Instant::now() >= deadline) {
+                    Some(penalties) => penalties.map(Rc::new),
+                    None => return false,
+                }
+            }
+            None => None,
+        };
+        self.penalty_ascent = None;
         if let Some(p) = &penalties {
             self.root_bound = self.root_bound.max(self.model.round_bound(p.root_bound));
             debug_log(|| {
                 format!(
-                    "node penalties in {:?}: root L1 {} -> {} ({} iterations)",
-                    began.elapsed(),
-                    p.plain_l1,
-                    p.root_bound,
-                    p.iterations
+                    "node penalties: root L1 {} -> {} ({} iterations)",
+                    p.plain_l1, p.root_bound, p.iterations
                 )
             });
         }
         self.penalties = penalties;
-        let began = Instant::now();
-        let arborescence = lagrange::arborescence_bound(
+        self.arborescence = ArborescenceAscent::new(
             &self.model,
             upper_bound,
             self.penalties.as_ref().map(|p| p.lambda.as_slice()),
-            PenaltyOptions {
-                iterations: 4 * options.penalty_iterations,
-                work: 4.0 * work,
-            },
+            arborescence,
         );
-        if let Some((bound, iterations)) = arborescence {
-            self.root_bound = self.root_bound.max(self.model.round_bound(bound));
-            debug_log(|| {
-                format!(
-                    "arborescence bound in {:?}: {bound} ({iterations} iterations)",
-                    began.elapsed()
-                )
-            });
-        }
+        true
+    }
+
+    /// Iterations of the arborescence bound until `deadline` (at least one); whether it is
+    /// done (or there is none).
+    fn advance_arborescence(&mut self, deadline: Instant) -> bool {
+        let Some(ascent) = self.arborescence.as_mut() else {
+            return true;
+        };
+        let Some((bound, iterations)) = ascent.advance(&self.model, &|| Instant::now() >= deadline)
+        else {
+            return false;
+        };
+        self.arborescence = None;
+        self.root_bound = self.root_bound.max(self.model.round_bound(bound));
+        debug_log(|| format!("arborescence bound: {bound} ({iterations} iterations)"));
+        true
     }
 
     /// The position-indexed completion bound (`completion.rs`).
@@ -420,8 +465,7 @@ impl Run {
         if options.position_iterations == 0 || self.model.m > 256 {
             return;
         }
-        let began = Instant::now();
-        let position = PositionBound::build(
+        self.position_ascent = PositionAscent::new(
             &self.model,
             upper_bound,
             PositionBoundOptions {
@@ -431,18 +475,29 @@ impl Run {
                 known_bound: self.root_bound,
             },
         );
-        if let Some(p) = &position {
-            self.root_bound = self.root_bound.max(self.model.round_bound(p.root_bound));
-            debug_log(|| {
-                format!(
-                    "position bound in {:?}: root {} ({} iterations)",
-                    began.elapsed(),
-                    p.root_bound,
-                    p.iterations
-                )
-            });
-        }
-        self.position = position.map(Rc::new);
+    }
+
+    /// Iterations of the position bound's ascent until `deadline` (at least one); whether it
+    /// is done (or there is none).
+    fn advance_position(&mut self, deadline: Instant) -> bool {
+        let Some(ascent) = self.position_ascent.as_mut() else {
+            return true;
+        };
+        let Some(position) = ascent.advance(&self.model, &|| Instant::now() >= deadline) else {
+            return false;
+        };
+        self.position_ascent = None;
+        self.root_bound = self
+            .root_bound
+            .max(self.model.round_bound(position.root_bound));
+        debug_log(|| {
+            format!(
+                "position bound: root {} ({} iterations)",
+                position.root_bound, position.iterations
+            )
+        });
+        self.position = Some(Rc::new(position));
+        true
     }
 
     /// A new DP engine with every bound this run has.
@@ -491,6 +546,8 @@ pub struct ExactSolver {
     runs: Vec<Run>,
     /// Start nodes whose run is still to be built (reversed: next is last).
     unbuilt: Vec<usize>,
+    /// The model being built, a piece per [`ExactSolver::build_unit`].
+    building: Option<ModelBuilder>,
     /// The model built last, its root bound not yet computed.
     unbounded: Option<Model>,
     current_run: usize,
@@ -506,23 +563,33 @@ impl ExactSolver {
     /// Prepares the solver (preprocessing and root bounds; no search yet).
     pub fn new(instance: &Instance, options: ExactOptions) -> Result<ExactSolver, SolverError> {
         let mut solver = ExactSolver::deferred(instance, options)?;
-        while solver.build_unit() {}
+        while solver.build_unit(&|| false) {}
         Ok(solver)
     }
 
     /// Like [`ExactSolver::new`] but cheap: the instance is checked here and each start
     /// node's model and root bound are built later, each in a [`ExactSolver::step`] of its own
     /// (on thousands of nodes each takes seconds, which a caller answering Stop between steps
-    /// cannot wait for). Until they are built, [`ExactSolver::root_bound`] is −∞.
+    /// cannot wait for; a model is built in pieces itself, [`ModelBuilder`]). Until they are
+    /// built, [`ExactSolver::root_bound`] is −∞.
     pub fn deferred(
         instance: &Instance,
+        options: ExactOptions,
+    ) -> Result<ExactSolver, SolverError> {
+        ExactSolver::deferred_owned(instance.clone(), options)
+    }
+
+    /// [`ExactSolver::deferred`] on an instance it keeps (a caller that copied it in pieces
+    /// saves the copy `deferred` makes: hundreds of MB on a big discretisation).
+    pub fn deferred_owned(
+        instance: Instance,
         options: ExactOptions,
     ) -> Result<ExactSolver, SolverError> {
         if instance.node_count > u16::MAX as usize {
             return Err(SolverError::TooManyNodes(instance.node_count));
         }
         // The only way a model fails: the precedence pairs are no partial order.
-        PrecedenceOrder::new(instance)?;
+        PrecedenceOrder::new(&instance)?;
         let phase = if options.heuristic {
             Phase::Heuristic {
                 beam: 0,
@@ -534,10 +601,11 @@ impl ExactSolver {
         let mut unbuilt = instance.clusters[instance.depot].clone();
         unbuilt.reverse();
         Ok(ExactSolver {
-            instance: instance.clone(),
+            instance,
             options,
             runs: Vec::new(),
             unbuilt,
+            building: None,
             unbounded: None,
             current_run: 0,
             incumbent: Incumbent {
@@ -554,12 +622,13 @@ impl ExactSolver {
     /// Whether every start node's run (model and root bound) is built (always, but for a
     /// [`ExactSolver::deferred`] solver before its first steps).
     pub fn runs_built(&self) -> bool {
-        self.unbuilt.is_empty() && self.unbounded.is_none()
+        self.unbuilt.is_empty() && self.building.is_none() && self.unbounded.is_none()
     }
 
-    /// Builds one piece of the runs: the next start node's model, or its root bound. Returns
-    /// whether it did anything (false once all are built).
-    fn build_unit(&mut self) -> bool {
+    /// Builds one piece of the runs: pieces of the next start node's model until `pause()`
+    /// (at least one), or its root bound. Returns whether it did anything (false once all are
+    /// built).
+    fn build_unit(&mut self, pause: &dyn Fn() -> bool) -> bool {
         if let Some(model) = self.unbounded.take() {
             let depot = model.depot;
             let root_bound = model.round_bound(ResidualBounder::default().compute(
@@ -577,6 +646,10 @@ impl ExactSolver {
                 position: None,
                 prepared: None,
                 penalties_built: false,
+                penalty_ascent: None,
+                arborescence: None,
+                position_checked: false,
+                position_ascent: None,
                 root_bound,
                 engine: None,
                 finished_bound: None,
@@ -584,16 +657,29 @@ impl ExactSolver {
             });
             return true;
         }
+        if let Some(builder) = self.building.as_mut() {
+            let t = Instant::now();
+            if let Some(model) = builder.advance(&self.instance, pause) {
+                let start = model.start;
+                debug_log(|| {
+                    format!(
+                        "model of start node {start} built (last piece {:?})",
+                        t.elapsed()
+                    )
+                });
+                self.building = None;
+                self.unbounded = Some(model);
+            }
+            return true;
+        }
         let Some(start) = self.unbuilt.pop() else {
             return false;
         };
-        let t = Instant::now();
         // Checked in `deferred`: the order is a partial order, so the model builds.
-        match Model::new(&self.instance, start) {
-            Ok(model) => self.unbounded = Some(model),
+        match ModelBuilder::new(&self.instance, start) {
+            Ok(builder) => self.building = Some(builder),
             Err(e) => debug_log(|| format!("start node {start}: no model ({e})")),
         }
-        debug_log(|| format!("model of start node {start} built in {:?}", t.elapsed()));
         true
     }
 
@@ -733,7 +819,8 @@ impl ExactSolver {
             }
             // The runs of a deferred solver: one model or root bound per piece, at least one
             // per step whatever its budget (so tiny slices still advance).
-            if !built_one && self.build_unit() {
+            let pause = || began.elapsed() >= deadline;
+            if !built_one && self.build_unit(&pause) {
                 built_one = true;
                 continue;
             }
@@ -741,7 +828,7 @@ impl ExactSolver {
                 self.elapsed += began.elapsed();
                 return Status::Running;
             }
-            if self.build_unit() {
+            if self.build_unit(&pause) {
                 continue;
             }
             if self.bounds_meet_incumbent() {

@@ -3,21 +3,26 @@
 //!
 //! `cargo run --release -p cutroute-bench --bin time_limits -- [--time-limit 5] [--slice-ms 40]
 //! [--step 50] [--solvers ccp,exact,…] [--filter NAME[,NAME…]] [--set nests|pcgtsp|all]
-//! [--generated 1000,10000] [--data DIR] [--trace] [--rules-hard]
+//! [--generated 1000,10000] [--data DIR] [--trace] [--rules-hard] [--kerf]
 //! [--cli BIN --cli-input FILE[,FILE…] --cli-limit S]`
 //!
 //! `--rules-hard` runs every job with `--rules part,sheet,islands --rules-hard` (the repair and
 //! the rule check after the solver are steps of the job too).
 //!
+//! `--kerf` runs every nest job on the full cutting route (issue #17's plasma: kerf 2, d₁ 5,
+//! d₂ 1, an 8 mm arc lead-in, a 2 mm line lead-out): the kerf job with exact over the
+//! full-route model, the chain attach of leads, and the others.
+//!
 //! `--trace` prints every call longer than its slice + 50 ms to stderr, with the job's phase
 //! before and after it.
 //!
 //! Inputs: every real nest of `data/nests` (dbs, dbs-json, dxf, svg, tflex), every PCGTSP
-//! instance of `data/pcgtsp` (industrial, pcgtsplib) and generated nests of the given sizes
+//! instance of `data/pcgtsp` (industrial, pcgtsplib) and `data/nests/pcgtsp` and generated nests of the given sizes
 //! (`generate_nest(n, 1)`; their discretisations are the 1,000-cluster PCGTSP instances).
 //!
 //! Prints a Markdown table: solver, input, limit, wall (start + steps), wall − limit, `start_job`'s own time
-//! (the model is built there), the longest `step` call, the number of steps, and what ended the
+//! (the model is built there), the longest `step` call, the 99th percentile of the step calls
+//! (nearest rank), the number of steps, and what ended the
 //! job: "limit" when the wall reached the limit, "finished" when the solver ended before it.
 //! A row is marked **over** when the wall exceeds limit + 1 s (the promise), and "long step"
 //! when one call (start or step) exceeds its slice by more than 50 ms (Stop waits for it). A
@@ -71,11 +76,18 @@ fn nest_inputs(data: &std::path::Path, generated: &[usize]) -> Vec<Input> {
 
 fn pcgtsp_inputs(data: &std::path::Path) -> Vec<Input> {
     let mut inputs = Vec::new();
-    for set in ["industrial", "pcgtsplib"] {
-        let Ok(entries) = std::fs::read_dir(data.join("pcgtsp").join(set)) else {
+    for dir in ["pcgtsp/industrial", "pcgtsp/pcgtsplib", "nests/pcgtsp"] {
+        let Ok(entries) = std::fs::read_dir(data.join(dir)) else {
             continue;
         };
-        let mut paths: Vec<PathBuf> = entries.filter_map(|e| e.ok().map(|e| e.path())).collect();
+        // Beside the instances, `nests/pcgtsp` holds their result files (`.txt`).
+        let mut paths: Vec<PathBuf> = entries
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| {
+                p.extension()
+                    .is_some_and(|x| x == "pcglns" || x == "pcgtsp")
+            })
+            .collect();
         paths.sort();
         for path in paths {
             inputs.push(Input {
@@ -89,6 +101,32 @@ fn pcgtsp_inputs(data: &std::path::Path) -> Vec<Input> {
     inputs
 }
 
+/// Issue #17's plasma settings: kerf 2, d₁ 5, d₂ 1, an 8 mm arc lead-in, a 2 mm line lead-out
+/// (the engine tests' `plasma`).
+fn plasma() -> cutroute_geometry::KerfSettings {
+    use cutroute_geometry::{KerfSettings, LeadShape, LeadSpec, TabSpec};
+    KerfSettings {
+        kerf: 2.0,
+        pierce_clearance: 5.0,
+        switch_off_clearance: 1.0,
+        lead_in: LeadSpec::new(LeadShape::Arc, 8.0),
+        lead_out: LeadSpec::new(LeadShape::Line, 2.0),
+        overcut: 0.0,
+        tabs: TabSpec::default(),
+        edge_pierce: false,
+    }
+}
+
+/// The nearest-rank `q` quantile of `times` (0 when empty); sorts them.
+fn percentile(times: &mut [f64], q: f64) -> f64 {
+    if times.is_empty() {
+        return 0.0;
+    }
+    times.sort_by(f64::total_cmp);
+    let rank = ((q * times.len() as f64).ceil() as usize).clamp(1, times.len());
+    times[rank - 1]
+}
+
 pub fn main() {
     let mut limit = 5.0f64;
     let mut slice = Duration::from_millis(40);
@@ -100,6 +138,7 @@ pub fn main() {
     let mut data = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../data");
     let mut trace = false;
     let mut thermal = cutroute_protocol::ThermalSettings::default();
+    let mut kerf = false;
     let mut cli: Option<PathBuf> = None;
     let mut cli_inputs: Vec<PathBuf> = Vec::new();
     let mut cli_limit = 120.0f64;
@@ -139,6 +178,7 @@ pub fn main() {
             }
             "--data" => data = PathBuf::from(value()),
             "--trace" => trace = true,
+            "--kerf" => kerf = true,
             "--rules-hard" => {
                 thermal = cutroute_protocol::ThermalSettings {
                     rules: cutroute_protocol::RuleSet::ALL,
@@ -163,9 +203,9 @@ pub fn main() {
         inputs.retain(|i| names.iter().any(|n| i.name.contains(n.as_str())));
     }
     println!(
-        "| solver | input | limit s | wall s | wall − limit s | start s | longest step s | steps | ended by | |"
+        "| solver | input | limit s | wall s | wall − limit s | start s | longest step s | p99 step s | steps | ended by | |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|");
     let mut worst_step = 0.0f64;
     let mut worst_over = f64::NEG_INFINITY;
     let mut wall_overs = 0;
@@ -190,6 +230,11 @@ pub fn main() {
                     time_limit_s: limit,
                     discretisation_step_mm: step_mm,
                     thermal,
+                    kerf: if kerf && !is_pcgtsp {
+                        plasma()
+                    } else {
+                        cutroute_geometry::KerfSettings::default()
+                    },
                     ..SolverParams::default()
                 },
             };
@@ -197,6 +242,7 @@ pub fn main() {
             let job = start_job(&request);
             let start_s = started.elapsed().as_secs_f64();
             let mut longest = 0.0f64;
+            let mut step_times: Vec<f64> = Vec::new();
             let mut steps = 0usize;
             let ended_by = match job {
                 Err(e) => format!("refused: {e}"),
@@ -210,6 +256,7 @@ pub fn main() {
                     let status = job.step(slice);
                     let took = t.elapsed().as_secs_f64();
                     longest = longest.max(took);
+                    step_times.push(took);
                     if trace && took > slice.as_secs_f64() + 0.05 {
                         eprintln!(
                             "{} {}: step {steps} took {took:.3} s from phase \"{phase}\" to \"{}\"",
@@ -234,6 +281,7 @@ pub fn main() {
                 },
             };
             let wall = started.elapsed().as_secs_f64();
+            let p99 = percentile(&mut step_times, 0.99);
             let call = longest.max(start_s);
             worst_step = worst_step.max(call);
             let wall_over = wall > limit + 1.0;
@@ -249,7 +297,7 @@ pub fn main() {
                 row.5 += usize::from(call > 0.2);
             }
             println!(
-                "| {} | {} | {limit} | {wall:.2} | {:+.2} | {start_s:.3} | {longest:.3} | {steps} | {ended_by} | {} |",
+                "| {} | {} | {limit} | {wall:.2} | {:+.2} | {start_s:.3} | {longest:.3} | {p99:.3} | {steps} | {ended_by} | {} |",
                 solver.name(),
                 input.name,
                 wall - limit,
