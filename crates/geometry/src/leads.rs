@@ -614,6 +614,13 @@ pub enum LeadProblem {
     /// The lead chain does not run from M to the entry, or from the exit to M*.
     #[error("a lead does not join its end points")]
     Disjoint,
+    /// A path's overcut is negative or not finite, runs on past the start of an open path
+    /// (one that does not end where it starts), or is longer than the path.
+    #[error("an overcut of {length} mm on an open path, or longer than its path")]
+    OvercutMisplaced {
+        /// The overcut, mm.
+        length: f64,
+    },
     /// A tab lies outside the cut, out of order, off the equidistant, over a corner, or in a
     /// hole (holes get no tabs).
     #[error("the tab at ({x}, {y}) is misplaced")]
@@ -724,14 +731,14 @@ impl<'a> LeadFitter<'a> {
         self.nest
     }
 
-    /// This fitter with the settings paths are fitted under: no overcut and no tabs (a path's
-    /// cut is the solver's, not a contour round and on).
+    /// This fitter with the settings paths are fitted under: no tabs (a path's cut is the
+    /// solver's, not a contour round; the overcut applies to closed paths only, see
+    /// [`LeadFitter::attach_path`]).
     pub fn for_paths(&self) -> LeadFitter<'a> {
         LeadFitter {
             nest: self.nest,
             forest: self.forest.clone(),
             settings: KerfSettings {
-                overcut: 0.0,
                 tabs: TabSpec::default(),
                 ..self.settings
             },
@@ -885,7 +892,7 @@ impl<'a> LeadFitter<'a> {
     /// An edge lead-in to `entry` of contour `r`: the straight line from the nearest point of
     /// the sheet's border, when edge piercing is on, `r` may be pierced at the border, the line
     /// is no longer than [`KerfSettings::edge_reach`] and it keeps kerf/2 from every contour.
-    fn edge_lead_in(&self, r: ContourRef, entry: Point) -> Option<Vec<Vertex>> {
+    pub(crate) fn edge_lead_in(&self, r: ContourRef, entry: Point) -> Option<Vec<Vertex>> {
         if !self.settings.edge_pierce {
             return None;
         }

@@ -68,9 +68,19 @@ impl ToolOnPath {
             .map_or(0.0, |l| l.lead_in_length() + l.lead_out_length())
     }
 
-    /// Tool-on length of the path, leads included, mm.
+    /// The overcut's spans: the path's first spans again, as far as its leads' overcut (none
+    /// without leads or overcut).
+    pub fn overcut_spans(&self) -> Vec<Span> {
+        self.leads
+            .as_ref()
+            .map_or_else(Vec::new, |l| l.overcut_spans(&self.spans, 0.0))
+    }
+
+    /// Tool-on length of the path, leads and overcut included, mm.
     pub fn length(&self) -> f64 {
-        self.spans.iter().map(|s| s.length()).sum::<f64>() + self.leads_length()
+        self.spans.iter().map(|s| s.length()).sum::<f64>()
+            + self.overcut_spans().iter().map(Span::length).sum::<f64>()
+            + self.leads_length()
     }
 }
 
@@ -467,6 +477,15 @@ impl PathRoute {
     /// Number of pierces: one per path.
     pub fn pierce_count(&self) -> usize {
         self.paths.len()
+    }
+
+    /// The pierces of [`PathRoute::pierce_count`] made at the sheet's edge (edge-pierced
+    /// paths, priced at the machine's edge-pierce time).
+    pub fn edge_pierce_count(&self) -> usize {
+        self.paths
+            .iter()
+            .filter(|p| p.leads.as_ref().is_some_and(|l| l.edge_pierce))
+            .count()
     }
 
     /// Machining time, seconds (formula 1.2).

@@ -212,10 +212,15 @@ impl Toolpath {
                 at: path.pierce,
                 step,
             });
-            // With leads: the lead-in, the spans, the lead-out, torch on throughout.
+            // With leads: the lead-in, the spans, the overcut, the lead-out, torch on
+            // throughout.
             let lead_in = path.leads.iter().flat_map(|l| chain_spans(&l.lead_in));
             let lead_out = path.leads.iter().flat_map(|l| chain_spans(&l.lead_out));
-            for span in lead_in.chain(path.spans.iter().copied()).chain(lead_out) {
+            for span in lead_in
+                .chain(path.spans.iter().copied())
+                .chain(path.overcut_spans())
+                .chain(lead_out)
+            {
                 if span.length() > MIN_PIECE_LENGTH {
                     moves.push(ToolMove::Cut {
                         step,
