@@ -593,3 +593,62 @@ fn kerf_pierces_sit_in_a_kerf_cut_before_and_save_time() {
         cut / 10.0 + idle / 500.0 + 7.0 * (pierces - kerf.len() as f64) + 2.0 * kerf.len() as f64;
     assert!((time(&report) - expected).abs() < 1e-6 * expected);
 }
+
+#[test]
+fn path_solvers_pierce_at_the_sheet_border_and_take_the_edge_pierce_time() {
+    // test1: a 2000 × 1000 sheet.
+    let file = data("nests/dbs-json/test1.dbs.json");
+    for solver in ["sccp", "aoe"] {
+        let mut args = vec![
+            "solve",
+            &file,
+            "--solver",
+            solver,
+            "--json",
+            "--edge-pierce",
+            "--edge-pierce-time",
+            "2",
+            "--overcut",
+            "1.5",
+        ];
+        args.extend(PLASMA);
+        let report = json(&args);
+        let paths = report["route"]["paths"].as_array().expect("paths");
+        let edge: Vec<&Value> = paths
+            .iter()
+            .filter(|p| p.get("edge_pierce").is_some())
+            .collect();
+        assert_eq!(
+            report["edge_pierces"].as_u64().unwrap() as usize,
+            edge.len(),
+            "{solver}"
+        );
+        assert!(!edge.is_empty(), "{solver}");
+        for path in &edge {
+            let (x, y) = point(&path["pierce"]);
+            let to_border = x
+                .abs()
+                .min((x - 2000.0).abs())
+                .min(y.abs())
+                .min((y - 1000.0).abs());
+            assert!(
+                to_border < 1e-6,
+                "{solver}: edge pierce ({x}, {y}) off the border"
+            );
+        }
+        assert!(paths.iter().any(|p| p.get("overcut").is_some()), "{solver}");
+        // Time: cut at 10 mm/s, idle at 500 mm/s, 7 s a pierce in the sheet, 2 s at its edge.
+        let (cut, idle) = (
+            report["cut_length"].as_f64().unwrap(),
+            report["idle_length"].as_f64().unwrap(),
+        );
+        let pierces = report["pierces"].as_u64().unwrap() as f64;
+        let n = edge.len() as f64;
+        let expected = cut / 10.0 + idle / 500.0 + 7.0 * (pierces - n) + 2.0 * n;
+        let time = report["time_s"].as_f64().unwrap();
+        assert!(
+            (time - expected).abs() < 1e-6 * expected,
+            "{solver}: {time} vs {expected}"
+        );
+    }
+}
