@@ -293,7 +293,7 @@ impl Kerf {
     /// lead lengths (and `edge_pierces` with edge piercing on); each path of the report's
     /// `route` carries its `pierce` (M), `entry` and `switch_off` as [x, y], `lead_in` and
     /// `lead_out` as [x, y, bulge] vertices, `edge_pierce` when pierced at the sheet's border
-    /// and `overcut` (mm) when it runs on past its start.
+    /// `overcut` (mm) when it runs on past its start, and `tabs` (each gap's `from` and `to`).
     pub fn report_paths(&self, report: &mut Value, route: &PathRoute) {
         if !self.report_head(report, route.start, route.finish) {
             return;
@@ -305,6 +305,7 @@ impl Kerf {
             "switch_off_clearance": s.switch_off_clearance,
             // Closed paths only: an open path ends where the solver ends it.
             "overcut": s.overcut,
+            "tabs": { "per_part": s.tabs.count, "width": s.tabs.width },
             "optimised_with_leads": true,
             "edge_pierce": s.edge_pierce,
         });
@@ -333,6 +334,14 @@ impl Kerf {
                 path["lead_in"] = json!(triples(&l.lead_in));
                 path["lead_out"] = json!(triples(&l.lead_out));
                 path["switch_off"] = json!([l.switch_off.x, l.switch_off.y]);
+                if !l.tabs.is_empty() {
+                    // Each gap: where the torch stops and where it pierces again.
+                    path["tabs"] = json!(l
+                        .tabs
+                        .iter()
+                        .map(|t| json!({ "from": [t.from.x, t.from.y], "to": [t.to.x, t.to.y] }))
+                        .collect::<Vec<_>>());
+                }
                 if let Some(fields) = path.as_object_mut() {
                     fields.remove("leads");
                 }

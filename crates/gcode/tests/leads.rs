@@ -303,7 +303,7 @@ fn a_path_route_with_leads_reads_back_with_the_same_lengths_pierces_and_leads() 
 }
 
 #[test]
-fn a_path_route_with_edge_pierces_and_overcut_reads_back_with_the_same_lengths_and_pierces() {
+fn a_path_route_with_edge_pierces_overcut_and_tabs_reads_back_with_the_same_lengths_and_pierces() {
     // The generated nest on a sheet 4 mm round its parts: the parts at its border can be
     // pierced there.
     let mut nest = generate_nest(40, 11);
@@ -325,6 +325,10 @@ fn a_path_route_with_edge_pierces_and_overcut_reads_back_with_the_same_lengths_a
         lead_out: LeadSpec::new(LeadShape::Line, 2.0),
         overcut: 1.5,
         edge_pierce: true,
+        tabs: TabSpec {
+            count: 2,
+            width: 1.5,
+        },
         ..KerfSettings::default()
     };
     let fitter = LeadFitter::new(&nest, settings);
@@ -335,6 +339,8 @@ fn a_path_route_with_edge_pierces_and_overcut_reads_back_with_the_same_lengths_a
     let route = fitter.attach_paths(&paths).unwrap();
     assert_eq!(route.problems(&nest, 1e-6), Vec::new());
     assert!(route.edge_pierce_count() > 0);
+    // Pierces after the tabs' gaps too.
+    assert!(route.pierce_count() > route.paths.len());
     assert!(route
         .paths
         .iter()
@@ -368,13 +374,17 @@ fn a_path_route_with_edge_pierces_and_overcut_reads_back_with_the_same_lengths_a
     );
     assert!((program.idle_length() - route.idle_length()).abs() < 1e-3);
     // Each path read back pierces at M (on the border where edge-pierced) and switches off
-    // at M*, its tool-on length the spans, the overcut and the leads.
+    // at M*, its tool-on length the spans, the overcut and the leads less the tabs' gaps
+    // (A tab's gap splits a path in two where read back.)
     let back = program.path_route();
-    assert_eq!(back.paths.len(), route.paths.len());
-    for (read, written) in back.paths.iter().zip(&route.paths) {
+    assert_eq!(back.paths.len(), route.pierce_count());
+    let mut read = back.paths.iter();
+    for written in &route.paths {
         let leads = written.leads.as_ref().unwrap();
-        assert!(read.pierce.distance(written.pierce) < 1e-5);
-        assert!(read.end().distance(leads.switch_off) < 1e-5);
-        assert!((read.length() - written.length()).abs() < 1e-3);
+        let pieces: Vec<_> = read.by_ref().take(1 + written.tabs().len()).collect();
+        assert!(pieces[0].pierce.distance(written.pierce) < 1e-5);
+        assert!(pieces.last().unwrap().end().distance(leads.switch_off) < 1e-5);
+        let length: f64 = pieces.iter().map(|p| p.length()).sum();
+        assert!((length - written.length()).abs() < 1e-3);
     }
 }

@@ -412,41 +412,11 @@ impl StepLeads {
     /// the torch cuts between the entry, the gaps and the exit, in order (one piece without
     /// tabs). Pieces shorter than `min_piece` are dropped.
     pub fn equidistant_pieces(&self, equidistant: &Contour, min_piece: f64) -> Vec<Vec<Span>> {
-        let cut = self.equidistant_cut(equidistant, 0.0);
-        let mut pieces = vec![Vec::new()];
-        // Cut intervals [from, to] of arc length between the tabs.
-        let mut bounds = vec![0.0];
-        for tab in &self.tabs {
-            bounds.push(tab.start);
-            bounds.push(tab.end);
-        }
-        bounds.push(f64::INFINITY);
-        let intervals: Vec<(f64, f64)> = bounds.chunks(2).map(|w| (w[0], w[1])).collect();
-        let mut at = 0.0;
-        let mut current = 0;
-        for span in cut {
-            let length = span.length();
-            let (begin, end) = (at, at + length);
-            at = end;
-            while current < intervals.len() {
-                let (from, to) = intervals[current];
-                let (a, b) = (begin.max(from), end.min(to));
-                if b > a && length > 0.0 {
-                    let piece = span.sub_span((a - begin) / length, (b - begin) / length);
-                    if piece.length() > min_piece {
-                        pieces[current].push(piece);
-                    }
-                }
-                if to <= end {
-                    current += 1;
-                    pieces.push(Vec::new());
-                } else {
-                    break;
-                }
-            }
-        }
-        pieces.truncate(intervals.len());
-        pieces
+        split_at_tabs(
+            self.equidistant_cut(equidistant, 0.0),
+            &self.tabs,
+            min_piece,
+        )
     }
 
     /// Length of the lead-in, mm.
@@ -485,6 +455,46 @@ impl StepLeads {
         }
         cut
     }
+}
+
+/// `cut` (spans from the entry, in cut order) split at `tabs` (arc lengths from the entry):
+/// the pieces the torch cuts between the entry, the gaps and the end, in order (one piece
+/// without tabs). Pieces shorter than `min_piece` are dropped.
+pub(crate) fn split_at_tabs(cut: Vec<Span>, tabs: &[Tab], min_piece: f64) -> Vec<Vec<Span>> {
+    let mut pieces = vec![Vec::new()];
+    // Cut intervals [from, to] of arc length between the tabs.
+    let mut bounds = vec![0.0];
+    for tab in tabs {
+        bounds.push(tab.start);
+        bounds.push(tab.end);
+    }
+    bounds.push(f64::INFINITY);
+    let intervals: Vec<(f64, f64)> = bounds.chunks(2).map(|w| (w[0], w[1])).collect();
+    let mut at = 0.0;
+    let mut current = 0;
+    for span in cut {
+        let length = span.length();
+        let (begin, end) = (at, at + length);
+        at = end;
+        while current < intervals.len() {
+            let (from, to) = intervals[current];
+            let (a, b) = (begin.max(from), end.min(to));
+            if b > a && length > 0.0 {
+                let piece = span.sub_span((a - begin) / length, (b - begin) / length);
+                if piece.length() > min_piece {
+                    pieces[current].push(piece);
+                }
+            }
+            if to <= end {
+                current += 1;
+                pieces.push(Vec::new());
+            } else {
+                break;
+            }
+        }
+    }
+    pieces.truncate(intervals.len());
+    pieces
 }
 
 /// The spans of `contour` opened at the point nearest to `at`: the rest of that span, the
@@ -729,21 +739,6 @@ impl<'a> LeadFitter<'a> {
     /// The nest the fitter fits leads in.
     pub fn nest(&self) -> &'a Nest {
         self.nest
-    }
-
-    /// This fitter with the settings paths are fitted under: no tabs (a path's cut is the
-    /// solver's, not a contour round; the overcut applies to closed paths only, see
-    /// [`LeadFitter::attach_path`]).
-    pub fn for_paths(&self) -> LeadFitter<'a> {
-        LeadFitter {
-            nest: self.nest,
-            forest: self.forest.clone(),
-            settings: KerfSettings {
-                tabs: TabSpec::default(),
-                ..self.settings
-            },
-            boxes: self.boxes.clone(),
-        }
     }
 
     /// The nest's containment forest.

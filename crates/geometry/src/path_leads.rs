@@ -18,14 +18,16 @@
 //! (one that ends where it starts) runs on past its start by the overcut before its lead-out,
 //! over its own first spans ([`PathLeads::overcut_spans`]); an open path ends where the solver
 //! ends it and gets no overcut (running on would cut past a piece the route cuts elsewhere).
-//! Tabs are not applied to paths.
+//! A path that cuts a part's outer contour round (one equidistant, from its start back to it)
+//! gets that contour's tabs, placed as a contour step's ([`crate::place_tabs`]); a part whose
+//! outer contour is cut in pieces by several paths (chains of common edges) gets none.
 
 use serde::{Deserialize, Serialize};
 
-use crate::leads::{lead_in_chain, lead_out_chain, vertex, vertex_triples};
+use crate::leads::{lead_in_chain, lead_out_chain, split_at_tabs, vertex, vertex_triples};
 use crate::{
     chain_spans, opened_at, Contour, ContourRef, KerfSettings, LeadError, LeadFitter, LeadProblem,
-    PathRoute, Point, Span, StepLeads, ToolOnPath, Vertex,
+    PathRoute, Point, Span, StepLeads, Tab, ToolOnPath, Vertex,
 };
 
 /// How far (mm) a point may lie from an equidistant and still count as on it: the checker's
@@ -68,9 +70,28 @@ pub struct PathLeads {
     /// checker holds it to the border instead of G_M.
     #[serde(default)]
     pub edge_pierce: bool,
+    /// Micro-joints of the path's cut, in cut order, their arc lengths measured along the
+    /// spans from the entry.
+    #[serde(default)]
+    pub tabs: Vec<Tab>,
 }
 
 impl PathLeads {
+    /// Total width of the tabs' gaps, mm.
+    pub fn tab_width(&self) -> f64 {
+        self.tabs.iter().map(Tab::width).sum()
+    }
+
+    /// `spans` (the path's, from the entry) split at the tabs: the pieces the torch cuts
+    /// between the entry, the gaps and the end (one piece without tabs).
+    pub fn pieces(&self, spans: &[Span], min_piece: f64) -> Vec<Vec<Span>> {
+        if self.tabs.is_empty() {
+            // The spans as they are (splitting would rebuild each span from its ends).
+            return vec![spans.to_vec()];
+        }
+        split_at_tabs(spans.to_vec(), &self.tabs, min_piece)
+    }
+
     /// The overcut of a path whose spans (from the entry) are `spans`: its first spans up to
     /// [`PathLeads::overcut`] mm, the last one cut short. Pieces no longer than `min_piece`
     /// are dropped.
@@ -131,7 +152,7 @@ impl PathLeads {
             overcut: 0.0,
             pierce_clearance: self.pierce_clearance,
             switch_off_clearance: self.switch_off_clearance,
-            tabs: Vec::new(),
+            tabs: self.tabs.clone(),
             edge_pierce: self.edge_pierce,
             kerf_pierce: None,
         }
@@ -315,8 +336,8 @@ impl LeadFitter<'_> {
     }
 
     /// `path` (a path over [`LeadFitter::kerf_nest`], its spans on the equidistants) with
-    /// leads (see the module notes). Use a fitter [`LeadFitter::for_paths`]. An empty path is
-    /// returned as it is (the checker reports it).
+    /// leads (see the module notes). An empty path is returned as it is (the checker reports
+    /// it).
     pub fn attach_path(&self, path: &ToolOnPath) -> Result<ToolOnPath, LeadError> {
         let (Some(first), Some(last)) = (path.spans.first(), path.spans.last()) else {
             return Ok(path.clone());
@@ -351,6 +372,7 @@ impl LeadFitter<'_> {
                 switch_off_clearance: leads.switch_off_clearance,
                 overcut: leads.overcut,
                 edge_pierce: leads.edge_pierce,
+                tabs: leads.tabs.clone(),
             };
             let exit = path_leads
                 .overcut_spans(&spans, MIN_PIECE)
@@ -396,6 +418,7 @@ impl LeadFitter<'_> {
             switch_off_clearance: settings.switch_off_clearance,
             overcut,
             edge_pierce: false,
+            tabs: Vec::new(),
         };
         let edge_lead = at_start.iter().find_map(|&r| self.edge_lead_in(r, start));
         leads.edge_pierce = edge_lead.is_some();
@@ -423,11 +446,10 @@ impl LeadFitter<'_> {
     /// `route` (over [`LeadFitter::kerf_nest`]) with leads on every path; fails with every
     /// contour where no lead fits.
     pub fn attach_paths(&self, route: &PathRoute) -> Result<PathRoute, Vec<LeadError>> {
-        let fitter = self.for_paths();
         let mut errors = Vec::new();
         let mut paths = Vec::with_capacity(route.paths.len());
         for path in &route.paths {
-            match fitter.attach_path(path) {
+            match self.attach_path(path) {
                 Ok(p) => paths.push(p),
                 Err(e) => errors.push(e),
             }
@@ -470,6 +492,19 @@ impl LeadFitter<'_> {
                 problems.push(LeadProblem::OvercutMisplaced { length: overcut });
             }
         }
+        // Tabs lie within the path's own cut (the contour checker places them on the
+        // equidistant and away from its corners).
+        let length: f64 = path.spans.iter().map(Span::length).sum();
+        problems.extend(
+            leads
+                .tabs
+                .iter()
+                .filter(|t| !(t.start >= 0.0 && t.end <= length + tolerance))
+                .map(|t| LeadProblem::TabMisplaced {
+                    x: t.from.x,
+                    y: t.from.y,
+                }),
+        );
         let exit = leads
             .overcut_spans(&path.spans, MIN_PIECE)
             .last()

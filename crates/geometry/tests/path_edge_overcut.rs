@@ -4,7 +4,8 @@
 
 use cutroute_geometry::{
     Contour, ContourRef, KerfSettings, LeadFitter, LeadProblem, LeadShape, LeadSpec, Nest, Part,
-    PathLeadError, PathRoute, PathRouteError, Point, Route, Span, ToolOnPath, Toolpath, Vertex,
+    PathLeadError, PathRoute, PathRouteError, Point, Route, Span, TabSpec, ToolOnPath, Toolpath,
+    Vertex,
 };
 
 fn rectangle(x0: f64, y0: f64, x1: f64, y1: f64) -> Contour {
@@ -260,4 +261,73 @@ fn open_paths_get_no_overcut_and_an_overcut_on_one_is_refused() {
     assert!(lead_problems(&wrong, &nest)
         .iter()
         .any(|p| matches!(p, LeadProblem::OvercutMisplaced { .. })));
+}
+
+#[test]
+fn whole_outer_contours_get_tabs_that_count_as_pierces_and_idle_gaps() {
+    let nest = nest();
+    let settings = KerfSettings {
+        tabs: TabSpec {
+            count: 2,
+            width: 1.5,
+        },
+        ..plasma()
+    };
+    let route = whole_contours(&nest, settings);
+    assert_eq!(route.problems(&nest, 1e-6), Vec::new());
+    let tabs: usize = route.paths.iter().map(|p| p.tabs().len()).sum();
+    // Two per part's outer contour, none in the hole.
+    assert_eq!(tabs, 4);
+    assert_eq!(route.pierce_count(), route.paths.len() + 4);
+    let plain = whole_contours(&nest, plasma());
+    let cut = |r: &PathRoute| r.cut_length();
+    assert!((cut(&plain) - cut(&route) - 4.0 * 1.5).abs() < 1e-6);
+    // The toolpath (what the G-code writes) stops at every gap and pierces after it.
+    let toolpath = Toolpath::from_path_route(&route);
+    assert_eq!(toolpath.pierce_count(), route.pierce_count());
+    assert!((toolpath.cut_length() - route.cut_length()).abs() < 1e-9);
+    assert!((toolpath.idle_length() - route.idle_length()).abs() < 1e-9);
+    // A tab moved past the end of its path's cut is refused.
+    let mut late = route.clone();
+    let path = late
+        .paths
+        .iter_mut()
+        .find(|p| !p.tabs().is_empty())
+        .unwrap();
+    let length: f64 = path.spans.iter().map(Span::length).sum();
+    let tab = &mut path.leads.as_mut().unwrap().tabs[0];
+    tab.start = length + 1.0;
+    tab.end = length + 2.5;
+    assert!(lead_problems(&late, &nest)
+        .iter()
+        .any(|p| matches!(p, LeadProblem::TabMisplaced { .. })));
+    // A tab slid onto a corner of the equidistant (its ends moved with it) is refused.
+    let mut corner = route.clone();
+    let path = corner
+        .paths
+        .iter_mut()
+        .find(|p| !p.tabs().is_empty())
+        .unwrap();
+    let first = path.spans[0];
+    let to_corner = first.length();
+    let spans = path.spans.clone();
+    let at = |s: f64| {
+        let mut left = s;
+        for span in &spans {
+            let l = span.length();
+            if left <= l {
+                return span.point_at(left / l);
+            }
+            left -= l;
+        }
+        spans.last().unwrap().end
+    };
+    let tab = &mut path.leads.as_mut().unwrap().tabs[0];
+    tab.start = to_corner - 0.5;
+    tab.end = to_corner + 1.0;
+    tab.from = at(tab.start);
+    tab.to = at(tab.end);
+    assert!(lead_problems(&corner, &nest)
+        .iter()
+        .any(|p| matches!(p, LeadProblem::TabMisplaced { .. })));
 }
