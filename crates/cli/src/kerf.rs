@@ -290,8 +290,10 @@ impl Kerf {
 
 impl Kerf {
     /// Adds the full-route fields to a path report: `start`, `finish`, the settings and the
-    /// lead lengths; each path of the report's `route` carries its `pierce` (M), `entry` and
-    /// `switch_off` as [x, y], `lead_in` and `lead_out` as [x, y, bulge] vertices.
+    /// lead lengths (and `edge_pierces` with edge piercing on); each path of the report's
+    /// `route` carries its `pierce` (M), `entry` and `switch_off` as [x, y], `lead_in` and
+    /// `lead_out` as [x, y, bulge] vertices, `edge_pierce` when pierced at the sheet's border
+    /// `overcut` (mm) when it runs on past its start, and `tabs` (each gap's `from` and `to`).
     pub fn report_paths(&self, report: &mut Value, route: &PathRoute) {
         if !self.report_head(report, route.start, route.finish) {
             return;
@@ -301,8 +303,15 @@ impl Kerf {
             "kerf": s.kerf,
             "pierce_clearance": s.pierce_clearance,
             "switch_off_clearance": s.switch_off_clearance,
+            // Closed paths only: an open path ends where the solver ends it.
+            "overcut": s.overcut,
+            "tabs": { "per_part": s.tabs.count, "width": s.tabs.width },
             "optimised_with_leads": true,
+            "edge_pierce": s.edge_pierce,
         });
+        if s.edge_pierce {
+            report["edge_pierces"] = json!(route.edge_pierce_count());
+        }
         let leads = || route.paths.iter().filter_map(|p| p.leads.as_ref());
         // The form: points as [x, y] (the route's serde form is {x, y}).
         if let Some(paths) = report["route"]["paths"].as_array_mut() {
@@ -316,9 +325,23 @@ impl Kerf {
                 };
                 path["pierce"] = json!([p.pierce.x, p.pierce.y]);
                 path["entry"] = json!([l.entry.x, l.entry.y]);
+                if l.edge_pierce {
+                    path["edge_pierce"] = json!(true);
+                }
+                if l.overcut > 0.0 {
+                    path["overcut"] = json!(l.overcut);
+                }
                 path["lead_in"] = json!(triples(&l.lead_in));
                 path["lead_out"] = json!(triples(&l.lead_out));
                 path["switch_off"] = json!([l.switch_off.x, l.switch_off.y]);
+                if !l.tabs.is_empty() {
+                    // Each gap: where the torch stops and where it pierces again.
+                    path["tabs"] = json!(l
+                        .tabs
+                        .iter()
+                        .map(|t| json!({ "from": [t.from.x, t.from.y], "to": [t.to.x, t.to.y] }))
+                        .collect::<Vec<_>>());
+                }
                 if let Some(fields) = path.as_object_mut() {
                     fields.remove("leads");
                 }

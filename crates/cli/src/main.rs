@@ -1549,13 +1549,16 @@ impl PathReport<'_> {
             route.cut_length(),
             route.pierce_count(),
         );
+        // Edge pierces (`--edge-pierce`) take the machine's edge-pierce time.
+        let time_s = machine.time(cut_length, idle_length, 0)
+            + machine.pierce_seconds(pierces, route.edge_pierce_count());
         let mut report = json!({
             "solver": solver_name,
             "idle_length": idle_length,
             "cut_length": cut_length,
             "recut_length": recut_length,
             "pierces": pierces,
-            "time_s": machine.time(cut_length, idle_length, pierces),
+            "time_s": time_s,
             "cost": machine.cost(cut_length, idle_length, pierces),
             "objective": objective.name(),
             "machine": machine_json(machine),

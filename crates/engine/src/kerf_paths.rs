@@ -111,7 +111,7 @@ impl PathLeadsRun {
 
     pub(crate) fn step(&mut self, budget: Duration) -> JobStatus {
         let started = Instant::now();
-        let fitter = LeadFitter::with_forest(&self.nest, &self.forest, self.settings).for_paths();
+        let fitter = LeadFitter::with_forest(&self.nest, &self.forest, self.settings);
         if self.solving {
             // The solver gets most of the slice; its newer routes get their leads in the rest.
             let status = self.job.step(budget * 3 / 4);

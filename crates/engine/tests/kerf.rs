@@ -449,3 +449,75 @@ fn a_nest_is_refused_only_where_its_gaps_are_narrower_than_the_kerf() {
         checked(&problem, &progress);
     }
 }
+
+#[test]
+fn path_solvers_pierce_at_the_edge_overcut_closed_paths_and_tab_whole_contours() {
+    // test1: a 2000 × 1000 sheet with parts near its border.
+    let problem = nest_problem("nests/dbs-json/test1.dbs.json");
+    let nest = nest_of(&problem);
+    let settings = KerfSettings {
+        overcut: 1.5,
+        edge_pierce: true,
+        tabs: TabSpec {
+            count: 2,
+            width: 1.5,
+        },
+        ..plasma()
+    };
+    for solver in [SolverKind::Sccp, SolverKind::Aoe] {
+        let progress = run_to_end(
+            start_job(&request(&problem, solver, settings, false))
+                .expect("starts")
+                .as_mut(),
+            &mut |_| {},
+        );
+        let route = progress
+            .path_route()
+            .unwrap_or_else(|| panic!("{solver:?}: no route: {}", progress.phase));
+        let problems: Vec<_> = route
+            .problems(nest, nest.check_tolerance())
+            .into_iter()
+            .filter(|p| !matches!(p, cutroute_geometry::PathRouteError::Overlap { .. }))
+            .collect();
+        assert_eq!(problems, Vec::new(), "{solver:?}");
+        // Whether a path starts within the edge reach of the border depends on the solver's
+        // route (anytime, under load): the geometry tests pin edge pierces down; here every
+        // one made is checked (the checker, and M on the border).
+        let border = &nest.sheet.as_ref().expect("a sheet").contours[0];
+        let mut overcut = 0.0;
+        for path in &route.paths {
+            let leads = path.leads.as_ref().expect("leads");
+            if leads.edge_pierce {
+                assert!(border.distance_to(path.pierce) < 1e-6, "{solver:?}");
+            }
+            let closed = path.spans[0].start.distance(path.spans.last().unwrap().end) < 1e-9;
+            assert_eq!(leads.overcut, if closed { 1.5 } else { 0.0 }, "{solver:?}");
+            overcut += leads.overcut;
+        }
+        assert!(overcut > 0.0, "{solver:?}");
+        assert!(
+            route.paths.iter().any(|p| !p.tabs().is_empty()),
+            "{solver:?}"
+        );
+        let tabs: usize = route.paths.iter().map(|p| p.tabs().len()).sum();
+        assert_eq!(route.pierce_count(), route.paths.len() + tabs, "{solver:?}");
+        let gaps: f64 = route
+            .paths
+            .iter()
+            .flat_map(|p| p.tabs())
+            .map(|t| t.width())
+            .sum();
+        // The cut length counts the overcut, less the tabs' gaps.
+        let spans: f64 = route
+            .paths
+            .iter()
+            .flat_map(|p| &p.spans)
+            .map(|s| s.length())
+            .sum();
+        let leads: f64 = route.paths.iter().map(|p| p.leads_length()).sum();
+        assert!(
+            (route.cut_length() - spans - leads - overcut + gaps).abs() < 1e-6,
+            "{solver:?}"
+        );
+    }
+}

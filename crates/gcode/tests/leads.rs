@@ -5,8 +5,8 @@ use cutroute_gcode::{
     path_route_gcode, read_gcode, route_gcode, ArcOutput, DistanceMode, GcodeOptions, ReadOptions,
 };
 use cutroute_geometry::{
-    chain_spans, generate_nest, KerfSettings, LeadFitter, LeadShape, LeadSpec, Nest, PathRoute,
-    Point, Route, TabSpec, Toolpath,
+    chain_spans, generate_nest, Contour, KerfSettings, LeadFitter, LeadShape, LeadSpec, Nest, Part,
+    PathRoute, Point, Route, TabSpec, Toolpath, Vertex,
 };
 
 /// A generated nest and its baseline route (innermost first) with leads fitted under `settings`,
@@ -299,5 +299,92 @@ fn a_path_route_with_leads_reads_back_with_the_same_lengths_pierces_and_leads() 
             }
             assert!((read.length() - written.length()).abs() < 1e-3, "{what}");
         }
+    }
+}
+
+#[test]
+fn a_path_route_with_edge_pierces_overcut_and_tabs_reads_back_with_the_same_lengths_and_pierces() {
+    // The generated nest on a sheet 4 mm round its parts: the parts at its border can be
+    // pierced there.
+    let mut nest = generate_nest(40, 11);
+    let b = nest.bounding_box().expanded(4.0);
+    nest.sheet = Some(Part {
+        name: "sheet".into(),
+        contours: vec![Contour::new(vec![
+            Vertex::line(b.min.x, b.min.y),
+            Vertex::line(b.min.x, b.max.y),
+            Vertex::line(b.max.x, b.max.y),
+            Vertex::line(b.max.x, b.min.y),
+        ])],
+    });
+    let settings = KerfSettings {
+        kerf: 2.0,
+        pierce_clearance: 2.0,
+        switch_off_clearance: 1.0,
+        lead_in: LeadSpec::new(LeadShape::Arc, 4.0),
+        lead_out: LeadSpec::new(LeadShape::Line, 2.0),
+        overcut: 1.5,
+        edge_pierce: true,
+        tabs: TabSpec {
+            count: 2,
+            width: 1.5,
+        },
+        ..KerfSettings::default()
+    };
+    let fitter = LeadFitter::new(&nest, settings);
+    let kerf_nest = fitter.kerf_nest();
+    let origin = Point::new(0.0, 0.0);
+    let route = Route::innermost_first(&kerf_nest, origin, Some(origin));
+    let paths = PathRoute::from_route(&route, &kerf_nest).unwrap();
+    let route = fitter.attach_paths(&paths).unwrap();
+    assert_eq!(route.problems(&nest, 1e-6), Vec::new());
+    assert!(route.edge_pierce_count() > 0);
+    // Pierces after the tabs' gaps too.
+    assert!(route.pierce_count() > route.paths.len());
+    assert!(route
+        .paths
+        .iter()
+        .all(|p| p.leads.as_ref().unwrap().overcut == 1.5));
+    let overcut: f64 = route
+        .paths
+        .iter()
+        .flat_map(|p| p.overcut_spans())
+        .map(|s| s.length())
+        .sum();
+    assert!((overcut - 1.5 * route.paths.len() as f64).abs() < 1e-6);
+    let options = GcodeOptions {
+        decimals: 6,
+        ..GcodeOptions::default()
+    };
+    let text = path_route_gcode(&route, &options).unwrap();
+    let program = read_gcode(
+        &text,
+        &ReadOptions {
+            start: route.start,
+            ..ReadOptions::default()
+        },
+    )
+    .unwrap();
+    assert_eq!(program.pierce_count(), route.pierce_count());
+    assert!(
+        (program.cut_length() - route.cut_length()).abs() < 1e-3,
+        "cut {} vs {}",
+        program.cut_length(),
+        route.cut_length()
+    );
+    assert!((program.idle_length() - route.idle_length()).abs() < 1e-3);
+    // Each path read back pierces at M (on the border where edge-pierced) and switches off
+    // at M*, its tool-on length the spans, the overcut and the leads less the tabs' gaps
+    // (A tab's gap splits a path in two where read back.)
+    let back = program.path_route();
+    assert_eq!(back.paths.len(), route.pierce_count());
+    let mut read = back.paths.iter();
+    for written in &route.paths {
+        let leads = written.leads.as_ref().unwrap();
+        let pieces: Vec<_> = read.by_ref().take(1 + written.tabs().len()).collect();
+        assert!(pieces[0].pierce.distance(written.pierce) < 1e-5);
+        assert!(pieces.last().unwrap().end().distance(leads.switch_off) < 1e-5);
+        let length: f64 = pieces.iter().map(|p| p.length()).sum();
+        assert!((length - written.length()).abs() < 1e-3);
     }
 }

@@ -412,41 +412,11 @@ impl StepLeads {
     /// the torch cuts between the entry, the gaps and the exit, in order (one piece without
     /// tabs). Pieces shorter than `min_piece` are dropped.
     pub fn equidistant_pieces(&self, equidistant: &Contour, min_piece: f64) -> Vec<Vec<Span>> {
-        let cut = self.equidistant_cut(equidistant, 0.0);
-        let mut pieces = vec![Vec::new()];
-        // Cut intervals [from, to] of arc length between the tabs.
-        let mut bounds = vec![0.0];
-        for tab in &self.tabs {
-            bounds.push(tab.start);
-            bounds.push(tab.end);
-        }
-        bounds.push(f64::INFINITY);
-        let intervals: Vec<(f64, f64)> = bounds.chunks(2).map(|w| (w[0], w[1])).collect();
-        let mut at = 0.0;
-        let mut current = 0;
-        for span in cut {
-            let length = span.length();
-            let (begin, end) = (at, at + length);
-            at = end;
-            while current < intervals.len() {
-                let (from, to) = intervals[current];
-                let (a, b) = (begin.max(from), end.min(to));
-                if b > a && length > 0.0 {
-                    let piece = span.sub_span((a - begin) / length, (b - begin) / length);
-                    if piece.length() > min_piece {
-                        pieces[current].push(piece);
-                    }
-                }
-                if to <= end {
-                    current += 1;
-                    pieces.push(Vec::new());
-                } else {
-                    break;
-                }
-            }
-        }
-        pieces.truncate(intervals.len());
-        pieces
+        split_at_tabs(
+            self.equidistant_cut(equidistant, 0.0),
+            &self.tabs,
+            min_piece,
+        )
     }
 
     /// Length of the lead-in, mm.
@@ -485,6 +455,46 @@ impl StepLeads {
         }
         cut
     }
+}
+
+/// `cut` (spans from the entry, in cut order) split at `tabs` (arc lengths from the entry):
+/// the pieces the torch cuts between the entry, the gaps and the end, in order (one piece
+/// without tabs). Pieces shorter than `min_piece` are dropped.
+pub(crate) fn split_at_tabs(cut: Vec<Span>, tabs: &[Tab], min_piece: f64) -> Vec<Vec<Span>> {
+    let mut pieces = vec![Vec::new()];
+    // Cut intervals [from, to] of arc length between the tabs.
+    let mut bounds = vec![0.0];
+    for tab in tabs {
+        bounds.push(tab.start);
+        bounds.push(tab.end);
+    }
+    bounds.push(f64::INFINITY);
+    let intervals: Vec<(f64, f64)> = bounds.chunks(2).map(|w| (w[0], w[1])).collect();
+    let mut at = 0.0;
+    let mut current = 0;
+    for span in cut {
+        let length = span.length();
+        let (begin, end) = (at, at + length);
+        at = end;
+        while current < intervals.len() {
+            let (from, to) = intervals[current];
+            let (a, b) = (begin.max(from), end.min(to));
+            if b > a && length > 0.0 {
+                let piece = span.sub_span((a - begin) / length, (b - begin) / length);
+                if piece.length() > min_piece {
+                    pieces[current].push(piece);
+                }
+            }
+            if to <= end {
+                current += 1;
+                pieces.push(Vec::new());
+            } else {
+                break;
+            }
+        }
+    }
+    pieces.truncate(intervals.len());
+    pieces
 }
 
 /// The spans of `contour` opened at the point nearest to `at`: the rest of that span, the
@@ -614,6 +624,13 @@ pub enum LeadProblem {
     /// The lead chain does not run from M to the entry, or from the exit to M*.
     #[error("a lead does not join its end points")]
     Disjoint,
+    /// A path's overcut is negative or not finite, runs on past the start of an open path
+    /// (one that does not end where it starts), or is longer than the path.
+    #[error("an overcut of {length} mm on an open path, or longer than its path")]
+    OvercutMisplaced {
+        /// The overcut, mm.
+        length: f64,
+    },
     /// A tab lies outside the cut, out of order, off the equidistant, over a corner, or in a
     /// hole (holes get no tabs).
     #[error("the tab at ({x}, {y}) is misplaced")]
@@ -722,21 +739,6 @@ impl<'a> LeadFitter<'a> {
     /// The nest the fitter fits leads in.
     pub fn nest(&self) -> &'a Nest {
         self.nest
-    }
-
-    /// This fitter with the settings paths are fitted under: no overcut and no tabs (a path's
-    /// cut is the solver's, not a contour round and on).
-    pub fn for_paths(&self) -> LeadFitter<'a> {
-        LeadFitter {
-            nest: self.nest,
-            forest: self.forest.clone(),
-            settings: KerfSettings {
-                overcut: 0.0,
-                tabs: TabSpec::default(),
-                ..self.settings
-            },
-            boxes: self.boxes.clone(),
-        }
     }
 
     /// The nest's containment forest.
@@ -885,7 +887,7 @@ impl<'a> LeadFitter<'a> {
     /// An edge lead-in to `entry` of contour `r`: the straight line from the nearest point of
     /// the sheet's border, when edge piercing is on, `r` may be pierced at the border, the line
     /// is no longer than [`KerfSettings::edge_reach`] and it keeps kerf/2 from every contour.
-    fn edge_lead_in(&self, r: ContourRef, entry: Point) -> Option<Vec<Vertex>> {
+    pub(crate) fn edge_lead_in(&self, r: ContourRef, entry: Point) -> Option<Vec<Vertex>> {
         if !self.settings.edge_pierce {
             return None;
         }

@@ -10,14 +10,24 @@
 //! that starts or ends inside a chain of edges (contours meeting on the kerf nest) keeps its
 //! ends, which the rest of the route depends on: there the leads are the asked ones, shorter
 //! and turned ones, on either side of the cut. A contour where none fits is reported, never
-//! dropped. Overcut and tabs are not applied to paths.
+//! dropped.
+//!
+//! With edge piercing on ([`KerfSettings::edge_pierce`]) a path that starts on the equidistant
+//! of a part's outer contour in the sheet's scrap may start with a straight edge lead-in from
+//! the sheet's border, the contour steps' own (`LeadFitter::edge_lead_in`). A closed path
+//! (one that ends where it starts) runs on past its start by the overcut before its lead-out,
+//! over its own first spans ([`PathLeads::overcut_spans`]); an open path ends where the solver
+//! ends it and gets no overcut (running on would cut past a piece the route cuts elsewhere).
+//! A path that cuts a part's outer contour round (one equidistant, from its start back to it)
+//! gets that contour's tabs, placed as a contour step's ([`crate::place_tabs`]); a part whose
+//! outer contour is cut in pieces by several paths (chains of common edges) gets none.
 
 use serde::{Deserialize, Serialize};
 
-use crate::leads::{lead_in_chain, lead_out_chain, vertex, vertex_triples};
+use crate::leads::{lead_in_chain, lead_out_chain, split_at_tabs, vertex, vertex_triples};
 use crate::{
     chain_spans, opened_at, Contour, ContourRef, KerfSettings, LeadError, LeadFitter, LeadProblem,
-    PathRoute, Point, Span, StepLeads, ToolOnPath, Vertex,
+    PathRoute, Point, Span, StepLeads, Tab, ToolOnPath, Vertex,
 };
 
 /// How far (mm) a point may lie from an equidistant and still count as on it: the checker's
@@ -52,9 +62,58 @@ pub struct PathLeads {
     /// d₂ the switch-off point was placed under, mm.
     #[serde(default)]
     pub switch_off_clearance: f64,
+    /// How far a closed path runs on past its start over its own first spans before the
+    /// lead-out, mm (0 on open paths).
+    #[serde(default)]
+    pub overcut: f64,
+    /// M lies on the sheet's border (an edge pierce, see [`KerfSettings::edge_pierce`]): the
+    /// checker holds it to the border instead of G_M.
+    #[serde(default)]
+    pub edge_pierce: bool,
+    /// Micro-joints of the path's cut, in cut order, their arc lengths measured along the
+    /// spans from the entry.
+    #[serde(default)]
+    pub tabs: Vec<Tab>,
 }
 
 impl PathLeads {
+    /// Total width of the tabs' gaps, mm.
+    pub fn tab_width(&self) -> f64 {
+        self.tabs.iter().map(Tab::width).sum()
+    }
+
+    /// `spans` (the path's, from the entry) split at the tabs: the pieces the torch cuts
+    /// between the entry, the gaps and the end (one piece without tabs).
+    pub fn pieces(&self, spans: &[Span], min_piece: f64) -> Vec<Vec<Span>> {
+        if self.tabs.is_empty() {
+            // The spans as they are (splitting would rebuild each span from its ends).
+            return vec![spans.to_vec()];
+        }
+        split_at_tabs(spans.to_vec(), &self.tabs, min_piece)
+    }
+
+    /// The overcut of a path whose spans (from the entry) are `spans`: its first spans up to
+    /// [`PathLeads::overcut`] mm, the last one cut short. Pieces no longer than `min_piece`
+    /// are dropped.
+    pub fn overcut_spans(&self, spans: &[Span], min_piece: f64) -> Vec<Span> {
+        let mut out = Vec::new();
+        let mut left = self.overcut;
+        for span in spans {
+            if !(left > min_piece) {
+                break;
+            }
+            let l = span.length();
+            if l <= left {
+                out.push(*span);
+                left -= l;
+            } else {
+                out.push(span.sub_span(0.0, left / l));
+                left = 0.0;
+            }
+        }
+        out
+    }
+
     /// Length of the lead-in, mm.
     pub fn lead_in_length(&self) -> f64 {
         chain_spans(&self.lead_in).map(|s| s.length()).sum()
@@ -93,9 +152,8 @@ impl PathLeads {
             overcut: 0.0,
             pierce_clearance: self.pierce_clearance,
             switch_off_clearance: self.switch_off_clearance,
-            tabs: Vec::new(),
-            // A path's leads are fitted in G_M (edge piercing is for whole contours).
-            edge_pierce: false,
+            tabs: self.tabs.clone(),
+            edge_pierce: self.edge_pierce,
             kerf_pierce: None,
         }
     }
@@ -114,7 +172,6 @@ impl PathLeads {
             pierce_clearance: self.pierce_clearance,
             switch_off_clearance: self.switch_off_clearance,
             tabs: Vec::new(),
-            // A path's leads are fitted in G_M (edge piercing is for whole contours).
             edge_pierce: false,
             kerf_pierce: None,
         }
@@ -279,8 +336,8 @@ impl LeadFitter<'_> {
     }
 
     /// `path` (a path over [`LeadFitter::kerf_nest`], its spans on the equidistants) with
-    /// leads (see the module notes). Use a fitter [`LeadFitter::for_paths`]. An empty path is
-    /// returned as it is (the checker reports it).
+    /// leads (see the module notes). An empty path is returned as it is (the checker reports
+    /// it).
     pub fn attach_path(&self, path: &ToolOnPath) -> Result<ToolOnPath, LeadError> {
         let (Some(first), Some(last)) = (path.spans.first(), path.spans.last()) else {
             return Ok(path.clone());
@@ -290,32 +347,46 @@ impl LeadFitter<'_> {
         // count as on an equidistant and are moved onto it.
         let snap = self.nest().check_tolerance().max(ON_EQUIDISTANT);
         let at_start = self.contours_near_equidistant(first.start, snap);
+        // A closed path runs on past its start; an open one ends where the solver ends it.
+        let overcut = if first.start.distance(last.end) <= snap {
+            self.settings().overcut
+        } else {
+            0.0
+        };
         if let Some((r, eq)) = self.whole_loop(path, &at_start, snap) {
+            // Fitted as a contour step with the overcut: its lead-out leaves where it ends.
             let leads = self.fit_on(r, &eq, path.pierce)?;
             let spans = opened_at(&eq, leads.entry, MIN_PIECE);
-            let exit = spans.last().map_or(leads.entry, |s| s.end);
-            let mut lead_out = leads.lead_out.clone();
-            if let Some(v) = lead_out.first_mut() {
-                // The same point computed twice (frame and opening): the cut's end is exact.
-                v.point = exit;
-            }
             let entry = spans.first().map_or(leads.entry, |s| s.start);
             let mut lead_in = leads.lead_in.clone();
             if let Some(v) = lead_in.last_mut() {
                 v.point = entry;
             }
+            let mut path_leads = PathLeads {
+                entry,
+                lead_in,
+                lead_out: leads.lead_out.clone(),
+                switch_off: leads.switch_off,
+                offset: leads.offset,
+                pierce_clearance: leads.pierce_clearance,
+                switch_off_clearance: leads.switch_off_clearance,
+                overcut: leads.overcut,
+                edge_pierce: leads.edge_pierce,
+                tabs: leads.tabs.clone(),
+            };
+            let exit = path_leads
+                .overcut_spans(&spans, MIN_PIECE)
+                .last()
+                .or(spans.last())
+                .map_or(entry, |s| s.end);
+            if let Some(v) = path_leads.lead_out.first_mut() {
+                // The same point computed twice (frame and opening): the cut's end is exact.
+                v.point = exit;
+            }
             return Ok(ToolOnPath {
                 pierce: leads.pierce,
                 spans,
-                leads: Some(PathLeads {
-                    entry,
-                    lead_in,
-                    lead_out,
-                    switch_off: leads.switch_off,
-                    offset: leads.offset,
-                    pierce_clearance: leads.pierce_clearance,
-                    switch_off_clearance: leads.switch_off_clearance,
-                }),
+                leads: Some(path_leads),
             });
         }
         let onto = |p: Point, candidates: &[ContourRef]| {
@@ -328,36 +399,57 @@ impl LeadFitter<'_> {
         let at_end = self.contours_near_equidistant(last.end, snap);
         let mut spans = path.spans.clone();
         let start = onto(first.start, &at_start);
-        let end = onto(last.end, &at_end);
+        let end = if overcut > 0.0 {
+            start
+        } else {
+            onto(last.end, &at_end)
+        };
         spans[0].start = start;
         let n = spans.len();
         spans[n - 1].end = end;
-        let lead_in = self.fit_path_end(&at_start, start, spans[0].tangent_at(0.0), true)?;
-        let lead_out = self.fit_path_end(&at_end, end, spans[n - 1].tangent_at(1.0), false)?;
         let settings = self.settings();
+        let mut leads = PathLeads {
+            entry: start,
+            lead_in: Vec::new(),
+            lead_out: Vec::new(),
+            switch_off: end,
+            offset: settings.kerf / 2.0,
+            pierce_clearance: settings.pierce_clearance,
+            switch_off_clearance: settings.switch_off_clearance,
+            overcut,
+            edge_pierce: false,
+            tabs: Vec::new(),
+        };
+        let edge_lead = at_start.iter().find_map(|&r| self.edge_lead_in(r, start));
+        leads.edge_pierce = edge_lead.is_some();
+        leads.lead_in = match edge_lead {
+            Some(chain) => chain,
+            None => self.fit_path_end(&at_start, start, spans[0].tangent_at(0.0), true)?,
+        };
+        let (exit, exit_tangent, at_exit) = match leads.overcut_spans(&spans, MIN_PIECE).last() {
+            Some(s) => (
+                s.end,
+                s.tangent_at(1.0),
+                self.contours_near_equidistant(s.end, snap),
+            ),
+            None => (end, spans[n - 1].tangent_at(1.0), at_end),
+        };
+        leads.lead_out = self.fit_path_end(&at_exit, exit, exit_tangent, false)?;
+        leads.switch_off = leads.lead_out.last().map_or(exit, |v| v.point);
         Ok(ToolOnPath {
-            pierce: lead_in[0].point,
+            pierce: leads.lead_in[0].point,
             spans,
-            leads: Some(PathLeads {
-                entry: start,
-                switch_off: lead_out.last().map_or(end, |v| v.point),
-                lead_in,
-                lead_out,
-                offset: settings.kerf / 2.0,
-                pierce_clearance: settings.pierce_clearance,
-                switch_off_clearance: settings.switch_off_clearance,
-            }),
+            leads: Some(leads),
         })
     }
 
     /// `route` (over [`LeadFitter::kerf_nest`]) with leads on every path; fails with every
     /// contour where no lead fits.
     pub fn attach_paths(&self, route: &PathRoute) -> Result<PathRoute, Vec<LeadError>> {
-        let fitter = self.for_paths();
         let mut errors = Vec::new();
         let mut paths = Vec::with_capacity(route.paths.len());
         for path in &route.paths {
-            match fitter.attach_path(path) {
+            match self.attach_path(path) {
                 Ok(p) => paths.push(p),
                 Err(e) => errors.push(e),
             }
@@ -373,7 +465,9 @@ impl LeadFitter<'_> {
     }
 
     /// Every rule the leads of `path` break (this fitter's nest; the rules are the leads'):
-    /// the chains joined to M, the entry, the exit and M*; the entry and exit on the
+    /// the chains joined to M, the entry, the exit (after the overcut) and M*; an overcut only
+    /// on a closed path and no longer than it; an edge pierce's M on the sheet's border, its
+    /// contour a part's outer one in the sheet's scrap; the entry and exit on the
     /// equidistant of some contour; M ∈ G_M and M* ∈ G_M* of that contour; both leads at
     /// least kerf/2 from every contour. `tolerance` is how far joined points may lie apart.
     pub fn path_lead_problems(
@@ -384,9 +478,40 @@ impl LeadFitter<'_> {
     ) -> Vec<LeadProblem> {
         let mut problems = Vec::new();
         let near = |a: Option<Point>, b: Point| a.is_some_and(|a| a.distance(b) <= tolerance);
+        // An overcut runs on over the path's first spans: only a closed path has them after
+        // its end, and only as far as the path goes.
+        let overcut = leads.overcut;
+        if overcut != 0.0 {
+            let length: f64 = path.spans.iter().map(Span::length).sum();
+            let closed = path
+                .spans
+                .first()
+                .zip(path.spans.last())
+                .is_some_and(|(a, b)| a.start.distance(b.end) <= tolerance);
+            if !(overcut > 0.0 && overcut <= length + tolerance && closed) {
+                problems.push(LeadProblem::OvercutMisplaced { length: overcut });
+            }
+        }
+        // Tabs lie within the path's own cut (the contour checker places them on the
+        // equidistant and away from its corners).
+        let length: f64 = path.spans.iter().map(Span::length).sum();
+        problems.extend(
+            leads
+                .tabs
+                .iter()
+                .filter(|t| !(t.start >= 0.0 && t.end <= length + tolerance))
+                .map(|t| LeadProblem::TabMisplaced {
+                    x: t.from.x,
+                    y: t.from.y,
+                }),
+        );
+        let exit = leads
+            .overcut_spans(&path.spans, MIN_PIECE)
+            .last()
+            .map_or(path.end(), |s| s.end);
         let joined = near(leads.lead_in.first().map(|v| v.point), path.pierce)
             && near(leads.lead_in.last().map(|v| v.point), leads.entry)
-            && near(leads.lead_out.first().map(|v| v.point), path.end())
+            && near(leads.lead_out.first().map(|v| v.point), exit)
             && near(leads.lead_out.last().map(|v| v.point), leads.switch_off);
         if !joined {
             problems.push(LeadProblem::Disjoint);

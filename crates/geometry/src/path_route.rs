@@ -68,9 +68,25 @@ impl ToolOnPath {
             .map_or(0.0, |l| l.lead_in_length() + l.lead_out_length())
     }
 
-    /// Tool-on length of the path, leads included, mm.
+    /// The overcut's spans: the path's first spans again, as far as its leads' overcut (none
+    /// without leads or overcut).
+    pub fn overcut_spans(&self) -> Vec<Span> {
+        self.leads
+            .as_ref()
+            .map_or_else(Vec::new, |l| l.overcut_spans(&self.spans, 0.0))
+    }
+
+    /// The path's tabs (micro-joints), none without leads.
+    pub fn tabs(&self) -> &[crate::Tab] {
+        self.leads.as_ref().map_or(&[], |l| l.tabs.as_slice())
+    }
+
+    /// Tool-on length of the path, leads and overcut included, the tabs' gaps left out, mm.
     pub fn length(&self) -> f64 {
-        self.spans.iter().map(|s| s.length()).sum::<f64>() + self.leads_length()
+        self.spans.iter().map(|s| s.length()).sum::<f64>()
+            + self.overcut_spans().iter().map(Span::length).sum::<f64>()
+            + self.leads_length()
+            - self.leads.as_ref().map_or(0.0, PathLeads::tab_width)
     }
 }
 
@@ -439,13 +455,15 @@ impl PathRoute {
         })
     }
 
-    /// The straight idle moves `(from, to)`: start → first pierce, each path's end → next
-    /// pierce, last end → finish.
+    /// The straight idle moves `(from, to)`: start → first pierce, the crossings of each
+    /// path's tabs, each path's end → next pierce, last end → finish.
     pub fn idle_moves(&self) -> Vec<(Point, Point)> {
         let mut moves = Vec::with_capacity(self.paths.len() + 1);
         let mut at = self.start;
         for p in &self.paths {
             moves.push((at, p.pierce));
+            // The head crosses each tab's gap with the torch off.
+            moves.extend(p.tabs().iter().map(|tab| (tab.from, tab.to)));
             at = p.switch_off();
         }
         if let Some(finish) = self.finish {
@@ -464,9 +482,18 @@ impl PathRoute {
         self.paths.iter().map(|p| p.length()).sum()
     }
 
-    /// Number of pierces: one per path.
+    /// Number of pierces: one per path, and one after every tab.
     pub fn pierce_count(&self) -> usize {
-        self.paths.len()
+        self.paths.len() + self.paths.iter().map(|p| p.tabs().len()).sum::<usize>()
+    }
+
+    /// The pierces of [`PathRoute::pierce_count`] made at the sheet's edge (edge-pierced
+    /// paths, priced at the machine's edge-pierce time).
+    pub fn edge_pierce_count(&self) -> usize {
+        self.paths
+            .iter()
+            .filter(|p| p.leads.as_ref().is_some_and(|l| l.edge_pierce))
+            .count()
     }
 
     /// Machining time, seconds (formula 1.2).

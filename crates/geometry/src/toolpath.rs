@@ -212,10 +212,7 @@ impl Toolpath {
                 at: path.pierce,
                 step,
             });
-            // With leads: the lead-in, the spans, the lead-out, torch on throughout.
-            let lead_in = path.leads.iter().flat_map(|l| chain_spans(&l.lead_in));
-            let lead_out = path.leads.iter().flat_map(|l| chain_spans(&l.lead_out));
-            for span in lead_in.chain(path.spans.iter().copied()).chain(lead_out) {
+            let push = |moves: &mut Vec<ToolMove>, span: Span| {
                 if span.length() > MIN_PIECE_LENGTH {
                     moves.push(ToolMove::Cut {
                         step,
@@ -223,7 +220,31 @@ impl Toolpath {
                         link: false,
                     });
                 }
+            };
+            // With leads: the lead-in, the spans (torch off across each tab's gap, pierce
+            // again after it), the overcut, the lead-out.
+            let lead_in = path.leads.iter().flat_map(|l| chain_spans(&l.lead_in));
+            lead_in.for_each(|span| push(&mut moves, span));
+            let pieces = match &path.leads {
+                Some(l) => l.pieces(&path.spans, MIN_PIECE_LENGTH),
+                None => vec![path.spans.clone()],
+            };
+            let tabs = path.tabs();
+            for (k, piece) in pieces.into_iter().enumerate() {
+                if let Some(tab) = k.checked_sub(1).and_then(|t| tabs.get(t)) {
+                    moves.push(ToolMove::Idle {
+                        from: tab.from,
+                        to: tab.to,
+                    });
+                    moves.push(ToolMove::Pierce { at: tab.to, step });
+                }
+                piece.into_iter().for_each(|span| push(&mut moves, span));
             }
+            path.overcut_spans()
+                .into_iter()
+                .for_each(|span| push(&mut moves, span));
+            let lead_out = path.leads.iter().flat_map(|l| chain_spans(&l.lead_out));
+            lead_out.for_each(|span| push(&mut moves, span));
             at = path.switch_off();
         }
         if let Some(finish) = route.finish {

@@ -87,6 +87,10 @@ fn as_paths(route: &Route, nest: &Nest) -> PathRoute {
                     offset: leads.offset,
                     pierce_clearance: leads.pierce_clearance,
                     switch_off_clearance: leads.switch_off_clearance,
+                    // The spans are the step's whole cut already.
+                    overcut: 0.0,
+                    edge_pierce: leads.edge_pierce,
+                    tabs: Vec::new(),
                 }),
             }
         })

@@ -114,6 +114,7 @@ fn plasma() -> cutroute_geometry::KerfSettings {
         overcut: 0.0,
         tabs: TabSpec::default(),
         edge_pierce: false,
+        kerf_pierce: false,
     }
 }
 
