@@ -546,16 +546,6 @@ mod tests {
     use crate::{LeadShape, LeadSpec, Nest, Part, PathLeadError, PathRouteError, Route};
     use proptest::prelude::*;
 
-    /// Clockwise rectangle (outer contours run clockwise).
-    fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> Contour {
-        Contour::new(vec![
-            Vertex::line(x0, y0),
-            Vertex::line(x0, y1),
-            Vertex::line(x1, y1),
-            Vertex::line(x1, y0),
-        ])
-    }
-
     fn nest(contours: Vec<Vec<Contour>>) -> Nest {
         let mut nest = Nest {
             sheet: None,
@@ -585,8 +575,11 @@ mod tests {
     /// A plate 100 × 60 with a 40 × 30 hole, and a second part 50 × 50 beside it.
     fn plates() -> Nest {
         nest(vec![
-            vec![rect(0.0, 0.0, 100.0, 60.0), rect(20.0, 15.0, 60.0, 45.0)],
-            vec![rect(130.0, 0.0, 180.0, 50.0)],
+            vec![
+                Contour::rectangle(0.0, 0.0, 100.0, 60.0),
+                Contour::rectangle(20.0, 15.0, 60.0, 45.0),
+            ],
+            vec![Contour::rectangle(130.0, 0.0, 180.0, 50.0)],
         ])
     }
 
@@ -722,8 +715,8 @@ mod tests {
         // Two squares 1 mm apart: their equidistants at 1 mm cross, each cut burns into the
         // other part.
         let close = nest(vec![
-            vec![rect(0.0, 0.0, 50.0, 50.0)],
-            vec![rect(51.0, 0.0, 101.0, 50.0)],
+            vec![Contour::rectangle(0.0, 0.0, 50.0, 50.0)],
+            vec![Contour::rectangle(51.0, 0.0, 101.0, 50.0)],
         ]);
         let fitter = LeadFitter::new(&close, plasma());
         let kerf_nest = fitter.kerf_nest();
@@ -742,7 +735,7 @@ mod tests {
     fn open_paths_keep_their_ends_and_get_leads_on_the_scrap_side() {
         // One square's equidistant cut in two open paths, the second against the contour's
         // direction: its scrap is on the right, so its leads are the mirrored ones.
-        let nest = nest(vec![vec![rect(0.0, 0.0, 50.0, 50.0)]]);
+        let nest = nest(vec![vec![Contour::rectangle(0.0, 0.0, 50.0, 50.0)]]);
         let fitter = LeadFitter::new(&nest, plasma());
         let r = ContourRef {
             part: 0,
@@ -773,8 +766,8 @@ mod tests {
     fn a_contour_without_room_is_reported() {
         // A 3 mm hole: with kerf 2 and d₁ 5 no pierce point fits inside it.
         let nest = nest(vec![vec![
-            rect(0.0, 0.0, 60.0, 60.0),
-            rect(20.0, 20.0, 23.0, 23.0),
+            Contour::rectangle(0.0, 0.0, 60.0, 60.0),
+            Contour::rectangle(20.0, 20.0, 23.0, 23.0),
         ]]);
         let errors = with_leads(&nest, plasma()).expect_err("no room in the hole");
         assert!(errors.iter().any(|e| match e {
@@ -804,8 +797,8 @@ mod tests {
                 for j in 0..rows {
                     let (x, y) = (i as f64 * (w + gap), j as f64 * (h + gap));
                     parts.push(vec![
-                        rect(x, y, x + w, y + h),
-                        rect(x + w / 4.0, y + h / 4.0, x + 3.0 * w / 4.0, y + 3.0 * h / 4.0),
+                        Contour::rectangle(x, y, x + w, y + h),
+                        Contour::rectangle(x + w / 4.0, y + h / 4.0, x + 3.0 * w / 4.0, y + 3.0 * h / 4.0),
                     ]);
                 }
             }

@@ -849,16 +849,6 @@ mod tests {
 
     const TOL: f64 = 1e-7;
 
-    /// Clockwise rectangle (outer contours run clockwise).
-    fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> Contour {
-        Contour::new(vec![
-            Vertex::line(x0, y0),
-            Vertex::line(x0, y1),
-            Vertex::line(x1, y1),
-            Vertex::line(x1, y0),
-        ])
-    }
-
     fn part(contours: Vec<Contour>) -> Part {
         Part {
             name: String::new(),
@@ -891,8 +881,8 @@ mod tests {
         Nest {
             sheet: None,
             parts: vec![
-                part(vec![rect(0.0, 0.0, 10.0, 10.0)]),
-                part(vec![rect(10.0, 0.0, 20.0, 10.0)]),
+                part(vec![Contour::rectangle(0.0, 0.0, 10.0, 10.0)]),
+                part(vec![Contour::rectangle(10.0, 0.0, 20.0, 10.0)]),
             ],
         }
     }
@@ -903,10 +893,10 @@ mod tests {
             sheet: None,
             parts: vec![
                 part(vec![
-                    rect(0.0, 0.0, 100.0, 100.0),
-                    rect(20.0, 20.0, 80.0, 80.0).reversed(),
+                    Contour::rectangle(0.0, 0.0, 100.0, 100.0),
+                    Contour::rectangle(20.0, 20.0, 80.0, 80.0).reversed(),
                 ]),
-                part(vec![rect(40.0, 40.0, 60.0, 60.0)]),
+                part(vec![Contour::rectangle(40.0, 40.0, 60.0, 60.0)]),
             ],
         }
     }
@@ -1021,7 +1011,7 @@ mod tests {
         let tolerance = 0.01;
         let nest = Nest {
             sheet: None,
-            parts: vec![part(vec![rect(0.0, 0.0, 10.0, 10.0)])],
+            parts: vec![part(vec![Contour::rectangle(0.0, 0.0, 10.0, 10.0)])],
         };
         let pierce = 1.3 * tolerance;
         let route = PathRoute {
@@ -1377,7 +1367,7 @@ mod tests {
         fn dropped_or_repeated_spans_are_found(path in 0..6usize, pick in 0.0..1.0f64, fraction in 0.0..1.0f64) {
             let nest = Nest {
                 sheet: None,
-                parts: (0..6).map(|i| part(vec![Contour::circle(p(i as f64 * 30.0, 0.0), 10.0, true), rect(i as f64 * 30.0 - 5.0, -5.0, i as f64 * 30.0 + 5.0, 3.0).reversed()])).collect(),
+                parts: (0..6).map(|i| part(vec![Contour::circle(p(i as f64 * 30.0, 0.0), 10.0, true), Contour::rectangle(i as f64 * 30.0 - 5.0, -5.0, i as f64 * 30.0 + 5.0, 3.0).reversed()])).collect(),
             };
             let steps = (0..6).flat_map(|i| {
                 let hole = ContourRef { part: i, contour: 1 };
@@ -1412,7 +1402,7 @@ mod tests {
         fn whole_contour_routes_stay_valid(order in Just((0..6usize).collect::<Vec<_>>()).prop_shuffle(), fractions in prop::collection::vec(0.0..1.0f64, 6)) {
             let nest = Nest {
                 sheet: None,
-                parts: (0..6).map(|i| part(vec![rect(i as f64 * 15.0, 0.0, i as f64 * 15.0 + 10.0, 7.0)])).collect(),
+                parts: (0..6).map(|i| part(vec![Contour::rectangle(i as f64 * 15.0, 0.0, i as f64 * 15.0 + 10.0, 7.0)])).collect(),
             };
             let steps = order.iter().map(|&i| {
                 let r = ContourRef { part: i, contour: 0 };

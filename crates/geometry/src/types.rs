@@ -57,6 +57,25 @@ impl Contour {
     pub fn new(vertices: Vec<Vertex>) -> Self {
         Self { vertices }
     }
+
+    /// The axis-parallel rectangle with corners (x0, y0) and (x1, y1), its vertices in the
+    /// order (x0, y0), (x0, y1), (x1, y1), (x1, y0): clockwise when x0 < x1 and y0 < y1, the
+    /// direction outer contours run in.
+    ///
+    /// ```
+    /// use cutroute_geometry::Contour;
+    /// let square = Contour::rectangle(0.0, 0.0, 10.0, 10.0);
+    /// assert_eq!(square.vertices.len(), 4);
+    /// assert!((square.perimeter() - 40.0).abs() < 1e-12);
+    /// ```
+    pub fn rectangle(x0: f64, y0: f64, x1: f64, y1: f64) -> Self {
+        Self::new(vec![
+            Vertex::line(x0, y0),
+            Vertex::line(x0, y1),
+            Vertex::line(x1, y1),
+            Vertex::line(x1, y0),
+        ])
+    }
 }
 
 /// A part: its outer contour first, then its holes.

@@ -6,15 +6,6 @@ use cutroute_geometry::{
     MachineParameters, Nest, Part, Point, Route, TabSpec, Vertex,
 };
 
-fn rectangle(x0: f64, y0: f64, x1: f64, y1: f64) -> Contour {
-    Contour::new(vec![
-        Vertex::line(x0, y0),
-        Vertex::line(x0, y1),
-        Vertex::line(x1, y1),
-        Vertex::line(x1, y0),
-    ])
-}
-
 /// Kerf 2, d₁ 5, d₂ 1, an 8 mm arc lead-in, a 2 mm line lead-out, edge piercing on.
 fn plasma_edge() -> KerfSettings {
     KerfSettings {
@@ -36,24 +27,24 @@ fn nest() -> Nest {
     let mut nest = Nest {
         sheet: Some(Part {
             name: "sheet".into(),
-            contours: vec![rectangle(0.0, 0.0, 200.0, 100.0)],
+            contours: vec![Contour::rectangle(0.0, 0.0, 200.0, 100.0)],
         }),
         parts: vec![
             Part {
                 name: "edge".into(),
-                contours: vec![rectangle(4.0, 4.0, 40.0, 30.0)],
+                contours: vec![Contour::rectangle(4.0, 4.0, 40.0, 30.0)],
             },
             Part {
                 name: "middle".into(),
-                contours: vec![rectangle(80.0, 30.0, 120.0, 70.0)],
+                contours: vec![Contour::rectangle(80.0, 30.0, 120.0, 70.0)],
             },
             Part {
                 name: "blocker".into(),
-                contours: vec![rectangle(3.0, 55.0, 9.0, 65.0)],
+                contours: vec![Contour::rectangle(3.0, 55.0, 9.0, 65.0)],
             },
             Part {
                 name: "behind".into(),
-                contours: vec![rectangle(20.0, 45.0, 50.0, 75.0)],
+                contours: vec![Contour::rectangle(20.0, 45.0, 50.0, 75.0)],
             },
         ],
     };

@@ -7,15 +7,6 @@ use cutroute_geometry::{
     MachineParameters, Nest, Part, Point, Route, RouteError, TabSpec, Vertex,
 };
 
-fn rectangle(x0: f64, y0: f64, x1: f64, y1: f64) -> Contour {
-    Contour::new(vec![
-        Vertex::line(x0, y0),
-        Vertex::line(x0, y1),
-        Vertex::line(x1, y1),
-        Vertex::line(x1, y0),
-    ])
-}
-
 /// Kerf 2, d₁ 5, d₂ 1, an 8 mm line lead-in, a 2 mm line lead-out, kerf piercing on.
 fn plasma() -> KerfSettings {
     KerfSettings {
@@ -48,11 +39,11 @@ fn nest() -> Nest {
         contours: vec![c],
     };
     let mut nest = Nest {
-        sheet: Some(part("sheet", rectangle(0.0, 0.0, 300.0, 200.0))),
+        sheet: Some(part("sheet", Contour::rectangle(0.0, 0.0, 300.0, 200.0))),
         parts: vec![
-            part("first", rectangle(60.0, 60.0, 100.0, 100.0)),
-            part("beside", rectangle(108.0, 60.0, 148.0, 100.0)),
-            part("far", rectangle(220.0, 140.0, 260.0, 180.0)),
+            part("first", Contour::rectangle(60.0, 60.0, 100.0, 100.0)),
+            part("beside", Contour::rectangle(108.0, 60.0, 148.0, 100.0)),
+            part("far", Contour::rectangle(220.0, 140.0, 260.0, 180.0)),
         ],
     };
     nest.normalize_orientation();

@@ -8,15 +8,6 @@ use cutroute_geometry::{
     Vertex,
 };
 
-fn rectangle(x0: f64, y0: f64, x1: f64, y1: f64) -> Contour {
-    Contour::new(vec![
-        Vertex::line(x0, y0),
-        Vertex::line(x0, y1),
-        Vertex::line(x1, y1),
-        Vertex::line(x1, y0),
-    ])
-}
-
 /// Kerf 2, d₁ 5, d₂ 1, an 8 mm arc lead-in, a 2 mm line lead-out, 3 mm overcut, edge
 /// piercing on.
 fn plasma() -> KerfSettings {
@@ -37,18 +28,18 @@ fn nest() -> Nest {
     let mut nest = Nest {
         sheet: Some(Part {
             name: "sheet".into(),
-            contours: vec![rectangle(0.0, 0.0, 200.0, 100.0)],
+            contours: vec![Contour::rectangle(0.0, 0.0, 200.0, 100.0)],
         }),
         parts: vec![
             Part {
                 name: "edge".into(),
-                contours: vec![rectangle(4.0, 4.0, 40.0, 30.0)],
+                contours: vec![Contour::rectangle(4.0, 4.0, 40.0, 30.0)],
             },
             Part {
                 name: "middle".into(),
                 contours: vec![
-                    rectangle(80.0, 30.0, 140.0, 70.0),
-                    rectangle(95.0, 40.0, 125.0, 60.0),
+                    Contour::rectangle(80.0, 30.0, 140.0, 70.0),
+                    Contour::rectangle(95.0, 40.0, 125.0, 60.0),
                 ],
             },
         ],
