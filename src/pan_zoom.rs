@@ -19,7 +19,7 @@
 use std::collections::HashMap;
 use std::time::Duration;
 
-use cutroute_geometry::{BoundingBox, Point, Viewport};
+use cutroute_geometry::{BoundingBox, Point, Transform, Viewport};
 use leptos::prelude::*;
 use wasm_bindgen::JsCast;
 use web_sys::{KeyboardEvent, PointerEvent, SvgGraphicsElement, WheelEvent};
@@ -61,34 +61,38 @@ pub fn gesture_transform(a: f64, committed: Viewport, live: Viewport) -> (f64, f
     (a * k * (c0.x - c.x), a * k * (c0.y - c.y), k)
 }
 
-/// Screen ↔ drawing mapping of a live view box, from the screen matrix of the committed one.
+/// Screen → drawing mapping of a live view box, from the screen matrix of the committed one:
+/// a similarity (scale about the screen centre of the view, then a move to the live view's
+/// centre), in geometry's `Transform` like every other affine map of the project.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct LiveMapping {
-    /// Screen pixels per drawing unit in the live view.
-    scale: f64,
-    /// Screen point of the committed view's centre (also the live view's centre).
-    screen_centre: Point,
-    /// Drawing point at the centre of the live view.
-    live_centre: Point,
+    to_drawing: Transform,
 }
 
 impl LiveMapping {
     /// The mapping, given the committed view's screen matrix `screen = a · user + (e, f)`.
     fn new(a: f64, e: f64, f: f64, committed: Viewport, live: Viewport) -> Self {
         let centre = committed.centre();
+        // Screen pixels per drawing unit in the live view.
+        let scale = a * committed.width / live.width;
+        // The committed view's centre on screen is the live view's centre.
+        let screen_centre = Point::new(a * centre.x + e, a * centre.y + f);
+        let live_centre = live.centre();
         Self {
-            scale: a * committed.width / live.width,
-            screen_centre: Point::new(a * centre.x + e, a * centre.y + f),
-            live_centre: live.centre(),
+            to_drawing: Transform::translation(-screen_centre.x, -screen_centre.y)
+                .then(&Transform::scaling(1.0 / scale))
+                .then(&Transform::translation(live_centre.x, live_centre.y)),
         }
     }
 
     /// The drawing point under a screen point.
     fn drawing_at(self, client_x: f64, client_y: f64) -> Point {
-        Point::new(
-            self.live_centre.x + (client_x - self.screen_centre.x) / self.scale,
-            self.live_centre.y + (client_y - self.screen_centre.y) / self.scale,
-        )
+        self.to_drawing.apply(Point::new(client_x, client_y))
+    }
+
+    /// The drawing vector of a screen move.
+    fn drawing_vector(self, dx: f64, dy: f64) -> Point {
+        self.to_drawing.apply_vector(Point::new(dx, dy))
     }
 }
 
@@ -292,10 +296,7 @@ impl PanZoom {
                 view.zoomed_about(d_before / d_now, mapping.drawing_at(mid.0, mid.1))
             }
         } else {
-            view.panned(Point::new(
-                -(now.0 - before.0) / mapping.scale,
-                -(now.1 - before.1) / mapping.scale,
-            ))
+            view.panned(-mapping.drawing_vector(now.0 - before.0, now.1 - before.1))
         };
         self.pointers.update_value(|p| {
             p.insert(id, now);
