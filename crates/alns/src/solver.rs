@@ -84,8 +84,10 @@ struct FamilyAt {
 }
 
 /// Runs move family `family` (0 2-opt, 1 or-opt, 2 reinsertion, 3 block reversal of segments
-/// up to `max_len`) on `tour` until `pause()`: whether it improved the tour, and whether it is
-/// finished (else it goes on from `at` in the next call, with the result of one call).
+/// up to `max_len`) on `tour` until `pause()`, setting `changed` when it improved the tour;
+/// whether it is finished. Unfinished, `at` is marked under way and the next call goes on from
+/// it (with the result of one call); finished, `at` is reset for the next family.
+#[allow(clippy::too_many_arguments)]
 fn run_family(
     search: &mut LocalSearch,
     p: &Problem,
@@ -93,14 +95,22 @@ fn run_family(
     family: u8,
     max_len: usize,
     at: &mut FamilyAt,
+    changed: &mut bool,
     pause: &dyn Fn() -> bool,
-) -> (bool, bool) {
-    match family {
+) -> bool {
+    let (better, finished) = match family {
         0 => search.two_opt_until(p, tour, pause),
         1 => search.or_opt_until(p, tour, pause),
         2 => search.reinsert_until(p, tour, &mut at.reinsert, pause),
         _ => search.block_reverse_until(p, tour, max_len, pause),
+    };
+    *changed |= better;
+    if finished {
+        *at = FamilyAt::default();
+    } else {
+        at.partial = true;
     }
+    finished
 }
 
 /// An iteration under way ([`AlnsSolver::iterate_unit`]): its operators, its candidate and
@@ -430,46 +440,40 @@ impl AlnsSolver {
                 if descent.unit == 0 && !descent.family.partial {
                     descent.changed = false;
                 }
-                let family = &mut descent.family;
-                let (better, finished) = run_family(
+                let finished = run_family(
                     &mut self.local_search,
                     p,
                     &mut tour,
                     descent.unit,
                     max_len,
-                    family,
+                    &mut descent.family,
+                    &mut descent.changed,
                     pause,
                 );
-                descent.changed |= better;
                 if !finished {
-                    family.partial = true;
                     self.current = tour;
                     self.descent = Some(descent);
                     return false;
                 }
-                descent.family = FamilyAt::default();
             }
             3 => {
                 // Block reversal only after a round that changed nothing (or to finish it).
                 if !descent.changed || descent.family.partial {
-                    let family = &mut descent.family;
-                    let (better, finished) = run_family(
+                    let finished = run_family(
                         &mut self.local_search,
                         p,
                         &mut tour,
                         3,
                         max_len,
-                        family,
+                        &mut descent.family,
+                        &mut descent.changed,
                         pause,
                     );
-                    descent.changed |= better;
                     if !finished {
-                        family.partial = true;
                         self.current = tour;
                         self.descent = Some(descent);
                         return false;
                     }
-                    descent.family = FamilyAt::default();
                     if !descent.changed {
                         // A local optimum: the descent is over.
                         debug_assert!(p.order_is_valid(&tour));
@@ -579,24 +583,21 @@ impl AlnsSolver {
                 if at.unit == 1 && !at.family.partial {
                     at.changed = false;
                 }
-                let family = &mut at.family;
-                let (better, finished) = run_family(
+                let finished = run_family(
                     &mut self.local_search,
                     p,
                     &mut it.candidate,
                     at.unit - 1,
                     max_len,
-                    family,
+                    &mut at.family,
+                    &mut at.changed,
                     pause,
                 );
-                at.changed |= better;
                 if !finished {
-                    family.partial = true;
                     it.improve = Some(at);
                     self.iteration = Some(it);
                     return false;
                 }
-                at.family = FamilyAt::default();
             }
             4 => {
                 // Block reversal only after a round that changed nothing and on a candidate
@@ -604,24 +605,21 @@ impl AlnsSolver {
                 if !at.changed || at.family.partial {
                     let gated = !at.family.partial && it.cost > at.deep_below;
                     if !gated {
-                        let family = &mut at.family;
-                        let (better, finished) = run_family(
+                        let finished = run_family(
                             &mut self.local_search,
                             p,
                             &mut it.candidate,
                             3,
                             max_len,
-                            family,
+                            &mut at.family,
+                            &mut at.changed,
                             pause,
                         );
-                        at.changed |= better;
                         if !finished {
-                            family.partial = true;
                             it.improve = Some(at);
                             self.iteration = Some(it);
                             return false;
                         }
-                        at.family = FamilyAt::default();
                     }
                     if !at.changed {
                         debug_assert!(p.order_is_valid(&it.candidate));
