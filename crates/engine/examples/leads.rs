@@ -12,9 +12,7 @@
 use std::path::PathBuf;
 
 use cutroute_engine::{open_document, run_to_end, start_job};
-use cutroute_geometry::{
-    KerfSettings, LeadFitter, LeadShape, LeadSpec, MachineParameters, Route, TabSpec,
-};
+use cutroute_geometry::{KerfSettings, LeadFitter, MachineParameters, Route};
 use cutroute_protocol::{
     JobRequest, KerfNote, KerfSource, Phase, Problem, Progress, SolverKind, SolverParams,
 };
@@ -40,17 +38,7 @@ fn main() {
         .nth(1)
         .and_then(|a| a.parse().ok())
         .unwrap_or(2.0);
-    let settings = KerfSettings {
-        kerf: 2.0,
-        pierce_clearance: 5.0,
-        switch_off_clearance: 1.0,
-        lead_in: LeadSpec::new(LeadShape::Arc, 8.0),
-        lead_out: LeadSpec::new(LeadShape::Line, 2.0),
-        overcut: 0.0,
-        tabs: TabSpec::default(),
-        edge_pierce: false,
-        kerf_pierce: false,
-    };
+    let settings = KerfSettings::plasma_reference();
     let machine = MachineParameters::default();
     let here = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     let root = here.join("../../data/nests");

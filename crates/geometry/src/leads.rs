@@ -326,6 +326,19 @@ impl KerfSettings {
             && !self.kerf_pierce
     }
 
+    /// Issue #17's plasma settings, the reference of its benchmarks and tests: kerf 2, d₁ 5,
+    /// d₂ 1, an 8 mm arc lead-in, a 2 mm line lead-out, nothing else.
+    pub fn plasma_reference() -> KerfSettings {
+        KerfSettings {
+            kerf: 2.0,
+            pierce_clearance: 5.0,
+            switch_off_clearance: 1.0,
+            lead_in: LeadSpec::new(LeadShape::Arc, 8.0),
+            lead_out: LeadSpec::new(LeadShape::Line, 2.0),
+            ..KerfSettings::default()
+        }
+    }
+
     /// The longest edge lead-in, mm: the asked lead-in's longest chain plus d₁, as far as the
     /// asked lead and its pierce region would reach from the entry anyway.
     pub fn edge_reach(&self) -> f64 {

@@ -104,18 +104,7 @@ fn pcgtsp_inputs(data: &std::path::Path) -> Vec<Input> {
 /// Issue #17's plasma settings: kerf 2, d₁ 5, d₂ 1, an 8 mm arc lead-in, a 2 mm line lead-out
 /// (the engine tests' `plasma`).
 fn plasma() -> cutroute_geometry::KerfSettings {
-    use cutroute_geometry::{KerfSettings, LeadShape, LeadSpec, TabSpec};
-    KerfSettings {
-        kerf: 2.0,
-        pierce_clearance: 5.0,
-        switch_off_clearance: 1.0,
-        lead_in: LeadSpec::new(LeadShape::Arc, 8.0),
-        lead_out: LeadSpec::new(LeadShape::Line, 2.0),
-        overcut: 0.0,
-        tabs: TabSpec::default(),
-        edge_pierce: false,
-        kerf_pierce: false,
-    }
+    cutroute_geometry::KerfSettings::plasma_reference()
 }
 
 /// The nearest-rank `q` quantile of `times` (0 when empty); sorts them.

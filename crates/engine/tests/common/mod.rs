@@ -4,7 +4,7 @@
 
 use std::path::PathBuf;
 
-use cutroute_geometry::{KerfSettings, LeadShape, LeadSpec, Nest, TabSpec};
+use cutroute_geometry::{KerfSettings, Nest};
 use cutroute_protocol::{Problem, Progress};
 
 /// The name and bytes of a file under `data/`; panics naming the file when it is missing.
@@ -54,15 +54,5 @@ pub fn nest_of(problem: &Problem) -> &Nest {
 
 /// Kerf 2, d₁ 5, d₂ 1, an 8 mm arc lead-in and a 2 mm line lead-out (issue #17's plasma).
 pub fn plasma() -> KerfSettings {
-    KerfSettings {
-        kerf: 2.0,
-        pierce_clearance: 5.0,
-        switch_off_clearance: 1.0,
-        lead_in: LeadSpec::new(LeadShape::Arc, 8.0),
-        lead_out: LeadSpec::new(LeadShape::Line, 2.0),
-        overcut: 0.0,
-        tabs: TabSpec::default(),
-        edge_pierce: false,
-        kerf_pierce: false,
-    }
+    KerfSettings::plasma_reference()
 }
