@@ -156,6 +156,62 @@ fn quadratic_roots(a: f64, b: f64, c: f64) -> Vec<f64> {
 
 /// Golden-section search for the least value of `f` on `[lo, hi]`, where it is unimodal; the
 /// bracket's ends are tried too (a monotone `f` is least there): `(t, f(t))`.
+/// Value of the polynomial `c[0] + c[1]·x + … + c[n]·xⁿ` (Horner).
+fn polynomial_value(c: &[f64], x: f64) -> f64 {
+    c.iter().rev().fold(0.0, |acc, &k| acc * x + k)
+}
+
+/// The real roots in `[lo, hi]` of the polynomial `c[0] + c[1]·x + … ` and the roots of each
+/// of its derivatives there (its turning points and theirs), unsorted. By induction on the
+/// degree: the derivative's roots cut `[lo, hi]` into pieces on which the polynomial is
+/// monotone, so each piece holds at most one root, found by bisection where the sign changes.
+/// A double root shows as a root of the derivative, which is why those are returned too.
+/// Leading coefficients below `1e-13` of the largest count as zero.
+fn polynomial_roots_and_turns(c: &[f64], lo: f64, hi: f64) -> Vec<f64> {
+    let largest = c.iter().fold(0.0f64, |m, &k| m.max(k.abs()));
+    let degree = c.iter().rposition(|&k| k.abs() > 1e-13 * largest);
+    let Some(degree) = degree.filter(|&d| d > 0) else {
+        return Vec::new();
+    };
+    let c = &c[..=degree];
+    let derivative: Vec<f64> = (1..=degree).map(|k| k as f64 * c[k]).collect();
+    let mut turns = polynomial_roots_and_turns(&derivative, lo, hi);
+    let mut cuts: Vec<f64> = turns
+        .iter()
+        .copied()
+        .filter(|x| (lo..=hi).contains(x))
+        .collect();
+    cuts.extend([lo, hi]);
+    cuts.sort_by(f64::total_cmp);
+    let mut roots = Vec::new();
+    for piece in cuts.windows(2) {
+        let (mut a, mut b) = (piece[0], piece[1]);
+        let (fa, fb) = (polynomial_value(c, a), polynomial_value(c, b));
+        if fa == 0.0 {
+            roots.push(a);
+            continue;
+        }
+        if fa.signum() == fb.signum() {
+            continue;
+        }
+        // Bisection to the last bit: ≤ ~64 halvings of a finite interval.
+        for _ in 0..200 {
+            let mid = 0.5 * (a + b);
+            if mid <= a || mid >= b {
+                break;
+            }
+            if polynomial_value(c, mid).signum() == fa.signum() {
+                a = mid;
+            } else {
+                b = mid;
+            }
+        }
+        roots.push(0.5 * (a + b));
+    }
+    turns.extend(roots);
+    turns
+}
+
 fn golden_section(f: &impl Fn(f64) -> f64, mut lo: f64, mut hi: f64) -> (f64, f64) {
     const R: f64 = 0.618_033_988_749_894_8;
     let (first, last) = (lo, hi);
@@ -560,7 +616,9 @@ impl Span {
     /// where a pierce point on this span costs the least idle travel between the previous exit
     /// `a` and the next entry `b`. A span crossing the segment `ab` gives `|ab|` at the
     /// crossing; otherwise the sum is convex along a line (golden-section search) and, on an
-    /// arc, is searched around the best of samples every π/8 at most.
+    /// arc, is least at one of its stationary points or an end, all of which are found
+    /// (a sextic's roots); nearly straight arcs (bulge below 10⁻³) are searched around the
+    /// best of samples every π/8 at most.
     pub fn detour_minimum(&self, a: Point, b: Option<Point>) -> (f64, f64) {
         let Some(b) = b else {
             let q = self.nearest_point(a);
@@ -576,6 +634,9 @@ impl Span {
         if self.is_line() {
             return golden_section(&f, 0.0, 1.0);
         }
+        if let Some(best) = self.arc_detour_stationary(a, b) {
+            return best;
+        }
         let n = 8 + (self.sweep().abs() / (std::f64::consts::PI / 8.0)).ceil() as usize;
         let k = (0..=n)
             .min_by(|&x, &y| f(x as f64 / n as f64).total_cmp(&f(y as f64 / n as f64)))
@@ -585,6 +646,73 @@ impl Span {
             k.saturating_sub(1) as f64 / n as f64,
             (k + 1).min(n) as f64 / n as f64,
         )
+    }
+
+    /// [`Span::detour_minimum`] on an arc of bulge ≥ 10⁻³ from its stationary points, which
+    /// are all found: `f = |a m| + |m b|` can have two local minima on an arc (a sampled
+    /// search picked the wrong one, 1 mm above the least), so no search in one basin is
+    /// enough. With the centre at the origin, the arc's midpoint on the x axis and
+    /// `m = R·(cos θ, sin θ)`, `f′(θ) = 0` is `cross(A, m)/|m − A| = −cross(B, m)/|m − B|`;
+    /// squared and with `t = tan(θ/2)` (the arc is `|t| ≤ |β|`, as `θ ≤ sweep/2 = 2·atan β`)
+    /// it is the sextic `p_A²·q_B − p_B²·q_A = 0` with the quadratics
+    /// `p_X = cross(X, m)·(1 + t²)/R` and `q_X = |m − X|²·(1 + t²)`. Its roots, the roots of
+    /// its derivatives and the two ends are the candidates; the least true `f` among them is
+    /// returned. `None` for nearly straight arcs (their centre is too far for the sextic to be
+    /// well conditioned), left to the sampled search.
+    fn arc_detour_stationary(&self, a: Point, b: Point) -> Option<(f64, f64)> {
+        if self.bulge.abs() < 1e-3 {
+            return None;
+        }
+        let centre = self.centre()?;
+        let radius = self.radius();
+        let axis = (self.midpoint() - centre) * (1.0 / radius);
+        if !(radius.is_finite() && axis.is_finite()) {
+            return None;
+        }
+        // Coordinates in the frame (axis, axis rotated a quarter), in units of the radius.
+        let local = |p: Point| {
+            let v = (p - centre) * (1.0 / radius);
+            (v.dot(axis), axis.cross(v))
+        };
+        let quadratics = |(x, y): (f64, f64)| {
+            // cross(X, u)·(1 + t²) with u = ((1 − t²), 2t)/(1 + t²): x·2t − y·(1 − t²).
+            let p = [-y, 2.0 * x, y];
+            // |u − X|²·(1 + t²) = (1 + |X|²)(1 + t²) − 2(x(1 − t²) + 2y·t).
+            let r = 1.0 + x * x + y * y;
+            let q = [r - 2.0 * x, -4.0 * y, r + 2.0 * x];
+            (p, q)
+        };
+        let multiply = |u: &[f64], v: &[f64]| {
+            let mut w = vec![0.0; u.len() + v.len() - 1];
+            for (i, &x) in u.iter().enumerate() {
+                for (j, &y) in v.iter().enumerate() {
+                    w[i + j] += x * y;
+                }
+            }
+            w
+        };
+        let (pa, qa) = quadratics(local(a));
+        let (pb, qb) = quadratics(local(b));
+        let left = multiply(&multiply(&pa, &pa), &qb);
+        let right = multiply(&multiply(&pb, &pb), &qa);
+        let sextic: Vec<f64> = left.iter().zip(&right).map(|(l, r)| l - r).collect();
+        if !sextic.iter().all(|k| k.is_finite()) {
+            return None;
+        }
+        let reach = self.bulge.abs();
+        let sweep = self.sweep();
+        let f = |t: f64| {
+            let m = self.point_at(t);
+            a.distance(m) + m.distance(b)
+        };
+        polynomial_roots_and_turns(&sextic, -reach, reach)
+            .into_iter()
+            .filter(|t| t.is_finite())
+            // θ = 2·atan t from the midpoint; the span's parameter is 1/2 + θ/sweep.
+            .map(|t| (0.5 + 2.0 * t.atan() / sweep).clamp(0.0, 1.0))
+            .chain([0.0, 1.0])
+            .map(|t| (t, f(t)))
+            .min_by(|x, y| x.1.total_cmp(&y.1))
     }
 
     /// The least distance between a point of this span and a point of `other`: 0 when they

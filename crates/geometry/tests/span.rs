@@ -255,3 +255,26 @@ fn half_bulges_recombine() {
         assert!((2.0 * h / (1.0 - h * h) - b).abs() < 1e-12);
     }
 }
+
+/// f = |a m| + |m b| has two local minima on this arc; the better of the sampled search's
+/// brackets held the other one, 192.57 against a least value below 191.62 (a proptest case).
+#[test]
+fn the_detour_minimum_is_found_when_the_arc_holds_two_local_minima() {
+    let arc = Span::new(
+        Point::new(64.33468337245407, 49.3502017348437),
+        Point::new(-51.647170579616684, -5.068487445678068),
+        1.193528076114086,
+    );
+    let (a, b) = (
+        Point::new(-29.51977187672266, 79.8792481752956),
+        Point::new(5.96412638157747, -92.60131367470302),
+    );
+    let f = |t: f64| a.distance(arc.point_at(t)) + arc.point_at(t).distance(b);
+    let sampled = (0..=100_000)
+        .map(|k| f(k as f64 / 100_000.0))
+        .fold(f64::INFINITY, f64::min);
+    let (t, value) = arc.detour_minimum(a, Some(b));
+    assert!((f(t) - value).abs() < 1e-9);
+    assert!(value <= sampled + 1e-9, "{value} against {sampled}");
+    assert!(value < 191.62, "{value}");
+}
