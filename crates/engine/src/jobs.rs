@@ -733,6 +733,13 @@ impl Job for ChainJob {
             return JobStatus::Running;
         }
         if self.chaining.is_none() {
+            if self.deadline.is_some_and(|end| Instant::now() >= end) {
+                // CCP-Relax used up the limit (a 100,000-contour nest): chaining could not
+                // finish a group, and only preparing it (the route's check, the containment
+                // forest, the close groups, the report) ran 1–2 s past the limit. CCP's route
+                // is the answer.
+                return JobStatus::Done;
+            }
             let Some(route) = self.ccp.progress().solution.and_then(Solution::into_route) else {
                 self.failure = Some(ChainFailure::NoCcpRoute);
                 return JobStatus::Done;
