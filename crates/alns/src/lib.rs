@@ -13,7 +13,8 @@
 //! keeps returning to. Operator weights adapt to their success.
 //!
 //! It is deterministic for a given seed (its own PRNG, no threads, time only decides when to
-//! stop), runs on wasm32 (`web_time`), and is resumable: [`AlnsSolver::step`] does a slice of
+//! stop, and, when the limit comes before the first tour is whole, how its rest is inserted),
+//! runs on wasm32 (`web_time`), and is resumable: [`AlnsSolver::step`] does a slice of
 //! work so that a web worker or a job engine can interleave it with other work.
 //!
 //! ```

@@ -358,6 +358,31 @@ impl Operators {
         true
     }
 
+    /// Inserts the next pending cluster of a repair begun by [`Operators::begin_repair`] at its
+    /// cheapest feasible place in `t` as it is now, without looking at the other pending
+    /// clusters; whether one was left to insert. A repair that has to end soon (a first tour
+    /// whose time limit came first) finishes this way: one cluster costs a scan of `t` and of
+    /// its feasible edges, where [`Operators::insert_one`] updates the best insertion of every
+    /// pending cluster (0.7 s on Nest03 at 25 mm, 2 s under load, for the clusters left).
+    /// Any pending cluster has a feasible place: the clusters of `t` keep the precedence, so
+    /// its present predecessors all come before its present successors.
+    pub(crate) fn insert_one_quickly(
+        &mut self,
+        p: &Problem,
+        t: &mut Vec<usize>,
+        rng: &mut Rng,
+    ) -> bool {
+        let Some(c) = self.pending.pop() else {
+            return false;
+        };
+        let (lo, hi) = interval_by_scan(p, t, c);
+        let Candidate {
+            node: v, edge: e, ..
+        } = full_candidate(p, t, c, lo, hi, 0.0, rng);
+        t.insert(e, v);
+        true
+    }
+
     /// Sets `candidate[c].lo ..= candidate[c].hi` of every pending cluster `c` to its feasible
     /// insertion interval in the partial tour `t`: after its last present predecessor, up to
     /// its first present successor. The prefixes of a feasible tour are ideals of the order, so
@@ -462,7 +487,8 @@ fn full_candidate(
 }
 
 /// The feasible insertion interval of cluster `c` in `t` by scanning the whole tour: the
-/// reference the incremental bounds are checked against in tests and debug builds.
+/// reference the incremental bounds are checked against in tests and debug builds, and the
+/// interval of [`Operators::insert_one_quickly`].
 fn interval_by_scan(p: &Problem, t: &[usize], c: usize) -> (usize, usize) {
     let mut lo = 1;
     let mut hi = t.len();

@@ -146,7 +146,9 @@ const FIRST_INSERTION: Insertion = Insertion {
 /// Anytime ALNS for PCGTSP / GTSP that can be advanced in slices (see [`AlnsSolver::step`]).
 ///
 /// The search trajectory depends only on the seed and the number of iterations: time only
-/// decides where it stops, so the same seed and iteration limit always give the same tour.
+/// decides where it stops, so the same seed and iteration limit always give the same tour (a
+/// limit that comes before the first tour is whole also makes its rest go in the quick way,
+/// [`AlnsSolver::hurry_first_tour`]).
 #[derive(Clone, Debug)]
 pub struct AlnsSolver {
     problem: Problem,
@@ -172,8 +174,11 @@ pub struct AlnsSolver {
     started: bool,
     /// The first tour under way (cheapest insertion a cluster per [`AlnsSolver::step`] unit,
     /// finished before any limit is checked, as when it was one piece: the search always has
-    /// a tour once started).
+    /// a tour once started; past the limit its rest is inserted cheaply, see `hurry`).
     first: Option<Vec<usize>>,
+    /// The rest of the first tour is inserted cheaply ([`AlnsSolver::hurry_first_tour`]): the
+    /// limit came before the tour, and a tour is still owed.
+    hurry: bool,
     /// The first tour's descent under way, a move family per [`AlnsSolver::step`] unit (on
     /// thousands of clusters it takes seconds: one piece would block Stop that long).
     descent: Option<Descent>,
@@ -258,6 +263,7 @@ impl AlnsSolver {
             elite: Vec::new(),
             started: false,
             first: None,
+            hurry: false,
             descent: None,
             iteration: None,
             stop: None,
@@ -302,6 +308,13 @@ impl AlnsSolver {
             let improved = if !self.started {
                 self.start()
             } else if let Some(tour) = self.first.take() {
+                if self
+                    .options
+                    .time_limit
+                    .is_some_and(|limit| self.elapsed >= limit)
+                {
+                    self.hurry = true;
+                }
                 self.build_first(tour)
             } else if let Some(descent) = self.descent.take() {
                 self.descend(descent, &pause)
@@ -323,6 +336,20 @@ impl AlnsSolver {
                 }
                 return Status::Running;
             }
+        }
+    }
+
+    /// Finishes a first tour under way quickly: each remaining cluster is inserted at its
+    /// cheapest feasible place in the tour as it is then, in units of one cluster, instead of
+    /// the cheapest insertion that weighs every remaining cluster's best place before each
+    /// one. For a caller whose limit came before the first tour (a job whose model took the
+    /// time: the cheapest insertion of 460 clusters in 12,000 nodes took 0.7–2 s more); the
+    /// solver does it itself when its own time limit passes during that tour. The tour is worse
+    /// than the cheapest insertion's but checked the same, and the search stops after it at
+    /// the limit. No effect once the first tour is complete.
+    pub fn hurry_first_tour(&mut self) {
+        if self.first.is_some() || !self.started {
+            self.hurry = true;
         }
     }
 
@@ -402,10 +429,14 @@ impl AlnsSolver {
     /// ([`AlnsSolver::descend`]). Returns whether the best improved.
     fn build_first(&mut self, mut tour: Vec<usize>) -> bool {
         let p = &self.problem;
-        if self
-            .operators
-            .insert_one(p, &mut tour, FIRST_INSERTION, 0.0, &mut self.rng)
-        {
+        let inserted = if self.hurry {
+            self.operators
+                .insert_one_quickly(p, &mut tour, &mut self.rng)
+        } else {
+            self.operators
+                .insert_one(p, &mut tour, FIRST_INSERTION, 0.0, &mut self.rng)
+        };
+        if inserted {
             self.first = Some(tour);
             return false;
         }
@@ -917,6 +948,81 @@ mod tests {
             assert!(calls > 5, "{name}: {calls} units");
             assert_eq!(units.current, whole_first_tour(&instance, 5), "{name}");
             assert!(whole.best_cost <= last + 1e-9);
+        }
+    }
+
+    /// A limit that comes before the first tour is whole (none at all, or the caller's
+    /// `hurry_first_tour` half-way through) still gives a tour: its rest is inserted a cluster
+    /// per unit at its cheapest feasible place, the tour passes the independent checker at the
+    /// cost the solver reports, and the search stops at the limit right after it.
+    #[test]
+    fn a_limit_before_the_first_tour_still_gives_a_checked_tour() {
+        for (set, name) in [("pcgtsplib", "ry48p.1"), ("industrial", "e1x_2")] {
+            let instance = instance(set, name);
+            let clusters = instance.clusters.len();
+            // Its own limit passed at once: every cluster goes in the quick way.
+            let mut solver = AlnsSolver::new(
+                &instance,
+                AlnsOptions {
+                    seed: 7,
+                    time_limit: Some(Duration::ZERO),
+                    ..AlnsOptions::default()
+                },
+            )
+            .unwrap();
+            let mut units = 1;
+            while solver.step(Duration::ZERO) == Status::Running {
+                units += 1;
+            }
+            assert!(solver.hurry, "{name}");
+            // The start, a unit per cluster but the depot's, and the node-choice DP.
+            assert_eq!(units, 1 + (clusters - 1) + 1, "{name}: a unit per cluster");
+            assert_eq!(solver.progress().stop_reason, Some(StopReason::TimeLimit));
+            let (tour, cost) = solver.best().expect("a tour at the limit");
+            let checked = check_tour(&instance, tour).unwrap();
+            assert!(
+                (checked - cost).abs() <= 1e-6 * (1.0 + cost.abs()),
+                "{name}"
+            );
+
+            // The caller hurries half-way through the cheapest insertion.
+            let options = AlnsOptions {
+                seed: 7,
+                time_limit: None,
+                max_iterations: Some(0),
+                ..AlnsOptions::default()
+            };
+            let mut solver = AlnsSolver::new(&instance, options).unwrap();
+            for _ in 0..clusters / 2 {
+                solver.step(Duration::ZERO);
+            }
+            assert!(solver.first.is_some() && solver.best().is_none(), "{name}");
+            solver.hurry_first_tour();
+            while solver.first.is_some() {
+                solver.step(Duration::ZERO);
+            }
+            let (tour, cost) = solver.best().expect("a tour once hurried");
+            let checked = check_tour(&instance, tour).unwrap();
+            assert!(
+                (checked - cost).abs() <= 1e-6 * (1.0 + cost.abs()),
+                "{name}"
+            );
+            // Once the tour is whole, hurrying changes nothing.
+            let mut whole = AlnsSolver::new(
+                &instance,
+                AlnsOptions {
+                    seed: 7,
+                    time_limit: None,
+                    max_iterations: Some(0),
+                    ..AlnsOptions::default()
+                },
+            )
+            .unwrap();
+            while whole.first.is_some() || !whole.started {
+                whole.step(Duration::ZERO);
+            }
+            whole.hurry_first_tour();
+            assert!(!whole.hurry, "{name}");
         }
     }
 

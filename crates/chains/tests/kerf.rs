@@ -63,3 +63,42 @@ fn chains_over_the_kerf_nest_come_back_valid_with_leads() {
     }
     assert!(chained_somewhere, "no chain survived anywhere");
 }
+
+/// Leads attached in pieces (`ChainedAttach`, paused after every piece, as the kerf job runs
+/// it between slices) give the very result of `attach_chained` in one call, broken links and
+/// errors included, on chained routes of nested.dbs and of generated nests.
+#[test]
+fn leads_attached_in_pieces_equal_leads_attached_at_once() {
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/nests/dbs/nested.dbs");
+    let nested = cutroute_formats::read_nest(&std::fs::read(path).unwrap()).unwrap();
+    let mut nests = vec![nested];
+    nests.extend((1..=3).map(|seed| generate_nest(30, seed)));
+    let mut linked = 0;
+    for nest in &nests {
+        for s in [settings(2.0, 5.0, 1.0, 8.0), settings(0.2, 1.0, 0.5, 3.0)] {
+            let fitter = LeadFitter::new(nest, s);
+            let kerf_nest = fitter.kerf_nest();
+            let origin = Point::new(0.0, 0.0);
+            let route = Route::innermost_first(&kerf_nest, origin, Some(origin));
+            let chained = chain_route(&kerf_nest, &route, &ChainOptions::default())
+                .unwrap()
+                .route;
+            linked += chained.steps.iter().filter(|s| !s.is_pierced()).count();
+            for (passes, positions) in [(0, 0), (1, 12)] {
+                let whole = fitter.attach_chained(&chained, passes, positions);
+                let mut work = cutroute_geometry::ChainedAttach::new(&chained, passes, positions);
+                let mut pieces = 1;
+                let sliced = loop {
+                    match work.advance(&fitter, &chained, &|| true) {
+                        Some(result) => break result,
+                        None => pieces += 1,
+                    }
+                };
+                assert_eq!(sliced, whole);
+                assert!(pieces >= chained.steps.len(), "{pieces} pieces");
+            }
+        }
+    }
+    assert!(linked > 0, "no links to attach");
+}

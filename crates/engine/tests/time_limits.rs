@@ -193,3 +193,57 @@ fn the_final_rule_check_runs_in_short_steps_on_a_large_nest() {
     assert!(wall <= limit_s + 1.0, "{wall:.2} s on a {limit_s} s limit");
     assert!(steps > 3, "the check ran in slices ({steps} steps)");
 }
+
+/// A job whose limit passed before the heuristic's first tour was whole (a big model took the
+/// time) still ends with a tour that passes the independent checker, within the limit + 1 s:
+/// the first tour's rest is inserted the quick way. Here the limit has passed when the job is
+/// made (its request arrived `limit` ago), so every cluster goes in that way, for both modes.
+#[test]
+fn a_limit_before_the_first_tour_still_gives_a_checked_tour() {
+    let _alone = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../data/pcgtsp/pcgtsplib/rbg174a.pcglns");
+    let instance =
+        cutroute_pcgtsp::Instance::parse(&std::fs::read_to_string(&path).expect("rbg174a"))
+            .expect("parses");
+    let limit = Duration::from_millis(300);
+    for mode in [
+        cutroute_engine::DiscreteMode::Heuristic,
+        cutroute_engine::DiscreteMode::Exact,
+    ] {
+        let now = Instant::now();
+        let arrived = now.checked_sub(limit).expect("a clock past the limit");
+        let mut job =
+            cutroute_engine::DiscreteJob::unbuilt(1, instance.clone(), mode, limit, arrived, 1);
+        let mut longest_step = 0.0f64;
+        loop {
+            let t = Instant::now();
+            let status = cutroute_engine::Job::step(&mut job, SLICE);
+            longest_step = longest_step.max(t.elapsed().as_secs_f64());
+            if status == JobStatus::Done {
+                break;
+            }
+            assert!(
+                now.elapsed() < Duration::from_secs(30),
+                "{mode:?} still running"
+            );
+        }
+        // The wall from the request's arrival: the limit and the promise's second.
+        let wall = arrived.elapsed().as_secs_f64();
+        let progress = cutroute_engine::Job::progress(&job);
+        let tour = progress
+            .solution
+            .as_ref()
+            .and_then(|s| s.tour())
+            .unwrap_or_else(|| panic!("{mode:?}: a tour past the limit ({})", progress.phase));
+        cutroute_pcgtsp::check_tour(&instance, tour).unwrap_or_else(|e| panic!("{mode:?}: {e}"));
+        assert!(
+            wall <= limit.as_secs_f64() + 1.0,
+            "{mode:?}: {wall:.2} s on a {limit:?} limit"
+        );
+        assert!(
+            longest_step <= LONGEST_STEP_S,
+            "{mode:?}: a step took {longest_step:.3} s"
+        );
+    }
+}

@@ -14,7 +14,7 @@
 //! lead fits at all is reported, never dropped.
 
 use crate::route::link_problems;
-use crate::{Contour, CutStep, Entry, LeadError, LeadFitter, Nest, Route};
+use crate::{Contour, CutStep, Entry, LeadError, LeadFitter, Nest, Point, Route};
 
 /// A chained route with leads, and how many of the solver's links gave way to pierces.
 #[derive(Clone, Debug, PartialEq)]
@@ -47,119 +47,10 @@ impl LeadFitter<'_> {
         passes: usize,
         positions: usize,
     ) -> Result<ChainedLeads, Vec<LeadError>> {
-        let n = route.steps.len();
-        let mut errors = Vec::new();
-        let mut linked: Vec<bool> = route
-            .steps
-            .iter()
-            .enumerate()
-            .map(|(i, s)| i > 0 && !s.is_pierced())
-            .collect();
-        // Each step's equidistant and the arc length of its entry on it.
-        let mut eqs: Vec<Option<(Contour, f64)>> = Vec::with_capacity(n);
-        // Where each step cut on its own wants its pierce point.
-        let mut near = Vec::with_capacity(n);
-        for (i, step) in route.steps.iter().enumerate() {
-            // A step with leads already (a route being fitted again after a change of its
-            // links) keeps its entry, unless its point on the contour moved away from it.
-            let (at, wanted) = match (&step.leads, self.nest().contour(step.contour)) {
-                (Some(l), Some(c))
-                    if c.nearest_point(l.entry).is_some_and(|p| {
-                        p.point.distance(step.pierce_point) <= self.nest().check_tolerance()
-                    }) =>
-                {
-                    (l.entry, l.pierce)
-                }
-                _ => (step.pierce_point, step.pierce_point),
-            };
-            near.push(wanted);
-            match self.equidistant(step.contour) {
-                Ok(eq) => {
-                    let s = eq
-                        .nearest_point(at)
-                        .map_or(0.0, |p| eq.length_at(p.position));
-                    eqs.push(Some((eq, s)));
-                }
-                Err(e) => {
-                    errors.push(e);
-                    eqs.push(None);
-                    // No chain runs through a contour that cannot be cut with kerf.
-                    linked[i] = false;
-                    if i + 1 < n {
-                        linked[i + 1] = false;
-                    }
-                }
-            }
-        }
-        let mut leads: Vec<Option<crate::StepLeads>> = vec![None; n];
-        let mut no_room = vec![false; n];
-        let links = |linked: &[bool]| linked.iter().filter(|&&l| l).count();
-        let links_given = links(&linked);
+        let mut work = ChainedAttach::new(route, passes, positions);
         loop {
-            let mut i = 0;
-            while i < n {
-                let Some((eq, s)) = &eqs[i] else {
-                    i += 1;
-                    continue;
-                };
-                if leads[i].is_some() || no_room[i] {
-                    i += 1;
-                    continue;
-                }
-                let r = route.steps[i].contour;
-                let (linked_in, linked_out) = (linked[i], i + 1 < n && linked[i + 1]);
-                if !linked_in && !linked_out {
-                    match self.fit_on(r, eq, near[i]) {
-                        Ok(l) => leads[i] = Some(l),
-                        Err(e) => {
-                            errors.push(e);
-                            no_room[i] = true;
-                        }
-                    }
-                    i += 1;
-                    continue;
-                }
-                match self.fit_at_linked(r, eq, *s, linked_in, linked_out) {
-                    Ok(l) => {
-                        leads[i] = Some(l);
-                        i += 1;
-                    }
-                    // No lead-in at the chain's start: the next contour is pierced instead,
-                    // and this one is fitted again, free.
-                    Err((true, _)) => {
-                        linked[i + 1] = false;
-                        leads[i + 1] = None;
-                    }
-                    // No lead-out at the chain's end: this contour is pierced on its own, and
-                    // the one before ends its chain (or stands alone) and is fitted again.
-                    Err((false, _)) => {
-                        linked[i] = false;
-                        leads[i - 1] = None;
-                        i -= 1;
-                    }
-                }
-            }
-            if !errors.is_empty() {
-                return Err(errors);
-            }
-            let built = self.chained_route(route, &linked, &leads);
-            let forest = self.forest();
-            let tolerance = self.nest().check_tolerance();
-            let mut changed = false;
-            for i in 1..n {
-                if linked[i] && !link_problems(&built, i, self.nest(), forest, tolerance).is_empty()
-                {
-                    linked[i] = false;
-                    leads[i - 1] = None;
-                    leads[i] = None;
-                    changed = true;
-                }
-            }
-            if !changed {
-                return Ok(ChainedLeads {
-                    route: self.relax(&built, passes, positions),
-                    broken_links: links_given - links(&linked),
-                });
+            if let Some(result) = work.advance(self, route, &|| false) {
+                return result;
             }
         }
     }
@@ -198,6 +89,182 @@ impl LeadFitter<'_> {
         Route {
             steps,
             ..route.clone()
+        }
+    }
+}
+
+/// [`LeadFitter::attach_chained`] in pieces, for a job that answers Stop between slices (on
+/// seven.dbs one call took 0.35–0.5 s, each chained route of the search fitted anew): a piece
+/// is one step's equidistant, one step's lead fit, or the links' check of a fitted route.
+/// [`ChainedAttach::advance`] with the same fitter and route until it returns gives what
+/// `attach_chained` gives, wherever the pieces fall.
+#[derive(Clone, Debug)]
+pub struct ChainedAttach {
+    passes: usize,
+    positions: usize,
+    /// Per step: entered by a link that still stands.
+    linked: Vec<bool>,
+    /// Each step's equidistant and the arc length of its entry on it (made so far).
+    eqs: Vec<Option<(Contour, f64)>>,
+    /// Where each step cut on its own wants its pierce point.
+    near: Vec<Point>,
+    errors: Vec<LeadError>,
+    leads: Vec<Option<crate::StepLeads>>,
+    no_room: Vec<bool>,
+    links_given: usize,
+    /// The step the fitting pass is at.
+    at: usize,
+}
+
+impl ChainedAttach {
+    /// The work of attaching leads to `route` (see [`LeadFitter::attach_chained`]).
+    pub fn new(route: &Route, passes: usize, positions: usize) -> ChainedAttach {
+        let n = route.steps.len();
+        let linked: Vec<bool> = route
+            .steps
+            .iter()
+            .enumerate()
+            .map(|(i, s)| i > 0 && !s.is_pierced())
+            .collect();
+        ChainedAttach {
+            passes,
+            positions,
+            // Counted before the equidistants (`attach_chained` counted after them): a link
+            // lost to a contour without an equidistant ends in an error either way.
+            links_given: linked.iter().filter(|&&l| l).count(),
+            linked,
+            eqs: Vec::with_capacity(n),
+            near: Vec::with_capacity(n),
+            errors: Vec::new(),
+            leads: vec![None; n],
+            no_room: vec![false; n],
+            at: 0,
+        }
+    }
+
+    /// Works until done (the chained route with leads, or every contour where no lead fits)
+    /// or `pause()` says so after a piece (`None`: call again with the same fitter and route).
+    pub fn advance(
+        &mut self,
+        fitter: &LeadFitter<'_>,
+        route: &Route,
+        pause: &dyn Fn() -> bool,
+    ) -> Option<Result<ChainedLeads, Vec<LeadError>>> {
+        let n = route.steps.len();
+        while self.eqs.len() < n {
+            let i = self.eqs.len();
+            let step = &route.steps[i];
+            // A step with leads already (a route being fitted again after a change of its
+            // links) keeps its entry, unless its point on the contour moved away from it.
+            let (at, wanted) = match (&step.leads, fitter.nest().contour(step.contour)) {
+                (Some(l), Some(c))
+                    if c.nearest_point(l.entry).is_some_and(|p| {
+                        p.point.distance(step.pierce_point) <= fitter.nest().check_tolerance()
+                    }) =>
+                {
+                    (l.entry, l.pierce)
+                }
+                _ => (step.pierce_point, step.pierce_point),
+            };
+            self.near.push(wanted);
+            match fitter.equidistant(step.contour) {
+                Ok(eq) => {
+                    let s = eq
+                        .nearest_point(at)
+                        .map_or(0.0, |p| eq.length_at(p.position));
+                    self.eqs.push(Some((eq, s)));
+                }
+                Err(e) => {
+                    self.errors.push(e);
+                    self.eqs.push(None);
+                    // No chain runs through a contour that cannot be cut with kerf.
+                    self.linked[i] = false;
+                    if i + 1 < n {
+                        self.linked[i + 1] = false;
+                    }
+                }
+            }
+            if pause() {
+                return None;
+            }
+        }
+        loop {
+            while self.at < n {
+                let i = self.at;
+                let Some((eq, s)) = &self.eqs[i] else {
+                    self.at += 1;
+                    continue;
+                };
+                if self.leads[i].is_some() || self.no_room[i] {
+                    self.at += 1;
+                    continue;
+                }
+                let r = route.steps[i].contour;
+                let (linked_in, linked_out) = (self.linked[i], i + 1 < n && self.linked[i + 1]);
+                if !linked_in && !linked_out {
+                    match fitter.fit_on(r, eq, self.near[i]) {
+                        Ok(l) => self.leads[i] = Some(l),
+                        Err(e) => {
+                            self.errors.push(e);
+                            self.no_room[i] = true;
+                        }
+                    }
+                    self.at += 1;
+                } else {
+                    match fitter.fit_at_linked(r, eq, *s, linked_in, linked_out) {
+                        Ok(l) => {
+                            self.leads[i] = Some(l);
+                            self.at += 1;
+                        }
+                        // No lead-in at the chain's start: the next contour is pierced
+                        // instead, and this one is fitted again, free.
+                        Err((true, _)) => {
+                            self.linked[i + 1] = false;
+                            self.leads[i + 1] = None;
+                        }
+                        // No lead-out at the chain's end: this contour is pierced on its own,
+                        // and the one before ends its chain (or stands alone) and is fitted
+                        // again.
+                        Err((false, _)) => {
+                            self.linked[i] = false;
+                            self.leads[i - 1] = None;
+                            self.at -= 1;
+                        }
+                    }
+                }
+                if pause() {
+                    return None;
+                }
+            }
+            if !self.errors.is_empty() {
+                return Some(Err(std::mem::take(&mut self.errors)));
+            }
+            let built = fitter.chained_route(route, &self.linked, &self.leads);
+            let forest = fitter.forest();
+            let tolerance = fitter.nest().check_tolerance();
+            let mut changed = false;
+            for i in 1..n {
+                if self.linked[i]
+                    && !link_problems(&built, i, fitter.nest(), forest, tolerance).is_empty()
+                {
+                    self.linked[i] = false;
+                    self.leads[i - 1] = None;
+                    self.leads[i] = None;
+                    changed = true;
+                }
+            }
+            if !changed {
+                let links = self.linked.iter().filter(|&&l| l).count();
+                return Some(Ok(ChainedLeads {
+                    route: fitter.relax(&built, self.passes, self.positions),
+                    broken_links: self.links_given - links,
+                }));
+            }
+            // The fitting pass again, from the first step (the broken links' ends).
+            self.at = 0;
+            if pause() {
+                return None;
+            }
         }
     }
 }

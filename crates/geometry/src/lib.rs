@@ -95,7 +95,7 @@ mod types;
 mod viewport;
 
 pub use bbox::BoundingBox;
-pub use chain_leads::ChainedLeads;
+pub use chain_leads::{ChainedAttach, ChainedLeads};
 pub use contour::{
     ClosureError, ContourError, ContourPosition, ContourProjection, SelfIntersection,
 };

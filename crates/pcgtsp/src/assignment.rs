@@ -10,6 +10,8 @@ pub struct Assignment {
     way: Vec<usize>,
     minv: Vec<f64>,
     used: Vec<bool>,
+    /// The next row to assign (1-based) of a solve in pieces.
+    next_row: usize,
 }
 
 impl Assignment {
@@ -17,8 +19,14 @@ impl Assignment {
     /// Afterwards [`Assignment::row_potential`] and [`Assignment::column_potential`] give
     /// feasible duals (`u_i + v_j ≤ cost_ij`) whose sum is the optimum.
     pub fn solve(&mut self, k: usize, cost: &[f64]) -> f64 {
-        debug_assert_eq!(cost.len(), k * k);
-        let inf = f64::INFINITY;
+        self.begin(k);
+        self.solve_until(k, cost, &|| false)
+            .expect("runs to the end without a pause")
+    }
+
+    /// Starts [`Assignment::solve`] in pieces: [`Assignment::solve_until`] then adds a row at a
+    /// time (one shortest augmenting path, O(k²)): at k = 1,000 the whole solve is seconds.
+    pub fn begin(&mut self, k: usize) {
         self.u.clear();
         self.u.resize(k + 1, 0.0);
         self.v.clear();
@@ -27,7 +35,18 @@ impl Assignment {
         self.p.resize(k + 1, 0);
         self.way.clear();
         self.way.resize(k + 1, 0);
-        for i in 1..=k {
+        self.next_row = 1;
+    }
+
+    /// Goes on with the solve [`Assignment::begin`] started (the same `k` and `cost` on every
+    /// call): rows until all are assigned (the optimum, as [`Assignment::solve`] gives it) or
+    /// `pause()` says so after one (`None`: call again).
+    pub fn solve_until(&mut self, k: usize, cost: &[f64], pause: &dyn Fn() -> bool) -> Option<f64> {
+        debug_assert_eq!(cost.len(), k * k);
+        let inf = f64::INFINITY;
+        while self.next_row <= k {
+            let i = self.next_row;
+            self.next_row += 1;
             self.p[0] = i;
             let mut j0 = 0usize;
             self.minv.clear();
@@ -56,7 +75,8 @@ impl Assignment {
                     }
                 }
                 if delta == inf {
-                    return inf;
+                    self.next_row = k + 1;
+                    return Some(inf);
                 }
                 for j in 0..=k {
                     if self.used[j] {
@@ -80,12 +100,15 @@ impl Assignment {
                     break;
                 }
             }
+            if self.next_row <= k && pause() {
+                return None;
+            }
         }
         let mut total = 0.0;
         for j in 1..=k {
             total += cost[(self.p[j] - 1) * k + (j - 1)];
         }
-        total
+        Some(total)
     }
 
     /// Dual potential of row `i` (0-based) after [`Assignment::solve`].
@@ -160,6 +183,46 @@ mod tests {
                     }
                 }
                 assert!((dual - got).abs() < 1e-9);
+            }
+        }
+    }
+
+    /// The solve in pieces (a pause after every row) gives the one-piece solve's optimum and
+    /// duals, on random matrices with forbidden entries.
+    #[test]
+    fn a_solve_in_pieces_equals_the_solve_in_one() {
+        let mut rng = cutroute_geometry::SplitMix64::new(777);
+        let mut next = || rng.next_u64();
+        for round in 0..100 {
+            let k = 1 + (round % 30);
+            let cost: Vec<f64> = (0..k * k)
+                .map(|_| {
+                    let r = next();
+                    if r % 9 == 0 {
+                        f64::INFINITY
+                    } else {
+                        (r % 1000) as f64 / 7.0
+                    }
+                })
+                .collect();
+            let mut whole = Assignment::default();
+            let want = whole.solve(k, &cost);
+            let mut pieces = Assignment::default();
+            pieces.begin(k);
+            let mut calls = 1;
+            let got = loop {
+                match pieces.solve_until(k, &cost, &|| true) {
+                    Some(value) => break value,
+                    None => calls += 1,
+                }
+            };
+            assert_eq!(got.to_bits(), want.to_bits(), "k={k}");
+            if want.is_finite() {
+                assert_eq!(calls, k, "a row per call");
+                for i in 0..k {
+                    assert_eq!(pieces.row_potential(i), whole.row_potential(i));
+                    assert_eq!(pieces.column_potential(i), whole.column_potential(i));
+                }
             }
         }
     }

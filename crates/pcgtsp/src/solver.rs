@@ -548,8 +548,9 @@ pub struct ExactSolver {
     unbuilt: Vec<usize>,
     /// The model being built, a piece per [`ExactSolver::build_unit`].
     building: Option<ModelBuilder>,
-    /// The model built last, its root bound not yet computed.
+    /// The model built last, its root bound not yet computed (or under way in `root_bounder`).
     unbounded: Option<Model>,
+    root_bounder: ResidualBounder,
     current_run: usize,
     incumbent: Incumbent,
     phase: Phase,
@@ -607,6 +608,7 @@ impl ExactSolver {
             unbuilt,
             building: None,
             unbounded: None,
+            root_bounder: ResidualBounder::default(),
             current_run: 0,
             incumbent: Incumbent {
                 upper_bound: INF,
@@ -626,17 +628,23 @@ impl ExactSolver {
     }
 
     /// Builds one piece of the runs: pieces of the next start node's model until `pause()`
-    /// (at least one), or its root bound. Returns whether it did anything (false once all are
-    /// built).
+    /// (at least one), or rows of its root bound's assignments until `pause()` (at least one).
+    /// Returns whether it did anything (false once all are built).
     fn build_unit(&mut self, pause: &dyn Fn() -> bool) -> bool {
         if let Some(model) = self.unbounded.take() {
             let depot = model.depot;
-            let root_bound = model.round_bound(ResidualBounder::default().compute(
+            // In pieces: on a discretisation of 1,000 clusters the assignments took 2.9 s.
+            let Some(bound) = self.root_bounder.compute_until(
                 &model,
                 &|c| c == depot,
                 depot,
                 self.options.use_l2,
-            ));
+                pause,
+            ) else {
+                self.unbounded = Some(model);
+                return true;
+            };
+            let root_bound = model.round_bound(bound);
             self.runs.push(Run {
                 model,
                 lattice: None,

@@ -3,7 +3,7 @@
 //!
 //! `cargo run --release -p cutroute-bench --bin time_limits -- [--time-limit 5] [--slice-ms 40]
 //! [--step 50] [--solvers ccp,exact,…] [--filter NAME[,NAME…]] [--set nests|pcgtsp|all]
-//! [--generated 1000,10000] [--data DIR] [--trace] [--rules-hard] [--kerf]
+//! [--generated 1000,10000] [--data DIR] [--trace] [--phases] [--rules-hard] [--kerf]
 //! [--cli BIN --cli-input FILE[,FILE…] --cli-limit S]`
 //!
 //! `--rules-hard` runs every job with `--rules part,sheet,islands --rules-hard` (the repair and
@@ -14,7 +14,8 @@
 //! full-route model, the chain attach of leads, and the others.
 //!
 //! `--trace` prints every call longer than its slice + 50 ms to stderr, with the job's phase
-//! before and after it.
+//! before and after it. `--phases` prints every change of the job's phase to stderr with the
+//! wall time it was first seen at (where a job spends the time past its limit).
 //!
 //! Inputs: every real nest of `data/nests` (dbs, dbs-json, dxf, svg, tflex), every PCGTSP
 //! instance of `data/pcgtsp` (industrial, pcgtsplib) and `data/nests/pcgtsp` and generated nests of the given sizes
@@ -23,7 +24,8 @@
 //! Prints a Markdown table: solver, input, limit, wall (start + steps), wall − limit, `start_job`'s own time
 //! (the model is built there), the longest `step` call, the 99th percentile of the step calls
 //! (nearest rank), the number of steps, and what ended the
-//! job: "limit" when the wall reached the limit, "finished" when the solver ended before it.
+//! job: "limit" when the wall reached the limit, "finished" when the solver ended before it
+//! ("no solution" added when the job ended without a route or tour).
 //! A row is marked **over** when the wall exceeds limit + 1 s (the promise), and "long step"
 //! when one call (start or step) exceeds its slice by more than 50 ms (Stop waits for it). A
 //! job still running at limit + 60 s is abandoned ("abandoned"). After the table: per solver,
@@ -127,6 +129,7 @@ pub fn main() {
     let mut generated: Vec<usize> = vec![1000];
     let mut data = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../data");
     let mut trace = false;
+    let mut phases = false;
     let mut thermal = cutroute_protocol::ThermalSettings::default();
     let mut kerf = false;
     let mut cli: Option<PathBuf> = None;
@@ -168,6 +171,7 @@ pub fn main() {
             }
             "--data" => data = PathBuf::from(value()),
             "--trace" => trace = true,
+            "--phases" => phases = true,
             "--kerf" => kerf = true,
             "--rules-hard" => {
                 thermal = cutroute_protocol::ThermalSettings {
@@ -234,9 +238,22 @@ pub fn main() {
             let mut longest = 0.0f64;
             let mut step_times: Vec<f64> = Vec::new();
             let mut steps = 0usize;
+            let mut last_phase = String::new();
             let ended_by = match job {
                 Err(e) => format!("refused: {e}"),
                 Ok(mut job) => loop {
+                    if phases {
+                        let phase = job.progress().phase.to_string();
+                        if phase != last_phase {
+                            eprintln!(
+                                "{} {}: {:.3} s \"{phase}\"",
+                                solver.name(),
+                                input.name,
+                                started.elapsed().as_secs_f64()
+                            );
+                            last_phase = phase;
+                        }
+                    }
                     let phase = if trace {
                         job.progress().phase.to_string()
                     } else {
@@ -258,12 +275,15 @@ pub fn main() {
                     steps += 1;
                     let wall = started.elapsed().as_secs_f64();
                     if status == JobStatus::Done {
-                        break if wall >= limit - 0.05 {
+                        let ended = if wall >= limit - 0.05 {
                             "limit"
                         } else {
                             "finished"
-                        }
-                        .to_string();
+                        };
+                        break match job.progress().solution {
+                            Some(_) => ended.to_string(),
+                            None => format!("{ended}, no solution"),
+                        };
                     }
                     if wall > limit + 60.0 {
                         break "abandoned".to_string();

@@ -39,6 +39,20 @@ pub(crate) struct ResidualBounder {
     pub l2: f64,
     /// The last problem was too large for the assignment: every bound is 0.
     skipped: bool,
+    /// Where a bound in pieces is ([`ResidualBounder::compute_until`]).
+    stage: ResidualStage,
+}
+
+/// The part of a residual bound under way.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+enum ResidualStage {
+    /// Nothing under way: the next call sets up the problem.
+    #[default]
+    Start,
+    /// The L1 assignment.
+    L1,
+    /// The L2 assignment.
+    L2,
 }
 
 impl ResidualBounder {
@@ -52,6 +66,78 @@ impl ResidualBounder {
         last: usize,
         with_l2: bool,
     ) -> f64 {
+        self.stage = ResidualStage::Start;
+        self.compute_until(model, in_ideal, last, with_l2, &|| false)
+            .expect("runs to the end without a pause")
+    }
+
+    /// [`ResidualBounder::compute`] in pieces: the matrices at once (O(k²)), the assignments
+    /// a row at a time, until `pause()` says so after one (`None`: call again with the same
+    /// arguments; the last call gives what `compute` gives). The root bound of a
+    /// discretisation of 1,000 clusters took 2.9 s in one piece.
+    pub fn compute_until(
+        &mut self,
+        model: &Model,
+        in_ideal: &dyn Fn(usize) -> bool,
+        last: usize,
+        with_l2: bool,
+        pause: &dyn Fn() -> bool,
+    ) -> Option<f64> {
+        let depot = model.depot;
+        let root = last == depot;
+        // Clusters whose predecessors are all visited: the only possible next clusters.
+        let addable = |c: usize| model.order.predecessors[c].iter().all(in_ideal);
+        if self.stage == ResidualStage::Start {
+            if let Some(done) = self.start_l1(model, in_ideal, last) {
+                return Some(done);
+            }
+            self.assignment.begin(self.clusters.len());
+            self.stage = ResidualStage::L1;
+        }
+        let k = self.clusters.len();
+        if self.stage == ResidualStage::L1 {
+            let l1 = self.assignment.solve_until(k, &self.matrix, pause)?;
+            self.l1 = l1;
+            self.last_row.clear();
+            if l1.is_finite() {
+                let mut dual_sum = 0.0;
+                for i in 0..k {
+                    dual_sum +=
+                        self.assignment.row_potential(i) + self.assignment.column_potential(i);
+                }
+                self.base_without_last = dual_sum - self.assignment.row_potential(0);
+                for j in 1..k {
+                    if self.matrix[j].is_finite() {
+                        self.last_row
+                            .push((self.clusters[j], self.assignment.column_potential(j)));
+                    }
+                }
+            }
+            self.l2 = -INF;
+            if !(with_l2 && l1.is_finite() && k >= 3) {
+                self.stage = ResidualStage::Start;
+                return Some(l1.max(self.l2));
+            }
+            self.fill_l2(model, &addable, last, root);
+            self.assignment.begin(k);
+            self.stage = ResidualStage::L2;
+            if pause() {
+                return None;
+            }
+        }
+        self.l2 = self.assignment.solve_until(k, &self.matrix, pause)?;
+        self.stage = ResidualStage::Start;
+        Some(self.l1.max(self.l2))
+    }
+
+    /// The clusters and the L1 matrix of the residual problem; `Some(bound)` when no
+    /// assignment is needed (too large: 0; the root with nothing left: 0).
+    fn start_l1(
+        &mut self,
+        model: &Model,
+        in_ideal: &dyn Fn(usize) -> bool,
+        last: usize,
+    ) -> Option<f64> {
         let m = model.m;
         let depot = model.depot;
         self.clusters.clear();
@@ -70,7 +156,7 @@ impl ResidualBounder {
             self.l2 = -INF;
             self.last_row.clear();
             self.base_without_last = 0.0;
-            return 0.0;
+            return Some(0.0);
         }
         if !root {
             self.clusters.push(depot);
@@ -117,38 +203,13 @@ impl ResidualBounder {
             self.l2 = -INF;
             self.last_row.clear();
             self.base_without_last = 0.0;
-            return 0.0;
+            return Some(0.0);
         }
-        let l1 = self.assignment.solve(k, &self.matrix);
-        self.l1 = l1;
-        self.last_row.clear();
-        if l1.is_finite() {
-            let mut dual_sum = 0.0;
-            for i in 0..k {
-                dual_sum += self.assignment.row_potential(i) + self.assignment.column_potential(i);
-            }
-            self.base_without_last = dual_sum - self.assignment.row_potential(0);
-            for j in 1..k {
-                if self.matrix[j].is_finite() {
-                    self.last_row
-                        .push((self.clusters[j], self.assignment.column_potential(j)));
-                }
-            }
-        }
-        self.l2 = -INF;
-        if with_l2 && l1.is_finite() && k >= 3 {
-            self.l2 = self.compute_l2(model, &addable, last, root);
-        }
-        l1.max(self.l2)
+        None
     }
 
-    fn compute_l2(
-        &mut self,
-        model: &Model,
-        addable: &dyn Fn(usize) -> bool,
-        last: usize,
-        root: bool,
-    ) -> f64 {
+    /// The L2 matrix (H2 halved) of the residual problem [`ResidualBounder::start_l1`] set up.
+    fn fill_l2(&mut self, model: &Model, addable: &dyn Fn(usize) -> bool, last: usize, root: bool) {
         let m = model.m;
         let depot = model.depot;
         let k = self.clusters.len();
@@ -191,7 +252,6 @@ impl ResidualBounder {
                 self.matrix[i * k + j] = w;
             }
         }
-        self.assignment.solve(k, &self.matrix)
     }
 
     /// The L1 bound for a completion starting at node `x` of the last cluster, from the duals of
@@ -210,5 +270,48 @@ impl ResidualBounder {
             }
         }
         self.base_without_last + best
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::instance::Instance;
+
+    /// The root bound in pieces (paused after every assignment row) is the one-piece bound,
+    /// L1, L2 and the node refinement's duals alike, with and without L2, on real instances.
+    #[test]
+    fn the_root_bound_in_pieces_equals_the_bound_at_once() {
+        for name in ["industrial/e1x_4", "pcgtsplib/kro124p.1", "pcgtsplib/ESC47"] {
+            let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join(format!("../../data/pcgtsp/{name}.pcglns"));
+            let instance = Instance::parse(&std::fs::read_to_string(path).unwrap()).unwrap();
+            let model = Model::new(&instance, instance.clusters[instance.depot][0]).unwrap();
+            let depot = model.depot;
+            for with_l2 in [false, true] {
+                let mut whole = ResidualBounder::default();
+                let want = whole.compute(&model, &|c| c == depot, depot, with_l2);
+                let mut pieces = ResidualBounder::default();
+                let mut calls = 1;
+                let got = loop {
+                    match pieces.compute_until(&model, &|c| c == depot, depot, with_l2, &|| true) {
+                        Some(bound) => break bound,
+                        None => calls += 1,
+                    }
+                };
+                assert_eq!(got.to_bits(), want.to_bits(), "{name}");
+                assert_eq!(pieces.l1.to_bits(), whole.l1.to_bits(), "{name}");
+                assert_eq!(pieces.l2.to_bits(), whole.l2.to_bits(), "{name}");
+                for x in 0..model.n {
+                    let (a, b) = (pieces.node_bound(&model, x), whole.node_bound(&model, x));
+                    assert_eq!(a.to_bits(), b.to_bits(), "{name}: node {x}");
+                }
+                assert!(
+                    calls >= model.m - 1,
+                    "{name}: {calls} calls for {} clusters",
+                    model.m
+                );
+            }
+        }
     }
 }
