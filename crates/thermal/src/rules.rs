@@ -302,6 +302,14 @@ pub fn check_rules(
 ) -> Result<RuleReport, ThermalError> {
     params.validate()?;
     check_steps(route, nest)?;
+    if !rules.any() {
+        // Nothing to check: the layout's boxes and rasters alone took 0.4 s on 100,000
+        // contours, in the CLI's report after the time limit.
+        return Ok(RuleReport {
+            rules,
+            violations: Vec::new(),
+        });
+    }
     let layout = Layout::new(nest);
     let mut violations = Vec::new();
     if rules.part {
