@@ -69,10 +69,14 @@ fn main() {
         if ng.iterations() >= printed + 5 {
             printed = ng.iterations();
             println!(
-                "{:.1} s: {} iterations, ng-path bound {:.1}",
+                "{:.1} s: {} iterations, ng-path bound {:.1} (labels {}, pruned {}, backward {:.1} s, forward {:.1} s)",
                 began.elapsed().as_secs_f64(),
                 ng.iterations(),
-                ng.lower_bound()
+                ng.lower_bound(),
+                ng.stats().labels,
+                ng.stats().pruned,
+                ng.stats().backward_seconds,
+                ng.stats().forward_seconds,
             );
         }
     }
