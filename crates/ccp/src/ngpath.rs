@@ -552,21 +552,55 @@ impl NgPathBound {
             return;
         }
         if k > 0 && self.floor.iter().any(|f| f.is_finite()) {
-            for (u, &from) in self.floor.iter().enumerate() {
-                let cu = self.cluster[u];
-                if !from.is_finite() || cu == usize::MAX {
-                    continue;
-                }
-                let row = &self.cost[u * n..(u + 1) * n];
-                for (v, (&arc, slot)) in row.iter().zip(floor.iter_mut()).enumerate() {
-                    let cv = self.cluster[v];
-                    if cv == usize::MAX || cv == cu {
+            // Per node: the least way in from the previous layer's floors over the source
+            // clusters, the best and the second best by distinct clusters (a way in from the
+            // node's own cluster does not count). One cluster's sources at a time, so the
+            // inner loop is a plain min-plus over a row (vectorised).
+            let mut from_cluster = vec![f64::INFINITY; n];
+            let mut first = vec![(f64::INFINITY, usize::MAX); n];
+            let mut second = vec![f64::INFINITY; n];
+            for (c, nodes) in self.members.iter().enumerate() {
+                let mut any = false;
+                for &u in nodes {
+                    let from = self.floor[u];
+                    if !from.is_finite() {
                         continue;
                     }
-                    let total = from + arc - self.lambda[cv];
-                    if total < *slot {
-                        *slot = total;
+                    if !any {
+                        from_cluster.fill(f64::INFINITY);
+                        any = true;
                     }
+                    let row = &self.cost[u * n..(u + 1) * n];
+                    for (slot, &arc) in from_cluster.iter_mut().zip(row) {
+                        let total = from + arc;
+                        *slot = if total < *slot { total } else { *slot };
+                    }
+                }
+                if !any {
+                    continue;
+                }
+                for ((&x, best), next) in from_cluster.iter().zip(&mut first).zip(&mut second) {
+                    if x < best.0 {
+                        *next = best.0;
+                        *best = (x, c);
+                    } else if x < *next {
+                        *next = x;
+                    }
+                }
+            }
+            for (v, slot) in floor.iter_mut().enumerate() {
+                let cv = self.cluster[v];
+                if cv == usize::MAX {
+                    continue;
+                }
+                let way_in = if first[v].1 == cv {
+                    second[v]
+                } else {
+                    first[v].0
+                };
+                let total = way_in - self.lambda[cv];
+                if total < *slot {
+                    *slot = total;
                 }
             }
         }
