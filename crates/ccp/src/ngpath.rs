@@ -129,9 +129,14 @@ pub struct NgPathBound {
 /// Counters of the ng-path DP (diagnostics, e.g. `CCP_BOUND_DEBUG`).
 #[derive(Clone, Debug, Default)]
 pub struct NgStats {
+    /// Labels kept, over all passes.
     pub labels: u64,
+    /// Labels dropped by the completion bound (not counting those never generated because a
+    /// whole source cluster could not beat it).
     pub pruned: u64,
+    /// Time in the passes on the reversed arcs.
     pub backward_seconds: f64,
+    /// Time in the forward passes.
     pub forward_seconds: f64,
 }
 
