@@ -81,10 +81,11 @@ fn main() {
         }
     }
     println!(
-        "{} nodes, ng {ng_size}: {:.1} after {} iterations in {:.1} s",
+        "{} nodes, ng {ng_size}: {:.1} after {} iterations in {:.1} s (longest layer {:.3} s)",
         instance.node_count,
         ng.lower_bound(),
         ng.iterations(),
-        began.elapsed().as_secs_f64()
+        began.elapsed().as_secs_f64(),
+        ng.stats().longest_layer_seconds
     );
 }

@@ -138,6 +138,8 @@ pub struct NgStats {
     pub backward_seconds: f64,
     /// Time in the forward passes.
     pub forward_seconds: f64,
+    /// The longest layer (the unit of work between deadline checks), in seconds.
+    pub longest_layer_seconds: f64,
 }
 
 /// Passes without a better bound after which the level's distance δ is halved.
@@ -448,6 +450,8 @@ impl NgPathBound {
             if done {
                 self.finish_pass();
             }
+            let layer = began.elapsed().as_secs_f64();
+            self.stats.longest_layer_seconds = self.stats.longest_layer_seconds.max(layer);
             if Instant::now() >= deadline {
                 return true;
             }
