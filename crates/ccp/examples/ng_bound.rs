@@ -81,11 +81,11 @@ fn main() {
         }
     }
     println!(
-        "{} nodes, ng {ng_size}: {:.1} after {} iterations in {:.1} s (longest layer {:.3} s)",
+        "{} nodes, ng {ng_size}: {:.1} after {} iterations in {:.1} s (longest step overrun {:.3} s)",
         instance.node_count,
         ng.lower_bound(),
         ng.iterations(),
         began.elapsed().as_secs_f64(),
-        ng.stats().longest_layer_seconds
+        ng.stats().longest_overrun_seconds
     );
 }

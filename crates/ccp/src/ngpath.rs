@@ -45,6 +45,26 @@ struct Label {
     value: f64,
 }
 
+/// The previous layer's labels as sources of the next: per node its run of labels in the
+/// layer `(node, start, end)` and its cheapest label `(value, index)`; per cluster its runs and
+/// their cheapest value.
+struct Sources {
+    runs: Vec<(usize, usize, usize)>,
+    run_best: Vec<(f64, u32)>,
+    cluster_runs: Vec<Vec<usize>>,
+    cluster_best: Vec<f64>,
+}
+
+/// A layer under way: its sources, the labels and pruned floors so far, and the next target
+/// cluster.
+struct LayerWork {
+    sources: Sources,
+    next: Vec<Label>,
+    floor: Vec<f64>,
+    pruned: u64,
+    d: usize,
+}
+
 /// The resumable subgradient search of the ng-path bound on one instance.
 pub struct NgPathBound {
     n: usize,
@@ -67,8 +87,10 @@ pub struct NgPathBound {
     gap: Vec<f64>,
     /// Penalty per cluster visit.
     lambda: Vec<f64>,
-    /// Layers of the DP under way (index k = k + 1 visits), each sorted by node.
+    /// Layers of the DP under way (index k = k + 1 visits), each sorted by node, and the
+    /// layer being built.
     layers: Vec<Vec<Label>>,
+    work: Option<LayerWork>,
     best: f64,
     best_lambda: Vec<f64>,
     /// Nodes of the walk of the last completed pass (for refinement), and its `L(λ)`.
@@ -138,8 +160,9 @@ pub struct NgStats {
     pub backward_seconds: f64,
     /// Time in the forward passes.
     pub forward_seconds: f64,
-    /// The longest layer (the unit of work between deadline checks), in seconds.
-    pub longest_layer_seconds: f64,
+    /// How long after its deadline a step returned, at most, in seconds (the work between
+    /// deadline checks: one target cluster of a layer, or a pass's closing).
+    pub longest_overrun_seconds: f64,
 }
 
 /// Passes without a better bound after which the level's distance δ is halved.
@@ -317,6 +340,7 @@ impl NgPathBound {
             best_lambda: lambda.clone(),
             lambda,
             layers: Vec::new(),
+            work: None,
             best: f64::NEG_INFINITY,
             last_walk: Vec::new(),
             last_value: f64::NEG_INFINITY,
@@ -437,22 +461,24 @@ impl NgPathBound {
             let m = self.members.len();
             let done = match self.backward.as_mut().filter(|_| self.pass_backward) {
                 Some(back) => {
-                    back.extend_layer();
+                    let complete = back.extend_layer(deadline);
                     self.stats.backward_seconds += began.elapsed().as_secs_f64();
-                    back.layers.len() == m
+                    complete && back.layers.len() == m
                 }
                 None => {
-                    self.extend_layer();
+                    let complete = self.extend_layer(deadline);
                     self.stats.forward_seconds += began.elapsed().as_secs_f64();
-                    self.layers.len() == m
+                    complete && self.layers.len() == m
                 }
             };
             if done {
                 self.finish_pass();
             }
-            let layer = began.elapsed().as_secs_f64();
-            self.stats.longest_layer_seconds = self.stats.longest_layer_seconds.max(layer);
-            if Instant::now() >= deadline {
+            let now = Instant::now();
+            if now >= deadline {
+                let overrun = now.duration_since(deadline).as_secs_f64();
+                self.stats.longest_overrun_seconds =
+                    self.stats.longest_overrun_seconds.max(overrun);
                 return true;
             }
         }
@@ -505,6 +531,7 @@ impl NgPathBound {
         self.lambda.clear();
         self.lambda.extend_from_slice(lambda);
         self.layers.clear();
+        self.work = None;
         self.pass_upper = upper;
         self.pass_margin = margin;
         self.rest_ready = false;
@@ -649,8 +676,9 @@ impl NgPathBound {
         Some(out)
     }
 
-    /// Computes the next layer of the DP.
-    fn extend_layer(&mut self) {
+    /// Works on the next layer of the DP until `deadline` (at least one target cluster); true
+    /// when the layer is complete.
+    fn extend_layer(&mut self, deadline: Instant) -> bool {
         let n = self.n;
         let m = self.members.len();
         let mut next: Vec<Label> = Vec::new();
@@ -681,38 +709,31 @@ impl NgPathBound {
             self.stats.labels += next.len() as u64;
             self.record_prefix(&next, floor);
             self.layers.push(next);
-            return;
+            return true;
         }
+        let LayerWork {
+            sources,
+            mut next,
+            mut floor,
+            mut pruned,
+            d: first,
+        } = match self.work.take() {
+            Some(work) => work,
+            None => LayerWork {
+                sources: self.sources(),
+                next,
+                floor,
+                pruned: 0,
+                d: 0,
+            },
+        };
+        let Sources {
+            runs,
+            run_best,
+            cluster_runs,
+            cluster_best,
+        } = &sources;
         let prev = self.layers.last().expect("a layer");
-        // Per source node: its labels (a contiguous run of `prev`) and its cheapest one.
-        let mut runs: Vec<(usize, usize, usize)> = Vec::new(); // (node, start, end)
-        let mut i = 0;
-        while i < prev.len() {
-            let v = prev[i].node as usize;
-            let mut j = i;
-            while j < prev.len() && prev[j].node as usize == v {
-                j += 1;
-            }
-            runs.push((v, i, j));
-            i = j;
-        }
-        // Per run: its cheapest label; per cluster: its runs and their cheapest label.
-        let run_best: Vec<(f64, u32)> = runs
-            .iter()
-            .map(|&(_, start, end)| {
-                (start..end)
-                    .map(|i| (prev[i].value, i as u32))
-                    .min_by(|a, b| a.0.total_cmp(&b.0))
-                    .expect("a run is not empty")
-            })
-            .collect();
-        let mut cluster_runs: Vec<Vec<usize>> = vec![Vec::new(); m];
-        let mut cluster_best = vec![f64::INFINITY; m];
-        for (r, &(v, _, _)) in runs.iter().enumerate() {
-            let c = self.cluster[v];
-            cluster_runs[c].push(r);
-            cluster_best[c] = cluster_best[c].min(run_best[r].0);
-        }
         // Candidates per target node of one cluster, a dense table over the memories (bit 0,
         // the cluster itself, is always set): (value, pred), and the memories touched.
         let width = 1usize << (self.ng[0].len() - 1);
@@ -720,8 +741,18 @@ impl NgPathBound {
         let mut touched: Vec<Vec<u32>> = Vec::new();
         let mut projected: Vec<(u32, f64, u32)> = Vec::new();
         let mut list: Vec<(u32, f64, u32)> = Vec::new();
-        let mut pruned = 0u64;
-        for d in 0..m {
+        for d in first..m {
+            if d > first && Instant::now() >= deadline {
+                self.work = Some(LayerWork {
+                    sources,
+                    next,
+                    floor,
+                    pruned,
+                    d,
+                });
+                return false;
+            }
+
             let targets = &self.members[d];
             let penalty = self.lambda[d];
             // Per target: the largest entry (before the penalty) that survives the pruning.
@@ -839,6 +870,48 @@ impl NgPathBound {
         self.stats.pruned += pruned;
         self.record_prefix(&next, floor);
         self.layers.push(next);
+        true
+    }
+
+    /// The previous layer's labels grouped for the next layer: per node, per cluster.
+    fn sources(&self) -> Sources {
+        let m = self.members.len();
+        let prev = self.layers.last().expect("a layer");
+        // Per source node: its labels (a contiguous run of `prev`) and its cheapest one.
+        let mut runs: Vec<(usize, usize, usize)> = Vec::new(); // (node, start, end)
+        let mut i = 0;
+        while i < prev.len() {
+            let v = prev[i].node as usize;
+            let mut j = i;
+            while j < prev.len() && prev[j].node as usize == v {
+                j += 1;
+            }
+            runs.push((v, i, j));
+            i = j;
+        }
+        // Per run: its cheapest label; per cluster: its runs and their cheapest label.
+        let run_best: Vec<(f64, u32)> = runs
+            .iter()
+            .map(|&(_, start, end)| {
+                (start..end)
+                    .map(|i| (prev[i].value, i as u32))
+                    .min_by(|a, b| a.0.total_cmp(&b.0))
+                    .expect("a run is not empty")
+            })
+            .collect();
+        let mut cluster_runs: Vec<Vec<usize>> = vec![Vec::new(); m];
+        let mut cluster_best = vec![f64::INFINITY; m];
+        for (r, &(v, _, _)) in runs.iter().enumerate() {
+            let c = self.cluster[v];
+            cluster_runs[c].push(r);
+            cluster_best[c] = cluster_best[c].min(run_best[r].0);
+        }
+        Sources {
+            runs,
+            run_best,
+            cluster_runs,
+            cluster_best,
+        }
     }
 
     /// Offers the labels `labels` of source node `v` (cluster `c`; `start`: the index of the
