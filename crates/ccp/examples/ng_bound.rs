@@ -69,18 +69,23 @@ fn main() {
         if ng.iterations() >= printed + 5 {
             printed = ng.iterations();
             println!(
-                "{:.1} s: {} iterations, ng-path bound {:.1}",
+                "{:.1} s: {} iterations, ng-path bound {:.1} (labels {}, pruned {}, backward {:.1} s, forward {:.1} s)",
                 began.elapsed().as_secs_f64(),
                 ng.iterations(),
-                ng.lower_bound()
+                ng.lower_bound(),
+                ng.stats().labels,
+                ng.stats().pruned,
+                ng.stats().backward_seconds,
+                ng.stats().forward_seconds,
             );
         }
     }
     println!(
-        "{} nodes, ng {ng_size}: {:.1} after {} iterations in {:.1} s",
+        "{} nodes, ng {ng_size}: {:.1} after {} iterations in {:.1} s (longest step overrun {:.3} s)",
         instance.node_count,
         ng.lower_bound(),
         ng.iterations(),
-        began.elapsed().as_secs_f64()
+        began.elapsed().as_secs_f64(),
+        ng.stats().longest_overrun_seconds
     );
 }

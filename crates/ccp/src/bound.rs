@@ -1075,6 +1075,7 @@ impl CcpLowerBound {
                     solver.offer_incumbent(&tour, cost);
                 }
                 if let Some(ng) = &mut s.ng {
+                    ng.offer_tour(&tour);
                     ng.set_upper(cost);
                 }
             }

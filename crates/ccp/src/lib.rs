@@ -94,7 +94,7 @@ pub use discrete::{
     build_pcgtsp, DiscreteInstance, DiscreteNode, DiscretisationOptions, PcgtspBuilder,
     MAX_DISCRETE_NODES,
 };
-pub use ngpath::NgPathBound;
+pub use ngpath::{NgPathBound, NgStats};
 pub use route::{idle_length, route_certificates, route_metrics, ContourCertificate, RouteMetrics};
 pub use solver::{
     solve, solve_with_cancel, CcpOptions, CcpPhase, CcpProgress, CcpResult, CcpSolver, HeatPenalty,
