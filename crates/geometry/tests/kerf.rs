@@ -120,7 +120,10 @@ fn offsets_beside_nearly_straight_arcs_lie_at_their_distance() {
                 assert_eq!(offset.is_clockwise(), contour.is_clockwise());
                 for p in samples(&offset) {
                     let error = (contour.distance_to(p) - d).abs();
-                    assert!(error < 1e-6, "bulge {flat:e}, hole {hole}, d {d}: {error:e} off");
+                    assert!(
+                        error < 1e-6,
+                        "bulge {flat:e}, hole {hole}, d {d}: {error:e} off"
+                    );
                     assert_eq!(contour.contains(p), hole);
                 }
             }
