@@ -28,7 +28,7 @@ use cavalier_contours::polyline::{
 };
 use thiserror::Error;
 
-use crate::{Contour, ContourRef, Nest, Point, Vertex};
+use crate::{offset_carrier, Contour, ContourRef, Nest, Point, Vertex};
 
 /// Why a contour has no single equidistant at the asked distance.
 #[derive(Clone, Debug, PartialEq, Error)]
@@ -95,7 +95,7 @@ pub fn equidistant(contour: &Contour, distance: f64) -> Result<Contour, OffsetEr
     // Repeated and collinear vertices (files have them) trip cavalier's internal asserts:
     // drop them first, within an epsilon relative to the contour's size, and retry with a
     // coarser one if the library still fails.
-    let pline = to_polyline(contour);
+    let pline = to_polyline(&offset_carrier::flattened(contour));
     let scale = (contour.bounding_box().width() + contour.bounding_box().height()).max(1.0);
     let mut loops = None;
     for relative_eps in [1e-9, 1e-6, 1e-4] {
@@ -109,28 +109,31 @@ pub fn equidistant(contour: &Contour, distance: f64) -> Result<Contour, OffsetEr
             break;
         }
     }
+    let loops = loops.ok_or(OffsetError::Failed { distance })?;
+    // The library's vertices can be micrometres off beside nearly straight arcs (and the arcs
+    // it was given as chords are not yet arcs): the loop that is returned gets exact vertices
+    // and bulges from the contour itself.
+    let exact = |l: &Polyline<f64>| offset_carrier::refine(contour, &from_polyline(l), distance);
     // Corners drawn as runs of tiny segments can leave degenerate loops of zero area beside
     // the real one (a 17 mm slot of seven.dbs came back in three pieces at 1 mm: the slot and
     // two 2-vertex loops); they enclose nothing and are no part of the tool's path.
     let degenerate = 1e-12 * scale * scale;
     let mut loops: Vec<Polyline<f64>> = loops
-        .ok_or(OffsetError::Failed { distance })?
         .into_iter()
         .filter(|l| from_polyline(l).area().abs() > degenerate)
         .collect();
     match loops.len() {
         0 => Err(OffsetError::Vanishes { distance }),
-        1 => Ok(from_polyline(&loops.remove(0))),
+        1 => Ok(exact(&loops.remove(0))),
         // Outward (a clockwise contour's left): a notch narrower than twice the distance
         // closes and leaves an enclosed loop the tool never reaches; the path is the loop
         // round the outside, the largest.
         _ if contour.is_clockwise() => {
             let outside = loops
                 .iter()
-                .map(from_polyline)
-                .max_by(|a, b| a.area().total_cmp(&b.area()))
+                .max_by(|a, b| from_polyline(a).area().total_cmp(&from_polyline(b).area()))
                 .expect("several loops");
-            Ok(outside)
+            Ok(exact(outside))
         }
         pieces => Err(OffsetError::Splits { distance, pieces }),
     }

@@ -83,6 +83,7 @@ mod generator;
 mod kerf;
 mod kerf_clearance;
 mod leads;
+mod offset_carrier;
 mod path_leads;
 mod path_route;
 mod point;

@@ -3,8 +3,8 @@
 //! where the kerf is really open when the tool gets there.
 
 use cutroute_geometry::{
-    Contour, ContourRef, CutStep, KerfSettings, LeadFitter, LeadProblem, LeadShape, LeadSpec,
-    MachineParameters, Nest, Part, Point, Route, RouteError, TabSpec, Vertex,
+    generate_nest, Contour, ContourRef, CutStep, KerfSettings, LeadFitter, LeadProblem, LeadShape,
+    LeadSpec, MachineParameters, Nest, Part, Point, Route, RouteError, StepLeads, TabSpec, Vertex,
 };
 
 /// Kerf 2, d₁ 5, d₂ 1, an 8 mm line lead-in, a 2 mm line lead-out, kerf piercing on.
@@ -233,4 +233,178 @@ fn a_tab_is_material_no_kerf_pierce_lands_in_its_gap() {
         moved_to.kerf_pierce.is_none() || moved_to.pierce.distance(m) > 1.0,
         "{moved_to:?}"
     );
+}
+
+/// The kerf-piercing pass as first written, through the public API: every step tested against
+/// the boxes of all the steps before it (quadratic in the route's length). The pass looks the
+/// earlier cuts up in an R-tree instead and must pierce exactly where this does.
+// `!(distance <= reach)` as in the pass: a NaN distance is not within reach.
+#[allow(clippy::neg_cmp_op_on_partial_ord)]
+fn pierce_into_kerfs_by_scanning(
+    fitter: &LeadFitter,
+    route: &mut Route,
+    machine: &MachineParameters,
+) -> usize {
+    let settings = fitter.settings();
+    if !settings.kerf_pierce || settings.kerf <= 0.0 {
+        return 0;
+    }
+    let reach = settings.edge_reach();
+    let half = settings.kerf / 2.0;
+    let mut moved = 0;
+    for i in 0..route.steps.len() {
+        let step = &route.steps[i];
+        let Some(leads) = step.leads.as_ref().filter(|_| step.is_pierced()) else {
+            continue;
+        };
+        if leads.edge_pierce || leads.kerf_pierce.is_some() {
+            continue;
+        }
+        let before = if i == 0 {
+            route.start
+        } else {
+            route.steps[i - 1].switch_off_point()
+        };
+        let seconds = |m: Point, pierce: f64| before.distance(m) / machine.idle_speed + pierce;
+        let mut best: (f64, Option<StepLeads>) = (seconds(leads.pierce, machine.pierce_time), None);
+        for earlier in &route.steps[..i] {
+            let (kerf_of, Some(cut)) = (earlier.contour, earlier.leads.as_ref()) else {
+                continue;
+            };
+            let near = fitter.nest().contour(kerf_of).is_some_and(|c| {
+                c.bounding_box()
+                    .expanded(half + reach)
+                    .contains_point(leads.entry)
+            });
+            if kerf_of == step.contour || !near {
+                continue;
+            }
+            let Ok(eq) = fitter.equidistant(kerf_of) else {
+                continue;
+            };
+            let Some(at) = eq.nearest_point(leads.entry).map(|n| n.point) else {
+                continue;
+            };
+            let time = seconds(at, machine.edge_pierce_seconds());
+            if !(at.distance(leads.entry) <= reach) || time >= best.0 - 1e-9 {
+                continue;
+            }
+            let pierced = StepLeads {
+                pierce: at,
+                lead_in: vec![
+                    Vertex::line(at.x, at.y),
+                    Vertex::line(leads.entry.x, leads.entry.y),
+                ],
+                kerf_pierce: Some(kerf_of),
+                ..leads.clone()
+            };
+            // The step's other leads passed the checker before, so the whole set passes
+            // (entered without a pierce in G_M) exactly when the new lead-in does.
+            if fitter.kerf_pierce_problem(kerf_of, cut, at).is_none()
+                && fitter
+                    .problems_linked(step.contour, &pierced, true, false)
+                    .is_empty()
+            {
+                best = (time, Some(pierced));
+            }
+        }
+        if let (_, Some(pierced)) = best {
+            route.steps[i].leads = Some(pierced);
+            moved += 1;
+        }
+    }
+    moved
+}
+
+/// Every contour of `nest` in a route that cuts the deepest contours first (so every contour
+/// after those inside it), each pierced near its first vertex (contours with no room for the
+/// leads left out), with leads attached.
+fn route_with_leads(fitter: &LeadFitter, nest: &Nest) -> Route {
+    let forest = nest.containment_forest();
+    let mut refs: Vec<ContourRef> = nest.contour_refs().collect();
+    refs.sort_by_key(|&r| std::cmp::Reverse(forest.depth(r)));
+    let steps = refs
+        .into_iter()
+        .filter_map(|r| {
+            let near = nest.contour(r)?.vertices[0].point;
+            fitter.attach_to_step(&CutStep::pierced(r, near)).ok()
+        })
+        .collect();
+    Route {
+        start: Point::new(0.0, 0.0),
+        steps,
+        finish: None,
+    }
+}
+
+/// `nest` without the contours that have no room for the leads (a part whose outer contour
+/// has none goes whole): the generator's smallest holes are narrower than d₁ = 5.
+fn with_room(nest: Nest, settings: KerfSettings) -> Nest {
+    let fitter = LeadFitter::new(&nest, settings);
+    let fits = |part: usize, contour: usize| {
+        let r = ContourRef { part, contour };
+        let near = nest.contour(r).unwrap().vertices[0].point;
+        fitter.attach_to_step(&CutStep::pierced(r, near)).is_ok()
+    };
+    let parts = (0..nest.parts.len())
+        .filter(|&p| fits(p, 0))
+        .map(|p| Part {
+            name: nest.parts[p].name.clone(),
+            contours: (0..nest.parts[p].contours.len())
+                .filter(|&c| c == 0 || fits(p, c))
+                .map(|c| nest.parts[p].contours[c].clone())
+                .collect(),
+        })
+        .collect();
+    Nest {
+        sheet: nest.sheet.clone(),
+        parts,
+    }
+}
+
+/// The R-tree pass and the scanning one pierce the same steps the same way, on the nests of
+/// the benchmark and generated ones, and every route still passes the checker.
+#[test]
+fn the_indexed_pass_pierces_exactly_where_scanning_every_earlier_cut_does() {
+    let read = |name: &str| {
+        let path = format!("{}/../../data/nests/{name}", env!("CARGO_MANIFEST_DIR"));
+        let bytes = std::fs::read(&path).unwrap_or_else(|e| panic!("cannot read {path}: {e}"));
+        let mut nest = cutroute_formats::read_nest(&bytes).expect("a nest");
+        nest.normalize_orientation();
+        nest
+    };
+    let settings = KerfSettings {
+        lead_in: LeadSpec::new(LeadShape::Arc, 8.0),
+        lead_out: LeadSpec::new(LeadShape::Line, 2.0),
+        ..plasma()
+    };
+    let nests = [
+        ("nested.dbs", read("dbs/nested.dbs")),
+        ("test1.dbs.json", read("dbs-json/test1.dbs.json")),
+        (
+            "generated 400, seed 1",
+            with_room(generate_nest(400, 1), settings),
+        ),
+        (
+            "generated 400, seed 2",
+            with_room(generate_nest(400, 2), settings),
+        ),
+    ];
+    let mut pierced_somewhere = 0;
+    for (name, nest) in &nests {
+        let forest = nest.containment_forest();
+        let fitter = LeadFitter::new(nest, settings);
+        let route = route_with_leads(&fitter, nest);
+        let problems = route.problems(nest, &forest, 1e-6);
+        assert!(problems.is_empty(), "{name}: {problems:?}");
+        let (mut indexed, mut scanned) = (route.clone(), route);
+        let moved = fitter.pierce_into_kerfs(&mut indexed, &machine());
+        let moved_by_scanning = pierce_into_kerfs_by_scanning(&fitter, &mut scanned, &machine());
+        assert_eq!(moved, moved_by_scanning, "{name}");
+        assert_eq!(indexed, scanned, "{name}");
+        let problems = indexed.problems(nest, &forest, 1e-6);
+        assert!(problems.is_empty(), "{name}: {problems:?}");
+        pierced_somewhere += usize::from(moved > 0);
+    }
+    assert_eq!(pierced_somewhere, nests.len());
 }
