@@ -720,6 +720,21 @@ impl<'a> LeadFitter<'a> {
             .fold(f64::INFINITY, f64::min)
     }
 
+    /// The least distance from a point of `span` to any contour whose box comes within
+    /// `limit` of the span's box (`f64::INFINITY` when none does): exact, from
+    /// [`Span::distance_to_span`] against each of those contours' spans.
+    fn span_clearance(&self, span: &Span, limit: f64) -> f64 {
+        let reach = span.bounding_box().expanded(limit);
+        self.nest
+            .contour_refs()
+            .filter(|&r| self.box_of(r).is_some_and(|b| b.intersects(&reach)))
+            .filter_map(|r| self.nest.contour(r))
+            .flat_map(|c| c.spans())
+            .filter(|s| s.bounding_box().intersects(&reach))
+            .map(|s| span.distance_to_span(&s))
+            .fold(f64::INFINITY, f64::min)
+    }
+
     /// [`crate::in_clear_scrap`] with the boxes built once: a contour contains no point outside its
     /// box.
     fn in_clear_scrap(&self, r: ContourRef, p: Point, distance: f64) -> bool {
@@ -1029,17 +1044,23 @@ impl<'a> LeadFitter<'a> {
         }
         let half = self.settings.kerf / 2.0;
         for span in chain_spans(chain) {
-            let samples = ((span.length() / (half / 4.0).clamp(0.05, 0.5)).ceil() as usize).max(2);
-            for i in 0..=samples {
-                let p = span.point_at(i as f64 / samples as f64);
-                let d = self.clearance(p, half + 1.0);
-                if d < half - TOLERANCE {
-                    return Some(LeadProblem::LeadTooClose {
-                        x: p.x,
-                        y: p.y,
-                        distance: d,
-                    });
-                }
+            // Exact, not sampled: a lead can dip between samples (0.99973 from a hole where
+            // kerf/2 = 1 was required, between samples 0.25 mm apart).
+            let d = self.span_clearance(&span, half + 1.0);
+            if d < half - TOLERANCE {
+                // Where: the nearest of dense samples (the distance reported is the exact one).
+                let p = (0..=256)
+                    .map(|i| span.point_at(i as f64 / 256.0))
+                    .min_by(|a, b| {
+                        self.clearance(*a, half + 1.0)
+                            .total_cmp(&self.clearance(*b, half + 1.0))
+                    })
+                    .unwrap_or(span.start);
+                return Some(LeadProblem::LeadTooClose {
+                    x: p.x,
+                    y: p.y,
+                    distance: d,
+                });
             }
             // With no kerf, sampling cannot see a crossing: test it exactly, away from the
             // lead's end on its own contour.
