@@ -51,6 +51,20 @@ pub enum OffsetError {
         /// The distance asked.
         distance: f64,
     },
+    /// The contour turns back on itself at a vertex (its two spans leave it in opposite
+    /// directions, a spike of no width), and the offset library finds no equidistant outward
+    /// (it sees the spans cross again micrometres from the vertex).
+    #[error(
+        "the contour turns back on itself at ({x:.6}, {y:.6}) (a cusp): no equidistant at {distance} mm"
+    )]
+    Cusp {
+        /// The distance asked.
+        distance: f64,
+        /// The cusp vertex.
+        x: f64,
+        /// The cusp vertex.
+        y: f64,
+    },
     /// An inward offset falls apart into several closed loops (a hole with a narrow waist),
     /// so one cut cannot follow it. (Outward, the loop round the outside is the equidistant.)
     #[error("the contour splits into {pieces} loops when offset by {distance} mm")]
@@ -123,6 +137,15 @@ pub fn equidistant(contour: &Contour, distance: f64) -> Result<Contour, OffsetEr
         .filter(|l| from_polyline(l).area().abs() > degenerate)
         .collect();
     match loops.len() {
+        // Outward a contour never vanishes: the library failed, at a cusp where it has seen one.
+        0 if contour.is_clockwise() => Err(match cusp(contour) {
+            Some(p) => OffsetError::Cusp {
+                distance,
+                x: p.x,
+                y: p.y,
+            },
+            None => OffsetError::Failed { distance },
+        }),
         0 => Err(OffsetError::Vanishes { distance }),
         1 => Ok(exact(&loops.remove(0))),
         // Outward (a clockwise contour's left): a notch narrower than twice the distance
@@ -137,6 +160,17 @@ pub fn equidistant(contour: &Contour, distance: f64) -> Result<Contour, OffsetEr
         }
         pieces => Err(OffsetError::Splits { distance, pieces }),
     }
+}
+
+/// The first vertex where the contour turns back on itself: the span into it ends in the
+/// direction opposite to where the span out of it starts (within 1.4·10⁻³ rad).
+fn cusp(contour: &Contour) -> Option<Point> {
+    let spans: Vec<_> = contour.spans().collect();
+    (0..spans.len()).find_map(|k| {
+        let into = &spans[(k + spans.len() - 1) % spans.len()];
+        let out = &spans[k];
+        (into.tangent_at(1.0).dot(out.tangent_at(0.0)) < -1.0 + 1e-6).then_some(out.start)
+    })
 }
 
 /// The least distance from `p` to any contour of the nest, searching only contours whose

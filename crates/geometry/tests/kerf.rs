@@ -58,6 +58,15 @@ proptest! {
             }
             // Only a hole (inward) can close up or fall apart.
             Err(OffsetError::Vanishes { .. } | OffsetError::Splits { .. }) => prop_assert!(hole),
+            // A cusp is named only where the contour does turn back on itself there.
+            Err(OffsetError::Cusp { x, y, .. }) => {
+                let spans: Vec<_> = contour.spans().collect();
+                let k = spans.iter().position(|s| s.start == Point::new(x, y));
+                prop_assert!(k.is_some(), "no vertex at ({}, {})", x, y);
+                let k = k.unwrap();
+                let into = spans[(k + spans.len() - 1) % spans.len()].tangent_at(1.0);
+                prop_assert!(into.dot(spans[k].tangent_at(0.0)) < -0.999, "no cusp at ({}, {})", x, y);
+            }
             Err(e) => prop_assert!(false, "{}", e),
         }
     }
@@ -466,4 +475,33 @@ fn an_outward_offset_closes_a_narrow_notch_and_follows_the_outside() {
     let rounded_square = 80.0 + std::f64::consts::TAU;
     assert!(offset.perimeter() > rounded_square - 1.0 && offset.perimeter() < rounded_square + 1.0);
     assert!(offset.bounding_box().height() > 21.9);
+}
+
+/// A star whose three concave arcs make one vertex turn back on itself by 180° (to 5·10⁻⁶ rad),
+/// so the spans cross again 0.4 µm from it: the offset library builds no outward equidistant,
+/// and the error says where (a proptest case, reported as "vanishes" before).
+#[test]
+fn a_cusp_is_named_where_no_outward_equidistant_is_built() {
+    let contour = star(
+        Point::new(0.0, 0.0),
+        &[34.840447109320436, 39.67430069497756, 21.56448585148291],
+        &[-0.2133152152693176],
+        false,
+    );
+    assert!(contour.validate().is_ok());
+    match equidistant(&contour, 0.05) {
+        Err(OffsetError::Cusp { x, y, .. }) => {
+            assert!(
+                Point::new(x, y).distance(Point::new(-19.837150347488773, 34.35895227923318))
+                    < 1e-9
+            );
+        }
+        // Should the library learn to offset it, the equidistant must hold its distance.
+        Ok(offset) => {
+            for p in samples(&offset) {
+                assert!((contour.distance_to(p) - 0.05).abs() < 1e-6);
+            }
+        }
+        Err(e) => panic!("{e}"),
+    }
 }
