@@ -105,6 +105,13 @@ const NG_INITIAL_PIECES: usize = 1600;
 /// at 2,500, and the subgradient needs many passes.
 const NG_ALONE_MAX_NODES: usize = 1200;
 
+/// A stage with the ng-path bound goes on past its time share while that bound still rises by
+/// more than this fraction per pass (over its last `NG_RISE_PASSES` passes): a refinement
+/// restarts the search on a larger instance with slower passes, and on nested.dbs one stage
+/// got only 1–7 passes of 2–5 s while the bound still rose by ~0.4 % per pass.
+const NG_RISE_PER_PASS: f64 = 0.003;
+const NG_RISE_PASSES: usize = 3;
+
 /// Most groups of the decomposition bound.
 const MAX_GROUPS: usize = 64;
 
@@ -299,6 +306,33 @@ struct Solving {
     /// Slices of this stage so far (the exact search gets every eighth beside the ng-path
     /// bound).
     turns: usize,
+    /// The ng-path bound's best value after each of its passes in this stage.
+    ng_history: Vec<f64>,
+}
+
+impl Solving {
+    /// Whether the ng-path bound rose by more than `NG_RISE_PER_PASS` per pass over its last
+    /// `NG_RISE_PASSES` passes (true before it has run that many: too few to judge).
+    fn ng_rising(&self) -> bool {
+        if !self.ng_running {
+            return false;
+        }
+        let h = &self.ng_history;
+        if h.len() <= NG_RISE_PASSES {
+            return true;
+        }
+        let last = h[h.len() - 1];
+        if !last.is_finite() || last <= 0.0 {
+            return false;
+        }
+        let before = h[h.len() - 1 - NG_RISE_PASSES];
+        let rise = if before.is_finite() {
+            last - before
+        } else {
+            f64::INFINITY
+        };
+        rise > NG_RISE_PER_PASS * NG_RISE_PASSES as f64 * last
+    }
 }
 
 enum Stage {
@@ -1031,6 +1065,7 @@ impl CcpLowerBound {
             ng,
             exact_over: false,
             turns: 0,
+            ng_history: Vec::new(),
         })
     }
 
@@ -1105,7 +1140,11 @@ impl CcpLowerBound {
                 self.best = self.best.max(progress.lower_bound);
             }
         } else if let Some(ng) = s.ng.as_mut().filter(|_| s.ng_running) {
+            let passes = ng.iterations();
             s.ng_running = ng.step(deadline);
+            if ng.iterations() > passes {
+                s.ng_history.push(ng.lower_bound());
+            }
             if ng.lower_bound().is_finite() {
                 self.best = self.best.max(ng.lower_bound());
                 self.ng_best = self.ng_best.max(ng.lower_bound());
@@ -1114,8 +1153,11 @@ impl CcpLowerBound {
         }
         s.spent += now.elapsed();
         // The stage is over when the exact search ended (its bound is then the relaxation's
-        // optimum), when neither search can go on, or when its time is up.
-        s.exact_over || s.spent >= s.share || (s.solver.is_none() && !s.ng_running)
+        // optimum), when neither search can go on, or when its time is up and the ng-path
+        // bound no longer rises fast.
+        s.exact_over
+            || (s.spent >= s.share && !s.ng_rising())
+            || (s.solver.is_none() && !s.ng_running)
     }
 
     /// Splits the pieces of the relaxed tour and those holding the incumbent's pierce points
