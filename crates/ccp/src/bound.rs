@@ -51,7 +51,8 @@
 //! of that PCGTSP is sound by step 3.
 //!
 //! **Refinement.** A stage builds the instance (row by row, in slices), then runs the exact
-//! solver for a doubling time share. Then the pieces holding the best route's pierce points and
+//! solver for a doubling time share (a stage with the ng-path bound goes on past it while that
+//! bound still rises by more than 0.3 % per pass). Then the pieces holding the best route's pierce points and
 //! the pieces of the relaxed tour are halved, and the next stage starts. Finer pieces only raise
 //! the relaxed optimum; the reported bound is the best over all stages.
 //!
