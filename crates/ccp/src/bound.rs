@@ -51,8 +51,7 @@
 //! of that PCGTSP is sound by step 3.
 //!
 //! **Refinement.** A stage builds the instance (row by row, in slices), then runs the exact
-//! solver for a doubling time share (a stage with the ng-path bound goes on past it while that
-//! bound still rises by more than 0.3 % per pass). Then the pieces holding the best route's pierce points and
+//! solver for a doubling time share. Then the pieces holding the best route's pierce points and
 //! the pieces of the relaxed tour are halved, and the next stage starts. Finer pieces only raise
 //! the relaxed optimum; the reported bound is the best over all stages.
 //!
@@ -105,13 +104,6 @@ const NG_INITIAL_PIECES: usize = 1600;
 /// pass over Nest02's 359 kept contours took ~2 s at 824 nodes, ~5 s at 1,627 and over 20 s
 /// at 2,500, and the subgradient needs many passes.
 const NG_ALONE_MAX_NODES: usize = 1200;
-
-/// A stage with the ng-path bound goes on past its time share while that bound still rises by
-/// more than this fraction per pass (over its last `NG_RISE_PASSES` passes): a refinement
-/// restarts the search on a larger instance with slower passes, and on nested.dbs one stage
-/// got only 1–7 passes of 2–5 s while the bound still rose by ~0.4 % per pass.
-const NG_RISE_PER_PASS: f64 = 0.003;
-const NG_RISE_PASSES: usize = 3;
 
 /// Most groups of the decomposition bound.
 const MAX_GROUPS: usize = 64;
@@ -307,33 +299,6 @@ struct Solving {
     /// Slices of this stage so far (the exact search gets every eighth beside the ng-path
     /// bound).
     turns: usize,
-    /// The ng-path bound's best value after each of its passes in this stage.
-    ng_history: Vec<f64>,
-}
-
-impl Solving {
-    /// Whether the ng-path bound rose by more than `NG_RISE_PER_PASS` per pass over its last
-    /// `NG_RISE_PASSES` passes (true before it has run that many: too few to judge).
-    fn ng_rising(&self) -> bool {
-        if !self.ng_running {
-            return false;
-        }
-        let h = &self.ng_history;
-        if h.len() <= NG_RISE_PASSES {
-            return true;
-        }
-        let last = h[h.len() - 1];
-        if !last.is_finite() || last <= 0.0 {
-            return false;
-        }
-        let before = h[h.len() - 1 - NG_RISE_PASSES];
-        let rise = if before.is_finite() {
-            last - before
-        } else {
-            f64::INFINITY
-        };
-        rise > NG_RISE_PER_PASS * NG_RISE_PASSES as f64 * last
-    }
 }
 
 enum Stage {
@@ -1066,7 +1031,6 @@ impl CcpLowerBound {
             ng,
             exact_over: false,
             turns: 0,
-            ng_history: Vec::new(),
         })
     }
 
@@ -1141,11 +1105,7 @@ impl CcpLowerBound {
                 self.best = self.best.max(progress.lower_bound);
             }
         } else if let Some(ng) = s.ng.as_mut().filter(|_| s.ng_running) {
-            let passes = ng.iterations();
             s.ng_running = ng.step(deadline);
-            if ng.iterations() > passes {
-                s.ng_history.push(ng.lower_bound());
-            }
             if ng.lower_bound().is_finite() {
                 self.best = self.best.max(ng.lower_bound());
                 self.ng_best = self.ng_best.max(ng.lower_bound());
@@ -1154,11 +1114,8 @@ impl CcpLowerBound {
         }
         s.spent += now.elapsed();
         // The stage is over when the exact search ended (its bound is then the relaxation's
-        // optimum), when neither search can go on, or when its time is up and the ng-path
-        // bound no longer rises fast.
-        s.exact_over
-            || (s.spent >= s.share && !s.ng_rising())
-            || (s.solver.is_none() && !s.ng_running)
+        // optimum), when neither search can go on, or when its time is up.
+        s.exact_over || s.spent >= s.share || (s.solver.is_none() && !s.ng_running)
     }
 
     /// Splits the pieces of the relaxed tour and those holding the incumbent's pierce points
