@@ -4,7 +4,7 @@
 
 use cutroute_chains::{chain_route, ChainOptions};
 use cutroute_geometry::{
-    generate_nest, KerfSettings, LeadFitter, LeadShape, LeadSpec, Point, Route,
+    generate_nest, KerfSettings, LeadFitter, LeadShape, LeadSpec, Nest, Point, Route,
 };
 
 fn settings(kerf: f64, d1: f64, d2: f64, lead_in: f64) -> KerfSettings {
@@ -18,19 +18,26 @@ fn settings(kerf: f64, d1: f64, d2: f64, lead_in: f64) -> KerfSettings {
     }
 }
 
+/// The nest's lead fitter and a chained route over its kerf nest (innermost first from the
+/// origin, back to it).
+fn chained_over_kerf_nest(nest: &Nest, s: KerfSettings) -> (LeadFitter<'_>, Route) {
+    let fitter = LeadFitter::new(nest, s);
+    let kerf_nest = fitter.kerf_nest();
+    let origin = Point::new(0.0, 0.0);
+    let route = Route::innermost_first(&kerf_nest, origin, Some(origin));
+    let chained = chain_route(&kerf_nest, &route, &ChainOptions::default())
+        .unwrap()
+        .route;
+    (fitter, chained)
+}
+
 #[test]
 fn chains_over_the_kerf_nest_come_back_valid_with_leads() {
     let mut chained_somewhere = false;
     for seed in 1..=6 {
         let nest = generate_nest(30, seed);
         for s in [settings(2.0, 5.0, 1.0, 8.0), settings(0.2, 1.0, 0.5, 3.0)] {
-            let fitter = LeadFitter::new(&nest, s);
-            let kerf_nest = fitter.kerf_nest();
-            let origin = Point::new(0.0, 0.0);
-            let route = Route::innermost_first(&kerf_nest, origin, Some(origin));
-            let chained = chain_route(&kerf_nest, &route, &ChainOptions::default())
-                .unwrap()
-                .route;
+            let (fitter, chained) = chained_over_kerf_nest(&nest, s);
             match fitter.attach_chained(&chained, 1, 12) {
                 Ok(with_leads) => {
                     let r = with_leads.route;
@@ -77,13 +84,7 @@ fn leads_attached_in_pieces_equal_leads_attached_at_once() {
     let mut linked = 0;
     for nest in &nests {
         for s in [settings(2.0, 5.0, 1.0, 8.0), settings(0.2, 1.0, 0.5, 3.0)] {
-            let fitter = LeadFitter::new(nest, s);
-            let kerf_nest = fitter.kerf_nest();
-            let origin = Point::new(0.0, 0.0);
-            let route = Route::innermost_first(&kerf_nest, origin, Some(origin));
-            let chained = chain_route(&kerf_nest, &route, &ChainOptions::default())
-                .unwrap()
-                .route;
+            let (fitter, chained) = chained_over_kerf_nest(nest, s);
             linked += chained.steps.iter().filter(|s| !s.is_pierced()).count();
             for (passes, positions) in [(0, 0), (1, 12)] {
                 let whole = fitter.attach_chained(&chained, passes, positions);
