@@ -669,6 +669,9 @@ pub struct LeadFitter<'a> {
     /// The contours' boxes by part and contour, built on first use: a box is a pass over
     /// the contour's spans, and the fitter tests thousands of points.
     boxes: std::cell::OnceCell<Vec<Vec<BoundingBox>>>,
+    /// The same boxes in an R-tree, built on first use: clearance tests ask for the contours
+    /// near a point, and scanning every box made that O(n) per test (20,000 contours).
+    box_index: std::cell::OnceCell<RTree<GeomWithData<Rectangle<[f64; 2]>, ContourRef>>>,
 }
 
 impl<'a> LeadFitter<'a> {
@@ -679,6 +682,7 @@ impl<'a> LeadFitter<'a> {
             forest: Cow::Owned(nest.containment_forest()),
             settings,
             boxes: Default::default(),
+            box_index: Default::default(),
         }
     }
 
@@ -693,7 +697,36 @@ impl<'a> LeadFitter<'a> {
             forest: Cow::Borrowed(forest),
             settings,
             boxes: Default::default(),
+            box_index: Default::default(),
         }
+    }
+
+    /// The contours whose boxes meet `area`, in the nest's order (part, then contour), so a
+    /// search that stops at its first find finds what a scan in that order would.
+    fn contours_meeting(&self, area: &BoundingBox) -> Vec<ContourRef> {
+        let index = self.box_index.get_or_init(|| {
+            RTree::bulk_load(
+                self.nest
+                    .contour_refs()
+                    .filter_map(|r| {
+                        let b = self.box_of(r)?;
+                        Some(GeomWithData::new(
+                            Rectangle::from_corners([b.min.x, b.min.y], [b.max.x, b.max.y]),
+                            r,
+                        ))
+                    })
+                    .collect(),
+            )
+        });
+        let query = rstar::AABB::from_corners([area.min.x, area.min.y], [area.max.x, area.max.y]);
+        let mut found: Vec<ContourRef> = index
+            .locate_in_envelope_intersecting(&query)
+            .map(|g| g.data)
+            // The index's own test is the same closed-box test; this keeps it exactly ours.
+            .filter(|&r| self.box_of(r).is_some_and(|b| b.intersects(area)))
+            .collect();
+        found.sort_unstable();
+        found
     }
 
     pub(crate) fn box_of(&self, r: ContourRef) -> Option<&BoundingBox> {
@@ -709,8 +742,9 @@ impl<'a> LeadFitter<'a> {
 
     /// [`crate::clearance`] with the boxes built once.
     fn clearance(&self, p: Point, limit: f64) -> f64 {
-        self.nest
-            .contour_refs()
+        let around = BoundingBox::from_corners(p, p).expanded(limit);
+        self.contours_meeting(&around)
+            .into_iter()
             .filter(|&r| {
                 self.box_of(r)
                     .is_some_and(|b| b.expanded(limit).contains_point(p))
@@ -725,9 +759,8 @@ impl<'a> LeadFitter<'a> {
     /// [`Span::distance_to_span`] against each of those contours' spans.
     fn span_clearance(&self, span: &Span, limit: f64) -> f64 {
         let reach = span.bounding_box().expanded(limit);
-        self.nest
-            .contour_refs()
-            .filter(|&r| self.box_of(r).is_some_and(|b| b.intersects(&reach)))
+        self.contours_meeting(&reach)
+            .into_iter()
             .filter_map(|r| self.nest.contour(r))
             .flat_map(|c| c.spans())
             .filter(|s| s.bounding_box().intersects(&reach))
@@ -1081,11 +1114,8 @@ impl<'a> LeadFitter<'a> {
     /// (the end at t = 1 of a lead-in, t = 0 of a lead-out).
     fn crossing(&self, r: ContourRef, span: &Span, lead_in: bool) -> Option<Point> {
         let bbox = span.bounding_box();
-        for other in self.nest.contour_refs() {
+        for other in self.contours_meeting(&bbox) {
             let c = self.nest.contour(other)?;
-            if !c.bounding_box().intersects(&bbox) {
-                continue;
-            }
             for s in c.spans() {
                 for x in span.intersections(&s) {
                     let at_own_end = other == r
