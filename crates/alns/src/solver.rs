@@ -467,34 +467,18 @@ impl AlnsSolver {
         let mut improved = false;
         let max_len = self.options.parameters.block_reverse_length;
         match descent.unit {
-            0..=2 => {
+            0..=3 => {
                 if descent.unit == 0 && !descent.family.partial {
                     descent.changed = false;
                 }
-                let finished = run_family(
-                    &mut self.local_search,
-                    p,
-                    &mut tour,
-                    descent.unit,
-                    max_len,
-                    &mut descent.family,
-                    &mut descent.changed,
-                    pause,
-                );
-                if !finished {
-                    self.current = tour;
-                    self.descent = Some(descent);
-                    return false;
-                }
-            }
-            3 => {
-                // Block reversal only after a round that changed nothing (or to finish it).
-                if !descent.changed || descent.family.partial {
+                // Block reversal (unit 3) only after a round that changed nothing (or to
+                // finish it).
+                if descent.unit < 3 || !descent.changed || descent.family.partial {
                     let finished = run_family(
                         &mut self.local_search,
                         p,
                         &mut tour,
-                        3,
+                        descent.unit,
                         max_len,
                         &mut descent.family,
                         &mut descent.changed,
@@ -505,7 +489,7 @@ impl AlnsSolver {
                         self.descent = Some(descent);
                         return false;
                     }
-                    if !descent.changed {
+                    if descent.unit == 3 && !descent.changed {
                         // A local optimum: the descent is over.
                         debug_assert!(p.order_is_valid(&tour));
                         self.current = tour;
