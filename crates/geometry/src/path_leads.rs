@@ -561,17 +561,6 @@ mod tests {
         nest
     }
 
-    fn plasma() -> KerfSettings {
-        KerfSettings {
-            kerf: 2.0,
-            pierce_clearance: 5.0,
-            switch_off_clearance: 1.0,
-            lead_in: LeadSpec::new(LeadShape::Arc, 8.0),
-            lead_out: LeadSpec::new(LeadShape::Line, 2.0),
-            ..KerfSettings::default()
-        }
-    }
-
     /// A plate 100 × 60 with a 40 × 30 hole, and a second part 50 × 50 beside it.
     fn plates() -> Nest {
         nest(vec![
@@ -595,7 +584,8 @@ mod tests {
     #[test]
     fn whole_contour_paths_get_leads_that_pass_the_checker() {
         let nest = plates();
-        let route = with_leads(&nest, plasma()).expect("room for every lead");
+        let route =
+            with_leads(&nest, KerfSettings::plasma_reference()).expect("room for every lead");
         assert_eq!(route.paths.len(), 3);
         assert_eq!(route.problems(&nest, 1e-6), Vec::new());
         for path in &route.paths {
@@ -625,7 +615,7 @@ mod tests {
 
     #[test]
     fn json_carries_the_leads_and_reads_back() {
-        let route = with_leads(&plates(), plasma()).expect("room");
+        let route = with_leads(&plates(), KerfSettings::plasma_reference()).expect("room");
         let json = serde_json::to_value(&route).expect("serialises");
         let leads = &json["paths"][0]["leads"];
         for field in ["entry", "lead_in", "lead_out", "switch_off"] {
@@ -645,7 +635,7 @@ mod tests {
     #[test]
     fn the_checker_catches_broken_leads() {
         let nest = plates();
-        let good = with_leads(&nest, plasma()).expect("room");
+        let good = with_leads(&nest, KerfSettings::plasma_reference()).expect("room");
         let first_lead = |route: &PathRoute| {
             route
                 .problems(&nest, 1e-6)
@@ -718,7 +708,7 @@ mod tests {
             vec![Contour::rectangle(0.0, 0.0, 50.0, 50.0)],
             vec![Contour::rectangle(51.0, 0.0, 101.0, 50.0)],
         ]);
-        let fitter = LeadFitter::new(&close, plasma());
+        let fitter = LeadFitter::new(&close, KerfSettings::plasma_reference());
         let kerf_nest = fitter.kerf_nest();
         let route = Route::innermost_first(&kerf_nest, Point::new(-50.0, 25.0), None);
         let paths = PathRoute::from_route(&route, &kerf_nest).unwrap();
@@ -736,7 +726,7 @@ mod tests {
         // One square's equidistant cut in two open paths, the second against the contour's
         // direction: its scrap is on the right, so its leads are the mirrored ones.
         let nest = nest(vec![vec![Contour::rectangle(0.0, 0.0, 50.0, 50.0)]]);
-        let fitter = LeadFitter::new(&nest, plasma());
+        let fitter = LeadFitter::new(&nest, KerfSettings::plasma_reference());
         let r = ContourRef {
             part: 0,
             contour: 0,
@@ -769,7 +759,8 @@ mod tests {
             Contour::rectangle(0.0, 0.0, 60.0, 60.0),
             Contour::rectangle(20.0, 20.0, 23.0, 23.0),
         ]]);
-        let errors = with_leads(&nest, plasma()).expect_err("no room in the hole");
+        let errors =
+            with_leads(&nest, KerfSettings::plasma_reference()).expect_err("no room in the hole");
         assert!(errors.iter().any(|e| match e {
             LeadError::NoFit { contour, .. } | LeadError::Offset { contour, .. } =>
                 contour.contour == 1,
@@ -813,7 +804,7 @@ mod tests {
                     ..KerfSettings::default()
                 }
             } else {
-                plasma()
+                KerfSettings::plasma_reference()
             };
             let route = with_leads(&nest, settings).expect("room");
             prop_assert_eq!(route.problems(&nest, 1e-6), Vec::new());

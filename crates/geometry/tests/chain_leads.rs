@@ -3,8 +3,8 @@
 //! link's ends).
 
 use cutroute_geometry::{
-    Contour, ContourRef, CutStep, Entry, KerfSettings, LeadFitter, LeadShape, LeadSpec, Nest, Part,
-    Point, Route, RouteError, Vertex,
+    Contour, ContourRef, CutStep, Entry, KerfSettings, LeadFitter, Nest, Part, Point, Route,
+    RouteError, Vertex,
 };
 use proptest::prelude::*;
 
@@ -32,17 +32,6 @@ fn row(size: f64, gaps: &[f64]) -> Nest {
         }
     }
     Nest { sheet: None, parts }
-}
-
-fn plasma() -> KerfSettings {
-    KerfSettings {
-        kerf: 2.0,
-        pierce_clearance: 5.0,
-        switch_off_clearance: 1.0,
-        lead_in: LeadSpec::new(LeadShape::Arc, 8.0),
-        lead_out: LeadSpec::new(LeadShape::Line, 2.0),
-        ..KerfSettings::default()
-    }
 }
 
 fn r(part: usize) -> ContourRef {
@@ -79,7 +68,7 @@ fn chained_over_kerf_nest(nest: &Nest, half: f64, y: f64) -> Route {
 #[test]
 fn a_chain_pierces_once_with_a_lead_in_and_ends_with_a_lead_out() {
     let nest = row(20.0, &[12.0]);
-    let fitter = LeadFitter::new(&nest, plasma());
+    let fitter = LeadFitter::new(&nest, KerfSettings::plasma_reference());
     let kerf_nest = fitter.kerf_nest();
     let route = chained_over_kerf_nest(&nest, 1.0, 10.0);
     // The hand-made chain is a valid chain of the kerf nest.
@@ -118,7 +107,7 @@ fn a_chain_start_without_room_for_a_lead_in_is_pierced_apart() {
     // A 6 mm gap: no point of it is d₁ = 5 from both squares, and the chain's first entry
     // faces it, so no lead-in fits there; the link is given up for a second pierce.
     let nest = row(20.0, &[6.0]);
-    let fitter = LeadFitter::new(&nest, plasma());
+    let fitter = LeadFitter::new(&nest, KerfSettings::plasma_reference());
     let route = chained_over_kerf_nest(&nest, 1.0, 10.0);
     assert_eq!(route.validate(&fitter.kerf_nest(), 1e-6), Ok(()));
     let chained = fitter.attach_chained(&route, 2, 24).unwrap();
@@ -131,7 +120,7 @@ fn a_chain_start_without_room_for_a_lead_in_is_pierced_apart() {
 #[test]
 fn the_checker_holds_links_to_half_the_kerf() {
     let nest = row(20.0, &[12.0]);
-    let fitter = LeadFitter::new(&nest, plasma());
+    let fitter = LeadFitter::new(&nest, KerfSettings::plasma_reference());
     let mut route = fitter
         .attach_chained(&chained_over_kerf_nest(&nest, 1.0, 10.0), 0, 0)
         .unwrap()
@@ -157,7 +146,7 @@ fn a_pierced_step_s_pierce_point_is_still_held_to_the_pierce_region() {
     // The chain start's lead-in swapped for none: its pierce point is then the entry, 1 mm
     // from the square, which only a linked step may have.
     let nest = row(20.0, &[12.0]);
-    let fitter = LeadFitter::new(&nest, plasma());
+    let fitter = LeadFitter::new(&nest, KerfSettings::plasma_reference());
     let mut route = fitter
         .attach_chained(&chained_over_kerf_nest(&nest, 1.0, 10.0), 0, 0)
         .unwrap()
@@ -192,7 +181,7 @@ proptest! {
         kerf in prop::sample::select(vec![0.2, 2.0]),
     ) {
         let nest = row(20.0, &gaps);
-        let settings = KerfSettings { kerf, pierce_clearance: if kerf < 1.0 { 1.0 } else { 5.0 }, ..plasma() };
+        let settings = KerfSettings { kerf, pierce_clearance: if kerf < 1.0 { 1.0 } else { 5.0 }, ..KerfSettings::plasma_reference() };
         let fitter = LeadFitter::new(&nest, settings);
         let route = chained_over_kerf_nest(&nest, kerf / 2.0, y);
         prop_assume!(gaps.iter().all(|g| *g > kerf));
@@ -214,7 +203,7 @@ proptest! {
 #[test]
 fn a_chain_fitted_again_after_a_link_became_a_pierce_is_valid() {
     let nest = row(20.0, &[12.0]);
-    let fitter = LeadFitter::new(&nest, plasma());
+    let fitter = LeadFitter::new(&nest, KerfSettings::plasma_reference());
     let mut route = fitter
         .attach_chained(&chained_over_kerf_nest(&nest, 1.0, 10.0), 0, 0)
         .unwrap()

@@ -39,19 +39,6 @@ fn r(part: usize, contour: usize) -> ContourRef {
     ContourRef { part, contour }
 }
 
-/// Plasma settings: kerf 2, d₁ 5, d₂ 1, arc lead-in, line lead-out, no overcut (so a step's cut
-/// is the same spans as a path's).
-fn plasma() -> KerfSettings {
-    KerfSettings {
-        kerf: 2.0,
-        pierce_clearance: 5.0,
-        switch_off_clearance: 1.0,
-        lead_in: LeadSpec::new(LeadShape::Arc, 8.0),
-        lead_out: LeadSpec::new(LeadShape::Line, 2.0),
-        ..KerfSettings::default()
-    }
-}
-
 /// The innermost-first route of `nest` with leads fitted under `settings`.
 fn with_leads(nest: &Nest, settings: KerfSettings) -> Route {
     let fitter = LeadFitter::new(nest, settings);
@@ -124,7 +111,7 @@ fn two_squares_1_mm_apart_fail_with_kerf_2_once_per_pair() {
     assert!(p.distance < 1e-9 && p.required == 1.0, "{p:?}");
     assert!((50.0..=51.0).contains(&p.at.x), "{p:?}");
 
-    let route = with_leads(&nest, plasma());
+    let route = with_leads(&nest, KerfSettings::plasma_reference());
     let overlaps = kerf_overlaps_of(&route, &nest);
     // Both cuts eat into the other part; the pair is reported once.
     assert_eq!(overlaps.len(), 1, "{overlaps:?}");
@@ -155,7 +142,7 @@ fn two_squares_3_mm_apart_pass_and_exactly_the_kerf_apart_pass() {
             vec![square(50.0 + gap, 0.0, 50.0)],
         ]);
         assert!(kerf_overlaps(&nest, 1.0, nest.check_tolerance()).is_empty());
-        let route = with_leads(&nest, plasma());
+        let route = with_leads(&nest, KerfSettings::plasma_reference());
         let problems = route.problems(&nest, &nest.containment_forest(), nest.check_tolerance());
         assert!(problems.is_empty(), "gap {gap}: {problems:?}");
         assert_eq!(cut_too_close(&as_paths(&route, &nest), &nest), 0);
@@ -172,7 +159,7 @@ fn three_squares_in_a_row_make_two_pairs() {
     let pairs = kerf_overlaps(&nest, 1.0, nest.check_tolerance());
     let named: Vec<(ContourRef, ContourRef)> = pairs.iter().map(|p| (p.contour, p.other)).collect();
     assert_eq!(named, vec![(r(0, 0), r(1, 0)), (r(1, 0), r(2, 0))]);
-    let route = with_leads(&nest, plasma());
+    let route = with_leads(&nest, KerfSettings::plasma_reference());
     assert_eq!(kerf_overlaps_of(&route, &nest).len(), 2);
 }
 
@@ -236,7 +223,7 @@ fn circles_overlap_by_their_arcs_exactly_when_closer_than_the_kerf() {
             // The cut (radius 11) reaches to 0.5 mm inside the other circle's 1 mm: 0.5 from it.
             assert!((pairs[0].distance - (gap - 1.0)).abs() < 1e-9, "{pairs:?}");
         }
-        let route = with_leads(&nest, plasma());
+        let route = with_leads(&nest, KerfSettings::plasma_reference());
         assert_eq!(kerf_overlaps_of(&route, &nest).len(), usize::from(overlap));
     }
 }
