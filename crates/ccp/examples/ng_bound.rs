@@ -2,7 +2,9 @@
 //! stages, against the exact search's bound on the same instance.
 //!
 //! `cargo run --release -p cutroute-ccp --example ng_bound -- data/nests/dbs/nested.dbs 400 8 20 9535`
-//! (nest, pieces, neighbourhood size, seconds, a known route's idle length).
+//! (nest, pieces, neighbourhood size, seconds, a known route's idle length). With `NG_DUMP=FILE`
+//! the relaxed instance is also written to FILE (PCGLNS), for a heuristic to bound its optimum
+//! from above: `cutroute solve FILE --solver heuristic`.
 
 use std::time::{Duration, Instant};
 
@@ -58,6 +60,12 @@ fn main() {
     let Some(instance) = bound.relaxed_instance() else {
         return;
     };
+    if let Ok(dump) = std::env::var("NG_DUMP") {
+        // The relaxed instance for another solver (e.g. `cutroute solve FILE --solver
+        // heuristic`): how far its optimum lies above the bound.
+        std::fs::write(&dump, instance.to_pcglns()).expect("writable");
+        println!("wrote {dump} ({} nodes)", instance.node_count);
+    }
     let began = Instant::now();
     let mut ng = NgPathBound::new(instance, ng_size, &[]).expect("a depot node");
     ng.set_upper(target);
