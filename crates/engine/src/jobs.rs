@@ -202,6 +202,10 @@ pub struct DiscreteJob {
     started: Instant,
     /// Why the job ended without a search.
     failure: Option<DiscreteFailure>,
+    /// The nearest-neighbour tour and its cost, made when the limit came before the heuristic
+    /// had a tour (the build took the time): a route to show rather than none.
+    fallback: Option<(Vec<usize>, f64)>,
+    fallback_tried: bool,
 }
 
 /// Why a discrete job ended without a search; its words are the phase's reason.
@@ -302,6 +306,8 @@ impl DiscreteJob {
             offered_route_cost: f64::INFINITY,
             started,
             failure: None,
+            fallback: None,
+            fallback_tried: false,
         }
     }
 
@@ -445,12 +451,50 @@ impl DiscreteJob {
         self.failure = Some(refusal.into());
     }
 
+    /// The best tour: the solvers', or the nearest-neighbour one if it is cheaper or the only.
     fn best_tour(&self) -> Option<(Vec<usize>, f64)> {
+        [self.solvers_tour(), self.fallback.clone()]
+            .into_iter()
+            .flatten()
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+    }
+
+    /// The better of the heuristic's and the exact search's best tours.
+    fn solvers_tour(&self) -> Option<(Vec<usize>, f64)> {
         let heuristic = self.alns.as_ref().and_then(best_with_cost);
         let exact = self.exact.as_ref().and_then(best_with_cost);
-        match (heuristic, exact) {
-            (Some(h), Some(e)) => Some(if e.1 < h.1 { e } else { h }),
-            (h, e) => h.or(e),
+        [heuristic, exact]
+            .into_iter()
+            .flatten()
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+    }
+
+    /// The nearest-neighbour tour of what is built so far: from the candidate points while the
+    /// matrix is being filled (no matrix needed), else from the instance's costs.
+    fn nearest_neighbour_tour(&self) -> Option<(Vec<usize>, f64)> {
+        if let Some(builder) = &self.builder {
+            return builder.nearest_neighbour_tour();
+        }
+        let instance = self
+            .instance
+            .as_ref()
+            .or(self.discrete.as_ref().map(|d| &d.instance))?;
+        let &start = instance.clusters.get(instance.depot)?.first()?;
+        cutroute_pcgtsp::nearest_neighbour_tour(
+            start,
+            instance.depot,
+            &instance.clusters,
+            &instance.precedence,
+            &|a, b| instance.arc_cost(a, b),
+        )
+    }
+
+    /// A tour's route: by the discretisation, or by its builder while the matrix is unfinished.
+    fn route_of(&self, tour: &[usize]) -> Option<Route> {
+        match (&self.discrete, &self.builder) {
+            (Some(discrete), _) => discrete.tour_to_route(tour).ok(),
+            (None, Some(builder)) => builder.tour_to_route(tour).ok(),
+            (None, None) => None,
         }
     }
 }
@@ -475,7 +519,16 @@ impl Job for DiscreteJob {
             return JobStatus::Done;
         }
         if !self.build(budget) {
-            // A build past the limit ends the job (no solver yet: no tour to keep). The
+            if Instant::now() >= self.deadline && self.alns.is_none() && !self.fallback_tried {
+                // The limit came before the heuristic could give its first tour: the
+                // nearest-neighbour one (tens of milliseconds on Nest03 at 25 mm, from the
+                // points) is kept, and replaced if the heuristic's preparation still ends in time.
+                self.fallback_tried = true;
+                self.fallback = self.nearest_neighbour_tour();
+                return JobStatus::Running;
+            }
+            // A build past the limit ends the job (no solver yet: the tour, if any, is the
+            // nearest-neighbour one). The
             // heuristic's own preparation, once started, is finished (it is one pass over the
             // matrix, bounded, and then gives the first tour), as when it was one step ...
             let now = Instant::now();
@@ -493,7 +546,7 @@ impl Job for DiscreteJob {
                 JobStatus::Running
             };
         }
-        if Instant::now() >= self.deadline && self.best_tour().is_some() {
+        if Instant::now() >= self.deadline && self.solvers_tour().is_some() {
             // The solvers count only their own shares of the slices (and were made after the
             // build): the job's limit is wall time from the request, so it ends here.
             if self.exact.is_some() && self.exact_done.is_none() {
@@ -589,10 +642,7 @@ impl Job for DiscreteJob {
     fn progress(&self) -> Progress {
         let best = self.best_tour();
         let exact = self.exact.as_ref().map(|e| e.progress());
-        let route: Option<Route> = match (&self.discrete, &best) {
-            (Some(discrete), Some((tour, _))) => discrete.tour_to_route(tour).ok(),
-            _ => None,
-        };
+        let route: Option<Route> = best.as_ref().and_then(|(tour, _)| self.route_of(tour));
         let proven_optimal = self.exact_done == Some(true);
         let phase = match (&exact, self.exact_done) {
             _ if matches!(self.failure, Some(DiscreteFailure::BuildTimedOut)) => {

@@ -247,3 +247,104 @@ fn a_limit_before_the_first_tour_still_gives_a_checked_tour() {
         );
     }
 }
+
+/// A discretised nest whose cost matrix is not built by the limit still ends with a route: the
+/// nearest-neighbour tour over its candidate points, made from the points without the matrix
+/// (Nest03 at 25 mm with a 2–3 s limit used to end with none). Steps of no budget fill one row
+/// each, so the matrix is unfinished at the first step past the limit on any machine.
+#[test]
+fn a_limit_before_the_matrix_still_gives_a_checked_route() {
+    let _alone = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../data/nests/dbs/seven.dbs");
+    let mut nest =
+        cutroute_formats::read_nest(&std::fs::read(&path).expect("seven.dbs")).expect("a nest");
+    nest.normalize_orientation();
+    let options = cutroute_ccp::DiscretisationOptions {
+        start: Point::new(0.0, 0.0),
+        step: 25.0,
+        ..Default::default()
+    };
+    let builder = cutroute_ccp::PcgtspBuilder::new(&nest, &options).expect("discretises");
+    let candidates: Vec<Point> = builder
+        .nodes()
+        .iter()
+        .filter_map(|node| match node {
+            cutroute_ccp::DiscreteNode::Pierce { point, .. } => Some(*point),
+            cutroute_ccp::DiscreteNode::Depot(_) => None,
+        })
+        .collect();
+    let limit = Duration::from_millis(300);
+    for mode in [
+        cutroute_engine::DiscreteMode::Heuristic,
+        cutroute_engine::DiscreteMode::Exact,
+    ] {
+        let arrived = Instant::now()
+            .checked_sub(limit)
+            .expect("a clock past the limit");
+        let mut job = cutroute_engine::DiscreteJob::building(
+            1,
+            cutroute_ccp::PcgtspBuilder::new(&nest, &options).expect("discretises"),
+            mode,
+            limit,
+            arrived,
+            1,
+        );
+        let mut first = true;
+        loop {
+            let status = cutroute_engine::Job::step(&mut job, Duration::ZERO);
+            if first {
+                // One row of the matrix, then the limit: the nearest-neighbour route.
+                let progress = cutroute_engine::Job::progress(&job);
+                assert!(
+                    matches!(
+                        progress.phase,
+                        cutroute_protocol::Phase::BuildingMatrix { .. }
+                    ),
+                    "{mode:?}: {}",
+                    progress.phase
+                );
+                let route = progress
+                    .solution
+                    .as_ref()
+                    .and_then(|s| s.route())
+                    .expect("a route");
+                let upper = progress.bounds.upper.expect("an upper bound");
+                assert!(
+                    (upper - route.idle_length()).abs() <= 1e-9 * upper,
+                    "{mode:?}: the bound {upper} is the route's idle length {}",
+                    route.idle_length()
+                );
+                first = false;
+            }
+            if status == JobStatus::Done {
+                break;
+            }
+            assert!(
+                arrived.elapsed() < Duration::from_secs(30),
+                "{mode:?} still running"
+            );
+        }
+        let wall = arrived.elapsed().as_secs_f64();
+        let progress = cutroute_engine::Job::progress(&job);
+        let route = progress
+            .solution
+            .as_ref()
+            .and_then(|s| s.route())
+            .unwrap_or_else(|| panic!("{mode:?}: a route past the limit ({})", progress.phase));
+        let forest = cutroute_geometry::ContainmentForest::new(&nest);
+        assert_eq!(
+            route.problems(&nest, &forest, nest.check_tolerance()),
+            vec![],
+            "{mode:?}"
+        );
+        assert_eq!(route.steps.len(), nest.contour_count(), "{mode:?}");
+        assert!(
+            route
+                .steps
+                .iter()
+                .all(|s| candidates.contains(&s.pierce_point)),
+            "{mode:?}: every pierce at a candidate point"
+        );
+        assert!(wall <= limit.as_secs_f64() + 1.0, "{mode:?}: {wall:.2} s");
+    }
+}

@@ -3,6 +3,7 @@
 //! clusters or short cluster chains to better precedence-feasible positions (or-opt).
 
 use crate::model::Model;
+use crate::order::ClusterSet;
 use web_time::Instant;
 
 const INF: f64 = f64::INFINITY;
@@ -136,22 +137,82 @@ fn feasible(model: &Model, clusters: &[usize]) -> bool {
     true
 }
 
-/// Nearest-neighbour construction: from the start node, repeatedly move to the cheapest node
-/// of any cluster whose predecessors are all visited. `None` if it gets stuck on forbidden arcs.
+/// Nearest-neighbour construction on the prepared model (see [`nearest_neighbour_tour`]).
 pub(crate) fn greedy(model: &Model) -> Option<Vec<usize>> {
-    let m = model.m;
-    let mut visited = crate::order::ClusterSet::new(m);
-    visited.insert(model.depot);
-    let mut tour = vec![model.start];
-    let mut current = model.start;
+    greedy_tour(
+        model.start,
+        model.depot,
+        &model.cluster_nodes,
+        &|c, visited| model.order.predecessors[c].is_subset(visited),
+        &|a, b| model.arc(a, b),
+    )
+}
+
+/// Nearest-neighbour construction: from node `start` (of cluster `start_cluster`), repeatedly
+/// move to the cheapest node of any cluster whose predecessors (the `precedence` pairs
+/// `(before, after)`) are all visited, and close the tour back to `start`. Returns the tour and
+/// its cost, `None` if it gets stuck on forbidden (infinite) arcs. `arc` need not be a stored
+/// matrix: a discretised nest's first tour is made this way from its points when the time
+/// limit comes before its matrix is built.
+///
+/// ```
+/// use cutroute_pcgtsp::nearest_neighbour_tour;
+///
+/// // Depot node 0, then clusters {1, 2} and {3}; cluster 1 must come before cluster 2.
+/// let clusters = vec![vec![0], vec![1, 2], vec![3]];
+/// let x: [f64; 4] = [0.0, 5.0, 1.0, 2.0];
+/// let arc = |a: usize, b: usize| (x[a] - x[b]).abs();
+/// let (tour, cost) = nearest_neighbour_tour(0, 0, &clusters, &[(1, 2)], &arc).unwrap();
+/// assert_eq!(tour, vec![0, 2, 3]);
+/// assert_eq!(cost, 1.0 + 1.0 + 2.0);
+/// ```
+pub fn nearest_neighbour_tour(
+    start: usize,
+    start_cluster: usize,
+    cluster_nodes: &[Vec<usize>],
+    precedence: &[(usize, usize)],
+    arc: &dyn Fn(usize, usize) -> f64,
+) -> Option<(Vec<usize>, f64)> {
+    let mut predecessors = vec![Vec::new(); cluster_nodes.len()];
+    for &(before, after) in precedence {
+        predecessors.get_mut(after)?.push(before);
+    }
+    let tour = greedy_tour(
+        start,
+        start_cluster,
+        cluster_nodes,
+        &|c, visited| predecessors[c].iter().all(|&p| visited.contains(p)),
+        arc,
+    )?;
+    let cost = tour
+        .iter()
+        .zip(tour.iter().cycle().skip(1))
+        .map(|(&a, &b)| arc(a, b))
+        .sum();
+    Some((tour, cost))
+}
+
+/// The nearest-neighbour tour with `ready(c, visited)` saying whether cluster `c` may come next.
+fn greedy_tour(
+    start: usize,
+    start_cluster: usize,
+    cluster_nodes: &[Vec<usize>],
+    ready: &dyn Fn(usize, &ClusterSet) -> bool,
+    arc: &dyn Fn(usize, usize) -> f64,
+) -> Option<Vec<usize>> {
+    let m = cluster_nodes.len();
+    let mut visited = ClusterSet::new(m);
+    visited.insert(start_cluster);
+    let mut tour = vec![start];
+    let mut current = start;
     for _ in 1..m {
         let mut best = (INF, usize::MAX, usize::MAX);
-        for c in 0..m {
-            if visited.contains(c) || !model.order.predecessors[c].is_subset(&visited) {
+        for (c, nodes) in cluster_nodes.iter().enumerate() {
+            if visited.contains(c) || !ready(c, &visited) {
                 continue;
             }
-            for &x in &model.cluster_nodes[c] {
-                let w = model.arc(current, x);
+            for &x in nodes {
+                let w = arc(current, x);
                 if w < best.0 {
                     best = (w, c, x);
                 }
@@ -164,5 +225,5 @@ pub(crate) fn greedy(model: &Model) -> Option<Vec<usize>> {
         tour.push(best.2);
         current = best.2;
     }
-    model.arc(current, model.start).is_finite().then_some(tour)
+    arc(current, start).is_finite().then_some(tour)
 }

@@ -67,6 +67,7 @@ pub use bounds::lattice::count_ideals;
 pub use bounds::{root_bounds, RootBounds};
 pub use check::{check_tour, TourError};
 pub use cutroute_anytime::{AnytimeSolver, Bounds, Status};
+pub use heuristic::nearest_neighbour_tour;
 pub use instance::Instance;
 pub use order::{ClusterSet, OrderError, PrecedenceOrder};
 pub use parse::{ParseError, PcglnsResult, MAX_NODES, MAX_WEIGHT};

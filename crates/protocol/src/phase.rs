@@ -178,7 +178,8 @@ pub enum Phase {
     },
     /// The exact search proved the best tour optimal.
     ProvenOptimal,
-    /// The time limit passed while the model was built: no tour.
+    /// The time limit passed while the model was built: no tour, or on a discretised nest the
+    /// nearest-neighbour one over its candidate points.
     BuildTimedOut,
     /// The search stopped, for this reason if any.
     Stopped {
