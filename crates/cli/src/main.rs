@@ -518,6 +518,12 @@ fn run_job(job: &mut dyn Job, watch: &Watch, on_progress: &mut dyn FnMut(&Progre
         if status == cutroute_engine::JobStatus::Done || stop {
             if stop {
                 seen.stopped = *watch.reason.lock().unwrap_or_else(|e| e.into_inner());
+                if status != cutroute_engine::JobStatus::Done {
+                    // The final answer: with what only a final answer carries (CCP's
+                    // certificates), whichever of the job and the watch saw the limit first.
+                    job.stop();
+                    seen.last = Some(job.progress());
+                }
             }
             // A copy, not `take`: the job is dropped after this returns, and dropping a large
             // one (the exact search's states) can outlast the grace, when the main thread

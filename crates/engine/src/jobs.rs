@@ -64,6 +64,11 @@ impl CcpJob {
 }
 
 impl Job for CcpJob {
+    fn stop(&mut self) {
+        self.solver.cancel();
+        self.done = true;
+    }
+
     fn step(&mut self, budget: Duration) -> JobStatus {
         if self.done {
             return JobStatus::Done;
@@ -108,7 +113,8 @@ impl Job for CcpJob {
     fn progress(&self) -> Progress {
         let state = self.solver.progress();
         let has_route = !state.route.steps.is_empty();
-        // Certificates cost a pass over the route: only for the final answer.
+        // Certificates cost a pass over the route: only for the final answer (done, or
+        // stopped).
         let certified = if self.done && has_route {
             let by_contour: std::collections::HashMap<_, _> = self
                 .solver
@@ -771,6 +777,15 @@ impl ChainJob {
 }
 
 impl Job for ChainJob {
+    fn stop(&mut self) {
+        // Stopped before chaining ended, the answer is CCP's route (the group under way is
+        // given up, and a later step ends the job).
+        self.ccp.stop();
+        self.ccp_done = true;
+        self.chaining = None;
+        self.deadline = Some(Instant::now());
+    }
+
     fn step(&mut self, budget: Duration) -> JobStatus {
         if self.chained.is_some() || self.failure.is_some() {
             return JobStatus::Done;

@@ -94,6 +94,10 @@ pub trait Job {
     fn step(&mut self, budget: Duration) -> JobStatus;
     /// The current state: bounds, best route or tour, phase.
     fn progress(&self) -> Progress;
+    /// The job is stopped before it is done (Stop, or the caller's own limit): its next
+    /// [`Job::progress`] is the final answer and carries what only a final answer does (CCP's
+    /// certificates, a pass over the route). Nothing to do for most jobs.
+    fn stop(&mut self) {}
 }
 
 /// Why a job could not start.

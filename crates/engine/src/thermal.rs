@@ -572,6 +572,10 @@ impl ThermalJob {
 }
 
 impl Job for ThermalJob {
+    fn stop(&mut self) {
+        self.inner.stop();
+    }
+
     fn step(&mut self, budget: Duration) -> JobStatus {
         if self.done {
             return JobStatus::Done;

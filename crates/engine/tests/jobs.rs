@@ -57,6 +57,56 @@ fn every_nest_solver_returns_a_valid_route() {
     }
 }
 
+/// A CCP job stopped before it is done (Stop in the app, the CLI's watch at the limit) still
+/// answers with its route's certificates, the same as a recount on that route: the CLI used to
+/// report 0 or 48 certified contours on seven.dbs, whichever of the job and its watch saw the
+/// limit first.
+#[test]
+fn a_stopped_ccp_job_keeps_its_certificates() {
+    for solver in [SolverKind::Ccp, SolverKind::Chain] {
+        let (name, bytes) = data("nests/dbs/seven.dbs");
+        let document = open_document(&name, &bytes).expect("opens");
+        let request = JobRequest {
+            job_id: 3,
+            problem: document.problem.clone(),
+            solver,
+            params: SolverParams {
+                time_limit_s: 30.0,
+                ..SolverParams::default()
+            },
+        };
+        let mut job = start_job(&request).expect("starts");
+        while job.progress().route().is_none() {
+            assert_eq!(job.step(Duration::from_millis(40)), JobStatus::Running);
+        }
+        assert!(
+            job.progress().certified.is_empty(),
+            "{solver:?}: not final yet"
+        );
+        job.stop();
+        let stopped = job.progress();
+        let route = stopped.route().expect("a route");
+        let Problem::Nest { nest, .. } = &document.problem else {
+            panic!("a nest")
+        };
+        let recount: Vec<bool> = cutroute_ccp::route_certificates(nest, route)
+            .expect("certificates")
+            .iter()
+            .map(|c| c.condition1)
+            .collect();
+        assert_eq!(stopped.certified, recount, "{solver:?}");
+        assert!(
+            recount.iter().any(|&c| c),
+            "{solver:?}: some contour certified"
+        );
+        assert_eq!(
+            job.step(Duration::from_millis(40)),
+            JobStatus::Done,
+            "{solver:?}"
+        );
+    }
+}
+
 #[test]
 fn the_chain_solver_saves_pierces_and_cost_over_its_ccp_route() {
     for file in ["nests/dbs-json/E1X_6_01.dbs.json", "nests/dbs/nested.dbs"] {

@@ -151,7 +151,8 @@ mod web {
                     );
                 }
                 ToWorker::Cancel { job_id } => {
-                    if let Some(running) = self.jobs.remove(&job_id) {
+                    if let Some(mut running) = self.jobs.remove(&job_id) {
+                        running.job.stop();
                         let mut progress = running.job.progress();
                         progress.phase = cutroute_protocol::Phase::Cancelled;
                         scope.respond(running.requester, FromWorker::Cancelled(progress));
