@@ -50,6 +50,7 @@
 //! ```
 #![deny(missing_docs)]
 
+mod exhaustive;
 mod local_search;
 mod nodes;
 mod operators;
@@ -235,8 +236,9 @@ pub enum StopReason {
     IterationLimit,
     /// A tour at or below the target cost was found.
     TargetReached,
-    /// The instance is so small (at most one cluster besides the depot) that the first tour
-    /// is optimal.
+    /// The instance is so small that every cluster order was tried, each with its best nodes
+    /// (at most 10 clusters besides the depot, and fewer with larger clusters): the tour is
+    /// optimal.
     Exhausted,
     /// [`AlnsSolver::cancel`] was called.
     Cancelled,

@@ -412,9 +412,18 @@ impl AlnsSolver {
     /// Starts the first tour: cheapest insertion from the depot, a cluster per unit
     /// ([`AlnsSolver::build_first`]), then its descent ([`AlnsSolver::descend`], the same
     /// moves as [`AlnsSolver::improve`] with no depth gate). The tour is the best from its
-    /// node-choice DP on: every unit of the descent keeps it valid.
+    /// node-choice DP on: every unit of the descent keeps it valid. A tiny instance is solved
+    /// here instead, by trying every order ([`crate::exhaustive`]).
     fn start(&mut self) -> bool {
         self.started = true;
+        if let Some((tour, cost)) =
+            crate::exhaustive::optimal_tour(&self.problem, &mut self.node_choice)
+        {
+            // Every order was tried: the search has nothing left to find.
+            self.publish_first(tour, cost);
+            self.stop = Some(StopReason::Exhausted);
+            return true;
+        }
         let p = &self.problem;
         let mut tour = Vec::with_capacity(p.m);
         self.operators.destroy_all(p, &mut tour);

@@ -198,7 +198,13 @@ fn reaches_known_optimum_on_small_reference_instances() {
             result.cost.unwrap(),
         );
         assert_eq!(cost, optimum, "{name}: got {cost}");
-        assert_eq!(result.progress.stop_reason, Some(StopReason::TargetReached));
+        // ESC07 (7 clusters besides the depot) is small enough to try every order.
+        let reason = if name == "ESC07" {
+            StopReason::Exhausted
+        } else {
+            StopReason::TargetReached
+        };
+        assert_eq!(result.progress.stop_reason, Some(reason), "{name}");
     }
 }
 
@@ -530,4 +536,40 @@ fn a_solver_built_in_pieces_searches_as_one_built_at_once() {
         }
     };
     assert!(matches!(failed, AlnsError::BadCost { .. }));
+}
+
+/// Tiny instances are solved outright (every order with its best nodes): the brute-force
+/// optimum, reported as proven. On this stream the destroy–repair search alone ended above
+/// the optimum on 22 of 595 instances of 3–8 clusters after 3,000 iterations (seed 1321: 4
+/// clusters, 92 against 82; seed 1425: 6 clusters, 90 against 70).
+#[test]
+fn tiny_instances_are_solved_outright() {
+    let mut cases = 0;
+    for seed in 1000..1300u64 {
+        let m = 3 + (seed % 5) as usize; // 3..=7 clusters
+        let symmetric = seed % 2 == 0;
+        let precedence = (seed % 4) as usize * 2;
+        let forbid = [0, 10, 30][(seed % 3) as usize];
+        let instance = random_instance(seed + 1, m, symmetric, precedence, forbid);
+        let Some(optimum) = brute_force(&instance) else {
+            continue;
+        };
+        let options = AlnsOptions {
+            seed,
+            time_limit: None,
+            max_iterations: Some(3000),
+            ..AlnsOptions::default()
+        };
+        let result = solve(&instance, options, &mut |_| {}).unwrap();
+        let tour = result.tour.expect("a tour");
+        let cost = checked(&instance, &tour, result.cost.unwrap());
+        assert_eq!(cost, optimum, "seed {seed}");
+        assert_eq!(
+            result.progress.stop_reason,
+            Some(StopReason::Exhausted),
+            "seed {seed}"
+        );
+        cases += 1;
+    }
+    assert!(cases > 200, "too few feasible cases ({cases})");
 }
