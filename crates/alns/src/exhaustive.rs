@@ -14,14 +14,20 @@ use crate::problem::Problem;
 /// Most orders × DP work tried (a few tens of milliseconds).
 const MAX_WORK: f64 = 2e7;
 
-/// Most clusters besides the depot's (the order set below is a `u32` mask).
+/// Most clusters besides the depot's (the order set below is a `u32` mask; 10! orders are
+/// beyond the work limit anyway).
 const MAX_CLUSTERS: usize = 10;
 
-/// The optimal tour (depot first) and its penalised cost, when the instance is small enough to
-/// try every order and has a tour without forbidden arcs; `None` otherwise.
-pub(crate) fn optimal_tour(p: &Problem, dp: &mut NodeChoice) -> Option<(Vec<usize>, f64)> {
+/// The optimal tour (depot first) and its penalised cost, when the instance has at most
+/// `up_to` clusters besides the depot's, is small enough to try every order, and has a tour
+/// without forbidden arcs; `None` otherwise.
+pub(crate) fn optimal_tour(
+    p: &Problem,
+    dp: &mut NodeChoice,
+    up_to: usize,
+) -> Option<(Vec<usize>, f64)> {
     let others: Vec<usize> = (0..p.m).filter(|&c| c != p.depot).collect();
-    if others.is_empty() || others.len() > MAX_CLUSTERS {
+    if others.is_empty() || others.len() > up_to.min(MAX_CLUSTERS) {
         return None;
     }
     let sizes = p.clusters.iter().map(|c| c.len() as f64);

@@ -171,6 +171,10 @@ pub struct AlnsParameters {
     /// Fraction of the non-depot clusters removed (and re-inserted at random) by the kick that
     /// starts an epoch after an epoch that did not improve the best tour.
     pub kick_fraction: f64,
+    /// Instances of at most this many clusters besides the depot's are solved outright at the
+    /// start (every order with its best nodes, when that is a few tens of milliseconds of
+    /// work; at most 10) and the search stops as [`StopReason::Exhausted`]; 0: always search.
+    pub exhaustive_up_to: usize,
 }
 
 impl Default for AlnsParameters {
@@ -196,6 +200,7 @@ impl Default for AlnsParameters {
             score_accepted: 13.0,
             elite_size: 6,
             kick_fraction: 0.3,
+            exhaustive_up_to: 10,
         }
     }
 }
@@ -237,8 +242,8 @@ pub enum StopReason {
     /// A tour at or below the target cost was found.
     TargetReached,
     /// The instance is so small that every cluster order was tried, each with its best nodes
-    /// (at most 10 clusters besides the depot, and fewer with larger clusters): the tour is
-    /// optimal.
+    /// ([`AlnsParameters::exhaustive_up_to`]), or it has at most one cluster besides the
+    /// depot: the tour is optimal.
     Exhausted,
     /// [`AlnsSolver::cancel`] was called.
     Cancelled,

@@ -416,9 +416,11 @@ impl AlnsSolver {
     /// here instead, by trying every order ([`crate::exhaustive`]).
     fn start(&mut self) -> bool {
         self.started = true;
-        if let Some((tour, cost)) =
-            crate::exhaustive::optimal_tour(&self.problem, &mut self.node_choice)
-        {
+        if let Some((tour, cost)) = crate::exhaustive::optimal_tour(
+            &self.problem,
+            &mut self.node_choice,
+            self.options.parameters.exhaustive_up_to,
+        ) {
             // Every order was tried: the search has nothing left to find.
             self.publish_first(tour, cost);
             self.stop = Some(StopReason::Exhausted);

@@ -140,22 +140,38 @@ fn brute_force(instance: &Instance) -> Option<f64> {
     best.is_finite().then_some(best)
 }
 
+/// A random instance of 3–7 clusters, symmetric or not, with 0–6 precedence pairs (0: plain
+/// GTSP) and none, 10 % or 30 % of its arcs forbidden, by `seed`.
+fn small_random_instance(seed: u64) -> Instance {
+    let m = 3 + (seed % 5) as usize;
+    let symmetric = seed.is_multiple_of(2);
+    let precedence = (seed % 4) as usize * 2;
+    let forbid = [0, 10, 30][(seed % 3) as usize];
+    random_instance(seed + 1, m, symmetric, precedence, forbid)
+}
+
+/// 3,000 iterations from `seed`, solved outright when `exhaustive`.
+fn small_run_options(seed: u64, exhaustive: bool) -> AlnsOptions {
+    AlnsOptions {
+        seed,
+        time_limit: None,
+        max_iterations: Some(3000),
+        parameters: AlnsParameters {
+            exhaustive_up_to: if exhaustive { 10 } else { 0 },
+            ..AlnsParameters::default()
+        },
+        ..AlnsOptions::default()
+    }
+}
+
+/// The destroy–repair search itself (the outright solution switched off) on small instances.
 #[test]
 fn matches_brute_force_on_small_random_instances() {
     let mut cases = 0;
     for seed in 0..60u64 {
-        let m = 3 + (seed % 5) as usize; // 3..=7 clusters
-        let symmetric = seed % 2 == 0;
-        let precedence = (seed % 4) as usize * 2; // 0 = plain GTSP
-        let forbid = [0, 10, 30][(seed % 3) as usize];
-        let instance = random_instance(seed + 1, m, symmetric, precedence, forbid);
+        let instance = small_random_instance(seed);
         let optimum = brute_force(&instance);
-        let options = AlnsOptions {
-            seed,
-            time_limit: None,
-            max_iterations: Some(3000),
-            ..AlnsOptions::default()
-        };
+        let options = small_run_options(seed, false);
         let result = solve(&instance, options, &mut |_| {}).unwrap();
         match (optimum, result.tour) {
             (Some(optimum), Some(tour)) => {
@@ -546,21 +562,11 @@ fn a_solver_built_in_pieces_searches_as_one_built_at_once() {
 fn tiny_instances_are_solved_outright() {
     let mut cases = 0;
     for seed in 1000..1300u64 {
-        let m = 3 + (seed % 5) as usize; // 3..=7 clusters
-        let symmetric = seed % 2 == 0;
-        let precedence = (seed % 4) as usize * 2;
-        let forbid = [0, 10, 30][(seed % 3) as usize];
-        let instance = random_instance(seed + 1, m, symmetric, precedence, forbid);
+        let instance = small_random_instance(seed);
         let Some(optimum) = brute_force(&instance) else {
             continue;
         };
-        let options = AlnsOptions {
-            seed,
-            time_limit: None,
-            max_iterations: Some(3000),
-            ..AlnsOptions::default()
-        };
-        let result = solve(&instance, options, &mut |_| {}).unwrap();
+        let result = solve(&instance, small_run_options(seed, true), &mut |_| {}).unwrap();
         let tour = result.tour.expect("a tour");
         let cost = checked(&instance, &tour, result.cost.unwrap());
         assert_eq!(cost, optimum, "seed {seed}");
