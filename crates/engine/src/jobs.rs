@@ -465,6 +465,14 @@ impl DiscreteJob {
             .min_by(|a, b| a.1.total_cmp(&b.1))
     }
 
+    /// Whether the heuristic solved the instance outright (a tiny one: every order tried), so
+    /// its tour is proven optimal.
+    fn heuristic_proved(&self) -> bool {
+        self.alns
+            .as_ref()
+            .is_some_and(|a| a.progress().stop_reason == Some(cutroute_alns::StopReason::Exhausted))
+    }
+
     /// The better of the heuristic's and the exact search's best tours.
     fn solvers_tour(&self) -> Option<(Vec<usize>, f64)> {
         let heuristic = self.alns.as_ref().and_then(best_with_cost);
@@ -595,6 +603,10 @@ impl Job for DiscreteJob {
                     exact.offer_incumbent(tour, cost);
                 }
             }
+            if self.heuristic_proved() {
+                // Solved outright: nothing is left for the exact search to prove.
+                return JobStatus::Done;
+            }
         }
         let mut exact_share = budget - budget / 4;
         if self.bound_running && self.exact_done.is_none() {
@@ -649,8 +661,10 @@ impl Job for DiscreteJob {
         let best = self.best_tour();
         let exact = self.exact.as_ref().map(|e| e.progress());
         let route: Option<Route> = best.as_ref().and_then(|(tour, _)| self.route_of(tour));
-        let proven_optimal = self.exact_done == Some(true);
+        let exhausted = self.heuristic_proved();
+        let proven_optimal = self.exact_done == Some(true) || exhausted;
         let phase = match (&exact, self.exact_done) {
+            _ if exhausted => Phase::ProvenOptimal,
             _ if matches!(self.failure, Some(DiscreteFailure::BuildTimedOut)) => {
                 Phase::BuildTimedOut
             }

@@ -176,6 +176,28 @@ fn heuristic_job_tours_are_feasible() {
     assert_eq!(result.bounds.lower, None);
 }
 
+/// ESC07 (7 clusters besides the depot) is solved outright by the heuristic: its tour is the
+/// known optimum and is reported as proven, with the bound equal to it, in both modes.
+#[test]
+fn a_tiny_instance_is_proven_optimal_by_the_heuristic() {
+    for solver in [SolverKind::Heuristic, SolverKind::Exact] {
+        let (problem, result) = run("pcgtsp/pcgtsplib/ESC07.pcglns", solver, 30.0);
+        let Problem::PcgtspText { text } = problem else {
+            panic!("an instance")
+        };
+        let instance = cutroute_pcgtsp::Instance::parse(&text).unwrap();
+        let cost = cutroute_pcgtsp::check_tour(&instance, result.tour().unwrap()).unwrap();
+        assert_eq!(cost, 1730.0, "{solver:?}: the known optimum of ESC07");
+        assert!(result.proven_optimal, "{solver:?}");
+        assert_eq!(result.bounds.lower, Some(1730.0), "{solver:?}");
+        assert_eq!(
+            result.phase,
+            cutroute_protocol::Phase::ProvenOptimal,
+            "{solver:?}"
+        );
+    }
+}
+
 #[test]
 fn a_long_job_yields_between_slices_so_it_can_be_cancelled() {
     let (name, bytes) = data("nests/dbs/seven.dbs");
