@@ -85,6 +85,7 @@ use cutroute_geometry::{BoundingBox, Contour, ContourRef, Nest, Point, Route, Sp
 use cutroute_pcgtsp::{ExactOptions, ExactSolver, Instance, Status};
 use web_time::{Duration, Instant};
 
+use crate::relaxed_tours::RelaxedTourSearch;
 use crate::{CcpError, NgPathBound};
 
 /// How much each relaxed arc cost is lowered so that rounding in the distance maths (true
@@ -297,8 +298,11 @@ struct Solving {
     ng_running: bool,
     exact_over: bool,
     /// Slices of this stage so far (the exact search gets every eighth beside the ng-path
-    /// bound).
+    /// bound, and so does the search for cheap relaxed tours).
     turns: usize,
+    /// Cheap tours of this relaxation (with the ng-path bound only): where its optimum lies
+    /// below the route, so where the next stage refines.
+    tours: Option<RelaxedTourSearch>,
 }
 
 enum Stage {
@@ -810,7 +814,7 @@ impl CcpLowerBound {
                     let progress = s.solver.as_ref().map(ExactSolver::progress);
                     debug_log(|| {
                         format!(
-                            "stage {} ({} nodes, {:.2} s of {:.2} s): relaxed lb {:.3} ub {:.3}, ng {:.3} ({} passes), best {:.3}, incumbent {:.3}",
+                            "stage {} ({} nodes, {:.2} s of {:.2} s): relaxed lb {:.3} ub {:.3}, ng {:.3} ({} passes), cheapest relaxed tour {:.3} ({} local searches), best {:.3}, incumbent {:.3}",
                             self.stages_done,
                             s.instance.node_count,
                             s.spent.as_secs_f64(),
@@ -819,6 +823,8 @@ impl CcpLowerBound {
                             progress.as_ref().map_or(f64::NAN, |p| p.upper_bound),
                             s.ng.as_ref().map_or(f64::NAN, NgPathBound::lower_bound),
                             s.ng.as_ref().map_or(0, NgPathBound::iterations),
+                            s.tours.as_ref().map_or(f64::NAN, RelaxedTourSearch::best_cost),
+                            s.tours.as_ref().map_or(0, RelaxedTourSearch::kicks),
                             self.best,
                             self.incumbent_length
                         )
@@ -828,9 +834,24 @@ impl CcpLowerBound {
                         self.stage = None;
                         return false;
                     }
-                    // The pieces of the relaxed tour and of the ng-path bound's cheapest walk
-                    // are where the next relaxed optimum tends to lie.
-                    let mut marked = progress.and_then(|p| p.best_tour).unwrap_or_default();
+                    // The pieces of the cheapest relaxed tours, of the incumbent, of the
+                    // exact search's relaxed tour and of the ng-path bound's cheapest walk are
+                    // where the next relaxed optimum tends to lie, in that order of priority.
+                    if let (Some(tours), Some(ng)) = (s.tours.as_mut(), s.ng.as_ref()) {
+                        // One more local search from the ng walk's order (a few ms).
+                        tours.add_start(&s.instance, ng.last_walk());
+                        tours.step(&s.instance, Instant::now());
+                    }
+                    let mut marked: Vec<usize> = Vec::new();
+                    if let Some(tours) = &s.tours {
+                        for (_, tour) in tours.pool() {
+                            marked.extend_from_slice(tour);
+                        }
+                    }
+                    if let Some(tour) = self.incumbent_tour(&s.node_piece) {
+                        marked.extend_from_slice(&tour);
+                    }
+                    marked.extend(progress.and_then(|p| p.best_tour).unwrap_or_default());
                     if let Some(ng) = &s.ng {
                         marked.extend_from_slice(ng.last_walk());
                     }
@@ -1021,6 +1042,7 @@ impl CcpLowerBound {
         if solver.is_none() && ng.is_none() {
             return None;
         }
+        let ng_tours = ng.is_some();
         Some(Solving {
             node_piece: b.node_piece,
             instance,
@@ -1031,6 +1053,7 @@ impl CcpLowerBound {
             ng,
             exact_over: false,
             turns: 0,
+            tours: ng_tours.then(|| RelaxedTourSearch::new(0x5eed ^ self.stages_done as u64)),
         })
     }
 
@@ -1078,6 +1101,9 @@ impl CcpLowerBound {
                     ng.offer_tour(&tour);
                     ng.set_upper(cost);
                 }
+                if let Some(tours) = &mut s.tours {
+                    tours.add_start(&s.instance, &tour);
+                }
             }
             self.incumbent_offered = true;
         }
@@ -1097,7 +1123,21 @@ impl CcpLowerBound {
         }
         s.turns += 1;
         let exact_turn = !s.ng_running || s.turns.is_multiple_of(8);
-        if let Some(solver) = s.solver.as_mut().filter(|_| !s.exact_over && exact_turn) {
+        let tours_turn = s.turns % 8 == 4;
+        if let Some(tours) = s.tours.as_mut().filter(|t| tours_turn && t.running()) {
+            // A cheaper relaxed tour bounds the ng-path DP's passes better (pruning, level).
+            if tours.step(&s.instance, deadline) {
+                let (cost, best) = &tours.pool()[0];
+                if let Some(solver) = &mut s.solver {
+                    let mut tour = vec![s.instance.clusters[s.instance.depot][0]];
+                    tour.extend_from_slice(best);
+                    solver.offer_incumbent(&tour, *cost);
+                }
+                if let Some(ng) = &mut s.ng {
+                    ng.offer_tour(best);
+                }
+            }
+        } else if let Some(solver) = s.solver.as_mut().filter(|_| !s.exact_over && exact_turn) {
             let status = solver.step(slice.max(Duration::from_millis(1)));
             s.exact_over = status != Status::Running;
             let progress = solver.progress();
@@ -1118,45 +1158,60 @@ impl CcpLowerBound {
         s.exact_over || s.spent >= s.share || (s.solver.is_none() && !s.ng_running)
     }
 
-    /// Splits the pieces of the relaxed tour and those holding the incumbent's pierce points
-    /// in four, and halves their neighbours along the contour (the next relaxed optimum tends
-    /// to move next door); false when no piece could be split (node limit or tiny pieces).
-    fn refine(&mut self, node_piece: &[(usize, usize)], tour: Option<&[usize]>) -> bool {
-        // Parts per piece: 1 keeps it, 2 halves it, 4 quarters it.
-        let mut parts: Vec<Vec<usize>> = self.pieces.iter().map(|p| vec![1; p.len()]).collect();
-        let mut mark = |leaf: usize, k: usize, pieces: &[(f64, f64)]| {
-            let n = pieces.len();
-            parts[leaf][k] = 4;
-            for j in [(k + n - 1) % n, (k + 1) % n] {
-                parts[leaf][j] = parts[leaf][j].max(2);
-            }
-        };
-        for &v in tour.unwrap_or(&[]) {
-            if let Some(&(leaf, k)) = v.checked_sub(1).and_then(|i| node_piece.get(i)) {
-                mark(leaf, k, &self.pieces[leaf]);
-            }
-        }
-        for &(leaf, s) in &self.incumbent {
-            if let Some(k) = self.pieces[leaf]
-                .iter()
-                .position(|&(a, b)| a <= s && s <= b)
-            {
-                mark(leaf, k, &self.pieces[leaf]);
-            }
-        }
-        let mut nodes = self.node_count();
+    /// Splits the pieces of `marked` (relaxed tours' nodes, most important first) in four
+    /// and halves their neighbours along the contour (the next relaxed optimum tends to move
+    /// next door), in that order until the node limit; then the pieces holding the
+    /// incumbent's pierce points. False when no piece could be split (node limit or tiny
+    /// pieces).
+    fn refine(&mut self, node_piece: &[(usize, usize)], marked: Option<&[usize]>) -> bool {
         let max_nodes = if self.exact_whole() {
             self.options.max_nodes
         } else {
             self.options.max_nodes.min(NG_ALONE_MAX_NODES)
         };
+        // Parts per piece: 1 keeps it, 2 halves it, 4 quarters it; granted in the order of
+        // `marked`, so that at the node limit the most important pieces are the split ones
+        // (not the first contours').
+        let mut parts: Vec<Vec<usize>> = self.pieces.iter().map(|p| vec![1; p.len()]).collect();
+        let mut nodes = self.node_count();
+        let mut grant = |leaf: usize, k: usize, n: usize, pieces: &[(f64, f64)]| {
+            let (a, b) = pieces[k];
+            let min_length = 1e-6 * (1.0 + self.leaves[leaf].perimeter());
+            let old = parts[leaf][k];
+            if n > old && b - a > n as f64 * min_length && nodes + n - old <= max_nodes {
+                nodes += n - old;
+                parts[leaf][k] = n;
+            }
+        };
+        let incumbent_nodes: Vec<(usize, usize)> = self
+            .incumbent
+            .iter()
+            .filter_map(|&(leaf, s)| {
+                let k = self.pieces[leaf]
+                    .iter()
+                    .position(|&(a, b)| a <= s && s <= b)?;
+                Some((leaf, k))
+            })
+            .collect();
+        let marks = marked
+            .unwrap_or(&[])
+            .iter()
+            .filter_map(|&v| v.checked_sub(1).and_then(|i| node_piece.get(i)).copied())
+            .chain(incumbent_nodes);
+        for (leaf, k) in marks {
+            let pieces = &self.pieces[leaf];
+            let n = pieces.len();
+            grant(leaf, k, 4, pieces);
+            for j in [(k + n - 1) % n, (k + 1) % n] {
+                grant(leaf, j, 2, pieces);
+            }
+        }
         let mut split_any = false;
         for (leaf, pieces) in self.pieces.iter_mut().enumerate() {
-            let min_length = 1e-6 * (1.0 + self.leaves[leaf].perimeter());
             let mut out = Vec::with_capacity(pieces.len() + 8);
             for (k, &(a, b)) in pieces.iter().enumerate() {
                 let n = parts[leaf][k];
-                if n > 1 && b - a > n as f64 * min_length && nodes + n - 1 <= max_nodes {
+                if n > 1 {
                     out.extend((0..n).map(|i| {
                         (
                             a + (b - a) * i as f64 / n as f64,
@@ -1167,7 +1222,6 @@ impl CcpLowerBound {
                             },
                         )
                     }));
-                    nodes += n - 1;
                     split_any = true;
                 } else {
                     out.push((a, b));

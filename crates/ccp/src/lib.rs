@@ -83,6 +83,7 @@ mod discrete;
 mod geom;
 mod ngpath;
 mod problem;
+mod relaxed_tours;
 mod relax;
 mod route;
 mod search;
