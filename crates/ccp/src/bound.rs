@@ -99,7 +99,16 @@ const COST_MARGIN: f64 = 1e-9;
 pub const MAX_RELAXATION_ENTRIES: usize = 1 << 24;
 
 /// First pieces of a relaxation that runs the ng-path bound.
-const NG_INITIAL_PIECES: usize = 1600;
+const NG_INITIAL_PIECES: usize = 800;
+
+/// Sharpening stages (see [`CcpLowerBound::sharpening`]) run until the relaxation has this
+/// many nodes, at most `SHARPEN_MAX_STAGES` of them, each for at most `SHARPEN_SHARE`.
+const SHARPEN_NODES: usize = 1600;
+const SHARPEN_MAX_STAGES: usize = 8;
+const SHARPEN_SHARE: Duration = Duration::from_millis(1500);
+
+/// Most nodes of a relaxation that runs the ng-path bound beside the exact search.
+const NG_MAX_NODES: usize = 1800;
 
 /// Most nodes of a relaxation that runs the ng-path bound without the exact search: one DP
 /// pass over Nest02's 359 kept contours took ~2 s at 824 nodes, ~5 s at 1,627 and over 20 s
@@ -283,6 +292,8 @@ struct Building {
     escape: Vec<f64>,
     cost: Vec<f64>,
     next_row: usize,
+    /// Time spent building (diagnostics).
+    spent: Duration,
 }
 
 /// A stage's exact search on its instance.
@@ -303,6 +314,10 @@ struct Solving {
     /// Cheap tours of this relaxation (with the ng-path bound only): where its optimum lies
     /// below the route, so where the next stage refines.
     tours: Option<RelaxedTourSearch>,
+    /// A sharpening stage: only the cheap tours' search runs, to choose the pieces to split.
+    sharpening: bool,
+    /// Time the stage's matrix took to build (diagnostics).
+    build_spent: Duration,
 }
 
 enum Stage {
@@ -321,6 +336,10 @@ pub struct CcpLowerBound {
     pieces: Vec<Vec<(f64, f64)>>,
     stage: Option<Stage>,
     stages_done: usize,
+    /// Of them, sharpening stages (see [`CcpLowerBound::sharpening`]).
+    sharpened: usize,
+    /// Sharpening has stopped splitting pieces (tiny pieces): no more sharpening stages.
+    sharpening_over: bool,
     best: f64,
     /// The best route's pierce points on kept contours, in route order: (leaf, arc length).
     incumbent: Vec<(usize, f64)>,
@@ -485,6 +504,8 @@ impl CcpLowerBound {
             pieces,
             stage: None,
             stages_done: 0,
+            sharpened: 0,
+            sharpening_over: false,
             best: 0.0,
             incumbent: Vec::new(),
             incumbent_length: f64::INFINITY,
@@ -773,6 +794,19 @@ impl CcpLowerBound {
         self.fixed || self.leaves.len() <= self.options.exact_max_kept.min(EXACT_MAX_KEPT)
     }
 
+    /// Whether the next stage of this bound's own relaxation is a *sharpening* stage: with the
+    /// ng-path bound (large relaxations, exact search beside it) and fewer nodes than
+    /// `SHARPEN_NODES`, a stage runs only the search for cheap relaxed tours and halves their
+    /// pieces, so that the ng-path bound's first stage starts on pieces where the relaxed
+    /// optimum needs them rather than on uniform ones.
+    fn sharpening(&self) -> bool {
+        self.ng_active()
+            && self.exact_whole()
+            && !self.sharpening_over
+            && self.sharpened < SHARPEN_MAX_STAGES
+            && self.node_count() < SHARPEN_NODES
+    }
+
     /// Whether this bound's own relaxation runs the ng-path bound beside the exact search.
     fn ng_active(&self) -> bool {
         !self.fixed && self.options.ng_size > 0 && self.leaves.len() > self.options.ng_above
@@ -792,9 +826,12 @@ impl CcpLowerBound {
                     self.stage = Some(Stage::Building(self.start_building()));
                 }
                 Some(Stage::Building(mut b)) => {
+                    let began = Instant::now();
                     // A complete matrix waits for the next slice when this one is used up:
                     // making the stage's solver is a long piece of work of its own.
-                    if self.build_rows(&mut b, deadline) && Instant::now() < deadline {
+                    let built = self.build_rows(&mut b, deadline);
+                    b.spent += began.elapsed();
+                    if built && Instant::now() < deadline {
                         match self.start_solving(b) {
                             Some(s) => self.stage = Some(Stage::Solving(Box::new(s))),
                             None => return false,
@@ -814,9 +851,10 @@ impl CcpLowerBound {
                     let progress = s.solver.as_ref().map(ExactSolver::progress);
                     debug_log(|| {
                         format!(
-                            "stage {} ({} nodes, {:.2} s of {:.2} s): relaxed lb {:.3} ub {:.3}, ng {:.3} ({} passes), cheapest relaxed tour {:.3} ({} local searches), best {:.3}, incumbent {:.3}",
+                            "stage {} ({} nodes, built in {:.2} s, {:.2} s of {:.2} s): relaxed lb {:.3} ub {:.3}, ng {:.3} ({} passes), cheapest relaxed tour {:.3} ({} local searches), best {:.3}, incumbent {:.3}",
                             self.stages_done,
                             s.instance.node_count,
+                            s.build_spent.as_secs_f64(),
                             s.spent.as_secs_f64(),
                             s.share.as_secs_f64(),
                             progress.as_ref().map_or(f64::NAN, |p| p.lower_bound),
@@ -857,7 +895,12 @@ impl CcpLowerBound {
                     }
                     // With no piece left to split, the next stage reruns the same pieces
                     // with twice the time.
-                    self.refine(&s.node_piece, Some(&marked));
+                    let split = if s.sharpening { 2 } else { 4 };
+                    let changed = self.refine(&s.node_piece, Some(&marked), split);
+                    if s.sharpening {
+                        self.sharpened += 1;
+                        self.sharpening_over |= !changed;
+                    }
                     if !self.own.is_empty() {
                         // A group's stage is over: the decomposition picks who goes next.
                         return true;
@@ -886,6 +929,7 @@ impl CcpLowerBound {
             escape: Vec::with_capacity(if self.others.is_empty() { 0 } else { n - 1 }),
             cost: vec![f64::INFINITY; n * n],
             next_row: 0,
+            spent: Duration::ZERO,
         }
     }
 
@@ -985,6 +1029,7 @@ impl CcpLowerBound {
 
     fn start_solving(&mut self, b: Building) -> Option<Solving> {
         let n = 1 + b.node_piece.len();
+        let build_spent = b.spent;
         let margin = self.margin;
         // In place: at 2,500 pieces the matrix is 50 MB, and the ng-path bound keeps its own.
         let mut cost = b.cost;
@@ -1007,11 +1052,14 @@ impl CcpLowerBound {
             precedence: Vec::new(),
             depot: 0,
         };
-        let share = if self.fixed {
+        let sharpening = self.sharpening();
+        let share = if sharpening {
+            SHARPEN_SHARE
+        } else if self.fixed {
             // One stage: it runs until the exact search ends or the caller stops.
             Duration::from_secs(1 << 40)
         } else {
-            self.options.first_stage * (1u32 << self.stages_done.min(16))
+            self.options.first_stage * (1u32 << (self.stages_done - self.sharpened).min(16))
         };
         let options = ExactOptions {
             time_limit: Some(share),
@@ -1029,20 +1077,21 @@ impl CcpLowerBound {
         // Deferred: the start node's model and root bound are built in the stage's first
         // slices, a piece each (`ExactSolver::new` built them here in one piece of up to
         // 0.6 s on nested.dbs, which Stop had to wait for).
-        let solver = if self.exact_whole() {
+        let solver = if self.exact_whole() && !sharpening {
             Some(ExactSolver::deferred(&instance, options).ok()?)
         } else {
             None
         };
         self.incumbent_offered = false;
-        let ng = self
-            .ng_active()
-            .then(|| NgPathBound::new(&instance, self.options.ng_size, &self.ng_lambda))
-            .flatten();
-        if solver.is_none() && ng.is_none() {
+        let ng = if self.ng_active() && !sharpening {
+            NgPathBound::new(&instance, self.options.ng_size, &self.ng_lambda)
+        } else {
+            None
+        };
+        if solver.is_none() && ng.is_none() && !sharpening {
             return None;
         }
-        let ng_tours = ng.is_some();
+        let ng_tours = ng.is_some() || sharpening;
         Some(Solving {
             node_piece: b.node_piece,
             instance,
@@ -1053,6 +1102,8 @@ impl CcpLowerBound {
             ng,
             exact_over: false,
             turns: 0,
+            build_spent,
+            sharpening,
             tours: ng_tours.then(|| RelaxedTourSearch::new(0x5eed ^ self.stages_done as u64)),
         })
     }
@@ -1108,6 +1159,13 @@ impl CcpLowerBound {
             self.incumbent_offered = true;
         }
         let now = Instant::now();
+        if s.sharpening {
+            if let Some(tours) = &mut s.tours {
+                tours.step(&s.instance, deadline);
+            }
+            s.spent += now.elapsed();
+            return s.spent >= s.share || !s.tours.as_ref().is_some_and(RelaxedTourSearch::running);
+        }
         let slice = deadline.saturating_duration_since(now);
         // With the ng-path bound beside it, the exact search (which cannot solve a relaxation
         // this large; its bounds stall early) gets every eighth slice.
@@ -1163,8 +1221,17 @@ impl CcpLowerBound {
     /// next door), in that order until the node limit; then the pieces holding the
     /// incumbent's pierce points. False when no piece could be split (node limit or tiny
     /// pieces).
-    fn refine(&mut self, node_piece: &[(usize, usize)], marked: Option<&[usize]>) -> bool {
-        let max_nodes = if self.exact_whole() {
+    fn refine(
+        &mut self,
+        node_piece: &[(usize, usize)],
+        marked: Option<&[usize]>,
+        split: usize,
+    ) -> bool {
+        let max_nodes = if self.sharpening() {
+            self.options.max_nodes.min(SHARPEN_NODES)
+        } else if self.exact_whole() && self.ng_active() {
+            self.options.max_nodes.min(NG_MAX_NODES)
+        } else if self.exact_whole() {
             self.options.max_nodes
         } else {
             self.options.max_nodes.min(NG_ALONE_MAX_NODES)
@@ -1201,9 +1268,9 @@ impl CcpLowerBound {
         for (leaf, k) in marks {
             let pieces = &self.pieces[leaf];
             let n = pieces.len();
-            grant(leaf, k, 4, pieces);
+            grant(leaf, k, split, pieces);
             for j in [(k + n - 1) % n, (k + 1) % n] {
-                grant(leaf, j, 2, pieces);
+                grant(leaf, j, split / 2, pieces);
             }
         }
         let mut split_any = false;
