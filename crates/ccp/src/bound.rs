@@ -51,9 +51,15 @@
 //! of that PCGTSP is sound by step 3.
 //!
 //! **Refinement.** A stage builds the instance (row by row, in slices), then runs the exact
-//! solver for a doubling time share. Then the pieces holding the best route's pierce points and
-//! the pieces of the relaxed tour are halved, and the next stage starts. Finer pieces only raise
-//! the relaxed optimum; the reported bound is the best over all stages.
+//! solver for a doubling time share. Then the pieces are split (in four, their neighbours in
+//! two) in order of importance until the node limit: with the ng-path bound first the pieces of
+//! the cheapest tours of the relaxation itself ([`crate::relaxed_tours`]: an iterated local
+//! search with the pieces re-chosen by a layered shortest path, run in every eighth slice; a
+//! relaxed tour that enters a long piece at one end and leaves at the other is where the
+//! relaxed optimum lies below the route), then the pieces holding the best route's pierce
+//! points, the exact search's relaxed tour and the ng-path bound's walk; and the next stage
+//! starts. Finer pieces only raise the relaxed optimum; the reported bound is the best over all
+//! stages.
 //!
 //! ```
 //! use cutroute_ccp::{CcpLowerBound, LowerBoundOptions};
@@ -99,16 +105,7 @@ const COST_MARGIN: f64 = 1e-9;
 pub const MAX_RELAXATION_ENTRIES: usize = 1 << 24;
 
 /// First pieces of a relaxation that runs the ng-path bound.
-const NG_INITIAL_PIECES: usize = 800;
-
-/// Sharpening stages (see [`CcpLowerBound::sharpening`]) run until the relaxation has this
-/// many nodes, at most `SHARPEN_MAX_STAGES` of them, each for at most `SHARPEN_SHARE`.
-const SHARPEN_NODES: usize = 1600;
-const SHARPEN_MAX_STAGES: usize = 8;
-const SHARPEN_SHARE: Duration = Duration::from_millis(1500);
-
-/// Most nodes of a relaxation that runs the ng-path bound beside the exact search.
-const NG_MAX_NODES: usize = 1800;
+const NG_INITIAL_PIECES: usize = 1600;
 
 /// Most nodes of a relaxation that runs the ng-path bound without the exact search: one DP
 /// pass over Nest02's 359 kept contours took ~2 s at 824 nodes, ~5 s at 1,627 and over 20 s
@@ -314,8 +311,6 @@ struct Solving {
     /// Cheap tours of this relaxation (with the ng-path bound only): where its optimum lies
     /// below the route, so where the next stage refines.
     tours: Option<RelaxedTourSearch>,
-    /// A sharpening stage: only the cheap tours' search runs, to choose the pieces to split.
-    sharpening: bool,
     /// Time the stage's matrix took to build (diagnostics).
     build_spent: Duration,
 }
@@ -336,10 +331,6 @@ pub struct CcpLowerBound {
     pieces: Vec<Vec<(f64, f64)>>,
     stage: Option<Stage>,
     stages_done: usize,
-    /// Of them, sharpening stages (see [`CcpLowerBound::sharpening`]).
-    sharpened: usize,
-    /// Sharpening has stopped splitting pieces (tiny pieces): no more sharpening stages.
-    sharpening_over: bool,
     best: f64,
     /// The best route's pierce points on kept contours, in route order: (leaf, arc length).
     incumbent: Vec<(usize, f64)>,
@@ -504,8 +495,6 @@ impl CcpLowerBound {
             pieces,
             stage: None,
             stages_done: 0,
-            sharpened: 0,
-            sharpening_over: false,
             best: 0.0,
             incumbent: Vec::new(),
             incumbent_length: f64::INFINITY,
@@ -794,19 +783,6 @@ impl CcpLowerBound {
         self.fixed || self.leaves.len() <= self.options.exact_max_kept.min(EXACT_MAX_KEPT)
     }
 
-    /// Whether the next stage of this bound's own relaxation is a *sharpening* stage: with the
-    /// ng-path bound (large relaxations, exact search beside it) and fewer nodes than
-    /// `SHARPEN_NODES`, a stage runs only the search for cheap relaxed tours and halves their
-    /// pieces, so that the ng-path bound's first stage starts on pieces where the relaxed
-    /// optimum needs them rather than on uniform ones.
-    fn sharpening(&self) -> bool {
-        self.ng_active()
-            && self.exact_whole()
-            && !self.sharpening_over
-            && self.sharpened < SHARPEN_MAX_STAGES
-            && self.node_count() < SHARPEN_NODES
-    }
-
     /// Whether this bound's own relaxation runs the ng-path bound beside the exact search.
     fn ng_active(&self) -> bool {
         !self.fixed && self.options.ng_size > 0 && self.leaves.len() > self.options.ng_above
@@ -895,12 +871,7 @@ impl CcpLowerBound {
                     }
                     // With no piece left to split, the next stage reruns the same pieces
                     // with twice the time.
-                    let split = if s.sharpening { 2 } else { 4 };
-                    let changed = self.refine(&s.node_piece, Some(&marked), split);
-                    if s.sharpening {
-                        self.sharpened += 1;
-                        self.sharpening_over |= !changed;
-                    }
+                    self.refine(&s.node_piece, Some(&marked));
                     if !self.own.is_empty() {
                         // A group's stage is over: the decomposition picks who goes next.
                         return true;
@@ -1052,14 +1023,11 @@ impl CcpLowerBound {
             precedence: Vec::new(),
             depot: 0,
         };
-        let sharpening = self.sharpening();
-        let share = if sharpening {
-            SHARPEN_SHARE
-        } else if self.fixed {
+        let share = if self.fixed {
             // One stage: it runs until the exact search ends or the caller stops.
             Duration::from_secs(1 << 40)
         } else {
-            self.options.first_stage * (1u32 << (self.stages_done - self.sharpened).min(16))
+            self.options.first_stage * (1u32 << self.stages_done.min(16))
         };
         let options = ExactOptions {
             time_limit: Some(share),
@@ -1077,21 +1045,20 @@ impl CcpLowerBound {
         // Deferred: the start node's model and root bound are built in the stage's first
         // slices, a piece each (`ExactSolver::new` built them here in one piece of up to
         // 0.6 s on nested.dbs, which Stop had to wait for).
-        let solver = if self.exact_whole() && !sharpening {
+        let solver = if self.exact_whole() {
             Some(ExactSolver::deferred(&instance, options).ok()?)
         } else {
             None
         };
         self.incumbent_offered = false;
-        let ng = if self.ng_active() && !sharpening {
-            NgPathBound::new(&instance, self.options.ng_size, &self.ng_lambda)
-        } else {
-            None
-        };
-        if solver.is_none() && ng.is_none() && !sharpening {
+        let ng = self
+            .ng_active()
+            .then(|| NgPathBound::new(&instance, self.options.ng_size, &self.ng_lambda))
+            .flatten();
+        if solver.is_none() && ng.is_none() {
             return None;
         }
-        let ng_tours = ng.is_some() || sharpening;
+        let ng_tours = ng.is_some();
         Some(Solving {
             node_piece: b.node_piece,
             instance,
@@ -1103,7 +1070,6 @@ impl CcpLowerBound {
             exact_over: false,
             turns: 0,
             build_spent,
-            sharpening,
             tours: ng_tours.then(|| RelaxedTourSearch::new(0x5eed ^ self.stages_done as u64)),
         })
     }
@@ -1159,13 +1125,6 @@ impl CcpLowerBound {
             self.incumbent_offered = true;
         }
         let now = Instant::now();
-        if s.sharpening {
-            if let Some(tours) = &mut s.tours {
-                tours.step(&s.instance, deadline);
-            }
-            s.spent += now.elapsed();
-            return s.spent >= s.share || !s.tours.as_ref().is_some_and(RelaxedTourSearch::running);
-        }
         let slice = deadline.saturating_duration_since(now);
         // With the ng-path bound beside it, the exact search (which cannot solve a relaxation
         // this large; its bounds stall early) gets every eighth slice.
@@ -1221,17 +1180,8 @@ impl CcpLowerBound {
     /// next door), in that order until the node limit; then the pieces holding the
     /// incumbent's pierce points. False when no piece could be split (node limit or tiny
     /// pieces).
-    fn refine(
-        &mut self,
-        node_piece: &[(usize, usize)],
-        marked: Option<&[usize]>,
-        split: usize,
-    ) -> bool {
-        let max_nodes = if self.sharpening() {
-            self.options.max_nodes.min(SHARPEN_NODES)
-        } else if self.exact_whole() && self.ng_active() {
-            self.options.max_nodes.min(NG_MAX_NODES)
-        } else if self.exact_whole() {
+    fn refine(&mut self, node_piece: &[(usize, usize)], marked: Option<&[usize]>) -> bool {
+        let max_nodes = if self.exact_whole() {
             self.options.max_nodes
         } else {
             self.options.max_nodes.min(NG_ALONE_MAX_NODES)
@@ -1268,9 +1218,9 @@ impl CcpLowerBound {
         for (leaf, k) in marks {
             let pieces = &self.pieces[leaf];
             let n = pieces.len();
-            grant(leaf, k, split, pieces);
+            grant(leaf, k, 4, pieces);
             for j in [(k + n - 1) % n, (k + 1) % n] {
-                grant(leaf, j, split / 2, pieces);
+                grant(leaf, j, 2, pieces);
             }
         }
         let mut split_any = false;
@@ -1391,6 +1341,60 @@ mod tests {
             .map(|i| square(20.0 * (i % columns) as f64, 20.0 * (i / columns) as f64))
             .collect();
         Nest { sheet: None, parts }
+    }
+
+    /// The pieces of every kept contour stay a partition of `[0, perimeter]` into contiguous,
+    /// non-empty intervals (sorted) under refinement with any marks, the node
+    /// limit holds, and the first marked piece is split while there is room.
+    #[test]
+    fn refinement_keeps_the_pieces_a_partition_within_the_node_limit() {
+        let nest = grid_nest(3, 2);
+        let mut rng = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = move || {
+            rng ^= rng >> 12;
+            rng ^= rng << 25;
+            rng ^= rng >> 27;
+            rng.wrapping_mul(0x2545_F491_4F6C_DD1D) as usize
+        };
+        for max_nodes in [20, 60, 200] {
+            let options = LowerBoundOptions {
+                initial_pieces: 12,
+                max_nodes,
+                group_size: 0,
+                ng_size: 0,
+                ..LowerBoundOptions::default()
+            };
+            let mut bound = CcpLowerBound::new(&nest, options).unwrap();
+            for _ in 0..12 {
+                let node_piece: Vec<(usize, usize)> = bound
+                    .pieces
+                    .iter()
+                    .enumerate()
+                    .flat_map(|(leaf, p)| (0..p.len()).map(move |k| (leaf, k)))
+                    .collect();
+                let marked: Vec<usize> = (0..8).map(|_| 1 + next() % node_piece.len()).collect();
+                let (leaf, k) = node_piece[marked[0] - 1];
+                let first = bound.pieces[leaf][k];
+                let before = bound.node_count();
+                bound.refine(&node_piece, Some(&marked));
+                assert!(bound.node_count() <= max_nodes.max(before));
+                if before + 3 <= max_nodes {
+                    assert!(
+                        !bound.pieces[leaf].contains(&first),
+                        "the first marked piece was not split"
+                    );
+                }
+                for (leaf, pieces) in bound.pieces.iter().enumerate() {
+                    let perimeter = bound.leaves[leaf].perimeter();
+                    assert_eq!(pieces[0].0, 0.0);
+                    assert_eq!(pieces.last().unwrap().1, perimeter);
+                    for w in pieces.windows(2) {
+                        assert_eq!(w[0].1, w[1].0, "a gap or overlap between pieces");
+                    }
+                    assert!(pieces.iter().all(|&(a, b)| a < b), "an empty piece");
+                }
+            }
+        }
     }
 
     /// The decomposition runs one group's stage at a time (the memory of a stage — its cost

@@ -113,7 +113,8 @@ pub(crate) fn local_search(instance: &Instance, nodes: &mut Vec<usize>) -> f64 {
             for i in 1..m {
                 for j in i + 1..=m {
                     let before = fwd[j + 1] - fwd[i - 1];
-                    let after = arc(ext[i - 1], ext[j]) + (bwd[j] - bwd[i]) + arc(ext[i], ext[j + 1]);
+                    let after =
+                        arc(ext[i - 1], ext[j]) + (bwd[j] - bwd[i]) + arc(ext[i], ext[j + 1]);
                     if after < before - eps {
                         nodes[i - 1..j].reverse();
                         current += after - before;
@@ -259,8 +260,7 @@ impl RelaxedTourSearch {
             let mut best = (f64::INFINITY, order.len());
             for p in 0..=order.len() {
                 let before = if p == 0 { instance.depot } else { order[p - 1] };
-                let value = near(before, c)
-                    + order.get(p).map_or(0.0, |&next| near(c, next));
+                let value = near(before, c) + order.get(p).map_or(0.0, |&next| near(c, next));
                 if value < best.0 {
                     best = (value, p);
                 }
@@ -466,7 +466,8 @@ mod tests {
                     "seed {seed}: layered {cost}, brute force {expected}"
                 );
                 assert!((tour_cost(&instance, &nodes) - cost).abs() <= 1e-9 * (1.0 + cost));
-                let clusters: Vec<usize> = nodes.iter().map(|&v| instance.node_cluster[v]).collect();
+                let clusters: Vec<usize> =
+                    nodes.iter().map(|&v| instance.node_cluster[v]).collect();
                 assert_eq!(clusters, order);
             }
         }
@@ -533,7 +534,8 @@ mod tests {
             let after = local_search(&instance, &mut nodes);
             assert!(after <= before + 1e-9 * (1.0 + before));
             assert!((after - tour_cost(&instance, &nodes)).abs() <= 1e-9 * (1.0 + after));
-            let mut clusters: Vec<usize> = nodes.iter().map(|&v| instance.node_cluster[v]).collect();
+            let mut clusters: Vec<usize> =
+                nodes.iter().map(|&v| instance.node_cluster[v]).collect();
             clusters.sort_unstable();
             assert_eq!(clusters, order);
         }
