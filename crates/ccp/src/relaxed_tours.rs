@@ -253,10 +253,10 @@ impl RelaxedTourSearch {
             }
             best
         };
-        for c in 0..instance.clusters.len() {
-            if seen[c] || instance.clusters[c].is_empty() {
-                continue;
-            }
+        let missing: Vec<usize> = (0..instance.clusters.len())
+            .filter(|&c| !seen[c] && !instance.clusters[c].is_empty())
+            .collect();
+        for c in missing {
             let mut best = (f64::INFINITY, order.len());
             for p in 0..=order.len() {
                 let before = if p == 0 { instance.depot } else { order[p - 1] };
