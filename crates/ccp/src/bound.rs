@@ -51,9 +51,15 @@
 //! of that PCGTSP is sound by step 3.
 //!
 //! **Refinement.** A stage builds the instance (row by row, in slices), then runs the exact
-//! solver for a doubling time share. Then the pieces holding the best route's pierce points and
-//! the pieces of the relaxed tour are halved, and the next stage starts. Finer pieces only raise
-//! the relaxed optimum; the reported bound is the best over all stages.
+//! solver for a doubling time share. Then the pieces are split (in four, their neighbours in
+//! two) in order of importance until the node limit: with the ng-path bound first the pieces of
+//! the cheapest tours of the relaxation itself ([`crate::relaxed_tours`]: an iterated local
+//! search with the pieces re-chosen by a layered shortest path, run in every eighth slice; a
+//! relaxed tour that enters a long piece at one end and leaves at the other is where the
+//! relaxed optimum lies below the route), then the pieces holding the best route's pierce
+//! points, the exact search's relaxed tour and the ng-path bound's walk; and the next stage
+//! starts. Finer pieces only raise the relaxed optimum; the reported bound is the best over all
+//! stages.
 //!
 //! ```
 //! use cutroute_ccp::{CcpLowerBound, LowerBoundOptions};
@@ -85,6 +91,7 @@ use cutroute_geometry::{BoundingBox, Contour, ContourRef, Nest, Point, Route, Sp
 use cutroute_pcgtsp::{ExactOptions, ExactSolver, Instance, Status};
 use web_time::{Duration, Instant};
 
+use crate::relaxed_tours::RelaxedTourSearch;
 use crate::{CcpError, NgPathBound};
 
 /// How much each relaxed arc cost is lowered so that rounding in the distance maths (true
@@ -282,6 +289,8 @@ struct Building {
     escape: Vec<f64>,
     cost: Vec<f64>,
     next_row: usize,
+    /// Time spent building (diagnostics).
+    spent: Duration,
 }
 
 /// A stage's exact search on its instance.
@@ -297,8 +306,13 @@ struct Solving {
     ng_running: bool,
     exact_over: bool,
     /// Slices of this stage so far (the exact search gets every eighth beside the ng-path
-    /// bound).
+    /// bound, and so does the search for cheap relaxed tours).
     turns: usize,
+    /// Cheap tours of this relaxation (with the ng-path bound only): where its optimum lies
+    /// below the route, so where the next stage refines.
+    tours: Option<RelaxedTourSearch>,
+    /// Time the stage's matrix took to build (diagnostics).
+    build_spent: Duration,
 }
 
 enum Stage {
@@ -788,9 +802,12 @@ impl CcpLowerBound {
                     self.stage = Some(Stage::Building(self.start_building()));
                 }
                 Some(Stage::Building(mut b)) => {
+                    let began = Instant::now();
                     // A complete matrix waits for the next slice when this one is used up:
                     // making the stage's solver is a long piece of work of its own.
-                    if self.build_rows(&mut b, deadline) && Instant::now() < deadline {
+                    let built = self.build_rows(&mut b, deadline);
+                    b.spent += began.elapsed();
+                    if built && Instant::now() < deadline {
                         match self.start_solving(b) {
                             Some(s) => self.stage = Some(Stage::Solving(Box::new(s))),
                             None => return false,
@@ -810,15 +827,18 @@ impl CcpLowerBound {
                     let progress = s.solver.as_ref().map(ExactSolver::progress);
                     debug_log(|| {
                         format!(
-                            "stage {} ({} nodes, {:.2} s of {:.2} s): relaxed lb {:.3} ub {:.3}, ng {:.3} ({} passes), best {:.3}, incumbent {:.3}",
+                            "stage {} ({} nodes, built in {:.2} s, {:.2} s of {:.2} s): relaxed lb {:.3} ub {:.3}, ng {:.3} ({} passes), cheapest relaxed tour {:.3} ({} local searches), best {:.3}, incumbent {:.3}",
                             self.stages_done,
                             s.instance.node_count,
+                            s.build_spent.as_secs_f64(),
                             s.spent.as_secs_f64(),
                             s.share.as_secs_f64(),
                             progress.as_ref().map_or(f64::NAN, |p| p.lower_bound),
                             progress.as_ref().map_or(f64::NAN, |p| p.upper_bound),
                             s.ng.as_ref().map_or(f64::NAN, NgPathBound::lower_bound),
                             s.ng.as_ref().map_or(0, NgPathBound::iterations),
+                            s.tours.as_ref().map_or(f64::NAN, RelaxedTourSearch::best_cost),
+                            s.tours.as_ref().map_or(0, RelaxedTourSearch::kicks),
                             self.best,
                             self.incumbent_length
                         )
@@ -828,9 +848,24 @@ impl CcpLowerBound {
                         self.stage = None;
                         return false;
                     }
-                    // The pieces of the relaxed tour and of the ng-path bound's cheapest walk
-                    // are where the next relaxed optimum tends to lie.
-                    let mut marked = progress.and_then(|p| p.best_tour).unwrap_or_default();
+                    // The pieces of the cheapest relaxed tours, of the incumbent, of the
+                    // exact search's relaxed tour and of the ng-path bound's cheapest walk are
+                    // where the next relaxed optimum tends to lie, in that order of priority.
+                    if let (Some(tours), Some(ng)) = (s.tours.as_mut(), s.ng.as_ref()) {
+                        // One more local search from the ng walk's order (a few ms).
+                        tours.add_start(&s.instance, ng.last_walk());
+                        tours.step(&s.instance, Instant::now());
+                    }
+                    let mut marked: Vec<usize> = Vec::new();
+                    if let Some(tours) = &s.tours {
+                        for (_, tour) in tours.pool() {
+                            marked.extend_from_slice(tour);
+                        }
+                    }
+                    if let Some(tour) = self.incumbent_tour(&s.node_piece) {
+                        marked.extend_from_slice(&tour);
+                    }
+                    marked.extend(progress.and_then(|p| p.best_tour).unwrap_or_default());
                     if let Some(ng) = &s.ng {
                         marked.extend_from_slice(ng.last_walk());
                     }
@@ -865,6 +900,7 @@ impl CcpLowerBound {
             escape: Vec::with_capacity(if self.others.is_empty() { 0 } else { n - 1 }),
             cost: vec![f64::INFINITY; n * n],
             next_row: 0,
+            spent: Duration::ZERO,
         }
     }
 
@@ -964,6 +1000,7 @@ impl CcpLowerBound {
 
     fn start_solving(&mut self, b: Building) -> Option<Solving> {
         let n = 1 + b.node_piece.len();
+        let build_spent = b.spent;
         let margin = self.margin;
         // In place: at 2,500 pieces the matrix is 50 MB, and the ng-path bound keeps its own.
         let mut cost = b.cost;
@@ -1021,6 +1058,7 @@ impl CcpLowerBound {
         if solver.is_none() && ng.is_none() {
             return None;
         }
+        let ng_tours = ng.is_some();
         Some(Solving {
             node_piece: b.node_piece,
             instance,
@@ -1031,6 +1069,8 @@ impl CcpLowerBound {
             ng,
             exact_over: false,
             turns: 0,
+            build_spent,
+            tours: ng_tours.then(|| RelaxedTourSearch::new(0x5eed ^ self.stages_done as u64)),
         })
     }
 
@@ -1078,6 +1118,9 @@ impl CcpLowerBound {
                     ng.offer_tour(&tour);
                     ng.set_upper(cost);
                 }
+                if let Some(tours) = &mut s.tours {
+                    tours.add_start(&s.instance, &tour);
+                }
             }
             self.incumbent_offered = true;
         }
@@ -1097,7 +1140,21 @@ impl CcpLowerBound {
         }
         s.turns += 1;
         let exact_turn = !s.ng_running || s.turns.is_multiple_of(8);
-        if let Some(solver) = s.solver.as_mut().filter(|_| !s.exact_over && exact_turn) {
+        let tours_turn = s.turns % 8 == 4;
+        if let Some(tours) = s.tours.as_mut().filter(|t| tours_turn && t.running()) {
+            // A cheaper relaxed tour bounds the ng-path DP's passes better (pruning, level).
+            if tours.step(&s.instance, deadline) {
+                let (cost, best) = &tours.pool()[0];
+                if let Some(solver) = &mut s.solver {
+                    let mut tour = vec![s.instance.clusters[s.instance.depot][0]];
+                    tour.extend_from_slice(best);
+                    solver.offer_incumbent(&tour, *cost);
+                }
+                if let Some(ng) = &mut s.ng {
+                    ng.offer_tour(best);
+                }
+            }
+        } else if let Some(solver) = s.solver.as_mut().filter(|_| !s.exact_over && exact_turn) {
             let status = solver.step(slice.max(Duration::from_millis(1)));
             s.exact_over = status != Status::Running;
             let progress = solver.progress();
@@ -1118,45 +1175,60 @@ impl CcpLowerBound {
         s.exact_over || s.spent >= s.share || (s.solver.is_none() && !s.ng_running)
     }
 
-    /// Splits the pieces of the relaxed tour and those holding the incumbent's pierce points
-    /// in four, and halves their neighbours along the contour (the next relaxed optimum tends
-    /// to move next door); false when no piece could be split (node limit or tiny pieces).
-    fn refine(&mut self, node_piece: &[(usize, usize)], tour: Option<&[usize]>) -> bool {
-        // Parts per piece: 1 keeps it, 2 halves it, 4 quarters it.
-        let mut parts: Vec<Vec<usize>> = self.pieces.iter().map(|p| vec![1; p.len()]).collect();
-        let mut mark = |leaf: usize, k: usize, pieces: &[(f64, f64)]| {
-            let n = pieces.len();
-            parts[leaf][k] = 4;
-            for j in [(k + n - 1) % n, (k + 1) % n] {
-                parts[leaf][j] = parts[leaf][j].max(2);
-            }
-        };
-        for &v in tour.unwrap_or(&[]) {
-            if let Some(&(leaf, k)) = v.checked_sub(1).and_then(|i| node_piece.get(i)) {
-                mark(leaf, k, &self.pieces[leaf]);
-            }
-        }
-        for &(leaf, s) in &self.incumbent {
-            if let Some(k) = self.pieces[leaf]
-                .iter()
-                .position(|&(a, b)| a <= s && s <= b)
-            {
-                mark(leaf, k, &self.pieces[leaf]);
-            }
-        }
-        let mut nodes = self.node_count();
+    /// Splits the pieces of `marked` (relaxed tours' nodes, most important first) in four
+    /// and halves their neighbours along the contour (the next relaxed optimum tends to move
+    /// next door), in that order until the node limit; then the pieces holding the
+    /// incumbent's pierce points. False when no piece could be split (node limit or tiny
+    /// pieces).
+    fn refine(&mut self, node_piece: &[(usize, usize)], marked: Option<&[usize]>) -> bool {
         let max_nodes = if self.exact_whole() {
             self.options.max_nodes
         } else {
             self.options.max_nodes.min(NG_ALONE_MAX_NODES)
         };
+        // Parts per piece: 1 keeps it, 2 halves it, 4 quarters it; granted in the order of
+        // `marked`, so that at the node limit the most important pieces are the split ones
+        // (not the first contours').
+        let mut parts: Vec<Vec<usize>> = self.pieces.iter().map(|p| vec![1; p.len()]).collect();
+        let mut nodes = self.node_count();
+        let mut grant = |leaf: usize, k: usize, n: usize, pieces: &[(f64, f64)]| {
+            let (a, b) = pieces[k];
+            let min_length = 1e-6 * (1.0 + self.leaves[leaf].perimeter());
+            let old = parts[leaf][k];
+            if n > old && b - a > n as f64 * min_length && nodes + n - old <= max_nodes {
+                nodes += n - old;
+                parts[leaf][k] = n;
+            }
+        };
+        let incumbent_nodes: Vec<(usize, usize)> = self
+            .incumbent
+            .iter()
+            .filter_map(|&(leaf, s)| {
+                let k = self.pieces[leaf]
+                    .iter()
+                    .position(|&(a, b)| a <= s && s <= b)?;
+                Some((leaf, k))
+            })
+            .collect();
+        let marks = marked
+            .unwrap_or(&[])
+            .iter()
+            .filter_map(|&v| v.checked_sub(1).and_then(|i| node_piece.get(i)).copied())
+            .chain(incumbent_nodes);
+        for (leaf, k) in marks {
+            let pieces = &self.pieces[leaf];
+            let n = pieces.len();
+            grant(leaf, k, 4, pieces);
+            for j in [(k + n - 1) % n, (k + 1) % n] {
+                grant(leaf, j, 2, pieces);
+            }
+        }
         let mut split_any = false;
         for (leaf, pieces) in self.pieces.iter_mut().enumerate() {
-            let min_length = 1e-6 * (1.0 + self.leaves[leaf].perimeter());
             let mut out = Vec::with_capacity(pieces.len() + 8);
             for (k, &(a, b)) in pieces.iter().enumerate() {
                 let n = parts[leaf][k];
-                if n > 1 && b - a > n as f64 * min_length && nodes + n - 1 <= max_nodes {
+                if n > 1 {
                     out.extend((0..n).map(|i| {
                         (
                             a + (b - a) * i as f64 / n as f64,
@@ -1167,7 +1239,6 @@ impl CcpLowerBound {
                             },
                         )
                     }));
-                    nodes += n - 1;
                     split_any = true;
                 } else {
                     out.push((a, b));
@@ -1270,6 +1341,60 @@ mod tests {
             .map(|i| square(20.0 * (i % columns) as f64, 20.0 * (i / columns) as f64))
             .collect();
         Nest { sheet: None, parts }
+    }
+
+    /// The pieces of every kept contour stay a partition of `[0, perimeter]` into contiguous,
+    /// non-empty intervals (sorted) under refinement with any marks, the node
+    /// limit holds, and the first marked piece is split while there is room.
+    #[test]
+    fn refinement_keeps_the_pieces_a_partition_within_the_node_limit() {
+        let nest = grid_nest(3, 2);
+        let mut rng = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = move || {
+            rng ^= rng >> 12;
+            rng ^= rng << 25;
+            rng ^= rng >> 27;
+            rng.wrapping_mul(0x2545_F491_4F6C_DD1D) as usize
+        };
+        for max_nodes in [20, 60, 200] {
+            let options = LowerBoundOptions {
+                initial_pieces: 12,
+                max_nodes,
+                group_size: 0,
+                ng_size: 0,
+                ..LowerBoundOptions::default()
+            };
+            let mut bound = CcpLowerBound::new(&nest, options).unwrap();
+            for _ in 0..12 {
+                let node_piece: Vec<(usize, usize)> = bound
+                    .pieces
+                    .iter()
+                    .enumerate()
+                    .flat_map(|(leaf, p)| (0..p.len()).map(move |k| (leaf, k)))
+                    .collect();
+                let marked: Vec<usize> = (0..8).map(|_| 1 + next() % node_piece.len()).collect();
+                let (leaf, k) = node_piece[marked[0] - 1];
+                let first = bound.pieces[leaf][k];
+                let before = bound.node_count();
+                bound.refine(&node_piece, Some(&marked));
+                assert!(bound.node_count() <= max_nodes.max(before));
+                if before + 3 <= max_nodes {
+                    assert!(
+                        !bound.pieces[leaf].contains(&first),
+                        "the first marked piece was not split"
+                    );
+                }
+                for (leaf, pieces) in bound.pieces.iter().enumerate() {
+                    let perimeter = bound.leaves[leaf].perimeter();
+                    assert_eq!(pieces[0].0, 0.0);
+                    assert_eq!(pieces.last().unwrap().1, perimeter);
+                    for w in pieces.windows(2) {
+                        assert_eq!(w[0].1, w[1].0, "a gap or overlap between pieces");
+                    }
+                    assert!(pieces.iter().all(|&(a, b)| a < b), "an empty piece");
+                }
+            }
+        }
     }
 
     /// The decomposition runs one group's stage at a time (the memory of a stage — its cost

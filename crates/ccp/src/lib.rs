@@ -84,6 +84,7 @@ mod geom;
 mod ngpath;
 mod problem;
 mod relax;
+mod relaxed_tours;
 mod route;
 mod search;
 mod solver;
