@@ -88,7 +88,7 @@ use std::collections::HashMap;
 use std::sync::Arc;
 
 use cutroute_geometry::{BoundingBox, Contour, ContourRef, Nest, Point, Route, Span};
-use cutroute_pcgtsp::{ExactOptions, ExactSolver, Instance, Status};
+use cutroute_pcgtsp::{AnytimeSolver, ExactOptions, ExactSolver, Instance, Status};
 use web_time::{Duration, Instant};
 
 use crate::relaxed_tours::RelaxedTourSearch;
@@ -1142,7 +1142,10 @@ impl CcpLowerBound {
         // Once the ng-path bound is above the exact search's (on nested.dbs ~7,900 against
         // ~4,600), the exact search's eighth of the slices goes to the ng-path bound too.
         let ng_ahead = match (&s.ng, &s.solver) {
-            (Some(ng), Some(solver)) => ng.lower_bound() > solver.progress().lower_bound,
+            // `bounds`, not `progress`: no copy of the incumbent tour nor DP statistics per slice.
+            (Some(ng), Some(solver)) => {
+                ng.lower_bound() > solver.bounds().lower.unwrap_or(f64::NEG_INFINITY)
+            }
             _ => false,
         };
         let exact_turn = !s.ng_running || (s.turns.is_multiple_of(8) && !ng_ahead);
