@@ -13,6 +13,7 @@
 //! re-chooses all pieces along the order, until no move helps; an iterated local search kicks
 //! the best tour (a double bridge) and keeps the few cheapest distinct tours.
 
+use cutroute_geometry::SplitMix64;
 use cutroute_pcgtsp::Instance;
 use web_time::Instant;
 
@@ -204,7 +205,7 @@ pub(crate) struct RelaxedTourSearch {
     starts: Vec<Vec<usize>>,
     /// The cheapest distinct tours found (cost, nodes without the depot), cheapest first.
     pool: Vec<(f64, Vec<usize>)>,
-    rng: u64,
+    rng: SplitMix64,
     stalled: usize,
     kicks: usize,
 }
@@ -214,7 +215,7 @@ impl RelaxedTourSearch {
         RelaxedTourSearch {
             starts: Vec::new(),
             pool: Vec::new(),
-            rng: seed | 1,
+            rng: SplitMix64::new(seed),
             stalled: 0,
             kicks: 0,
         }
@@ -290,14 +291,6 @@ impl RelaxedTourSearch {
         !self.starts.is_empty() || (!self.pool.is_empty() && self.stalled < STALL_KICKS)
     }
 
-    fn next_random(&mut self) -> u64 {
-        // xorshift64*: deterministic across platforms.
-        self.rng ^= self.rng >> 12;
-        self.rng ^= self.rng << 25;
-        self.rng ^= self.rng >> 27;
-        self.rng.wrapping_mul(0x2545_F491_4F6C_DD1D)
-    }
-
     /// Runs local searches until `deadline` (at least one); returns true when the pool's
     /// cheapest tour improved.
     pub(crate) fn step(&mut self, instance: &Instance, deadline: Instant) -> bool {
@@ -310,7 +303,7 @@ impl RelaxedTourSearch {
                 cheapest_pieces(instance, &order).map(|(nodes, _)| nodes)
             } else {
                 // A double bridge on one of the pool's tours (the best one twice as often).
-                let pick = (self.next_random() as usize) % (self.pool.len() + 1);
+                let pick = self.rng.index_below(self.pool.len() + 1);
                 let mut order: Vec<usize> = self.pool[pick.saturating_sub(1)]
                     .1
                     .iter()
@@ -318,9 +311,8 @@ impl RelaxedTourSearch {
                     .collect();
                 let m = order.len();
                 if m >= 8 {
-                    let mut cut: Vec<usize> = (0..3)
-                        .map(|_| 1 + (self.next_random() as usize) % (m - 1))
-                        .collect();
+                    let mut cut: Vec<usize> =
+                        (0..3).map(|_| 1 + self.rng.index_below(m - 1)).collect();
                     cut.sort_unstable();
                     let (a, b, c) = (cut[0], cut[1], cut[2]);
                     let mut kicked = order[..a].to_vec();
@@ -329,8 +321,8 @@ impl RelaxedTourSearch {
                     kicked.extend_from_slice(&order[c..]);
                     order = kicked;
                 } else if m >= 2 {
-                    let i = (self.next_random() as usize) % m;
-                    let j = (self.next_random() as usize) % m;
+                    let i = self.rng.index_below(m);
+                    let j = self.rng.index_below(m);
                     order.swap(i, j);
                 }
                 cheapest_pieces(instance, &order).map(|(nodes, _)| nodes)
@@ -375,13 +367,8 @@ mod tests {
     /// A random instance: a depot and `m` clusters of 1–`k` nodes at random points, costs the
     /// distances (asymmetric when `skew`), the return arcs half the distance (a tail).
     fn random_instance(seed: u64, m: usize, k: usize, skew: bool) -> Instance {
-        let mut rng = seed | 1;
-        let mut next = move || {
-            rng ^= rng >> 12;
-            rng ^= rng << 25;
-            rng ^= rng >> 27;
-            (rng.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = SplitMix64::new(seed);
+        let mut next = move || rng.next_f64();
         let mut points = vec![(0.0, 0.0)];
         let mut clusters = vec![vec![0]];
         let mut node_cluster = vec![0];
