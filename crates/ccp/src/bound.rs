@@ -28,6 +28,10 @@
 //! candidate instead, so the relaxed PCGTSP is the discrete instance restricted to the kept
 //! contours (with the tail above) and there is nothing to refine: one stage, solved until
 //! it ends. Its optimum lies between the continuous relaxation's and the discrete optimum.
+//! A node is then a point, entered and left at the same place, so the relaxation loses none
+//! of the "enter a piece at one end, leave at the other" that caps the continuous one: with
+//! more kept contours than `ng_above` the ng-path bound runs on it as below (nested.dbs at
+//! 25 mm: 9,086 in 60 s against the continuous bound's ~7,950, a discrete route of 9,632).
 //!
 //! **Decomposition by spatial groups** (nests of more than `decompose_above` kept contours):
 //! the kept contours are split into compact groups of at most `group_size` (the holes of one
@@ -91,6 +95,7 @@ use cutroute_geometry::{BoundingBox, Contour, ContourRef, Nest, Point, Route, Sp
 use cutroute_pcgtsp::{AnytimeSolver, ExactOptions, ExactSolver, Instance, Status};
 use web_time::{Duration, Instant};
 
+use crate::ngpath::MAX_NG;
 use crate::relaxed_tours::RelaxedTourSearch;
 use crate::{CcpError, NgPathBound};
 
@@ -111,6 +116,10 @@ const NG_INITIAL_PIECES: usize = 1600;
 /// pass over Nest02's 359 kept contours took ~2 s at 824 nodes, ~5 s at 1,627 and over 20 s
 /// at 2,500, and the subgradient needs many passes.
 const NG_ALONE_MAX_NODES: usize = 1200;
+
+/// Passes of the ng-path bound at fixed candidates before the largest neighbourhoods
+/// ([`MAX_NG`]) take over with its penalties.
+const ESCALATE_PASSES: usize = 24;
 
 /// Most groups of the decomposition bound.
 const MAX_GROUPS: usize = 64;
@@ -301,8 +310,10 @@ struct Solving {
     solver: Option<ExactSolver>,
     spent: Duration,
     share: Duration,
-    /// The ng-path bound on the same instance (large relaxations only), sharing the slices.
+    /// The ng-path bound on the same instance (large relaxations only), sharing the slices,
+    /// and its neighbourhoods' size.
     ng: Option<NgPathBound>,
+    ng_size: usize,
     ng_running: bool,
     exact_over: bool,
     /// Slices of this stage so far (the exact search gets every eighth beside the ng-path
@@ -778,14 +789,15 @@ impl CcpLowerBound {
     }
 
     /// Whether this bound's own relaxation runs the exact search (few enough kept contours
-    /// for its keys; fixed candidates always do, they are within the discrete solver's).
+    /// for its keys).
     fn exact_whole(&self) -> bool {
-        self.fixed || self.leaves.len() <= self.options.exact_max_kept.min(EXACT_MAX_KEPT)
+        self.leaves.len() <= self.options.exact_max_kept.min(EXACT_MAX_KEPT)
     }
 
-    /// Whether this bound's own relaxation runs the ng-path bound beside the exact search.
+    /// Whether this bound's own relaxation runs the ng-path bound (beside the exact search
+    /// where that runs), at fixed candidates too.
     fn ng_active(&self) -> bool {
-        !self.fixed && self.options.ng_size > 0 && self.leaves.len() > self.options.ng_above
+        self.options.ng_size > 0 && self.leaves.len() > self.options.ng_above
     }
 
     fn step_until(&mut self, deadline: Instant) -> bool {
@@ -1067,6 +1079,7 @@ impl CcpLowerBound {
             share,
             ng_running: ng.is_some(),
             ng,
+            ng_size: self.options.ng_size,
             exact_over: false,
             turns: 0,
             build_spent,
@@ -1177,6 +1190,25 @@ impl CcpLowerBound {
                 self.ng_best = self.ng_best.max(ng.lower_bound());
             }
             self.ng_lambda = ng.best_lambda().to_vec();
+            // At fixed candidates the stage is the last: once the small neighbourhoods have
+            // set the penalties (or converged), the largest ones take over from them. Their
+            // passes cost ~5 times as much, but their walks revisit far fewer contours: on
+            // nested.dbs at 25 mm the walks of ng = 8 cycled through 21–44 of 70 contours
+            // (cycles of 12–15), and ng = 12 reached 9,183 in 10 passes where ng = 8 had
+            // 8,563 (9,2xx converged).
+            let escalate = !s.ng_running || ng.iterations() >= ESCALATE_PASSES;
+            // (Not where every contour is already in every neighbourhood.)
+            let wider_exists = s.ng_size < MAX_NG && self.leaves.len() > s.ng_size;
+            if self.fixed && escalate && wider_exists {
+                if let Some(mut wider) = NgPathBound::new(&s.instance, MAX_NG, &self.ng_lambda) {
+                    for walk in ng.offered_tours() {
+                        wider.offer_tour(walk);
+                    }
+                    s.ng_size = MAX_NG;
+                    s.ng_running = true;
+                    *ng = wider;
+                }
+            }
         }
         s.spent += now.elapsed();
         // The stage is over when the exact search ended (its bound is then the relaxation's

@@ -400,6 +400,12 @@ impl NgPathBound {
         }
     }
 
+    /// The tours offered so far (each cluster once, without the depot), for a successor on
+    /// the same instance.
+    pub fn offered_tours(&self) -> impl Iterator<Item = &[usize]> {
+        self.tours.iter().map(|(_, tour)| tour.as_slice())
+    }
+
     /// The arc cost of a walk from the depot through `walk` and back.
     fn walk_cost(&self, walk: &[usize]) -> f64 {
         let n = self.n;

@@ -172,8 +172,12 @@ pub enum Refusal {
 }
 
 /// Most kept (innermost) contours for which the discrete exact job bounds at the
-/// discretisation's candidates rather than with the refined continuous relaxation.
-const DISCRETE_BOUND_MAX_KEPT: usize = 22;
+/// discretisation's candidates rather than with the refined continuous relaxation. Up to ~22
+/// the candidates' instance is solved exactly; above, the ng-path bound runs on it, which on
+/// nested.dbs (70 kept) reached 9,086 in 60 s where the continuous bound reached ~7,950. Much
+/// larger nests keep the continuous bound: its spatial groups are the stronger bound there
+/// (the ng-path bound alone on Nest02's 359 kept contours: 3,400–4,000 against 12,000).
+const DISCRETE_BOUND_MAX_KEPT: usize = 100;
 
 /// Most contours of a discretised nest for which the exact job runs without the continuous
 /// bound (the exact search's own bounds prove such nests: test0, test1, E1X_6_01 in seconds).
@@ -457,10 +461,9 @@ fn start_solver_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
             };
             let bound = cutroute_ccp::CcpLowerBound::new(nest, bound_options.clone())
                 .map_err(|e| refused(e.into()))?;
-            // Where the relaxed instance is solved exactly (the lattice of its ideals, 2^kept
-            // without precedence, is built up to a few million), the bound at the
-            // discretisation's own candidates is tighter than the continuous one and needs no
-            // refinement.
+            // The bound at the discretisation's own candidates is tighter than the continuous
+            // one and needs no refinement: its nodes are points, entered and left at one
+            // place. Where the candidates do not fit its matrix, the continuous bound stays.
             let bound = if bound.kept_contours() <= DISCRETE_BOUND_MAX_KEPT {
                 cutroute_ccp::CcpLowerBound::for_candidates(
                     nest,

@@ -14,7 +14,7 @@ use web_time::Duration;
 /// proven here by the exact solver alone on small random nests (5–7 contours, coarse steps),
 /// with and without a finish point, for the refined continuous bound, the same with the
 /// decomposition by spatial groups forced on (groups of one and two kept contours), and the
-/// bound at the discretisation's candidates.
+/// bound at the discretisation's candidates (with and without the ng-path bound).
 #[test]
 fn discrete_exact_job_bound_never_exceeds_the_discrete_optimum() {
     use cutroute_ccp::{CcpLowerBound, DiscreteNode, LowerBoundOptions};
@@ -61,6 +61,7 @@ fn discrete_exact_job_bound_never_exceeds_the_discrete_optimum() {
             (false, 1, false),
             (false, 2, false),
             (true, 0, false),
+            (true, 0, true),
             (false, 0, true),
             (false, 2, true),
         ] {
@@ -110,8 +111,8 @@ fn discrete_exact_job_bound_never_exceeds_the_discrete_optimum() {
     }
 }
 
-/// On nested.dbs (87 contours, 70 innermost: the bound runs the decomposition by spatial
-/// groups) the job's bound stays below its own route.
+/// On nested.dbs (87 contours, 70 innermost: the bound runs the ng-path bound at the
+/// discretisation's candidates) the job's bound stays below its own route.
 #[test]
 fn discrete_exact_job_on_nested_reports_a_bound_below_its_route() {
     let (name, bytes) = data("nests/dbs/nested.dbs");
