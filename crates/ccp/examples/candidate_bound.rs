@@ -8,7 +8,7 @@
 use std::time::{Duration, Instant};
 
 use cutroute_ccp::{
-    build_pcgtsp, CcpLowerBound, DiscreteNode, DiscretisationOptions, LowerBoundOptions,
+    build_pcgtsp, pierce_candidates, CcpLowerBound, DiscretisationOptions, LowerBoundOptions,
 };
 
 fn main() {
@@ -29,14 +29,7 @@ fn main() {
         },
     )
     .expect("an instance");
-    let candidates: Vec<_> = discrete
-        .nodes
-        .iter()
-        .filter_map(|n| match *n {
-            DiscreteNode::Pierce { contour, point } => Some((contour, point)),
-            DiscreteNode::Depot(_) => None,
-        })
-        .collect();
+    let candidates: Vec<_> = pierce_candidates(&discrete.nodes);
     let options = LowerBoundOptions {
         budget_seconds: seconds,
         first_stage: Duration::from_secs_f64((seconds / 10.0).clamp(0.25, 3.0)),

@@ -49,6 +49,18 @@ pub enum DiscreteNode {
     },
 }
 
+/// The candidate pierce points among `nodes` (contour, point), in node order: what
+/// [`crate::CcpLowerBound::for_candidates`] bounds.
+pub fn pierce_candidates(nodes: &[DiscreteNode]) -> Vec<(ContourRef, Point)> {
+    nodes
+        .iter()
+        .filter_map(|n| match *n {
+            DiscreteNode::Pierce { contour, point } => Some((contour, point)),
+            DiscreteNode::Depot(_) => None,
+        })
+        .collect()
+}
+
 /// A PCGTSP instance built from a nest, with the meaning of its nodes.
 #[derive(Clone, Debug, PartialEq)]
 pub struct DiscreteInstance {

@@ -92,8 +92,8 @@ mod solver;
 pub use bound::{CcpLowerBound, LowerBoundOptions, MAX_RELAXATION_ENTRIES};
 pub use cutroute_anytime::{AnytimeSolver, Bounds, Status};
 pub use discrete::{
-    build_pcgtsp, DiscreteInstance, DiscreteNode, DiscretisationOptions, PcgtspBuilder,
-    MAX_DISCRETE_NODES,
+    build_pcgtsp, pierce_candidates, DiscreteInstance, DiscreteNode, DiscretisationOptions,
+    PcgtspBuilder, MAX_DISCRETE_NODES,
 };
 pub use ngpath::{NgPathBound, NgStats};
 pub use route::{idle_length, route_certificates, route_metrics, ContourCertificate, RouteMetrics};

@@ -269,48 +269,57 @@ fn a_sheet_too_large_for_the_relaxation_keeps_the_trivial_bound() {
     assert_eq!(bound.lower_bound(), 0.0);
 }
 
+/// The optimum of `nest` discretised every `step` mm (proven by the exact solver alone) and the
+/// discretisation's candidate pierce points.
+fn discrete_optimum(
+    nest: &Nest,
+    start: Point,
+    finish: Option<Point>,
+    step: f64,
+) -> (f64, Vec<(ContourRef, Point)>) {
+    use cutroute_ccp::{build_pcgtsp, pierce_candidates, DiscretisationOptions};
+    let discrete = build_pcgtsp(
+        nest,
+        &DiscretisationOptions {
+            start,
+            finish,
+            step,
+            ..DiscretisationOptions::default()
+        },
+    )
+    .unwrap();
+    let solved = cutroute_pcgtsp::solve(
+        &discrete.instance,
+        cutroute_pcgtsp::ExactOptions {
+            time_limit: None,
+            ..Default::default()
+        },
+        &mut |_| {},
+    )
+    .unwrap();
+    assert!(
+        solved.proven_optimal(),
+        "the discrete optimum is not proven"
+    );
+    (
+        solved.progress.upper_bound,
+        pierce_candidates(&discrete.nodes),
+    )
+}
+
 /// The bound at fixed candidates (a discretisation's pierce points) is never above the discrete
 /// optimum (proven by the exact solver alone), with the exact search, the ng-path bound beside
 /// it, or the ng-path bound alone; and where every contour is kept (no holes, so nothing is
 /// relaxed but the pieces' micrometre widths) the exact search's equals that optimum.
 #[test]
 fn at_fixed_candidates_never_above_the_discrete_optimum_and_exact_without_holes() {
-    use cutroute_ccp::{build_pcgtsp, DiscreteNode, DiscretisationOptions};
     let mut without_holes = 0;
     let mut ng_alone = Vec::new();
     for seed in 1..=12u64 {
         let nest = random_nest(seed);
         let start = Point::new(-30.0, -10.0);
         let finish = (seed % 3 == 0).then_some(Point::new(150.0, -20.0));
-        let discrete = build_pcgtsp(
-            &nest,
-            &DiscretisationOptions {
-                start,
-                finish,
-                step: 9.0,
-                ..DiscretisationOptions::default()
-            },
-        )
-        .unwrap();
-        let optimum = cutroute_pcgtsp::solve(
-            &discrete.instance,
-            cutroute_pcgtsp::ExactOptions {
-                time_limit: None,
-                ..Default::default()
-            },
-            &mut |_| {},
-        )
-        .unwrap();
-        assert!(optimum.proven_optimal(), "seed {seed}");
-        let optimum = optimum.progress.upper_bound;
-        let candidates: Vec<(ContourRef, Point)> = discrete
-            .nodes
-            .iter()
-            .filter_map(|n| match *n {
-                DiscreteNode::Pierce { contour, point } => Some((contour, point)),
-                DiscreteNode::Depot(_) => None,
-            })
-            .collect();
+        let (optimum, candidates) = discrete_optimum(&nest, start, finish, 9.0);
         // The exact search alone (as on nests of up to ~22 kept contours), the ng-path bound
         // beside it (as on larger ones), and the ng-path bound alone. Its neighbourhoods start
         // at two contours, so that the widest ones take over on these small nests too.
@@ -367,39 +376,11 @@ fn at_fixed_candidates_never_above_the_discrete_optimum_and_exact_without_holes(
 /// of the candidates' relaxation, and never above the discrete optimum.
 #[test]
 fn at_fixed_candidates_the_widest_neighbourhoods_take_over() {
-    use cutroute_ccp::{build_pcgtsp, DiscreteNode, DiscretisationOptions};
     let mut ratios = Vec::new();
     for seed in 1..=6u64 {
         let nest = packed_nest(seed);
         let start = Point::new(-30.0, -10.0);
-        let discrete = build_pcgtsp(
-            &nest,
-            &DiscretisationOptions {
-                start,
-                step: 6.0,
-                ..DiscretisationOptions::default()
-            },
-        )
-        .unwrap();
-        let optimum = cutroute_pcgtsp::solve(
-            &discrete.instance,
-            cutroute_pcgtsp::ExactOptions {
-                time_limit: None,
-                ..Default::default()
-            },
-            &mut |_| {},
-        )
-        .unwrap();
-        assert!(optimum.proven_optimal(), "seed {seed}");
-        let optimum = optimum.progress.upper_bound;
-        let candidates: Vec<(ContourRef, Point)> = discrete
-            .nodes
-            .iter()
-            .filter_map(|n| match *n {
-                DiscreteNode::Pierce { contour, point } => Some((contour, point)),
-                DiscreteNode::Depot(_) => None,
-            })
-            .collect();
+        let (optimum, candidates) = discrete_optimum(&nest, start, None, 6.0);
         let options = LowerBoundOptions {
             start,
             budget_seconds: 2.0,

@@ -183,19 +183,6 @@ const DISCRETE_BOUND_MAX_KEPT: usize = 100;
 /// bound (the exact search's own bounds prove such nests: test0, test1, E1X_6_01 in seconds).
 const DISCRETE_EXACT_ALONE_CONTOURS: usize = 35;
 
-/// The candidate pierce points of a discretisation (its nodes but the depot).
-fn pierce_candidates(
-    nodes: &[cutroute_ccp::DiscreteNode],
-) -> Vec<(cutroute_geometry::ContourRef, cutroute_geometry::Point)> {
-    nodes
-        .iter()
-        .filter_map(|n| match *n {
-            cutroute_ccp::DiscreteNode::Pierce { contour, point } => Some((contour, point)),
-            cutroute_ccp::DiscreteNode::Depot(_) => None,
-        })
-        .collect()
-}
-
 /// Build the job a request asks for. On a nest, the job runs inside a [`ThermalJob`]: its
 /// progress carries H and the rule violations of [`SolverParams::thermal`], and with `hard`
 /// its final route is repaired until the rules hold; with a positive heat weight, nearest, ccp
@@ -411,7 +398,7 @@ fn start_solver_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
                     weight_mm,
                     &params.machine,
                 );
-                let candidates = pierce_candidates(&discrete.nodes);
+                let candidates = cutroute_ccp::pierce_candidates(&discrete.nodes);
                 let instance = discrete.instance.clone();
                 let job = DiscreteJob::new(
                     request.job_id,
@@ -427,7 +414,7 @@ fn start_solver_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
             } else {
                 let builder = cutroute_ccp::PcgtspBuilder::new(nest, &options)
                     .map_err(|e| refused(e.into()))?;
-                let candidates = pierce_candidates(builder.nodes());
+                let candidates = cutroute_ccp::pierce_candidates(builder.nodes());
                 let job = DiscreteJob::building(
                     request.job_id,
                     builder,

@@ -17,7 +17,7 @@ use web_time::Duration;
 /// bound at the discretisation's candidates (with and without the ng-path bound).
 #[test]
 fn discrete_exact_job_bound_never_exceeds_the_discrete_optimum() {
-    use cutroute_ccp::{CcpLowerBound, DiscreteNode, LowerBoundOptions};
+    use cutroute_ccp::{pierce_candidates, CcpLowerBound, LowerBoundOptions};
     use cutroute_engine::{DiscreteJob, DiscreteMode};
     use cutroute_geometry::{generate_nest, Point};
     for seed in 1..=6u64 {
@@ -47,14 +47,7 @@ fn discrete_exact_job_bound_never_exceeds_the_discrete_optimum() {
         .unwrap();
         assert!(alone.proven_optimal(), "seed {seed}: not proven");
         let optimum = alone.progress.upper_bound;
-        let candidates: Vec<_> = discrete
-            .nodes
-            .iter()
-            .filter_map(|n| match *n {
-                DiscreteNode::Pierce { contour, point } => Some((contour, point)),
-                DiscreteNode::Depot(_) => None,
-            })
-            .collect();
+        let candidates: Vec<_> = pierce_candidates(&discrete.nodes);
         // (at the candidates, group size, ng-path bound forced on the whole relaxation)
         for (at_candidates, group_size, ng) in [
             (false, 0, false),
