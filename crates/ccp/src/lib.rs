@@ -95,7 +95,7 @@ pub use discrete::{
     build_pcgtsp, pierce_candidates, DiscreteInstance, DiscreteNode, DiscretisationOptions,
     PcgtspBuilder, MAX_DISCRETE_NODES,
 };
-pub use ngpath::{NgPathBound, NgStats};
+pub use ngpath::{NgPathBound, NgStats, MAX_NG};
 pub use route::{idle_length, route_certificates, route_metrics, ContourCertificate, RouteMetrics};
 pub use solver::{
     solve, solve_with_cancel, CcpOptions, CcpPhase, CcpProgress, CcpResult, CcpSolver, HeatPenalty,

@@ -65,10 +65,118 @@ struct LayerWork {
     d: usize,
 }
 
+/// The candidate entries of one target cluster's nodes, per memory on entering it: a compact
+/// table (memories in order of appearance, times targets) rather than a dense one over all
+/// `2^(ng − 1)` memories, which at ng = 12 took megabytes to clear per target cluster.
+struct Entries {
+    /// Per memory (`mask >> 1`): its slot, `u32::MAX` when not seen for this cluster.
+    slot_of: Vec<u32>,
+    /// Per slot: its memory.
+    masks: Vec<u32>,
+    /// `values[slot * targets + t]`: the least arrival at target `t` with that memory (before
+    /// the penalty), and the label it came from (`preds`).
+    values: Vec<f64>,
+    preds: Vec<u32>,
+    targets: usize,
+}
+
+impl Entries {
+    fn new(width: usize) -> Entries {
+        Entries {
+            slot_of: vec![u32::MAX; width],
+            masks: Vec::new(),
+            values: Vec::new(),
+            preds: Vec::new(),
+            targets: 0,
+        }
+    }
+
+    /// Empties the table for a cluster of `targets` nodes; slot 0 is the memory {d} alone.
+    fn reset(&mut self, targets: usize) {
+        for &mask in &self.masks {
+            self.slot_of[(mask >> 1) as usize] = u32::MAX;
+        }
+        self.masks.clear();
+        self.values.clear();
+        self.preds.clear();
+        self.targets = targets;
+        self.slot(1);
+    }
+
+    /// The slot of memory `mask`, made on first sight.
+    #[inline]
+    fn slot(&mut self, mask: u32) -> usize {
+        let e = &mut self.slot_of[(mask >> 1) as usize];
+        if *e == u32::MAX {
+            *e = self.masks.len() as u32;
+            self.masks.push(mask);
+            self.values
+                .resize(self.values.len() + self.targets, f64::INFINITY);
+            self.preds.resize(self.preds.len() + self.targets, u32::MAX);
+        }
+        *e as usize
+    }
+
+    /// Offers the arrivals `value + arcs[t]` (from label `pred`) to the targets' entries with
+    /// the memory of `slot`.
+    #[inline]
+    fn relax(&mut self, slot: usize, value: f64, pred: u32, arcs: &[f32]) {
+        let range = slot * self.targets..(slot + 1) * self.targets;
+        let values = &mut self.values[range.clone()];
+        let preds = &mut self.preds[range];
+        for ((e, p), &arc) in values.iter_mut().zip(preds.iter_mut()).zip(arcs) {
+            let total = value + f64::from(arc);
+            if total < *e {
+                *e = total;
+                *p = pred;
+            }
+        }
+    }
+
+    /// The largest entry of the memory {d} over the targets.
+    fn alone_max(&self) -> f64 {
+        self.values[..self.targets]
+            .iter()
+            .copied()
+            .fold(f64::NEG_INFINITY, f64::max)
+    }
+}
+
+/// How the memories of a cluster `c`'s labels become memories on entering `d`: by lookup in
+/// two halves of the mask (an ng neighbourhood has at most 12 clusters), or `None` when the
+/// memory holds `d`.
+struct MemoryMap {
+    forbidden: u32,
+    low: [u32; 64],
+    high: [u32; 64],
+}
+
+impl MemoryMap {
+    #[inline]
+    fn enter(&self, mask: u32) -> Option<u32> {
+        (mask & self.forbidden == 0)
+            .then(|| 1 | self.low[(mask & 63) as usize] | self.high[(mask >> 6) as usize & 63])
+    }
+}
+
+/// An arc cost as the DP reads it: the nearest `f32` at or below it. Half the memory of `f64`,
+/// and the DP is bound by reading the arcs (on nested.dbs at 25 mm, 2,141 nodes: 37 MB as
+/// `f64`). No walk costs more than it did, so a bound of the rounded instance bounds the
+/// instance.
+fn round_down(x: f64) -> f32 {
+    let f = x as f32;
+    if f64::from(f) > x {
+        f.next_down()
+    } else {
+        f
+    }
+}
+
 /// The resumable subgradient search of the ng-path bound on one instance.
 pub struct NgPathBound {
     n: usize,
-    cost: Arc<Vec<f64>>,
+    /// The arc costs rounded down to `f32` (see `round_down`).
+    cost: Arc<Vec<f32>>,
     /// Arc costs from and to the depot (the backward DP swaps them).
     from_depot: Vec<f64>,
     to_depot: Vec<f64>,
@@ -76,6 +184,9 @@ pub struct NgPathBound {
     cluster: Vec<usize>,
     /// Per non-depot cluster: its nodes.
     members: Vec<Vec<usize>>,
+    /// Per non-depot cluster: its first node when its nodes are consecutive (then the arcs
+    /// into it are a slice of each cost row, as in the discretised instances).
+    spans: Vec<Option<usize>>,
     /// Per cluster: `ng(c)`, `c` first.
     ng: Vec<Vec<usize>>,
     /// `position[c * m + x]`: position of cluster `x` in `ng(c)`, or -1.
@@ -173,6 +284,8 @@ const POOL_SIZE: usize = 16;
 
 /// Most clusters in a neighbourhood (the DP keeps a dense table over the memories).
 pub const MAX_NG: usize = 12;
+// `MemoryMap` looks a memory up in two halves of six bits.
+const _: () = assert!(MAX_NG <= 12);
 
 impl NgPathBound {
     /// Prepares the bound with neighbourhoods of `ng_size` clusters (nearest by least arc cost)
@@ -203,6 +316,7 @@ impl NgPathBound {
                 cluster[v] = c;
             }
         }
+        let cost: Arc<Vec<f32>> = Arc::new(instance.cost.iter().map(|&x| round_down(x)).collect());
         // Least arc cost between clusters: the neighbourhoods are the nearest ones.
         let mut near = vec![f64::INFINITY; m * m];
         for (a, &ca) in cluster.iter().enumerate() {
@@ -213,7 +327,7 @@ impl NgPathBound {
                 if cb == usize::MAX || cb == ca {
                     continue;
                 }
-                let c = instance.cost[a * n + b].min(instance.cost[b * n + a]);
+                let c = f64::from(cost[a * n + b].min(cost[b * n + a]));
                 let e = &mut near[ca * m + cb];
                 *e = e.min(c);
             }
@@ -244,9 +358,8 @@ impl NgPathBound {
                 .map(|x| if x.is_finite() { x } else { 0.0 })
                 .collect()
         };
-        let cost = Arc::new(instance.cost.clone());
-        let from_depot: Vec<f64> = (0..n).map(|w| cost[depot * n + w]).collect();
-        let to_depot: Vec<f64> = (0..n).map(|v| cost[v * n + depot]).collect();
+        let from_depot: Vec<f64> = (0..n).map(|w| f64::from(cost[depot * n + w])).collect();
+        let to_depot: Vec<f64> = (0..n).map(|v| f64::from(cost[v * n + depot])).collect();
         // Every other pass runs backwards: on the reversed arcs (the same matrix when the arcs
         // between clusters are symmetric, as the interval relaxation's are), with the depot's
         // ways in and out swapped.
@@ -256,7 +369,7 @@ impl NgPathBound {
         let reversed = if symmetric {
             Arc::clone(&cost)
         } else {
-            let mut t = vec![f64::INFINITY; n * n];
+            let mut t = vec![f32::INFINITY; n * n];
             for a in 0..n {
                 for b in 0..n {
                     t[b * n + a] = cost[a * n + b];
@@ -295,7 +408,7 @@ impl NgPathBound {
     #[allow(clippy::too_many_arguments)]
     fn from_parts(
         n: usize,
-        cost: Arc<Vec<f64>>,
+        cost: Arc<Vec<f32>>,
         from_depot: Vec<f64>,
         to_depot: Vec<f64>,
         cluster: Vec<usize>,
@@ -326,6 +439,17 @@ impl NgPathBound {
                     position[c * m + d] >= 0 || ng[c].iter().any(|&x| position[d * m + x] >= 0);
             }
         }
+        let spans = members
+            .iter()
+            .map(|nodes| {
+                let first = *nodes.first()?;
+                nodes
+                    .iter()
+                    .enumerate()
+                    .all(|(k, &v)| v == first + k)
+                    .then_some(first)
+            })
+            .collect();
         NgPathBound {
             n,
             cost,
@@ -333,6 +457,7 @@ impl NgPathBound {
             to_depot,
             cluster,
             members,
+            spans,
             ng,
             position,
             related,
@@ -412,7 +537,10 @@ impl NgPathBound {
         let (Some(&first), Some(&last)) = (walk.first(), walk.last()) else {
             return f64::INFINITY;
         };
-        let inner: f64 = walk.windows(2).map(|p| self.cost[p[0] * n + p[1]]).sum();
+        let inner: f64 = walk
+            .windows(2)
+            .map(|p| f64::from(self.cost[p[0] * n + p[1]]))
+            .sum();
         self.from_depot[first] + inner + self.to_depot[last]
     }
 
@@ -614,7 +742,7 @@ impl NgPathBound {
                     }
                     let row = &self.cost[u * n..(u + 1) * n];
                     for (slot, &arc) in from_cluster.iter_mut().zip(row) {
-                        let total = from + arc;
+                        let total = from + f64::from(arc);
                         *slot = if total < *slot { total } else { *slot };
                     }
                 }
@@ -660,26 +788,29 @@ impl NgPathBound {
         self.floor = floor;
     }
 
-    /// The memory after entering cluster `d` from a label at cluster `c` with memory `mask`,
-    /// or `None` when `d` is remembered.
-    #[inline]
-    fn enter(&self, c: usize, mask: u32, d: usize) -> Option<u32> {
+    /// The memory after entering cluster `d` from a label at cluster `c`, as a lookup table
+    /// over the label's memory (bits over the positions of `ng(c)`).
+    fn memory_map(&self, c: usize, d: usize) -> MemoryMap {
         let m = self.members.len();
         let p = self.position[c * m + d];
-        if p >= 0 && mask & (1 << p) != 0 {
-            return None;
-        }
-        let mut out = 1u32;
-        let mut bits = mask;
-        while bits != 0 {
-            let p = bits.trailing_zeros() as usize;
-            bits &= bits - 1;
-            let q = self.position[d * m + self.ng[c][p]];
-            if q >= 0 {
-                out |= 1 << q;
+        // Position `p` of ng(c), as a bit of the memory in ng(d).
+        let bit = |p: usize| -> u32 {
+            match self.ng[c].get(p) {
+                Some(&x) if self.position[d * m + x] >= 0 => 1 << self.position[d * m + x],
+                _ => 0,
             }
+        };
+        let mut map = MemoryMap {
+            forbidden: if p >= 0 { 1 << p } else { 0 },
+            low: [0; 64],
+            high: [0; 64],
+        };
+        for i in 1..64usize {
+            let lowest = i.trailing_zeros() as usize;
+            map.low[i] = map.low[i & (i - 1)] | bit(lowest);
+            map.high[i] = map.high[i & (i - 1)] | bit(lowest + 6);
         }
-        Some(out)
+        map
     }
 
     /// Works on the next layer of the DP until `deadline` (at least one target cluster); true
@@ -740,13 +871,14 @@ impl NgPathBound {
             cluster_best,
         } = &sources;
         let prev = self.layers.last().expect("a layer");
-        // Candidates per target node of one cluster, a dense table over the memories (bit 0,
-        // the cluster itself, is always set): (value, pred), and the memories touched.
+        // Candidates per target node of one cluster, per memory on entering it (bit 0, the
+        // cluster itself, is always set).
         let width = 1usize << (self.ng[0].len() - 1);
-        let mut table: Vec<(f64, u32)> = Vec::new();
-        let mut touched: Vec<Vec<u32>> = Vec::new();
-        let mut projected: Vec<(u32, f64, u32)> = Vec::new();
+        let mut entries = Entries::new(width);
+        let mut gathered: Vec<f32> = Vec::new();
+        let mut projected: (Vec<u32>, Vec<(f64, u32)>) = (Vec::new(), Vec::new());
         let mut list: Vec<(u32, f64, u32)> = Vec::new();
+        let mut kept: Vec<u32> = Vec::new();
         for d in first..m {
             if d > first && Instant::now() >= deadline {
                 self.work = Some(LayerWork {
@@ -767,10 +899,7 @@ impl NgPathBound {
                 .map(|&w| self.value_limit(w, left) + penalty)
                 .collect();
             let cap = limits.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-            table.clear();
-            table.resize(targets.len() * width, (f64::INFINITY, u32::MAX));
-            touched.clear();
-            touched.resize(targets.len(), Vec::new());
+            entries.reset(targets.len());
             // The source clusters by their least possible arrival (cheapest label plus least
             // arc to d). A cluster whose arrival is no lower than every target's entry with
             // the memory {d} cannot improve any entry (that one dominates all it would add,
@@ -793,75 +922,69 @@ impl NgPathBound {
                     }
                     break;
                 }
-                if self.related[c * m + d] {
-                    // The memory matters: every label.
-                    for &r in &cluster_runs[c] {
-                        let (v, start, end) = runs[r];
-                        self.relax_from(
-                            v,
-                            c,
-                            d,
-                            &prev[start..end],
-                            start,
-                            &mut projected,
-                            targets,
-                            &mut table,
-                            &mut touched,
-                            width,
-                        );
-                    }
-                } else {
-                    // No cluster of ng(c) is in ng(d), nor d in ng(c): every label enters
-                    // with the memory {d}, so only the cheapest counts.
-                    for &r in &cluster_runs[c] {
-                        let (v, _, _) = runs[r];
-                        let (value, index) = run_best[r];
-                        let row = &self.cost[v * n..(v + 1) * n];
-                        for (t, &w) in targets.iter().enumerate() {
-                            let arc = row[w];
-                            if !arc.is_finite() {
-                                continue;
+                let map = self.related[c * m + d].then(|| self.memory_map(c, d));
+                for &r in &cluster_runs[c] {
+                    let (v, start, end) = runs[r];
+                    let row = &self.cost[v * n..(v + 1) * n];
+                    let arcs: &[f32] = match self.spans[d] {
+                        Some(first) => &row[first..first + targets.len()],
+                        None => {
+                            gathered.clear();
+                            gathered.extend(targets.iter().map(|&w| row[w]));
+                            &gathered
+                        }
+                    };
+                    match &map {
+                        // The memory matters: every label not dominated as it enters d.
+                        Some(map) => {
+                            // A label at or above this enters no target below its entry
+                            // with the memory {d} alone (which dominates it there).
+                            let least =
+                                f64::from(arcs.iter().copied().fold(f32::INFINITY, f32::min));
+                            let ceiling = entries.alone_max() - least;
+                            let labels = &prev[start..end];
+                            Self::project(map, labels, start, ceiling, &mut projected);
+                            for (&mask, &(value, pred)) in projected.0.iter().zip(&projected.1) {
+                                let slot = entries.slot(mask);
+                                entries.relax(slot, value, pred, arcs);
                             }
-                            let e = &mut table[t * width];
-                            if e.1 == u32::MAX {
-                                touched[t].push(1);
-                            }
-                            if value + arc < e.0 {
-                                *e = (value + arc, index);
-                            }
+                        }
+                        // No cluster of ng(c) is in ng(d), nor d in ng(c): every label enters
+                        // with the memory {d}, so only the cheapest counts.
+                        None => {
+                            let (value, index) = run_best[r];
+                            entries.relax(0, value, index, arcs);
                         }
                     }
                 }
-                threshold = (0..targets.len())
-                    .map(|t| table[t * width].0)
-                    .fold(f64::NEG_INFINITY, f64::max);
+                threshold = entries.alone_max();
             }
+            let slots = entries.masks.len();
             for (t, &w) in targets.iter().enumerate() {
                 list.clear();
-                list.extend(touched[t].iter().map(|&mask| {
-                    let (value, pred) = table[t * width + (mask >> 1) as usize];
-                    (mask, value, pred)
-                }));
-                // Fewer remembered clusters first: a label is dropped when one with a subset
-                // of its memory is no dearer.
-                list.sort_by(|a, b| {
-                    a.0.count_ones()
-                        .cmp(&b.0.count_ones())
-                        .then(a.1.total_cmp(&b.1))
-                });
-                let start = next.len();
-                for &(mask, value, pred) in list.iter() {
+                for slot in 0..slots {
+                    let k = slot * targets.len() + t;
+                    let value = entries.values[k];
+                    if value == f64::INFINITY {
+                        // No arrival with this memory.
+                        continue;
+                    }
                     if value > limits[t] {
                         pruned += 1;
                         floor[w] = floor[w].min(value - penalty);
+                    } else {
+                        list.push((entries.masks[slot], value, entries.preds[k]));
+                    }
+                }
+                // Cheapest first: a label is dropped when one kept before it (no dearer) has
+                // a subset of its memory.
+                list.sort_unstable_by(|a, b| a.1.total_cmp(&b.1));
+                kept.clear();
+                for &(mask, value, pred) in list.iter() {
+                    if kept.iter().any(|&k| k & !mask == 0) {
                         continue;
                     }
-                    if next[start..]
-                        .iter()
-                        .any(|l| l.mask & mask == l.mask && l.value <= value - penalty)
-                    {
-                        continue;
-                    }
+                    kept.push(mask);
                     next.push(Label {
                         node: w as u32,
                         mask,
@@ -871,7 +994,8 @@ impl NgPathBound {
                 }
             }
         }
-        next.sort_by_key(|l| l.node);
+        // By node, each node's labels cheapest first (`project` relies on it).
+        next.sort_unstable_by(|a, b| a.node.cmp(&b.node).then(a.value.total_cmp(&b.value)));
         self.stats.labels += next.len() as u64;
         self.stats.pruned += pruned;
         self.record_prefix(&next, floor);
@@ -920,57 +1044,31 @@ impl NgPathBound {
         }
     }
 
-    /// Offers the labels `labels` of source node `v` (cluster `c`; `start`: the index of the
-    /// first in the previous layer) to the targets of cluster `d`: each label's memory as it
-    /// enters `d`, dominated ones dropped, then every arc into the table.
-    #[allow(clippy::too_many_arguments)]
-    fn relax_from(
-        &self,
-        v: usize,
-        c: usize,
-        d: usize,
+    /// The memories of one source node's labels `labels` (cheapest first; `start`: the index
+    /// of the first in the previous layer) below `ceiling` as they enter the target cluster,
+    /// by `map`: into `projected` (memories; values and labels), those dropped that a cheaper
+    /// one with a subset of the memory dominates.
+    fn project(
+        map: &MemoryMap,
         labels: &[Label],
         start: usize,
-        projected: &mut Vec<(u32, f64, u32)>,
-        targets: &[usize],
-        table: &mut [(f64, u32)],
-        touched: &mut [Vec<u32>],
-        width: usize,
+        ceiling: f64,
+        projected: &mut (Vec<u32>, Vec<(f64, u32)>),
     ) {
-        let n = self.n;
-        projected.clear();
+        let (masks, values) = projected;
+        masks.clear();
+        values.clear();
         for (k, label) in labels.iter().enumerate() {
-            if let Some(mask) = self.enter(c, label.mask, d) {
-                let value = label.value;
-                if projected
-                    .iter()
-                    .any(|&(pm, pv, _)| pm & mask == pm && pv <= value)
-                {
+            if label.value >= ceiling {
+                break;
+            }
+            if let Some(mask) = map.enter(label.mask) {
+                // The labels come cheapest first: one kept before is no dearer.
+                if masks.iter().any(|&pm| pm & !mask == 0) {
                     continue;
                 }
-                projected.retain(|&(pm, pv, _)| !(mask & pm == mask && value <= pv));
-                projected.push((mask, value, (start + k) as u32));
-            }
-        }
-        if projected.is_empty() {
-            return;
-        }
-        let row = &self.cost[v * n..(v + 1) * n];
-        for (t, &w) in targets.iter().enumerate() {
-            let arc = row[w];
-            if !arc.is_finite() {
-                continue;
-            }
-            let row = &mut table[t * width..(t + 1) * width];
-            for &(mask, value, pred) in projected.iter() {
-                let total = value + arc;
-                let e = &mut row[(mask >> 1) as usize];
-                if e.1 == u32::MAX {
-                    touched[t].push(mask);
-                }
-                if total < e.0 {
-                    *e = (total, pred);
-                }
+                masks.push(mask);
+                values.push((label.value, (start + k) as u32));
             }
         }
     }
@@ -1187,6 +1285,29 @@ mod tests {
         (1..n)
             .map(|v| f[full * n + v] + instance.cost[v * n])
             .fold(f64::INFINITY, f64::min)
+    }
+
+    #[test]
+    fn arcs_are_rounded_down_to_the_nearest_f32() {
+        let mut rng = SplitMix64::new(7);
+        for i in 0..100_000i32 {
+            // Lengths over many scales, exact f32 values among them.
+            let x = match i % 4 {
+                0 => rng.next_f64() * 10f64.powi(i % 13 - 3),
+                1 => f64::from((rng.next_f64() * 1e4) as f32),
+                2 => -rng.next_f64() * 100.0,
+                _ => rng.next_f64(),
+            };
+            let r = f64::from(round_down(x));
+            assert!(r <= x, "{x} rounded up to {r}");
+            // The nearest below: the next f32 up is above x.
+            assert!(
+                f64::from(round_down(x).next_up()) > x,
+                "{x} rounded to {r}, too low"
+            );
+        }
+        assert_eq!(round_down(f64::INFINITY), f32::INFINITY);
+        assert_eq!(round_down(0.0), 0.0);
     }
 
     #[test]
