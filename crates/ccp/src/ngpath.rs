@@ -142,6 +142,16 @@ impl Entries {
     }
 }
 
+/// One source node's labels as they enter a target cluster (`NgPathBound::project`): their
+/// memories there, and their values with the labels they are; `seen[mask >> 1] == round`
+/// marks a memory already projected for this source (a later label with it is no cheaper).
+struct Projection {
+    masks: Vec<u32>,
+    values: Vec<(f64, u32)>,
+    seen: Vec<u32>,
+    round: u32,
+}
+
 /// How the memories of a cluster `c`'s labels become memories on entering `d`: by lookup in
 /// two halves of the mask (an ng neighbourhood has at most 12 clusters), or `None` when the
 /// memory holds `d`.
@@ -198,8 +208,8 @@ pub struct NgPathBound {
     gap: Vec<f64>,
     /// Penalty per cluster visit.
     lambda: Vec<f64>,
-    /// Layers of the DP under way (index k = k + 1 visits), each sorted by node, and the
-    /// layer being built.
+    /// Layers of the DP under way (index k = k + 1 visits), each grouped by node with a
+    /// node's labels cheapest first, and the layer being built.
     layers: Vec<Vec<Label>>,
     work: Option<LayerWork>,
     best: f64,
@@ -842,7 +852,6 @@ impl NgPathBound {
                     }
                 }
             }
-            next.sort_by_key(|l| l.node);
             self.stats.labels += next.len() as u64;
             self.record_prefix(&next, floor);
             self.layers.push(next);
@@ -876,7 +885,12 @@ impl NgPathBound {
         let width = 1usize << (self.ng[0].len() - 1);
         let mut entries = Entries::new(width);
         let mut gathered: Vec<f32> = Vec::new();
-        let mut projected: (Vec<u32>, Vec<(f64, u32)>) = (Vec::new(), Vec::new());
+        let mut projected = Projection {
+            masks: Vec::new(),
+            values: Vec::new(),
+            seen: vec![0; width],
+            round: 0,
+        };
         let mut list: Vec<(u32, f64, u32)> = Vec::new();
         let mut kept: Vec<u32> = Vec::new();
         for d in first..m {
@@ -944,7 +958,8 @@ impl NgPathBound {
                             let ceiling = entries.alone_max() - least;
                             let labels = &prev[start..end];
                             Self::project(map, labels, start, ceiling, &mut projected);
-                            for (&mask, &(value, pred)) in projected.0.iter().zip(&projected.1) {
+                            let pairs = projected.masks.iter().zip(&projected.values);
+                            for (&mask, &(value, pred)) in pairs {
                                 let slot = entries.slot(mask);
                                 entries.relax(slot, value, pred, arcs);
                             }
@@ -994,8 +1009,8 @@ impl NgPathBound {
                 }
             }
         }
-        // By node, each node's labels cheapest first (`project` relies on it).
-        next.sort_unstable_by(|a, b| a.node.cmp(&b.node).then(a.value.total_cmp(&b.value)));
+        // Made target by target, each target's labels cheapest first: the layer is grouped
+        // by node, each node's labels cheapest first (`sources` and `project` rely on it).
         self.stats.labels += next.len() as u64;
         self.stats.pruned += pruned;
         self.record_prefix(&next, floor);
@@ -1053,20 +1068,33 @@ impl NgPathBound {
         labels: &[Label],
         start: usize,
         ceiling: f64,
-        projected: &mut (Vec<u32>, Vec<(f64, u32)>),
+        projected: &mut Projection,
     ) {
-        let (masks, values) = projected;
+        let Projection {
+            masks,
+            values,
+            seen,
+            round,
+        } = projected;
         masks.clear();
         values.clear();
+        *round = round.wrapping_add(1);
+        if *round == 0 {
+            seen.fill(0);
+            *round = 1;
+        }
         for (k, label) in labels.iter().enumerate() {
             if label.value >= ceiling {
                 break;
             }
             if let Some(mask) = map.enter(label.mask) {
-                // The labels come cheapest first: one kept before is no dearer.
-                if masks.iter().any(|&pm| pm & !mask == 0) {
+                // The labels come cheapest first: one kept before is no dearer. (Most
+                // repeat a memory already projected: that test first.)
+                let stamp = &mut seen[(mask >> 1) as usize];
+                if *stamp == *round || masks.iter().any(|&pm| pm & !mask == 0) {
                     continue;
                 }
+                *stamp = *round;
                 masks.push(mask);
                 values.push((label.value, (start + k) as u32));
             }
