@@ -35,22 +35,22 @@ use cutroute_pcgtsp::Instance;
 use web_time::Instant;
 
 /// One label of a layer: a walk with `k` visits ending at `node` with memory `mask` (bits over
-/// the positions of `ng(cluster(node))`) and reduced cost `value`; `pred` is the label it came
-/// from in the previous layer (`u32::MAX` for the first visit).
+/// the positions of `ng(cluster(node))`) and reduced cost `value`. The label it came from is
+/// not kept (the DP's inner loop is leaner without it): the cheapest walk is traced back by
+/// value (`cheapest_walk`).
 #[derive(Clone, Copy, Debug)]
 struct Label {
     node: u32,
     mask: u32,
-    pred: u32,
     value: f64,
 }
 
 /// The previous layer's labels as sources of the next: per node its run of labels in the
-/// layer `(node, start, end)` and its cheapest label `(value, index)`; per cluster its runs and
-/// their cheapest value.
+/// layer `(node, start, end)` and its cheapest label's value; per cluster its runs and their
+/// cheapest value.
 struct Sources {
     runs: Vec<(usize, usize, usize)>,
-    run_best: Vec<(f64, u32)>,
+    run_best: Vec<f64>,
     cluster_runs: Vec<Vec<usize>>,
     cluster_best: Vec<f64>,
 }
@@ -74,9 +74,8 @@ struct Entries {
     /// Per slot: its memory.
     masks: Vec<u32>,
     /// `values[slot * targets + t]`: the least arrival at target `t` with that memory (before
-    /// the penalty), and the label it came from (`preds`).
+    /// the penalty).
     values: Vec<f64>,
-    preds: Vec<u32>,
     targets: usize,
 }
 
@@ -86,7 +85,6 @@ impl Entries {
             slot_of: vec![u32::MAX; width],
             masks: Vec::new(),
             values: Vec::new(),
-            preds: Vec::new(),
             targets: 0,
         }
     }
@@ -98,7 +96,6 @@ impl Entries {
         }
         self.masks.clear();
         self.values.clear();
-        self.preds.clear();
         self.targets = targets;
         self.slot(1);
     }
@@ -112,24 +109,19 @@ impl Entries {
             self.masks.push(mask);
             self.values
                 .resize(self.values.len() + self.targets, f64::INFINITY);
-            self.preds.resize(self.preds.len() + self.targets, u32::MAX);
         }
         *e as usize
     }
 
-    /// Offers the arrivals `value + arcs[t]` (from label `pred`) to the targets' entries with
-    /// the memory of `slot`.
+    /// Offers the arrivals `value + arcs[t]` to the targets' entries with the memory of
+    /// `slot`.
     #[inline]
-    fn relax(&mut self, slot: usize, value: f64, pred: u32, arcs: &[f32]) {
-        let range = slot * self.targets..(slot + 1) * self.targets;
-        let values = &mut self.values[range.clone()];
-        let preds = &mut self.preds[range];
-        for ((e, p), &arc) in values.iter_mut().zip(preds.iter_mut()).zip(arcs) {
+    fn relax(&mut self, slot: usize, value: f64, arcs: &[f32]) {
+        let values = &mut self.values[slot * self.targets..(slot + 1) * self.targets];
+        for (e, &arc) in values.iter_mut().zip(arcs) {
             let total = value + f64::from(arc);
-            if total < *e {
-                *e = total;
-                *p = pred;
-            }
+            // (A select, not a branch: the loop vectorises.)
+            *e = if total < *e { total } else { *e };
         }
     }
 
@@ -143,11 +135,11 @@ impl Entries {
 }
 
 /// One source node's labels as they enter a target cluster (`NgPathBound::project`): their
-/// memories there, and their values with the labels they are; `seen[mask >> 1] == round`
+/// memories there and their values; `seen[mask >> 1] == round`
 /// marks a memory already projected for this source (a later label with it is no cheaper).
 struct Projection {
     masks: Vec<u32>,
-    values: Vec<(f64, u32)>,
+    values: Vec<f64>,
     seen: Vec<u32>,
     round: u32,
 }
@@ -846,7 +838,6 @@ impl NgPathBound {
                         next.push(Label {
                             node: w as u32,
                             mask: 1,
-                            pred: u32::MAX,
                             value: c - self.lambda[d],
                         });
                     }
@@ -891,7 +882,7 @@ impl NgPathBound {
             seen: vec![0; width],
             round: 0,
         };
-        let mut list: Vec<(u32, f64, u32)> = Vec::new();
+        let mut list: Vec<(u32, f64)> = Vec::new();
         let mut kept: Vec<u32> = Vec::new();
         for d in first..m {
             if d > first && Instant::now() >= deadline {
@@ -957,18 +948,17 @@ impl NgPathBound {
                                 f64::from(arcs.iter().copied().fold(f32::INFINITY, f32::min));
                             let ceiling = entries.alone_max() - least;
                             let labels = &prev[start..end];
-                            Self::project(map, labels, start, ceiling, &mut projected);
+                            Self::project(map, labels, ceiling, &mut projected);
                             let pairs = projected.masks.iter().zip(&projected.values);
-                            for (&mask, &(value, pred)) in pairs {
+                            for (&mask, &value) in pairs {
                                 let slot = entries.slot(mask);
-                                entries.relax(slot, value, pred, arcs);
+                                entries.relax(slot, value, arcs);
                             }
                         }
                         // No cluster of ng(c) is in ng(d), nor d in ng(c): every label enters
                         // with the memory {d}, so only the cheapest counts.
                         None => {
-                            let (value, index) = run_best[r];
-                            entries.relax(0, value, index, arcs);
+                            entries.relax(0, run_best[r], arcs);
                         }
                     }
                 }
@@ -988,14 +978,14 @@ impl NgPathBound {
                         pruned += 1;
                         floor[w] = floor[w].min(value - penalty);
                     } else {
-                        list.push((entries.masks[slot], value, entries.preds[k]));
+                        list.push((entries.masks[slot], value));
                     }
                 }
                 // Cheapest first: a label is dropped when one kept before it (no dearer) has
                 // a subset of its memory.
                 list.sort_unstable_by(|a, b| a.1.total_cmp(&b.1));
                 kept.clear();
-                for &(mask, value, pred) in list.iter() {
+                for &(mask, value) in list.iter() {
                     if kept.iter().any(|&k| k & !mask == 0) {
                         continue;
                     }
@@ -1003,7 +993,6 @@ impl NgPathBound {
                     next.push(Label {
                         node: w as u32,
                         mask,
-                        pred,
                         value: value - penalty,
                     });
                 }
@@ -1035,21 +1024,17 @@ impl NgPathBound {
             i = j;
         }
         // Per run: its cheapest label; per cluster: its runs and their cheapest label.
-        let run_best: Vec<(f64, u32)> = runs
+        // (A node's labels come cheapest first.)
+        let run_best: Vec<f64> = runs
             .iter()
-            .map(|&(_, start, end)| {
-                (start..end)
-                    .map(|i| (prev[i].value, i as u32))
-                    .min_by(|a, b| a.0.total_cmp(&b.0))
-                    .expect("a run is not empty")
-            })
+            .map(|&(_, start, _)| prev[start].value)
             .collect();
         let mut cluster_runs: Vec<Vec<usize>> = vec![Vec::new(); m];
         let mut cluster_best = vec![f64::INFINITY; m];
         for (r, &(v, _, _)) in runs.iter().enumerate() {
             let c = self.cluster[v];
             cluster_runs[c].push(r);
-            cluster_best[c] = cluster_best[c].min(run_best[r].0);
+            cluster_best[c] = cluster_best[c].min(run_best[r]);
         }
         Sources {
             runs,
@@ -1059,17 +1044,10 @@ impl NgPathBound {
         }
     }
 
-    /// The memories of one source node's labels `labels` (cheapest first; `start`: the index
-    /// of the first in the previous layer) below `ceiling` as they enter the target cluster,
-    /// by `map`: into `projected` (memories; values and labels), those dropped that a cheaper
-    /// one with a subset of the memory dominates.
-    fn project(
-        map: &MemoryMap,
-        labels: &[Label],
-        start: usize,
-        ceiling: f64,
-        projected: &mut Projection,
-    ) {
+    /// The memories of one source node's labels `labels` (cheapest first) below `ceiling` as
+    /// they enter the target cluster, by `map`: into `projected` (memories and values), those
+    /// dropped that a cheaper one with a subset of the memory dominates.
+    fn project(map: &MemoryMap, labels: &[Label], ceiling: f64, projected: &mut Projection) {
         let Projection {
             masks,
             values,
@@ -1083,7 +1061,7 @@ impl NgPathBound {
             seen.fill(0);
             *round = 1;
         }
-        for (k, label) in labels.iter().enumerate() {
+        for label in labels {
             if label.value >= ceiling {
                 break;
             }
@@ -1096,7 +1074,7 @@ impl NgPathBound {
                 }
                 *stamp = *round;
                 masks.push(mask);
-                values.push((label.value, (start + k) as u32));
+                values.push(label.value);
             }
         }
     }
@@ -1115,16 +1093,55 @@ impl NgPathBound {
         }
         let mut walk = Vec::with_capacity(self.members.len());
         if best.1 != usize::MAX {
-            let mut i = best.1;
-            for layer in self.layers.iter().rev() {
-                let l = layer[i];
-                walk.push(l.node as usize);
-                i = l.pred as usize;
+            let mut label = self.layers[self.layers.len() - 1][best.1];
+            walk.push(label.node as usize);
+            for layer in self.layers.iter().rev().skip(1) {
+                let Some(before) = self.predecessor(layer, label) else {
+                    // (Cannot happen; the caller then takes a known walk for the step.)
+                    walk.clear();
+                    break;
+                };
+                label = before;
+                walk.push(label.node as usize);
             }
             walk.reverse();
         }
         self.layers.clear();
         (best.0, walk)
+    }
+
+    /// A label of `layer` (the one before `label`'s) that `label` extends: its value plus the
+    /// arc, less the penalty, is `label`'s value to the bit (the DP's own sums), and its memory
+    /// on entering `label`'s cluster is within `label`'s. Some label was extended into it, so
+    /// one is found; the walk traced this way is an ng-walk of the minimum's cost.
+    fn predecessor(&self, layer: &[Label], label: Label) -> Option<Label> {
+        let n = self.n;
+        let m = self.members.len();
+        let w = label.node as usize;
+        let d = self.cluster[w];
+        let penalty = self.lambda[d];
+        let enters = |p: &Label| -> bool {
+            let c = self.cluster[p.node as usize];
+            if c == d
+                || p.value + f64::from(self.cost[p.node as usize * n + w]) - penalty != label.value
+            {
+                return false;
+            }
+            // The memory on entering d (as `memory_map` has it), bit by bit.
+            let at = self.position[c * m + d];
+            if at >= 0 && p.mask & (1 << at) != 0 {
+                return false;
+            }
+            let mut mask = 1u32;
+            for (bit, &x) in self.ng[c].iter().enumerate() {
+                let q = self.position[d * m + x];
+                if p.mask & (1 << bit) != 0 && q >= 0 {
+                    mask |= 1 << q;
+                }
+            }
+            mask & !label.mask == 0
+        };
+        layer.iter().find(|p| enters(p)).copied()
     }
 
     /// Closes the walks (return arc), records the bound and takes a subgradient step.
@@ -1150,8 +1167,9 @@ impl NgPathBound {
             }
         } else if self.pass_upper.is_finite() {
             // Nothing beat the known walk (every label that could was pruned): it is the
-            // minimum.
-            best = self.pass_upper;
+            // minimum. (Or the walk could not be traced: its value stands, the known walk
+            // gives the step.)
+            best = best.min(self.pass_upper);
             walk = self.pass_upper_walk.clone();
         }
         self.iterations += 1;
@@ -1384,6 +1402,30 @@ mod tests {
         assert!(closed_at_least_once >= 30, "{closed_at_least_once}");
     }
 
+    /// The walk of `bound`'s last pass (under the penalties `lambda`) is an ng-walk (each
+    /// cluster entered only when not remembered) whose value is the pass's value: the walk
+    /// traced back from the minimum is the minimum's.
+    fn assert_walk_of_the_pass(bound: &NgPathBound, lambda: &[f64], context: &str) {
+        let walk = bound.last_walk();
+        assert_eq!(walk.len(), bound.members.len(), "{context}");
+        let mut memory: Vec<usize> = Vec::new();
+        for &v in walk {
+            let d = bound.cluster[v];
+            assert!(!memory.contains(&d), "{context}: {walk:?} re-enters {d}");
+            memory.retain(|x| bound.ng[d].contains(x));
+            memory.push(d);
+        }
+        let reduced =
+            bound.walk_cost(walk) - walk.iter().map(|&v| lambda[bound.cluster[v]]).sum::<f64>();
+        let value = reduced + lambda.iter().sum::<f64>();
+        let scale = 1e-9 * (value.abs() + lambda.iter().map(|l| l.abs()).sum::<f64>() + 1.0);
+        assert!(
+            (value - bound.last_value).abs() <= scale,
+            "{context}: walk {value} against the pass's {}",
+            bound.last_value
+        );
+    }
+
     /// Runs `bound` until its pass under way (or the next one) ends.
     fn one_pass(bound: &mut NgPathBound) {
         let done = bound.iterations();
@@ -1416,10 +1458,12 @@ mod tests {
                 }
                 let lambda = fast.lambda.clone();
                 one_pass(&mut fast);
+                assert_walk_of_the_pass(&fast, &lambda, &format!("seed {seed}, pass {pass}"));
                 // The same penalties, the plain DP (forwards, nothing pruned).
                 plain.lambda.clone_from(&lambda);
                 plain.mu = 1.0;
                 one_pass(&mut plain);
+                assert_walk_of_the_pass(&plain, &lambda, &format!("seed {seed}, plain {pass}"));
                 let scale = 1e-9 * (plain.last_value.abs() + 1.0);
                 assert!(
                     (fast.last_value - plain.last_value).abs() <= scale,
