@@ -325,42 +325,50 @@ impl NgPathBound {
             }
         }
         let cost: Arc<Vec<f32>> = Arc::new(instance.cost.iter().map(|&x| round_down(x)).collect());
-        // Least arc cost between clusters: the neighbourhoods are the nearest ones.
+        // Least arc cost between clusters, either way: the neighbourhoods are the nearest
+        // ones. The matrix is read row by row, then the two ways are merged (reading columns
+        // misses the cache: all of `new` on 2,141 nodes took 0.089 s at best that way, 0.070
+        // s now; it is one piece of the bound's slices).
         let mut near = vec![f64::INFINITY; m * m];
         for (a, &ca) in cluster.iter().enumerate() {
             if ca == usize::MAX {
                 continue;
             }
-            for (b, &cb) in cluster.iter().enumerate() {
-                if cb == usize::MAX || cb == ca {
-                    continue;
+            let near_row = &mut near[ca * m..(ca + 1) * m];
+            for (&arc, &cb) in cost[a * n..(a + 1) * n].iter().zip(&cluster) {
+                if cb != usize::MAX && cb != ca {
+                    near_row[cb] = near_row[cb].min(f64::from(arc));
                 }
-                let c = f64::from(cost[a * n + b].min(cost[b * n + a]));
-                let e = &mut near[ca * m + cb];
-                *e = e.min(c);
+            }
+        }
+        for c in 0..m {
+            for d in 0..c {
+                let least = near[c * m + d].min(near[d * m + c]);
+                near[c * m + d] = least;
+                near[d * m + c] = least;
             }
         }
         let lambda = if lambda.len() == m {
             lambda.to_vec()
         } else {
             // A start near the node-penalty bound: each visit is worth half its cheapest way
-            // in plus half its cheapest way out through the same node.
+            // in plus half its cheapest way out through the same node (both found row by row).
+            let mut into = vec![f64::INFINITY; n];
+            let mut out = vec![f64::INFINITY; n];
+            for (v, least_out) in out.iter_mut().enumerate() {
+                for (w, &arc) in instance.cost[v * n..(v + 1) * n].iter().enumerate() {
+                    if w != v {
+                        into[w] = into[w].min(arc);
+                        *least_out = least_out.min(arc);
+                    }
+                }
+            }
             members
                 .iter()
                 .map(|nodes| {
                     nodes
                         .iter()
-                        .map(|&w| {
-                            let least = |f: &dyn Fn(usize) -> f64| {
-                                (0..n)
-                                    .filter(|&v| v != w)
-                                    .map(f)
-                                    .fold(f64::INFINITY, f64::min)
-                            };
-                            let into = least(&|v| instance.cost[v * n + w]);
-                            let out = least(&|v| instance.cost[w * n + v]);
-                            0.5 * (into + out)
-                        })
+                        .map(|&w| 0.5 * (into[w] + out[w]))
                         .fold(f64::INFINITY, f64::min)
                 })
                 .map(|x| if x.is_finite() { x } else { 0.0 })
@@ -371,16 +379,29 @@ impl NgPathBound {
         // Every other pass runs backwards: on the reversed arcs (the same matrix when the arcs
         // between clusters are symmetric, as the interval relaxation's are), with the depot's
         // ways in and out swapped.
-        let symmetric = (0..n).all(|a| {
-            a == depot || (0..a).all(|b| b == depot || cost[a * n + b] == cost[b * n + a])
+        // (Both compared and transposed in tiles, so that the columns come from the cache.)
+        const TILE: usize = 64;
+        let tile = |start: usize| start..(start + TILE).min(n);
+        let symmetric = (0..n).step_by(TILE).all(|a0| {
+            (0..=a0).step_by(TILE).all(|b0| {
+                tile(a0).all(|a| {
+                    tile(b0).all(|b| {
+                        b >= a || a == depot || b == depot || cost[a * n + b] == cost[b * n + a]
+                    })
+                })
+            })
         });
         let reversed = if symmetric {
             Arc::clone(&cost)
         } else {
             let mut t = vec![f32::INFINITY; n * n];
-            for a in 0..n {
-                for b in 0..n {
-                    t[b * n + a] = cost[a * n + b];
+            for a0 in (0..n).step_by(TILE) {
+                for b0 in (0..n).step_by(TILE) {
+                    for a in tile(a0) {
+                        for b in tile(b0) {
+                            t[b * n + a] = cost[a * n + b];
+                        }
+                    }
                 }
             }
             Arc::new(t)
