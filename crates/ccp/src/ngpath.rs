@@ -1144,32 +1144,23 @@ impl NgPathBound {
     /// one is found; the walk traced this way is an ng-walk of the minimum's cost.
     fn predecessor(&self, layer: &[Label], label: Label) -> Option<Label> {
         let n = self.n;
-        let m = self.members.len();
         let w = label.node as usize;
         let d = self.cluster[w];
         let penalty = self.lambda[d];
-        let enters = |p: &Label| -> bool {
-            let c = self.cluster[p.node as usize];
-            if c == d
-                || p.value + f64::from(self.cost[p.node as usize * n + w]) - penalty != label.value
-            {
-                return false;
-            }
-            // The memory on entering d (as `memory_map` has it), bit by bit.
-            let at = self.position[c * m + d];
-            if at >= 0 && p.mask & (1 << at) != 0 {
-                return false;
-            }
-            let mut mask = 1u32;
-            for (bit, &x) in self.ng[c].iter().enumerate() {
-                let q = self.position[d * m + x];
-                if p.mask & (1 << bit) != 0 && q >= 0 {
-                    mask |= 1 << q;
-                }
-            }
-            mask & !label.mask == 0
-        };
-        layer.iter().find(|p| enters(p)).copied()
+        layer
+            .iter()
+            .find(|p| {
+                let c = self.cluster[p.node as usize];
+                // (The memory's table is made only for the few labels of the right value.)
+                c != d
+                    && p.value + f64::from(self.cost[p.node as usize * n + w]) - penalty
+                        == label.value
+                    && self
+                        .memory_map(c, d)
+                        .enter(p.mask)
+                        .is_some_and(|mask| mask & !label.mask == 0)
+            })
+            .copied()
     }
 
     /// Closes the walks (return arc), records the bound and takes a subgradient step.
