@@ -513,7 +513,10 @@ impl NgPathBound {
             (0..=a0).step_by(TILE).all(|b0| {
                 tile(a0).all(|a| {
                     tile(b0).all(|b| {
-                        b >= a || a == depot || b == depot || cost[a * n + b] == cost[b * n + a]
+                        b >= a
+                            || a == depot
+                            || b == depot
+                            || round_down(cost[a * n + b]) == round_down(cost[b * n + a])
                     })
                 })
             })
