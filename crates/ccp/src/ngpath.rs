@@ -228,8 +228,6 @@ struct ArcTable {
     block_start: Vec<usize>,
     /// Per node: its position in its cluster's member list (0 for the depot).
     slot: Vec<u32>,
-    /// Per node: its cluster (`usize::MAX` for the depot).
-    cluster: Vec<usize>,
     /// Per non-depot cluster: its size.
     sizes: Vec<usize>,
     arcs: Vec<f32>,
@@ -238,11 +236,9 @@ struct ArcTable {
 impl ArcTable {
     /// The table of `arc(v, w)` over all nodes `v` and the non-depot nodes `w` of `members`.
     fn new(n: usize, members: &[Vec<usize>], arc: impl Fn(usize, usize) -> f32) -> ArcTable {
-        let mut cluster = vec![usize::MAX; n];
         let mut slot = vec![0u32; n];
-        for (c, nodes) in members.iter().enumerate() {
+        for nodes in members {
             for (k, &w) in nodes.iter().enumerate() {
-                cluster[w] = c;
                 slot[w] = k as u32;
             }
         }
@@ -266,7 +262,6 @@ impl ArcTable {
         ArcTable {
             block_start,
             slot,
-            cluster,
             sizes,
             arcs,
         }
@@ -280,10 +275,10 @@ impl ArcTable {
         &self.arcs[start..start + size]
     }
 
-    /// The arc from `v` to the non-depot node `w`.
+    /// The arc from `v` to the node `w` of cluster `d`.
     #[inline]
-    fn get(&self, v: usize, w: usize) -> f32 {
-        self.arcs_into(v, self.cluster[w])[self.slot[w] as usize]
+    fn get(&self, v: usize, w: usize, d: usize) -> f32 {
+        self.arcs_into(v, d)[self.slot[w] as usize]
     }
 }
 
@@ -678,7 +673,7 @@ impl NgPathBound {
         };
         let inner: f64 = walk
             .windows(2)
-            .map(|p| f64::from(self.arcs.get(p[0], p[1])))
+            .map(|p| f64::from(self.arcs.get(p[0], p[1], self.cluster[p[1]])))
             .sum();
         self.from_depot[first] + inner + self.to_depot[last]
     }
@@ -1262,7 +1257,7 @@ impl NgPathBound {
                 let c = self.cluster[p.node as usize];
                 // (The memory's table is made only for the few labels of the right value.)
                 c != d
-                    && p.value + f64::from(self.arcs.get(p.node as usize, w)) - penalty
+                    && p.value + f64::from(self.arcs.get(p.node as usize, w, d)) - penalty
                         == label.value
                     && self
                         .memory_map(c, d)
@@ -1504,7 +1499,7 @@ mod tests {
                 assert_eq!(into.len(), nodes.len());
                 for (&w, &a) in nodes.iter().zip(into) {
                     assert_eq!(a, arc(v, w), "{v} -> {w} in the block of cluster {d}");
-                    assert_eq!(table.get(v, w), arc(v, w));
+                    assert_eq!(table.get(v, w, d), arc(v, w));
                 }
             }
         }
