@@ -186,6 +186,9 @@ pub struct AlnsSolver {
     /// [`AlnsSolver::step`] unit (on thousands of nodes one iteration's local search took
     /// 0.4–0.6 s: one piece would block Stop that long).
     iteration: Option<Iteration>,
+    /// A tour offered from outside ([`AlnsSolver::offer_tour`]), cheaper than the best: the
+    /// search goes on from it at the next unit that starts afresh.
+    offered: Option<(Vec<usize>, f64)>,
     stop: Option<StopReason>,
     iterations: u64,
     improvements: u64,
@@ -266,6 +269,7 @@ impl AlnsSolver {
             hurry: false,
             descent: None,
             iteration: None,
+            offered: None,
             stop: None,
             iterations: 0,
             improvements: 0,
@@ -307,6 +311,8 @@ impl AlnsSolver {
             }
             let improved = if !self.started {
                 self.start()
+            } else if self.iteration.is_none() && self.first.is_none() && self.offered.is_some() {
+                self.take_offered()
             } else if let Some(tour) = self.first.take() {
                 if self
                     .options
@@ -351,6 +357,46 @@ impl AlnsSolver {
         if self.first.is_some() || !self.started {
             self.hurry = true;
         }
+    }
+
+    /// Offers a tour found elsewhere (nodes, depot first, every cluster once in an order the
+    /// precedence allows, no forbidden arc), e.g. another solver's route on the same
+    /// instance. When it is cheaper than the best it becomes the best at once, and the search
+    /// goes on from it (its local descent first) at its next unit of work. Returns whether it
+    /// was taken.
+    pub fn offer_tour(&mut self, tour: &[usize]) -> bool {
+        let p = &self.problem;
+        if tour.len() != p.m
+            || tour.iter().any(|&v| v >= p.n)
+            || !p.order_is_valid(tour)
+            || !p.uses_no_forbidden_arc(tour)
+        {
+            return false;
+        }
+        let cost: f64 = tour.windows(2).map(|w| p.d(w[0], w[1])).sum::<f64>()
+            + p.d(tour[tour.len() - 1], tour[0]);
+        // (A NaN cost is refused too.)
+        if cost.is_nan() || cost >= self.best_cost - eps(p) {
+            return false;
+        }
+        self.best = tour.to_vec();
+        self.best_cost = cost;
+        self.offered = Some((tour.to_vec(), cost));
+        true
+    }
+
+    /// The offered tour as current, epoch best and best (unless the search found a cheaper
+    /// one since), and its descent next. Returns whether the best improved.
+    fn take_offered(&mut self) -> bool {
+        let Some((tour, cost)) = self.offered.take() else {
+            return false;
+        };
+        if cost > self.best_cost {
+            return false;
+        }
+        self.publish_first(tour, cost);
+        self.descent = Some(Descent::default());
+        true
     }
 
     /// Stops the search: later calls to `step` return [`Status::Stopped`] at once.
@@ -463,8 +509,11 @@ impl AlnsSolver {
         self.current_cost = cost;
         self.epoch_best.clone_from(&tour);
         self.epoch_best_cost = cost;
-        self.best = tour;
-        self.best_cost = cost;
+        // (An offered tour may be the best already.)
+        if cost <= self.best_cost || self.best.is_empty() {
+            self.best = tour;
+            self.best_cost = cost;
+        }
     }
 
     /// One unit of the first tour's descent: one move family over the tour, or the
@@ -1097,6 +1146,56 @@ mod tests {
     /// After a stagnant epoch the next one starts from a kicked elite tour: feasible (checked
     /// independently), costing what the solver believes, usually different from the best
     /// tour, and the elite stays sorted, distinct and bounded.
+    /// A cheaper tour from outside becomes the best at once and the search goes on from it;
+    /// a dearer or invalid one is refused.
+    #[test]
+    fn an_offered_tour_is_taken_when_cheaper_and_valid() {
+        let instance = instance("pcgtsplib", "ry48p.1");
+        let mut long = AlnsSolver::new(
+            &instance,
+            AlnsOptions {
+                seed: 1,
+                time_limit: None,
+                max_iterations: Some(600),
+                ..AlnsOptions::default()
+            },
+        )
+        .unwrap();
+        while long.step(Duration::from_secs(3600)).is_running() {}
+        let (good, good_cost) = long.best().map(|(t, c)| (t.to_vec(), c)).unwrap();
+        let mut short = AlnsSolver::new(
+            &instance,
+            AlnsOptions {
+                seed: 2,
+                time_limit: None,
+                max_iterations: Some(3),
+                ..AlnsOptions::default()
+            },
+        )
+        .unwrap();
+        short.step(Duration::ZERO);
+        // A tour that visits a cluster twice, and one with the depot elsewhere.
+        let mut twice = good.clone();
+        twice[2] = twice[1];
+        assert!(!short.offer_tour(&twice));
+        let mut rotated = good.clone();
+        rotated.rotate_left(1);
+        assert!(!short.offer_tour(&rotated));
+        let first_cost = short.best().map(|(_, c)| c);
+        let taken = short.offer_tour(&good);
+        assert_eq!(taken, first_cost.is_none_or(|c| good_cost < c));
+        if taken {
+            assert_eq!(short.best().unwrap().0, good.as_slice());
+            // Offered again: no longer cheaper than the best.
+            assert!(!short.offer_tour(&good));
+        }
+        while short.step(Duration::from_secs(3600)).is_running() {}
+        let (tour, cost) = short.best().unwrap();
+        assert!(cost <= good_cost + 1e-9);
+        let checked = check_tour(&instance, tour).unwrap();
+        assert!((checked - cost).abs() <= 1e-6 * checked.max(1.0));
+    }
+
     #[test]
     fn a_stagnant_epoch_restarts_from_a_feasible_kicked_elite_tour() {
         for (set, name) in [("pcgtsplib", "ry48p.1"), ("industrial", "e1x_2")] {
