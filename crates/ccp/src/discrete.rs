@@ -297,6 +297,39 @@ impl DiscreteInstance {
             self.finish,
         )
     }
+
+    /// The cheapest node tour (depot first) that visits the contours in `route`'s order, and
+    /// its cost: each contour's candidate chosen by a shortest path through the clusters in
+    /// that order. So a route of the continuous solver, whose pierce points lie anywhere on
+    /// the contours, gives a discrete tour of the same order at the nearest cost the
+    /// candidates allow (nested.dbs at 25 mm: CCP's 9,535 mm gives 9,558 mm, where the
+    /// heuristic alone reached 9,622–9,632 in 60 s). `None` when the route does not visit
+    /// every contour of the instance once.
+    pub fn tour_in_order_of(&self, route: &Route) -> Option<(Vec<usize>, f64)> {
+        let mut cluster_of = std::collections::HashMap::new();
+        for (v, node) in self.nodes.iter().enumerate() {
+            if let DiscreteNode::Pierce { contour, .. } = node {
+                cluster_of.insert(*contour, self.instance.node_cluster[v]);
+            }
+        }
+        let mut seen = vec![false; self.instance.clusters.len()];
+        let mut order = Vec::with_capacity(route.steps.len());
+        for step in &route.steps {
+            let &c = cluster_of.get(&step.contour)?;
+            if std::mem::replace(&mut seen[c], true) {
+                return None;
+            }
+            order.push(c);
+        }
+        if order.len() + 1 != self.instance.clusters.len() {
+            return None;
+        }
+        let (nodes, cost) = crate::relaxed_tours::cheapest_pieces(&self.instance, &order)?;
+        let mut tour = Vec::with_capacity(nodes.len() + 1);
+        tour.push(*self.instance.clusters[self.instance.depot].first()?);
+        tour.extend(nodes);
+        Some((tour, cost))
+    }
 }
 
 /// A closed node tour (any rotation; the depot node once and one node of every cluster) as a

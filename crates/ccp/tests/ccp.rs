@@ -230,6 +230,7 @@ fn discrete_instance_round_trips_and_is_no_better_than_ccp() {
             .all(|&(a, b)| order.iter().position(|&c| c == a) < order.iter().position(|&c| c == b))
     };
     let mut best = (f64::INFINITY, Vec::new());
+    let mut per_order = std::collections::HashMap::new();
     let mut perm = vec![1, 2, 3, 4];
     permute(&mut perm, 0, &mut |order| {
         if !feasible(order) {
@@ -255,6 +256,8 @@ fn discrete_instance_round_trips_and_is_no_better_than_ccp() {
         }
         for (u, cost, path) in &layer {
             let total = cost + inst.arc_cost(*u, 0);
+            let least = per_order.entry(order.to_vec()).or_insert(f64::INFINITY);
+            *least = f64::min(*least, total);
             if total < best.0 {
                 best = (total, path.clone());
             }
@@ -274,6 +277,21 @@ fn discrete_instance_round_trips_and_is_no_better_than_ccp() {
     );
     // A tour missing a cluster is refused.
     assert!(d.tour_to_route(&best.1[..3]).is_err());
+    // CCP's order at the candidates: the cheapest tour of that order (brute force above).
+    let (tour, cost) = d.tour_in_order_of(&ccp.route).unwrap();
+    let order: Vec<usize> = tour[1..].iter().map(|&v| inst.node_cluster[v]).collect();
+    assert!(
+        (cost - per_order[&order]).abs() < 1e-9,
+        "{cost} vs {}",
+        per_order[&order]
+    );
+    assert!((cutroute_pcgtsp::check_tour(inst, &tour).unwrap() - cost).abs() < 1e-9);
+    assert!(cost >= best.0 - 1e-9);
+    // The optimum's own route gives the optimum back; a route missing a contour gives none.
+    assert!((d.tour_in_order_of(&route).unwrap().1 - best.0).abs() < 1e-9);
+    let mut short = route.clone();
+    short.steps.pop();
+    assert!(d.tour_in_order_of(&short).is_none());
 }
 
 fn permute(v: &mut Vec<usize>, k: usize, f: &mut dyn FnMut(&[usize])) {
