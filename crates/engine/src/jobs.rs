@@ -213,6 +213,10 @@ pub struct DiscreteJob {
     /// had a tour (the build took the time): a route to show rather than none.
     fallback: Option<(Vec<usize>, f64)>,
     fallback_tried: bool,
+    /// CCP-Relax on the nest the instance discretises, run first in the heuristic's share:
+    /// its route, in its order of contours at the cheapest candidates, seeds the heuristic
+    /// (`with_route_seed`).
+    route_seed: Option<Box<cutroute_ccp::CcpSolver>>,
 }
 
 /// Why a discrete job ended without a search; its words are the phase's reason.
@@ -315,7 +319,45 @@ impl DiscreteJob {
             failure: None,
             fallback: None,
             fallback_tried: false,
+            route_seed: None,
         }
+    }
+
+    /// Seeds the heuristic with a continuous route of the nest this job's instance
+    /// discretises: `ccp` runs first in the heuristic's share of the slices (to its own time
+    /// limit), and its route, in its order of contours at the cheapest candidates
+    /// ([`cutroute_ccp::DiscreteInstance::tour_in_order_of`]), is offered to the heuristic,
+    /// which goes on from it when it is cheaper. Free pierce points find better orders than
+    /// a search over the candidates: on nested.dbs at 25 mm, 9,558 mm against the heuristic's
+    /// 9,622–9,632 in 60 s.
+    pub fn with_route_seed(mut self, ccp: cutroute_ccp::CcpSolver) -> Self {
+        self.route_seed = Some(Box::new(ccp));
+        self
+    }
+
+    /// One slice of the heuristic's `share`: the seeding CCP-Relax while it runs (its route
+    /// offered to the heuristic when it ends), then the heuristic. Whether the heuristic has
+    /// finished.
+    fn heuristic_step(&mut self, share: Duration) -> bool {
+        // (After the heuristic's first tour: a route to show comes first.)
+        let first_tour = self.alns.as_ref().is_some_and(|a| a.best().is_some());
+        if let Some(ccp) = self.route_seed.as_mut().filter(|_| first_tour) {
+            if !ccp.step(share).is_done() {
+                return false;
+            }
+            let route = cutroute_anytime::AnytimeSolver::best(&**ccp);
+            self.route_seed = None;
+            let tour = route
+                .zip(self.discrete.as_ref())
+                .and_then(|(route, discrete)| discrete.tour_in_order_of(&route));
+            if let (Some((tour, _)), Some(alns)) = (tour, self.alns.as_mut()) {
+                alns.offer_tour(&tour);
+            }
+            return false;
+        }
+        self.alns
+            .as_mut()
+            .is_some_and(|alns| alns_step(alns, share))
     }
 
     /// Adds the continuous lower bound (`CcpLowerBound`) of the nest this job's instance
@@ -584,20 +626,23 @@ impl Job for DiscreteJob {
                 JobStatus::Running
             };
         }
-        let Some(exact) = self.exact.as_mut() else {
-            if self.alns_done || alns.step(budget).is_done() {
+        if self.exact.is_none() {
+            if self.alns_done || self.heuristic_step(budget) {
                 self.alns_done = true;
                 return JobStatus::Done;
             }
             return JobStatus::Running;
-        };
+        }
         if !self.alns_done {
             let share = if self.exact_done.is_some() {
                 budget
             } else {
                 budget / 4
             };
-            self.alns_done = alns.step(share).is_done();
+            self.alns_done = self.heuristic_step(share);
+            let (Some(alns), Some(exact)) = (self.alns.as_ref(), self.exact.as_mut()) else {
+                return JobStatus::Running;
+            };
             if let Some((tour, cost)) = alns.best() {
                 if cost < self.offered_cost {
                     self.offered_cost = cost;
@@ -650,7 +695,7 @@ impl Job for DiscreteJob {
         };
         if self.exact_done.is_none() && left < piece {
             if !self.alns_done {
-                self.alns_done = alns_step(self.alns.as_mut().expect("built"), exact_share);
+                self.alns_done = self.heuristic_step(exact_share);
             }
             return JobStatus::Running;
         }
@@ -909,5 +954,77 @@ fn ccp_stage(phase: cutroute_ccp::CcpPhase) -> CcpStage {
         CcpPhase::LocalSearch => CcpStage::LocalSearch,
         CcpPhase::Shaking => CcpStage::Shaking,
         CcpPhase::Done => CcpStage::Done,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use cutroute_ccp::{build_pcgtsp, CcpSolver, DiscretisationOptions};
+    use cutroute_geometry::{generate_nest, Point};
+
+    /// The seeding CCP-Relax's route reaches the heuristic in the step where CCP ends
+    /// (`DiscreteJob::with_route_seed`): from then on the job's best tour costs at most that
+    /// route's tour in its order of contours at the cheapest candidates, before the heuristic
+    /// has searched beyond its first tour. The same CCP run beside the job (its VNS ends on its
+    /// own here, before its limit) gives the same route. Then the job's route passes the
+    /// checker.
+    #[test]
+    fn the_seeding_route_reaches_the_heuristic_when_ccp_ends() {
+        for seed in [13u64, 16] {
+            let nest = generate_nest(30, seed);
+            let b = nest.bounding_box();
+            let start = Point::new(b.min.x - 10.0, b.min.y - 10.0);
+            let step = (b.max.x - b.min.x).max(b.max.y - b.min.y) / 60.0;
+            let discrete = build_pcgtsp(
+                &nest,
+                &DiscretisationOptions {
+                    start,
+                    step,
+                    ..Default::default()
+                },
+            )
+            .unwrap();
+            let options = CcpOptions {
+                max_non_improving_shakes: 40,
+                restarts: 0,
+                ..ccp_options(
+                    start,
+                    None,
+                    Duration::from_secs(600),
+                    seed,
+                    Default::default(),
+                )
+            };
+            let mut ccp = CcpSolver::new(&nest, options.clone()).unwrap();
+            while ccp.step(Duration::from_secs(60)).is_running() {}
+            let (tour, seed_cost) = discrete.tour_in_order_of(&ccp.result().route).unwrap();
+            let checked = cutroute_pcgtsp::check_tour(&discrete.instance, &tour).unwrap();
+            assert!((checked - seed_cost).abs() <= 1e-9 * checked);
+            let mut job = DiscreteJob::new(
+                1,
+                discrete.instance.clone(),
+                Some(discrete.clone()),
+                DiscreteMode::Heuristic,
+                Duration::from_secs(600),
+                Instant::now(),
+                seed,
+            )
+            .unwrap()
+            .with_route_seed(CcpSolver::new(&nest, options).unwrap());
+            let mut before = f64::INFINITY;
+            while job.route_seed.is_some() {
+                before = job.best_tour().map_or(f64::INFINITY, |(_, c)| c);
+                assert_eq!(job.step(Duration::from_millis(40)), JobStatus::Running);
+            }
+            let (best, cost) = job.best_tour().unwrap();
+            assert!(
+                cost <= seed_cost + 1e-9,
+                "seed {seed}: {cost} > {seed_cost} (before {before})"
+            );
+            let route = job.route_of(&best).unwrap();
+            route.validate(&nest, 1e-6).unwrap();
+            assert!((route.idle_length() - cost).abs() <= 1e-6 * cost);
+        }
     }
 }
