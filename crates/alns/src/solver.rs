@@ -1143,9 +1143,6 @@ mod tests {
         tour
     }
 
-    /// After a stagnant epoch the next one starts from a kicked elite tour: feasible (checked
-    /// independently), costing what the solver believes, usually different from the best
-    /// tour, and the elite stays sorted, distinct and bounded.
     /// A cheaper tour from outside becomes the best at once and the search goes on from it;
     /// a dearer or invalid one is refused.
     #[test]
@@ -1196,6 +1193,9 @@ mod tests {
         assert!((checked - cost).abs() <= 1e-6 * checked.max(1.0));
     }
 
+    /// After a stagnant epoch the next one starts from a kicked elite tour: feasible (checked
+    /// independently), costing what the solver believes, usually different from the best
+    /// tour, and the elite stays sorted, distinct and bounded.
     #[test]
     fn a_stagnant_epoch_restarts_from_a_feasible_kicked_elite_tour() {
         for (set, name) in [("pcgtsplib", "ry48p.1"), ("industrial", "e1x_2")] {
