@@ -340,8 +340,9 @@ impl DiscreteJob {
     /// finished.
     fn heuristic_step(&mut self, share: Duration) -> bool {
         // (After the heuristic's first tour: a route to show comes first.)
-        let first_tour = self.alns.as_ref().is_some_and(|a| a.best().is_some());
-        if let Some(ccp) = self.route_seed.as_mut().filter(|_| first_tour) {
+        let first_tour = |job: &Self| job.alns.as_ref().is_some_and(|a| a.best().is_some());
+        if self.route_seed.is_some() && first_tour(self) {
+            let ccp = self.route_seed.as_mut().expect("checked above");
             if !ccp.step(share).is_done() {
                 return false;
             }
