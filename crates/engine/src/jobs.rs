@@ -802,6 +802,27 @@ pub fn ccp_options(
     }
 }
 
+/// The certified lower bound on the idle length of every CCP route of `nest` from `start`
+/// (to `finish`), planned for `budget` of its own time: the `ccp` job's, and the segment jobs'
+/// where every segment is a whole contour.
+pub fn continuous_lower_bound(
+    nest: &Nest,
+    start: cutroute_geometry::Point,
+    finish: Option<cutroute_geometry::Point>,
+    budget: Duration,
+) -> Result<CcpLowerBound, cutroute_ccp::CcpError> {
+    CcpLowerBound::new(
+        nest,
+        cutroute_ccp::LowerBoundOptions {
+            start,
+            finish,
+            budget_seconds: budget.as_secs_f64(),
+            first_stage: (budget / 10).clamp(Duration::from_millis(500), Duration::from_secs(5)),
+            ..Default::default()
+        },
+    )
+}
+
 /// CCP-Relax, then chain cutting of its route (`cutroute-chains`): the CCP phase streams its
 /// progress as a CCP job does; the chaining is set up in the step after CCP ends and tries its
 /// groups in the steps after that.

@@ -349,20 +349,8 @@ fn start_solver_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
                         .with_time_limit(started, time_limit),
                 ));
             }
-            let bound = cutroute_ccp::CcpLowerBound::new(
-                nest,
-                cutroute_ccp::LowerBoundOptions {
-                    start: *start,
-                    finish: *finish,
-                    budget_seconds: time_limit.as_secs_f64(),
-                    first_stage: (time_limit / 10).clamp(
-                        web_time::Duration::from_millis(500),
-                        web_time::Duration::from_secs(5),
-                    ),
-                    ..Default::default()
-                },
-            )
-            .map_err(|e| refused(e.into()))?;
+            let bound = jobs::continuous_lower_bound(nest, *start, *finish, time_limit)
+                .map_err(|e| refused(e.into()))?;
             Ok(Box::new(
                 CcpJob::new(request.job_id, ccp).with_lower_bound(bound, time_limit),
             ))

@@ -8,6 +8,7 @@ use cutroute_aoe::{
     AoeHeat, AoeSolution, AoeSolveError, AoeSolveOptions, AoeSolving, AoeStage, EmbeddingError,
     PlanError, PlanGraph, PlanOptions,
 };
+use cutroute_ccp::CcpLowerBound;
 use cutroute_geometry::float::Libm;
 use cutroute_geometry::{BoundingBox, MachineParameters, Nest, Objective, PathRoute, Point, Span};
 use cutroute_protocol::{
@@ -18,9 +19,11 @@ use cutroute_segments::{
     Candidate, EnsembleKind, EnsembleReport, GsccpOptions, GsccpSearch, GsccpStage, PathHeat,
     SccpOptions,
 };
+use std::cmp::Ordering;
 use std::collections::HashMap;
 use web_time::{Duration, Instant};
 
+use crate::jobs::continuous_lower_bound;
 use crate::{EngineError, Job, JobStatus};
 
 /// Why a [`PlanBound`] could not be measured: the nest gives no plane graph.
@@ -54,6 +57,12 @@ pub struct PlanBound {
     /// over the plan's components and the travel from the start to the parts' bounding box and
     /// from it to the finish.
     pub idle_length: f64,
+    /// Whether every component is one contour (no two contours touch): then every tool-on path
+    /// runs along one contour, and a bound on CCP routes carries over
+    /// ([`PlanBound::any_route_with_ccp`]).
+    pub whole_contours: bool,
+    /// The largest bounding-box diagonal of a contour (mm): at least its diameter.
+    pub diameter: f64,
 }
 
 /// The work [`idle_tree_bound`] may spend on exact component distances (span pairs measured);
@@ -251,13 +260,100 @@ impl PlanBound {
             let dy = (b.min.y - p.y).max(p.y - b.max.y).max(0.0);
             dx.hypot_libm(dy)
         };
+        let contours = nest.parts.iter().flat_map(|p| &p.contours);
         Ok(PlanBound {
             // Merged copies of a common edge agree within the tolerance at their ends.
             cut_length: (length - 4.0 * tolerance * edges as f64).max(0.0),
             components: components.len(),
             trail_pierces,
             idle_length: tree.max(to_box(start) + finish.map_or(0.0, to_box)),
+            // A contour is connected, so it lies in one component and each component holds
+            // one at least: as many components as contours means one contour each.
+            whole_contours: components.len() == nest.contour_count(),
+            diameter: contours
+                .map(|c| {
+                    let b = c.bounding_box();
+                    (b.max.x - b.min.x).hypot_libm(b.max.y - b.min.y)
+                })
+                .fold(0.0, f64::max),
         })
+    }
+
+    /// The objective's lower bound for every route, given `ccp_idle`: a certified lower
+    /// bound on the idle length of every CCP route from the same start (and to the same
+    /// finish; `cutroute-ccp`'s `CcpLowerBound`). Where contours touch it is
+    /// [`PlanBound::any_route`].
+    ///
+    /// Why it holds when every component is one contour (so every tool-on path runs along one
+    /// contour): take a route with `n + e` pierces (`n` contours) that cuts `r` mm more than
+    /// the plan. Cut each contour whole at the time of its last path, from that path's start
+    /// round to it, and drop its other paths. That is a CCP route: each contour is cut after
+    /// every contour inside it, as the route's precedence already had it. Its idle length
+    /// grows by at most a diameter `D` per path of a contour cut in several (at most `2D` per
+    /// extra pierce), and where one path both cuts a contour whole and ends away from its
+    /// start, by at most the part cut twice. So the route idles at least
+    /// `max(tree, ccp_idle − 2D·e − r)`, and with the prices `a` (per mm cut), `b` (per mm
+    /// idle) and `c` (per pierce), its value is at least
+    /// `any_route + (ccp_idle − tree)⁺ · min(a, b, c / 2D)`: a pierce saves at most `2D` mm
+    /// of idle travel, a millimetre cut twice at most one.
+    pub fn any_route_with_ccp(
+        &self,
+        ccp_idle: f64,
+        objective: Objective,
+        machine: &MachineParameters,
+    ) -> f64 {
+        let plain = self.any_route(objective, machine);
+        // (A NaN bound tells nothing either.)
+        if !self.whole_contours
+            || ccp_idle.partial_cmp(&self.idle_length) != Some(Ordering::Greater)
+        {
+            return plain;
+        }
+        let (a, b, c) = prices(objective, machine);
+        let per_pierce = if self.diameter > 0.0 {
+            c / (2.0 * self.diameter)
+        } else {
+            f64::INFINITY
+        };
+        plain + (ccp_idle - self.idle_length) * a.min(b).min(per_pierce).max(0.0)
+    }
+
+    /// A lower bound on the idle length (mm) of every route whose objective value is at most
+    /// `upper` (the best route's: every route at least as good idles at least this much),
+    /// given `ccp_idle` as in [`PlanBound::any_route_with_ccp`]. Where contours touch, or
+    /// without `upper`, it is [`PlanBound::idle_length`].
+    ///
+    /// A route with `e` extra pierces and `r` mm cut twice idles `x ≥ ccp_idle − 2D·e − r`
+    /// (see [`PlanBound::any_route_with_ccp`]), and being at least as good it has
+    /// `c·e + a·r + b·x ≤ S = upper − value(plan cut, no idle, n pierces)`. Extra pierces
+    /// need `c ≤ S`; then `2D·e + r ≤ k·(S − b·x)` with `k = max(2D / c, 1 / a)` (else
+    /// `k = 1 / a`), so `x ≥ (ccp_idle − k·S) / (1 − k·b)` when `k·b < 1`.
+    pub fn idle_at_most(
+        &self,
+        ccp_idle: f64,
+        upper: Option<f64>,
+        objective: Objective,
+        machine: &MachineParameters,
+    ) -> f64 {
+        let Some(upper) = upper.filter(|_| self.whole_contours && ccp_idle > self.idle_length)
+        else {
+            return self.idle_length;
+        };
+        let (a, b, c) = prices(objective, machine);
+        let slack =
+            (upper - objective.value(machine, self.cut_length, 0.0, self.components)).max(0.0);
+        let per_recut = if a > 0.0 { 1.0 / a } else { f64::INFINITY };
+        let k = if c > slack {
+            per_recut
+        } else if c > 0.0 {
+            (2.0 * self.diameter / c).max(per_recut)
+        } else {
+            f64::INFINITY
+        };
+        if (k * b).partial_cmp(&1.0) != Some(Ordering::Less) {
+            return self.idle_length;
+        }
+        self.idle_length.max((ccp_idle - k * slack) / (1.0 - k * b))
     }
 
     /// The objective's lower bound for routes that may cut edges twice (GSCCP's standard
@@ -275,6 +371,17 @@ impl PlanBound {
             self.trail_pierces,
         )
     }
+}
+
+/// An objective's prices: per mm cut, per mm of idle travel, per pierce (it is linear in
+/// each).
+fn prices(objective: Objective, machine: &MachineParameters) -> (f64, f64, f64) {
+    let zero = objective.value(machine, 0.0, 0.0, 0);
+    (
+        objective.value(machine, 1.0, 0.0, 0) - zero,
+        objective.value(machine, 0.0, 1.0, 0) - zero,
+        objective.value(machine, 0.0, 0.0, 1) - zero,
+    )
 }
 
 fn summary(name: &str, route: &PathRoute, machine: &MachineParameters) -> RouteSummary {
@@ -328,7 +435,10 @@ fn nest_of(request: &JobRequest) -> Result<(&Nest, Point, Option<Point>), Engine
 /// Segment cutting (`cutroute-segments`' [`GsccpSearch`]): CCP-Relax seeds the orders, then
 /// each ensemble is built and searched in slices; SCCP is the chains ensemble alone, GSCCP
 /// every ensemble, the best by the objective kept. The first step measures the plan graph for
-/// the lower bound (at least the plan's length cut and one pierce per component).
+/// the lower bound (at least the plan's length cut and one pierce per component). Where no two
+/// contours touch, the next makes the continuous bound of CCP, which then gets half of each
+/// slice while the search runs and tightens the bound ([`PlanBound::any_route_with_ccp`]);
+/// the job ends with the search.
 pub struct SegmentJob {
     job_id: JobId,
     search: GsccpSearch,
@@ -339,7 +449,39 @@ pub struct SegmentJob {
     objective: Objective,
     tolerance: f64,
     bound: Option<Result<PlanBound, PlanBoundError>>,
+    ccp_bound: CcpBound,
+    time_limit: Duration,
     started: Instant,
+}
+
+/// The continuous bound of CCP inside a [`SegmentJob`].
+enum CcpBound {
+    /// Waiting for the plan graph: it tells whether the bound carries over.
+    Undecided,
+    /// Contours touch (a path may leave a contour along a common edge), there is no plane
+    /// graph, or the bound could not be made.
+    Inapplicable,
+    /// Computed beside the search; `running` is false once it has nothing left to do.
+    Computing {
+        bound: Box<CcpLowerBound>,
+        running: bool,
+        /// The idle length of the last CCP-Relax route offered to it (its pierce points
+        /// guide the refinement).
+        offered: f64,
+    },
+}
+
+impl CcpBound {
+    fn value(&self) -> Option<f64> {
+        match self {
+            CcpBound::Computing { bound, .. } => Some(bound.lower_bound()),
+            _ => None,
+        }
+    }
+
+    fn is_running(&self) -> bool {
+        matches!(self, CcpBound::Computing { running: true, .. })
+    }
 }
 
 impl SegmentJob {
@@ -391,6 +533,8 @@ impl SegmentJob {
             objective: params.objective,
             tolerance: nest.check_tolerance(),
             bound: None,
+            ccp_bound: CcpBound::Undecided,
+            time_limit: Duration::from_secs_f64(params.time_limit_s.clamp(0.0, 1.0e7)),
             started: Instant::now(),
         })
     }
@@ -418,7 +562,46 @@ impl Job for SegmentJob {
             ));
             return JobStatus::Running;
         }
-        self.search.step(budget).into()
+        if matches!(self.ccp_bound, CcpBound::Undecided) {
+            // Making the bound (the nest's pieces and first relaxation) is a step of its own.
+            let carries_over = matches!(&self.bound, Some(Ok(plan)) if plan.whole_contours);
+            self.ccp_bound = match carries_over.then(|| {
+                // It gets half of the search's slices.
+                continuous_lower_bound(&self.nest, self.start, self.finish, self.time_limit / 2)
+            }) {
+                Some(Ok(bound)) => CcpBound::Computing {
+                    bound: Box::new(bound),
+                    running: true,
+                    offered: f64::INFINITY,
+                },
+                _ => CcpBound::Inapplicable,
+            };
+            return JobStatus::Running;
+        }
+        let share = if self.ccp_bound.is_running() {
+            budget / 2
+        } else {
+            budget
+        };
+        let status = self.search.step(share);
+        if let CcpBound::Computing {
+            bound,
+            running: running @ true,
+            offered,
+        } = &mut self.ccp_bound
+        {
+            if let Some(route) = self.search.ccp_cutting_route() {
+                let idle = route.idle_length();
+                if idle < *offered {
+                    bound.offer_route(route);
+                    *offered = idle;
+                }
+            }
+            let left = self.time_limit.saturating_sub(self.started.elapsed());
+            *running =
+                status.is_running() && !left.is_zero() && bound.step((budget - share).min(left));
+        }
+        status.into()
     }
 
     fn progress(&self) -> Progress {
@@ -449,25 +632,29 @@ impl Job for SegmentJob {
             Some(Ok(bound)) => Some(bound),
             _ => None,
         };
-        let lower_bound = bound.map(|b| b.any_route(self.objective, &self.machine));
-        let idle_lower_bound = bound.map(|b| b.idle_length);
+        // The route's own objective value (a candidate's value adds W·H with a heat weight,
+        // which the plan bound does not bound).
+        let upper = best.map(|c| {
+            self.objective.value(
+                &self.machine,
+                c.route.cut_length(),
+                c.route.idle_length(),
+                c.route.pierce_count(),
+            )
+        });
+        let ccp_idle = self.ccp_bound.value().unwrap_or(0.0);
+        let lower_bound =
+            bound.map(|b| b.any_route_with_ccp(ccp_idle, self.objective, &self.machine));
+        let idle_lower_bound =
+            bound.map(|b| b.idle_at_most(ccp_idle, upper, self.objective, &self.machine));
         for s in alternatives.iter_mut().filter(|s| s.chosen) {
             s.idle_lower_bound = idle_lower_bound;
         }
         Progress {
             job_id: self.job_id,
             elapsed_s: self.started.elapsed().as_secs_f64(),
-            // The route's own objective value (a candidate's value adds W·H with a heat
-            // weight, which the plan bound does not bound).
             bounds: Bounds {
-                upper: best.map(|c| {
-                    self.objective.value(
-                        &self.machine,
-                        c.route.cut_length(),
-                        c.route.idle_length(),
-                        c.route.pierce_count(),
-                    )
-                }),
+                upper,
                 lower: lower_bound,
                 unit: self.objective.unit(),
             },

@@ -542,6 +542,135 @@ fn the_idle_bound_is_below_brute_force_on_separate_circles() {
         // The plan's tree is the same less the merging tolerance on each of its k + 1 edges.
         let slack = 2.0 * nest.check_tolerance() * (k + 1) as f64;
         assert!(plan.idle_length >= tree - slack - 1e-9, "trial {trial}");
+        assert!(plan.whole_contours, "trial {trial}: no circles touch");
+
+        // The sccp job adds the continuous bound of CCP (every route of its cuts each circle
+        // whole). Its objective bound holds for the enumerated route, its idle bound for every
+        // route at least as good as its own, and it is no weaker than the tree.
+        let problem = Problem::Nest {
+            nest: nest.clone(),
+            start,
+            finish,
+        };
+        let params = params(2.0, Objective::Time);
+        let mut job = start_job(&request(&problem, SolverKind::Sccp, params.clone())).unwrap();
+        let progress = run_to_end(job.as_mut(), &mut |_| {});
+        let route = check_progress(&format!("trial {trial}"), &problem, &params, &progress);
+        let (ub, lb) = (
+            progress.bounds.upper.unwrap(),
+            progress.bounds.lower.unwrap(),
+        );
+        let idle_lb = progress.idle_lower_bound.unwrap();
+        let enumerated_value =
+            Objective::Time.value(&params.machine, route.cut_length(), enumerated, k);
+        assert!(
+            lb <= enumerated_value + 1e-9,
+            "trial {trial}: lb {lb} > {enumerated_value}"
+        );
+        if enumerated_value <= ub {
+            assert!(
+                idle_lb <= enumerated + 1e-9,
+                "trial {trial}: idle lb {idle_lb} > {enumerated}"
+            );
+        }
+        assert!(idle_lb >= plan.idle_length, "trial {trial}");
+        // Close: the tree alone is 3–30 % below the enumerated optimum on these nests.
+        assert!(
+            idle_lb >= 0.97 * (enumerated - spacings),
+            "trial {trial}: idle lb {idle_lb} against {enumerated} − {spacings} (tree {tree})"
+        );
+    }
+}
+
+/// [`PlanBound::any_route_with_ccp`] and [`PlanBound::idle_at_most`] against their definition,
+/// minimised by brute force over whole numbers of extra pierces `e` and a fine grid of lengths
+/// `r` cut twice: a route idles at least `max(tree, ccp − 2D·e − r)` and is worth
+/// `value(plan cut + r, idle, n + e)`. The objective bound must equal that minimum (up to the
+/// grid), and the idle bound must not exceed the least idle of a route worth at most `upper`.
+#[test]
+fn the_bounds_from_ccp_are_the_minimum_over_extra_pierces_and_recut() {
+    let mut rng = SplitMix64::new(20261125);
+    for trial in 0..300 {
+        let machine = MachineParameters {
+            idle_speed: rng.range(50.0, 1000.0),
+            cut_speed: rng.range(1.0, 100.0),
+            pierce_time: rng.range(0.0, 10.0),
+            idle_price_per_metre: rng.range(0.1, 5.0),
+            cut_price_per_metre: rng.range(0.1, 5.0),
+            pierce_price: rng.range(0.0, 3.0),
+            ..MachineParameters::default()
+        };
+        let objective = if trial % 2 == 0 {
+            Objective::Time
+        } else {
+            Objective::Cost
+        };
+        let tree = rng.range(0.0, 500.0);
+        let ccp = tree + rng.range(0.0, 2000.0);
+        let plan = PlanBound {
+            cut_length: rng.range(100.0, 5000.0),
+            components: 1 + (trial % 7),
+            trail_pierces: 1 + (trial % 7),
+            idle_length: tree,
+            whole_contours: true,
+            diameter: rng.range(5.0, 3000.0),
+        };
+        let n = plan.components;
+        let value = |r: f64, idle: f64, e: usize| {
+            objective.value(&machine, plan.cut_length + r, idle, n + e)
+        };
+        let idle_of = |e: usize, r: f64| tree.max(ccp - 2.0 * plan.diameter * e as f64 - r);
+        let grid: Vec<f64> = (0..=400).map(|i| ccp * i as f64 / 400.0).collect();
+        let mut least = f64::INFINITY;
+        for e in 0..=400usize {
+            for &r in &grid {
+                least = least.min(value(r, idle_of(e, r), e));
+            }
+        }
+        let bound = plan.any_route_with_ccp(ccp, objective, &machine);
+        // Below by at most the grid's step and a pierce (the bound lets `e` be fractional).
+        let zero = objective.value(&machine, 0.0, 0.0, 0);
+        let per_mm = (objective.value(&machine, 1.0, 0.0, 0) - zero)
+            .max(objective.value(&machine, 0.0, 1.0, 0) - zero);
+        let slack = ccp / 400.0 * per_mm + (objective.value(&machine, 0.0, 0.0, 1) - zero);
+        assert!(
+            bound <= least + 1e-9 * least,
+            "trial {trial}: {bound} > {least}"
+        );
+        assert!(
+            bound >= least - slack - 1e-9 * least,
+            "trial {trial}: {bound} ≪ {least}"
+        );
+        // Routes worth at most `upper` (a route at e = 0, r = 0 idling a little over ccp).
+        let upper = value(0.0, ccp + rng.range(0.0, 300.0), 0);
+        let mut least_idle = f64::INFINITY;
+        for e in 0..=400usize {
+            for &r in &grid {
+                let idle = idle_of(e, r);
+                if value(r, idle, e) <= upper {
+                    least_idle = least_idle.min(idle);
+                }
+            }
+        }
+        let idle_bound = plan.idle_at_most(ccp, Some(upper), objective, &machine);
+        assert!(
+            idle_bound <= least_idle + 1e-9 * least_idle.max(1.0),
+            "trial {trial}: {idle_bound} > {least_idle}"
+        );
+        assert!(idle_bound >= tree, "trial {trial}");
+        // Where contours touch, nothing carries over.
+        let touching = PlanBound {
+            whole_contours: false,
+            ..plan
+        };
+        assert_eq!(
+            touching.any_route_with_ccp(ccp, objective, &machine),
+            touching.any_route(objective, &machine)
+        );
+        assert_eq!(
+            touching.idle_at_most(ccp, Some(upper), objective, &machine),
+            tree
+        );
     }
 }
 

@@ -218,6 +218,8 @@ pub struct GsccpSearch {
     started: Instant,
     stage: Stage,
     ccp_route: Option<Route>,
+    /// CCP-Relax's best route so far (its snapshots while it runs, then its end route).
+    ccp_best: Option<Route>,
     ccp_path: Option<PathRoute>,
     reports: Vec<EnsembleReport>,
     best: Option<Candidate>,
@@ -261,6 +263,7 @@ impl GsccpSearch {
             started,
             stage: Stage::Ccp(Box::new(ccp)),
             ccp_route: None,
+            ccp_best: None,
             ccp_path: None,
             reports: Vec::new(),
             best: None,
@@ -292,6 +295,13 @@ impl GsccpSearch {
                 // Ending a phase (a check over the whole nest) and building an ensemble (a
                 // plan graph) cannot be cut: each ends the step, so a step holds at most one.
                 Stage::Ccp(mut solver) => {
+                    // CCP-Relax counts its own time; its share of the limit is wall time here,
+                    // as the ensembles' shares are, so a caller that steps the search in part
+                    // of each slice (the segment job with its bound) still ends on time.
+                    let ccp_limit = self.options.sccp.time_limit.mul_f64(self.options.ccp_share);
+                    if now >= self.started + ccp_limit {
+                        solver.cancel();
+                    }
                     if solver.step(left).is_done() {
                         self.ccp_done(&solver);
                         return self.status();
@@ -394,6 +404,12 @@ impl GsccpSearch {
         self.ccp_path.as_ref()
     }
 
+    /// CCP-Relax's best route so far as pierce points per contour (a CCP [`Route`]): taken
+    /// at the snapshots while it runs (see [`GsccpSearch::step`]), then its route.
+    pub fn ccp_cutting_route(&self) -> Option<&Route> {
+        self.ccp_best.as_ref()
+    }
+
     /// Why the run failed, if it did (CCP-Relax gave no usable route).
     pub fn failure(&self) -> Option<&SegmentError> {
         self.failure.as_ref()
@@ -493,6 +509,7 @@ impl GsccpSearch {
                         value,
                     });
                 }
+                self.ccp_best = Some(route.clone());
                 self.ccp_route = Some(route);
                 self.ccp_path = Some(path);
                 self.stage = Stage::Build(0);
@@ -592,6 +609,7 @@ impl GsccpSearch {
             .and_then(|route| Some((self.checked(&route).ok()?.0, route)));
         self.next_snapshot = Instant::now() + SNAPSHOT_INTERVAL.max(now.elapsed() * 10);
         self.snapshot_idle = progress.best_idle_length;
+        self.ccp_best = Some(progress.route.clone());
         if let Some((value, route)) = checked {
             self.provisional = Some(Candidate {
                 source: None,
