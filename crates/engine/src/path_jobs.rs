@@ -438,7 +438,7 @@ fn nest_of(request: &JobRequest) -> Result<(&Nest, Point, Option<Point>), Engine
 /// the lower bound (at least the plan's length cut and one pierce per component). Where no two
 /// contours touch, the next makes the continuous bound of CCP, which then gets half of each
 /// slice while the search runs and tightens the bound ([`PlanBound::any_route_with_ccp`]);
-/// the job ends with the search.
+/// the job ends with the search, once the bound's first stage is done (within the limit).
 pub struct SegmentJob {
     job_id: JobId,
     search: GsccpSearch,
@@ -578,11 +578,13 @@ impl Job for SegmentJob {
             };
             return JobStatus::Running;
         }
-        let share = if self.ccp_bound.is_running() {
-            budget / 2
-        } else {
-            budget
+        let searching = !self.search.is_finished();
+        let share = match (searching, self.ccp_bound.is_running()) {
+            (true, true) => budget / 2,
+            (true, false) => budget,
+            (false, _) => Duration::ZERO,
         };
+        // (A finished search returns its status at once.)
         let status = self.search.step(share);
         if let CcpBound::Computing {
             bound,
@@ -598,8 +600,13 @@ impl Job for SegmentJob {
                 }
             }
             let left = self.time_limit.saturating_sub(self.started.elapsed());
-            *running =
-                status.is_running() && !left.is_zero() && bound.step((budget - share).min(left));
+            // A search that ends first (small nests end in a second) still waits for the
+            // bound's first stage, so the bound does not depend on which of the two was faster.
+            let wanted = status.is_running() || bound.stages() == 0;
+            *running = wanted && !left.is_zero() && bound.step((budget - share).min(left));
+            if !status.is_running() && *running {
+                return JobStatus::Running;
+            }
         }
         status.into()
     }
