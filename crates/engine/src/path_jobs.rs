@@ -592,8 +592,7 @@ impl Job for SegmentJob {
             offered,
         } = &mut self.ccp_bound
         {
-            if let Some(route) = self.search.ccp_cutting_route() {
-                let idle = route.idle_length();
+            if let Some((route, idle)) = self.search.ccp_cutting_route() {
                 if idle < *offered {
                     bound.offer_route(route);
                     *offered = idle;

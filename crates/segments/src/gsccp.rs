@@ -218,8 +218,9 @@ pub struct GsccpSearch {
     started: Instant,
     stage: Stage,
     ccp_route: Option<Route>,
-    /// CCP-Relax's best route so far (its snapshots while it runs, then its end route).
-    ccp_best: Option<Route>,
+    /// CCP-Relax's best route so far (its snapshots while it runs, then its end route) and
+    /// its idle length.
+    ccp_best: Option<(Route, f64)>,
     ccp_path: Option<PathRoute>,
     reports: Vec<EnsembleReport>,
     best: Option<Candidate>,
@@ -404,10 +405,11 @@ impl GsccpSearch {
         self.ccp_path.as_ref()
     }
 
-    /// CCP-Relax's best route so far as pierce points per contour (a CCP [`Route`]): taken
-    /// at the snapshots while it runs (see [`GsccpSearch::step`]), then its route.
-    pub fn ccp_cutting_route(&self) -> Option<&Route> {
-        self.ccp_best.as_ref()
+    /// CCP-Relax's best route so far as pierce points per contour (a CCP [`Route`]), with its
+    /// idle length: taken at the snapshots while it runs (see [`GsccpSearch::step`]), then its
+    /// route.
+    pub fn ccp_cutting_route(&self) -> Option<(&Route, f64)> {
+        self.ccp_best.as_ref().map(|(route, idle)| (route, *idle))
     }
 
     /// Why the run failed, if it did (CCP-Relax gave no usable route).
@@ -509,7 +511,7 @@ impl GsccpSearch {
                         value,
                     });
                 }
-                self.ccp_best = Some(route.clone());
+                self.ccp_best = Some((route.clone(), route.idle_length()));
                 self.ccp_route = Some(route);
                 self.ccp_path = Some(path);
                 self.stage = Stage::Build(0);
@@ -609,7 +611,7 @@ impl GsccpSearch {
             .and_then(|route| Some((self.checked(&route).ok()?.0, route)));
         self.next_snapshot = Instant::now() + SNAPSHOT_INTERVAL.max(now.elapsed() * 10);
         self.snapshot_idle = progress.best_idle_length;
-        self.ccp_best = Some(progress.route.clone());
+        self.ccp_best = Some((progress.route.clone(), progress.best_idle_length));
         if let Some((value, route)) = checked {
             self.provisional = Some(Candidate {
                 source: None,
