@@ -23,6 +23,11 @@
 //!    for the continuous problem. Each arc cost is lowered by a tiny margin so that rounding
 //!    in the distance computations cannot lift it above the true set distance.
 //!
+//! **Chain cutting** ([`LinkPrices`]): where a contour may also be entered by a tool-on link
+//! from a sibling, each move of the relaxation is priced as the cheapest way to make it (a
+//! link, or an idle move and a pierce) instead of by its length, and the bound is on the
+//! route's cost less the cut of its perimeters (no spatial groups then).
+//!
 //! **Fixed candidates** ([`CcpLowerBound::for_candidates`]): for routes that pierce only at
 //! given points (a discretised nest's candidates), each piece is a tiny arc around one
 //! candidate instead, so the relaxed PCGTSP is the discrete instance restricted to the kept
@@ -91,7 +96,9 @@
 use std::collections::HashMap;
 use std::sync::Arc;
 
-use cutroute_geometry::{BoundingBox, Contour, ContourRef, Nest, Point, Route, Span};
+use cutroute_geometry::{
+    is_scrap_region, BoundingBox, Contour, ContourRef, Nest, Point, Route, Span,
+};
 use cutroute_pcgtsp::{AnytimeSolver, ExactOptions, ExactSolver, Instance, Status};
 use web_time::{Duration, Instant};
 
@@ -171,6 +178,55 @@ pub struct LowerBoundOptions {
     /// seconds, it reached 3,400–4,000 in 120 s against the groups' 12,000–12,800, and the
     /// slices it took lowered the groups' sum (BENCHMARKS.md).
     pub ng_alone: bool,
+    /// Chain cutting: a route may also enter a contour by a tool-on link from the previous one
+    /// (see [`LinkPrices`]), and the bound is on the moves' prices instead of idle length.
+    /// `None`: every move is idle, the bound is in mm.
+    pub links: Option<LinkPrices>,
+}
+
+/// Prices of the moves between pierce points of chain cutting (`cutroute-chains`), per mm and
+/// per pierce in the unit of the route's cost. A contour is entered either by an idle move and
+/// a pierce, or, from a sibling in one scrap region (children of the sheet or of one hole), by a
+/// tool-on link that is at least as long as the straight distance and leaves it where it
+/// entered. So a move of straight length `d` between two kept contours costs at least
+/// [`LinkPrices::between_siblings`] (siblings) or [`LinkPrices::pierced`] (others: the way
+/// between them has a pierce), and both prices are increasing and subadditive, so dropping the
+/// outer contours from the route (step 1 of the module documentation) still only lowers it.
+/// With these prices the relaxation bounds the route's cost less the cut of its perimeters.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LinkPrices {
+    /// Per mm of idle travel.
+    pub idle_per_mm: f64,
+    /// Per mm of cut (a link is cut).
+    pub cut_per_mm: f64,
+    /// Per pierce.
+    pub pierce: f64,
+}
+
+impl LinkPrices {
+    /// The least price of a move of straight length `d` into a sibling in one scrap region:
+    /// a link, or an idle move and a pierce.
+    pub fn between_siblings(&self, d: f64) -> f64 {
+        (self.cut_per_mm * d).min(self.idle_per_mm * d + self.pierce)
+    }
+
+    /// The least price of a way of straight length `d` that has a pierce on it (into a
+    /// contour that is no sibling, from the start, or to an outer contour of the last one).
+    pub fn pierced(&self, d: f64) -> f64 {
+        self.idle_per_mm.min(self.cut_per_mm) * d + self.pierce
+    }
+
+    /// The least price of `d` mm of travel (idle or linked).
+    fn travel(&self, d: f64) -> f64 {
+        self.idle_per_mm.min(self.cut_per_mm) * d
+    }
+
+    /// Whether the prices are finite and non-negative.
+    fn valid(&self) -> bool {
+        [self.idle_per_mm, self.cut_per_mm, self.pierce]
+            .iter()
+            .all(|p| p.is_finite() && *p >= 0.0)
+    }
 }
 
 impl Default for LowerBoundOptions {
@@ -189,6 +245,7 @@ impl Default for LowerBoundOptions {
             ng_above: 24,
             exact_max_kept: EXACT_MAX_KEPT,
             ng_alone: false,
+            links: None,
         }
     }
 }
@@ -203,6 +260,10 @@ struct Leaf {
     offsets: Vec<f64>,
     /// Least tail after this contour when it is cut last, per piece (computed with the pieces).
     outermost: Option<ContourRef>,
+    /// The scrap region it lies in, named by its parent (`Some(None)`: the sheet), or `None`
+    /// for a hole of a part: with [`LinkPrices`], only contours of one scrap region are
+    /// joined by links.
+    scrap_region: Option<Option<ContourRef>>,
 }
 
 impl Leaf {
@@ -393,10 +454,24 @@ impl CcpLowerBound {
                 "initial_pieces ≥ 1 and max_nodes ≥ 2 are required".into(),
             ));
         }
+        if options.links.is_some_and(|l| !l.valid()) {
+            return Err(CcpError::InvalidOption(
+                "link prices must be finite and non-negative".into(),
+            ));
+        }
         let forest = nest.containment_forest();
         let mut leaves = Vec::new();
         let mut outermost_shapes = HashMap::new();
-        for r in forest.leaves() {
+        // With links every contour is kept: dropping one would drop the pierce or link that
+        // enters it, which only a crossing of the idle route gets for free.
+        let kept = if options.links.is_some() {
+            (0..forest.len())
+                .filter_map(|i| forest.contour_ref(i))
+                .collect()
+        } else {
+            forest.leaves()
+        };
+        for r in kept {
             let Some(contour) = nest.contour(r).filter(|c| !c.vertices.is_empty()) else {
                 continue;
             };
@@ -405,7 +480,11 @@ impl CcpLowerBound {
             for s in &spans {
                 offsets.push(offsets.last().copied().unwrap_or(0.0) + s.length());
             }
-            let outermost = forest.ancestors(r).last();
+            let outermost = if options.links.is_some() {
+                None
+            } else {
+                forest.ancestors(r).last()
+            };
             if let Some(o) = outermost {
                 if let Some(c) = nest.contour(o) {
                     outermost_shapes
@@ -413,12 +492,14 @@ impl CcpLowerBound {
                         .or_insert_with(|| PieceShape::new(c.spans().collect()));
                 }
             }
+            let parent = forest.parent(r);
             leaves.push(Leaf {
                 contour_ref: r,
                 contour: contour.clone(),
                 spans,
                 offsets,
                 outermost,
+                scrap_region: is_scrap_region(&forest, parent).then_some(parent),
             });
         }
         let b = nest.bounding_box();
@@ -430,7 +511,11 @@ impl CcpLowerBound {
             .max(b.min.x.abs())
             .max(b.min.y.abs())
             + options.start.x.abs().max(options.start.y.abs());
-        let margin = COST_MARGIN * (1.0 + if scale.is_finite() { scale } else { 0.0 });
+        let mut margin = COST_MARGIN * (1.0 + if scale.is_finite() { scale } else { 0.0 });
+        if let Some(links) = options.links {
+            // A price moves by at most the dearer price per mm as the distance does.
+            margin *= links.idle_per_mm.max(links.cut_per_mm);
+        }
         let group_size = options.group_size;
         let mut bound = CcpLowerBound::from_leaves(
             leaves,
@@ -442,7 +527,10 @@ impl CcpLowerBound {
         );
         // Beyond MAX_GROUPS groups each would get too little time to count, and the sheets
         // that large do not fit a relaxation anyway.
+        // (Not with links: a group's region argument charges lengths inside the regions, and a
+        // pierce on a way that crosses a border belongs to neither side.)
         if group_size > 0
+            && bound.options.links.is_none()
             && bound.leaves.len() > group_size.max(bound.options.decompose_above)
             && bound.leaves.len() <= MAX_GROUPS * group_size
         {
@@ -921,17 +1009,38 @@ impl CcpLowerBound {
     }
 
     /// The least tail after the last kept contour when it is cut from `piece`.
+    ///
+    /// With [`LinkPrices`] its price: the way to the outermost contour has a pierce (that
+    /// contour is no sibling of anything inside it), the rest is travel.
     fn tail(&self, leaf: usize, piece: &PieceShape) -> f64 {
         let to_outermost = self.leaves[leaf]
             .outermost
             .and_then(|o| self.outermost_shapes.get(&o));
+        let (travel, pierced): (&dyn Fn(f64) -> f64, &dyn Fn(f64) -> f64) =
+            match &self.options.links {
+                Some(links) => (&|d| links.travel(d), &|d| links.pierced(d)),
+                None => (&|d| d, &|d| d),
+            };
         match (self.options.finish, to_outermost) {
             (None, None) => 0.0,
-            (None, Some(o)) => piece.distance_to(o),
-            (Some(f), None) => piece.distance_to_point(f),
-            (Some(f), Some(o)) => piece
-                .distance_to_point(f)
-                .max(piece.distance_to(o) + o.distance_to_point(f)),
+            (None, Some(o)) => pierced(piece.distance_to(o)),
+            (Some(f), None) => travel(piece.distance_to_point(f)),
+            (Some(f), Some(o)) => travel(piece.distance_to_point(f))
+                .max(pierced(piece.distance_to(o)) + travel(o.distance_to_point(f))),
+        }
+    }
+
+    /// The least price of a move of straight length `d` from the start (`from` is `None`) or
+    /// a piece of kept contour `from` to one of kept contour `to`: the length itself, or with
+    /// [`LinkPrices`] a link's price between siblings and a pierced way's otherwise.
+    fn move_price(&self, from: Option<usize>, to: usize, d: f64) -> f64 {
+        let Some(links) = &self.options.links else {
+            return d;
+        };
+        let region = |leaf: usize| self.leaves[leaf].scrap_region;
+        match (from.and_then(region), region(to)) {
+            (Some(a), Some(b)) if a == b => links.between_siblings(d),
+            _ => links.pierced(d),
         }
     }
 
@@ -991,8 +1100,12 @@ impl CcpLowerBound {
             for c in 0..n {
                 let value = match (a, c) {
                     (0, 0) => continue,
-                    (0, c) => b.shapes[c - 1]
-                        .distance_to_point(self.options.start)
+                    (0, c) => self
+                        .move_price(
+                            None,
+                            b.node_piece[c - 1].0,
+                            b.shapes[c - 1].distance_to_point(self.options.start),
+                        )
                         .min(escape(c)),
                     (a, 0) => self
                         .tail(b.node_piece[a - 1].0, &b.shapes[a - 1])
@@ -1000,8 +1113,12 @@ impl CcpLowerBound {
                     (a, c) if b.node_piece[a - 1].0 == b.node_piece[c - 1].0 => continue,
                     // Symmetric: the lower triangle was filled from the upper one.
                     (a, c) if c < a => b.cost[c * n + a],
-                    (a, c) => b.shapes[a - 1]
-                        .distance_to(&b.shapes[c - 1])
+                    (a, c) => self
+                        .move_price(
+                            Some(b.node_piece[a - 1].0),
+                            b.node_piece[c - 1].0,
+                            b.shapes[a - 1].distance_to(&b.shapes[c - 1]),
+                        )
                         .min(escape(a) + escape(c)),
                 };
                 b.cost[a * n + c] = value;

@@ -5,8 +5,12 @@
 
 use std::time::Duration;
 
-use cutroute_ccp::{containment_pairs, solve, CcpLowerBound, CcpOptions, LowerBoundOptions};
-use cutroute_geometry::{Contour, ContourRef, Nest, Part, Point, SplitMix64, Vertex};
+use cutroute_ccp::{
+    containment_pairs, solve, CcpLowerBound, CcpOptions, LinkPrices, LowerBoundOptions,
+};
+use cutroute_geometry::{
+    is_scrap_region, Contour, ContourRef, Nest, Part, Point, SplitMix64, Vertex,
+};
 
 /// A convex polygon of `n` corners around `centre` (some sides bulged outwards), clockwise as
 /// outer contours are after opening; `hole` gives the counter-clockwise orientation of holes.
@@ -65,6 +69,20 @@ fn random_nest(seed: u64) -> Nest {
 /// The shortest route over every order of the contours that cuts inner contours first, with
 /// pierce points sampled every `h` mm: a feasible route, so no lower bound may exceed it.
 fn brute_force(nest: &Nest, start: Point, finish: Option<Point>, h: f64) -> f64 {
+    brute_force_priced(nest, start, finish, h, &|_, _, d| d, &|d| d)
+}
+
+/// [`brute_force`] with each move priced by `move_price(from, to, d)` (contour indices in
+/// `nest.contour_refs()` order, `from` `None` for the start; `d` the straight length) and the
+/// way to the finish by `finish_price(d)`.
+fn brute_force_priced(
+    nest: &Nest,
+    start: Point,
+    finish: Option<Point>,
+    h: f64,
+    move_price: &dyn Fn(Option<usize>, usize, f64) -> f64,
+    finish_price: &dyn Fn(f64) -> f64,
+) -> f64 {
     let refs: Vec<ContourRef> = nest.contour_refs().collect();
     let samples: Vec<Vec<Point>> = refs
         .iter()
@@ -97,7 +115,7 @@ fn brute_force(nest: &Nest, start: Point, finish: Option<Point>, h: f64) -> f64 
         }
         let mut cur: Vec<f64> = samples[order[0]]
             .iter()
-            .map(|p| p.distance(start))
+            .map(|p| move_price(None, order[0], p.distance(start)))
             .collect();
         for w in order.windows(2) {
             let (from, to) = (&samples[w[0]], &samples[w[1]]);
@@ -106,7 +124,7 @@ fn brute_force(nest: &Nest, start: Point, finish: Option<Point>, h: f64) -> f64 
                 .map(|q| {
                     from.iter()
                         .zip(&cur)
-                        .map(|(p, d)| d + p.distance(*q))
+                        .map(|(p, d)| d + move_price(Some(w[0]), w[1], p.distance(*q)))
                         .fold(f64::INFINITY, f64::min)
                 })
                 .collect();
@@ -115,7 +133,7 @@ fn brute_force(nest: &Nest, start: Point, finish: Option<Point>, h: f64) -> f64 
         let value = cur
             .iter()
             .zip(last)
-            .map(|(d, p)| d + finish.map_or(0.0, |f| p.distance(f)))
+            .map(|(d, p)| d + finish.map_or(0.0, |f| finish_price(p.distance(f))))
             .fold(f64::INFINITY, f64::min);
         best = best.min(value);
     });
@@ -186,6 +204,71 @@ fn never_above_brute_force_and_close_to_it_on_random_small_nests() {
             bound.stages()
         );
     }
+}
+
+/// With link prices (chain cutting) the bound is never above the cheapest route that may
+/// enter a contour by a straight tool-on link from a sibling in one scrap region (every order
+/// that cuts inner contours first × pierce points every mm × link or pierce per move; real
+/// links bend round obstacles, so they cost no less), less the cut of the perimeters, and
+/// close to it. Prices vary from seed to seed so that links pay over some moves and not over
+/// others; some nests have a hole with nothing in it (never linked).
+#[test]
+fn with_link_prices_never_above_brute_force_chain_routes() {
+    let mut ratios = Vec::new();
+    for seed in 1..=12u64 {
+        let mut nest = random_nest(seed);
+        let mut rng = SplitMix64::new(seed ^ 0xC4A1);
+        if seed % 2 == 1 {
+            let part = nest.parts.last_mut().unwrap();
+            // The outline's corners lie evenly round its centre: their mean is the centre,
+            // and a regular polygon of radius ≥ 10 holds a circle of radius 5.
+            let corners = &part.contours[0].vertices;
+            let (x, y) = corners
+                .iter()
+                .fold((0.0, 0.0), |(x, y), v| (x + v.point.x, y + v.point.y));
+            let centre = Point::new(x / corners.len() as f64, y / corners.len() as f64);
+            part.contours.push(polygon(&mut rng, centre, 4.0, 4, true));
+        }
+        let links = LinkPrices {
+            idle_per_mm: rng.range(0.0, 2e-4),
+            cut_per_mm: rng.range(5e-4, 2e-3),
+            pierce: rng.range(0.0, 0.06),
+        };
+        let start = Point::new(-30.0, -10.0);
+        let finish = (seed % 3 == 0).then_some(Point::new(150.0, -20.0));
+        let forest = nest.containment_forest();
+        let refs: Vec<ContourRef> = nest.contour_refs().collect();
+        let region = |c: usize| {
+            let parent = forest.parent(refs[c]);
+            is_scrap_region(&forest, parent).then_some(parent)
+        };
+        let move_price = |from: Option<usize>, to: usize, d: f64| match from {
+            Some(a) if region(a).is_some() && region(a) == region(to) => {
+                (links.cut_per_mm * d).min(links.idle_per_mm * d + links.pierce)
+            }
+            _ => links.idle_per_mm * d + links.pierce,
+        };
+        let brute = brute_force_priced(&nest, start, finish, 1.0, &move_price, &|d| {
+            links.idle_per_mm * d
+        });
+        let options = LowerBoundOptions {
+            start,
+            finish,
+            budget_seconds: 2.0,
+            links: Some(links),
+            ..LowerBoundOptions::default()
+        };
+        let mut bound = CcpLowerBound::new(&nest, options).unwrap();
+        let lb = run_bound(&mut bound, 8, Duration::from_secs(3));
+        assert!(
+            lb <= brute + 1e-9,
+            "seed {seed} {links:?}: bound {lb} above the brute-force chain route {brute}"
+        );
+        ratios.push(lb / brute);
+    }
+    eprintln!("bound / brute-force chain route: {ratios:?}");
+    let least = ratios.iter().copied().fold(f64::INFINITY, f64::min);
+    assert!(least >= 0.9, "bound / brute-force chain route: {ratios:?}");
 }
 
 fn read_nest(path: &str) -> Nest {
