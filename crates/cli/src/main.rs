@@ -53,7 +53,7 @@ use cutroute_geometry::{
     ContainmentForest, Entry, MachineParameters, Nest, Objective, PathRoute, Route,
 };
 use cutroute_protocol::{
-    Document, JobRequest, Problem, Progress, Solution, SolverKind, SolverParams,
+    CostUnit, Document, JobRequest, Problem, Progress, Solution, SolverKind, SolverParams,
 };
 use serde_json::{json, Value};
 
@@ -1462,8 +1462,17 @@ fn route_report(
             step
         }).collect::<Vec<_>>(),
         "certified_contours": result.certified.iter().filter(|c| **c).count(),
-        "ub": if final_route_rejected.is_some() { Some(route.idle_length()) } else { result.bounds.upper },
+        // In the job's unit: idle mm, or (chain) the route's cost.
+        "ub": if final_route_rejected.is_some() {
+            Some(match result.bounds.unit {
+                CostUnit::Cost => machine.cost(cut_length, idle_length, pierces),
+                _ => idle_length,
+            })
+        } else {
+            result.bounds.upper
+        },
         "lb": result.bounds.lower,
+        "unit": result.bounds.unit,
         "gap": result.gap(),
         "proven_optimal": result.proven_optimal,
         "elapsed_s": result.elapsed_s,

@@ -2,7 +2,7 @@
 
 use cutroute_alns::{AlnsBuilder, AlnsOptions, AlnsSolver};
 use cutroute_anytime::AnytimeSolver;
-use cutroute_ccp::{CcpLowerBound, CcpOptions, CcpSolver, DiscreteInstance};
+use cutroute_ccp::{CcpLowerBound, CcpOptions, CcpSolver, DiscreteInstance, LinkPrices};
 use cutroute_chains::{ChainError, ChainOptions, Chained, Chaining};
 use cutroute_geometry::{MachineParameters, Nest, Route};
 use cutroute_pcgtsp::{ExactOptions, ExactSolver, Instance};
@@ -811,6 +811,33 @@ pub fn continuous_lower_bound(
     finish: Option<cutroute_geometry::Point>,
     budget: Duration,
 ) -> Result<CcpLowerBound, cutroute_ccp::CcpError> {
+    lower_bound_with(nest, start, finish, budget, None)
+}
+
+/// The certified lower bound on the cost of every chain-cutting route of `nest` (links and
+/// pierces at `machine`'s prices) less the cut of its perimeters; planned for `budget`.
+pub fn chain_lower_bound(
+    nest: &Nest,
+    start: cutroute_geometry::Point,
+    finish: Option<cutroute_geometry::Point>,
+    machine: &MachineParameters,
+    budget: Duration,
+) -> Result<CcpLowerBound, cutroute_ccp::CcpError> {
+    let links = LinkPrices {
+        idle_per_mm: machine.idle_price_per_metre * 1e-3,
+        cut_per_mm: machine.cut_price_per_metre * 1e-3,
+        pierce: machine.pierce_price,
+    };
+    lower_bound_with(nest, start, finish, budget, Some(links))
+}
+
+fn lower_bound_with(
+    nest: &Nest,
+    start: cutroute_geometry::Point,
+    finish: Option<cutroute_geometry::Point>,
+    budget: Duration,
+    links: Option<LinkPrices>,
+) -> Result<CcpLowerBound, cutroute_ccp::CcpError> {
     CcpLowerBound::new(
         nest,
         cutroute_ccp::LowerBoundOptions {
@@ -818,6 +845,7 @@ pub fn continuous_lower_bound(
             finish,
             budget_seconds: budget.as_secs_f64(),
             first_stage: (budget / 10).clamp(Duration::from_millis(500), Duration::from_secs(5)),
+            links,
             ..Default::default()
         },
     )
@@ -825,7 +853,10 @@ pub fn continuous_lower_bound(
 
 /// CCP-Relax, then chain cutting of its route (`cutroute-chains`): the CCP phase streams its
 /// progress as a CCP job does; the chaining is set up in the step after CCP ends and tries its
-/// groups in the steps after that.
+/// groups in the steps after that. Its bounds are on the route's cost (formula 1.3: what
+/// chaining minimises), and with [`ChainJob::with_lower_bound`] the certified bound of chain
+/// cutting runs beside both phases, as long as each step's route work did, and on alone after
+/// them until its first stage is done (within the limit).
 pub struct ChainJob {
     ccp: CcpJob,
     nest: Nest,
@@ -840,6 +871,22 @@ pub struct ChainJob {
     started: Instant,
     /// The job's wall-clock end: chain cutting gives up the group under way there.
     deadline: Option<Instant>,
+    /// The lower bound beside the route's search (see [`ChainJob::with_lower_bound`]).
+    bound: Option<ChainBound>,
+}
+
+/// The certified bound of a [`ChainJob`].
+struct ChainBound {
+    /// The moves' part (`cutroute_ccp::LinkPrices`).
+    moves: CcpLowerBound,
+    /// Every contour's perimeter cut, at the cut price: what every route pays besides.
+    perimeters: f64,
+    /// Whether it may still improve.
+    running: bool,
+    /// The idle length of the last route offered to it.
+    offered: f64,
+    /// When CCP-Relax, which shares the slices with it, is stopped (its share of the limit).
+    ccp_end: Instant,
 }
 
 impl ChainJob {
@@ -858,6 +905,7 @@ impl ChainJob {
             ccp_done: false,
             started: Instant::now(),
             deadline: None,
+            bound: None,
         }
     }
 
@@ -867,23 +915,45 @@ impl ChainJob {
         self.deadline = Some(started + time_limit);
         self
     }
-}
 
-impl Job for ChainJob {
-    fn stop(&mut self) {
-        // Stopped before chaining ended, the answer is CCP's route (the group under way is
-        // given up, and a later step ends the job).
-        self.ccp.stop();
-        self.ccp_done = true;
-        self.chaining = None;
-        self.deadline = Some(Instant::now());
+    /// Adds the certified lower bound of chain cutting (`bound`, from [`chain_lower_bound`]
+    /// at the job's machine) computed beside the search; CCP-Relax, whose own time no longer
+    /// keeps pace with the clock, is stopped `ccp_share` after `started`.
+    pub fn with_lower_bound(
+        mut self,
+        bound: CcpLowerBound,
+        started: Instant,
+        ccp_share: Duration,
+    ) -> Self {
+        let perimeters: f64 = self
+            .nest
+            .contour_refs()
+            .filter_map(|r| self.nest.contour(r))
+            .map(|c| c.perimeter())
+            .sum();
+        self.bound = Some(ChainBound {
+            moves: bound,
+            perimeters: perimeters * 1e-3 * self.options.machine.cut_price_per_metre,
+            running: true,
+            offered: f64::INFINITY,
+            ccp_end: started + ccp_share,
+        });
+        self
     }
 
-    fn step(&mut self, budget: Duration) -> JobStatus {
+    /// The route's part of a step: CCP-Relax, then chaining's set-up, then its groups.
+    fn step_route(&mut self, budget: Duration) -> JobStatus {
         if self.chained.is_some() || self.failure.is_some() {
             return JobStatus::Done;
         }
         if !self.ccp_done {
+            if self
+                .bound
+                .as_ref()
+                .is_some_and(|b| Instant::now() >= b.ccp_end)
+            {
+                self.ccp.stop();
+            }
             if self.ccp.step(budget) == JobStatus::Running {
                 return JobStatus::Running;
             }
@@ -925,14 +995,121 @@ impl Job for ChainJob {
         JobStatus::Done
     }
 
+    /// The best route so far: chained, else CCP's.
+    fn best_route(&self) -> Option<Route> {
+        match &self.chained {
+            Some(chained) => Some(chained.route.clone()),
+            None => self.ccp.progress().solution.and_then(Solution::into_route),
+        }
+    }
+
+    /// The bound's part of a step: `budget` at most, and within the job's limit; true while it
+    /// may still improve. Once the route is done (`route_done`) the bound works on only until
+    /// its first stage is done (in short pieces, so a long slice does not run it to the
+    /// limit), so that it does not depend on which of the two was faster.
+    fn step_bound(&mut self, budget: Duration, route_done: bool) -> bool {
+        let Some(b) = self.bound.as_mut().filter(|b| b.running) else {
+            return false;
+        };
+        match &self.chained {
+            Some(chained) if chained.route.idle_length() < b.offered => {
+                b.offered = chained.route.idle_length();
+                b.moves.offer_route(&chained.route);
+            }
+            Some(_) => {}
+            None => {
+                let state = self.ccp.solver.progress();
+                if !state.route.steps.is_empty() && state.best_idle_length < b.offered {
+                    b.offered = state.best_idle_length;
+                    b.moves.offer_route(&state.route);
+                }
+            }
+        }
+        let end = Instant::now() + budget;
+        let end = self.deadline.map_or(end, |limit| end.min(limit));
+        let piece = if route_done {
+            Duration::from_millis(50)
+        } else {
+            budget
+        };
+        loop {
+            let left = end.saturating_duration_since(Instant::now());
+            let wanted = !route_done || b.moves.stages() == 0;
+            if !wanted || left.is_zero() {
+                b.running = wanted && self.deadline.is_none_or(|limit| Instant::now() < limit);
+                return b.running;
+            }
+            if !b.moves.step(left.min(piece)) {
+                b.running = false;
+                return false;
+            }
+            if !route_done {
+                return true;
+            }
+        }
+    }
+}
+
+impl Job for ChainJob {
+    fn stop(&mut self) {
+        // Stopped before chaining ended, the answer is CCP's route (the group under way is
+        // given up, and a later step ends the job).
+        self.ccp.stop();
+        self.ccp_done = true;
+        self.chaining = None;
+        self.deadline = Some(Instant::now());
+        if let Some(b) = &mut self.bound {
+            b.running = false;
+        }
+    }
+
+    fn step(&mut self, budget: Duration) -> JobStatus {
+        let route_done = self.chained.is_some() || self.failure.is_some();
+        if route_done || self.bound.is_none() {
+            if route_done && self.step_bound(budget, true) {
+                return JobStatus::Running;
+            }
+            return self.step_route(budget);
+        }
+        // The route and the bound take turns within the slice, the bound as long as the
+        // route's part ran (so a slice of an hour does not hand the bound the whole limit
+        // while CCP-Relax ends in seconds).
+        let began = Instant::now();
+        let status = self.step_route(budget / 2);
+        let used = began.elapsed();
+        let more = self.step_bound(used.min(budget / 2), status == JobStatus::Done);
+        if status == JobStatus::Done && more {
+            JobStatus::Running
+        } else {
+            status
+        }
+    }
+
     fn progress(&self) -> Progress {
         let mut progress = self.ccp.progress();
+        // The route's cost, what chaining minimises; a CCP route is a chain route too.
+        let upper = self
+            .best_route()
+            .map(|route| route.cost(&self.nest, &self.options.machine));
+        let lower = self
+            .bound
+            .as_ref()
+            .map(|b| b.perimeters + b.moves.lower_bound());
+        progress.bounds = Bounds {
+            upper,
+            lower,
+            unit: CostUnit::Cost,
+        };
+        progress.proven_optimal = matches!(
+            (upper, lower),
+            (Some(u), Some(l)) if l >= u * (1.0 - 1e-9)
+        );
+        if self.bound.is_some() {
+            progress.elapsed_s = self.started.elapsed().as_secs_f64();
+        }
         if let Some(chained) = &self.chained {
             let r = &chained.report;
             progress.elapsed_s = self.started.elapsed().as_secs_f64();
-            progress.bounds = Bounds::idle_mm(Some(chained.route.idle_length()), None);
-            // (No lower bound: links are tool-on travel, so no bound on standard cutting's
-            // idle length holds here.)
             progress.phase = Phase::Chained {
                 saved: r.pierces_before - r.pierces_after,
                 pierces: r.pierces_before,

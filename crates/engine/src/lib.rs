@@ -344,9 +344,14 @@ fn start_solver_job(request: &JobRequest) -> Result<Box<dyn Job>, EngineError> {
                 jobs::ccp_options(*start, *finish, ccp_limit, params.seed, params.machine);
             let ccp = cutroute_ccp::CcpSolver::new(nest, options).map_err(|e| refused(e.into()))?;
             if solver == SolverKind::Chain {
+                // The bound gets about half of the slices while the route is searched.
+                let bound =
+                    jobs::chain_lower_bound(nest, *start, *finish, &params.machine, time_limit / 2)
+                        .map_err(|e| refused(e.into()))?;
                 return Ok(Box::new(
                     ChainJob::new(request.job_id, ccp, nest.clone(), params.machine)
-                        .with_time_limit(started, time_limit),
+                        .with_time_limit(started, time_limit)
+                        .with_lower_bound(bound, started, ccp_limit),
                 ));
             }
             let bound = jobs::continuous_lower_bound(nest, *start, *finish, time_limit)

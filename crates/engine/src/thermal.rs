@@ -28,7 +28,9 @@ use cutroute_ccp::HeatPenalty;
 use cutroute_geometry::{
     MachineParameters, Nest, Objective, PathRoute, PathRouteError, Route, RouteError,
 };
-use cutroute_protocol::{Phase, Progress, Solution, SolverKind, ThermalNote, ThermalSettings};
+use cutroute_protocol::{
+    CostUnit, Phase, Progress, Solution, SolverKind, ThermalNote, ThermalSettings,
+};
 use cutroute_thermal::{
     admissible_pierce_points, check_rules, contour_route_of_paths, enforce_rules,
     path_route_pierces, relax_pierce_points, route_pierces, HeatModel, RuleCheck, RuleCounts,
@@ -706,7 +708,12 @@ impl ThermalJob {
                 // every route stays sound (the rules only remove routes); the discrete one is
                 // about routes through its candidate points, which the changed route leaves.
                 // The optimality proof and the tour do not describe the changed route.
-                progress.bounds.upper = Some(route.idle_length());
+                progress.bounds.upper = Some(match progress.bounds.unit {
+                    // Chain cutting's bounds are on the route's cost.
+                    CostUnit::Cost => route.cost(&self.nest, &self.machine),
+                    CostUnit::Seconds => route.time(&self.nest, &self.machine),
+                    CostUnit::IdleMm | CostUnit::TourCost => route.idle_length(),
+                });
                 if self.discrete() {
                     progress.bounds.lower = None;
                 }

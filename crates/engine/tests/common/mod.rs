@@ -4,8 +4,8 @@
 
 use std::path::PathBuf;
 
-use cutroute_geometry::{KerfSettings, Nest};
-use cutroute_protocol::{Problem, Progress};
+use cutroute_geometry::{KerfSettings, MachineParameters, Nest};
+use cutroute_protocol::{CostUnit, Problem, Progress};
 
 /// The name and bytes of a file under `data/`; panics naming the file when it is missing.
 pub fn data(relative: &str) -> (String, Vec<u8>) {
@@ -17,9 +17,15 @@ pub fn data(relative: &str) -> (String, Vec<u8>) {
     (relative.to_string(), bytes)
 }
 
-/// The route of a nest job's result, through the independent checker; its idle length, which
-/// must be the reported upper bound.
+/// The route of a nest job's result, through the independent checker; its idle length. The
+/// reported upper bound must be the route's value in the job's unit: its idle length, or
+/// (chain cutting) its cost at the default machine's prices.
 pub fn check_route(problem: &Problem, result: &Progress) -> f64 {
+    check_route_at(problem, result, &MachineParameters::default())
+}
+
+/// [`check_route`] for a job run at `machine`'s prices.
+pub fn check_route_at(problem: &Problem, result: &Progress, machine: &MachineParameters) -> f64 {
     let Problem::Nest { nest, .. } = problem else {
         panic!("a nest")
     };
@@ -28,10 +34,15 @@ pub fn check_route(problem: &Problem, result: &Progress) -> f64 {
         .validate(nest, 1e-3)
         .expect("the route passes the independent checker");
     let idle = route.idle_length();
+    let value = match result.bounds.unit {
+        CostUnit::Cost => route.cost(nest, machine),
+        _ => idle,
+    };
     let reported = result.bounds.upper.expect("an upper bound");
     assert!(
-        (idle - reported).abs() <= 1e-6 * idle.max(1.0),
-        "reported {reported} vs recomputed {idle}"
+        (value - reported).abs() <= 1e-6 * value.max(1.0),
+        "reported {reported} vs recomputed {value} ({:?})",
+        result.bounds.unit
     );
     idle
 }
