@@ -237,6 +237,14 @@ test('the chain solver runs and its G-code (links included) reads back as the sa
   // for both, cutroute_geometry::float), so the same links.
   assertRounded(shown.cut, oracle.cut_length, 3, 'cut length (links included)');
   assertRounded(await page.textContent('#upper-bound'), oracle.ub, 1, 'upper bound');
+  // Chain cutting's bounds are on the route's cost (what it minimises), the lower one
+  // certified: below the route's cost and above the perimeters' cut at the default 1 per metre,
+  // which every route pays (so it bounds the links, idle moves and pierces too).
+  assert.equal(oracle.unit, 'Cost');
+  const lower = Number(await page.textContent('#lower-bound'));
+  const perimeters = (oracle.cut_length - oracle.link_length) * 1e-3;
+  assert.ok(lower <= oracle.ub + 0.05 && lower > perimeters + 0.05,
+    `chain LB ${lower} between the perimeters' ${perimeters} and the route's ${oracle.ub}`);
   await page.click('.export summary');
   const program = await downloader(page)('#export-gcode');
   await page.setInputFiles('#file-input', program);
