@@ -83,6 +83,7 @@ mod generator;
 mod kerf;
 mod kerf_clearance;
 mod leads;
+mod neighbours;
 mod offset_carrier;
 mod path_leads;
 mod path_route;
@@ -109,6 +110,7 @@ pub use leads::{
     chain_spans, opened_at, place_tabs, KerfSettings, LeadError, LeadFitter, LeadProblem,
     LeadShape, LeadSpec, StepLeads, Tab, TabSpec,
 };
+pub use neighbours::nearest_groups;
 pub use path_leads::PathLeads;
 pub use path_route::{PathLeadError, PathRoute, PathRouteError, ToolOnPath};
 pub use rng::{SplitMix64, Xoshiro256};

@@ -454,3 +454,48 @@ proptest! {
         prop_assert!(with.len() >= without.len());
     }
 }
+
+/// `nearest_groups` by comparing all pairs: the `k` nearest other groups by their least
+/// point-to-point distance, nearest first, ties by index.
+fn nearest_groups_by_all_pairs(groups: &[Vec<Point>], k: usize) -> Vec<Vec<usize>> {
+    (0..groups.len())
+        .map(|a| {
+            let mut d: Vec<(f64, usize)> = (0..groups.len())
+                .filter(|&b| b != a && !groups[b].is_empty())
+                .map(|b| {
+                    let d = groups[a]
+                        .iter()
+                        .flat_map(|p| groups[b].iter().map(move |q| p.distance(*q)))
+                        .fold(f64::INFINITY, f64::min);
+                    (d, b)
+                })
+                .filter(|(d, _)| d.is_finite())
+                .collect();
+            d.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+            d.truncate(k);
+            d.into_iter().map(|(_, b)| b).collect()
+        })
+        .collect()
+}
+
+proptest! {
+    /// The R-tree's neighbour lists are the all-pairs ones (random real coordinates, so no
+    /// ties), for groups of one or two points and any k.
+    #[test]
+    fn nearest_groups_are_those_of_all_pairs(
+        groups in prop::collection::vec(
+            prop::collection::vec((-100.0f64..100.0, -100.0f64..100.0), 1..3),
+            0..40,
+        ),
+        k in 0usize..8,
+    ) {
+        let groups: Vec<Vec<Point>> = groups
+            .into_iter()
+            .map(|g| g.into_iter().map(|(x, y)| Point::new(x, y)).collect())
+            .collect();
+        prop_assert_eq!(
+            cutroute_geometry::nearest_groups(&groups, k),
+            nearest_groups_by_all_pairs(&groups, k)
+        );
+    }
+}

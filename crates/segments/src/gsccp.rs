@@ -536,6 +536,13 @@ impl GsccpSearch {
             .sccp
             .time_limit
             .saturating_sub(self.started.elapsed());
+        if left.is_zero() {
+            // The limit has passed: building the ensemble (a plan graph of the whole nest,
+            // seconds on 10,000 contours) would only run past it.
+            self.not_run(k);
+            self.stage = Stage::Finished;
+            return;
+        }
         let remaining: f64 = self.options.kinds[k..].iter().map(|&x| weight(x)).sum();
         let share = left.mul_f64(weight(kind) / remaining);
         let mut report = EnsembleReport {

@@ -21,8 +21,8 @@ use std::time::Duration;
 use cutroute_anytime::{AnytimeSolver, Bounds, CostUnit, Status};
 use cutroute_ccp::HeatPenalty;
 use cutroute_geometry::{
-    BoundingBox, ContourRef, MachineParameters, PathRoute, Point, Route, Span, SplitMix64,
-    ToolOnPath,
+    nearest_groups, BoundingBox, ContourRef, MachineParameters, PathRoute, Point, Route, Span,
+    SplitMix64, ToolOnPath,
 };
 use cutroute_thermal::path_route_pierces;
 use web_time::Instant;
@@ -766,26 +766,7 @@ impl SccpSearch {
                 }
             })
             .collect();
-        let k = options.neighbours.min(n.saturating_sub(1));
-        let neighbours: Vec<Vec<usize>> = (0..n)
-            .map(|a| {
-                let mut d: Vec<(f64, usize)> = (0..n)
-                    .filter(|&b| b != a)
-                    .map(|b| {
-                        let dist = reps[a]
-                            .iter()
-                            .flat_map(|p| reps[b].iter().map(move |q| p.distance(*q)))
-                            .fold(f64::INFINITY, f64::min);
-                        (dist, b)
-                    })
-                    .collect();
-                if d.len() > k {
-                    d.select_nth_unstable_by(k, |x, y| x.0.total_cmp(&y.0));
-                    d.truncate(k);
-                }
-                d.into_iter().map(|(_, b)| b).collect()
-            })
-            .collect();
+        let neighbours = nearest_groups(&reps, options.neighbours.min(n.saturating_sub(1)));
 
         // First order: by hint rank within precedence (Kahn's algorithm with a priority queue),
         // or greedy nearest neighbour.
