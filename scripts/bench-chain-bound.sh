@@ -29,14 +29,18 @@ for nest in data/nests/dbs/nested.dbs data/nests/dbs/seven.dbs data/nests/dbs-js
   echo "$out" | NEST="$(basename "$nest")" LIMIT="$LIMIT" COST="$COST" WALL="$wall" CONTOURS="$contours" python3 -c '
 import json, os, sys
 d = json.load(sys.stdin)
-c_on, c_pt = (float(x) for x in os.environ["COST"].split(",")[1:])
+env = os.environ
+c_on, c_pt = (float(x) for x in env["COST"].split(",")[1:])
 ub, lb = d["ub"], d["lb"]
 p = (d["cut_length"] - d["link_length"]) * 1e-3 * c_on
 moves = ub - p
 gap = (ub - lb) / ub
 moves_gap = (ub - lb) / moves if moves > 0 else 0.0
 trivial = (ub - p - c_pt) / moves if moves > 0 else 0.0
-print(f"| {os.environ[\"NEST\"]} | {os.environ[\"CONTOURS\"]} | {os.environ[\"LIMIT\"]} | {os.environ[\"COST\"]} | {d[\"pierces\"]} "
-      f"| {ub:.3f} | {lb:.3f} | {100 * gap:.2f} % | {p:.3f} | {100 * moves_gap:.2f} % | {100 * trivial:.2f} % | {float(os.environ[\"WALL\"]):.2f} |")
+wall = float(env["WALL"])
+cells = [env["NEST"], env["CONTOURS"], env["LIMIT"], env["COST"], str(d["pierces"]),
+         f"{ub:.3f}", f"{lb:.3f}", f"{100 * gap:.2f} %", f"{p:.3f}",
+         f"{100 * moves_gap:.2f} %", f"{100 * trivial:.2f} %", f"{wall:.2f}"]
+print("| " + " | ".join(cells) + " |")
 ' || echo "| $(basename "$nest") | $contours | $LIMIT | $COST | failed | | | | | | | |"
 done
