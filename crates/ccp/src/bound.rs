@@ -111,6 +111,9 @@ const COST_MARGIN: f64 = 1e-9;
 /// 137 GB matrix (it did, and aborted the process) and the browser's worker stays in memory.
 pub const MAX_RELAXATION_ENTRIES: usize = 1 << 24;
 
+/// Most nodes of a relaxation whose dense matrix fits [`MAX_RELAXATION_ENTRIES`].
+const MAX_RELAXATION_NODES: usize = 1 << 12;
+
 /// First pieces of a relaxation that runs the ng-path bound.
 const NG_INITIAL_PIECES: usize = 1600;
 
@@ -140,7 +143,8 @@ pub struct LowerBoundOptions {
     /// Pieces in the first stage, shared among the kept contours by perimeter (at least 2
     /// each).
     pub initial_pieces: usize,
-    /// Refinement stops adding pieces at this many PCGTSP nodes (the cost matrix is dense).
+    /// Refinement stops adding pieces at this many PCGTSP nodes (the cost matrix is dense);
+    /// relaxations that run the ng-path bound beside the exact search use `ng_max_nodes`.
     pub max_nodes: usize,
     /// Memory the exact solver of a stage may use.
     pub memory_limit_bytes: usize,
@@ -173,6 +177,12 @@ pub struct LowerBoundOptions {
     /// seconds, it reached 3,400–4,000 in 120 s against the groups' 12,000–12,800, and the
     /// slices it took lowered the groups' sum (BENCHMARKS.md).
     pub ng_alone: bool,
+    /// Node limit of the refinement instead of `max_nodes` for relaxations that run the
+    /// ng-path bound beside the exact search (more kept contours than `ng_above`); at most
+    /// 4,096 (the dense matrix's [`MAX_RELAXATION_ENTRIES`]). Their DP passes are fast
+    /// enough for more pieces than the exact search alone: on nested.dbs 4,000 raised the
+    /// 60 s bound from ~8,360 to ~8,520 (BENCHMARKS.md).
+    pub ng_max_nodes: usize,
 }
 
 impl Default for LowerBoundOptions {
@@ -191,6 +201,7 @@ impl Default for LowerBoundOptions {
             ng_above: 24,
             exact_max_kept: EXACT_MAX_KEPT,
             ng_alone: false,
+            ng_max_nodes: 4000,
         }
     }
 }
@@ -1265,10 +1276,13 @@ impl CcpLowerBound {
         tours: &[Vec<usize>],
         at_turns: bool,
     ) -> bool {
-        let max_nodes = if self.exact_whole() {
-            self.options.max_nodes
-        } else {
+        let max_nodes = if !self.exact_whole() {
             self.options.max_nodes.min(NG_ALONE_MAX_NODES)
+        } else if self.ng_active() {
+            // Past the largest dense matrix the next stage would not be built at all.
+            self.options.ng_max_nodes.min(MAX_RELAXATION_NODES)
+        } else {
+            self.options.max_nodes
         };
         let cuts = if at_turns {
             self.cuts_at_turns(node_piece, tours, max_nodes)
