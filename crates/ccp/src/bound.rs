@@ -181,7 +181,7 @@ pub struct LowerBoundOptions {
     /// ng-path bound beside the exact search (more kept contours than `ng_above`); at most
     /// 4,096 (the dense matrix's [`MAX_RELAXATION_ENTRIES`]). Their DP passes are fast
     /// enough for more pieces than the exact search alone: on nested.dbs 4,000 raised the
-    /// 60 s bound from ~8,360 to ~8,520 (BENCHMARKS.md).
+    /// 60 s bound from ~8,360 to ~8,490 (BENCHMARKS.md).
     pub ng_max_nodes: usize,
 }
 
