@@ -60,15 +60,17 @@
 //! of that PCGTSP is sound by step 3.
 //!
 //! **Refinement.** A stage builds the instance (row by row, in slices), then runs the exact
-//! solver for a doubling time share. Then the pieces are split (in four, their neighbours in
-//! two) in order of importance until the node limit: with the ng-path bound first the pieces of
-//! the cheapest tours of the relaxation itself ([`crate::relaxed_tours`]: an iterated local
-//! search with the pieces re-chosen by a layered shortest path, run in every eighth slice; a
-//! relaxed tour that enters a long piece at one end and leaves at the other is where the
-//! relaxed optimum lies below the route), then the pieces holding the best route's pierce
-//! points, the exact search's relaxed tour and the ng-path bound's walk; and the next stage
-//! starts. Finer pieces only raise the relaxed optimum; the reported bound is the best over all
-//! stages.
+//! solver for a doubling time share. Then the pieces relaxed tours visit are split in order of
+//! importance until the node limit: with the ng-path bound first the cheapest tours of the
+//! relaxation itself ([`crate::relaxed_tours`]: an iterated local search with the pieces
+//! re-chosen by a layered shortest path, run in every eighth slice; a relaxed tour that enters
+//! a long piece at one end and leaves at the other is where the relaxed optimum lies below the
+//! route), then the best route, the exact search's relaxed tour and the ng-path bound's walk;
+//! and the next stage starts. With the ng-path bound a visited piece is cut once, halfway
+//! between its points nearest to the tour's previous and next pieces (where the relaxation
+//! charges the move in and the move out), else it is split in four; its neighbours along the
+//! contour are halved. Finer pieces only raise the relaxed optimum; the reported bound is the
+//! best over all stages.
 //!
 //! ```
 //! use cutroute_ccp::{CcpLowerBound, LowerBoundOptions};
@@ -116,6 +118,9 @@ const COST_MARGIN: f64 = 1e-9;
 /// 137 GB matrix (it did, and aborted the process) and the browser's worker stays in memory.
 pub const MAX_RELAXATION_ENTRIES: usize = 1 << 24;
 
+/// Most nodes of a relaxation whose dense matrix fits [`MAX_RELAXATION_ENTRIES`].
+const MAX_RELAXATION_NODES: usize = 1 << 12;
+
 /// First pieces of a relaxation that runs the ng-path bound.
 const NG_INITIAL_PIECES: usize = 1600;
 
@@ -145,7 +150,8 @@ pub struct LowerBoundOptions {
     /// Pieces in the first stage, shared among the kept contours by perimeter (at least 2
     /// each).
     pub initial_pieces: usize,
-    /// Refinement stops adding pieces at this many PCGTSP nodes (the cost matrix is dense).
+    /// Refinement stops adding pieces at this many PCGTSP nodes (the cost matrix is dense);
+    /// relaxations that run the ng-path bound beside the exact search use `ng_max_nodes`.
     pub max_nodes: usize,
     /// Memory the exact solver of a stage may use.
     pub memory_limit_bytes: usize,
@@ -182,6 +188,12 @@ pub struct LowerBoundOptions {
     /// (see [`LinkPrices`]), and the bound is on the moves' prices instead of idle length.
     /// `None`: every move is idle, the bound is in mm.
     pub links: Option<LinkPrices>,
+    /// Node limit of the refinement instead of `max_nodes` for relaxations that run the
+    /// ng-path bound beside the exact search (more kept contours than `ng_above`); at most
+    /// 4,096 (the dense matrix's [`MAX_RELAXATION_ENTRIES`]). Their DP passes are fast
+    /// enough for more pieces than the exact search alone: on nested.dbs 4,000 raised the
+    /// 60 s bound from ~8,360 to ~8,490 (BENCHMARKS.md).
+    pub ng_max_nodes: usize,
 }
 
 /// Prices of the moves between pierce points of chain cutting (`cutroute-chains`), per mm and
@@ -246,6 +258,7 @@ impl Default for LowerBoundOptions {
             exact_max_kept: EXACT_MAX_KEPT,
             ng_alone: false,
             links: None,
+            ng_max_nodes: 4000,
         }
     }
 }
@@ -321,6 +334,31 @@ impl PieceShape {
             .iter()
             .fold(BoundingBox::default(), |acc, b| acc.union(*b));
         PieceShape { spans, boxes, bbox }
+    }
+
+    /// A single point as a shape (a span of no length).
+    fn point(p: Point) -> Self {
+        PieceShape::new(vec![Span::line(p, p)])
+    }
+
+    /// The arc length along the contour of this piece's point nearest to `other`, the piece
+    /// beginning at arc length `start` (its spans in order along the contour).
+    fn nearest_length(&self, start: f64, other: &PieceShape) -> f64 {
+        let (mut best, mut at) = (f64::INFINITY, start);
+        let mut offset = start;
+        for (s, sb) in self.spans.iter().zip(&self.boxes) {
+            let length = s.length();
+            if sb.distance_to_box(&other.bbox) < best {
+                for o in &other.spans {
+                    let q = s.nearest_point_to_span(o);
+                    if q.distance < best {
+                        (best, at) = (q.distance, offset + q.t * length);
+                    }
+                }
+            }
+            offset += length;
+        }
+        at
     }
 
     fn distance_to_point(&self, p: Point) -> f64 {
@@ -961,22 +999,18 @@ impl CcpLowerBound {
                         tours.add_start(&s.instance, ng.last_walk());
                         tours.step(&s.instance, Instant::now());
                     }
-                    let mut marked: Vec<usize> = Vec::new();
-                    if let Some(tours) = &s.tours {
-                        for (_, tour) in tours.pool() {
-                            marked.extend_from_slice(tour);
-                        }
+                    let mut tours: Vec<Vec<usize>> = Vec::new();
+                    if let Some(search) = &s.tours {
+                        tours.extend(search.pool().iter().map(|(_, tour)| tour.clone()));
                     }
-                    if let Some(tour) = self.incumbent_tour(&s.node_piece) {
-                        marked.extend_from_slice(&tour);
-                    }
-                    marked.extend(progress.and_then(|p| p.best_tour).unwrap_or_default());
+                    tours.extend(self.incumbent_tour(&s.node_piece));
+                    tours.extend(progress.and_then(|p| p.best_tour));
                     if let Some(ng) = &s.ng {
-                        marked.extend_from_slice(ng.last_walk());
+                        tours.push(ng.last_walk().to_vec());
                     }
                     // With no piece left to split, the next stage reruns the same pieces
                     // with twice the time.
-                    self.refine(&s.node_piece, Some(&marked));
+                    self.refine(&s.node_piece, &tours, s.tours.is_some());
                     if !self.own.is_empty() {
                         // A group's stage is over: the decomposition picks who goes next.
                         return true;
@@ -1344,27 +1378,78 @@ impl CcpLowerBound {
         s.exact_over || s.spent >= s.share || (s.solver.is_none() && !s.ng_running)
     }
 
-    /// Splits the pieces of `marked` (relaxed tours' nodes, most important first) in four
-    /// and halves their neighbours along the contour (the next relaxed optimum tends to move
-    /// next door), in that order until the node limit; then the pieces holding the
-    /// incumbent's pierce points. False when no piece could be split (node limit or tiny
-    /// pieces).
-    fn refine(&mut self, node_piece: &[(usize, usize)], marked: Option<&[usize]>) -> bool {
-        let max_nodes = if self.exact_whole() {
-            self.options.max_nodes
-        } else {
+    /// Splits pieces where the relaxed `tours` (node sequences of the stage's instance, most
+    /// important first; depot nodes are skipped) may gain, in order until the node limit; false
+    /// when no piece could be split (node limit or tiny pieces).
+    ///
+    /// With `at_turns` (the relaxations that run the ng-path bound) a tour's visit to a piece
+    /// is split once, between the points where the relaxation charges the move in and the
+    /// move out ([`CcpLowerBound::cuts_at_turns`]): after the split each part holds only one
+    /// of them. Without it, the visited pieces are split in four
+    /// ([`CcpLowerBound::cuts_in_parts`]). Either way their neighbours along the contour are
+    /// halved (the next relaxed optimum tends to move next door).
+    fn refine(
+        &mut self,
+        node_piece: &[(usize, usize)],
+        tours: &[Vec<usize>],
+        at_turns: bool,
+    ) -> bool {
+        let max_nodes = if !self.exact_whole() {
             self.options.max_nodes.min(NG_ALONE_MAX_NODES)
+        } else if self.ng_active() {
+            // Past the largest dense matrix the next stage would not be built at all.
+            self.options.ng_max_nodes.min(MAX_RELAXATION_NODES)
+        } else {
+            self.options.max_nodes
         };
-        // Parts per piece: 1 keeps it, 2 halves it, 4 quarters it; granted in the order of
-        // `marked`, so that at the node limit the most important pieces are the split ones
-        // (not the first contours').
+        let cuts = if at_turns {
+            self.cuts_at_turns(node_piece, tours, max_nodes)
+        } else {
+            self.cuts_in_parts(node_piece, tours, max_nodes)
+        };
+        let mut split_any = false;
+        for (leaf, pieces) in self.pieces.iter_mut().enumerate() {
+            let mut out = Vec::with_capacity(pieces.len() + 8);
+            for (k, &(a, b)) in pieces.iter().enumerate() {
+                let mut at = cuts[leaf][k].clone();
+                at.sort_by(f64::total_cmp);
+                split_any |= !at.is_empty();
+                let mut from = a;
+                for c in at {
+                    out.push((from, c));
+                    from = c;
+                }
+                out.push((from, b));
+            }
+            *pieces = out;
+        }
+        split_any
+    }
+
+    /// Least length of a piece's part (relative rounding of the arc lengths).
+    fn min_part(&self, leaf: usize) -> f64 {
+        1e-6 * (1.0 + self.leaves[leaf].perimeter())
+    }
+
+    /// Cuts (arc lengths strictly inside each piece, per leaf and piece) that split the pieces
+    /// `tours` visit in four and halve their neighbours, granted in the tours' order while
+    /// the node count stays within `max_nodes`, then the pieces holding the incumbent's pierce
+    /// points.
+    fn cuts_in_parts(
+        &self,
+        node_piece: &[(usize, usize)],
+        tours: &[Vec<usize>],
+        max_nodes: usize,
+    ) -> Vec<Vec<Vec<f64>>> {
+        // Parts per piece: 1 keeps it, 2 halves it, 4 quarters it; granted in the tours'
+        // order, so that at the node limit the most important pieces are the split ones (not
+        // the first contours').
         let mut parts: Vec<Vec<usize>> = self.pieces.iter().map(|p| vec![1; p.len()]).collect();
         let mut nodes = self.node_count();
         let mut grant = |leaf: usize, k: usize, n: usize, pieces: &[(f64, f64)]| {
             let (a, b) = pieces[k];
-            let min_length = 1e-6 * (1.0 + self.leaves[leaf].perimeter());
             let old = parts[leaf][k];
-            if n > old && b - a > n as f64 * min_length && nodes + n - old <= max_nodes {
+            if n > old && b - a > n as f64 * self.min_part(leaf) && nodes + n - old <= max_nodes {
                 nodes += n - old;
                 parts[leaf][k] = n;
             }
@@ -1379,9 +1464,9 @@ impl CcpLowerBound {
                 Some((leaf, k))
             })
             .collect();
-        let marks = marked
-            .unwrap_or(&[])
+        let marks = tours
             .iter()
+            .flatten()
             .filter_map(|&v| v.checked_sub(1).and_then(|i| node_piece.get(i)).copied())
             .chain(incumbent_nodes);
         for (leaf, k) in marks {
@@ -1392,30 +1477,124 @@ impl CcpLowerBound {
                 grant(leaf, j, 2, pieces);
             }
         }
-        let mut split_any = false;
-        for (leaf, pieces) in self.pieces.iter_mut().enumerate() {
-            let mut out = Vec::with_capacity(pieces.len() + 8);
-            for (k, &(a, b)) in pieces.iter().enumerate() {
-                let n = parts[leaf][k];
-                if n > 1 {
-                    out.extend((0..n).map(|i| {
-                        (
-                            a + (b - a) * i as f64 / n as f64,
-                            if i + 1 == n {
-                                b
-                            } else {
-                                a + (b - a) * (i + 1) as f64 / n as f64
-                            },
-                        )
-                    }));
-                    split_any = true;
-                } else {
-                    out.push((a, b));
+        self.pieces
+            .iter()
+            .zip(&parts)
+            .map(|(pieces, parts)| {
+                pieces
+                    .iter()
+                    .zip(parts)
+                    .map(|(&(a, b), &n)| {
+                        (1..n).map(|i| a + (b - a) * i as f64 / n as f64).collect()
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+
+    /// Cuts (as [`CcpLowerBound::cuts_in_parts`]) where the tours turn: for each visit of a
+    /// tour, in the tours' order while the node count stays within `max_nodes`, one cut at the
+    /// midpoint of the stretch between the points where the visit is charged for entering and
+    /// for leaving its piece ([`CcpLowerBound::turn_split`]), unless a cut already lies in the
+    /// middle half of that stretch; then the piece's neighbours along the contour are halved
+    /// unless already cut (with the piece split, the next relaxed optimum tends to move next
+    /// door). On nested.dbs at 2,500 nodes one such cut raised the cheapest relaxed tour
+    /// about twice as much per node as quartering the visited piece.
+    fn cuts_at_turns(
+        &self,
+        node_piece: &[(usize, usize)],
+        tours: &[Vec<usize>],
+        max_nodes: usize,
+    ) -> Vec<Vec<Vec<f64>>> {
+        let mut cuts: Vec<Vec<Vec<f64>>> = self
+            .pieces
+            .iter()
+            .map(|p| vec![Vec::new(); p.len()])
+            .collect();
+        let visits = |tour: &[usize]| -> Vec<usize> {
+            tour.iter()
+                .copied()
+                .filter(|&v| v > 0 && v <= node_piece.len())
+                .collect()
+        };
+        let mut shapes: Vec<Option<PieceShape>> = vec![None; node_piece.len()];
+        for v in tours.iter().flat_map(|t| visits(t)) {
+            if shapes[v - 1].is_none() {
+                let (leaf, k) = node_piece[v - 1];
+                let (a, b) = self.pieces[leaf][k];
+                shapes[v - 1] = Some(PieceShape::new(self.leaves[leaf].piece_spans(a, b)));
+            }
+        }
+        let start = PieceShape::point(self.options.start);
+        let finish = self.options.finish.map(PieceShape::point);
+        let mut nodes = self.node_count();
+        for tour in tours {
+            let visits = visits(tour);
+            for (i, &v) in visits.iter().enumerate() {
+                let (leaf, k) = node_piece[v - 1];
+                let from = match i.checked_sub(1) {
+                    Some(j) => shapes[visits[j] - 1].as_ref(),
+                    None => Some(&start),
+                };
+                // After the last visit the tail goes to the outermost contour around it, else
+                // to the finish; an open route without either ends in the piece (no exit).
+                let to = match visits.get(i + 1) {
+                    Some(&w) => shapes[w - 1].as_ref(),
+                    None => self.leaves[leaf]
+                        .outermost
+                        .and_then(|o| self.outermost_shapes.get(&o))
+                        .or(finish.as_ref()),
+                };
+                let (Some(from), Some(to), Some(piece)) = (from, to, shapes[v - 1].as_ref()) else {
+                    continue;
+                };
+                let Some((entry, exit)) = self.turn_split(leaf, k, piece, from, to) else {
+                    continue;
+                };
+                let min_part = self.min_part(leaf);
+                let cut = 0.5 * (entry + exit);
+                let here = &cuts[leaf][k];
+                let (a, b) = self.pieces[leaf][k];
+                let taken = here
+                    .iter()
+                    .any(|&c| (c - cut).abs() < 0.25 * (entry - exit).abs());
+                let room = [a, b]
+                    .iter()
+                    .chain(here)
+                    .all(|&c| (c - cut).abs() > min_part);
+                if !taken && room && nodes < max_nodes {
+                    cuts[leaf][k].push(cut);
+                    nodes += 1;
+                }
+                let n = self.pieces[leaf].len();
+                for j in [(k + n - 1) % n, (k + 1) % n] {
+                    let (a, b) = self.pieces[leaf][j];
+                    if cuts[leaf][j].is_empty() && b - a > 2.0 * min_part && nodes < max_nodes {
+                        cuts[leaf][j].push(0.5 * (a + b));
+                        nodes += 1;
+                    }
                 }
             }
-            *pieces = out;
         }
-        split_any
+        cuts
+    }
+
+    /// The arc lengths of the points of piece `k` of kept contour `leaf` (whose shape is
+    /// `piece`) nearest to `from` and to `to`: where a relaxed tour that comes from `from` and
+    /// goes on to `to` is charged for entering and for leaving the piece. `None` when they are
+    /// too close to be told apart by a cut.
+    fn turn_split(
+        &self,
+        leaf: usize,
+        k: usize,
+        piece: &PieceShape,
+        from: &PieceShape,
+        to: &PieceShape,
+    ) -> Option<(f64, f64)> {
+        let (a, b) = self.pieces[leaf][k];
+        let entry = piece.nearest_length(a, from).clamp(a, b);
+        let exit = piece.nearest_length(a, to).clamp(a, b);
+        ((entry - exit).abs() > 2.0 * self.min_part(leaf)).then_some((entry, exit))
     }
 }
 
@@ -1545,7 +1724,7 @@ mod tests {
                 let (leaf, k) = node_piece[marked[0] - 1];
                 let first = bound.pieces[leaf][k];
                 let before = bound.node_count();
-                bound.refine(&node_piece, Some(&marked));
+                bound.refine(&node_piece, &[marked], false);
                 assert!(bound.node_count() <= max_nodes.max(before));
                 if before + 3 <= max_nodes {
                     assert!(
@@ -1561,6 +1740,125 @@ mod tests {
                         assert_eq!(w[0].1, w[1].0, "a gap or overlap between pieces");
                     }
                     assert!(pieces.iter().all(|&(a, b)| a < b), "an empty piece");
+                }
+            }
+        }
+    }
+
+    /// Splitting at the turns of relaxed tours: every visit whose entry and exit points lie
+    /// apart gets a piece boundary strictly between them while there is room (so neither part
+    /// holds both), the pieces stay a partition of `[0, perimeter]`, and the node limit
+    /// holds; open and closed routes, outermost contours around the kept ones or not.
+    #[test]
+    fn splits_at_turns_separate_entry_and_exit_within_the_node_limit() {
+        let framed = {
+            let mut nest = grid_nest(3, 2);
+            nest.parts.push(Part {
+                name: "frame".into(),
+                contours: vec![Contour::new(vec![
+                    Vertex::line(-5.0, -5.0),
+                    Vertex::line(-5.0, 35.0),
+                    Vertex::line(55.0, 35.0),
+                    Vertex::line(55.0, -5.0),
+                ])],
+            });
+            nest
+        };
+        let mut rng = 0x2545_f491_4f6c_dd1du64;
+        let mut next = move || {
+            rng ^= rng >> 12;
+            rng ^= rng << 25;
+            rng ^= rng >> 27;
+            rng.wrapping_mul(0x9e37_79b9_7f4a_7c15) as usize
+        };
+        for (nest, finish) in [
+            (grid_nest(3, 2), None),
+            (grid_nest(3, 2), Some(Point::new(70.0, 50.0))),
+            (framed, None),
+        ] {
+            for max_nodes in [10, 30, 400] {
+                let options = LowerBoundOptions {
+                    start: Point::new(-20.0, 7.0),
+                    finish,
+                    initial_pieces: 12,
+                    max_nodes,
+                    group_size: 0,
+                    ng_size: 0,
+                    ..LowerBoundOptions::default()
+                };
+                let mut bound = CcpLowerBound::new(&nest, options).unwrap();
+                let clusters = bound.leaves.len();
+                for _ in 0..6 {
+                    let node_piece: Vec<(usize, usize)> = bound
+                        .pieces
+                        .iter()
+                        .enumerate()
+                        .flat_map(|(leaf, p)| (0..p.len()).map(move |k| (leaf, k)))
+                        .collect();
+                    let first_node: Vec<usize> = (0..clusters)
+                        .map(|leaf| 1 + node_piece.iter().position(|&(l, _)| l == leaf).unwrap())
+                        .collect();
+                    // A random order of the contours, a random piece of each, after the depot.
+                    let mut order: Vec<usize> = (0..clusters).collect();
+                    for i in (1..order.len()).rev() {
+                        order.swap(i, next() % (i + 1));
+                    }
+                    let mut tour = vec![0];
+                    tour.extend(
+                        order
+                            .iter()
+                            .map(|&leaf| first_node[leaf] + next() % bound.pieces[leaf].len()),
+                    );
+                    let shape = |b: &CcpLowerBound, v: usize| {
+                        let (leaf, k) = node_piece[v - 1];
+                        let (x, y) = b.pieces[leaf][k];
+                        PieceShape::new(b.leaves[leaf].piece_spans(x, y))
+                    };
+                    let start = PieceShape::point(bound.options.start);
+                    let mut stretches = Vec::new();
+                    for i in 1..tour.len() {
+                        let (leaf, k) = node_piece[tour[i] - 1];
+                        let from = if i == 1 {
+                            start.clone()
+                        } else {
+                            shape(&bound, tour[i - 1])
+                        };
+                        let to = match tour.get(i + 1) {
+                            Some(&w) => Some(shape(&bound, w)),
+                            None => bound.leaves[leaf]
+                                .outermost
+                                .and_then(|o| bound.outermost_shapes.get(&o).cloned())
+                                .or(finish.map(PieceShape::point)),
+                        };
+                        let Some(to) = to else { continue };
+                        let piece = shape(&bound, tour[i]);
+                        if let Some((entry, exit)) = bound.turn_split(leaf, k, &piece, &from, &to) {
+                            let (a, b) = bound.pieces[leaf][k];
+                            assert!(a <= entry.min(exit) && entry.max(exit) <= b);
+                            stretches.push((leaf, entry.min(exit), entry.max(exit)));
+                        }
+                    }
+                    let before = bound.node_count();
+                    bound.refine(&node_piece, &[tour], true);
+                    assert!(bound.node_count() <= max_nodes.max(before));
+                    if bound.node_count() + 1 < max_nodes {
+                        // Room was left, so no visit was refused its cut.
+                        for &(leaf, lo, hi) in &stretches {
+                            assert!(
+                                bound.pieces[leaf].iter().any(|&(a, _)| lo < a && a < hi),
+                                "entry {lo} and exit {hi} still in one piece of contour {leaf}"
+                            );
+                        }
+                    }
+                    for (leaf, pieces) in bound.pieces.iter().enumerate() {
+                        let perimeter = bound.leaves[leaf].perimeter();
+                        assert_eq!(pieces[0].0, 0.0);
+                        assert_eq!(pieces.last().unwrap().1, perimeter);
+                        for w in pieces.windows(2) {
+                            assert_eq!(w[0].1, w[1].0, "a gap or overlap between pieces");
+                        }
+                        assert!(pieces.iter().all(|&(a, b)| a < b), "an empty piece");
+                    }
                 }
             }
         }

@@ -744,6 +744,48 @@ impl Span {
         best
     }
 
+    /// The point of this span nearest to `other`, with its parameter and its distance to
+    /// `other` (the set distance of [`Span::distance_to_span`], to rounding): where an idle
+    /// move from or to `other` reaches this span at its shortest. A meeting point when they
+    /// meet; else the best of the candidates the set distance is attained at (this span's
+    /// ends, its points nearest to the other's ends, and its points where a line normal to
+    /// both can meet it, from either side). Which point among several equally near ones is
+    /// unspecified.
+    pub fn nearest_point_to_span(&self, other: &Span) -> SpanProjection {
+        if let Some(x) = self.intersections(other).first() {
+            return SpanProjection {
+                t: x.t_self,
+                point: x.point,
+                distance: 0.0,
+            };
+        }
+        let at = |t: f64| {
+            let point = self.point_at(t);
+            SpanProjection {
+                t,
+                point,
+                distance: other.distance_to(point),
+            }
+        };
+        // The other's points where the least distance can be attained, carried onto this span
+        // by their nearest points.
+        let from_other = [other.start, other.end]
+            .into_iter()
+            .chain(other.normal_candidates(self))
+            .map(|p| self.nearest_point(p).t);
+        let own = self
+            .normal_candidates(other)
+            .into_iter()
+            .map(|p| self.parameter_of(p).clamp(0.0, 1.0));
+        [0.0, 1.0]
+            .into_iter()
+            .chain(from_other)
+            .chain(own)
+            .map(at)
+            .min_by(|a, b| a.distance.total_cmp(&b.distance))
+            .unwrap_or_else(|| at(0.0))
+    }
+
     /// Points of this arc (none for a segment) where a line normal to it can also be normal to
     /// `other`: the arc's points in the direction (±) of the other's centre, or of the other
     /// segment's normal.

@@ -153,6 +153,29 @@ proptest! {
     }
 
     #[test]
+    fn nearest_point_to_a_span_attains_the_set_distance(
+        s in span(),
+        o in span(),
+        shift in prop_oneof![Just(Point::new(0.0, 0.0)), point(), point().prop_map(|p| p * 3.0)],
+    ) {
+        let o = Span::new(o.start + shift, o.end + shift, o.bulge);
+        let n = s.nearest_point_to_span(&o);
+        // A point of this span at its parameter, whose distance to the other is the one given …
+        prop_assert!((0.0..=1.0).contains(&n.t));
+        let tol = 1e-7 * (1.0 + s.length() + o.length() + n.distance);
+        prop_assert!(s.point_at(n.t).distance(n.point) <= tol);
+        prop_assert!((o.distance_to(n.point) - n.distance).abs() <= tol);
+        // … and that is the set distance, so no sampled point of this span is nearer.
+        prop_assert!((n.distance - s.distance_to_span(&o)).abs() <= tol,
+            "{} vs set distance {}", n.distance, s.distance_to_span(&o));
+        let sampled = samples(&s, 600)
+            .iter()
+            .map(|p| o.distance_to(*p))
+            .fold(f64::INFINITY, f64::min);
+        prop_assert!(n.distance <= sampled + tol, "{} above sampled {}", n.distance, sampled);
+    }
+
+    #[test]
     fn span_bounding_box_is_exact(s in span()) {
         let b = s.bounding_box();
         let pts = samples(&s, 4000);
