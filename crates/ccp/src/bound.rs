@@ -1675,6 +1675,20 @@ mod tests {
     use super::*;
     use cutroute_geometry::{Contour, Part, Vertex};
 
+    /// Every kept contour's pieces are a partition of `[0, perimeter]` into contiguous,
+    /// non-empty intervals.
+    fn assert_pieces_partition(bound: &CcpLowerBound) {
+        for (leaf, pieces) in bound.pieces.iter().enumerate() {
+            let perimeter = bound.leaves[leaf].perimeter();
+            assert_eq!(pieces[0].0, 0.0);
+            assert_eq!(pieces.last().unwrap().1, perimeter);
+            for w in pieces.windows(2) {
+                assert_eq!(w[0].1, w[1].0, "a gap or overlap between pieces");
+            }
+            assert!(pieces.iter().all(|&(a, b)| a < b), "an empty piece");
+        }
+    }
+
     fn grid_nest(columns: usize, rows: usize) -> Nest {
         let square = |x: f64, y: f64| Part {
             name: format!("square at {x},{y}"),
@@ -1732,15 +1746,7 @@ mod tests {
                         "the first marked piece was not split"
                     );
                 }
-                for (leaf, pieces) in bound.pieces.iter().enumerate() {
-                    let perimeter = bound.leaves[leaf].perimeter();
-                    assert_eq!(pieces[0].0, 0.0);
-                    assert_eq!(pieces.last().unwrap().1, perimeter);
-                    for w in pieces.windows(2) {
-                        assert_eq!(w[0].1, w[1].0, "a gap or overlap between pieces");
-                    }
-                    assert!(pieces.iter().all(|&(a, b)| a < b), "an empty piece");
-                }
+                assert_pieces_partition(&bound);
             }
         }
     }
@@ -1850,15 +1856,7 @@ mod tests {
                             );
                         }
                     }
-                    for (leaf, pieces) in bound.pieces.iter().enumerate() {
-                        let perimeter = bound.leaves[leaf].perimeter();
-                        assert_eq!(pieces[0].0, 0.0);
-                        assert_eq!(pieces.last().unwrap().1, perimeter);
-                        for w in pieces.windows(2) {
-                            assert_eq!(w[0].1, w[1].0, "a gap or overlap between pieces");
-                        }
-                        assert!(pieces.iter().all(|&(a, b)| a < b), "an empty piece");
-                    }
+                    assert_pieces_partition(&bound);
                 }
             }
         }
