@@ -481,12 +481,12 @@ impl PlanGraph {
     pub fn components(&self) -> Result<Vec<PlanComponent>, EmbeddingError> {
         let graph = &self.graph;
         let mut component = vec![usize::MAX; graph.vertex_count()];
-        let mut result = Vec::new();
+        let mut members: Vec<Vec<usize>> = Vec::new();
         for root in 0..graph.vertex_count() {
             if component[root] != usize::MAX {
                 continue;
             }
-            let id = result.len();
+            let id = members.len();
             let mut vertices = vec![root];
             component[root] = id;
             let mut i = 0;
@@ -500,12 +500,19 @@ impl PlanGraph {
                 }
                 i += 1;
             }
+            members.push(vertices);
+        }
+        // Each component's edges in increasing order, in one pass over the edges (a pass per
+        // component was quadratic: 0.3 s per call on 10,000 contours).
+        let mut edges_of: Vec<Vec<usize>> = vec![Vec::new(); members.len()];
+        for e in 0..graph.edge_count() {
+            edges_of[component[graph.ends(e).0]].push(e);
+        }
+        let mut result = Vec::with_capacity(members.len());
+        for (mut vertices, edges) in members.into_iter().zip(edges_of) {
             vertices.sort_unstable();
             let local: HashMap<usize, usize> =
                 vertices.iter().enumerate().map(|(i, &v)| (v, i)).collect();
-            let edges: Vec<usize> = (0..graph.edge_count())
-                .filter(|&e| component[graph.ends(e).0] == id)
-                .collect();
             let edge_local: HashMap<usize, usize> =
                 edges.iter().enumerate().map(|(i, &e)| (e, i)).collect();
             let ends: Vec<(usize, usize)> = edges
