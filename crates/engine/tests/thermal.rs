@@ -11,7 +11,8 @@ use cutroute_engine::{
 };
 use cutroute_geometry::{MachineParameters, Nest, Objective, PathRoute, PathRouteError};
 use cutroute_protocol::{
-    JobRequest, Problem, Progress, RuleSet, Solution, SolverKind, SolverParams, ThermalSettings,
+    CostUnit, JobRequest, Problem, Progress, RuleSet, Solution, SolverKind, SolverParams,
+    ThermalSettings,
 };
 use cutroute_thermal::route_pierces;
 
@@ -109,16 +110,22 @@ fn hard_rules_leave_no_violation_on_every_contour_route_solver() {
                 1e-3
             )
         );
-        let idle = route.idle_length();
+        // The bounds are the repaired route's value in the job's unit: idle length, or (chain
+        // cutting) the route's cost.
+        let value = match result.bounds.unit {
+            CostUnit::Cost => route.cost(nest_of(&problem), &MachineParameters::default()),
+            _ => route.idle_length(),
+        };
         let ub = result.bounds.upper.expect("an upper bound");
         assert!(
-            (idle - ub).abs() <= 1e-6 * idle,
-            "{solver:?}: ub {ub} vs idle {idle}"
+            (value - ub).abs() <= 1e-6 * value,
+            "{solver:?}: ub {ub} vs the route's {value} ({:?})",
+            result.bounds.unit
         );
         if let Some(lb) = result.bounds.lower {
             assert!(
-                lb <= idle + 1e-6,
-                "{solver:?}: lb {lb} above the route {idle}"
+                lb <= value + 1e-6,
+                "{solver:?}: lb {lb} above the route {value}"
             );
         }
         let h = heat_by_definition(&problem, &result, &hard);
