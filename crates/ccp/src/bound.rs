@@ -52,7 +52,10 @@
 //! the tail after the last one runs inside or leaves. Each group is small enough to be solved
 //! exactly, so the sum of the groups' bounds is a certified bound; the reported bound is the
 //! larger of it and the whole relaxation's. What it loses is the travel across the group
-//! borders, little where groups are separated by space, much on tightly packed sheets.
+//! borders, little where groups are separated by space, much on tightly packed sheets. Where
+//! nothing solves the whole relaxation (more kept contours than the exact search's keys hold),
+//! the groups are the bound, and they are made wide (`wide_group_size`) and run the ng-path
+//! bound below: fewer borders lose less than small groups solved exactly gain.
 //!
 //! **The ng-path bound** ([`NgPathBound`], more kept contours than `ng_above`) runs on the whole
 //! relaxation's instance beside its exact search, and, with `ng_alone`, alone where the exact
@@ -136,6 +139,12 @@ const ESCALATE_PASSES: usize = 24;
 /// Most groups of the decomposition bound.
 const MAX_GROUPS: usize = 64;
 
+/// Node limit of a group's relaxation with the ng-path bound (wide groups): their DP passes
+/// are what limits them, not their pieces (on Nest02, groups of 90 in 60 s of the bound's own
+/// time: 14,800 at 4,000 nodes, 15,357–16,074 at 2,500, 16,746–16,784 at 2,000, 16,524 at
+/// 1,700).
+const GROUP_NG_MAX_NODES: usize = 2000;
+
 /// Most kept contours for which the whole relaxation's exact search runs (its keys hold at
 /// most 256 clusters).
 const EXACT_MAX_KEPT: usize = 256;
@@ -165,6 +174,13 @@ pub struct LowerBoundOptions {
     /// per group and reports the larger of the whole relaxation's bound and the groups' sum.
     /// 0: no decomposition.
     pub group_size: usize,
+    /// Most kept contours per group where the whole relaxation is not solved (more kept
+    /// contours than the exact search's keys hold, without `ng_alone`): the groups are then
+    /// the whole bound, and groups this large run the ng-path bound, which loses far less at
+    /// fewer borders than small groups solved exactly gain inside them (Nest02 in 100 s of the
+    /// bound's own time: groups of 16 reached 13,501, of 60 16,944, of 90 17,471, of 130
+    /// 16,643; BENCHMARKS.md). Ignored where `group_size` is larger.
+    pub wide_group_size: usize,
     /// Decompose only with more kept contours than this: up to about 22 the whole relaxation
     /// is solved exactly stage after stage and converges on its own, and groups would only
     /// take its time.
@@ -252,6 +268,7 @@ impl Default for LowerBoundOptions {
             first_stage: Duration::from_millis(500),
             budget_seconds: 10.0,
             group_size: 16,
+            wide_group_size: 90,
             decompose_above: 24,
             ng_size: 8,
             ng_above: 24,
@@ -554,7 +571,7 @@ impl CcpLowerBound {
             // A price moves by at most the dearer price per mm as the distance does.
             margin *= links.idle_per_mm.max(links.cut_per_mm);
         }
-        let group_size = options.group_size;
+        let mut group_size = options.group_size;
         let mut bound = CcpLowerBound::from_leaves(
             leaves,
             outermost_shapes,
@@ -563,6 +580,12 @@ impl CcpLowerBound {
             Arc::new(Vec::new()),
             Vec::new(),
         );
+        // Where nothing solves the whole relaxation, the groups are the bound: wide ones, each
+        // with the ng-path bound.
+        let whole_solved = bound.exact_whole() || (bound.options.ng_alone && bound.ng_active());
+        if group_size > 0 && !whole_solved && bound.options.ng_size > 0 {
+            group_size = group_size.max(bound.options.wide_group_size);
+        }
         // Beyond MAX_GROUPS groups each would get too little time to count, and the sheets
         // that large do not fit a relaxation anyway.
         // (Not with links: a group's region argument charges lengths inside the regions, and a
@@ -710,6 +733,7 @@ impl CcpLowerBound {
                 group_size: 0,
                 // Groups are small: the test threshold is the whole relaxation's only.
                 exact_max_kept: EXACT_MAX_KEPT,
+                ng_max_nodes: GROUP_NG_MAX_NODES.min(self.options.ng_max_nodes),
                 ..self.options.clone()
             };
             let absorbed: Vec<bool> = leaves

@@ -578,6 +578,82 @@ fn the_groups_sum_never_above_brute_force() {
     );
 }
 
+/// Where nothing solves the whole relaxation (more kept contours than the exact search's keys,
+/// forced to 1 here, and no `ng_alone`), the groups are `wide_group_size` large and run the
+/// ng-path bound beside their exact search: their sum is never above a brute-force route, on
+/// random and packed nests, open and closed, and it is not trivial.
+#[test]
+fn wide_groups_with_the_ng_path_bound_never_above_brute_force() {
+    let mut positive = 0;
+    let mut cases = 0;
+    for seed in 1..=8u64 {
+        for (nest, h) in [(random_nest(seed), 0.25), (packed_nest(seed), 1.0)] {
+            let start = Point::new(-30.0, -10.0);
+            let finish = (seed % 3 == 0).then_some(Point::new(150.0, -20.0));
+            let options = LowerBoundOptions {
+                start,
+                finish,
+                budget_seconds: 2.0,
+                group_size: 1,
+                wide_group_size: 2,
+                decompose_above: 0,
+                ng_size: 8,
+                ng_above: 0,
+                exact_max_kept: 1,
+                ..LowerBoundOptions::default()
+            };
+            let mut bound = CcpLowerBound::new(&nest, options).unwrap();
+            let kept = bound.kept_contours();
+            if kept <= 2 {
+                assert_eq!(
+                    bound.group_count(),
+                    0,
+                    "seed {seed}: groups of two are wide"
+                );
+                continue;
+            }
+            assert!(
+                bound.group_count() >= 2 && bound.group_count() < kept,
+                "seed {seed}: {} groups of {kept} kept contours, not groups of two",
+                bound.group_count()
+            );
+            let brute = brute_force(&nest, start, finish, h);
+            let ccp = solve(
+                &nest,
+                CcpOptions {
+                    start,
+                    finish,
+                    time_limit: Duration::from_millis(300),
+                    ..CcpOptions::default()
+                },
+                &mut |_| {},
+            )
+            .unwrap();
+            bound.offer_route(&ccp.route);
+            let lb = run_bound(&mut bound, usize::MAX, Duration::from_secs(2));
+            let sum = bound.group_sum();
+            cases += 1;
+            positive += usize::from(sum > 0.05 * brute);
+            assert_eq!(
+                bound.whole_bound(),
+                0.0,
+                "seed {seed}: the whole relaxation ran"
+            );
+            assert!(
+                sum <= brute + 1e-9 && lb <= brute + 1e-9,
+                "seed {seed}: groups' sum {sum}, bound {lb}, brute force {brute}"
+            );
+            assert!(lb <= ccp.metrics.idle_length + 1e-9);
+        }
+    }
+    assert!(cases >= 8, "only {cases} cases had groups");
+    assert!(
+        positive * 2 >= cases,
+        "the groups' sum was trivial in {} of {cases} cases",
+        cases - positive
+    );
+}
+
 /// The ng-path bound on the whole relaxation (forced on small nests, neighbourhoods of 2 and 8
 /// contours) is never above a brute-force route, on random and packed nests, open and closed;
 /// and it is not trivial.
