@@ -2,8 +2,10 @@
 //! sum of the spatial groups' bounds) on a nest, over time, with CCP's route guiding both.
 //!
 //! `cargo run --release -p cutroute-ccp --example group_bound -- data/nests/dbs/nested.dbs 16 60`
-//! (nest, group size (0: no groups; also the wide groups' size), seconds of the bound's own time; CCP runs 10 s first;
-//! then optionally a window `x0 y0 x1 y1`: only the parts inside it).
+//! (nest, group size (0: no groups), seconds of the bound's own time; CCP runs 10 s first;
+//! then optionally a window `x0 y0 x1 y1`: only the parts inside it). Where the whole
+//! relaxation is not solved, wide groups (`LowerBoundOptions::wide_group_size`) may take over
+//! from groups of a smaller size; a size of at least that runs groups of that size alone.
 
 use std::time::Duration;
 
@@ -51,7 +53,6 @@ fn main() {
         budget_seconds: seconds,
         first_stage: Duration::from_secs_f64((seconds / 10.0).clamp(0.5, 5.0)),
         group_size,
-        wide_group_size: group_size,
         decompose_above: 0,
         ..LowerBoundOptions::default()
     };

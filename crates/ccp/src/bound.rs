@@ -179,8 +179,17 @@ pub struct LowerBoundOptions {
     /// the whole bound, and groups this large run the ng-path bound, which loses far less at
     /// fewer borders than small groups solved exactly gain inside them (Nest02 in 100 s of the
     /// bound's own time: groups of 16 reached 13,501, of 60 16,944, of 90 17,471, of 130
-    /// 16,643; BENCHMARKS.md). Ignored where `group_size` is larger.
+    /// 16,643; BENCHMARKS.md). They take over from the small groups only where these lose
+    /// much (`wide_below`); 0 or at most `group_size`: never.
     pub wide_group_size: usize,
+    /// Where wide groups may take over: once every small group has finished its first stage,
+    /// they give way to wide ones if their sum is below this share of the best route offered.
+    /// Small groups lose the travel across their borders, which on a tightly packed sheet is
+    /// most of it (Nest02: 0.22 of its route after their short first stages, 0.36 with four
+    /// times the share), and little where parts lie apart (a generated 1,000-contour sheet:
+    /// 0.67 and 0.72; there wide groups, whose stages take longer, reached 18,124 in 40 s
+    /// against the small ones' 22,240). The best sum of the small groups stays a bound.
+    pub wide_below: f64,
     /// Decompose only with more kept contours than this: up to about 22 the whole relaxation
     /// is solved exactly stage after stage and converges on its own, and groups would only
     /// take its time.
@@ -269,6 +278,7 @@ impl Default for LowerBoundOptions {
             budget_seconds: 10.0,
             group_size: 16,
             wide_group_size: 90,
+            wide_below: 0.5,
             decompose_above: 24,
             ng_size: 8,
             ng_above: 24,
@@ -486,6 +496,14 @@ pub struct CcpLowerBound {
     groups_running: Vec<bool>,
     /// Whether this bound's own relaxation (of all its kept contours) may still improve.
     own_running: bool,
+    /// The size of the wide groups that may take over from the small ones (0: none pending),
+    /// the small groups' sum when they gave way (a bound that stays), and the last route
+    /// offered (for the wide groups' refinement).
+    wide_size: usize,
+    floor: f64,
+    last_route: Option<Route>,
+    /// In a small group that wide ones may replace: its first stage is a short probe.
+    probe: bool,
     /// Slices handed out so far (the own relaxation gets one of four beside the groups, three
     /// with the ng-path bound).
     turns: usize,
@@ -571,7 +589,7 @@ impl CcpLowerBound {
             // A price moves by at most the dearer price per mm as the distance does.
             margin *= links.idle_per_mm.max(links.cut_per_mm);
         }
-        let mut group_size = options.group_size;
+        let group_size = options.group_size;
         let mut bound = CcpLowerBound::from_leaves(
             leaves,
             outermost_shapes,
@@ -580,22 +598,33 @@ impl CcpLowerBound {
             Arc::new(Vec::new()),
             Vec::new(),
         );
-        // Where nothing solves the whole relaxation, the groups are the bound: wide ones, each
-        // with the ng-path bound.
-        let whole_solved = bound.exact_whole() || (bound.options.ng_alone && bound.ng_active());
-        if group_size > 0 && !whole_solved && bound.options.ng_size > 0 {
-            group_size = group_size.max(bound.options.wide_group_size);
-        }
         // Beyond MAX_GROUPS groups each would get too little time to count, and the sheets
         // that large do not fit a relaxation anyway.
         // (Not with links: a group's region argument charges lengths inside the regions, and a
         // pierce on a way that crosses a border belongs to neither side.)
-        if group_size > 0
-            && bound.options.links.is_none()
-            && bound.leaves.len() > group_size.max(bound.options.decompose_above)
-            && bound.leaves.len() <= MAX_GROUPS * group_size
-        {
+        let fits = |size: usize, bound: &CcpLowerBound| {
+            size > 0
+                && bound.options.links.is_none()
+                && bound.leaves.len() > size.max(bound.options.decompose_above)
+                && bound.leaves.len() <= MAX_GROUPS * size
+        };
+        // Where nothing solves the whole relaxation, the groups are the bound, and wide ones
+        // with the ng-path bound may take over from the small ones (`wide_below`).
+        let whole_solved = bound.exact_whole() || (bound.options.ng_alone && bound.ng_active());
+        let wide = bound.options.wide_group_size;
+        let wide_pending = !whole_solved
+            && bound.options.ng_size > 0
+            && wide > group_size
+            && group_size > 0
+            && fits(wide, &bound);
+        if fits(group_size, &bound) {
+            if wide_pending {
+                bound.wide_size = wide;
+            }
             bound.decompose(group_size);
+        } else if wide_pending {
+            // Too many kept contours for small groups: wide ones from the start.
+            bound.decompose(wide);
         }
         // The exact search keys hold at most 256 clusters: beyond, the whole relaxation runs
         // the ng-path bound alone (its own DP needs no keys) when asked, or not at all (its
@@ -673,6 +702,10 @@ impl CcpLowerBound {
             groups: Vec::new(),
             groups_running: Vec::new(),
             own_running: true,
+            wide_size: 0,
+            floor: 0.0,
+            last_route: None,
+            probe: false,
             turns: 0,
             ng_lambda: Vec::new(),
             ng_best: 0.0,
@@ -728,10 +761,23 @@ impl CcpLowerBound {
                 // Finer first pieces than the whole relaxation: a group's exact search is
                 // cheap, and its bound is only as good as its pieces.
                 initial_pieces: (12 * leaves.len()).min(self.options.initial_pieces),
-                first_stage: (self.options.first_stage / 4).max(Duration::from_millis(100)),
+                // Wide groups run the ng-path bound, whose passes a stage's rebuild restarts: they
+                // get the whole relaxation's first share (Nest02, groups of 90, 60 s of the
+                // bound's own time: 16,932 with a quarter of it, 17,858–18,079 with all of it,
+                // 17,331 with twice it).
+                // Small groups that wide ones may replace first tell whether they should, in a
+                // sixty-fourth of the share (Nest02's 25 groups took 17 s with a quarter of 5 s
+                // each, ~3 s with this; the sums they tell by are lower, see `wide_below`).
+                first_stage: if leaves.len() > self.options.ng_above && self.options.ng_size > 0 {
+                    self.options.first_stage
+                } else if self.wide_size > size {
+                    (self.options.first_stage / 64).max(Duration::from_millis(100))
+                } else {
+                    (self.options.first_stage / 4).max(Duration::from_millis(100))
+                },
                 budget_seconds: (2.0 * self.options.budget_seconds / count as f64).max(2.0),
                 group_size: 0,
-                // Groups are small: the test threshold is the whole relaxation's only.
+                // Groups fit the exact search's keys: the test threshold is the whole relaxation's only.
                 exact_max_kept: EXACT_MAX_KEPT,
                 ng_max_nodes: GROUP_NG_MAX_NODES.min(self.options.ng_max_nodes),
                 ..self.options.clone()
@@ -761,6 +807,7 @@ impl CcpLowerBound {
                 own,
             );
             bound.absorbed = absorbed;
+            bound.probe = self.wide_size > size;
             bound.foreign_outlines = foreign_outlines;
             self.groups.push(bound);
             self.groups_running.push(true);
@@ -812,13 +859,10 @@ impl CcpLowerBound {
     }
 
     /// The best certified lower bound so far (mm of idle travel; 0 before the first stage):
-    /// the whole relaxation's, or the sum of the groups' bounds when larger.
+    /// the whole relaxation's, or the sum of the groups' bounds (or of the small groups', when
+    /// wide ones took over) when larger.
     pub fn lower_bound(&self) -> f64 {
-        if self.groups.is_empty() {
-            self.best
-        } else {
-            self.best.max(self.group_sum())
-        }
+        self.best.max(self.group_sum()).max(self.floor)
     }
 
     /// The decomposition's bound: the sum of the groups' bounds (0 without groups).
@@ -829,6 +873,11 @@ impl CcpLowerBound {
     /// Groups of the decomposition bound (0: none).
     pub fn group_count(&self) -> usize {
         self.groups.len()
+    }
+
+    /// Whether wide groups may still take over from the small ones (`wide_below`).
+    pub fn wide_pending(&self) -> bool {
+        self.wide_size > 0
     }
 
     /// The best ng-path bound on the whole relaxation so far (0 when it does not run).
@@ -886,6 +935,53 @@ impl CcpLowerBound {
         for group in &mut self.groups {
             group.offer_route(route);
         }
+        if self.wide_size > 0 {
+            self.last_route = Some(route.clone());
+        }
+    }
+
+    /// Once every small group has finished its first stage: wide groups take over if the
+    /// small ones' sum is below `wide_below` of the best route, else the small ones stay.
+    fn maybe_widen(&mut self) {
+        if self.wide_size == 0 {
+            return;
+        }
+        let first_stages_done = self
+            .groups
+            .iter()
+            .zip(&self.groups_running)
+            .all(|(g, &running)| !g.probe || !running);
+        if !first_stages_done {
+            return;
+        }
+        let size = std::mem::take(&mut self.wide_size);
+        let sum = self.group_sum();
+        debug_log(|| {
+            format!(
+                "small groups' first stages: sum {sum:.3} = {:.3} of the route",
+                sum / self.incumbent_length
+            )
+        });
+        // (Without a route the threshold is infinite: wide groups, unless `wide_below` is 0.)
+        let widen = sum < self.options.wide_below * self.incumbent_length;
+        if !widen {
+            // The small groups stay, with their usual shares from now on.
+            let first_stage = (self.options.first_stage / 4).max(Duration::from_millis(100));
+            for group in &mut self.groups {
+                group.options.first_stage = first_stage;
+            }
+            self.last_route = None;
+            return;
+        }
+        self.floor = self.floor.max(sum);
+        self.groups.clear();
+        self.groups_running.clear();
+        self.decompose(size);
+        if let Some(route) = self.last_route.take() {
+            for group in &mut self.groups {
+                group.offer_route(&route);
+            }
+        }
     }
 
     /// Works for about `budget`; returns false when nothing is left to do (the bound is exact
@@ -906,6 +1002,7 @@ impl CcpLowerBound {
     /// One slice of the decomposition: to the group that has had the least time so far, or to
     /// the whole relaxation (which stays the bound where groups lose much at their borders).
     fn step_shared(&mut self, deadline: Instant) -> bool {
+        self.maybe_widen();
         self.turns += 1;
         // A group in the middle of a stage keeps the groups' turns until that stage ends, and
         // only then the group that has had the least time so far starts its next one: so at
@@ -988,6 +1085,13 @@ impl CcpLowerBound {
                     let finished = self.solve_slice(&mut s, deadline);
                     if !finished {
                         self.stage = Some(Stage::Solving(s));
+                        return true;
+                    }
+                    if std::mem::take(&mut self.probe) {
+                        // A small group's probe (see `wide_below`): its bound counts, but it
+                        // neither counts as a stage nor refines (the pieces it would add
+                        // slowed every later stage: a generated 1,000-contour sheet's bound
+                        // at 60 s fell by 2 %), so the usual stages follow as before.
                         return true;
                     }
                     self.stages_done += 1;

@@ -579,9 +579,11 @@ fn the_groups_sum_never_above_brute_force() {
 }
 
 /// Where nothing solves the whole relaxation (more kept contours than the exact search's keys,
-/// forced to 1 here, and no `ng_alone`), the groups are `wide_group_size` large and run the
-/// ng-path bound beside their exact search: their sum is never above a brute-force route, on
-/// random and packed nests, open and closed, and it is not trivial.
+/// forced to 1 here, and no `ng_alone`), groups of `wide_group_size` that run the ng-path bound
+/// beside their exact search take over from the small groups once these have made their first
+/// stages, if their sum is below `wide_below` of the route (always here; never with 0): the
+/// bound is never above a brute-force route, on random and packed nests, open and closed, and
+/// it is not trivial.
 #[test]
 fn wide_groups_with_the_ng_path_bound_never_above_brute_force() {
     let mut positive = 0;
@@ -596,26 +598,33 @@ fn wide_groups_with_the_ng_path_bound_never_above_brute_force() {
                 budget_seconds: 2.0,
                 group_size: 1,
                 wide_group_size: 2,
+                wide_below: f64::INFINITY,
                 decompose_above: 0,
                 ng_size: 8,
                 ng_above: 0,
                 exact_max_kept: 1,
                 ..LowerBoundOptions::default()
             };
+            let mut stays_small = CcpLowerBound::new(
+                &nest,
+                LowerBoundOptions {
+                    wide_below: 0.0,
+                    ..options.clone()
+                },
+            )
+            .unwrap();
             let mut bound = CcpLowerBound::new(&nest, options).unwrap();
             let kept = bound.kept_contours();
             if kept <= 2 {
-                assert_eq!(
-                    bound.group_count(),
-                    0,
-                    "seed {seed}: groups of two are wide"
-                );
+                // No wide groups of two: the small groups of one stay.
+                assert!(!bound.wide_pending(), "seed {seed}");
                 continue;
             }
-            assert!(
-                bound.group_count() >= 2 && bound.group_count() < kept,
-                "seed {seed}: {} groups of {kept} kept contours, not groups of two",
-                bound.group_count()
+            assert!(bound.wide_pending(), "seed {seed}: no wide groups pending");
+            assert_eq!(
+                bound.group_count(),
+                kept,
+                "seed {seed}: groups of one first"
             );
             let brute = brute_force(&nest, start, finish, h);
             let ccp = solve(
@@ -632,6 +641,18 @@ fn wide_groups_with_the_ng_path_bound_never_above_brute_force() {
             bound.offer_route(&ccp.route);
             let lb = run_bound(&mut bound, usize::MAX, Duration::from_secs(2));
             let sum = bound.group_sum();
+            assert!(
+                !bound.wide_pending() && bound.group_count() >= 2 && bound.group_count() < kept,
+                "seed {seed}: {} groups of {kept} kept contours, not groups of two",
+                bound.group_count()
+            );
+            stays_small.offer_route(&ccp.route);
+            let small = run_bound(&mut stays_small, usize::MAX, Duration::from_secs(2));
+            assert_eq!(stays_small.group_count(), kept, "seed {seed}: widened");
+            assert!(
+                small <= brute + 1e-9,
+                "seed {seed}: small groups {small} above {brute}"
+            );
             cases += 1;
             positive += usize::from(sum > 0.05 * brute);
             assert_eq!(
