@@ -54,8 +54,10 @@
 //! larger of it and the whole relaxation's. What it loses is the travel across the group
 //! borders, little where groups are separated by space, much on tightly packed sheets. Where
 //! nothing solves the whole relaxation (more kept contours than the exact search's keys hold),
-//! the groups are the bound, and they are made wide (`wide_group_size`) and run the ng-path
-//! bound below: fewer borders lose less than small groups solved exactly gain.
+//! the groups are the bound; where the small groups' first sum shows that their borders lose
+//! most of the route (`wide_below`: tightly packed sheets), wide groups (`wide_group_size`)
+//! that run the ng-path bound below take over: fewer borders lose less than small groups
+//! solved exactly gain.
 //!
 //! **The ng-path bound** ([`NgPathBound`], more kept contours than `ng_above`) runs on the whole
 //! relaxation's instance beside its exact search, and, with `ng_alone`, alone where the exact
