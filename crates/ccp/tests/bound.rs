@@ -6,7 +6,7 @@
 use std::time::Duration;
 
 use cutroute_ccp::{
-    containment_pairs, solve, CcpLowerBound, CcpOptions, LinkPrices, LowerBoundOptions,
+    containment_pairs, solve, CcpLowerBound, CcpOptions, CcpResult, LinkPrices, LowerBoundOptions,
 };
 use cutroute_geometry::{
     is_scrap_region, Contour, ContourRef, Nest, Part, Point, SplitMix64, Vertex,
@@ -152,6 +152,18 @@ fn permute(v: &mut [usize], k: usize, f: &mut dyn FnMut(&[usize])) {
     }
 }
 
+/// CCP-Relax's route of `nest` within `limit` (the route that guides the bound, as in the
+/// engine's job).
+fn ccp_route(nest: &Nest, start: Point, finish: Option<Point>, limit: Duration) -> CcpResult {
+    let options = CcpOptions {
+        start,
+        finish,
+        time_limit: limit,
+        ..CcpOptions::default()
+    };
+    solve(nest, options, &mut |_| {}).unwrap()
+}
+
 /// Runs the bound for up to `stages` stages or `limit` of its own time.
 fn run_bound(bound: &mut CcpLowerBound, stages: usize, limit: Duration) -> f64 {
     while bound.stages() < stages
@@ -176,17 +188,7 @@ fn never_above_brute_force_and_close_to_it_on_random_small_nests() {
         };
         let mut bound = CcpLowerBound::new(&nest, options).unwrap();
         // The best CCP route guides the refinement, as in the engine's job.
-        let ccp = solve(
-            &nest,
-            CcpOptions {
-                start,
-                finish,
-                time_limit: Duration::from_secs(1),
-                ..CcpOptions::default()
-            },
-            &mut |_| {},
-        )
-        .unwrap();
+        let ccp = ccp_route(&nest, start, finish, Duration::from_secs(1));
         bound.offer_route(&ccp.route);
         let lb = run_bound(&mut bound, 8, Duration::from_secs(3));
         assert!(
@@ -294,17 +296,7 @@ fn never_above_the_ccp_route_on_the_real_nests() {
         let nest = read_nest(path);
         let start = Point::new(0.0, 0.0);
         for finish in [None, Some(start)] {
-            let ccp = solve(
-                &nest,
-                CcpOptions {
-                    start,
-                    finish,
-                    time_limit: Duration::from_secs(2),
-                    ..CcpOptions::default()
-                },
-                &mut |_| {},
-            )
-            .unwrap();
+            let ccp = ccp_route(&nest, start, finish, Duration::from_secs(2));
             let options = LowerBoundOptions {
                 start,
                 finish,
@@ -517,6 +509,21 @@ fn packed_nest(seed: u64) -> Nest {
     Nest { sheet: None, parts }
 }
 
+/// The small nests the bounds are tried on against brute force: per seed 1–8 a random nest
+/// (brute force's step 0.25 mm) and a packed one (1 mm), from one start, open or (every third
+/// seed) closed.
+fn small_cases() -> Vec<(u64, Nest, f64, Point, Option<Point>)> {
+    (1..=8u64)
+        .flat_map(|seed| {
+            let start = Point::new(-30.0, -10.0);
+            let finish = (seed % 3 == 0).then_some(Point::new(150.0, -20.0));
+            [(random_nest(seed), 0.25), (packed_nest(seed), 1.0)]
+                .into_iter()
+                .map(move |(nest, h)| (seed, nest, h, start, finish))
+        })
+        .collect()
+}
+
 /// The decomposition bound (the sum of the spatial groups' bounds, each group charged only
 /// for the length a route runs inside its region) is never above a brute-force route, with
 /// groups of one and two kept contours (the most borders), on random and packed nests, open
@@ -525,49 +532,35 @@ fn packed_nest(seed: u64) -> Nest {
 fn the_groups_sum_never_above_brute_force() {
     let mut positive = 0;
     let mut cases = 0;
-    for seed in 1..=8u64 {
-        for (nest, h) in [(random_nest(seed), 0.25), (packed_nest(seed), 1.0)] {
-            let start = Point::new(-30.0, -10.0);
-            let finish = (seed % 3 == 0).then_some(Point::new(150.0, -20.0));
-            let brute = brute_force(&nest, start, finish, h);
-            for group_size in [1, 2] {
-                let options = LowerBoundOptions {
-                    start,
-                    finish,
-                    budget_seconds: 2.0,
-                    group_size,
-                    decompose_above: 0,
-                    ..LowerBoundOptions::default()
-                };
-                let mut bound = CcpLowerBound::new(&nest, options).unwrap();
-                if bound.kept_contours() <= group_size {
-                    assert_eq!(bound.group_count(), 0);
-                    continue;
-                }
-                assert!(bound.group_count() >= 2, "seed {seed}: no groups");
-                let ccp = solve(
-                    &nest,
-                    CcpOptions {
-                        start,
-                        finish,
-                        time_limit: Duration::from_millis(300),
-                        ..CcpOptions::default()
-                    },
-                    &mut |_| {},
-                )
-                .unwrap();
-                bound.offer_route(&ccp.route);
-                let lb = run_bound(&mut bound, usize::MAX, Duration::from_secs(2));
-                let sum = bound.group_sum();
-                cases += 1;
-                positive += usize::from(sum > 0.05 * brute);
-                assert!(
-                    sum <= brute + 1e-9,
-                    "seed {seed}, groups of {group_size}: sum {sum} above brute force {brute}"
-                );
-                assert!(lb <= brute + 1e-9, "seed {seed}: bound {lb} above {brute}");
-                assert!(lb >= sum && lb >= bound.whole_bound());
+    for (seed, nest, h, start, finish) in small_cases() {
+        let brute = brute_force(&nest, start, finish, h);
+        for group_size in [1, 2] {
+            let options = LowerBoundOptions {
+                start,
+                finish,
+                budget_seconds: 2.0,
+                group_size,
+                decompose_above: 0,
+                ..LowerBoundOptions::default()
+            };
+            let mut bound = CcpLowerBound::new(&nest, options).unwrap();
+            if bound.kept_contours() <= group_size {
+                assert_eq!(bound.group_count(), 0);
+                continue;
             }
+            assert!(bound.group_count() >= 2, "seed {seed}: no groups");
+            let ccp = ccp_route(&nest, start, finish, Duration::from_millis(300));
+            bound.offer_route(&ccp.route);
+            let lb = run_bound(&mut bound, usize::MAX, Duration::from_secs(2));
+            let sum = bound.group_sum();
+            cases += 1;
+            positive += usize::from(sum > 0.05 * brute);
+            assert!(
+                sum <= brute + 1e-9,
+                "seed {seed}, groups of {group_size}: sum {sum} above brute force {brute}"
+            );
+            assert!(lb <= brute + 1e-9, "seed {seed}: bound {lb} above {brute}");
+            assert!(lb >= sum && lb >= bound.whole_bound());
         }
     }
     assert!(cases >= 16, "only {cases} cases had groups");
@@ -588,84 +581,70 @@ fn the_groups_sum_never_above_brute_force() {
 fn wide_groups_with_the_ng_path_bound_never_above_brute_force() {
     let mut positive = 0;
     let mut cases = 0;
-    for seed in 1..=8u64 {
-        for (nest, h) in [(random_nest(seed), 0.25), (packed_nest(seed), 1.0)] {
-            let start = Point::new(-30.0, -10.0);
-            let finish = (seed % 3 == 0).then_some(Point::new(150.0, -20.0));
-            let options = LowerBoundOptions {
-                start,
-                finish,
-                budget_seconds: 2.0,
-                group_size: 1,
-                wide_group_size: 2,
-                wide_below: f64::INFINITY,
-                decompose_above: 0,
-                ng_size: 8,
-                ng_above: 0,
-                exact_max_kept: 1,
-                ..LowerBoundOptions::default()
-            };
-            let mut stays_small = CcpLowerBound::new(
-                &nest,
-                LowerBoundOptions {
-                    wide_below: 0.0,
-                    ..options.clone()
-                },
-            )
-            .unwrap();
-            let mut bound = CcpLowerBound::new(&nest, options).unwrap();
-            let kept = bound.kept_contours();
-            if kept <= 2 {
-                // No wide groups of two: the small groups of one stay.
-                assert!(!bound.wide_pending(), "seed {seed}");
-                continue;
-            }
-            assert!(bound.wide_pending(), "seed {seed}: no wide groups pending");
-            assert_eq!(
-                bound.group_count(),
-                kept,
-                "seed {seed}: groups of one first"
-            );
-            let brute = brute_force(&nest, start, finish, h);
-            let ccp = solve(
-                &nest,
-                CcpOptions {
-                    start,
-                    finish,
-                    time_limit: Duration::from_millis(300),
-                    ..CcpOptions::default()
-                },
-                &mut |_| {},
-            )
-            .unwrap();
-            bound.offer_route(&ccp.route);
-            let lb = run_bound(&mut bound, usize::MAX, Duration::from_secs(2));
-            let sum = bound.group_sum();
-            assert!(
-                !bound.wide_pending() && bound.group_count() >= 2 && bound.group_count() < kept,
-                "seed {seed}: {} groups of {kept} kept contours, not groups of two",
-                bound.group_count()
-            );
-            stays_small.offer_route(&ccp.route);
-            let small = run_bound(&mut stays_small, usize::MAX, Duration::from_secs(2));
-            assert_eq!(stays_small.group_count(), kept, "seed {seed}: widened");
-            assert!(
-                small <= brute + 1e-9,
-                "seed {seed}: small groups {small} above {brute}"
-            );
-            cases += 1;
-            positive += usize::from(sum > 0.05 * brute);
-            assert_eq!(
-                bound.whole_bound(),
-                0.0,
-                "seed {seed}: the whole relaxation ran"
-            );
-            assert!(
-                sum <= brute + 1e-9 && lb <= brute + 1e-9,
-                "seed {seed}: groups' sum {sum}, bound {lb}, brute force {brute}"
-            );
-            assert!(lb <= ccp.metrics.idle_length + 1e-9);
+    for (seed, nest, h, start, finish) in small_cases() {
+        let options = LowerBoundOptions {
+            start,
+            finish,
+            budget_seconds: 2.0,
+            group_size: 1,
+            wide_group_size: 2,
+            wide_below: f64::INFINITY,
+            decompose_above: 0,
+            ng_size: 8,
+            ng_above: 0,
+            exact_max_kept: 1,
+            ..LowerBoundOptions::default()
+        };
+        let mut stays_small = CcpLowerBound::new(
+            &nest,
+            LowerBoundOptions {
+                wide_below: 0.0,
+                ..options.clone()
+            },
+        )
+        .unwrap();
+        let mut bound = CcpLowerBound::new(&nest, options).unwrap();
+        let kept = bound.kept_contours();
+        if kept <= 2 {
+            // No wide groups of two: the small groups of one stay.
+            assert!(!bound.wide_pending(), "seed {seed}");
+            continue;
         }
+        assert!(bound.wide_pending(), "seed {seed}: no wide groups pending");
+        assert_eq!(
+            bound.group_count(),
+            kept,
+            "seed {seed}: groups of one first"
+        );
+        let brute = brute_force(&nest, start, finish, h);
+        let ccp = ccp_route(&nest, start, finish, Duration::from_millis(300));
+        bound.offer_route(&ccp.route);
+        let lb = run_bound(&mut bound, usize::MAX, Duration::from_secs(2));
+        let sum = bound.group_sum();
+        assert!(
+            !bound.wide_pending() && bound.group_count() >= 2 && bound.group_count() < kept,
+            "seed {seed}: {} groups of {kept} kept contours, not groups of two",
+            bound.group_count()
+        );
+        stays_small.offer_route(&ccp.route);
+        let small = run_bound(&mut stays_small, usize::MAX, Duration::from_secs(2));
+        assert_eq!(stays_small.group_count(), kept, "seed {seed}: widened");
+        assert!(
+            small <= brute + 1e-9,
+            "seed {seed}: small groups {small} above {brute}"
+        );
+        cases += 1;
+        positive += usize::from(sum > 0.05 * brute);
+        assert_eq!(
+            bound.whole_bound(),
+            0.0,
+            "seed {seed}: the whole relaxation ran"
+        );
+        assert!(
+            sum <= brute + 1e-9 && lb <= brute + 1e-9,
+            "seed {seed}: groups' sum {sum}, bound {lb}, brute force {brute}"
+        );
+        assert!(lb <= ccp.metrics.idle_length + 1e-9);
     }
     assert!(cases >= 8, "only {cases} cases had groups");
     assert!(
@@ -682,44 +661,30 @@ fn wide_groups_with_the_ng_path_bound_never_above_brute_force() {
 fn the_ng_path_bound_never_above_brute_force() {
     let mut strong = 0;
     let mut cases = 0;
-    for seed in 1..=8u64 {
-        for (nest, h) in [(random_nest(seed), 0.25), (packed_nest(seed), 1.0)] {
-            let start = Point::new(-30.0, -10.0);
-            let finish = (seed % 3 == 0).then_some(Point::new(150.0, -20.0));
-            let brute = brute_force(&nest, start, finish, h);
-            let ccp = solve(
-                &nest,
-                CcpOptions {
-                    start,
-                    finish,
-                    time_limit: Duration::from_millis(300),
-                    ..CcpOptions::default()
-                },
-                &mut |_| {},
-            )
-            .unwrap();
-            for ng_size in [2, 8] {
-                let options = LowerBoundOptions {
-                    start,
-                    finish,
-                    budget_seconds: 2.0,
-                    group_size: 0,
-                    ng_size,
-                    ng_above: 0,
-                    ..LowerBoundOptions::default()
-                };
-                let mut bound = CcpLowerBound::new(&nest, options).unwrap();
-                bound.offer_route(&ccp.route);
-                let lb = run_bound(&mut bound, 4, Duration::from_secs(2));
-                let ng = bound.ng_bound();
-                cases += 1;
-                strong += usize::from(ng >= 0.8 * brute);
-                assert!(
-                    ng <= brute + 1e-9 && lb <= brute + 1e-9,
-                    "seed {seed}, ng {ng_size}: ng-path bound {ng}, bound {lb}, brute force {brute}"
-                );
-                assert!(lb <= ccp.metrics.idle_length + 1e-9);
-            }
+    for (seed, nest, h, start, finish) in small_cases() {
+        let brute = brute_force(&nest, start, finish, h);
+        let ccp = ccp_route(&nest, start, finish, Duration::from_millis(300));
+        for ng_size in [2, 8] {
+            let options = LowerBoundOptions {
+                start,
+                finish,
+                budget_seconds: 2.0,
+                group_size: 0,
+                ng_size,
+                ng_above: 0,
+                ..LowerBoundOptions::default()
+            };
+            let mut bound = CcpLowerBound::new(&nest, options).unwrap();
+            bound.offer_route(&ccp.route);
+            let lb = run_bound(&mut bound, 4, Duration::from_secs(2));
+            let ng = bound.ng_bound();
+            cases += 1;
+            strong += usize::from(ng >= 0.8 * brute);
+            assert!(
+                ng <= brute + 1e-9 && lb <= brute + 1e-9,
+                "seed {seed}, ng {ng_size}: ng-path bound {ng}, bound {lb}, brute force {brute}"
+            );
+            assert!(lb <= ccp.metrics.idle_length + 1e-9);
         }
     }
     assert!(
@@ -738,54 +703,40 @@ fn the_ng_path_bound_never_above_brute_force() {
 fn the_ng_path_bound_without_the_exact_search_never_above_brute_force() {
     let mut strong = 0;
     let mut cases = 0;
-    for seed in 1..=8u64 {
-        for (nest, h) in [(random_nest(seed), 0.25), (packed_nest(seed), 1.0)] {
-            let start = Point::new(-30.0, -10.0);
-            let finish = (seed % 3 == 0).then_some(Point::new(150.0, -20.0));
-            let brute = brute_force(&nest, start, finish, h);
-            let ccp = solve(
-                &nest,
-                CcpOptions {
-                    start,
-                    finish,
-                    time_limit: Duration::from_millis(300),
-                    ..CcpOptions::default()
-                },
-                &mut |_| {},
-            )
-            .unwrap();
-            let options = LowerBoundOptions {
-                start,
-                finish,
-                budget_seconds: 2.0,
-                group_size: 2,
-                decompose_above: 0,
-                ng_size: 8,
-                ng_above: 0,
-                exact_max_kept: 1,
-                ng_alone: true,
-                ..LowerBoundOptions::default()
-            };
-            let mut bound = CcpLowerBound::new(&nest, options).unwrap();
-            if bound.kept_contours() <= 2 {
-                continue;
-            }
-            assert!(bound.group_count() >= 2, "seed {seed}: no groups");
-            bound.offer_route(&ccp.route);
-            let lb = run_bound(&mut bound, usize::MAX, Duration::from_secs(2));
-            let ng = bound.ng_bound();
-            cases += 1;
-            strong += usize::from(ng >= 0.8 * brute);
-            // Without the exact search only the ng-path bound raises the whole relaxation's.
-            assert_eq!(bound.whole_bound(), ng, "seed {seed}: the exact search ran");
-            assert!(ng > 0.0, "seed {seed}: the ng-path bound did not run");
-            assert!(
-                ng <= brute + 1e-9 && lb <= brute + 1e-9,
-                "seed {seed}: ng-path bound {ng}, bound {lb}, brute force {brute}"
-            );
-            assert!(lb <= ccp.metrics.idle_length + 1e-9);
-            assert!(lb >= bound.group_sum() && lb >= ng);
+    for (seed, nest, h, start, finish) in small_cases() {
+        let brute = brute_force(&nest, start, finish, h);
+        let ccp = ccp_route(&nest, start, finish, Duration::from_millis(300));
+        let options = LowerBoundOptions {
+            start,
+            finish,
+            budget_seconds: 2.0,
+            group_size: 2,
+            decompose_above: 0,
+            ng_size: 8,
+            ng_above: 0,
+            exact_max_kept: 1,
+            ng_alone: true,
+            ..LowerBoundOptions::default()
+        };
+        let mut bound = CcpLowerBound::new(&nest, options).unwrap();
+        if bound.kept_contours() <= 2 {
+            continue;
         }
+        assert!(bound.group_count() >= 2, "seed {seed}: no groups");
+        bound.offer_route(&ccp.route);
+        let lb = run_bound(&mut bound, usize::MAX, Duration::from_secs(2));
+        let ng = bound.ng_bound();
+        cases += 1;
+        strong += usize::from(ng >= 0.8 * brute);
+        // Without the exact search only the ng-path bound raises the whole relaxation's.
+        assert_eq!(bound.whole_bound(), ng, "seed {seed}: the exact search ran");
+        assert!(ng > 0.0, "seed {seed}: the ng-path bound did not run");
+        assert!(
+            ng <= brute + 1e-9 && lb <= brute + 1e-9,
+            "seed {seed}: ng-path bound {ng}, bound {lb}, brute force {brute}"
+        );
+        assert!(lb <= ccp.metrics.idle_length + 1e-9);
+        assert!(lb >= bound.group_sum() && lb >= ng);
     }
     assert!(cases >= 12, "only {cases} cases had groups");
     assert!(
