@@ -184,10 +184,10 @@ pub struct LowerBoundOptions {
     /// 16,643; BENCHMARKS.md). They take over from the small groups only where these lose
     /// much (`wide_below`); 0 or at most `group_size`: never.
     pub wide_group_size: usize,
-    /// Where wide groups may take over: once every small group has finished its first stage,
+    /// Where wide groups may take over: once every small group has run a short probe stage,
     /// they give way to wide ones if their sum is below this share of the best route offered.
     /// Small groups lose the travel across their borders, which on a tightly packed sheet is
-    /// most of it (Nest02: 0.22 of its route after their short first stages, 0.36 with four
+    /// most of it (Nest02: 0.22 of its route after their probes, 0.36 with four
     /// times the share), and little where parts lie apart (a generated 1,000-contour sheet:
     /// 0.67 and 0.72; there wide groups, whose stages take longer, reached 18,124 in 40 s
     /// against the small ones' 22,240). The best sum of the small groups stays a bound.
@@ -767,13 +767,8 @@ impl CcpLowerBound {
                 // get the whole relaxation's first share (Nest02, groups of 90, 60 s of the
                 // bound's own time: 16,932 with a quarter of it, 17,858–18,079 with all of it,
                 // 17,331 with twice it).
-                // Small groups that wide ones may replace first tell whether they should, in a
-                // sixty-fourth of the share (Nest02's 25 groups took 17 s with a quarter of 5 s
-                // each, ~3 s with this; the sums they tell by are lower, see `wide_below`).
                 first_stage: if leaves.len() > self.options.ng_above && self.options.ng_size > 0 {
                     self.options.first_stage
-                } else if self.wide_size > size {
-                    (self.options.first_stage / 64).max(Duration::from_millis(100))
                 } else {
                     (self.options.first_stage / 4).max(Duration::from_millis(100))
                 },
@@ -942,36 +937,31 @@ impl CcpLowerBound {
         }
     }
 
-    /// Once every small group has finished its first stage: wide groups take over if the
-    /// small ones' sum is below `wide_below` of the best route, else the small ones stay.
+    /// Once every small group has run its probe: wide groups take over if the small ones' sum
+    /// is below `wide_below` of the best route, else the small ones stay.
     fn maybe_widen(&mut self) {
         if self.wide_size == 0 {
             return;
         }
-        let first_stages_done = self
+        let probed = self
             .groups
             .iter()
             .zip(&self.groups_running)
             .all(|(g, &running)| !g.probe || !running);
-        if !first_stages_done {
+        if !probed {
             return;
         }
         let size = std::mem::take(&mut self.wide_size);
         let sum = self.group_sum();
         debug_log(|| {
             format!(
-                "small groups' first stages: sum {sum:.3} = {:.3} of the route",
+                "small groups' probes: sum {sum:.3} = {:.3} of the route",
                 sum / self.incumbent_length
             )
         });
         // (Without a route the threshold is infinite: wide groups, unless `wide_below` is 0.)
         let widen = sum < self.options.wide_below * self.incumbent_length;
         if !widen {
-            // The small groups stay, with their usual shares from now on.
-            let first_stage = (self.options.first_stage / 4).max(Duration::from_millis(100));
-            for group in &mut self.groups {
-                group.options.first_stage = first_stage;
-            }
             self.last_route = None;
             return;
         }
@@ -1324,6 +1314,11 @@ impl CcpLowerBound {
         let share = if self.fixed {
             // One stage: it runs until the exact search ends or the caller stops.
             Duration::from_secs(1 << 40)
+        } else if self.probe {
+            // Small groups that wide ones may replace first tell whether they should, in a
+            // sixteenth of their first share (Nest02's 25 groups took 17 s with all of it,
+            // ~3 s with this; the sums they tell by are lower, see `wide_below`).
+            (self.options.first_stage / 16).max(Duration::from_millis(100))
         } else {
             self.options.first_stage * (1u32 << self.stages_done.min(16))
         };
