@@ -62,7 +62,9 @@
 //! **The ng-path bound** ([`NgPathBound`], more kept contours than `ng_above`) runs on the whole
 //! relaxation's instance beside its exact search, and, with `ng_alone`, alone where the exact
 //! search cannot run (more kept contours than its keys hold, `exact_max_kept`); any lower bound
-//! of that PCGTSP is sound by step 3.
+//! of that PCGTSP is sound by step 3. Its neighbourhoods are `ng_size` contours in the first
+//! stage and `ng_refined_size` in the later ones, which start from the earlier penalties (the
+//! clusters stay the same).
 //!
 //! **Refinement.** A stage builds the instance (row by row, in slices), then runs the exact
 //! solver for a doubling time share. Then the pieces relaxed tours visit are split in order of
@@ -199,6 +201,13 @@ pub struct LowerBoundOptions {
     /// Clusters per neighbourhood of the ng-path bound ([`crate::NgPathBound`]) run on the
     /// relaxation beside the exact search; 0: none.
     pub ng_size: usize,
+    /// Clusters per neighbourhood from the second stage on (at most [`MAX_NG`]); 0: `ng_size`
+    /// in every stage. The first stage's small neighbourhoods set the penalties in quick
+    /// passes; on the finer pieces after it, wider ones forbid more of the short loops among
+    /// neighbours that the relaxation otherwise takes (nested.dbs in 60 s: 8,524 with 8
+    /// throughout, 8,650 with 10, 8,621 with 12, 8,669–8,702 with 8 then 10; BENCHMARKS.md).
+    /// Wide groups keep `ng_size`: their passes are few, and 10 lowered Nest03's sum by 7 %.
+    pub ng_refined_size: usize,
     /// Run the ng-path bound only on relaxations of more kept contours than this (up to about
     /// 22 the exact search solves each stage, and the ng-path bound would only take its time).
     pub ng_above: usize,
@@ -283,6 +292,7 @@ impl Default for LowerBoundOptions {
             wide_below: 0.5,
             decompose_above: 24,
             ng_size: 8,
+            ng_refined_size: 10,
             ng_above: 24,
             exact_max_kept: EXACT_MAX_KEPT,
             ng_alone: false,
@@ -777,6 +787,7 @@ impl CcpLowerBound {
                 // Groups fit the exact search's keys: the test threshold is the whole relaxation's only.
                 exact_max_kept: EXACT_MAX_KEPT,
                 ng_max_nodes: GROUP_NG_MAX_NODES.min(self.options.ng_max_nodes),
+                ng_refined_size: 0,
                 ..self.options.clone()
             };
             let absorbed: Vec<bool> = leaves
@@ -880,6 +891,15 @@ impl CcpLowerBound {
     /// The best ng-path bound on the whole relaxation so far (0 when it does not run).
     pub fn ng_bound(&self) -> f64 {
         self.ng_best
+    }
+
+    /// Clusters per neighbourhood of the ng-path bound on the current stage's relaxation
+    /// (before [`MAX_NG`] and the cluster count cap it); `None` while it has none.
+    pub fn ng_neighbourhood(&self) -> Option<usize> {
+        match &self.stage {
+            Some(Stage::Solving(s)) if s.ng.is_some() || s.ng_pending => Some(s.ng_size),
+            _ => None,
+        }
     }
 
     /// The bound of the whole relaxation alone (without the groups).
@@ -1357,7 +1377,10 @@ impl CcpLowerBound {
             ng_running: false,
             ng: None,
             ng_pending,
-            ng_size: self.options.ng_size,
+            ng_size: match self.options.ng_refined_size {
+                refined if refined > 0 && self.stages_done > 0 => refined,
+                _ => self.options.ng_size,
+            },
             exact_over: false,
             turns: 0,
             build_spent,

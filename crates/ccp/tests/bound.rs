@@ -3,6 +3,7 @@
 //! nests, within a few percent of it after a few stages, and never above CCP-Relax's route on
 //! the real nests.
 
+use std::collections::BTreeSet;
 use std::time::Duration;
 
 use cutroute_ccp::{
@@ -655,42 +656,71 @@ fn wide_groups_with_the_ng_path_bound_never_above_brute_force() {
 }
 
 /// The ng-path bound on the whole relaxation (forced on small nests, neighbourhoods of 2 and 8
-/// contours) is never above a brute-force route, on random and packed nests, open and closed;
-/// and it is not trivial.
+/// contours, and of 2 widened to 5 after the first stage) is never above a brute-force route,
+/// on random and packed nests, open and closed; it is not trivial; and the stages after the
+/// first use the refined neighbourhoods.
 #[test]
 fn the_ng_path_bound_never_above_brute_force() {
     let mut strong = 0;
     let mut cases = 0;
+    let mut refined_stages = 0;
     for (seed, nest, h, start, finish) in small_cases() {
         let brute = brute_force(&nest, start, finish, h);
         let ccp = ccp_route(&nest, start, finish, Duration::from_millis(300));
-        for ng_size in [2, 8] {
+        // Neighbourhoods of the first stage and of the later ones (0: the same), the later
+        // ones starting from the first's penalties.
+        for (ng_size, ng_refined_size) in [(2, 0), (8, 0), (2, 5)] {
             let options = LowerBoundOptions {
                 start,
                 finish,
                 budget_seconds: 2.0,
                 group_size: 0,
                 ng_size,
+                ng_refined_size,
                 ng_above: 0,
                 ..LowerBoundOptions::default()
             };
             let mut bound = CcpLowerBound::new(&nest, options).unwrap();
             bound.offer_route(&ccp.route);
-            let lb = run_bound(&mut bound, 4, Duration::from_secs(2));
+            let mut later = BTreeSet::new();
+            while bound.stages() < 4
+                && bound.elapsed() < Duration::from_secs(2)
+                && bound.step(Duration::from_millis(50))
+            {
+                if bound.stages() > 0 {
+                    later.extend(bound.ng_neighbourhood());
+                }
+            }
+            let lb = bound.lower_bound();
             let ng = bound.ng_bound();
             cases += 1;
             strong += usize::from(ng >= 0.8 * brute);
             assert!(
                 ng <= brute + 1e-9 && lb <= brute + 1e-9,
-                "seed {seed}, ng {ng_size}: ng-path bound {ng}, bound {lb}, brute force {brute}"
+                "seed {seed}, ng {ng_size} then {ng_refined_size}: ng-path bound {ng}, bound \
+                 {lb}, brute force {brute}"
             );
             assert!(lb <= ccp.metrics.idle_length + 1e-9);
+            let expected = if ng_refined_size > 0 {
+                ng_refined_size
+            } else {
+                ng_size
+            };
+            assert!(
+                later.iter().all(|&k| k == expected),
+                "seed {seed}: neighbourhoods {later:?} after the first stage, not {expected}"
+            );
+            refined_stages += usize::from(ng_refined_size > 0 && !later.is_empty());
         }
     }
     assert!(
         strong * 4 >= cases * 3,
         "the ng-path bound was below 80 % of the optimum in {} of {cases} cases",
         cases - strong
+    );
+    assert!(
+        refined_stages > 0,
+        "no case reached a stage with the refined neighbourhoods"
     );
 }
 
