@@ -205,7 +205,7 @@ pub struct LowerBoundOptions {
     /// in every stage. The first stage's small neighbourhoods set the penalties in quick
     /// passes; on the finer pieces after it, wider ones forbid more of the short loops among
     /// neighbours that the relaxation otherwise takes (nested.dbs in 60 s: 8,524 with 8
-    /// throughout, 8,650 with 10, 8,621 with 12, 8,669–8,702 with 8 then 10; BENCHMARKS.md).
+    /// throughout, 8,650 with 10, 8,621 with 12, 8,625–8,702 with 8 then 10; BENCHMARKS.md).
     /// Wide groups keep `ng_size`: their passes are few, and 10 lowered Nest03's sum by 7 %.
     pub ng_refined_size: usize,
     /// Run the ng-path bound only on relaxations of more kept contours than this (up to about
