@@ -167,10 +167,22 @@ fn ccp_route(nest: &Nest, start: Point, finish: Option<Point>, limit: Duration) 
 
 /// Runs the bound for up to `stages` stages or `limit` of its own time.
 fn run_bound(bound: &mut CcpLowerBound, stages: usize, limit: Duration) -> f64 {
+    run_bound_watched(bound, stages, limit, |_| {})
+}
+
+/// [`run_bound`], showing the bound to `watch` after every step.
+fn run_bound_watched(
+    bound: &mut CcpLowerBound,
+    stages: usize,
+    limit: Duration,
+    mut watch: impl FnMut(&CcpLowerBound),
+) -> f64 {
     while bound.stages() < stages
         && bound.elapsed() < limit
         && bound.step(Duration::from_millis(50))
-    {}
+    {
+        watch(bound);
+    }
     bound.lower_bound()
 }
 
@@ -683,15 +695,11 @@ fn the_ng_path_bound_never_above_brute_force() {
             let mut bound = CcpLowerBound::new(&nest, options).unwrap();
             bound.offer_route(&ccp.route);
             let mut later = BTreeSet::new();
-            while bound.stages() < 4
-                && bound.elapsed() < Duration::from_secs(2)
-                && bound.step(Duration::from_millis(50))
-            {
-                if bound.stages() > 0 {
-                    later.extend(bound.ng_neighbourhood());
+            let lb = run_bound_watched(&mut bound, 4, Duration::from_secs(2), |b| {
+                if b.stages() > 0 {
+                    later.extend(b.ng_neighbourhood());
                 }
-            }
-            let lb = bound.lower_bound();
+            });
             let ng = bound.ng_bound();
             cases += 1;
             strong += usize::from(ng >= 0.8 * brute);
