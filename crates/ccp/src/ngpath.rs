@@ -32,7 +32,7 @@
 use std::sync::Arc;
 
 use cutroute_pcgtsp::Instance;
-use web_time::Instant;
+use web_time::{Duration, Instant};
 
 /// One label of a layer: a walk with `k` visits ending at `node` with memory `mask` (bits over
 /// the positions of `ng(cluster(node))`) and reduced cost `value`. The label it came from is
@@ -234,8 +234,9 @@ struct ArcTable {
 }
 
 impl ArcTable {
-    /// The table of `arc(v, w)` over all nodes `v` and the non-depot nodes `w` of `members`.
-    fn new(n: usize, members: &[Vec<usize>], arc: impl Fn(usize, usize) -> f32) -> ArcTable {
+    /// An unfilled table over `n` nodes into the non-depot nodes of `members` (rows are
+    /// filled by [`ArcTable::fill_row`]).
+    fn empty(n: usize, members: &[Vec<usize>]) -> ArcTable {
         let mut slot = vec![0u32; n];
         for nodes in members {
             for (k, &w) in nodes.iter().enumerate() {
@@ -249,21 +250,22 @@ impl ArcTable {
             block_start.push(total);
             total += n * size;
         }
-        // Filled source by source (a row of the matrix at a time, as `arc` reads it best).
-        let mut arcs = vec![0.0; total];
-        for v in 0..n {
-            for (nodes, &start) in members.iter().zip(&block_start) {
-                let row = start + v * nodes.len();
-                for (slot, &w) in arcs[row..row + nodes.len()].iter_mut().zip(nodes) {
-                    *slot = arc(v, w);
-                }
-            }
-        }
         ArcTable {
             block_start,
             slot,
             sizes,
-            arcs,
+            arcs: vec![0.0; total],
+        }
+    }
+
+    /// Fills source `v`'s arcs `arc(w)` into every non-depot node `w` of `members` (a row of
+    /// the matrix at a time, as it is read best).
+    fn fill_row(&mut self, members: &[Vec<usize>], v: usize, arc: impl Fn(usize) -> f32) {
+        for (nodes, &start) in members.iter().zip(&self.block_start) {
+            let row = start + v * nodes.len();
+            for (slot, &w) in self.arcs[row..row + nodes.len()].iter_mut().zip(nodes) {
+                *slot = arc(w);
+            }
         }
     }
 
@@ -407,22 +409,54 @@ pub const MAX_NG: usize = 12;
 // `MemoryMap` looks a memory up in two halves of six bits.
 const _: () = assert!(MAX_NG <= 12);
 
-impl NgPathBound {
-    /// Prepares the bound with neighbourhoods of `ng_size` clusters (nearest by least arc cost)
-    /// and initial penalties `lambda` (one per non-depot cluster, in the instance's cluster
-    /// order without the depot's; zeros when the length does not match). `None` when the
-    /// depot's cluster does not hold exactly one node or there is no other cluster.
-    pub fn new(instance: &Instance, ng_size: usize, lambda: &[f64]) -> Option<NgPathBound> {
+/// The ng-path bound being made, a stretch of the matrix's rows at a time: one piece over
+/// the 4,000 nodes of nested.dbs' last stages took 0.26 s (three passes over a 128 MB
+/// matrix), longer than Stop may wait. Rows give the clusters' least arcs (the
+/// neighbourhoods), the starting penalties and the arc table; bands of rows then check
+/// whether the arcs are symmetric, and a reversed table is filled only if they are not.
+pub(crate) struct NgPathBuilder {
+    n: usize,
+    depot: usize,
+    ng_size: usize,
+    cluster: Vec<usize>,
+    members: Vec<Vec<usize>>,
+    /// `near[c * m + d]`: the least arc from cluster `c` into `d` so far.
+    near: Vec<f64>,
+    /// The given penalties, or empty: then made from `into` and `out` (per node, its
+    /// cheapest arc in and out).
+    lambda: Vec<f64>,
+    into: Vec<f64>,
+    out: Vec<f64>,
+    arcs: ArcTable,
+    next_row: usize,
+    /// The symmetry check's next band of rows, and its verdict so far.
+    next_band: usize,
+    symmetric: bool,
+    /// The reversed arcs' table when they are not symmetric, and its next row.
+    reversed: Option<ArcTable>,
+    next_reversed_row: usize,
+}
+
+/// Rows of the symmetry check compared at a time (tiles of this size, so that the columns
+/// come from the cache).
+const TILE: usize = 64;
+
+impl NgPathBuilder {
+    /// Prepares the making of [`NgPathBound::new`]'s bound (its arguments, and `None` in the
+    /// same cases); nothing of the matrix is read yet.
+    pub(crate) fn new(
+        instance: &Instance,
+        ng_size: usize,
+        lambda: &[f64],
+    ) -> Option<NgPathBuilder> {
         let n = instance.node_count;
         let depot_nodes = instance.clusters.get(instance.depot)?;
         let &[depot] = depot_nodes.as_slice() else {
             return None;
         };
-        let mut index = vec![usize::MAX; instance.clusters.len()];
         let mut members = Vec::new();
         for (c, nodes) in instance.clusters.iter().enumerate() {
             if c != instance.depot && !nodes.is_empty() {
-                index[c] = members.len();
                 members.push(nodes.clone());
             }
         }
@@ -436,22 +470,115 @@ impl NgPathBound {
                 cluster[v] = c;
             }
         }
+        let given = lambda.len() == m;
+        Some(NgPathBuilder {
+            n,
+            depot,
+            ng_size,
+            arcs: ArcTable::empty(n, &members),
+            cluster,
+            members,
+            near: vec![f64::INFINITY; m * m],
+            lambda: if given { lambda.to_vec() } else { Vec::new() },
+            into: if given {
+                Vec::new()
+            } else {
+                vec![f64::INFINITY; n]
+            },
+            out: if given {
+                Vec::new()
+            } else {
+                vec![f64::INFINITY; n]
+            },
+            next_row: 0,
+            next_band: 0,
+            symmetric: true,
+            reversed: None,
+            next_reversed_row: 0,
+        })
+    }
+
+    /// Reads the matrix of `instance` (the one given to [`NgPathBuilder::new`]) until
+    /// `deadline`, a row or a band at a time; true when everything is read.
+    pub(crate) fn step(&mut self, instance: &Instance, deadline: Instant) -> bool {
+        let (n, m) = (self.n, self.members.len());
         let cost = &instance.cost;
-        // Least arc cost between clusters, either way: the neighbourhoods are the nearest
-        // ones. The matrix is read row by row, then the two ways are merged (reading columns
-        // misses the cache).
-        let mut near = vec![f64::INFINITY; m * m];
-        for (a, &ca) in cluster.iter().enumerate() {
-            if ca == usize::MAX {
-                continue;
+        while self.next_row < n {
+            let v = self.next_row;
+            let row = &cost[v * n..(v + 1) * n];
+            let cv = self.cluster[v];
+            // Least arc cost between clusters: the neighbourhoods are the nearest ones.
+            if cv != usize::MAX {
+                let near_row = &mut self.near[cv * m..(cv + 1) * m];
+                for (&arc, &cw) in row.iter().zip(&self.cluster) {
+                    if cw != usize::MAX && cw != cv && arc < near_row[cw] {
+                        near_row[cw] = arc;
+                    }
+                }
             }
-            let near_row = &mut near[ca * m..(ca + 1) * m];
-            for (&arc, &cb) in cost[a * n..(a + 1) * n].iter().zip(&cluster) {
-                if cb != usize::MAX && cb != ca && arc < near_row[cb] {
-                    near_row[cb] = arc;
+            if self.lambda.is_empty() {
+                let mut least_out = f64::INFINITY;
+                for (w, &arc) in row.iter().enumerate() {
+                    if w != v {
+                        self.into[w] = if arc < self.into[w] {
+                            arc
+                        } else {
+                            self.into[w]
+                        };
+                        least_out = if arc < least_out { arc } else { least_out };
+                    }
+                }
+                self.out[v] = least_out;
+            }
+            self.arcs.fill_row(&self.members, v, |w| round_down(row[w]));
+            self.next_row += 1;
+            if Instant::now() >= deadline {
+                return false;
+            }
+        }
+        // Every other pass runs backwards: on the reversed arcs (the same table when the
+        // arcs between clusters are symmetric, as the interval relaxation's are).
+        let depot = self.depot;
+        while self.symmetric && self.next_band < n {
+            let a0 = self.next_band;
+            let tile = |start: usize| start..(start + TILE).min(n);
+            self.symmetric = (0..=a0).step_by(TILE).all(|b0| {
+                tile(a0).all(|a| {
+                    tile(b0).all(|b| {
+                        b >= a
+                            || a == depot
+                            || b == depot
+                            || round_down(cost[a * n + b]) == round_down(cost[b * n + a])
+                    })
+                })
+            });
+            self.next_band += TILE;
+            if Instant::now() >= deadline {
+                return false;
+            }
+        }
+        if !self.symmetric {
+            let members = &self.members;
+            let reversed = self
+                .reversed
+                .get_or_insert_with(|| ArcTable::empty(n, members));
+            while self.next_reversed_row < n {
+                let v = self.next_reversed_row;
+                reversed.fill_row(members, v, |w| round_down(cost[w * n + v]));
+                self.next_reversed_row += 1;
+                if Instant::now() >= deadline {
+                    return false;
                 }
             }
         }
+        true
+    }
+
+    /// The bound, once [`NgPathBuilder::step`] has read everything (`instance` as there).
+    pub(crate) fn finish(self, instance: &Instance) -> NgPathBound {
+        let (n, m, depot) = (self.n, self.members.len(), self.depot);
+        let cost = &instance.cost;
+        let mut near = self.near;
         // (Rounded as the DP's arcs are, once: rounding down keeps the order.)
         for x in &mut near {
             *x = f64::from(round_down(*x));
@@ -463,31 +590,21 @@ impl NgPathBound {
                 near[d * m + c] = least;
             }
         }
-        let lambda = if lambda.len() == m {
-            lambda.to_vec()
-        } else {
+        let lambda = if self.lambda.is_empty() {
             // A start near the node-penalty bound: each visit is worth half its cheapest way
-            // in plus half its cheapest way out through the same node (both found row by row).
-            let mut into = vec![f64::INFINITY; n];
-            let mut out = vec![f64::INFINITY; n];
-            for (v, least_out) in out.iter_mut().enumerate() {
-                for (w, &arc) in cost[v * n..(v + 1) * n].iter().enumerate() {
-                    if w != v {
-                        into[w] = if arc < into[w] { arc } else { into[w] };
-                        *least_out = if arc < *least_out { arc } else { *least_out };
-                    }
-                }
-            }
-            members
+            // in plus half its cheapest way out through the same node.
+            self.members
                 .iter()
                 .map(|nodes| {
                     nodes
                         .iter()
-                        .map(|&w| 0.5 * (into[w] + out[w]))
+                        .map(|&w| 0.5 * (self.into[w] + self.out[w]))
                         .fold(f64::INFINITY, f64::min)
                 })
                 .map(|x| if x.is_finite() { x } else { 0.0 })
                 .collect()
+        } else {
+            self.lambda
         };
         let from_depot: Vec<f64> = (0..n)
             .map(|w| f64::from(round_down(cost[depot * n + w])))
@@ -495,58 +612,76 @@ impl NgPathBound {
         let to_depot: Vec<f64> = (0..n)
             .map(|v| f64::from(round_down(cost[v * n + depot])))
             .collect();
-        let arcs = Arc::new(ArcTable::new(n, &members, |v, w| {
-            round_down(cost[v * n + w])
-        }));
-        // Every other pass runs backwards: on the reversed arcs (the same table when the arcs
-        // between clusters are symmetric, as the interval relaxation's are), with the depot's
-        // ways in and out swapped.
-        // (Compared in tiles, so that the columns come from the cache.)
-        const TILE: usize = 64;
-        let tile = |start: usize| start..(start + TILE).min(n);
-        let symmetric = (0..n).step_by(TILE).all(|a0| {
-            (0..=a0).step_by(TILE).all(|b0| {
-                tile(a0).all(|a| {
-                    tile(b0).all(|b| {
-                        b >= a
-                            || a == depot
-                            || b == depot
-                            || round_down(cost[a * n + b]) == round_down(cost[b * n + a])
-                    })
-                })
-            })
-        });
-        let reversed = if symmetric {
-            Arc::clone(&arcs)
-        } else {
-            Arc::new(ArcTable::new(n, &members, |v, w| {
-                round_down(cost[w * n + v])
-            }))
+        let arcs = Arc::new(self.arcs);
+        let reversed = match self.reversed {
+            Some(table) => Arc::new(table),
+            None => Arc::clone(&arcs),
         };
         let backward = NgPathBound::from_parts(
             n,
             reversed,
             to_depot.clone(),
             from_depot.clone(),
-            cluster.clone(),
-            members.clone(),
+            self.cluster.clone(),
+            self.members.clone(),
             near.clone(),
-            ng_size,
+            self.ng_size,
             lambda.clone(),
             None,
         );
-        Some(NgPathBound::from_parts(
+        NgPathBound::from_parts(
             n,
             arcs,
             from_depot,
             to_depot,
-            cluster,
-            members,
+            self.cluster,
+            self.members,
             near,
-            ng_size,
+            self.ng_size,
             lambda,
             Some(Box::new(backward)),
-        ))
+        )
+    }
+}
+
+impl NgPathBound {
+    /// Prepares the bound with neighbourhoods of `ng_size` clusters (nearest by least arc cost)
+    /// and initial penalties `lambda` (one per non-depot cluster, in the instance's cluster
+    /// order without the depot's; when the length does not match, half of each cluster's
+    /// cheapest way in and out through one node). `None` when the depot's cluster does not
+    /// hold exactly one node or there is no other cluster. Made in one piece; the bound of
+    /// the interval relaxation makes it in slices (`NgPathBuilder`).
+    pub fn new(instance: &Instance, ng_size: usize, lambda: &[f64]) -> Option<NgPathBound> {
+        let mut builder = NgPathBuilder::new(instance, ng_size, lambda)?;
+        while !builder.step(instance, Instant::now() + Duration::from_secs(3600)) {}
+        Some(builder.finish(instance))
+    }
+
+    /// The same bound with neighbourhoods of `ng_size` clusters from penalties `lambda`
+    /// (the current best ones when the length does not match): the arc tables are shared,
+    /// so this costs only the neighbourhoods, not a pass over the matrix.
+    pub fn widened(&self, ng_size: usize, lambda: &[f64]) -> NgPathBound {
+        let lambda = if lambda.len() == self.members.len() {
+            lambda.to_vec()
+        } else {
+            self.best_lambda.clone()
+        };
+        let remake = |bound: &NgPathBound, backward: Option<Box<NgPathBound>>| {
+            NgPathBound::from_parts(
+                bound.n,
+                Arc::clone(&bound.arcs),
+                bound.from_depot.clone(),
+                bound.to_depot.clone(),
+                bound.cluster.clone(),
+                bound.members.clone(),
+                bound.gap.clone(),
+                ng_size,
+                lambda.clone(),
+                backward,
+            )
+        };
+        let backward = self.backward.as_ref().map(|b| Box::new(remake(b, None)));
+        remake(self, backward)
     }
 
     /// The bound on prepared parts: neighbourhoods of `ng_size` nearest clusters by `near`,
@@ -1492,7 +1627,10 @@ mod tests {
             .map(|c| (1..n).filter(|v| v % 4 == c).collect())
             .collect();
         let arc = |v: usize, w: usize| (v * 31 + w * 7) as f32 + 0.25;
-        let table = ArcTable::new(n, &members, arc);
+        let mut table = ArcTable::empty(n, &members);
+        for v in 0..n {
+            table.fill_row(&members, v, |w| arc(v, w));
+        }
         for v in 0..n {
             for (d, nodes) in members.iter().enumerate() {
                 let into = table.arcs_into(v, d);
@@ -1651,6 +1789,175 @@ mod tests {
         }
         // The test exercises the pruning, not only the plain DP.
         assert!(pruned_some >= 16, "{pruned_some}");
+    }
+
+    /// The bound's fields that its making sets (arcs, the depot's ways, neighbourhoods,
+    /// penalties), of it and of its backward DP.
+    fn made_parts(bound: &NgPathBound) -> Vec<String> {
+        let mut parts = Vec::new();
+        let mut b = Some(bound);
+        while let Some(x) = b {
+            parts.push(format!(
+                "{:?} {:?} {:?} {:?} {:?} {:?} {:?} {:?}",
+                x.arcs.arcs, x.from_depot, x.to_depot, x.cluster, x.ng, x.gap, x.lambda, x.related
+            ));
+            b = x.backward.as_deref();
+        }
+        parts
+    }
+
+    /// Runs both bounds pass by pass (up to 4, or until they end) and checks that each pass
+    /// gives both the same value.
+    fn assert_same_passes(a: &mut NgPathBound, b: &mut NgPathBound, context: &str) {
+        for pass in 0..4 {
+            let done = a.iterations();
+            let mut running = (true, true);
+            while a.iterations() == done && running.0 {
+                running.0 = a.step(Instant::now());
+            }
+            while b.iterations() == done && running.1 {
+                running.1 = b.step(Instant::now());
+            }
+            assert_eq!(a.iterations(), b.iterations(), "{context}, pass {pass}");
+            assert_eq!(a.last_value, b.last_value, "{context}, pass {pass}");
+            assert_eq!(a.lower_bound(), b.lower_bound(), "{context}, pass {pass}");
+            if !running.0 || !running.1 {
+                assert_eq!(running.0, running.1, "{context}, pass {pass}");
+                return;
+            }
+        }
+    }
+
+    /// Checks the made bound's fields against `instance` directly: every arc (and the
+    /// backward DP's reversed one) rounded down, the depot's ways, the least arc between
+    /// clusters either way, and the penalties (`lambda`, or half the cheapest way in and out).
+    fn assert_made_from(bound: &NgPathBound, instance: &Instance, lambda: &[f64], context: &str) {
+        let n = instance.node_count;
+        let cost = |v: usize, w: usize| instance.cost[v * n + w];
+        let backward = bound.backward.as_deref().expect("a backward DP");
+        let m = bound.members.len();
+        let mut gap = vec![f64::INFINITY; m * m];
+        for (d, nodes) in bound.members.iter().enumerate() {
+            for v in 0..n {
+                for &w in nodes {
+                    assert_eq!(bound.arcs.get(v, w, d), round_down(cost(v, w)), "{context}");
+                    // (The depot's ways are `from_depot` and `to_depot`, swapped backwards.)
+                    if v != 0 {
+                        let reversed = backward.arcs.get(v, w, d);
+                        assert_eq!(reversed, round_down(cost(w, v)), "{context}");
+                    }
+                    let c = bound.cluster[v];
+                    if c != usize::MAX && c != d {
+                        let least = f64::from(round_down(cost(v, w).min(cost(w, v))));
+                        gap[c * m + d] = gap[c * m + d].min(least);
+                        gap[d * m + c] = gap[d * m + c].min(least);
+                    }
+                }
+            }
+        }
+        assert_eq!(bound.gap, gap, "{context}");
+        for v in 0..n {
+            assert_eq!(
+                bound.from_depot[v],
+                f64::from(round_down(cost(0, v))),
+                "{context}"
+            );
+            assert_eq!(
+                bound.to_depot[v],
+                f64::from(round_down(cost(v, 0))),
+                "{context}"
+            );
+        }
+        let expected: Vec<f64> = if lambda.len() == m {
+            lambda.to_vec()
+        } else {
+            let least = |w: usize, into: bool| {
+                (0..n)
+                    .filter(|&u| u != w)
+                    .map(|u| if into { cost(u, w) } else { cost(w, u) })
+                    .fold(f64::INFINITY, f64::min)
+            };
+            bound
+                .members
+                .iter()
+                .map(|nodes| {
+                    nodes
+                        .iter()
+                        .map(|&w| 0.5 * (least(w, true) + least(w, false)))
+                        .fold(f64::INFINITY, f64::min)
+                })
+                .map(|x| if x.is_finite() { x } else { 0.0 })
+                .collect()
+        };
+        assert_eq!(bound.lambda, expected, "{context}");
+    }
+
+    #[test]
+    fn made_a_row_at_a_time_it_equals_the_bound_made_at_once() {
+        for seed in 0..12u64 {
+            // Every other instance has asymmetric arcs (a reversed table of its own); one in
+            // three gets penalties to start from, the others make theirs.
+            let skew = if seed % 2 == 0 { 0.4 } else { 0.0 };
+            // (Past 128 nodes for the later seeds: the symmetry check takes several bands.)
+            let per = if seed < 6 { 12 } else { 60 };
+            let mut instance = random_instance_skewed(seed, 4 + (seed % 5) as usize, per, skew);
+            // Symmetric but for one arc between the last two clusters, far past the first
+            // band of the check (odd seeds from 7).
+            let one_asymmetric = seed >= 7 && skew == 0.0;
+            if one_asymmetric {
+                let n = instance.node_count;
+                let last = instance.clusters.len() - 1;
+                let (a, b) = (n - 1, *instance.clusters[last - 1].last().unwrap());
+                assert!(b >= 2 * TILE && instance.node_cluster[a] != instance.node_cluster[b]);
+                instance.cost[a * n + b] += 1.0;
+            }
+            let m = instance.clusters.len() - 1;
+            let lambda: Vec<f64> = if seed % 3 == 0 {
+                (0..m).map(|c| c as f64 * 0.5).collect()
+            } else {
+                Vec::new()
+            };
+            let at_once = NgPathBound::new(&instance, 3, &lambda).unwrap();
+            let mut builder = NgPathBuilder::new(&instance, 3, &lambda).unwrap();
+            // A deadline already past: one row (or one band of the check) per step.
+            let mut steps = 1;
+            while !builder.step(&instance, Instant::now()) {
+                steps += 1;
+            }
+            assert!(
+                steps >= instance.node_count,
+                "seed {seed}: {steps} steps for {} rows",
+                instance.node_count
+            );
+            let mut in_pieces = builder.finish(&instance);
+            assert_eq!(made_parts(&in_pieces), made_parts(&at_once), "seed {seed}");
+            assert_made_from(&in_pieces, &instance, &lambda, &format!("seed {seed}"));
+            assert_eq!(
+                Arc::ptr_eq(&in_pieces.arcs, &in_pieces.backward.as_ref().unwrap().arcs),
+                skew == 0.0 && !one_asymmetric,
+                "seed {seed}: the reversed table is shared exactly when the arcs are symmetric"
+            );
+            let mut at_once = at_once;
+            assert_same_passes(&mut in_pieces, &mut at_once, &format!("seed {seed}"));
+        }
+    }
+
+    #[test]
+    fn widened_equals_the_wider_bound_made_anew() {
+        for seed in 0..8u64 {
+            let skew = if seed % 2 == 0 { 0.4 } else { 0.0 };
+            let instance = random_instance_skewed(seed, 6, 4, skew);
+            let mut narrow = NgPathBound::new(&instance, 2, &[]).unwrap();
+            for _ in 0..2 {
+                let done = narrow.iterations();
+                while narrow.iterations() == done && narrow.step(Instant::now()) {}
+            }
+            let lambda = narrow.best_lambda().to_vec();
+            let mut widened = narrow.widened(5, &lambda);
+            let mut anew = NgPathBound::new(&instance, 5, &lambda).unwrap();
+            assert_eq!(made_parts(&widened), made_parts(&anew), "seed {seed}");
+            assert_same_passes(&mut widened, &mut anew, &format!("seed {seed}"));
+        }
     }
 
     #[test]
