@@ -88,6 +88,7 @@ mod offset_carrier;
 mod path_leads;
 mod path_route;
 mod point;
+mod read_warning;
 mod rng;
 mod route;
 mod span;
@@ -113,6 +114,7 @@ pub use leads::{
 pub use neighbours::nearest_groups;
 pub use path_leads::PathLeads;
 pub use path_route::{PathLeadError, PathRoute, PathRouteError, ToolOnPath};
+pub use read_warning::{ReadWarning, WarningKind, WarningPlace};
 pub use rng::{SplitMix64, Xoshiro256};
 pub use route::{
     in_scrap_region, is_scrap_region, ContourRef, CutStep, Entry, MachineParameters, Objective,
