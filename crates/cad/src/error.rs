@@ -51,9 +51,15 @@ pub enum CadError {
         first: String,
     },
 
-    /// DXF: the file is a binary DXF, which this reader does not read.
-    #[error("binary DXF is not supported; save the drawing as ASCII DXF")]
-    BinaryDxf,
+    /// DXF: a binary DXF file that does not read, at a byte offset (binary files have no
+    /// lines).
+    #[error("byte {offset}: binary DXF: {reason}")]
+    BinaryDxf {
+        /// Offset of the group concerned.
+        offset: usize,
+        /// What is wrong.
+        reason: String,
+    },
     /// DXF: a group code line does not hold an integer.
     #[error("line {line}: group code expected, found {text:?}")]
     BadGroupCode {

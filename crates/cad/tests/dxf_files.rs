@@ -87,7 +87,11 @@ fn square_r12_polyline() {
     assert_eq!(arcs(outer), 0);
     assert_box(outer, (0.0, 0.0), (100.0, 100.0));
     assert!((area(&polygon(outer)) + 10_000.0).abs() < 1e-9);
-    assert!(i.open_chains.is_empty() && i.warnings.is_empty());
+    assert!(i.open_chains.is_empty());
+    // The file declares no units: the only warning says millimetres were assumed.
+    assert_eq!(i.warnings.len(), 1, "{:?}", i.warnings);
+    assert_eq!(i.warnings[0].kind, cutroute_geometry::WarningKind::Units);
+    assert!(i.warnings[0].message.contains("millimetres assumed"));
 }
 
 #[test]

@@ -18,9 +18,24 @@ fn read(text: &str) -> Result<cutroute_cad::dxf::DxfImport, DxfError> {
 #[test]
 fn empty_and_binary_files() {
     assert_eq!(read(""), Err(DxfError::NoEntities));
+    // A binary DXF is read: with nothing after its sentinel it has no sections at all.
     assert_eq!(
         read_dxf(b"AutoCAD Binary DXF\r\n\x1a\x00", &DxfOptions::default()),
-        Err(DxfError::BinaryDxf)
+        Err(DxfError::NoEntities)
+    );
+    // Cut inside a string (R12 one-byte codes: `0`, then "SECTION" without its NUL).
+    let cut = read_dxf(
+        b"AutoCAD Binary DXF\r\n\x1a\x00\x00SECTION",
+        &DxfOptions::default(),
+    )
+    .unwrap_err();
+    assert!(
+        matches!(cut, DxfError::BinaryDxf { offset: 23, .. }),
+        "{cut}"
+    );
+    assert!(
+        cut.to_string().starts_with("byte 23: binary DXF: "),
+        "{cut}"
     );
 }
 
@@ -129,8 +144,19 @@ fn degenerate_entities_are_skipped_with_a_warning() {
     ));
     let import = read(&text).unwrap();
     assert_eq!(import.nest.parts.len(), 1);
-    let lines: Vec<usize> = import.warnings.iter().map(|w| w.line).collect();
-    assert_eq!(lines, [25, 37], "{:?}", import.warnings);
+    // Besides the drawing-wide note that no units are declared.
+    let lines: Vec<String> = import
+        .warnings
+        .iter()
+        .filter(|w| w.kind != cutroute_geometry::WarningKind::Units)
+        .map(|w| {
+            w.place
+                .as_ref()
+                .map(ToString::to_string)
+                .unwrap_or_default()
+        })
+        .collect();
+    assert_eq!(lines, ["line 25", "line 37"], "{:?}", import.warnings);
     assert!(import.warnings[0].message.contains("radius 0"));
 }
 

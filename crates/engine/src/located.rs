@@ -87,6 +87,7 @@ impl Located for CadError {
             | CadError::InvalidEntity { line, .. }
             | CadError::UnknownBlock { line, .. }
             | CadError::BlockNestingTooDeep { line, .. } => at_line(*line),
+            CadError::BinaryDxf { offset, .. } => Some(SourceLocation::Byte { offset: *offset }),
             CadError::Xml { line, column, .. }
             | CadError::BadAttribute { line, column, .. }
             | CadError::BadPathData { line, column, .. }
@@ -101,7 +102,6 @@ impl Located for CadError {
             CadError::TooComplex { .. }
             | CadError::InvalidOptions(_)
             | CadError::NothingClosed { .. }
-            | CadError::BinaryDxf
             | CadError::NoEntities
             | CadError::NotSvg { .. }
             | CadError::NotAProject { .. }

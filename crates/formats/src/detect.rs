@@ -77,19 +77,45 @@ pub fn detect(bytes: &[u8]) -> Format {
         }
         _ => {}
     }
+    // The binary DXF sentinel comes first: its bytes are no DBS record header either.
+    if bytes.starts_with(b"AutoCAD Binary DXF\r\n\x1a\0") {
+        return Format::Dxf;
+    }
     if looks_like_dbs(bytes) {
         return Format::DbsBinary;
     }
-    let head = &bytes[..bytes.len().min(4096)];
-    if text_start.starts_with(b"0") && contains(head, b"SECTION") {
+    if looks_like_ascii_dxf(text_start) {
         return Format::Dxf;
     }
+    let head = &bytes[..bytes.len().min(4096)];
     if text_start.starts_with(b"NAME")
         && (contains(head, b"GTSP_SETS") || contains(head, b"PCGLNS") || contains(head, b"GROUPS"))
     {
         return Format::Pcglns;
     }
     Format::Unknown
+}
+
+/// Whether a text starts as an ASCII DXF does: group-code/value line pairs whose first group
+/// (after any `999` comment groups, as LibreCAD, QCAD, OpenSCAD, Inkscape and CloudCompare
+/// write them, and blank lines) is `0 SECTION`.
+fn looks_like_ascii_dxf(text: &[u8]) -> bool {
+    let head = &text[..text.len().min(1 << 16)];
+    // Blank lines may stand where a code is due (as the reader allows); a value line is the
+    // line after its code, blank or not (an empty comment).
+    let mut lines = head.split(|&b| b == b'\n').map(<[u8]>::trim_ascii);
+    while let Some(code) = lines.next() {
+        if code.is_empty() {
+            continue;
+        }
+        let value = lines.next().unwrap_or_default();
+        match code {
+            b"999" => continue,
+            b"0" => return value.eq_ignore_ascii_case(b"SECTION"),
+            _ => return false,
+        }
+    }
+    false
 }
 
 /// Whether the first element of an XML text is `<svg>` (after the declaration, comments,
@@ -166,6 +192,31 @@ pub fn read_nest(bytes: &[u8]) -> Result<Nest, ReadError> {
         Format::ResultJson => Ok(result_json::read_result_json(bytes)?.nest()?),
         Format::TaskJson => Err(ReadError::NoGeometry(Format::TaskJson)),
         other => Err(ReadError::Unsupported(other)),
+    }
+}
+
+#[cfg(test)]
+mod dxf_detection {
+    use super::*;
+
+    #[test]
+    fn dxf_files_as_cad_programs_write_them_are_recognised() {
+        assert_eq!(detect(b"0\nSECTION\n2\nHEADER\n"), Format::Dxf);
+        assert_eq!(
+            detect(b"999\ndxflib 2.0.4.8\n  0\nSECTION\n  2\nHEADER\n"),
+            Format::Dxf
+        );
+        assert_eq!(
+            detect(b"\xEF\xBB\xBF\r\n999\r\nInkscape\r\n999\r\n\r\n0\r\nSECTION\r\n"),
+            Format::Dxf
+        );
+        assert_eq!(
+            detect(b"AutoCAD Binary DXF\r\n\x1a\0\0SECTION\0"),
+            Format::Dxf
+        );
+        // A comment alone, or a first group that is not `0 SECTION`, is no drawing.
+        assert_eq!(detect(b"999\nhello\n"), Format::Unknown);
+        assert_eq!(detect(b"999\nhello\n5\nSECTION\n"), Format::Unknown);
     }
 }
 

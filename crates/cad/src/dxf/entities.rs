@@ -3,7 +3,7 @@
 use cutroute_geometry::float::Libm;
 use std::collections::HashMap;
 
-use cutroute_geometry::{Point, Span, Transform};
+use cutroute_geometry::{Point, ReadWarning, Span, Transform, WarningKind};
 
 use super::groups::{decode_text, Codepage, Group};
 use super::{DxfError, DxfOptions, DxfWarning};
@@ -16,7 +16,7 @@ use crate::curves::{
 const MAX_BLOCK_DEPTH: usize = 16;
 /// Most block instances one drawing may expand to (MINSERT arrays and nesting multiply).
 const MAX_INSTANCES: usize = 1_000_000;
-/// Entity types that carry no cutting geometry and are skipped without a warning.
+/// Entity types that carry no cutting geometry: skipped, with one warning per type.
 const ANNOTATION: &[&str] = &[
     "TEXT",
     "MTEXT",
@@ -32,7 +32,6 @@ const ANNOTATION: &[&str] = &[
     "TRACE",
     "POINT",
     "VIEWPORT",
-    "SEQEND",
     "IMAGE",
     "WIPEOUT",
     "OLE2FRAME",
@@ -42,6 +41,19 @@ const ANNOTATION: &[&str] = &[
     "XLINE",
     "RAY",
 ];
+
+/// The end of a sweep from `start` that the file gives as ending at `end`: after `start`, by at
+/// most a full turn (angles like 0° → 720° mean one turn, and an end before the start means the
+/// sweep runs on through the next turn). Constant time for any magnitude of angle.
+fn sweep_end(start: f64, end: f64) -> f64 {
+    let end = if end <= start {
+        let d = (end - start).rem_euclid(std::f64::consts::TAU);
+        start + if d > 0.0 { d } else { std::f64::consts::TAU }
+    } else {
+        end
+    };
+    end.min(start + std::f64::consts::TAU)
+}
 
 /// One entity: its type, the line of its `0` group and its groups (without the `0` group).
 #[derive(Clone, Debug)]
@@ -150,8 +162,8 @@ struct Expander<'a, 'o> {
     instances: usize,
     pieces: Vec<Piece>,
     warnings: Vec<DxfWarning>,
-    /// Unknown entity types already warned about.
-    unknown: HashMap<String, usize>,
+    /// Entity types skipped: the line of the first and how many.
+    skipped: HashMap<String, (usize, usize)>,
 }
 
 /// Reads the sections and expands model-space entities into pieces.
@@ -161,7 +173,7 @@ pub(crate) fn collect_pieces(
     warnings: &mut Vec<DxfWarning>,
 ) -> Result<Vec<Piece>, DxfError> {
     let mut codepage = Codepage::Utf8OrAnsi1251;
-    let mut unit_scale = 1.0;
+    let mut unit_scale = None;
     let mut blocks = HashMap::new();
     let mut entities: Option<Vec<Record<'_>>> = None;
 
@@ -172,7 +184,7 @@ pub(crate) fn collect_pieces(
             break;
         }
         if !g.is(0, "SECTION") {
-            // Stray groups between sections are skipped: some writers emit comments (999).
+            // Stray groups between sections are skipped.
             i += 1;
             continue;
         }
@@ -200,6 +212,13 @@ pub(crate) fn collect_pieces(
         i = end + 1;
     }
     let entities = entities.ok_or(DxfError::NoEntities)?;
+    let unit_scale = unit_scale.unwrap_or_else(|| {
+        warnings.push(ReadWarning::new(
+            WarningKind::Units,
+            "the drawing declares no units ($INSUNITS missing); millimetres assumed",
+        ));
+        1.0
+    });
 
     let mut expander = Expander {
         blocks,
@@ -209,7 +228,7 @@ pub(crate) fn collect_pieces(
         instances: 0,
         pieces: Vec::new(),
         warnings: std::mem::take(warnings),
-        unknown: HashMap::new(),
+        skipped: HashMap::new(),
     };
     let world = Transform::scaling(unit_scale);
     for record in &entities {
@@ -219,38 +238,92 @@ pub(crate) fn collect_pieces(
         expander.entity(record, &world, 0, "")?;
     }
     if expander.pieces.is_empty() {
-        // Some drawings (cross.dxf) are drawn straight onto the layout sheet: with nothing in
-        // model space, the paper-space entities are the part.
-        let mut any = false;
+        // Some drawings are drawn straight onto the layout sheet: with nothing in model space,
+        // the paper-space entities are the part. Those of the active layout stand in ENTITIES
+        // (group 67 = 1); the other layouts' in the `*Paper_Space…` blocks, read only when the
+        // active one draws nothing either.
+        let mut read = 0;
         for record in &entities {
             if record.in_paper_space()? {
-                any = true;
+                read += 1;
                 expander.entity(record, &world, 0, "")?;
             }
         }
-        if any && !expander.pieces.is_empty() {
-            expander.warnings.push(DxfWarning {
-                line: 0,
-                message: "model space is empty; the paper-space entities were imported".into(),
-            });
+        let mut where_from = "the active layout";
+        if expander.pieces.is_empty() {
+            let mut layouts: Vec<Vec<u8>> = expander
+                .blocks
+                .keys()
+                .filter(|name| name.starts_with(b"*PAPER_SPACE"))
+                .cloned()
+                .collect();
+            layouts.sort();
+            for name in layouts {
+                let records = expander.blocks[&name].records.clone();
+                for record in &records {
+                    read += 1;
+                    expander.entity(record, &world, 0, "")?;
+                }
+            }
+            where_from = "the layouts";
+        }
+        if read > 0 && !expander.pieces.is_empty() {
+            expander.warnings.push(ReadWarning::new(
+                WarningKind::PaperSpace,
+                format!(
+                    "model space draws nothing; the {read} paper-space entities of {where_from} \
+                     were read instead"
+                ),
+            ));
         }
     }
-    let mut unknown: Vec<(String, usize)> = expander.unknown.drain().collect();
-    unknown.sort_by_key(|(_, line)| *line);
-    for (kind, line) in unknown {
-        expander.warnings.push(DxfWarning {
-            line,
-            message: format!("{kind} entities carry no supported geometry and were skipped"),
-        });
+    let mut skipped: Vec<(String, (usize, usize))> = expander.skipped.drain().collect();
+    skipped.sort_by_key(|(_, (line, _))| *line);
+    for (kind, (line, count)) in skipped {
+        let what = if ANNOTATION.contains(&kind.as_str()) {
+            "not cutting geometry"
+        } else {
+            "not read by cutroute"
+        };
+        let message = if count == 1 {
+            format!("1 {kind} entity skipped ({what})")
+        } else {
+            format!("{count} {kind} entities skipped ({what}); the first is here")
+        };
+        expander
+            .warnings
+            .push(ReadWarning::new(WarningKind::Skipped, message).at_line(line, None));
     }
     *warnings = expander.warnings;
     Ok(expander.pieces)
 }
 
+/// Millimetres per drawing unit of an `$INSUNITS` code, for the codes a cutting drawing can
+/// mean (lengths from microinches to metres); `None` for unitless (0), for the astronomic and
+/// geographic ones and for codes the DXF reference does not define.
+fn insunits_scale(units: i64) -> Option<f64> {
+    Some(match units {
+        1 => 25.4,
+        2 => 304.8,
+        4 => 1.0,
+        5 => 10.0,
+        6 => 1000.0,
+        8 => 25.4e-6,
+        9 => 25.4e-3,
+        10 => 914.4,
+        13 => 1e-3,
+        14 => 100.0,
+        21 => 1200.0 / 3937.0 * 1000.0,
+        22 => 1000.0 / 39.37,
+        23 => 3600.0 / 3937.0 * 1000.0,
+        _ => return None,
+    })
+}
+
 fn read_header(
     body: &[Group<'_>],
     codepage: &mut Codepage,
-    unit_scale: &mut f64,
+    unit_scale: &mut Option<f64>,
     warnings: &mut Vec<DxfWarning>,
 ) -> Result<(), DxfError> {
     let mut variable: &[u8] = b"";
@@ -277,20 +350,33 @@ fn read_header(
             }
             b"$INSUNITS" if g.code == 70 => {
                 let units = g.int()?;
-                // 0 = unitless (taken as mm), 4 = mm; convert the common others.
-                let scale = match units {
-                    1 => Some(25.4),
-                    2 => Some(304.8),
-                    5 => Some(10.0),
-                    6 => Some(1000.0),
-                    _ => None,
+                let (scale, message) = match (units, insunits_scale(units)) {
+                    (4, _) => (1.0, None),
+                    (_, Some(s)) => (
+                        s,
+                        Some(format!(
+                            "drawing units $INSUNITS = {units}; scaled by {s} to mm"
+                        )),
+                    ),
+                    (0, None) => (
+                        1.0,
+                        Some(
+                            "the drawing has no units ($INSUNITS = 0); millimetres assumed".into(),
+                        ),
+                    ),
+                    (_, None) => (
+                        1.0,
+                        Some(format!(
+                            "drawing units $INSUNITS = {units} are not lengths cutroute reads; \
+                             millimetres assumed"
+                        )),
+                    ),
                 };
-                if let Some(s) = scale {
-                    *unit_scale = s;
-                    warnings.push(DxfWarning {
-                        line: g.line + 1,
-                        message: format!("drawing units $INSUNITS = {units}; scaled by {s} to mm"),
-                    });
+                *unit_scale = Some(scale);
+                if let Some(message) = message {
+                    warnings.push(
+                        ReadWarning::new(WarningKind::Units, message).at_line(g.value_at, None),
+                    );
                 }
             }
             _ => {}
@@ -394,13 +480,20 @@ impl Expander<'_, '_> {
         }
     }
 
-    fn warn(&mut self, line: usize, message: impl Into<String>) {
+    fn skip(&mut self, record: &Record<'_>) {
+        let entry = self
+            .skipped
+            .entry(record.kind.clone())
+            .or_insert((record.line, 0));
+        entry.0 = entry.0.min(record.line);
+        entry.1 += 1;
+    }
+
+    fn warn(&mut self, kind: WarningKind, line: usize, message: impl Into<String>) {
         // Keep the report readable on hostile files with millions of bad entities.
         if self.warnings.len() < 1000 {
-            self.warnings.push(DxfWarning {
-                line,
-                message: message.into(),
-            });
+            self.warnings
+                .push(ReadWarning::new(kind, message).at_line(line, None));
         }
     }
 
@@ -413,6 +506,7 @@ impl Expander<'_, '_> {
     ) -> Result<(), DxfError> {
         let kind = record.kind.as_str();
         if ANNOTATION.contains(&kind) {
+            self.skip(record);
             return Ok(());
         }
         let layer = self.layer(record, inherited_layer);
@@ -426,32 +520,39 @@ impl Expander<'_, '_> {
                 let a = record.point(10, "start point")?;
                 let b = record.point(11, "end point")?;
                 if a == b {
-                    self.warn(record.line, "zero-length LINE skipped");
+                    self.warn(
+                        WarningKind::ZeroArea,
+                        record.line,
+                        "zero-length LINE skipped",
+                    );
                     return Ok(());
                 }
                 self.path(vec![Span::line(a, b)], false, to_world, source)
             }
             "ARC" | "CIRCLE" => {
                 let Some(ocs) = record.ocs()? else {
-                    self.warn(record.line, format!("{kind} in a tilted plane skipped"));
+                    self.warn(
+                        WarningKind::Skipped,
+                        record.line,
+                        format!("{kind} in a tilted plane skipped"),
+                    );
                     return Ok(());
                 };
                 let center = record.point(10, "centre")?;
                 let radius = record.real(40, "radius")?;
                 if radius <= 0.0 {
-                    self.warn(record.line, format!("{kind} with radius {radius} skipped"));
+                    self.warn(
+                        WarningKind::ZeroArea,
+                        record.line,
+                        format!("{kind} with radius {radius} skipped"),
+                    );
                     return Ok(());
                 }
                 let (t0, t1, closed) = if kind == "CIRCLE" {
                     (0.0, std::f64::consts::TAU, true)
                 } else {
                     let start = record.real(50, "start angle")?.to_radians();
-                    let mut end = record.real(51, "end angle")?.to_radians();
-                    while end <= start {
-                        end += std::f64::consts::TAU;
-                    }
-                    // Angles like 0° → 720° mean a full turn, not two.
-                    let end = end.min(start + std::f64::consts::TAU);
+                    let end = sweep_end(start, record.real(51, "end angle")?.to_radians());
                     (start, end, false)
                 };
                 let arc = EllipticArc {
@@ -469,15 +570,15 @@ impl Expander<'_, '_> {
                 let ratio = record.real(40, "axis ratio")?;
                 let nz = record.real_or(230, 1.0)?;
                 if ratio <= 0.0 || (major.x == 0.0 && major.y == 0.0) {
-                    self.warn(record.line, "degenerate ELLIPSE skipped");
+                    self.warn(
+                        WarningKind::ZeroArea,
+                        record.line,
+                        "degenerate ELLIPSE skipped",
+                    );
                     return Ok(());
                 }
                 let t0 = record.real_or(41, 0.0)?;
-                let mut t1 = record.real_or(42, std::f64::consts::TAU)?;
-                while t1 <= t0 {
-                    t1 += std::f64::consts::TAU;
-                }
-                let t1 = t1.min(t0 + std::f64::consts::TAU);
+                let t1 = sweep_end(t0, record.real_or(42, std::f64::consts::TAU)?);
                 let closed = (t1 - t0 - std::f64::consts::TAU).abs() < 1e-9;
                 // The minor axis is N × major scaled by the ratio: N = ±Z turns it ±90°.
                 let side = if nz < 0.0 { -1.0 } else { 1.0 };
@@ -493,7 +594,11 @@ impl Expander<'_, '_> {
             }
             "LWPOLYLINE" => {
                 let Some(ocs) = record.ocs()? else {
-                    self.warn(record.line, "LWPOLYLINE in a tilted plane skipped");
+                    self.warn(
+                        WarningKind::Skipped,
+                        record.line,
+                        "LWPOLYLINE in a tilted plane skipped",
+                    );
                     return Ok(());
                 };
                 let closed = record.int_or(70, 0)? & 1 == 1;
@@ -520,7 +625,11 @@ impl Expander<'_, '_> {
             "POLYLINE" => {
                 let flags = record.int_or(70, 0)?;
                 if flags & (16 | 64) != 0 {
-                    self.warn(record.line, "polygon mesh / polyface POLYLINE skipped");
+                    self.warn(
+                        WarningKind::Skipped,
+                        record.line,
+                        "polygon mesh / polyface POLYLINE skipped",
+                    );
                     return Ok(());
                 }
                 let is_3d = flags & 8 != 0;
@@ -530,7 +639,11 @@ impl Expander<'_, '_> {
                     record.ocs()?
                 };
                 let Some(ocs) = ocs else {
-                    self.warn(record.line, "POLYLINE in a tilted plane skipped");
+                    self.warn(
+                        WarningKind::Skipped,
+                        record.line,
+                        "POLYLINE in a tilted plane skipped",
+                    );
                     return Ok(());
                 };
                 let mut vertices = Vec::with_capacity(record.vertices.len());
@@ -553,8 +666,10 @@ impl Expander<'_, '_> {
             }
             "SPLINE" => self.spline(record, to_world, source),
             "INSERT" | "MINSERT" => self.insert(record, to_world, depth, &layer),
+            // The end of a heavy polyline's vertices carries nothing.
+            "SEQEND" => Ok(()),
             _ => {
-                self.unknown.entry(kind.to_owned()).or_insert(record.line);
+                self.skip(record);
                 Ok(())
             }
         }
@@ -580,6 +695,7 @@ impl Expander<'_, '_> {
         }
         if spans.is_empty() {
             self.warn(
+                WarningKind::ZeroArea,
                 record.line,
                 format!("{} without extent skipped", record.kind),
             );
@@ -719,6 +835,7 @@ impl Expander<'_, '_> {
             // Fit-point-only splines need AutoCAD's interpolation rules; the fit polyline is a
             // usable stand-in but not within the stated tolerance, so say so.
             self.warn(
+                WarningKind::Approximated,
                 record.line,
                 "SPLINE has only fit points: replaced by the polyline through them",
             );
@@ -746,7 +863,11 @@ impl Expander<'_, '_> {
         })?;
         let spans: Vec<Span> = spans.into_iter().filter(|s| s.start != s.end).collect();
         if spans.is_empty() {
-            self.warn(record.line, "SPLINE without extent skipped");
+            self.warn(
+                WarningKind::ZeroArea,
+                record.line,
+                "SPLINE without extent skipped",
+            );
             return Ok(());
         }
         // Closed splines come back to their start; the joiner closes them like any chain.
@@ -774,7 +895,11 @@ impl Expander<'_, '_> {
             });
         }
         let Some(ocs) = record.ocs()? else {
-            self.warn(record.line, "INSERT in a tilted plane skipped");
+            self.warn(
+                WarningKind::Skipped,
+                record.line,
+                "INSERT in a tilted plane skipped",
+            );
             return Ok(());
         };
         let at = Point::new(record.real_or(10, 0.0)?, record.real_or(20, 0.0)?);
@@ -786,6 +911,7 @@ impl Expander<'_, '_> {
         let row_spacing = record.real_or(45, 0.0)?;
         if scale.x == 0.0 || scale.y == 0.0 {
             self.warn(
+                WarningKind::ZeroArea,
                 record.line,
                 format!("INSERT of {display:?} with zero scale skipped"),
             );

@@ -1,4 +1,5 @@
-//! The ASCII DXF layer below entities: a file is a sequence of (group code, value) line pairs.
+//! The layer below entities: a file is a sequence of (group code, value) pairs, written as line
+//! pairs (ASCII DXF) or as typed binary records (binary DXF).
 
 use super::DxfError;
 
@@ -6,12 +7,27 @@ use super::DxfError;
 /// far below f64's range means no later sum or product can overflow to infinity.
 pub(crate) const MAX_MAGNITUDE: f64 = cutroute_geometry::MAX_COORDINATE;
 
-/// One group: its code, its value's text (trimmed) and the 1-based line of the code.
+/// The first bytes of every binary DXF file.
+pub(crate) const BINARY_SENTINEL: &[u8] = b"AutoCAD Binary DXF\r\n\x1a\0";
+
+/// The comment group: any writer may put it anywhere, and it carries nothing.
+const COMMENT: i32 = 999;
+
+/// One group: its code, its value and where it stands.
+///
+/// In an ASCII file `value` is the value line's text (trimmed) and `line` the 1-based line of
+/// the code. In a binary file `value` is the string of a string group (empty for numbers, whose
+/// value is in `number`), and `line` is the byte offset of the code: the places a reader of a
+/// binary file can point at.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Group<'a> {
     pub code: i32,
     pub value: &'a [u8],
     pub line: usize,
+    /// Where the value stands: the next line (ASCII) or the byte after the code (binary).
+    pub value_at: usize,
+    /// The value of a numeric group of a binary file.
+    pub number: Option<f64>,
 }
 
 impl Group<'_> {
@@ -22,14 +38,19 @@ impl Group<'_> {
 
     /// The value as a finite real of sane magnitude.
     pub fn real(&self) -> Result<f64, DxfError> {
-        let text = std::str::from_utf8(self.value).map_err(|_| self.bad_number())?;
-        let v: f64 = text.parse().map_err(|_| self.bad_number())?;
+        let v = match self.number {
+            Some(v) => v,
+            None => {
+                let text = std::str::from_utf8(self.value).map_err(|_| self.bad_number())?;
+                text.parse().map_err(|_| self.bad_number())?
+            }
+        };
         if !v.is_finite() {
             return Err(self.bad_number());
         }
         if v.abs() > MAX_MAGNITUDE {
             return Err(DxfError::OutOfRange {
-                line: self.line + 1,
+                line: self.value_at,
                 code: self.code,
                 value: v,
             });
@@ -39,6 +60,13 @@ impl Group<'_> {
 
     /// The value as an integer.
     pub fn int(&self) -> Result<i64, DxfError> {
+        if let Some(v) = self.number {
+            return if v.is_finite() && v.fract() == 0.0 && v.abs() < 1e15 {
+                Ok(v as i64)
+            } else {
+                Err(self.bad_number())
+            };
+        }
         let text = std::str::from_utf8(self.value).map_err(|_| self.bad_number())?;
         // Some writers put "1.0" or "  70" in integer groups; accept integral reals too.
         if let Ok(v) = text.parse::<i64>() {
@@ -52,18 +80,27 @@ impl Group<'_> {
 
     fn bad_number(&self) -> DxfError {
         DxfError::BadNumber {
-            line: self.line + 1,
+            line: self.value_at,
             code: self.code,
-            text: decode_text(self.value, Codepage::Utf8OrAnsi1251),
+            text: match self.number {
+                Some(v) => v.to_string(),
+                None => decode_text(self.value, Codepage::Utf8OrAnsi1251),
+            },
         }
     }
 }
 
-/// Splits the file into groups. Fails on a binary DXF, a code line that is not an integer, or a
-/// code without its value line (a truncated file).
+/// Whether the bytes are a binary DXF file.
+pub(crate) fn is_binary(bytes: &[u8]) -> bool {
+    bytes.starts_with(BINARY_SENTINEL)
+}
+
+/// Splits the file into groups, ASCII or binary, up to its `0 EOF` (what follows it, such as a
+/// DOS end-of-file byte or text, is not part of the drawing) and without comment groups. Fails
+/// on a code that is not an integer or a code without its value (a truncated file).
 pub(crate) fn split_groups(bytes: &[u8]) -> Result<Vec<Group<'_>>, DxfError> {
-    if bytes.starts_with(b"AutoCAD Binary DXF") {
-        return Err(DxfError::BinaryDxf);
+    if is_binary(bytes) {
+        return split_binary(bytes);
     }
     let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
     // The newline that ends the last line does not start another (empty) line: without this a
@@ -90,11 +127,139 @@ pub(crate) fn split_groups(bytes: &[u8]) -> Result<Vec<Group<'_>>, DxfError> {
                 code,
             });
         };
-        groups.push(Group {
+        if code == COMMENT {
+            continue;
+        }
+        let group = Group {
             code,
             value: trim(value_line),
             line: index + 1,
-        });
+            value_at: index + 2,
+            number: None,
+        };
+        groups.push(group);
+        if group.is(0, "EOF") {
+            break;
+        }
+    }
+    Ok(groups)
+}
+
+/// How a binary group's value is stored, by its code's range (the DXF reference's group code
+/// value types; binary DXF writes each type in its natural binary form).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum BinaryValue {
+    /// NUL-terminated string.
+    Text,
+    /// Little-endian IEEE double.
+    Double,
+    /// Little-endian signed integer of this many bytes.
+    Int(usize),
+    /// One byte (booleans, 290–299).
+    Byte,
+    /// A length byte and that many bytes (binary chunks).
+    Chunk,
+}
+
+fn binary_value(code: i32) -> BinaryValue {
+    match code {
+        10..=59 | 110..=149 | 210..=239 | 460..=469 | 1010..=1059 => BinaryValue::Double,
+        60..=79 | 170..=179 | 270..=289 | 370..=389 | 400..=409 | 1060..=1070 => {
+            BinaryValue::Int(2)
+        }
+        90..=99 | 420..=459 | 1071 => BinaryValue::Int(4),
+        160..=169 => BinaryValue::Int(8),
+        290..=299 => BinaryValue::Byte,
+        310..=319 | 1004 => BinaryValue::Chunk,
+        _ => BinaryValue::Text,
+    }
+}
+
+/// The groups of a binary DXF. Group codes are one byte (255 escapes to a 16-bit code) in R12
+/// files and always 16 bits from R13 on; the first group of every file is `0 SECTION`, whose
+/// second byte tells the two apart (`S` after a one-byte code, 0 after a two-byte one).
+fn split_binary(bytes: &[u8]) -> Result<Vec<Group<'_>>, DxfError> {
+    let start = BINARY_SENTINEL.len();
+    let wide_codes = bytes.get(start + 1) == Some(&0);
+    let truncated = |at: usize, code: i32| DxfError::BinaryDxf {
+        offset: at,
+        reason: format!("the value of group {code} is cut off by the end of the file (truncated?)"),
+    };
+    let mut groups = Vec::new();
+    let mut at = start;
+    while at < bytes.len() {
+        let code_at = at;
+        let code = if wide_codes {
+            let b = bytes.get(at..at + 2).ok_or_else(|| DxfError::BinaryDxf {
+                offset: at,
+                reason: "the file ends inside a group code (truncated?)".into(),
+            })?;
+            at += 2;
+            i32::from(i16::from_le_bytes([b[0], b[1]]))
+        } else if bytes[at] == 255 {
+            let b = bytes
+                .get(at + 1..at + 3)
+                .ok_or_else(|| DxfError::BinaryDxf {
+                    offset: at,
+                    reason: "the file ends inside a group code (truncated?)".into(),
+                })?;
+            at += 3;
+            i32::from(i16::from_le_bytes([b[0], b[1]]))
+        } else {
+            at += 1;
+            i32::from(bytes[code_at])
+        };
+        let value_at = at;
+        let fixed = |at: usize, n: usize| bytes.get(at..at + n).ok_or_else(|| truncated(at, code));
+        let (value, number, next): (&[u8], Option<f64>, usize) = match binary_value(code) {
+            BinaryValue::Text => {
+                let len = bytes[at..]
+                    .iter()
+                    .position(|&b| b == 0)
+                    .ok_or_else(|| truncated(at, code))?;
+                (&bytes[at..at + len], None, at + len + 1)
+            }
+            BinaryValue::Double => {
+                let b = fixed(at, 8)?;
+                let v = f64::from_le_bytes(b.try_into().expect("8 bytes"));
+                (&[], Some(v), at + 8)
+            }
+            BinaryValue::Int(n) => {
+                let b = fixed(at, n)?;
+                let v = match n {
+                    2 => f64::from(i16::from_le_bytes([b[0], b[1]])),
+                    4 => f64::from(i32::from_le_bytes(b.try_into().expect("4 bytes"))),
+                    // 64-bit groups are handles and counters, never coordinates: rounding
+                    // beyond 2^53 changes nothing the reader uses.
+                    _ => i64::from_le_bytes(b.try_into().expect("8 bytes")) as f64,
+                };
+                (&[], Some(v), at + n)
+            }
+            BinaryValue::Byte => {
+                let b = fixed(at, 1)?;
+                (&[], Some(f64::from(b[0])), at + 1)
+            }
+            BinaryValue::Chunk => {
+                let len = usize::from(*fixed(at, 1)?.first().expect("1 byte"));
+                let b = fixed(at + 1, len)?;
+                (b, None, at + 1 + len)
+            }
+        };
+        at = next;
+        if code == COMMENT {
+            continue;
+        }
+        let group = Group {
+            code,
+            value,
+            line: code_at,
+            value_at,
+            number,
+        };
+        groups.push(group);
+        if group.is(0, "EOF") {
+            break;
+        }
     }
     Ok(groups)
 }

@@ -269,3 +269,4 @@ pub fn distance_to_contour(p: Point, contour: &Contour) -> f64 {
     }
     best
 }
+pub mod realworld;
