@@ -157,7 +157,7 @@ fn degenerate_entities_are_skipped_with_a_warning() {
         })
         .collect();
     assert_eq!(lines, ["line 25", "line 37"], "{:?}", import.warnings);
-    assert!(import.warnings[0].message.contains("radius 0"));
+    assert!(import.warnings[1].message.contains("radius 0"));
 }
 
 #[test]
