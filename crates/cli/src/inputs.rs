@@ -59,6 +59,11 @@ pub fn read_profile(path: &Path) -> Result<MachineProfile, String> {
     profile
         .check()
         .map_err(|e| format!("{}: {e}", path.display()))?;
+    // The same ranges as the flags (a tab count of 4·10¹⁸ is no machine's).
+    if let Some(kerf) = &profile.kerf {
+        kerf.check()
+            .map_err(|e| format!("{}: {}", path.display(), e.in_profile()))?;
+    }
     if let Some(name) = &profile.gcode_preset {
         name.parse::<GcodePreset>()
             .map_err(|e| format!("{}: {e}", path.display()))?;

@@ -92,7 +92,7 @@ fn tabs(text: Option<&str>) -> Result<TabSpec, String> {
     let (count, width) = text.split_once(':').ok_or_else(bad)?;
     let count: usize = count.trim().parse().map_err(|_| bad())?;
     let width: f64 = width.trim().parse().map_err(|_| bad())?;
-    if !(width.is_finite() && width > 0.0) || count > 1000 {
+    if !(width.is_finite() && width > 0.0) || count > cutroute_geometry::MAX_TABS {
         return Err(bad());
     }
     Ok(TabSpec { count, width })
@@ -125,6 +125,8 @@ impl KerfArgs {
             edge_pierce: self.edge_pierce,
             kerf_pierce: self.kerf_pierce,
         };
+        // The ranges profiles and the engine hold the settings to, named by flag.
+        settings.check().map_err(|e| e.for_flag())?;
         Ok(Kerf {
             settings,
             after: self.leads_after,
@@ -216,7 +218,7 @@ impl Kerf {
             "pierce_clearance": s.pierce_clearance,
             "switch_off_clearance": s.switch_off_clearance,
             "overcut": s.overcut,
-            "tabs": { "per_part": s.tabs.count, "width": s.tabs.width },
+            "tabs": tabs_placed(s.tabs, route),
             "optimised_with_leads": !self.after,
             "edge_pierce": s.edge_pierce,
             "kerf_pierce": s.kerf_pierce,
@@ -305,7 +307,17 @@ impl Kerf {
             "switch_off_clearance": s.switch_off_clearance,
             // Closed paths only: an open path ends where the solver ends it.
             "overcut": s.overcut,
-            "tabs": { "per_part": s.tabs.count, "width": s.tabs.width },
+            "tabs": {
+                "per_part": s.tabs.count,
+                "width": s.tabs.width,
+                // A gap goes only where the cut has room away from corners and leads.
+                "placed": route
+                    .paths
+                    .iter()
+                    .filter_map(|p| p.leads.as_ref())
+                    .map(|l| l.tabs.len())
+                    .sum::<usize>(),
+            },
             "optimised_with_leads": true,
             "edge_pierce": s.edge_pierce,
         });
@@ -350,6 +362,23 @@ impl Kerf {
         report["lead_in_length"] = json!(leads().map(PathLeads::lead_in_length).sum::<f64>());
         report["lead_out_length"] = json!(leads().map(PathLeads::lead_out_length).sum::<f64>());
     }
+}
+
+/// The report's `tabs`: the asked gaps per part and width, how many were placed, and how many
+/// parts got fewer than asked (a gap goes only where the cut has room for it away from the
+/// corners and the leads, so a small or many-cornered part can get fewer, or none).
+fn tabs_placed(asked: TabSpec, route: &Route) -> Value {
+    let mut per_part: std::collections::BTreeMap<usize, usize> = Default::default();
+    for step in &route.steps {
+        let placed = step.leads.as_ref().map_or(0, |l| l.tabs.len());
+        *per_part.entry(step.contour.part).or_default() += placed;
+    }
+    json!({
+        "per_part": asked.count,
+        "width": asked.width,
+        "placed": per_part.values().sum::<usize>(),
+        "parts_with_fewer": per_part.values().filter(|&&n| n < asked.count).count(),
+    })
 }
 
 /// The error of contours without room for their leads, from `LeadError`'s words.

@@ -81,10 +81,14 @@ pub enum KerfSettingsError {
     /// Tabs are asked for with no width.
     #[error("tabs need a positive width")]
     TabWidth,
+    /// A setting outside its range ([`KerfSettings::check`], the table the CLI's flags and
+    /// profiles share).
+    #[error("{0}")]
+    OutOfRange(#[from] cutroute_geometry::KerfRangeError),
 }
 
-/// Checks the settings a request carries: every length finite and non-negative, and d₂ < d₁
-/// when d₁ is set (the model's 0 ≤ d₂ < d₁).
+/// Checks the settings a request carries: every length finite and non-negative, tabs with a
+/// width, then every setting in its range ([`KerfSettings::check`]).
 pub fn validate_kerf(settings: &KerfSettings) -> Result<(), KerfSettingsError> {
     let lengths = [
         ("kerf", settings.kerf),
@@ -103,6 +107,7 @@ pub fn validate_kerf(settings: &KerfSettings) -> Result<(), KerfSettingsError> {
     if settings.tabs.count > 0 && settings.tabs.width <= 0.0 {
         return Err(KerfSettingsError::TabWidth);
     }
+    settings.check()?;
     Ok(())
 }
 

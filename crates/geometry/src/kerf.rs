@@ -186,7 +186,8 @@ pub fn clearance(nest: &Nest, p: Point, limit: f64) -> f64 {
 /// Whether `p` lies in the region of points at least `distance` from every contour and in the
 /// scrap on the cut side of `contour` (outside it and its siblings, inside the hole that holds
 /// it; inside it and outside its islands for a hole) — G_M for d₁, G_M* for d₂, restricted to
-/// the scrap region the contour's leads live in.
+/// the scrap region the contour's leads live in, and on the sheet at least `distance` from its
+/// border where the nest has a sheet.
 pub fn in_clear_scrap(
     nest: &Nest,
     forest: &crate::ContainmentForest,
@@ -205,6 +206,7 @@ pub fn in_clear_scrap(
         forest.parent(contour)
     };
     p.is_finite()
+        && crate::leads::on_sheet(nest, p, distance)
         && crate::in_scrap_region(nest, forest, region, p)
         && !(clearance(nest, p, distance) < distance)
 }

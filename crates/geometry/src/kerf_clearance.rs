@@ -152,7 +152,9 @@ pub struct KerfOverlap {
     pub contour: ContourRef,
     /// The contour it comes too close to.
     pub other: ContourRef,
-    /// The least distance from the cut to `other`, mm.
+    /// The least distance from the cut to `other`, mm; for contours that touch or coincide
+    /// (where the cut may keep kerf/2 from `other` by running on its far side), the contours'
+    /// own distance.
     pub distance: f64,
     /// The least it may be: kerf/2, mm.
     pub required: f64,
@@ -226,6 +228,26 @@ pub fn kerf_overlaps(nest: &Nest, half: f64, tolerance: f64) -> Vec<KerfOverlap>
         seen.insert((r, r));
         let spans: Vec<Span> = eq.spans().collect();
         overlaps.extend(cut_overlaps(&index, r, &spans, half, tolerance, &mut seen));
+    }
+    // Contours that touch or coincide: where one lies exactly on another (a part in a hole of
+    // its own shape, two identical parts on top of each other) the cut round one runs exactly
+    // kerf/2 from the other, on its far side, so the test above sees no overlap; yet the kerf
+    // burns into both. Any contact of two contours is closer than any kerf.
+    for r in nest.contour_refs() {
+        let Some(contour) = nest.contour(r) else {
+            continue;
+        };
+        seen.insert((r, r));
+        let spans: Vec<Span> = contour.spans().collect();
+        overlaps.extend(
+            cut_overlaps(&index, r, &spans, 2.0 * tolerance, tolerance, &mut seen)
+                .into_iter()
+                .map(|touch| KerfOverlap {
+                    required: half,
+                    gap: touch.distance,
+                    ..touch
+                }),
+        );
     }
     overlaps
 }

@@ -209,7 +209,15 @@ pub fn place_tabs(eq: &Contour, offset: f64, entry: f64, overcut: f64, spec: Tab
     }
     let margin = width.max(1.0);
     let corners = corner_intervals(eq, offset, entry);
-    let mut tabs: Vec<Tab> = Vec::with_capacity(spec.count);
+    // No more gaps than the cut has room for (each takes its width and a margin), however
+    // many are asked: the count is the caller's, the room is the contour's.
+    let room = (perimeter / (width + margin)).floor();
+    let count = if room < spec.count as f64 {
+        room as usize
+    } else {
+        spec.count
+    };
+    let mut tabs: Vec<Tab> = Vec::with_capacity(count);
     let fits = |a: f64, tabs: &[Tab]| {
         a >= overcut + margin
             && a + width <= perimeter - margin
@@ -220,9 +228,12 @@ pub fn place_tabs(eq: &Contour, offset: f64, entry: f64, overcut: f64, spec: Tab
                 .iter()
                 .all(|t| a + width + margin < t.start || a > t.end + margin)
     };
-    let spacing = perimeter / spec.count as f64;
+    if count == 0 {
+        return Vec::new();
+    }
+    let spacing = perimeter / count as f64;
     const TRIES: usize = 200;
-    for k in 0..spec.count {
+    for k in 0..count {
         let even = spacing * (k as f64 + 0.5) - width / 2.0;
         let found = (0..=TRIES)
             .flat_map(|j| {
@@ -341,10 +352,258 @@ impl KerfSettings {
         }
     }
 
+    /// Every setting in its range ([`KerfField`]): kerf, overcut, radii and tab widths 0 or
+    /// from [`MIN_KERF_LENGTH`], clearances and lengths at most [`MAX_KERF_LENGTH`], a lead
+    /// of any shape but none at least [`MIN_KERF_LENGTH`] long, angles within ±89°, at most
+    /// [`MAX_TABS`] tabs. NaN and infinities are outside every range. The first setting out
+    /// of range is named.
+    pub fn check(&self) -> Result<(), KerfRangeError> {
+        use KerfField as F;
+        let length = |field, zero| KerfRange {
+            field,
+            zero,
+            min: MIN_KERF_LENGTH,
+            max: MAX_KERF_LENGTH,
+            unit: "mm",
+        };
+        let upto = |field| KerfRange {
+            field,
+            zero: true,
+            min: 0.0,
+            max: MAX_KERF_LENGTH,
+            unit: "mm",
+        };
+        let angle = |field| KerfRange {
+            field,
+            zero: true,
+            min: -89.0,
+            max: 89.0,
+            unit: "degrees",
+        };
+        let lead = |spec: LeadSpec, l, a, r| {
+            let shaped = spec.shape != LeadShape::None;
+            [
+                (length(l, !shaped), spec.length),
+                (angle(a), spec.angle),
+                (length(r, true), spec.radius),
+            ]
+        };
+        let mut table = vec![
+            (length(F::Kerf, true), self.kerf),
+            (upto(F::PierceClearance), self.pierce_clearance),
+            (upto(F::SwitchOffClearance), self.switch_off_clearance),
+            (upto(F::Overcut), self.overcut),
+        ];
+        table.extend(lead(
+            self.lead_in,
+            F::LeadInLength,
+            F::LeadInAngle,
+            F::LeadInRadius,
+        ));
+        table.extend(lead(
+            self.lead_out,
+            F::LeadOutLength,
+            F::LeadOutAngle,
+            F::LeadOutRadius,
+        ));
+        if self.tabs.count > 0 {
+            table.push((length(F::TabWidth, false), self.tabs.width));
+        }
+        for (range, value) in table {
+            if !range.holds(value) {
+                let zero_refused =
+                    matches!(range.field, F::LeadInLength | F::LeadOutLength) && value == 0.0;
+                return Err(KerfRangeError {
+                    field: range.field,
+                    value,
+                    range: range.words(),
+                    note: if zero_refused {
+                        " for a lead of a shape (or no lead)"
+                    } else {
+                        ""
+                    },
+                });
+            }
+        }
+        if self.tabs.count > MAX_TABS {
+            return Err(KerfRangeError {
+                field: F::TabCount,
+                value: self.tabs.count as f64,
+                range: format!("from 0 to {MAX_TABS}"),
+                note: " per part",
+            });
+        }
+        Ok(())
+    }
+
     /// The longest edge lead-in, mm: the asked lead-in's longest chain plus d₁, as far as the
     /// asked lead and its pierce region would reach from the entry anyway.
     pub fn edge_reach(&self) -> f64 {
         self.lead_in.longest_chain() + self.pierce_clearance
+    }
+}
+
+/// A setting of [`KerfSettings`] held to a range by [`KerfSettings::check`]: the one table of
+/// ranges that the command line's flags, machine profiles and the engine's requests share.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum KerfField {
+    /// [`KerfSettings::kerf`].
+    Kerf,
+    /// [`KerfSettings::pierce_clearance`].
+    PierceClearance,
+    /// [`KerfSettings::switch_off_clearance`].
+    SwitchOffClearance,
+    /// The lead-in's [`LeadSpec::length`].
+    LeadInLength,
+    /// The lead-in's [`LeadSpec::angle`].
+    LeadInAngle,
+    /// The lead-in's [`LeadSpec::radius`].
+    LeadInRadius,
+    /// The lead-out's [`LeadSpec::length`].
+    LeadOutLength,
+    /// The lead-out's [`LeadSpec::angle`].
+    LeadOutAngle,
+    /// The lead-out's [`LeadSpec::radius`].
+    LeadOutRadius,
+    /// [`KerfSettings::overcut`].
+    Overcut,
+    /// [`TabSpec::count`].
+    TabCount,
+    /// [`TabSpec::width`].
+    TabWidth,
+}
+
+impl KerfField {
+    /// The setting in words, as messages name it.
+    pub fn words(self) -> &'static str {
+        match self {
+            Self::Kerf => "kerf",
+            Self::PierceClearance => "pierce clearance",
+            Self::SwitchOffClearance => "switch-off clearance",
+            Self::LeadInLength => "lead-in length",
+            Self::LeadInAngle => "lead-in angle",
+            Self::LeadInRadius => "lead-in radius",
+            Self::LeadOutLength => "lead-out length",
+            Self::LeadOutAngle => "lead-out angle",
+            Self::LeadOutRadius => "lead-out radius",
+            Self::Overcut => "overcut",
+            Self::TabCount => "tab count",
+            Self::TabWidth => "tab width",
+        }
+    }
+
+    /// The command-line flag that sets it (`None`: only a profile does).
+    pub fn flag(self) -> Option<&'static str> {
+        match self {
+            Self::Kerf => Some("--kerf"),
+            Self::PierceClearance => Some("--pierce-clearance"),
+            Self::SwitchOffClearance => Some("--switch-off-clearance"),
+            Self::LeadInLength => Some("--lead-in-length"),
+            Self::LeadOutLength => Some("--lead-out-length"),
+            Self::Overcut => Some("--overcut"),
+            Self::TabCount | Self::TabWidth => Some("--tabs"),
+            Self::LeadInAngle | Self::LeadInRadius | Self::LeadOutAngle | Self::LeadOutRadius => {
+                None
+            }
+        }
+    }
+
+    /// Its key in a machine profile's JSON.
+    pub fn profile_key(self) -> &'static str {
+        match self {
+            Self::Kerf => "kerf.kerf",
+            Self::PierceClearance => "kerf.pierce_clearance",
+            Self::SwitchOffClearance => "kerf.switch_off_clearance",
+            Self::LeadInLength => "kerf.lead_in.length",
+            Self::LeadInAngle => "kerf.lead_in.angle",
+            Self::LeadInRadius => "kerf.lead_in.radius",
+            Self::LeadOutLength => "kerf.lead_out.length",
+            Self::LeadOutAngle => "kerf.lead_out.angle",
+            Self::LeadOutRadius => "kerf.lead_out.radius",
+            Self::Overcut => "kerf.overcut",
+            Self::TabCount => "kerf.tabs.count",
+            Self::TabWidth => "kerf.tabs.width",
+        }
+    }
+}
+
+/// The range of one setting: `zero` (off) or from `min` to `max`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct KerfRange {
+    /// The setting.
+    pub field: KerfField,
+    /// Whether 0 (the setting off) is allowed below `min`.
+    pub zero: bool,
+    /// The least value other than 0.
+    pub min: f64,
+    /// The largest value.
+    pub max: f64,
+    /// The unit the message gives.
+    pub unit: &'static str,
+}
+
+impl KerfRange {
+    /// Whether `value` is in the range.
+    pub fn holds(&self, value: f64) -> bool {
+        (self.zero && value == 0.0) || (value >= self.min && value <= self.max)
+    }
+
+    /// The range in words: "0 or from 0.001 to 100 mm".
+    pub fn words(&self) -> String {
+        let unit = if self.unit.is_empty() {
+            String::new()
+        } else {
+            format!(" {}", self.unit)
+        };
+        if self.zero {
+            format!("0 or from {} to {}{unit}", self.min, self.max)
+        } else {
+            format!("from {} to {}{unit}", self.min, self.max)
+        }
+    }
+}
+
+/// Smallest kerf, lead, radius and tab width other than 0, mm: below it the offsets and leads
+/// are below the checkers' tolerances (a kerf of 10⁻³⁰⁰ mm is no kerf, and a route built with
+/// it fails its own checks). No machine cuts with less.
+pub const MIN_KERF_LENGTH: f64 = 1e-3;
+
+/// Largest length of any kerf setting, mm (a lead or clearance of a metre is a typing error).
+pub const MAX_KERF_LENGTH: f64 = 1000.0;
+
+/// Largest number of tabs per part.
+pub const MAX_TABS: usize = 1000;
+
+/// Why [`KerfSettings::check`] refuses the settings: one setting outside its range.
+#[derive(Clone, Debug, PartialEq, Error)]
+#[error("{} {value}: must be {range}{}", field.words(), note)]
+pub struct KerfRangeError {
+    /// The setting.
+    pub field: KerfField,
+    /// Its value.
+    pub value: f64,
+    /// Its range in words.
+    pub range: String,
+    /// What else the message says (why 0 is not allowed here), or empty.
+    pub note: &'static str,
+}
+
+impl KerfRangeError {
+    /// The message naming the command-line flag (or the profile key when no flag sets it).
+    pub fn for_flag(&self) -> String {
+        let name = self.field.flag().unwrap_or(self.field.profile_key());
+        format!("{name} {}: must be {}{}", self.value, self.range, self.note)
+    }
+
+    /// The message naming the profile key.
+    pub fn in_profile(&self) -> String {
+        format!(
+            "{} {}: must be {}{}",
+            self.field.profile_key(),
+            self.value,
+            self.range,
+            self.note
+        )
     }
 }
 
@@ -590,6 +849,31 @@ pub enum LeadProblem {
         /// M, y.
         y: f64,
     },
+    /// M lies off the sheet, or closer than d₁ to the sheet's edge: the torch would pierce
+    /// beside the plate (or at its crumbling edge), where there is no scrap to pierce.
+    #[error("pierce point ({x}, {y}) is off the sheet or closer than d₁ to its edge")]
+    PierceOffSheet {
+        /// M, x.
+        x: f64,
+        /// M, y.
+        y: f64,
+    },
+    /// M* lies off the sheet, or closer than d₂ to its edge.
+    #[error("switch-off point ({x}, {y}) is off the sheet or closer than d₂ to its edge")]
+    SwitchOffOffSheet {
+        /// M*, x.
+        x: f64,
+        /// M*, y.
+        y: f64,
+    },
+    /// A lead's corner (between its straight part and its arc) lies off the sheet.
+    #[error("a lead runs off the sheet at ({x}, {y})")]
+    LeadOffSheet {
+        /// Where, x.
+        x: f64,
+        /// Where, y.
+        y: f64,
+    },
     /// M* is not in G_M*.
     #[error("switch-off point ({x}, {y}) is not in the switch-off region G_M*")]
     SwitchOffOutsideRegion {
@@ -792,6 +1076,14 @@ impl<'a> LeadFitter<'a> {
             && inside_region
             && !children.iter().any(|&c| contains(c))
             && !(self.clearance(p, distance) < distance)
+    }
+
+    /// Whether `p` lies on the nest's sheet at least `distance` inside its border (its first
+    /// contour, as for edge piercing); every point is on a nest without a sheet. A pierce or
+    /// switch-off point must be: off the plate there is nothing to pierce, and at its very
+    /// edge the plate crumbles like the part's own edge would.
+    pub fn on_sheet(&self, p: Point, distance: f64) -> bool {
+        on_sheet(self.nest, p, distance)
     }
 
     /// The settings.
@@ -1062,6 +1354,30 @@ impl<'a> LeadFitter<'a> {
         } else {
             (chain.last()?.point, self.settings.switch_off_clearance)
         };
+        if !linked && !self.on_sheet(free, distance - TOLERANCE) {
+            return Some(if lead_in {
+                LeadProblem::PierceOffSheet {
+                    x: free.x,
+                    y: free.y,
+                }
+            } else {
+                LeadProblem::SwitchOffOffSheet {
+                    x: free.x,
+                    y: free.y,
+                }
+            });
+        }
+        // The lead's inner vertices (a line-arc's corner) stay on the sheet too; its end on
+        // the equidistant may not (a part at the sheet's edge is cut round off the plate).
+        let inner = chain
+            .get(1..chain.len().saturating_sub(1))
+            .unwrap_or_default();
+        if let Some(v) = inner.iter().find(|v| !self.on_sheet(v.point, -TOLERANCE)) {
+            return Some(LeadProblem::LeadOffSheet {
+                x: v.point.x,
+                y: v.point.y,
+            });
+        }
         if !linked && !self.in_clear_scrap(r, free, distance - TOLERANCE) {
             return Some(if lead_in {
                 LeadProblem::PierceOutsideRegion {
@@ -1531,7 +1847,8 @@ impl LeadFitter<'_> {
                 let chain = vec![vertex(at), vertex(leads.entry)];
                 let open = eq
                     .as_ref()
-                    .is_some_and(|eq| in_open_kerf(eq, cut, at, half));
+                    .is_some_and(|eq| in_open_kerf(eq, cut, at, half))
+                    && self.on_sheet(at, 0.0);
                 if open
                     && self
                         .chain_problem_linked(step.contour, &chain, true, true)
@@ -1570,7 +1887,10 @@ impl LeadFitter<'_> {
         let Ok(eq) = self.equidistant(kerf_of) else {
             return Some(off);
         };
-        let on = eq.distance_to(pierce) <= 1e-6 && in_open_kerf(&eq, cut, pierce, half);
+        // A kerf that runs off the sheet (a part at its edge) is no place to pierce.
+        let on = eq.distance_to(pierce) <= 1e-6
+            && in_open_kerf(&eq, cut, pierce, half)
+            && self.on_sheet(pierce, -TOLERANCE);
         (!on).then_some(off)
     }
 }
@@ -1589,6 +1909,19 @@ fn in_open_kerf(eq: &Contour, cut: &StepLeads, at: Point, half: f64) -> bool {
     cut.tabs
         .iter()
         .all(|t| along <= t.start - half || along >= t.end + half)
+}
+
+/// Whether `p` lies inside the border of `nest`'s sheet (its first contour) and at least
+/// `distance` from it (see [`LeadFitter::on_sheet`]); true without a sheet.
+pub(crate) fn on_sheet(nest: &Nest, p: Point, distance: f64) -> bool {
+    let Some(border) = nest.sheet.as_ref().and_then(|s| s.contours.first()) else {
+        return true;
+    };
+    if border.vertices.len() < 2 {
+        return true;
+    }
+    p.is_finite() && border.contains(p) && !(border.distance_to(p) < distance)
+        || (distance <= 0.0 && border.distance_to(p) <= -distance)
 }
 
 pub(crate) fn vertex(p: Point) -> Vertex {

@@ -108,8 +108,9 @@ pub use generator::generate_nest;
 pub use kerf::{clearance, equidistant, in_clear_scrap, OffsetError};
 pub use kerf_clearance::{kerf_overlaps, ContourSpans, KerfOverlap, PartsTooClose, TooClose};
 pub use leads::{
-    chain_spans, opened_at, place_tabs, KerfSettings, LeadError, LeadFitter, LeadProblem,
-    LeadShape, LeadSpec, StepLeads, Tab, TabSpec,
+    chain_spans, opened_at, place_tabs, KerfField, KerfRange, KerfRangeError, KerfSettings,
+    LeadError, LeadFitter, LeadProblem, LeadShape, LeadSpec, StepLeads, Tab, TabSpec,
+    MAX_KERF_LENGTH, MAX_TABS, MIN_KERF_LENGTH,
 };
 pub use neighbours::nearest_groups;
 pub use path_leads::PathLeads;
