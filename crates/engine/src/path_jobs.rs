@@ -300,7 +300,7 @@ impl PlanBound {
         })
     }
 
-    /// The objective's lower bound for every route, given `ccp_idle`: a certified lower
+    /// The objective's lower bound for every route of the plan model (see below), given `ccp_idle`: a certified lower
     /// bound on the idle length of every CCP route from the same start (and to the same
     /// finish; `cutroute-ccp`'s `CcpLowerBound`). Where contours touch it is
     /// [`PlanBound::any_route`].
