@@ -25,6 +25,12 @@
 //!   out (components ordered inner-first with short idle moves), checked by both checkers;
 //! - [`random`]: seeded random plane 4-regular graphs (medial graphs of random plane multigraphs).
 //!
+//! [`pierce_lower_bound`] (and the job's `lb` built on it) bounds the routes of the plan model
+//! that cut every plan edge once as trails: tool-on only along the plan's edges, the torch off
+//! between paths. Routes that cut a common edge twice, and chain routes whose tool-on links
+//! run through the scrap, are outside it (the README's solver table says which routes every
+//! solver's `lb` bounds).
+//!
 //! ```
 //! use cutroute_aoe::{aoe_chain, check_chain, AoeOptions, Embedding, PlaneGraph};
 //!

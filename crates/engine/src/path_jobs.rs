@@ -63,6 +63,10 @@ pub struct PlanBound {
     pub whole_contours: bool,
     /// The largest bounding-box diagonal of a contour (mm): at least its diameter.
     pub diameter: f64,
+    /// How much longer the contours are than the plan graph (mm, at least 0): what a contour
+    /// traces twice over itself (a zero-area contour, a slit), which a CCP route cuts twice
+    /// and a route of the plan may cut once, ending away from its pierce point.
+    pub overlap: f64,
 }
 
 /// The work [`idle_tree_bound`] may spend on exact component distances (span pairs measured);
@@ -261,6 +265,21 @@ impl PlanBound {
             dx.hypot_libm(dy)
         };
         let contours = nest.parts.iter().flat_map(|p| &p.contours);
+        let perimeters: f64 = nest
+            .parts
+            .iter()
+            .flat_map(|p| &p.contours)
+            .map(|c| c.perimeter())
+            .sum();
+        // One contour per component: each component's edges belong to one contour alone (a
+        // contour the plan left out, e.g. one of zero size, would make the counts agree by
+        // chance otherwise).
+        let one_contour_each = components.iter().all(|c| {
+            let mut owners = c.edges.iter().flat_map(|&e| plan.edge_contours(e));
+            owners
+                .next()
+                .is_some_and(|first| owners.all(|other| other == first))
+        });
         Ok(PlanBound {
             // Merged copies of a common edge agree within the tolerance at their ends.
             cut_length: (length - 4.0 * tolerance * edges as f64).max(0.0),
@@ -269,17 +288,19 @@ impl PlanBound {
             idle_length: tree.max(to_box(start) + finish.map_or(0.0, to_box)),
             // A contour is connected, so it lies in one component and each component holds
             // one at least: as many components as contours means one contour each.
-            whole_contours: components.len() == nest.contour_count(),
+            whole_contours: one_contour_each && components.len() == nest.contour_count(),
             diameter: contours
                 .map(|c| {
                     let b = c.bounding_box();
                     (b.max.x - b.min.x).hypot_libm(b.max.y - b.min.y)
                 })
                 .fold(0.0, f64::max),
+            // The plan's edges may lie up to the tolerance short of their contours at each end.
+            overlap: (perimeters - length + 4.0 * tolerance * edges as f64).max(0.0),
         })
     }
 
-    /// The objective's lower bound for every route, given `ccp_idle`: a certified lower
+    /// The objective's lower bound for every route of the plan model (see below), given `ccp_idle`: a certified lower
     /// bound on the idle length of every CCP route from the same start (and to the same
     /// finish; `cutroute-ccp`'s `CcpLowerBound`). Where contours touch it is
     /// [`PlanBound::any_route`].
@@ -290,12 +311,20 @@ impl PlanBound {
     /// round to it, and drop its other paths. That is a CCP route: each contour is cut after
     /// every contour inside it, as the route's precedence already had it. Its idle length
     /// grows by at most a diameter `D` per path of a contour cut in several (at most `2D` per
-    /// extra pierce), and where one path both cuts a contour whole and ends away from its
-    /// start, by at most the part cut twice. So the route idles at least
-    /// `max(tree, ccp_idle − 2D·e − r)`, and with the prices `a` (per mm cut), `b` (per mm
-    /// idle) and `c` (per pierce), its value is at least
-    /// `any_route + (ccp_idle − tree)⁺ · min(a, b, c / 2D)`: a pierce saves at most `2D` mm
-    /// of idle travel, a millimetre cut twice at most one.
+    /// extra pierce), and where one path both cuts a contour whole and ends at `q` away from
+    /// its start `p`, by `|pq|`, which is at most the part cut twice plus the contour's own
+    /// overlap ([`PlanBound::overlap`]): on the plan's edges, those the path runs an odd
+    /// number of times join `p` to `q`, those the contour runs an odd number of times form
+    /// cycles, so their symmetric difference still joins `p` to `q`, and each of its edges is
+    /// run twice by the path (the part cut twice) or twice by the contour (the overlap). So
+    /// the route idles at least `max(tree, ccp_idle − Ω − 2D·e − r)` (`Ω` the overlap), and
+    /// with the prices `a` (per mm cut), `b` (per mm idle) and `c` (per pierce), its value is
+    /// at least `any_route + (ccp_idle − Ω − tree)⁺ · min(a, b, c / 2D)`: a pierce saves at
+    /// most `2D` mm of idle travel, a millimetre cut twice at most one.
+    ///
+    /// The routes bounded are those of the plan model: every tool-on path runs along the
+    /// contours, and between paths the tool is off (an idle move, then a pierce). A `chain`
+    /// route's tool-on links through the scrap leave that model and may be worth less.
     pub fn any_route_with_ccp(
         &self,
         ccp_idle: f64,
@@ -303,6 +332,7 @@ impl PlanBound {
         machine: &MachineParameters,
     ) -> f64 {
         let plain = self.any_route(objective, machine);
+        let ccp_idle = ccp_idle - self.overlap;
         // (A NaN bound tells nothing either.)
         if !self.whole_contours
             || ccp_idle.partial_cmp(&self.idle_length) != Some(Ordering::Greater)
@@ -323,11 +353,11 @@ impl PlanBound {
     /// given `ccp_idle` as in [`PlanBound::any_route_with_ccp`]. Where contours touch, or
     /// without `upper`, it is [`PlanBound::idle_length`].
     ///
-    /// A route with `e` extra pierces and `r` mm cut twice idles `x ≥ ccp_idle − 2D·e − r`
+    /// A route with `e` extra pierces and `r` mm cut twice idles `x ≥ ccp_idle − Ω − 2D·e − r`
     /// (see [`PlanBound::any_route_with_ccp`]), and being at least as good it has
     /// `c·e + a·r + b·x ≤ S = upper − value(plan cut, no idle, n pierces)`. Extra pierces
     /// need `c ≤ S`; then `2D·e + r ≤ k·(S − b·x)` with `k = max(2D / c, 1 / a)` (else
-    /// `k = 1 / a`), so `x ≥ (ccp_idle − k·S) / (1 − k·b)` when `k·b < 1`.
+    /// `k = 1 / a`), so `x ≥ (ccp_idle − Ω − k·S) / (1 − k·b)` when `k·b < 1`.
     pub fn idle_at_most(
         &self,
         ccp_idle: f64,
@@ -335,6 +365,7 @@ impl PlanBound {
         objective: Objective,
         machine: &MachineParameters,
     ) -> f64 {
+        let ccp_idle = ccp_idle - self.overlap;
         let Some(upper) = upper.filter(|_| self.whole_contours && ccp_idle > self.idle_length)
         else {
             return self.idle_length;

@@ -614,6 +614,7 @@ fn the_bounds_from_ccp_are_the_minimum_over_extra_pierces_and_recut() {
             idle_length: tree,
             whole_contours: true,
             diameter: rng.range(5.0, 3000.0),
+            overlap: 0.0,
         };
         let n = plan.components;
         let value = |r: f64, idle: f64, e: usize| {

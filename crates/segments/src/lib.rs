@@ -18,6 +18,12 @@
 //!   [`PathRoute::problems`](cutroute_geometry::PathRoute::problems), and the best by time or
 //!   cost ([`Objective`]) is kept, with every ensemble's numbers.
 //!
+//! The searches give no lower bound of their own; the job engine's bound for `sccp` and `gsccp`
+//! (`PlanBound` in `cutroute-engine`) bounds the routes of the plan model: tool-on paths
+//! only along the contours, an idle move and a pierce between paths. A `chain` route's
+//! tool-on links through the scrap are outside that model (the README's solver table says
+//! which routes every solver's `lb` bounds).
+//!
 //! ```
 //! use std::sync::atomic::AtomicBool;
 //! use cutroute_geometry::{Contour, Nest, Part, Vertex};
