@@ -96,6 +96,9 @@ const INKSCAPE_NS: &str = "http://www.inkscape.org/namespaces/inkscape";
 const MM_PER_PX: f64 = 25.4 / 96.0;
 /// CSS's initial `font-size`, in pixels (for `em` lengths).
 const INITIAL_FONT_PX: f64 = 16.0;
+/// The approximation tolerance of a Bézier curve as a fraction of its extent, where that is
+/// finer than the options' tolerance.
+const SMALL_CURVE_TOLERANCE: f64 = 1e-3;
 /// Elements visited per allowed span: bounds the walk of `<use>` trees that draw nothing.
 const VISITS_PER_SPAN: usize = 4;
 
@@ -406,10 +409,7 @@ impl<'a, 'input> Reader<'a, 'input, '_> {
 
     /// The size of a root user unit in millimetres along x and y, and the root viewport's size
     /// in user units (for percentages).
-    fn root_scale(
-        &mut self,
-        root: Node<'_, '_>,
-    ) -> Result<RootScale, SvgError> {
+    fn root_scale(&mut self, root: Node<'_, '_>) -> Result<RootScale, SvgError> {
         let view_box = self.view_box(root)?;
         let mut sizes = [None, None];
         let mut bare = false;
@@ -1191,12 +1191,19 @@ impl<'a, 'input> Reader<'a, 'input, '_> {
                     if world.iter().all(|&p| p == world[0]) {
                         continue;
                     }
+                    // A curve far smaller than the tolerance (the rounded corners Boxes.py
+                    // draws, 0.1 mm across) would be replaced by arcs of a visibly different
+                    // length: its tolerance shrinks with its size.
+                    let extent = world
+                        .iter()
+                        .map(|p| p.distance(world[0]))
+                        .fold(0.0, f64::max);
                     let pieces = approximate(
                         &|t| curve.point_at(t),
                         0.0,
                         1.0,
                         &[0.5],
-                        tolerance,
+                        tolerance.min(extent * SMALL_CURVE_TOLERANCE),
                         &mut self.budget,
                     )
                     .map_err(|ApproxFailure::BudgetExceeded| too_complex.clone())?;
