@@ -36,7 +36,7 @@
 //! };
 //! let options = GcodeOptions { pierce_dwell_s: 0.5, ..GcodeOptions::default() };
 //! let gcode = write_gcode(&path, &options)?;
-//! assert!(gcode.contains("G00 X10.000\nM03\nG04 P0.500\nG03 I-10.000 J0.000 F600\nM05\n"));
+//! assert!(gcode.contains("G00 X10.000 Y0.000\nM03\nG04 P0.500\nG03 I-10.000 J0.000 F600\nM05\n"));
 //!
 //! let program = read_gcode(&gcode, &ReadOptions::default())?;
 //! assert_eq!(program.pierce_count(), 1);

@@ -15,8 +15,9 @@ pub enum DistanceMode {
     /// `G90`: every X/Y is a position on the machine's coordinate system.
     #[default]
     Absolute,
-    /// `G91`: every X/Y is the increment from the previous position. The program then starts
-    /// where the head stands, which is the toolpath's start point.
+    /// `G91`: every X/Y is the increment from the previous position. So that the first move
+    /// does not depend on where the machine stands, the program first moves to the toolpath's
+    /// start in absolute coordinates (`G90`, `G00 X… Y…`) and then switches to `G91`.
     Incremental,
 }
 
@@ -229,7 +230,7 @@ pub enum GcodeError {
 
 /// Writes `toolpath` as a G-code program.
 pub fn write_gcode(toolpath: &Toolpath, options: &GcodeOptions) -> Result<String, GcodeError> {
-    write_labelled(toolpath, &|_| None, &[], options)
+    write_labelled(toolpath, toolpath, &|_| None, &[], options)
 }
 
 /// Writes the route's toolpath over `nest`, with a comment naming the part and contour before
@@ -249,16 +250,19 @@ pub fn route_gcode(
     };
     match options.kerf_compensation {
         KerfCompensation::InProgram => {
-            write_labelled(&Toolpath::new(route, nest)?, &label, &[], options)
+            let toolpath = Toolpath::new(route, nest)?;
+            write_labelled(&toolpath, &toolpath, &label, &[], options)
         }
         code => {
             let (toolpath, codes) = compensated_toolpath(nest, route, code, options.decimals)?;
+            // The header states what the controller runs: the tool centre's path.
+            let centre = Toolpath::new(route, nest)?;
             // Controllers compensate arcs of up to half a turn (full circles are split).
             let options = GcodeOptions {
                 max_arc_sweep_deg: options.max_arc_sweep_deg.min(180.0),
                 ..options.clone()
             };
-            write_labelled(&toolpath, &label, &codes, &options)
+            write_labelled(&toolpath, &centre, &label, &codes, &options)
         }
     }
 }
@@ -371,7 +375,7 @@ pub fn path_route_gcode(route: &PathRoute, options: &GcodeOptions) -> Result<Str
             path.length()
         ))
     };
-    write_labelled(&toolpath, &label, &[], options)
+    write_labelled(&toolpath, &toolpath, &label, &[], options)
 }
 
 /// Arcs whose sagitta is below this many quanta (units of the last written digit) are written
@@ -384,10 +388,21 @@ const MAX_CHORDS_PER_ARC: f64 = 100_000.0;
 const LONGEST_RADIUS_ARC_DEG: f64 = 150.0;
 /// No arc longer than this is written in one move (see [`GcodeOptions::max_arc_sweep_deg`]).
 const LONGEST_ARC_DEG: f64 = 350.0;
+/// Written arcs keep their start and end radii (from the written centre to the written ends)
+/// within this many mm, or within [`ARC_RADIUS_TOLERANCE_REL`] of the radius. LinuxCNC refuses
+/// an arc only when both its absolute and its relative (0.1 %) differences are too large, and
+/// its absolute limit is looser than this one, so this rule is a safe subset for it and for
+/// stricter controllers.
+const ARC_RADIUS_TOLERANCE_MM: f64 = 0.002;
+/// See [`ARC_RADIUS_TOLERANCE_MM`].
+const ARC_RADIUS_TOLERANCE_REL: f64 = 0.001;
 
 /// Writes the moves; `codes` are extra lines, each before the move of its index (in order).
+/// `centre` is the tool centre's path the controller will run (the toolpath itself unless the
+/// controller compensates the kerf), which the header comment summarises.
 fn write_labelled(
     toolpath: &Toolpath,
+    centre: &Toolpath,
     label: &dyn Fn(usize) -> Option<String>,
     codes: &[(usize, String)],
     options: &GcodeOptions,
@@ -396,20 +411,23 @@ fn write_labelled(
     let mut w = Writer::new(options, toolpath.start)?;
     if options.comments {
         w.comment(&format!(
-            "cutroute: {} pierces, cut {:.1} mm, idle {:.1} mm",
-            toolpath.pierce_count(),
-            toolpath.cut_length(),
-            toolpath.idle_length()
+            "cutroute: {} pierces, tool centre cuts {:.1} mm, idle {:.1} mm",
+            centre.pierce_count(),
+            centre.cut_length(),
+            centre.idle_length()
         ));
     }
     w.line("G21".into());
-    w.line(match options.distance_mode {
-        DistanceMode::Absolute => "G90".into(),
-        DistanceMode::Incremental => "G91".into(),
-    });
+    w.line("G90".into());
     w.line("G17".into());
     for line in &options.header {
         w.line(line.clone());
+    }
+    if options.distance_mode == DistanceMode::Incremental {
+        // The increments start from a known position, not from wherever the head stands.
+        let start = w.full_position(w.at);
+        w.line(format!("G00{start}"));
+        w.line("G91".into());
     }
     let mut codes = codes.iter().peekable();
     for (index, m) in toolpath.moves.iter().enumerate() {
@@ -424,6 +442,12 @@ fn write_labelled(
             }
             ToolMove::Pierce { step, .. } => {
                 w.torch_off();
+                if options.distance_mode == DistanceMode::Absolute && !w.positioned {
+                    // The torch fires where the program put the head, never where it stood.
+                    let here = w.full_position(w.at);
+                    w.line(format!("G00{here}"));
+                }
+                w.positioned = false;
                 if options.comments {
                     if let Some(text) = label(step) {
                         w.comment(&text);
@@ -511,6 +535,8 @@ struct Writer<'a> {
     /// Where the head is, in quanta, as written so far.
     at: (i64, i64),
     tool_on: bool,
+    /// A `G00` with every axis has put the head where it is since the last torch-on.
+    positioned: bool,
     feed_written: bool,
     line_number: u64,
     move_index: usize,
@@ -525,6 +551,7 @@ impl<'a> Writer<'a> {
             scale,
             at: (0, 0),
             tool_on: false,
+            positioned: false,
             feed_written: false,
             line_number: 0,
             move_index: 0,
@@ -596,6 +623,11 @@ impl<'a> Writer<'a> {
         }
     }
 
+    /// The absolute X/Y words of `target` (quanta), both axes.
+    fn full_position(&self, target: (i64, i64)) -> String {
+        format!(" X{} Y{}", self.number(target.0), self.number(target.1))
+    }
+
     /// The X/Y words of a move to `target` (quanta), or `None` when the head does not move.
     fn axis_words(&self, target: (i64, i64)) -> Option<String> {
         if target == self.at {
@@ -628,6 +660,15 @@ impl<'a> Writer<'a> {
 
     fn straight(&mut self, code: &str, to: Point, feed: bool) -> Result<(), GcodeError> {
         let target = self.quantize_point(to)?;
+        let rapid = !feed && self.options.distance_mode == DistanceMode::Absolute;
+        if rapid && target != self.at {
+            // Rapids write every axis: the move before a pierce never depends on the last one.
+            let words = self.full_position(target);
+            self.line(format!("{code}{words}"));
+            self.at = target;
+            self.positioned = true;
+            return Ok(());
+        }
         if let Some(words) = self.axis_words(target) {
             let f = if feed {
                 self.feed_word()
@@ -667,37 +708,81 @@ impl<'a> Writer<'a> {
         Ok(())
     }
 
+    /// `span` as `G01` chords, none leaving the arc by more than `tolerance_mm`.
+    fn chords(&mut self, span: Span, tolerance_mm: f64) -> Result<(), GcodeError> {
+        let r = span.radius();
+        let step = if tolerance_mm < r {
+            2.0 * (1.0 - tolerance_mm / r).acos_libm()
+        } else {
+            2.0 * PI / 3.0
+        };
+        let chords = (span.sweep().abs() / step)
+            .ceil()
+            .clamp(1.0, MAX_CHORDS_PER_ARC) as usize;
+        for k in 1..=chords {
+            let p = span.point_at(k as f64 / chords as f64);
+            self.straight("G01", p, true)?;
+        }
+        Ok(())
+    }
+
+    /// Chord tolerance of arcs the written resolution cannot hold as arcs: half the last
+    /// digit, below the rounding every written point already carries.
+    fn rounding_chord_tolerance(&self) -> f64 {
+        0.5 / self.scale
+    }
+
+    /// The centre (quanta) to write for an arc from the head to `end`: the rounded centre, or
+    /// the grid point next to it that best equalises the two radii, provided the radii then
+    /// agree within [`ARC_RADIUS_TOLERANCE_MM`] or [`ARC_RADIUS_TOLERANCE_REL`]; `None` when
+    /// no such point exists.
+    fn written_centre(&self, rounded: (i64, i64), end: (i64, i64)) -> Option<(i64, i64)> {
+        let radius = |p: (i64, i64), c: (i64, i64)| ((p.0 - c.0) as f64).hypot((p.1 - c.1) as f64);
+        let mismatch = |c: (i64, i64)| {
+            let (r1, r2) = (radius(self.at, c), radius(end, c));
+            let d = (r1 - r2).abs() / self.scale;
+            let ok = d <= ARC_RADIUS_TOLERANCE_MM
+                || d <= ARC_RADIUS_TOLERANCE_REL * r1.max(r2) / self.scale;
+            ok.then_some(d)
+        };
+        if mismatch(rounded).is_some_and(|d| d <= ARC_RADIUS_TOLERANCE_MM) {
+            return Some(rounded);
+        }
+        let mut best: Option<((i64, i64), f64)> = mismatch(rounded).map(|d| (rounded, d));
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                let c = (rounded.0 + dx, rounded.1 + dy);
+                if let Some(d) = mismatch(c) {
+                    if best.is_none_or(|(_, b)| d < b) {
+                        best = Some((c, d));
+                    }
+                }
+            }
+        }
+        best.map(|(c, _)| c)
+    }
+
     fn arc(&mut self, span: Span) -> Result<(), GcodeError> {
         let code = if span.bulge > 0.0 { "G03" } else { "G02" };
         match self.options.arcs {
-            ArcOutput::Lines { tolerance_mm } => {
-                let r = span.radius();
-                let step = if tolerance_mm < r {
-                    2.0 * (1.0 - tolerance_mm / r).acos_libm()
-                } else {
-                    2.0 * PI / 3.0
-                };
-                let chords = (span.sweep().abs() / step)
-                    .ceil()
-                    .clamp(1.0, MAX_CHORDS_PER_ARC) as usize;
-                for k in 1..=chords {
-                    let p = span.point_at(k as f64 / chords as f64);
-                    self.straight("G01", p, true)?;
-                }
-                Ok(())
-            }
+            ArcOutput::Lines { tolerance_mm } => self.chords(span, tolerance_mm),
             ArcOutput::CentreOffsets => {
                 let Some(centre) = span.centre() else {
                     return self.straight("G01", span.end, true);
                 };
-                let c = self.quantize_point(centre)?;
                 let target = self.quantize_point(span.end)?;
-                let (i, j) = (c.0 - self.at.0, c.1 - self.at.1);
                 // Ends that round to one point would read as a full circle: the piece is
                 // below the resolution (at most 350° pieces, so its radius is a few quanta).
                 let Some(words) = self.axis_words(target) else {
                     return Ok(());
                 };
+                let rounded = self.quantize_point(centre)?;
+                let Some(c) = self.written_centre(rounded, target) else {
+                    // No centre on the grid of written values gives equal radii at both
+                    // rounded ends: the controller would refuse the arc.
+                    return self.chords(span, self.rounding_chord_tolerance());
+                };
+                let (i, j) = (c.0 - self.at.0, c.1 - self.at.1);
                 let f = self.feed_word();
                 let centre_words = format!(" I{} J{}", self.number(i), self.number(j));
                 self.line(format!("{code}{words}{centre_words}{f}"));
@@ -711,6 +796,12 @@ impl<'a> Writer<'a> {
                     return Ok(());
                 };
                 let r = self.quantize(span.radius())?;
+                let (dx, dy) = (target.0 - self.at.0, target.1 - self.at.1);
+                let half_chord = 0.5 * (dx as f64).hypot(dy as f64);
+                if half_chord >= r as f64 {
+                    // The rounded radius cannot reach between the rounded ends.
+                    return self.chords(span, self.rounding_chord_tolerance());
+                }
                 let f = self.feed_word();
                 self.line(format!("{code}{words} R{}{f}", self.number(r)));
                 self.at = target;

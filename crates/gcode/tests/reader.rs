@@ -187,15 +187,18 @@ fn writer_options_show_in_the_program() {
         lines,
         [
             "N5 G21",
-            "N10 G91",
+            "N10 G90",
             "N15 G17",
             "N20 G64 P0.05",
-            "N25 M04 S1000",
-            "N30 G04 P0.250",
-            "N35 G03 X-10.00 Y10.00 R10.00 F600",
-            "N40 M05",
-            "N45 G00 X0 Y0",
-            "N50 M02",
+            // Incremental moves start from a known position, not from where the head stands.
+            "N25 G00 X10.00 Y0.00",
+            "N30 G91",
+            "N35 M04 S1000",
+            "N40 G04 P0.250",
+            "N45 G03 X-10.00 Y10.00 R10.00 F600",
+            "N50 M05",
+            "N55 G00 X0 Y0",
+            "N60 M02",
         ]
     );
     // Lines only: no arc codes.
