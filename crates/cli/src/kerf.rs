@@ -184,6 +184,21 @@ impl Kerf {
         Ok(fitted)
     }
 
+    /// A route the hard-rule repair changed, with leads fitted as [`Kerf::attach`] fits them
+    /// but never moved along the equidistants afterwards: the repair chose its pierce points
+    /// for the rules, and moving them to shorten the idle legs would break the rules again.
+    pub fn attach_repaired(&self, nest: &Nest, route: Route) -> Result<Route, String> {
+        let fixed = Kerf {
+            after: true,
+            broken_links: Default::default(),
+            ..*self
+        };
+        let fitted = fixed.attach(nest, route);
+        self.broken_links
+            .set(self.broken_links.get() + fixed.broken_links.get());
+        fitted
+    }
+
     /// The kerf job's word that some contours have no room for their leads, as an error.
     pub fn refused(&self, progress: Option<&Progress>) -> Result<(), String> {
         match progress.map(|p| &p.phase) {

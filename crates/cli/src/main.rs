@@ -1344,7 +1344,7 @@ fn solve(
                     // The job's route has its leads; a route the repair changed gets them
                     // fitted again.
                     last.solution = Some(Solution::Route(if enforced != route {
-                        kerf.attach(nest, enforced)?
+                        kerf.attach_repaired(nest, enforced)?
                     } else {
                         enforced
                     }));

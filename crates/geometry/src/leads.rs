@@ -418,7 +418,7 @@ impl KerfSettings {
                     value,
                     range: range.words(),
                     note: if zero_refused {
-                        " for a lead of a shape (or no lead)"
+                        " for a lead (a lead of no length is lead shape none)"
                     } else {
                         ""
                     },
@@ -576,7 +576,7 @@ pub const MAX_TABS: usize = 1000;
 
 /// Why [`KerfSettings::check`] refuses the settings: one setting outside its range.
 #[derive(Clone, Debug, PartialEq, Error)]
-#[error("{} {value}: must be {range}{}", field.words(), note)]
+#[error("{} {}: must be {range}{}", field.words(), number(*value), note)]
 pub struct KerfRangeError {
     /// The setting.
     pub field: KerfField,
@@ -591,19 +591,37 @@ pub struct KerfRangeError {
 impl KerfRangeError {
     /// The message naming the command-line flag (or the profile key when no flag sets it).
     pub fn for_flag(&self) -> String {
-        let name = self.field.flag().unwrap_or(self.field.profile_key());
-        format!("{name} {}: must be {}{}", self.value, self.range, self.note)
+        let name = match self.field {
+            KerfField::TabCount => "--tabs count".to_string(),
+            KerfField::TabWidth => "--tabs width".to_string(),
+            f => f.flag().unwrap_or(f.profile_key()).to_string(),
+        };
+        self.message(&name)
     }
 
     /// The message naming the profile key.
     pub fn in_profile(&self) -> String {
+        self.message(self.field.profile_key())
+    }
+
+    fn message(&self, name: &str) -> String {
         format!(
-            "{} {}: must be {}{}",
-            self.field.profile_key(),
-            self.value,
+            "{name} {}: must be {}{}",
+            number(self.value),
             self.range,
             self.note
         )
+    }
+}
+
+/// A value as a message gives it: plain, or in exponent form where plain would run to hundreds
+/// of digits (10⁻³⁰⁰, 4·10¹⁸).
+fn number(value: f64) -> String {
+    let size = value.abs();
+    if value != 0.0 && size.is_finite() && !(1e-4..1e9).contains(&size) {
+        format!("{value:e}")
+    } else {
+        format!("{value}")
     }
 }
 

@@ -383,8 +383,14 @@ impl LeadFitter<'_> {
                 // The same point computed twice (frame and opening): the cut's end is exact.
                 v.point = exit;
             }
+            // Without a lead the chain is that one point, so M* (M) moved with it: the
+            // chains' ends are the points, exactly, as the checker holds them.
+            if let Some(v) = path_leads.lead_out.last() {
+                path_leads.switch_off = v.point;
+            }
+            let pierce = path_leads.lead_in.first().map_or(leads.pierce, |v| v.point);
             return Ok(ToolOnPath {
-                pierce: leads.pierce,
+                pierce,
                 spans,
                 leads: Some(path_leads),
             });
