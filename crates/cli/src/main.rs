@@ -468,6 +468,9 @@ const KEPT_ROUTES: usize = 8;
 /// best state it published and exits (the promise is limit + 1 s, report included).
 const GRACE: std::time::Duration = std::time::Duration::from_millis(300);
 
+/// How long after the first Ctrl-C the CLI waits for the stopped solver's route.
+const CTRL_C_GRACE: std::time::Duration = std::time::Duration::from_secs(1);
+
 /// What the CLI's main thread and the solver's thread share.
 #[derive(Default)]
 struct Watch {
@@ -522,7 +525,22 @@ fn run_job(job: &mut dyn Job, watch: &Watch, on_progress: &mut dyn FnMut(&Progre
                     // The final answer: with what only a final answer carries (CCP's
                     // certificates), whichever of the job and the watch saw the limit first.
                     job.stop();
-                    seen.last = Some(job.progress());
+                    let mut last = job.progress();
+                    // A job with no route yet makes the one its limit would give (AOE checks
+                    // its ordering cut short) in further steps; the main thread reports what
+                    // was published if that outlasts its grace.
+                    drop(seen);
+                    while last.solution.is_none() {
+                        let status = job.step(cutroute_engine::DEFAULT_SLICE);
+                        last = job.progress();
+                        watch.seen.lock().unwrap_or_else(|e| e.into_inner()).last =
+                            Some(last.clone());
+                        if status == cutroute_engine::JobStatus::Done {
+                            break;
+                        }
+                    }
+                    seen = watch.seen.lock().unwrap_or_else(|e| e.into_inner());
+                    seen.last = Some(last);
                 }
             }
             // A copy, not `take`: the job is dropped after this returns, and dropping a large
@@ -576,7 +594,14 @@ fn run_bounded<T: Send + 'static>(
             watch.stop.store(true, Ordering::SeqCst);
             stop_at = Some(std::time::Instant::now());
         }
-        if stop_at.is_some_and(|at| at.elapsed() >= grace) {
+        // Ctrl-C waits a little longer for the route the solver makes when stopped (a second
+        // Ctrl-C quits at once); the limit keeps its limit + 1 s promise.
+        let waited = if limit_passed {
+            grace
+        } else {
+            grace.max(CTRL_C_GRACE)
+        };
+        if stop_at.is_some_and(|at| at.elapsed() >= waited) {
             let mut seen = watch.seen.lock().unwrap_or_else(|e| e.into_inner());
             let mut run = std::mem::take(&mut *seen);
             run.stopped = Some(if limit_passed {
@@ -702,12 +727,10 @@ impl SolverJob {
 }
 
 /// A finished run: its states, what the job adds to the report ([`SolverJob::report_extras`];
-/// empty when the run was cut in a long step), and whether the job returned by itself.
+/// empty when the run was cut in a long step, whose `run.stopped` then says so).
 struct FinishedRun {
     run: JobRun,
     extras: serde_json::Map<String, Value>,
-    /// False when the run was taken from the last published state at the grace's end.
-    returned: bool,
 }
 
 /// The time kept from a job's limit for the report that follows it: about 10 µs per contour
@@ -748,16 +771,12 @@ fn bounded_job_run(mut request: JobRequest, as_json: bool) -> Result<FinishedRun
         Ok((run, extras))
     })?;
     drop(display);
-    let (mut run, extras, returned) = match outcome {
-        Ok((run, extras)) => (run, extras, true),
-        Err(snapshot) => (snapshot, serde_json::Map::new(), false),
+    let (mut run, extras) = match outcome {
+        Ok((run, extras)) => (run, extras),
+        Err(snapshot) => (snapshot, serde_json::Map::new()),
     };
     run.time_limit_s = time_limit_s;
-    Ok(FinishedRun {
-        run,
-        extras,
-        returned,
-    })
+    Ok(FinishedRun { run, extras })
 }
 
 /// The run's route if it passes the checker, else the newest earlier route that does (with
@@ -1082,7 +1101,10 @@ fn convert(
     gcode: &cutroute_gcode::GcodeOptions,
     kerf: &kerf::Kerf,
 ) -> Result<(), Failure> {
-    let document = open((input, sheet))?;
+    let (document, read_s) = timed_open((input, sheet))?;
+    // The limit counts reading the file, as `solve`'s does.
+    let mut params = params;
+    params.time_limit_s = limit_after_reading(params.time_limit_s, read_s);
     Ok(convert_document(
         &document, input, output, to, solver, params, gcode, kerf,
     )?)
@@ -1284,7 +1306,11 @@ fn solve(
     kerf: &kerf::Kerf,
 ) -> Result<Value, Failure> {
     let solver = solver_kind(solver_name)?;
-    let document = open(input)?;
+    // The limit counts reading the file: the solver gets what is left of it.
+    let (document, read_s) = timed_open(input)?;
+    let user_limit_s = params.time_limit_s;
+    let mut params = params;
+    params.time_limit_s = limit_after_reading(user_limit_s, read_s);
     if solver.gives_path_route() && matches!(document.problem, Problem::PcgtspText { .. }) {
         return Err(Failure::Message(format!(
             "--solver {solver_name}: routes nests, not PCGTSP instances"
@@ -1307,6 +1333,8 @@ fn solve(
     thermal.warn_unpriced(solver);
     let started = std::time::Instant::now();
     let mut finished = bounded_job_run(request, as_json)?;
+    // Messages name the limit the user gave.
+    finished.run.time_limit_s = user_limit_s;
     // The report follows the solution's shape.
     let path_report = match finished.run.last.as_ref().and_then(|p| p.solution.as_ref()) {
         Some(solution) => solution.path_route().is_some(),
@@ -1358,7 +1386,29 @@ fn solve(
             report
         }
     };
+    let mut report = report;
+    if let Value::Object(fields) = &mut report {
+        // Apart from `elapsed_s` (the solver's run): how long opening the file took.
+        fields.insert("read_s".into(), json!(read_s));
+    }
     Ok(report)
+}
+
+/// The document at `input` and how long opening it took (s).
+fn timed_open(input: (&Path, usize)) -> Result<(Document, f64), Failure> {
+    let started = std::time::Instant::now();
+    let document = open(input)?;
+    Ok((document, started.elapsed().as_secs_f64()))
+}
+
+/// What is left of a limit of `limit_s` for the solver after `read_s` of reading (none left:
+/// the solver gives the route a zero limit gives).
+fn limit_after_reading(limit_s: f64, read_s: f64) -> f64 {
+    if limit_s.is_finite() {
+        (limit_s - read_s).max(0.0)
+    } else {
+        limit_s
+    }
 }
 
 /// A solve report, to standard output or `out`: one JSON object, or its keys one per line
@@ -1502,12 +1552,9 @@ impl PathReport<'_> {
     fn of(&self, nest: &Nest, finished: FinishedRun) -> Result<Value, Failure> {
         let (solver, solver_name, machine, objective) =
             (self.solver, self.solver_name, self.machine, self.objective);
-        // Stopped in a long step: the latest published state, without the job's own extras.
-        let stopped = if finished.returned {
-            None
-        } else {
-            finished.run.stopped
-        };
+        // Why the run ended early (the limit, Ctrl-C), as in a route's report; stopped in a
+        // long step, the latest published state, without the job's own extras.
+        let stopped = finished.run.stopped;
         let time_limit_s = finished.run.time_limit_s;
         let progress = finished.run.last.ok_or_else(|| {
             format!(

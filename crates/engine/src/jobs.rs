@@ -217,6 +217,8 @@ pub struct DiscreteJob {
     /// its route, in its order of contours at the cheapest candidates, seeds the heuristic
     /// (`with_route_seed`).
     route_seed: Option<Box<cutroute_ccp::CcpSolver>>,
+    /// [`Job::stop`] ended the job.
+    stopped: bool,
 }
 
 /// Why a discrete job ended without a search; its words are the phase's reason.
@@ -320,6 +322,7 @@ impl DiscreteJob {
             fallback: None,
             fallback_tried: false,
             route_seed: None,
+            stopped: false,
         }
     }
 
@@ -572,7 +575,27 @@ fn best_with_cost<S: AnytimeSolver>(solver: &S) -> Option<(S::Solution, f64)> {
 }
 
 impl Job for DiscreteJob {
+    fn stop(&mut self) {
+        // As the limit reached now: the solvers' best tour, or (none yet) the nearest-neighbour
+        // one that a limit passing during the build gives.
+        self.deadline = Instant::now();
+        self.first_tour_allowance = Duration::ZERO;
+        if self.solvers_tour().is_none() && !self.fallback_tried {
+            self.fallback_tried = true;
+            self.fallback = self.nearest_neighbour_tour();
+        }
+        if self.exact.is_some() && self.exact_done.is_none() {
+            self.exact_done = Some(false);
+        }
+        self.alns_done = true;
+        self.bound_running = false;
+        self.stopped = true;
+    }
+
     fn step(&mut self, budget: Duration) -> JobStatus {
+        if self.stopped {
+            return JobStatus::Done;
+        }
         if self.failure.is_some() {
             return JobStatus::Done;
         }

@@ -98,9 +98,13 @@ pub trait Job {
     fn step(&mut self, budget: Duration) -> JobStatus;
     /// The current state: bounds, best route or tour, phase.
     fn progress(&self) -> Progress;
-    /// The job is stopped before it is done (Stop, or the caller's own limit): its next
-    /// [`Job::progress`] is the final answer and carries what only a final answer does (CCP's
-    /// certificates, a pass over the route). Nothing to do for most jobs.
+    /// The job is stopped before it is done (Stop, Ctrl-C, or the caller's own limit): it ends
+    /// as it would at its own time limit reached now. Its next [`Job::progress`] is the final
+    /// answer and carries what only a final answer does (CCP's certificates, a pass over the
+    /// route) and the best route so far; where there is none yet, the route a very short limit
+    /// gives (the discrete jobs' nearest-neighbour tour), or, where that route still takes
+    /// work (AOE's ordering cut short and checked), further [`Job::step`] calls make it and
+    /// then return [`JobStatus::Done`]. Nothing to do for jobs that end in one step.
     fn stop(&mut self) {}
 }
 

@@ -35,6 +35,9 @@ pub enum PlanBoundError {
     /// A component of the plan graph could not be embedded.
     #[error(transparent)]
     Embedding(#[from] EmbeddingError),
+    /// The job was stopped before the plan graph was measured.
+    #[error("stopped before the plan graph was measured")]
+    Stopped,
 }
 
 /// What every route of a plan must at least cut and pierce, from the nest's plane graph
@@ -582,6 +585,21 @@ impl SegmentJob {
 }
 
 impl Job for SegmentJob {
+    fn stop(&mut self) {
+        // The search ends with its best checked route (CCP-Relax's at worst, its run cut
+        // short), the bound with what it has.
+        self.search.stop();
+        if let CcpBound::Computing { running, .. } = &mut self.ccp_bound {
+            *running = false;
+        } else {
+            self.ccp_bound = CcpBound::Inapplicable;
+        }
+        if self.bound.is_none() {
+            // No plan graph yet: the report goes without the bound rather than wait for one.
+            self.bound = Some(Err(PlanBoundError::Stopped));
+        }
+    }
+
     fn step(&mut self, budget: Duration) -> JobStatus {
         if self.bound.is_none() {
             // A plan graph: one piece of work, a step of its own.
@@ -772,6 +790,12 @@ impl AoeJob {
 }
 
 impl Job for AoeJob {
+    fn stop(&mut self) {
+        // As the limit reached now: the ordering ends with its best so far, and the next steps
+        // check its route (the build, if under way, still runs to its end).
+        self.solving.stop_at(Instant::now());
+    }
+
     fn step(&mut self, budget: Duration) -> JobStatus {
         if self.outcome.is_some() {
             return JobStatus::Done;
