@@ -344,3 +344,19 @@ fn csv_fields_with_quotes_commas_and_line_breaks() {
     assert_eq!(rows[1], ["x, \"y\"", "two\nlines"]);
     assert_eq!(rows[2], ["last", ""]);
 }
+
+#[test]
+fn a_generated_sheet_of_closed_splines_reads_every_spline_as_one_contour() {
+    let text = common::spline_sheet::spline_sheet(8, 5, 25);
+    let import = read_dxf(text.as_bytes(), &DxfOptions::default()).unwrap();
+    let contours: Vec<_> = import.nest.parts.iter().flat_map(|p| &p.contours).collect();
+    assert_eq!(contours.len(), 8 * 5);
+    assert!(import.open_chains.is_empty());
+    // Every blob keeps to its ring: control points 14 to 22 mm from its centre, and a clamped
+    // cubic stays inside their hull (so within 22 mm) and never reaches its centre.
+    for c in contours {
+        let b = c.bounding_box();
+        let (w, h) = (b.width(), b.height());
+        assert!((20.0..=44.0).contains(&w) && (20.0..=44.0).contains(&h), "{w} × {h}");
+    }
+}
