@@ -118,7 +118,9 @@ impl Nurbs {
         let t = t.clamp(a, b);
         // The knot span k with knots[k] ≤ t < knots[k+1], kept inside [p, n-1].
         let k = (self.knots.partition_point(|&u| u <= t).saturating_sub(1)).clamp(p, n - 1);
-        let mut d: Vec<[f64; 3]> = (0..=p).map(|j| self.control[j + k - p]).collect();
+        // On the stack: this runs for every sample of every span of every spline.
+        let mut d = [[0.0; 3]; MAX_SPLINE_DEGREE + 1];
+        d[..=p].copy_from_slice(&self.control[k - p..=k]);
         for r in 1..=p {
             for j in (r..=p).rev() {
                 let lo = self.knots[j + k - p];
@@ -197,6 +199,58 @@ pub(crate) fn arc_through(a: Point, m: Point, b: Point) -> Span {
         .unwrap_or(Span::line(a, b))
 }
 
+/// The distance from points to one span, with the span's centre and radius worked out once:
+/// the approximation measures 15 samples against every candidate arc, and the general
+/// [`Span::distance_to`] spends trigonometry on each.
+enum SpanDistance {
+    /// An arc of less than a half turn: its centre, radius, ends and turning sense.
+    Arc {
+        span: Span,
+        centre: Point,
+        radius: f64,
+        sense: f64,
+    },
+    /// A line, or an arc this shortcut does not cover.
+    General(Span),
+}
+
+impl SpanDistance {
+    fn new(span: &Span) -> Self {
+        match span.centre() {
+            Some(centre) if span.bulge != 0.0 && span.bulge.abs() < 1.0 => Self::Arc {
+                span: *span,
+                centre,
+                radius: span.radius(),
+                sense: span.bulge.signum(),
+            },
+            _ => Self::General(*span),
+        }
+    }
+
+    fn to(&self, p: Point) -> f64 {
+        match self {
+            Self::General(span) => span.distance_to(p),
+            Self::Arc {
+                span,
+                centre,
+                radius,
+                sense,
+            } => {
+                let cross = |u: Point, v: Point| {
+                    (u.x - centre.x) * (v.y - centre.y) - (u.y - centre.y) * (v.x - centre.x)
+                };
+                // Within the arc's sector (less than a half turn, so two half-planes bound it)
+                // the nearest point of the arc is on the ray from the centre; outside, an end.
+                if cross(span.start, p) * sense >= 0.0 && cross(p, span.end) * sense >= 0.0 {
+                    (p.distance(*centre) - radius).abs()
+                } else {
+                    p.distance(span.start).min(p.distance(span.end))
+                }
+            }
+        }
+    }
+}
+
 /// Approximates `curve` on `[t0, t1]` by arcs within `tolerance`, splitting first at `breaks`.
 ///
 /// `budget` is the number of spans the caller still allows; it is decreased by the spans made.
@@ -223,10 +277,11 @@ pub(crate) fn approximate(
             let pa = curve(a);
             let pb = curve(b);
             let span = arc_through(pa, curve(m), pb);
+            let distance = SpanDistance::new(&span);
             let fits = depth >= MAX_DEPTH
                 || (1..CHECK_SAMPLES).all(|k| {
                     let t = a + (b - a) * k as f64 / CHECK_SAMPLES as f64;
-                    span.distance_to(curve(t)) <= tolerance
+                    distance.to(curve(t)) <= tolerance
                 });
             if fits {
                 if *budget == 0 {
@@ -366,6 +421,30 @@ mod tests {
                 .map(|s| s.distance_to(p))
                 .fold(f64::INFINITY, f64::min);
             assert!(d <= tol * 1.01, "deviation {d} at t = {t}");
+        }
+    }
+
+    #[test]
+    fn the_shortcut_distance_to_an_arc_is_the_general_one() {
+        let mut seed = 7u64;
+        let mut random = move || {
+            seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
+            (seed >> 11) as f64 / (1u64 << 53) as f64 * 20.0 - 10.0
+        };
+        for _ in 0..200 {
+            let a = Point::new(random(), random());
+            let b = Point::new(random(), random());
+            let span = Span::new(a, b, random() / 10.5);
+            let fast = SpanDistance::new(&span);
+            assert!(matches!(fast, SpanDistance::Arc { .. }) || span.bulge == 0.0);
+            for _ in 0..20 {
+                let p = Point::new(random(), random());
+                let (f, g) = (fast.to(p), span.distance_to(p));
+                assert!(
+                    (f - g).abs() <= 1e-9 * (1.0 + g),
+                    "{span:?} {p:?}: {f} vs {g}"
+                );
+            }
         }
     }
 

@@ -93,7 +93,10 @@ fn duplicate_contours_are_dropped_with_a_warning() {
     assert_eq!(import.nest.parts[0].contours.len(), 1);
     // Four duplicates, after the note that the drawing declares no units.
     assert_eq!(import.warnings.len(), 5, "{:?}", import.warnings);
-    assert_eq!(import.warnings[0].kind, cutroute_geometry::WarningKind::Units);
+    assert_eq!(
+        import.warnings[0].kind,
+        cutroute_geometry::WarningKind::Units
+    );
     assert!(import.warnings[1]
         .message
         .contains("duplicates the entity at line 5"));

@@ -112,22 +112,56 @@ impl<'a> Record<'a> {
         Ok(self.int_or(67, 0)? == 1)
     }
 
-    /// The object coordinate system of 2D entities, as a map into world coordinates: identity
-    /// for the usual +Z extrusion, a mirror for −Z (mirrored geometry in many CAD exports),
-    /// `None` for a tilted plane, which has no faithful flat image.
-    fn ocs(&self) -> Result<Option<Transform>, DxfError> {
+    /// The object coordinate system of 2D entities, as a map of the plane into world
+    /// coordinates seen from above (world z dropped): identity for the usual +Z extrusion, a
+    /// mirror for −Z (mirrored geometry in many CAD exports), and for a tilted plane its
+    /// parallel projection onto the XY plane, as the drawing shows it in plan view — an affine
+    /// map, under which arcs become elliptic arcs and are approximated like any. `elevation` is
+    /// the group of the plane's height along the normal. `None` when the normal is zero, or
+    /// when the plane is tilted and `flat_only` (inside a block, where projecting each level
+    /// on its own would not compose into the 3D placement).
+    fn ocs(&self, elevation: i32, flat_only: bool) -> Result<Option<Transform>, DxfError> {
         let nx = self.real_or(210, 0.0)?;
         let ny = self.real_or(220, 0.0)?;
         let nz = self.real_or(230, 1.0)?;
         let len = (nx * nx + ny * ny + nz * nz).sqrt();
-        if len == 0.0 || (nx.abs() + ny.abs()) > 1e-9 * len {
+        if len == 0.0 {
             return Ok(None);
         }
-        Ok(Some(if nz > 0.0 {
-            Transform::IDENTITY
+        if (nx.abs() + ny.abs()) <= 1e-9 * len {
+            return Ok(Some(if nz > 0.0 {
+                Transform::IDENTITY
+            } else {
+                // The arbitrary-axis algorithm's OCS for extrusion (0, 0, −1): x ↦ −x.
+                Transform::mirror_y()
+            }));
+        }
+        if flat_only {
+            return Ok(None);
+        }
+        let n = [nx / len, ny / len, nz / len];
+        let cross = |a: [f64; 3], b: [f64; 3]| {
+            [
+                a[1] * b[2] - a[2] * b[1],
+                a[2] * b[0] - a[0] * b[2],
+                a[0] * b[1] - a[1] * b[0],
+            ]
+        };
+        let unit = |a: [f64; 3]| {
+            let l = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
+            [a[0] / l, a[1] / l, a[2] / l]
+        };
+        // The DXF reference's arbitrary axis algorithm.
+        let ax = if n[0].abs() < 1.0 / 64.0 && n[1].abs() < 1.0 / 64.0 {
+            unit(cross([0.0, 1.0, 0.0], n))
         } else {
-            // The arbitrary-axis algorithm's OCS for extrusion (0, 0, −1): x ↦ −x.
-            Transform::mirror_y()
+            unit(cross([0.0, 0.0, 1.0], n))
+        };
+        let ay = unit(cross(n, ax));
+        let z = self.real_or(elevation, 0.0)?;
+        Ok(Some(Transform {
+            matrix: [[ax[0], ay[0]], [ax[1], ay[1]]],
+            offset: Point::new(z * n[0], z * n[1]),
         }))
     }
 }
@@ -530,7 +564,7 @@ impl Expander<'_, '_> {
                 self.path(vec![Span::line(a, b)], false, to_world, source)
             }
             "ARC" | "CIRCLE" => {
-                let Some(ocs) = record.ocs()? else {
+                let Some(ocs) = record.ocs(30, depth > 0)? else {
                     self.warn(
                         WarningKind::Skipped,
                         record.line,
@@ -593,7 +627,7 @@ impl Expander<'_, '_> {
                 self.elliptic(arc, closed, to_world, source)
             }
             "LWPOLYLINE" => {
-                let Some(ocs) = record.ocs()? else {
+                let Some(ocs) = record.ocs(38, depth > 0)? else {
                     self.warn(
                         WarningKind::Skipped,
                         record.line,
@@ -636,7 +670,7 @@ impl Expander<'_, '_> {
                 let ocs = if is_3d {
                     Some(Transform::IDENTITY)
                 } else {
-                    record.ocs()?
+                    record.ocs(30, depth > 0)?
                 };
                 let Some(ocs) = ocs else {
                     self.warn(
@@ -894,7 +928,7 @@ impl Expander<'_, '_> {
                 limit: MAX_BLOCK_DEPTH,
             });
         }
-        let Some(ocs) = record.ocs()? else {
+        let Some(ocs) = record.ocs(30, depth > 0)? else {
             self.warn(
                 WarningKind::Skipped,
                 record.line,

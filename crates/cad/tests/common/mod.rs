@@ -270,3 +270,4 @@ pub fn distance_to_contour(p: Point, contour: &Contour) -> f64 {
     best
 }
 pub mod realworld;
+pub mod spline_sheet;
