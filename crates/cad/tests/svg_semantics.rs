@@ -288,6 +288,17 @@ fn units_of_lengths_and_of_the_root() {
         let units = import.warnings.iter().any(|w| w.kind == WarningKind::Units);
         assert_eq!(units, warned, "{attributes}: {:?}", import.warnings);
     }
+    // Inkscape before 0.92 drew 90 pixels to the inch; later versions 96.
+    let inkscape = |version: &str| {
+        read(&format!(
+            r#"<svg xmlns="http://www.w3.org/2000/svg" xmlns:inkscape="http://www.inkscape.org/namespaces/inkscape"
+                inkscape:version="{version}" width="210mm" height="297mm"><rect width="90" height="90"/></svg>"#
+        ))
+    };
+    let legacy = inkscape("0.48.3.1 r9886");
+    assert!((side(&legacy).0 - 25.4).abs() < 1e-9);
+    assert!(legacy.warnings.iter().any(|w| w.kind == WarningKind::Units));
+    assert!((side(&inkscape("1.0 (4035a4f, 2020-05-01)")).0 - 90.0 * px).abs() < 1e-9);
     // Cutroute's own export is drawn in millimetres.
     let own = root(r#"class="cutroute-nest" viewBox="0 -20 20 20""#);
     assert_eq!(side(&own), (10.0, 10.0));
