@@ -453,8 +453,24 @@ impl<'a, 'input> Reader<'a, 'input, '_> {
             (Some([_, _, w, _]), [Some(width), None]) => Some((width / w, width / w)),
             (Some([_, _, _, h]), [None, Some(height)]) => Some((height / h, height / h)),
             (Some(_), [None, None]) => None,
-            // Without a viewBox a user unit is a CSS pixel, whatever the size's unit.
-            (None, [Some(_), _] | [_, Some(_)]) => Some((MM_PER_PX, MM_PER_PX)),
+            // Without a viewBox a user unit is a CSS pixel, whatever the size's unit; but
+            // Inkscape before 0.92 drew 90 of its pixels to the inch, and its files say which
+            // version wrote them (Inkscape itself reads them so when it opens them).
+            (None, [Some(_), _] | [_, Some(_)]) => match legacy_inkscape(root) {
+                Some(version) => {
+                    self.warn(
+                        root,
+                        WarningKind::Units,
+                        format!(
+                            "written by Inkscape {version}, which drew 90 user units to the \
+                             inch (not CSS's 96): one user unit is {:.6} mm",
+                            25.4 / 90.0
+                        ),
+                    );
+                    Some((25.4 / 90.0, 25.4 / 90.0))
+                }
+                None => Some((MM_PER_PX, MM_PER_PX)),
+            },
             (None, [None, None]) => None,
         };
         let scale = scale.filter(|&(sx, sy)| {
@@ -1258,6 +1274,18 @@ struct Aspect {
     slice: bool,
     x: f64,
     y: f64,
+}
+
+/// The version of Inkscape before 0.92 that wrote the drawing, if one did.
+fn legacy_inkscape<'n>(root: Node<'n, '_>) -> Option<&'n str> {
+    let version = root.attribute((INKSCAPE_NS, "version"))?;
+    let mut numbers = version
+        .split(|c: char| !c.is_ascii_digit())
+        .map(|n| n.parse::<u32>().ok());
+    match (numbers.next()??, numbers.next()??) {
+        (0, minor) if minor < 92 => Some(version.trim()),
+        _ => None,
+    }
 }
 
 /// Spans as one polyline, arcs cut into chords of at most 1/32 turn, for drawing what was
