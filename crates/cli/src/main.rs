@@ -61,6 +61,7 @@ mod inputs;
 mod kerf;
 mod stdio;
 mod thermal;
+mod warnings;
 
 #[derive(Parser)]
 #[command(
@@ -938,6 +939,7 @@ fn inspect(
     let mut summary = summary;
     inputs::add_sheets(&mut summary, &document.sheets, document.sheet);
     if as_json {
+        warnings::add_to(&mut summary, &document.warnings);
         println!("{summary}");
     } else {
         for (key, value) in summary.as_object().into_iter().flatten() {
@@ -1083,6 +1085,7 @@ fn convert(
     kerf: &kerf::Kerf,
 ) -> Result<(), Failure> {
     let document = open((input, sheet))?;
+    warnings::print(&document.warnings);
     Ok(convert_document(
         &document, input, output, to, solver, params, gcode, kerf,
     )?)
@@ -1204,7 +1207,16 @@ fn convert_document(
             ))
         }
     };
-    stdio::write_output(output, &bytes)
+    stdio::write_output(output, &bytes)?;
+    // A nest format read back must give the nest written; what it does not is said.
+    if matches!(format.as_str(), "dbs" | "json" | "svg") {
+        warnings::print(&cutroute_engine::conversion_losses(
+            nest,
+            &output.to_string_lossy(),
+            &bytes,
+        ));
+    }
+    Ok(())
 }
 
 /// What a G-code or HTML output draws: a route of whole contours, or tool-on paths (segment
@@ -1285,6 +1297,7 @@ fn solve(
 ) -> Result<Value, Failure> {
     let solver = solver_kind(solver_name)?;
     let document = open(input)?;
+    warnings::print(&document.warnings);
     if solver.gives_path_route() && matches!(document.problem, Problem::PcgtspText { .. }) {
         return Err(Failure::Message(format!(
             "--solver {solver_name}: routes nests, not PCGTSP instances"
@@ -1358,6 +1371,8 @@ fn solve(
             report
         }
     };
+    let mut report = report;
+    warnings::add_to(&mut report, &document.warnings);
     Ok(report)
 }
 
