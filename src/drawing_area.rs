@@ -5,6 +5,7 @@ use leptos::prelude::*;
 
 use crate::animation::{Animation, AnimationControls};
 use crate::i18n::{tr, use_language};
+use crate::import_warnings::{ImportWarnings, LeftOutShown};
 use crate::nest_view::NestView;
 use crate::state::{DocumentState, JobState};
 
@@ -13,6 +14,8 @@ use crate::state::{DocumentState, JobState};
 pub fn DrawingArea() -> impl IntoView {
     let document = expect_context::<DocumentState>();
     let animation = expect_context::<Animation>();
+    // The warnings' toggle and the view's layer of left-out geometry share it.
+    provide_context(LeftOutShown(RwSignal::new(false)));
     view! {
         <section
             class="view"
@@ -39,18 +42,6 @@ fn FileNotes() -> impl IntoView {
     let document = expect_context::<DocumentState>();
     let job = expect_context::<JobState>();
     let language = use_language();
-    let open_notes = move || {
-        let notes = document
-            .document
-            .with(|d| d.as_ref().map(|d| d.warnings.clone()).unwrap_or_default());
-        (!notes.is_empty()).then(|| {
-            view! {
-                <ul id="open-notes" class="note" aria-label=tr("Notes on the open file", "Замечания к открытому файлу")>
-                    {notes.into_iter().map(|n| view! { <li>{n}</li> }).collect_view()}
-                </ul>
-            }
-        })
-    };
     // A local file cannot be reopened without the user: say which one it was.
     let last_file = move || {
         let shown = document.file_name();
@@ -69,7 +60,7 @@ fn FileNotes() -> impl IntoView {
     view! {
         {move || document.open_error.get().map(|e| view! { <p class="error" role="alert">{e.text(language.get())}</p> })}
         {move || job.worker_notice.get().map(|n| view! { <p id="worker-notice" class="error" role="status">{n.text(language.get())}</p> })}
-        {open_notes}
+        <ImportWarnings />
         {last_file}
     }
 }

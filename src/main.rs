@@ -13,6 +13,7 @@ mod export;
 mod fields;
 mod gallery;
 mod i18n;
+mod import_warnings;
 mod job_status;
 mod kerf;
 mod legend;

@@ -74,6 +74,7 @@ pub fn NestView() -> impl IntoView {
                 <CertificateLayer />
                 <RouteLayers extent=extent />
                 <ComparedRoutes />
+                <crate::import_warnings::LeftOutLayer extent=extent />
                 <g class="violations">
                     <ViolationMarks thermal=thermal nest=nest route=route extent=extent />
                 </g>

@@ -77,6 +77,8 @@ pub fn from_profile(
 
 /// Reads a profile file as the CLI does (unknown fields refused, numbers checked).
 pub fn parse_profile(text: &str) -> Result<MachineProfile, String> {
+    // A byte-order mark, as Windows editors write, is not part of the JSON.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let profile: MachineProfile = serde_json::from_str(text).map_err(|e| e.to_string())?;
     from_profile(&profile)?;
     Ok(profile)

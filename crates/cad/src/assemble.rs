@@ -10,7 +10,10 @@
 
 use std::collections::HashMap;
 
-use cutroute_geometry::{BoundingBox, Contour, Nest, Part, Point, Span, Transform, Vertex};
+use cutroute_geometry::{
+    flatten_spans, BoundingBox, Contour, ContourFault, Nest, Part, Point, ReadWarning, Span,
+    Transform, Vertex, WarningKind,
+};
 
 use crate::CadError;
 
@@ -47,6 +50,8 @@ pub struct OpenChain {
     pub length: f64,
     /// The entities of the chain, in chain order.
     pub entities: Vec<EntityRef>,
+    /// The chain flattened (arcs within the flattening tolerance), from `start` to `end`.
+    pub polyline: Vec<Point>,
 }
 
 impl std::fmt::Display for OpenChain {
@@ -81,10 +86,35 @@ pub(crate) struct AssembleLimits {
     pub flatten_tolerance: f64,
 }
 
-/// A contour dropped during assembly, with why.
+/// Geometry left out during assembly (an open chain, a duplicate entity, a contour that is not
+/// cuttable), with why: [`ReadWarning::from`] makes it the reader's warning, with its kind,
+/// line, length and the left-out geometry as polylines.
 pub(crate) struct Dropped {
+    pub kind: WarningKind,
+    /// 1-based line of the (first) entity.
     pub line: usize,
+    /// A sentence without the line.
     pub message: String,
+    /// What was left out, flattened, in millimetres with y up.
+    pub left_out: Vec<Vec<Point>>,
+}
+
+impl From<Dropped> for ReadWarning {
+    fn from(d: Dropped) -> Self {
+        ReadWarning::new(d.kind, d.message)
+            .at_line(d.line, None)
+            .leaving_out(d.left_out)
+    }
+}
+
+/// A closed contour as a polyline whose last point repeats the first (so its length is the
+/// perimeter, within the flattening).
+fn closed_polyline(contour: &Contour, tolerance: f64) -> Vec<Point> {
+    let mut points = contour.flatten(tolerance);
+    if let Some(&first) = points.first() {
+        points.push(first);
+    }
+    points
 }
 
 pub(crate) struct Assembled {
@@ -119,11 +149,30 @@ pub(crate) fn finish_import<W>(
     nothing_drawn: impl FnOnce(&[W]) -> String,
 ) -> Result<DrawingImport<W>, CadError> {
     let assembled = assemble(pieces, limits);
-    warnings.extend(assembled.dropped.into_iter().map(warning));
+    // Without a contour or an open chain, what assembly left out is why nothing was drawn.
+    let first_dropped = assembled.dropped.first().map(|d| {
+        ReadWarning::new(d.kind, d.message.clone())
+            .at_line(d.line, None)
+            .to_string()
+    });
+    warnings.extend(assembled.dropped.into_iter().map(&warning));
+    // One warning per open chain, so that nothing is left out in silence wherever the
+    // warnings go (the CLI, the reports, the page).
+    warnings.extend(assembled.open_chains.iter().map(|chain| {
+        warning(Dropped {
+            kind: WarningKind::OpenChain,
+            line: chain.entities.first().map_or(0, |e| e.line),
+            message: format!("{chain}; left out"),
+            left_out: vec![chain.polyline.clone()],
+        })
+    }));
     if assembled.parts.is_empty() {
         let first = match assembled.open_chains.first() {
             Some(chain) => chain.to_string(),
-            None => nothing_drawn(&warnings),
+            None => match first_dropped {
+                Some(dropped) => format!("nothing drawn; {dropped}"),
+                None => nothing_drawn(&warnings),
+            },
         };
         return Err(CadError::NothingClosed {
             open: assembled.open_chains.len(),
@@ -205,9 +254,10 @@ impl EndGrid {
 /// into zero-area "contours" and leave the real outline open.
 fn without_duplicates(
     pieces: Vec<Piece>,
-    tolerance: f64,
+    limits: &AssembleLimits,
     dropped: &mut Vec<Dropped>,
 ) -> Vec<Piece> {
+    let tolerance = limits.join_tolerance;
     let quantize = |p: Point| {
         (
             (p.x / tolerance).round() as i64,
@@ -240,11 +290,13 @@ fn without_duplicates(
         };
         if let Some(&line) = seen.get(&canonical) {
             dropped.push(Dropped {
+                kind: WarningKind::Duplicate,
                 line: piece.source.line,
                 message: format!(
                     "{} duplicates the entity at line {line}; ignored",
                     piece.source.entity
                 ),
+                left_out: vec![flatten_spans(&piece.spans, limits.flatten_tolerance)],
             });
             continue;
         }
@@ -260,7 +312,7 @@ pub(crate) fn assemble(pieces: Vec<Piece>, limits: &AssembleLimits) -> Assembled
     let mut contours: Vec<(Contour, SourceRef)> = Vec::new();
     let mut open_chains = Vec::new();
     let mut dropped = Vec::new();
-    let pieces = without_duplicates(pieces, tolerance, &mut dropped);
+    let pieces = without_duplicates(pieces, limits, &mut dropped);
 
     let ends: Vec<Point> = pieces
         .iter()
@@ -330,6 +382,7 @@ pub(crate) fn assemble(pieces: Vec<Piece>, limits: &AssembleLimits) -> Assembled
             let spans: Vec<Span> = chain_spans(&links, &pieces).collect();
             let length = spans.iter().map(Span::length).sum();
             open_chains.push(OpenChain {
+                polyline: flatten_spans(&spans, limits.flatten_tolerance),
                 start: spans[0].start,
                 end: spans[spans.len() - 1].end,
                 length,
@@ -405,13 +458,30 @@ fn group_into_parts(
     let mut placed: Vec<Placed> = Vec::with_capacity(contours.len());
     for (contour, source) in contours {
         let area = contour.signed_area();
-        if area.abs() <= tolerance * tolerance {
+        // The one meaning of a contour: a drawing commonly carries lines drawn twice (which
+        // join into loops enclosing nothing) and crossing outlines; they are left out, said.
+        if let Err(fault) = contour.check_cuttable(tolerance) {
+            let (kind, why) = match &fault {
+                ContourFault::SelfIntersecting { x, y, .. } => (
+                    WarningKind::SelfIntersecting,
+                    format!("crosses itself at ({x:.4}, {y:.4})"),
+                ),
+                f if f.is_zero_area() => (
+                    WarningKind::ZeroArea,
+                    "encloses no area (lines drawn twice, or a sliver narrower than the join \
+                     tolerance)"
+                        .to_string(),
+                ),
+                other => (WarningKind::Other, other.to_string()),
+            };
             dropped.push(Dropped {
+                kind,
                 line: source.line,
                 message: format!(
-                    "closed chain starting with {} encloses no area (duplicate entities?); dropped",
+                    "closed contour starting with {} {why}; left out",
                     source.entity
                 ),
+                left_out: vec![closed_polyline(&contour, limits.flatten_tolerance)],
             });
             continue;
         }
@@ -476,11 +546,16 @@ fn group_into_parts(
                 Containment::Same => {
                     duplicate[i] = true;
                     dropped.push(Dropped {
+                        kind: WarningKind::Duplicate,
                         line: inner.source.line,
                         message: format!(
                             "closed contour starting with {} duplicates the one at line {}; dropped",
                             inner.source.entity, outer.source.line
                         ),
+                        left_out: vec![closed_polyline(
+                            &inner.contour,
+                            limits.flatten_tolerance,
+                        )],
                     });
                     break;
                 }

@@ -510,8 +510,10 @@ impl<'d, 'i> Reader<'d, 'i> {
             }
         }
         let contour = Contour::new(vertices);
-        if contour.signed_area() == 0.0 {
-            return Err(self.invalid(node, "the contour encloses no area"));
+        // A nesting program's output: a contour that is not cuttable is refused, located, as
+        // the other nest formats refuse it.
+        if let Err(fault) = contour.check_cuttable(CONTINUITY_TOLERANCE) {
+            return Err(self.invalid(node, fault.to_string()));
         }
         Ok(contour)
     }

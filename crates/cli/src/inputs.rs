@@ -54,8 +54,10 @@ impl ProfileArg {
 /// Reads and checks a machine profile; errors name the file and the place in it.
 pub fn read_profile(path: &Path) -> Result<MachineProfile, String> {
     let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    // A byte-order mark, as Windows editors write, is not part of the JSON.
+    let json = text.strip_prefix('\u{feff}').unwrap_or(&text);
     let profile: MachineProfile =
-        serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+        serde_json::from_str(json).map_err(|e| format!("{}: {e}", path.display()))?;
     profile
         .check()
         .map_err(|e| format!("{}: {e}", path.display()))?;

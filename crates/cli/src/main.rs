@@ -61,6 +61,7 @@ mod inputs;
 mod kerf;
 mod stdio;
 mod thermal;
+mod warnings;
 
 #[derive(Parser)]
 #[command(
@@ -957,6 +958,7 @@ fn inspect(
     let mut summary = summary;
     inputs::add_sheets(&mut summary, &document.sheets, document.sheet);
     if as_json {
+        warnings::add_to(&mut summary, &document.warnings);
         println!("{summary}");
     } else {
         for (key, value) in summary.as_object().into_iter().flatten() {
@@ -1102,6 +1104,7 @@ fn convert(
     kerf: &kerf::Kerf,
 ) -> Result<(), Failure> {
     let (document, read_s) = timed_open((input, sheet))?;
+    warnings::print(&document.warnings);
     // The limit counts reading the file, as `solve`'s does.
     let mut params = params;
     params.time_limit_s = limit_after_reading(params.time_limit_s, read_s);
@@ -1226,7 +1229,16 @@ fn convert_document(
             ))
         }
     };
-    stdio::write_output(output, &bytes)
+    stdio::write_output(output, &bytes)?;
+    // A nest format read back must give the nest written; what it does not is said.
+    if matches!(format.as_str(), "dbs" | "json" | "svg") {
+        warnings::print(&cutroute_engine::conversion_losses(
+            nest,
+            &output.to_string_lossy(),
+            &bytes,
+        ));
+    }
+    Ok(())
 }
 
 /// What a G-code or HTML output draws: a route of whole contours, or tool-on paths (segment
@@ -1308,6 +1320,7 @@ fn solve(
     let solver = solver_kind(solver_name)?;
     // The limit counts reading the file: the solver gets what is left of it.
     let (document, read_s) = timed_open(input)?;
+    warnings::print(&document.warnings);
     let user_limit_s = params.time_limit_s;
     let mut params = params;
     params.time_limit_s = limit_after_reading(user_limit_s, read_s);
@@ -1391,6 +1404,7 @@ fn solve(
         // Apart from `elapsed_s` (the solver's run): how long opening the file took.
         fields.insert("read_s".into(), json!(read_s));
     }
+    warnings::add_to(&mut report, &document.warnings);
     Ok(report)
 }
 

@@ -53,8 +53,8 @@ pub use kerf::{
 pub use nearest::NearestNeighbourJob;
 pub use open::{format_name, OpenError};
 pub use open_files::{
-    is_pcglns_result, open_document, open_gcode, open_gcode_with, open_sheet, open_together,
-    task_instance, POINT_TOLERANCE_MM,
+    conversion_losses, is_pcglns_result, open_document, open_gcode, open_gcode_with, open_sheet,
+    open_together, task_instance, POINT_TOLERANCE_MM,
 };
 pub use path_jobs::{idle_tree_bound, AoeJob, PlanBound, PlanBoundError, SegmentJob};
 pub use thermal::{

@@ -4,7 +4,7 @@ use cutroute_cad::dxf::{read_dxf, DxfOptions};
 use cutroute_cad::svg::{read_svg, SvgOptions};
 use cutroute_cad::tflex::read_tfnesting_project;
 use cutroute_formats::{detect, read_nest, read_result_json, Format};
-use cutroute_geometry::{Nest, Point};
+use cutroute_geometry::{Nest, Point, ReadWarning, WarningKind};
 use cutroute_pcgtsp::Instance;
 use cutroute_protocol::{Document, Problem, SourceLocation};
 
@@ -361,25 +361,14 @@ pub(crate) fn open_model_file(
         Format::Dxf => {
             let import = read_dxf(bytes, &DxfOptions::default())
                 .map_err(|e| unreadable(e.to_string(), e.location()))?;
-            warnings.extend(import.warnings.iter().map(ToString::to_string));
-            warnings.extend(
-                import
-                    .open_chains
-                    .iter()
-                    .map(|chain| format!("open chain left out: {chain:?}")),
-            );
+            // The open chains are among the warnings (one each, with their geometry).
+            warnings.extend(import.warnings.into_iter().map(as_read_warning));
             import.nest
         }
         Format::Svg => {
             let import = read_svg(bytes, &SvgOptions::default())
                 .map_err(|e| unreadable(e.to_string(), e.location()))?;
-            warnings.extend(import.warnings.iter().map(ToString::to_string));
-            warnings.extend(
-                import
-                    .open_chains
-                    .iter()
-                    .map(|chain| format!("open chain left out: {chain}")),
-            );
+            warnings.extend(import.warnings.into_iter().map(as_read_warning));
             import.nest
         }
         Format::TflexXml => {
@@ -395,10 +384,13 @@ pub(crate) fn open_model_file(
                     .iter()
                     .map(|l| l.sheet_name.clone())
                     .collect();
-                warnings.push(format!(
-                    "the project has {count} sheets; showing sheet {} ({})",
-                    sheet + 1,
-                    sheets.get(sheet).map_or("", String::as_str)
+                warnings.push(ReadWarning::new(
+                    WarningKind::Sheets,
+                    format!(
+                        "the project has {count} sheets; showing sheet {} ({})",
+                        sheet + 1,
+                        sheets.get(sheet).map_or("", String::as_str)
+                    ),
                 ));
             }
             project
@@ -457,6 +449,15 @@ pub(crate) fn open_model_file(
         sheets,
         sheet,
     })
+}
+
+/// A reader's warning as the one warning type: a [`ReadWarning`] is kept as it is; a reader
+/// with a warning type of its own gives its sentence, of kind [`WarningKind::Other`].
+fn as_read_warning<W: std::fmt::Display + 'static>(warning: W) -> ReadWarning {
+    match (&warning as &dyn std::any::Any).downcast_ref::<ReadWarning>() {
+        Some(w) => w.clone(),
+        None => ReadWarning::new(WarningKind::Other, warning.to_string()),
+    }
 }
 
 /// Why a file is of no known format, located: a JSON object that does not parse gets serde's

@@ -10,8 +10,8 @@ use crate::open::{format_name, open_model_file, OpenError};
 use cutroute_formats::{detect, read_task_json, Format, RmTask};
 use cutroute_gcode::{read_gcode, Motion, ReadOptions};
 use cutroute_geometry::{
-    Contour, ContourRef, CutStep, Entry, Nest, Part, PathRoute, Point, Route, RouteError, Span,
-    Toolpath, Vertex,
+    flatten_spans, Contour, ContourRef, CutStep, Entry, Nest, Part, PathRoute, Point, ReadWarning,
+    Route, RouteError, Span, Toolpath, Vertex, WarningKind,
 };
 use cutroute_pcgtsp::{check_tour, Instance, PcglnsResult};
 use cutroute_protocol::{Document, Problem, TaskSpeeds};
@@ -19,6 +19,9 @@ use cutroute_protocol::{Document, Problem, TaskSpeeds};
 /// Pierce points of a task and the end points of G-code moves count as "the same point" within
 /// this distance, mm (files round coordinates to a few decimals).
 pub const POINT_TOLERANCE_MM: f64 = 0.01;
+
+/// Chord tolerance (mm) of the left-out geometry a warning carries: it is only drawn.
+const LEFT_OUT_FLATTENING_MM: f64 = 0.01;
 
 /// Whether the text is a PCGLNS run summary (`*.pcglns.result.txt`).
 pub fn is_pcglns_result(bytes: &[u8]) -> bool {
@@ -30,6 +33,81 @@ pub fn is_pcglns_result(bytes: &[u8]) -> bool {
 /// needs company, so it is an error alone).
 pub fn open_document(file_name: &str, bytes: &[u8]) -> Result<Document, OpenError> {
     open_sheet(file_name, bytes, 0)
+}
+
+/// What a conversion to a nest format loses: `written` (the bytes of `nest` in DBS, geometry
+/// JSON or SVG, to be saved as `file_name`) read back through [`open_document`] and compared
+/// with `nest`: the number of contours, the total perimeter (within 1e-6 relative) and the
+/// bounding box (within 1e-6 of its size). Each difference is a warning of kind
+/// [`WarningKind::Other`] saying what changed; none when the file reads back as written.
+pub fn conversion_losses(nest: &Nest, file_name: &str, written: &[u8]) -> Vec<ReadWarning> {
+    let lost = |message: String| vec![ReadWarning::new(WarningKind::Other, message)];
+    let back = match open_document(file_name, written) {
+        Ok(Document {
+            problem: Problem::Nest { nest, .. },
+            ..
+        }) => nest,
+        Ok(_) => return lost(format!("{file_name} reads back as no nest")),
+        Err(e) => return lost(format!("{file_name} cannot be read back: {e}")),
+    };
+    let mut out = Vec::new();
+    let (before, after) = (NestShape::of(nest), NestShape::of(&back));
+    if before.contours != after.contours {
+        out.push(format!(
+            "{file_name} reads back with {} of its {} contours (the sheet included)",
+            after.contours, before.contours
+        ));
+    }
+    let relative = (after.perimeter - before.perimeter).abs() / before.perimeter.max(1e-300);
+    if !(relative <= 1e-6) {
+        out.push(format!(
+            "{file_name} reads back with a total perimeter of {:.6} mm instead of {:.6} mm ({:+.4} %)",
+            after.perimeter,
+            before.perimeter,
+            100.0 * (after.perimeter - before.perimeter) / before.perimeter.max(1e-300)
+        ));
+    }
+    let size = (before.bbox.max.x - before.bbox.min.x)
+        .max(before.bbox.max.y - before.bbox.min.y)
+        .max(1e-9);
+    let moved = [
+        before.bbox.min.x - after.bbox.min.x,
+        before.bbox.min.y - after.bbox.min.y,
+        before.bbox.max.x - after.bbox.max.x,
+        before.bbox.max.y - after.bbox.max.y,
+    ]
+    .iter()
+    .fold(0.0f64, |m, d| m.max(d.abs()));
+    if !(moved <= 1e-6 * size) {
+        out.push(format!(
+            "{file_name} reads back with a bounding box ({:.6}, {:.6})–({:.6}, {:.6}) instead of ({:.6}, {:.6})–({:.6}, {:.6})",
+            after.bbox.min.x, after.bbox.min.y, after.bbox.max.x, after.bbox.max.y,
+            before.bbox.min.x, before.bbox.min.y, before.bbox.max.x, before.bbox.max.y
+        ));
+    }
+    out.into_iter()
+        .map(|m| ReadWarning::new(WarningKind::Other, m))
+        .collect()
+}
+
+/// The measures of a nest that a conversion must keep, the sheet included.
+struct NestShape {
+    contours: usize,
+    perimeter: f64,
+    bbox: cutroute_geometry::BoundingBox,
+}
+
+impl NestShape {
+    fn of(nest: &Nest) -> Self {
+        let all = || nest.sheet.iter().chain(&nest.parts);
+        Self {
+            contours: all().map(|p| p.contours.len()).sum(),
+            perimeter: all().map(Part::perimeter).sum(),
+            bbox: all().fold(cutroute_geometry::BoundingBox::EMPTY, |b, p| {
+                b.union(p.bounding_box())
+            }),
+        }
+    }
 }
 
 /// [`open_document`] for sheet `sheet` (from 0) of a multi-sheet file (T-FLEX projects list
@@ -94,14 +172,20 @@ pub fn open_gcode_with(
     // (loop, entry) in cutting order.
     let mut loops: Vec<(Contour, Entry)> = Vec::new();
     let mut run: Option<RunState> = None;
-    let finish_run = |run: Option<RunState>, warnings: &mut Vec<String>| {
+    let finish_run = |run: Option<RunState>, warnings: &mut Vec<ReadWarning>| {
         if let Some(r) = run {
             if !r.pending.is_empty() {
-                warnings.push(format!(
-                    "line {}: a tool-on path of {:.3} mm closes no contour and is not drawn",
-                    r.pending_line,
-                    r.pending.iter().map(Span::length).sum::<f64>()
-                ));
+                let length = r.pending.iter().map(Span::length).sum::<f64>();
+                warnings.push(
+                    ReadWarning::new(
+                        WarningKind::OpenChain,
+                        format!(
+                            "a tool-on path of {length:.3} mm closes no contour and is not drawn"
+                        ),
+                    )
+                    .at_line(r.pending_line, None)
+                    .leaving_out(vec![flatten_spans(&r.pending, LEFT_OUT_FLATTENING_MM)]),
+                );
             }
         }
     };
@@ -140,11 +224,17 @@ pub fn open_gcode_with(
                         .collect();
                     let entry = if r.loops_cut == 0 {
                         if !lead.is_empty() {
-                            warnings.push(format!(
-                                "line {}: a lead-in of {:.3} mm before the contour is not drawn",
-                                r.pending_line,
-                                lead.iter().map(Span::length).sum::<f64>()
-                            ));
+                            let length = lead.iter().map(Span::length).sum::<f64>();
+                            warnings.push(
+                                ReadWarning::new(
+                                    WarningKind::Skipped,
+                                    format!(
+                                        "a lead-in of {length:.3} mm before the contour is not drawn"
+                                    ),
+                                )
+                                .at_line(r.pending_line, None)
+                                .leaving_out(vec![flatten_spans(&lead, LEFT_OUT_FLATTENING_MM)]),
+                            );
                         }
                         Entry::Pierce
                     } else {
@@ -165,9 +255,12 @@ pub fn open_gcode_with(
             return Err(OpenError::GcodeCutsNothing(file_name.to_string()));
         }
         // No closed contour to make a nest of: the program's paths alone, to review.
-        warnings.push(format!(
-            "the program cuts no closed contour: shown as its {} tool-on paths (open paths: segment or common-edge cutting); there is no nest to solve",
-            program_paths.paths.len()
+        warnings.push(ReadWarning::new(
+            WarningKind::Other,
+            format!(
+                "the program cuts no closed contour: shown as its {} tool-on paths (open paths: segment or common-edge cutting); there is no nest to solve",
+                program_paths.paths.len()
+            ),
         ));
         return Ok(Document {
             file_name: file_name.to_string(),
@@ -207,7 +300,7 @@ pub fn open_gcode_with(
     // A program that cuts open paths: the nest holds only the loops they close, so the
     // program's own tool-on paths are what to show.
     let paths = open_paths_note(&nest, &route, &program_paths).map(|note| {
-        warnings.push(note);
+        warnings.push(ReadWarning::new(WarningKind::Other, note));
         program_paths
     });
     Ok(Document {
@@ -447,7 +540,7 @@ pub fn open_together(files: &[(String, Vec<u8>)]) -> Result<Document, OpenError>
                 route: None,
                 paths: None,
                 task_speeds: None,
-                warnings: notes,
+                warnings: notes_as_warnings(notes),
                 sheets: Vec::new(),
                 sheet: 0,
             });
@@ -517,8 +610,16 @@ pub fn open_together(files: &[(String, Vec<u8>)]) -> Result<Document, OpenError>
     }
     document.file_name = file_name;
     document.format = format;
-    document.warnings.extend(notes);
+    document.warnings.extend(notes_as_warnings(notes));
     Ok(document)
+}
+
+/// What a batch's checks found, as warnings of kind [`WarningKind::Other`].
+fn notes_as_warnings(notes: Vec<String>) -> Vec<ReadWarning> {
+    notes
+        .into_iter()
+        .map(|n| ReadWarning::new(WarningKind::Other, n))
+        .collect()
 }
 
 /// The independent check of a result's tour, and of the cost it reports.
@@ -722,12 +823,12 @@ mod tests {
         assert!(matches!(document.problem, Problem::PcgtspText { .. }));
         assert_eq!(document.format, "PCGTSP instance + PCGLNS result");
         assert!(
-            document.warnings[0].contains("feasible"),
+            document.warnings[0].message.contains("feasible"),
             "{:?}",
             document.warnings
         );
         assert!(
-            document.warnings[0].contains("reports 1514"),
+            document.warnings[0].message.contains("reports 1514"),
             "{:?}",
             document.warnings
         );
@@ -793,7 +894,9 @@ mod tests {
             "{} vs {cost}",
             route.idle_length()
         );
-        assert!(document.warnings[0].contains(&format!("feasible, cost {cost:.3}")));
+        assert!(document.warnings[0]
+            .message
+            .contains(&format!("feasible, cost {cost:.3}")));
         assert!(
             (cost - 1514.0).abs() < 0.5 * 17.0,
             "rounding explains the file's cost"
@@ -824,13 +927,17 @@ mod tests {
             "{problems:?}"
         );
         assert!(
-            document.warnings[0].contains("feasible, cost 4662.000"),
+            document.warnings[0]
+                .message
+                .contains("feasible, cost 4662.000"),
             "{:?}",
             document.warnings
         );
         // The task repeats two holes as parts of their own only once: those are not cut.
         assert!(
-            document.warnings[2].contains("does not list part 16 contour 0, part 18 contour 0 of"),
+            document.warnings[2]
+                .message
+                .contains("does not list part 16 contour 0, part 18 contour 0 of"),
             "{:?}",
             document.warnings
         );

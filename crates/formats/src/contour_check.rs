@@ -3,7 +3,7 @@
 //! with the location (byte offset or JSON path).
 
 use cutroute_geometry::float::Libm;
-use cutroute_geometry::{domain, Contour, DomainError, Vertex};
+use cutroute_geometry::{domain, Contour, ContourFault, DomainError, Vertex};
 
 /// How far apart (mm) the first and last stored points may be for the contour to count as closed.
 pub const DEFAULT_CLOSURE_TOLERANCE: f64 = 1e-3;
@@ -45,10 +45,17 @@ pub enum ContourProblem {
         /// Where they meet, y.
         y: f64,
     },
+    /// The contour encloses no area, or less than a region one closure tolerance wide (see
+    /// [`ContourFault`]).
+    #[error("{0}")]
+    NoArea(ContourFault),
 }
 
 /// Checks a stored point list `(x, y, bulge)` whose last point repeats the first, and returns the
-/// contour without the closing point.
+/// contour without the closing point. The contour must be cuttable
+/// ([`Contour::check_cuttable`] with the closure tolerance): a nest format refuses, with its
+/// location, what a drawing would leave out with a warning. `check_self_intersection: false`
+/// skips that whole check (the fuzz target, which exercises the parser).
 pub(crate) fn closed_contour(
     points: &[[f64; 3]],
     tolerance: f64,
@@ -87,13 +94,22 @@ pub(crate) fn closed_contour(
     let contour = Contour::new(vertices);
     domain::check_contour(&contour)?;
     if check_self_intersection {
-        if let Some(hit) = contour.first_self_intersection() {
-            return Err(ContourProblem::SelfIntersecting {
-                first_span: hit.first_span,
-                second_span: hit.second_span,
-                x: hit.point.x,
-                y: hit.point.y,
-            });
+        match contour.check_cuttable(tolerance) {
+            Ok(()) => {}
+            Err(ContourFault::SelfIntersecting {
+                first_span,
+                second_span,
+                x,
+                y,
+            }) => {
+                return Err(ContourProblem::SelfIntersecting {
+                    first_span,
+                    second_span,
+                    x,
+                    y,
+                })
+            }
+            Err(fault) => return Err(ContourProblem::NoArea(fault)),
         }
     }
     Ok(contour)

@@ -58,6 +58,28 @@ pub enum SheetDetection {
     None,
 }
 
+/// The contour with every arc of more than a semicircle (|bulge| > 1) halved at its middle:
+/// the same curve, stored well. DBS keeps coordinates and bulges as 32-bit floats, and the
+/// chord of a nearly full circle is short next to its radius, so its rounding grows into the
+/// radius (a bulge of 9999 moved a perimeter by 0.1 %); each half is at most a semicircle, whose
+/// radius follows its chord.
+fn with_short_arcs(contour: &Contour) -> std::borrow::Cow<'_, Contour> {
+    if contour.vertices.iter().all(|v| v.bulge.abs() <= 1.0) {
+        return std::borrow::Cow::Borrowed(contour);
+    }
+    let mut vertices = Vec::with_capacity(contour.vertices.len() + 1);
+    for (v, span) in contour.vertices.iter().zip(contour.spans()) {
+        if v.bulge.abs() > 1.0 {
+            let (first, second) = span.halved();
+            vertices.push(Vertex::arc(first.start.x, first.start.y, first.bulge));
+            vertices.push(Vertex::arc(second.start.x, second.start.y, second.bulge));
+        } else {
+            vertices.push(*v);
+        }
+    }
+    std::borrow::Cow::Owned(Contour::new(vertices))
+}
+
 /// Options of [`read_dbs_with`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct DbsReadOptions {
@@ -804,7 +826,7 @@ pub fn write_dbs_with(nest: &Nest, options: &DbsWriteOptions) -> Result<Vec<u8>,
         };
         for (k, contour) in part.contours.iter().enumerate() {
             let id = (seq + k + 1) as i16;
-            let points = contour_check::stored_points(contour);
+            let points = contour_check::stored_points(&with_short_arcs(contour));
             if contour.vertices.is_empty() {
                 return Err(DbsWriteError::EmptyContour {
                     part: index,

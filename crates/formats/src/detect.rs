@@ -156,9 +156,9 @@ fn contains(hay: &[u8], needle: &[u8]) -> bool {
 
 fn json_object_kind(bytes: &[u8]) -> Format {
     // Only the top-level keys matter; deserialising into a map of ignored values is cheap.
-    let Ok(map) =
-        serde_json::from_slice::<std::collections::HashMap<String, serde::de::IgnoredAny>>(bytes)
-    else {
+    let Ok(map) = serde_json::from_slice::<std::collections::HashMap<String, serde::de::IgnoredAny>>(
+        crate::json::without_bom(bytes),
+    ) else {
         return Format::Unknown;
     };
     if map.contains_key("TaskData") && map.contains_key("Contours") {

@@ -79,6 +79,9 @@ pub enum JsonWriteError {
 
 /// Parses `bytes` into `T`, mapping serde errors to [`JsonError`] with path and position.
 pub(crate) fn parse<T: DeserializeOwned>(bytes: &[u8]) -> Result<T, JsonError> {
+    // Windows editors save UTF-8 with a byte-order mark, which JSON forbids but every reader
+    // of text accepts; the DXF and SVG readers take it too.
+    let bytes = without_bom(bytes);
     let mut de = serde_json::Deserializer::from_slice(bytes);
     let value: T = serde_path_to_error::deserialize(&mut de).map_err(|e| {
         let path = e.path().to_string();
@@ -87,6 +90,11 @@ pub(crate) fn parse<T: DeserializeOwned>(bytes: &[u8]) -> Result<T, JsonError> {
     })?;
     de.end().map_err(|e| classify(e, None))?;
     Ok(value)
+}
+
+/// `bytes` without a leading UTF-8 byte-order mark.
+pub(crate) fn without_bom(bytes: &[u8]) -> &[u8] {
+    bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes)
 }
 
 fn classify(e: serde_json::Error, path: Option<String>) -> JsonError {

@@ -499,7 +499,7 @@ impl RmResult {
                 .iter()
                 .map(|&[x, y, a]| [x, y, degrees_to_bulge(a)])
                 .collect();
-            contour_check::closed_contour(&pts, DEFAULT_CLOSURE_TOLERANCE, false)
+            contour_check::closed_contour(&pts, DEFAULT_CLOSURE_TOLERANCE, true)
                 .map_err(|problem| JsonError::BadContour { path, problem })
         };
         let sheet = Part {

@@ -113,7 +113,11 @@ fn contour_data(mut data: Data, contour: &Contour) -> Data {
 
 /// Appends one span; `V`/`H`/`L` for straight spans, one or two `A` for arcs.
 pub(crate) fn span_data(data: Data, a: Point, z: Point, b: f64) -> Data {
-    if b == 0.0 || a == z {
+    // An arc whose radius lies beyond the coordinate domain is straight to within
+    // chord² / (8 · 1e9) mm, and its radius is a number no reader of the domain accepts
+    // (a bulge of 1e-13 gives a radius of 1e13 chords): it is written as the line it is.
+    let too_flat = b != 0.0 && !(Span::new(a, z, b).radius() <= cutroute_geometry::MAX_COORDINATE);
+    if b == 0.0 || a == z || too_flat {
         return if a.x == z.x {
             data.vertical_line_to(z.y)
         } else if a.y == z.y {
@@ -122,11 +126,14 @@ pub(crate) fn span_data(data: Data, a: Point, z: Point, b: f64) -> Data {
             data.line_to((z.x, z.y))
         };
     }
-    if b.abs() >= 1.0 {
-        // ≥ 180°: halve at the zenith so each piece is below 180° and needs no large-arc flag.
+    if b.abs() > 0.5 {
+        // Over about 106°: halved (again if need be) at the middle. An SVG arc is given by its
+        // radius, and near a semicircle the radius is about half the chord, where the rounding
+        // of the written numbers decides which side the centre lies on: a reader then draws
+        // the other half of the circle.
         let (first, second) = Span::new(a, z, b).halved();
-        return arc(
-            arc(data, a, first.end, first.bulge),
+        return span_data(
+            span_data(data, a, first.end, first.bulge),
             first.end,
             z,
             second.bulge,

@@ -75,6 +75,78 @@ pub enum ContourError {
     },
 }
 
+/// Why a contour is not one a machine can cut: the one meaning of a contour that every reader
+/// applies ([`Contour::check_cuttable`]).
+///
+/// A cuttable contour is
+/// - **closed** with at least 2 vertices and finite values (the type closes it implicitly);
+/// - **not a slit**: two straight spans are a line drawn out and back, never a region, so a
+///   contour needs 3 spans or an arc among its spans;
+/// - **not self-intersecting**: no two spans cross or touch away from the vertex they share
+///   ([`Contour::first_self_intersection`]), since inside and outside, and so the side the kerf
+///   goes to and which contour holds which, are undefined otherwise;
+/// - **not a sliver**: its enclosed area is at least `tolerance × perimeter / 2`, i.e. the region
+///   is on average at least one tolerance wide. A strip of width w and length L has area wL and
+///   perimeter about 2L, so this refuses exactly the strips whose two sides lie within the
+///   tolerance of each other: lines drawn twice that a join closed into a loop, a circle of
+///   radius below the tolerance. The tolerance is the reader's (the join tolerance of a drawing,
+///   the closure tolerance of a nest).
+///
+/// Readers of CAD drawings (DXF, SVG) leave such a contour out with a
+/// [`ReadWarning`](crate::ReadWarning) of the matching kind, since drawings commonly carry
+/// them; readers of nest formats (geometry JSON, result JSON, DBS, T-FLEX, G-code) refuse the
+/// file with the contour's location, since a nesting program never writes one on purpose.
+#[derive(Clone, Debug, PartialEq, Error)]
+pub enum ContourFault {
+    /// Fewer than two vertices.
+    #[error("a contour needs at least 2 vertices, got {count}")]
+    TooFewVertices {
+        /// Number of vertices.
+        count: usize,
+    },
+    /// A coordinate or bulge is NaN or infinite.
+    #[error("vertex {index} has a non-finite coordinate or bulge")]
+    NonFinite {
+        /// Index of the offending vertex.
+        index: usize,
+    },
+    /// Two straight spans: a slit drawn out and back, enclosing nothing.
+    #[error("the contour is a slit (two straight spans out and back) and encloses no area")]
+    Slit,
+    /// Two spans cross or touch away from their shared vertex.
+    #[error(
+        "the contour intersects itself: spans {first_span} and {second_span} meet at ({x}, {y})"
+    )]
+    SelfIntersecting {
+        /// The lower span index (span i runs from vertex i to vertex i + 1).
+        first_span: usize,
+        /// The higher span index.
+        second_span: usize,
+        /// Where they meet, x.
+        x: f64,
+        /// Where they meet, y.
+        y: f64,
+    },
+    /// The enclosed area is below `tolerance × perimeter / 2`: a sliver or a point.
+    #[error("the contour encloses {area:.3e} mm², less than the {minimum:.3e} mm² of a region one tolerance wide along its {perimeter:.3} mm perimeter")]
+    TooThin {
+        /// The enclosed area, mm².
+        area: f64,
+        /// The least area allowed, mm².
+        minimum: f64,
+        /// The perimeter, mm.
+        perimeter: f64,
+    },
+}
+
+impl ContourFault {
+    /// Whether the fault is that the contour encloses (next to) no area: a slit or a sliver,
+    /// which CAD drawings carry as lines drawn twice.
+    pub fn is_zero_area(&self) -> bool {
+        matches!(self, Self::Slit | Self::TooThin { .. })
+    }
+}
+
 /// A place on a contour: span index and arc-length parameter on that span.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct ContourPosition {
@@ -506,6 +578,59 @@ impl Contour {
         best
     }
 
+    /// Checks the one meaning of a contour every reader applies (see [`ContourFault`]), with
+    /// the reader's `tolerance` (mm) for how thin a region may be.
+    ///
+    /// ```
+    /// use cutroute_geometry::{Contour, ContourFault, Vertex};
+    /// assert!(Contour::rectangle(0.0, 0.0, 10.0, 10.0).check_cuttable(1e-3).is_ok());
+    /// let slit = Contour::new(vec![Vertex::line(0.0, 0.0), Vertex::line(10.0, 0.0)]);
+    /// assert_eq!(slit.check_cuttable(1e-3), Err(ContourFault::Slit));
+    /// let bow_tie = Contour::new(vec![
+    ///     Vertex::line(0.0, 0.0),
+    ///     Vertex::line(10.0, 10.0),
+    ///     Vertex::line(10.0, 0.0),
+    ///     Vertex::line(0.0, 10.0),
+    /// ]);
+    /// assert!(matches!(bow_tie.check_cuttable(1e-3), Err(ContourFault::SelfIntersecting { .. })));
+    /// ```
+    pub fn check_cuttable(&self, tolerance: f64) -> Result<(), ContourFault> {
+        let n = self.vertices.len();
+        if n < 2 {
+            return Err(ContourFault::TooFewVertices { count: n });
+        }
+        if let Some(index) = self
+            .vertices
+            .iter()
+            .position(|v| !v.point.is_finite() || !v.bulge.is_finite())
+        {
+            return Err(ContourFault::NonFinite { index });
+        }
+        if n == 2 && self.vertices.iter().all(|v| v.bulge == 0.0) {
+            return Err(ContourFault::Slit);
+        }
+        if let Some(x) = self.first_self_intersection() {
+            return Err(ContourFault::SelfIntersecting {
+                first_span: x.first_span,
+                second_span: x.second_span,
+                x: x.point.x,
+                y: x.point.y,
+            });
+        }
+        let area = self.area();
+        let perimeter = self.perimeter();
+        let minimum = tolerance.max(0.0) * perimeter / 2.0;
+        // `!(a >= b)` also refuses a NaN area.
+        if !(area >= minimum) || area == 0.0 {
+            return Err(ContourFault::TooThin {
+                area,
+                minimum,
+                perimeter,
+            });
+        }
+        Ok(())
+    }
+
     /// Checks that the contour is a usable simple closed curve: at least 2 vertices, finite
     /// values, no zero-length span, no self-intersection.
     pub fn validate(&self) -> Result<(), ContourError> {
@@ -549,6 +674,24 @@ impl Contour {
         }
         out
     }
+}
+
+/// An open chain of spans as a polyline (its first point, then every span's end) whose chords
+/// stay within `chord_tolerance` of every arc, as [`Contour::flatten`] cuts them.
+pub fn flatten_spans(spans: &[Span], chord_tolerance: f64) -> Vec<Point> {
+    let mut out = Vec::with_capacity(spans.len() + 1);
+    let Some(first) = spans.first() else {
+        return out;
+    };
+    out.push(first.start);
+    for s in spans {
+        if !s.is_line() {
+            let pieces = arc_pieces(s, chord_tolerance);
+            out.extend((1..pieces).map(|k| s.point_at(k as f64 / pieces as f64)));
+        }
+        out.push(s.end);
+    }
+    out
 }
 
 /// Signed crossings of the ray from `p` towards +x with one span (see

@@ -100,7 +100,8 @@ mod viewport;
 pub use bbox::BoundingBox;
 pub use chain_leads::{ChainedAttach, ChainedLeads};
 pub use contour::{
-    ClosureError, ContourError, ContourPosition, ContourProjection, SelfIntersection,
+    flatten_spans, ClosureError, ContourError, ContourFault, ContourPosition, ContourProjection,
+    SelfIntersection,
 };
 pub use domain::{DomainError, NestDomainError, MAX_BULGE, MAX_COORDINATE, MIN_CONTOUR_EXTENT};
 pub use forest::ContainmentForest;

@@ -24,7 +24,7 @@
 #![deny(missing_docs)]
 
 use cutroute_geometry::{
-    KerfSettings, MachineParameters, Nest, Objective, PathRoute, Point, Route,
+    KerfSettings, MachineParameters, Nest, Objective, PathRoute, Point, ReadWarning, Route,
 };
 use serde::{Deserialize, Serialize};
 
@@ -100,8 +100,11 @@ pub struct Document {
     /// The speeds and pierce time a task file of the batch sets for the machine.
     #[serde(default)]
     pub task_speeds: Option<TaskSpeeds>,
-    /// What the reader skipped, approximated or could not close, in plain words.
-    pub warnings: Vec<String>,
+    /// What the reader left out, skipped, approximated or assumed, as data: kind, place in the
+    /// file, a sentence, the length and the geometry left out (for the page to draw as a
+    /// layer). In JSON each is an object `{"kind": "open_chain", "place": …, "message": …,
+    /// "length_mm": …, "left_out": [[{x, y}, …], …]}`.
+    pub warnings: Vec<ReadWarning>,
     /// The names of the file's sheets when it holds several (T-FLEX projects), in file order;
     /// empty for files of one sheet. The engine's `open_sheet` opens any of them.
     #[serde(default)]
