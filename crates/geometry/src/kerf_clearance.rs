@@ -212,7 +212,11 @@ pub(crate) fn cut_overlaps<'a>(
 /// (kerf/2) comes closer than `half − tolerance` to the other: parts that sit closer than the
 /// kerf, where no full cutting route exists (the kerf of one eats into its neighbour). Each
 /// pair once; contours without an equidistant at `half` have no cut and are skipped (they have
-/// no room, which the lead fitter reports). Empty for `half` 0.
+/// no room, which the lead fitter reports). Contours that touch or lie on one another (a part
+/// exactly in a hole of its own shape, two identical parts stacked) are reported too, with gap
+/// 0. Empty for `half` 0: without kerf a line shared by two contours is cut once per contour,
+/// which still leaves both parts their shape (a part in a hole of its shape is then cut as the
+/// hole's slug and again as itself: one more pierce and cut, nothing cut wrong).
 pub fn kerf_overlaps(nest: &Nest, half: f64, tolerance: f64) -> Vec<KerfOverlap> {
     if !(half > 0.0) {
         return Vec::new();

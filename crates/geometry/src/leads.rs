@@ -948,8 +948,8 @@ pub enum LeadProblem {
         /// The overcut, mm.
         length: f64,
     },
-    /// A tab lies outside the cut, out of order, off the equidistant, over a corner, or in a
-    /// hole (holes get no tabs).
+    /// A tab lies outside the cut, out of order, off the equidistant, over a corner, in a
+    /// hole (holes get no tabs), or ends off the sheet.
     #[error("the tab at ({x}, {y}) is misplaced")]
     TabMisplaced {
         /// Where its gap begins, x.
@@ -1227,11 +1227,14 @@ impl<'a> LeadFitter<'a> {
             )
             .map_err(|problem| (false, problem))?
         };
-        let tabs = if self.is_hole(r) {
+        let mut tabs = if self.is_hole(r) {
             Vec::new()
         } else {
             place_tabs(eq, self.settings.kerf / 2.0, s, overcut, self.settings.tabs)
         };
+        // The torch pierces again at a tab's end: where the equidistant runs off the sheet (a
+        // part at its edge) there is neither material to hold nor scrap to pierce.
+        tabs.retain(|t| self.on_sheet(t.from, 0.0) && self.on_sheet(t.to, 0.0));
         Ok(StepLeads {
             pierce: lead_in[0].point,
             entry,
@@ -1767,7 +1770,8 @@ impl<'a> LeadFitter<'a> {
             let clear = corners
                 .iter()
                 .all(|&(c0, c1)| c1 <= tab.start || c0 >= tab.end);
-            if !(ordered && on_equidistant && clear) {
+            let on_sheet = self.on_sheet(tab.to, -tolerance);
+            if !(ordered && on_equidistant && clear && on_sheet) {
                 problems.push(misplaced(tab.from));
             }
             previous_end = tab.end;
