@@ -303,9 +303,9 @@ impl PlanBound {
         })
     }
 
-    /// The objective's lower bound for every route of the plan model (see below), given `ccp_idle`: a certified lower
-    /// bound on the idle length of every CCP route from the same start (and to the same
-    /// finish; `cutroute-ccp`'s `CcpLowerBound`). Where contours touch it is
+    /// The objective's lower bound for every route of the plan model (see below), given
+    /// `ccp_idle`: a certified lower bound on the idle length of every CCP route from the same
+    /// start (and to the same finish; `cutroute-ccp`'s `CcpLowerBound`). Where contours touch it is
     /// [`PlanBound::any_route`].
     ///
     /// Why it holds when every component is one contour (so every tool-on path runs along one
@@ -827,6 +827,12 @@ impl Job for AoeJob {
             Some(Ok(solved)) => Some(solved),
             _ => None,
         };
+        // A checked route waiting for its plan bound is shown (without the bound): a job
+        // stopped in that step keeps it.
+        let waiting = match (&self.outcome, self.solving.outcome()) {
+            (None, Some(Ok(solution))) => Some(solution),
+            _ => None,
+        };
         let phase = match &self.outcome {
             None => match self.solving.stage() {
                 AoeStage::Building => Phase::CommonEdgeGraph,
@@ -841,7 +847,7 @@ impl Job for AoeJob {
                 error: e.to_string(),
             },
         };
-        let route = solved.map(|(s, _)| &s.route);
+        let route = solved.map(|(s, _)| &s.route).or(waiting.map(|s| &s.route));
         let idle_lower_bound = solved.and_then(|(_, b)| b.as_ref()).map(|b| b.idle_length);
         Progress {
             job_id: self.job_id,
