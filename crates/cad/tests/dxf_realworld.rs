@@ -357,6 +357,9 @@ fn a_generated_sheet_of_closed_splines_reads_every_spline_as_one_contour() {
     for c in contours {
         let b = c.bounding_box();
         let (w, h) = (b.width(), b.height());
-        assert!((20.0..=44.0).contains(&w) && (20.0..=44.0).contains(&h), "{w} × {h}");
+        assert!(
+            (20.0..=44.0).contains(&w) && (20.0..=44.0).contains(&h),
+            "{w} × {h}"
+        );
     }
 }

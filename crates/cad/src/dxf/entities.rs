@@ -614,9 +614,25 @@ impl Expander<'_, '_> {
                 let t0 = record.real_or(41, 0.0)?;
                 let t1 = sweep_end(t0, record.real_or(42, std::f64::consts::TAU)?);
                 let closed = (t1 - t0 - std::f64::consts::TAU).abs() < 1e-9;
-                // The minor axis is N × major scaled by the ratio: N = ±Z turns it ±90°.
-                let side = if nz < 0.0 { -1.0 } else { 1.0 };
-                let v = Point::new(-major.y * ratio * side, major.x * ratio * side);
+                // The minor axis is N × major scaled by the ratio (N = ±Z turns it ±90°); both
+                // are world vectors, seen from above like the rest of the drawing.
+                let nx = record.real_or(210, 0.0)?;
+                let ny = record.real_or(220, 0.0)?;
+                let mz = record.real_or(31, 0.0)?;
+                let n_len = (nx * nx + ny * ny + nz * nz).sqrt();
+                if n_len == 0.0 {
+                    self.warn(
+                        WarningKind::Skipped,
+                        record.line,
+                        "ELLIPSE with a zero normal skipped",
+                    );
+                    return Ok(());
+                }
+                let (nx, ny, nz) = (nx / n_len, ny / n_len, nz / n_len);
+                let v = Point::new(
+                    (ny * mz - nz * major.y) * ratio,
+                    (nz * major.x - nx * mz) * ratio,
+                );
                 let arc = EllipticArc {
                     center,
                     u: major,
