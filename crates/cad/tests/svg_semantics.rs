@@ -328,3 +328,17 @@ fn text_and_clipping_are_told() {
         .iter()
         .any(|w| w.kind == WarningKind::Other && w.message.contains("clip-path")));
 }
+
+#[test]
+fn switch_draws_its_first_child_that_applies() {
+    let import = read(&mm(
+        100.0,
+        r#"<switch>
+             <foreignObject requiredExtensions="http://ns.adobe.com/AdobeIllustrator/10.0/"/>
+             <g><rect width="10" height="10"/></g>
+             <rect x="50" width="10" height="10"/>
+           </switch>"#,
+    ));
+    assert_eq!(boxes(&import).len(), 1);
+    assert_box(boxes(&import)[0], [0.0, 0.0, 10.0, 10.0]);
+}

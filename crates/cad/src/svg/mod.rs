@@ -69,7 +69,7 @@ mod style;
 use std::collections::HashMap;
 
 use cutroute_geometry::{Point, ReadWarning, Span, Transform, WarningKind};
-use roxmltree::{Document, Node, NodeId};
+use roxmltree::{Node, NodeId};
 
 use crate::assemble::{
     assemble, finish_import, is_bounded, AssembleLimits, DrawingImport, EntityRef, Piece,
@@ -98,7 +98,7 @@ const MM_PER_PX: f64 = 25.4 / 96.0;
 const INITIAL_FONT_PX: f64 = 16.0;
 /// The approximation tolerance of a Bézier curve as a fraction of its extent, where that is
 /// finer than the options' tolerance.
-const SMALL_CURVE_TOLERANCE: f64 = 1e-3;
+const SMALL_CURVE_TOLERANCE: f64 = 1e-2;
 /// Elements visited per allowed span: bounds the walk of `<use>` trees that draw nothing.
 const VISITS_PER_SPAN: usize = 4;
 
@@ -162,7 +162,7 @@ pub fn read_svg(bytes: &[u8], options: &SvgOptions) -> Result<SvgImport, SvgErro
         });
     }
     let mut reader = Reader {
-        doc: &doc,
+        lines: LineIndex::new(doc.input_text()),
         options,
         budget: options.max_spans,
         visits: options.max_spans.saturating_mul(VISITS_PER_SPAN),
@@ -312,7 +312,7 @@ enum Axis {
 }
 
 struct Reader<'a, 'input, 'o> {
-    doc: &'a Document<'input>,
+    lines: LineIndex<'input>,
     options: &'o SvgOptions,
     budget: usize,
     visits: usize,
@@ -332,8 +332,7 @@ struct Reader<'a, 'input, 'o> {
 
 impl<'a, 'input> Reader<'a, 'input, '_> {
     fn position(&self, node: Node<'_, '_>) -> (u32, u32) {
-        let p = self.doc.text_pos_at(node.range().start);
-        (p.row, p.col)
+        self.lines.position(node.range().start)
     }
 
     fn warn(&mut self, node: Node<'_, '_>, kind: WarningKind, message: impl Into<String>) {
@@ -836,6 +835,19 @@ impl<'a, 'input> Reader<'a, 'input, '_> {
                 if name == "svg" && depth > 0 {
                     self.enter_viewport(node, &mut context, None)?;
                 }
+                if name == "switch" {
+                    // SVG draws the first child whose conditions hold; this reader supports no
+                    // extensions (Illustrator puts its private data first behind one).
+                    let first = node.children().find(|c| {
+                        c.is_element()
+                            && c.tag_name().namespace().is_none_or(|ns| ns == SVG_NS)
+                            && !c.has_attribute("requiredExtensions")
+                    });
+                    return match first {
+                        Some(child) => self.walk(child, &context, depth + 1),
+                        None => Ok(()),
+                    };
+                }
                 self.walk_children(node, &context, depth)
             }
             "use" => self.expand_use(node, context, depth),
@@ -1266,6 +1278,48 @@ impl<'a, 'input> Reader<'a, 'input, '_> {
     }
 }
 
+/// Lines and columns of byte offsets in time linear in the file: roxmltree's `text_pos_at`
+/// counts from the start of the text at every call, which made every element's position cost
+/// the length of the file before it.
+struct LineIndex<'t> {
+    text: &'t str,
+    /// Byte offset of the start of each line.
+    starts: Vec<usize>,
+    /// The last position asked for, `(offset, column)`: positions are mostly asked in file
+    /// order, so the column is counted on from there along one line (minified files have one).
+    last: std::cell::Cell<(usize, u32)>,
+}
+
+impl<'t> LineIndex<'t> {
+    fn new(text: &'t str) -> Self {
+        let starts = std::iter::once(0)
+            .chain(text.match_indices('\n').map(|(k, _)| k + 1))
+            .collect();
+        Self {
+            text,
+            starts,
+            last: std::cell::Cell::new((0, 1)),
+        }
+    }
+
+    /// The 1-based line and column (in characters) of a byte offset.
+    fn position(&self, offset: usize) -> (u32, u32) {
+        let offset = offset.min(self.text.len());
+        let line = self.starts.partition_point(|&s| s <= offset).max(1);
+        let start = self.starts[line - 1];
+        let (last, last_column) = self.last.get();
+        let (from, column) = if last >= start && last <= offset {
+            (last, last_column)
+        } else {
+            (start, 1)
+        };
+        let between = self.text.get(from..offset).map_or(0, |t| t.chars().count());
+        let column = column.saturating_add(u32::try_from(between).unwrap_or(u32::MAX));
+        self.last.set((offset, column));
+        (u32::try_from(line).unwrap_or(u32::MAX), column)
+    }
+}
+
 /// A `preserveAspectRatio`: no uniform scaling (`none`), or uniform by the larger factor
 /// (`slice`) or the smaller (`meet`), aligned at the fractions `x`, `y` of the viewport.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -1455,5 +1509,19 @@ mod tests {
             <rect width="96" height="96"/></svg>"#;
         let import = read(svg);
         assert!((import.nest.parts[0].contours[0].area() - 25.4 * 25.4).abs() < 1e-9);
+    }
+
+    #[test]
+    fn line_index_agrees_with_the_xml_parser_in_any_order() {
+        let text = "<svg>\n  <g id=\"é\">  <rect/>\n\n<path d=\"M0 0\"/>ü<line/></g></svg>";
+        let doc = roxmltree::Document::parse(text).unwrap();
+        let lines = LineIndex::new(text);
+        let mut offsets: Vec<usize> = doc.descendants().map(|n| n.range().start).collect();
+        offsets.push(text.len());
+        let reversed: Vec<usize> = offsets.iter().rev().copied().collect();
+        for offset in offsets.into_iter().chain(reversed) {
+            let p = doc.text_pos_at(offset);
+            assert_eq!(lines.position(offset), (p.row, p.col), "offset {offset}");
+        }
     }
 }
