@@ -427,16 +427,22 @@ fn chain_spans<'a>(
     })
 }
 
+/// A span shorter than this (mm) is rounding, not geometry.
+const NO_LENGTH_MM: f64 = 1e-6;
+
 fn chain_contour(links: &[(usize, bool)], pieces: &[Piece]) -> Contour {
     // Each span starts at its own start point: gaps within the tolerance close implicitly.
-    Contour::new(
-        chain_spans(links, pieces)
-            .map(|s| Vertex {
-                point: s.start,
-                bulge: s.bulge,
-            })
-            .collect(),
-    )
+    let vertices: Vec<Vertex> = chain_spans(links, pieces)
+        .map(|s| Vertex {
+            point: s.start,
+            bulge: s.bulge,
+        })
+        .collect();
+    // Spans of no length (an SVG `z` after a path came back to its start, up to the rounding
+    // of computed arc ends) would keep the spans on either side from sharing their vertex, and
+    // their meeting there would count as a crossing.
+    Contour::from_closed_vertices(&vertices, NO_LENGTH_MM)
+        .unwrap_or_else(|_| Contour::new(vertices))
 }
 
 struct Placed {

@@ -33,7 +33,8 @@ fn each_sheet_of_a_project_opens() {
     assert!(second
         .warnings
         .iter()
-        .any(|w| w.contains("showing sheet 2")));
+        .any(|w| w.kind == cutroute_geometry::WarningKind::Sheets
+            && w.message.contains("showing sheet 2")));
     assert!(matches!(
         open_sheet("two-sheets.tfnesting", &bytes, 2),
         Err(OpenError::NoSuchSheet {

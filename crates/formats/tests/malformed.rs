@@ -887,3 +887,61 @@ fn two_number_points_default_the_bulge_to_zero() {
     assert!(sheet.contours[0].vertices.iter().all(|v| v.bulge == 0.0));
     assert!(nest.parts.is_empty());
 }
+
+/// A nest format refuses what is not a cuttable contour, located: a slit drawn out and back
+/// and a bow-tie; a byte-order mark is not an error.
+#[test]
+fn geometry_json_refuses_slits_and_bow_ties_and_accepts_a_bom() {
+    let sheet = "[[0,0,0],[0,500,0],[700,500,0],[700,0,0],[0,0,0]]";
+    let file = |contour: &str| {
+        format!(r#"[{{"partid":"LIST","paths":[{sheet}]}},{{"partid":"P","paths":[{contour}]}}]"#)
+    };
+    let slit = file("[[10,10,0],[20,10,0],[10,10,0]]");
+    let e = cutroute_formats::read_geometry_json(slit.as_bytes()).unwrap_err();
+    assert!(e.to_string().contains("[1].paths[0]"), "{e}");
+    assert!(e.to_string().contains("slit"), "{e}");
+    let bow_tie = file("[[0,0,0],[10,10,0],[10,0,0],[0,4,0],[0,0,0]]");
+    let e = cutroute_formats::read_geometry_json(bow_tie.as_bytes()).unwrap_err();
+    assert!(e.to_string().contains("intersects itself"), "{e}");
+    let square = file("[[10,10,0],[10,20,0],[20,20,0],[20,10,0],[10,10,0]]");
+    let with_bom = [b"\xEF\xBB\xBF".as_slice(), square.as_bytes()].concat();
+    assert_eq!(
+        cutroute_formats::detect(&with_bom),
+        cutroute_formats::Format::GeometryJson
+    );
+    let nest = cutroute_formats::read_geometry_json(&with_bom).unwrap();
+    assert_eq!(nest.parts.len(), 1);
+}
+
+/// Writers keep what they write: a bulge of 9999 survives DBS within 1e-6 of its perimeter,
+/// and a bulge of 1e-13 becomes an SVG line instead of a radius no reader accepts.
+#[test]
+fn extreme_bulges_survive_dbs_and_svg() {
+    use cutroute_geometry::{Contour, Nest, Part, Vertex};
+    let part = |contour: Contour| Nest {
+        sheet: None,
+        parts: vec![Part {
+            name: "P".into(),
+            contours: vec![contour],
+        }],
+    };
+    let nearly_full = part(Contour::new(vec![
+        Vertex::arc(100.0, 100.0, 9999.0),
+        Vertex::line(100.01, 100.0),
+    ]));
+    let back = cutroute_formats::read_dbs(&cutroute_formats::write_dbs(&nearly_full).unwrap())
+        .unwrap()
+        .nest;
+    let (before, after) = (nearly_full.parts[0].perimeter(), back.parts[0].perimeter());
+    assert!(
+        (after - before).abs() <= 1e-6 * before,
+        "{before} → {after}"
+    );
+    let flat = part(Contour::new(vec![
+        Vertex::arc(0.0, 0.0, 1e-13),
+        Vertex::line(0.0, 10.0),
+        Vertex::line(10.0, 10.0),
+    ]));
+    let svg = cutroute_formats::nest_svg(&flat, None, &cutroute_formats::SvgOptions::default());
+    assert!(!svg.contains(" A"), "{svg}");
+}

@@ -82,8 +82,8 @@ pub enum ContourError {
 /// - **closed** with at least 2 vertices and finite values (the type closes it implicitly);
 /// - **not a slit**: two straight spans are a line drawn out and back, never a region, so a
 ///   contour needs 3 spans or an arc among its spans;
-/// - **not self-intersecting**: no two spans cross or touch away from the vertex they share
-///   ([`Contour::first_self_intersection`]), since inside and outside, and so the side the kerf
+/// - **not self-intersecting**: no two spans cross or touch farther than the tolerance from the
+///   vertex they share ([`Contour::first_self_intersection_within`]), since inside and outside, and so the side the kerf
 ///   goes to and which contour holds which, are undefined otherwise;
 /// - **not a sliver**: its enclosed area is at least `tolerance × perimeter / 2`, i.e. the region
 ///   is on average at least one tolerance wide. A strip of width w and length L has area wL and
@@ -530,6 +530,14 @@ impl Contour {
     /// vertex that adjacent spans share. Spans are swept in order of their boxes' left edge,
     /// so a simple contour of n spans costs about O(n log n).
     pub fn first_self_intersection(&self) -> Option<SelfIntersection> {
+        self.first_self_intersection_within(0.0)
+    }
+
+    /// [`Contour::first_self_intersection`], with meetings within `tolerance` (mm) of the vertex
+    /// two spans share counted as that vertex: a file that rounds its numbers (an SVG's 32-bit
+    /// floats, a DBS file's) moves a line tangent to an arc enough to cut the circle again
+    /// √(2·R·rounding) from their vertex, which is no crossing at the reader's tolerance.
+    pub fn first_self_intersection_within(&self, tolerance: f64) -> Option<SelfIntersection> {
         let spans: Vec<Span> = self.spans().collect();
         let n = spans.len();
         if n < 2 {
@@ -562,7 +570,8 @@ impl Contour {
                 // again about √(2·R·rounding) away: that far is still "at the vertex".
                 let lengths = spans[lo].length() + spans[hi].length();
                 let magnitude = spans[lo].start.x.abs().max(spans[lo].start.y.abs());
-                let near = 1e-5 * lengths + (1e-14 * (1.0 + magnitude) * lengths).sqrt();
+                let near =
+                    (1e-5 * lengths + (1e-14 * (1.0 + magnitude) * lengths).sqrt()).max(tolerance);
                 for x in spans[lo].intersections(&spans[hi]) {
                     if !shared.iter().flatten().any(|v| v.distance(x.point) <= near) {
                         best = Some(SelfIntersection {
@@ -609,7 +618,7 @@ impl Contour {
         if n == 2 && self.vertices.iter().all(|v| v.bulge == 0.0) {
             return Err(ContourFault::Slit);
         }
-        if let Some(x) = self.first_self_intersection() {
+        if let Some(x) = self.first_self_intersection_within(tolerance.max(0.0)) {
             return Err(ContourFault::SelfIntersecting {
                 first_span: x.first_span,
                 second_span: x.second_span,

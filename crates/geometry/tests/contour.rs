@@ -417,3 +417,49 @@ fn part_area_subtracts_holes_in_either_orientation() {
     assert!((ring(-1.0).area() - expected).abs() < 1e-9);
     assert!((ring(1.0).perimeter() - 6.0 * PI).abs() < 1e-9);
 }
+
+/// The one meaning of a contour: a slit, a sliver narrower than the tolerance and a bow-tie of
+/// either shape are not cuttable; a square, a circle and a thin but wide-enough strip are.
+#[test]
+fn check_cuttable_refuses_slits_slivers_and_bow_ties() {
+    use cutroute_geometry::ContourFault;
+    let tolerance = 0.05;
+    assert_eq!(square_cw().check_cuttable(tolerance), Ok(()));
+    assert_eq!(
+        Contour::circle(p(0.0, 0.0), 1.0, true).check_cuttable(tolerance),
+        Ok(())
+    );
+    let slit = Contour::new(vec![Vertex::line(0.0, 0.0), Vertex::line(10.0, 0.0)]);
+    assert_eq!(slit.check_cuttable(tolerance), Err(ContourFault::Slit));
+    // A strip 0.01 wide (area 1, perimeter 200.02): below the 0.05 tolerance, above 0.001.
+    let strip = Contour::rectangle(0.0, 0.0, 100.0, 0.01);
+    assert!(matches!(
+        strip.check_cuttable(tolerance),
+        Err(ContourFault::TooThin { .. })
+    ));
+    assert!(strip.check_cuttable(tolerance).unwrap_err().is_zero_area());
+    assert_eq!(strip.check_cuttable(0.001), Ok(()));
+    let symmetric = Contour::new(vec![
+        Vertex::line(0.0, 0.0),
+        Vertex::line(10.0, 10.0),
+        Vertex::line(10.0, 0.0),
+        Vertex::line(0.0, 10.0),
+    ]);
+    let unequal = Contour::new(vec![
+        Vertex::line(0.0, 0.0),
+        Vertex::line(10.0, 10.0),
+        Vertex::line(10.0, 0.0),
+        Vertex::line(0.0, 4.0),
+    ]);
+    for bow_tie in [symmetric, unequal] {
+        assert!(matches!(
+            bow_tie.check_cuttable(tolerance),
+            Err(ContourFault::SelfIntersecting { .. })
+        ));
+    }
+    // A zero-area "circle" of radius below the tolerance is a point.
+    assert!(Contour::circle(p(0.0, 0.0), 0.01, true)
+        .check_cuttable(tolerance)
+        .unwrap_err()
+        .is_zero_area());
+}
