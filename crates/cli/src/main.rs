@@ -48,7 +48,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use cutroute_engine::{open_sheet, start_job, AoeJob, Job, SegmentJob};
+use cutroute_engine::{start_job, AoeJob, Job, SegmentJob};
 use cutroute_geometry::{
     ContainmentForest, Entry, MachineParameters, Nest, Objective, PathRoute, Route,
 };
@@ -57,8 +57,10 @@ use cutroute_protocol::{
 };
 use serde_json::{json, Value};
 
+mod gcode_input;
 mod inputs;
 mod kerf;
+mod output;
 mod stdio;
 mod thermal;
 
@@ -92,6 +94,8 @@ enum Command {
         /// and arc tolerance), e.g. kometa-2p32m's M71/M74.
         #[arg(long, value_enum, value_name = "NAME")]
         preset: Option<inputs::PresetArg>,
+        #[command(flatten)]
+        compensation: gcode_input::CompensationArg,
     },
     /// Convert a nest between formats (.dbs, .json, .svg), or route it and write the route as
     /// G-code (.nc, .gcode, .ngc, .tap) or a standalone HTML page (.html).
@@ -128,6 +132,8 @@ enum Command {
         sheet: inputs::SheetArg,
         #[command(flatten)]
         profile: inputs::ProfileArg,
+        #[command(flatten)]
+        compensation: gcode_input::CompensationArg,
     },
     /// Write a seeded synthetic nest (geometry JSON) for tests and benchmarks.
     Generate {
@@ -181,6 +187,8 @@ enum Command {
         sheet: inputs::SheetArg,
         #[command(flatten)]
         profile: inputs::ProfileArg,
+        #[command(flatten)]
+        compensation: gcode_input::CompensationArg,
     },
 }
 
@@ -335,7 +343,8 @@ fn main() -> ExitCode {
             sheet,
             step,
             preset,
-        } => inspect(&file, sheet.index(), json, step, preset),
+            compensation,
+        } => inspect(&file, sheet.index(), json, step, preset, &compensation),
         Command::Convert {
             input,
             output,
@@ -349,7 +358,11 @@ fn main() -> ExitCode {
             kerf,
             sheet,
             profile,
+            compensation,
         } => (|| -> Result<(), Failure> {
+            let inputs = [Some(input.as_path()), machine.task.as_deref()];
+            let inputs = inputs.into_iter().chain([profile.profile.as_deref()]);
+            output::refuse_overwriting_inputs(&output, inputs.flatten())?;
             let profile = profile.load()?;
             {
                 let kerf = kerf.parse()?.with_profile(profile.as_ref());
@@ -368,7 +381,7 @@ fn main() -> ExitCode {
                 };
                 let gcode = gcode.options(profile.as_ref(), &params.machine)?;
                 convert(
-                    (&input, sheet.index()),
+                    (&input, sheet.index(), &compensation),
                     &output,
                     to.as_deref(),
                     solver.as_deref(),
@@ -397,7 +410,13 @@ fn main() -> ExitCode {
             kerf,
             sheet,
             profile,
+            compensation,
         } => (|| {
+            if let Some(out) = &out {
+                let inputs = [Some(file.as_path()), machine.task.as_deref()];
+                let inputs = inputs.into_iter().chain([profile.profile.as_deref()]);
+                output::refuse_overwriting_inputs(out, inputs.flatten())?;
+            }
             let profile = profile.load()?;
             let kerf = kerf.parse()?.with_profile(profile.as_ref());
             let base = inputs::base_machine(profile.as_ref());
@@ -415,7 +434,7 @@ fn main() -> ExitCode {
                 kerf: Default::default(),
                 leads_after: false,
             };
-            let input = (file.as_path(), sheet.index());
+            let input = (file.as_path(), sheet.index(), &compensation);
             let report = solve(input, &solver, params, json, &thermal, &kerf)?;
             Ok(write_report(&report, json, out.as_deref())?)
         })(),
@@ -869,10 +888,14 @@ fn machine_parameters(
     Ok(machine)
 }
 
-/// Opens sheet `sheet` (from 0) of the file; every file has sheet 0.
-fn open((path, sheet): (&Path, usize)) -> Result<Document, Failure> {
+/// Opens sheet `sheet` (from 0) of the file; every file has sheet 0. A G-code program's
+/// `G41 D<n>` takes its radius from `--compensation-radius`.
+fn open(
+    (path, sheet): (&Path, usize),
+    compensation: &gcode_input::CompensationArg,
+) -> Result<Document, Failure> {
     let (name, bytes) = stdio::read_input(path)?;
-    Ok(open_sheet(&name, &bytes, sheet)?)
+    Ok(gcode_input::open(&name, &bytes, sheet, compensation)?)
 }
 
 fn inspect(
@@ -881,14 +904,16 @@ fn inspect(
     as_json: bool,
     step: Option<f64>,
     preset: Option<inputs::PresetArg>,
+    compensation: &gcode_input::CompensationArg,
 ) -> Result<(), Failure> {
     let document = match preset {
         Some(inputs::PresetArg(preset)) => {
             let (name, bytes) = stdio::read_input(path)?;
             let text = String::from_utf8(bytes).map_err(|e| format!("{name}: {e}"))?;
-            cutroute_engine::open_gcode_with(&name, &text, &preset.read_options())?
+            let options = compensation.apply(preset.read_options());
+            cutroute_engine::open_gcode_with(&name, &text, &options)?
         }
-        None => open((path, sheet))?,
+        None => open((path, sheet), compensation)?,
     };
     let summary = match &document.problem {
         Problem::Nest { nest, .. } => {
@@ -937,17 +962,20 @@ fn inspect(
     };
     let mut summary = summary;
     inputs::add_sheets(&mut summary, &document.sheets, document.sheet);
-    if as_json {
-        println!("{summary}");
+    // Written as one piece, so a failing standard output is an error, not a panic.
+    let text = if as_json {
+        format!("{summary}\n")
     } else {
+        let mut text = String::new();
         for (key, value) in summary.as_object().into_iter().flatten() {
-            println!("{key:>16}: {value}");
+            text.push_str(&format!("{key:>16}: {value}\n"));
         }
         for warning in &document.warnings {
-            println!("         warning: {warning}");
+            text.push_str(&format!("         warning: {warning}\n"));
         }
-    }
-    Ok(())
+        text
+    };
+    Ok(stdio::write_output(Path::new("-"), text.as_bytes())?)
 }
 
 /// Counts as stored in the file: the sheet counts as a part when the file has one.
@@ -1074,7 +1102,7 @@ impl GcodeArgs {
 }
 
 fn convert(
-    (input, sheet): (&Path, usize),
+    (input, sheet, compensation): (&Path, usize, &gcode_input::CompensationArg),
     output: &Path,
     to: Option<&str>,
     solver: Option<&str>,
@@ -1082,7 +1110,7 @@ fn convert(
     gcode: &cutroute_gcode::GcodeOptions,
     kerf: &kerf::Kerf,
 ) -> Result<(), Failure> {
-    let document = open((input, sheet))?;
+    let document = open((input, sheet), compensation)?;
     Ok(convert_document(
         &document, input, output, to, solver, params, gcode, kerf,
     )?)
@@ -1276,7 +1304,7 @@ fn generate(contours: usize, seed: u64, out: &Path) -> Result<(), String> {
 /// solution's shape (a tour, a route of whole contours, or tool-on paths), each checked again
 /// by the independent checker before it is printed.
 fn solve(
-    input: (&Path, usize),
+    input: (&Path, usize, &gcode_input::CompensationArg),
     solver_name: &str,
     params: SolverParams,
     as_json: bool,
@@ -1284,7 +1312,7 @@ fn solve(
     kerf: &kerf::Kerf,
 ) -> Result<Value, Failure> {
     let solver = solver_kind(solver_name)?;
-    let document = open(input)?;
+    let document = open((input.0, input.1), input.2)?;
     if solver.gives_path_route() && matches!(document.problem, Problem::PcgtspText { .. }) {
         return Err(Failure::Message(format!(
             "--solver {solver_name}: routes nests, not PCGTSP instances"
