@@ -93,3 +93,35 @@ fn third_party_programs_inspect_as_their_pierces_and_cuts() {
         assert_eq!(v["route_problems"], serde_json::json!([]), "{file}");
     }
 }
+
+/// Contours drawn with runs of 2 µm lines (what real drawings carry) read as the contours they
+/// are: a loop is a tool-on path that returns to its own start, not a step that ends near an
+/// earlier step's start.
+#[test]
+fn micrometre_lines_close_no_loops_of_their_own() {
+    let mut program = String::from("G21 G90\n");
+    for k in 0..21 {
+        let x0 = 30.0 * k as f64;
+        program.push_str(&format!("G0 X{x0:.3} Y0.000\nM3\n"));
+        let mut x = x0;
+        for _ in 0..40 {
+            x += 0.002;
+            program.push_str(&format!("G1 X{x:.3} Y0.000 F1000\n"));
+        }
+        program.push_str(&format!("G1 X{:.3} Y0.000\n", x0 + 20.0));
+        program.push_str(&format!("G1 X{:.3} Y20.000\n", x0 + 20.0));
+        program.push_str(&format!("G1 X{x0:.3} Y20.000\n"));
+        program.push_str(&format!("G1 X{x0:.3} Y0.006\n"));
+        for y in ["0.004", "0.002", "0.000"] {
+            program.push_str(&format!("G1 X{x0:.3} Y{y}\n"));
+        }
+        program.push_str("M5\n");
+    }
+    program.push_str("M2\n");
+    let file = std::env::temp_dir().join(format!("cutroute-micro-{}.nc", std::process::id()));
+    std::fs::write(&file, &program).unwrap();
+    let v = json(&["inspect", file.to_str().unwrap(), "--json"]);
+    let _ = std::fs::remove_file(&file);
+    assert_eq!(v["contours"], 21, "{v}");
+    assert_eq!(v["route_pierces"], 21);
+}
