@@ -48,7 +48,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use cutroute_engine::{open_sheet, start_job, AoeJob, Job, SegmentJob};
+use cutroute_engine::{start_job, AoeJob, Job, SegmentJob};
 use cutroute_geometry::{
     ContainmentForest, Entry, MachineParameters, Nest, Objective, PathRoute, Route,
 };
@@ -57,8 +57,10 @@ use cutroute_protocol::{
 };
 use serde_json::{json, Value};
 
+mod gcode_input;
 mod inputs;
 mod kerf;
+mod output;
 mod stdio;
 mod thermal;
 mod warnings;
@@ -93,6 +95,8 @@ enum Command {
         /// and arc tolerance), e.g. kometa-2p32m's M71/M74.
         #[arg(long, value_enum, value_name = "NAME")]
         preset: Option<inputs::PresetArg>,
+        #[command(flatten)]
+        compensation: gcode_input::CompensationArg,
     },
     /// Convert a nest between formats (.dbs, .json, .svg), or route it and write the route as
     /// G-code (.nc, .gcode, .ngc, .tap) or a standalone HTML page (.html).
@@ -129,6 +133,8 @@ enum Command {
         sheet: inputs::SheetArg,
         #[command(flatten)]
         profile: inputs::ProfileArg,
+        #[command(flatten)]
+        compensation: gcode_input::CompensationArg,
     },
     /// Write a seeded synthetic nest (geometry JSON) for tests and benchmarks.
     Generate {
@@ -182,6 +188,8 @@ enum Command {
         sheet: inputs::SheetArg,
         #[command(flatten)]
         profile: inputs::ProfileArg,
+        #[command(flatten)]
+        compensation: gcode_input::CompensationArg,
     },
 }
 
@@ -336,7 +344,8 @@ fn main() -> ExitCode {
             sheet,
             step,
             preset,
-        } => inspect(&file, sheet.index(), json, step, preset),
+            compensation,
+        } => inspect(&file, sheet.index(), json, step, preset, &compensation),
         Command::Convert {
             input,
             output,
@@ -350,7 +359,11 @@ fn main() -> ExitCode {
             kerf,
             sheet,
             profile,
+            compensation,
         } => (|| -> Result<(), Failure> {
+            let inputs = [Some(input.as_path()), machine.task.as_deref()];
+            let inputs = inputs.into_iter().chain([profile.profile.as_deref()]);
+            output::refuse_overwriting_inputs(&output, inputs.flatten())?;
             let profile = profile.load()?;
             {
                 let kerf = kerf.parse()?.with_profile(profile.as_ref());
@@ -369,7 +382,7 @@ fn main() -> ExitCode {
                 };
                 let gcode = gcode.options(profile.as_ref(), &params.machine)?;
                 convert(
-                    (&input, sheet.index()),
+                    (&input, sheet.index(), &compensation),
                     &output,
                     to.as_deref(),
                     solver.as_deref(),
@@ -398,7 +411,13 @@ fn main() -> ExitCode {
             kerf,
             sheet,
             profile,
+            compensation,
         } => (|| {
+            if let Some(out) = &out {
+                let inputs = [Some(file.as_path()), machine.task.as_deref()];
+                let inputs = inputs.into_iter().chain([profile.profile.as_deref()]);
+                output::refuse_overwriting_inputs(out, inputs.flatten())?;
+            }
             let profile = profile.load()?;
             let kerf = kerf.parse()?.with_profile(profile.as_ref());
             let base = inputs::base_machine(profile.as_ref());
@@ -416,7 +435,7 @@ fn main() -> ExitCode {
                 kerf: Default::default(),
                 leads_after: false,
             };
-            let input = (file.as_path(), sheet.index());
+            let input = (file.as_path(), sheet.index(), &compensation);
             let report = solve(input, &solver, params, json, &thermal, &kerf)?;
             Ok(write_report(&report, json, out.as_deref())?)
         })(),
@@ -889,10 +908,14 @@ fn machine_parameters(
     Ok(machine)
 }
 
-/// Opens sheet `sheet` (from 0) of the file; every file has sheet 0.
-fn open((path, sheet): (&Path, usize)) -> Result<Document, Failure> {
+/// Opens sheet `sheet` (from 0) of the file; every file has sheet 0. A G-code program's
+/// `G41 D<n>` takes its radius from `--compensation-radius`.
+fn open(
+    (path, sheet): (&Path, usize),
+    compensation: &gcode_input::CompensationArg,
+) -> Result<Document, Failure> {
     let (name, bytes) = stdio::read_input(path)?;
-    Ok(open_sheet(&name, &bytes, sheet)?)
+    Ok(gcode_input::open(&name, &bytes, sheet, compensation)?)
 }
 
 fn inspect(
@@ -901,14 +924,16 @@ fn inspect(
     as_json: bool,
     step: Option<f64>,
     preset: Option<inputs::PresetArg>,
+    compensation: &gcode_input::CompensationArg,
 ) -> Result<(), Failure> {
     let document = match preset {
         Some(inputs::PresetArg(preset)) => {
             let (name, bytes) = stdio::read_input(path)?;
             let text = String::from_utf8(bytes).map_err(|e| format!("{name}: {e}"))?;
-            cutroute_engine::open_gcode_with(&name, &text, &preset.read_options())?
+            let options = compensation.apply(preset.read_options());
+            cutroute_engine::open_gcode_with(&name, &text, &options)?
         }
-        None => open((path, sheet))?,
+        None => open((path, sheet), compensation)?,
     };
     let summary = match &document.problem {
         Problem::Nest { nest, .. } => {
@@ -957,18 +982,21 @@ fn inspect(
     };
     let mut summary = summary;
     inputs::add_sheets(&mut summary, &document.sheets, document.sheet);
-    if as_json {
+    // Written as one piece, so a failing standard output is an error, not a panic.
+    let text = if as_json {
         warnings::add_to(&mut summary, &document.warnings);
-        println!("{summary}");
+        format!("{summary}\n")
     } else {
+        let mut text = String::new();
         for (key, value) in summary.as_object().into_iter().flatten() {
-            println!("{key:>16}: {value}");
+            text.push_str(&format!("{key:>16}: {value}\n"));
         }
         for warning in &document.warnings {
-            println!("         warning: {warning}");
+            text.push_str(&format!("         warning: {warning}\n"));
         }
-    }
-    Ok(())
+        text
+    };
+    Ok(stdio::write_output(Path::new("-"), text.as_bytes())?)
 }
 
 /// Counts as stored in the file: the sheet counts as a part when the file has one.
@@ -1095,7 +1123,7 @@ impl GcodeArgs {
 }
 
 fn convert(
-    (input, sheet): (&Path, usize),
+    (input, sheet, compensation): (&Path, usize, &gcode_input::CompensationArg),
     output: &Path,
     to: Option<&str>,
     solver: Option<&str>,
@@ -1103,7 +1131,7 @@ fn convert(
     gcode: &cutroute_gcode::GcodeOptions,
     kerf: &kerf::Kerf,
 ) -> Result<(), Failure> {
-    let (document, read_s) = timed_open((input, sheet))?;
+    let (document, read_s) = timed_open((input, sheet), compensation)?;
     warnings::print(&document.warnings);
     // The limit counts reading the file, as `solve`'s does.
     let mut params = params;
@@ -1310,7 +1338,7 @@ fn generate(contours: usize, seed: u64, out: &Path) -> Result<(), String> {
 /// solution's shape (a tour, a route of whole contours, or tool-on paths), each checked again
 /// by the independent checker before it is printed.
 fn solve(
-    input: (&Path, usize),
+    input: (&Path, usize, &gcode_input::CompensationArg),
     solver_name: &str,
     params: SolverParams,
     as_json: bool,
@@ -1319,7 +1347,7 @@ fn solve(
 ) -> Result<Value, Failure> {
     let solver = solver_kind(solver_name)?;
     // The limit counts reading the file: the solver gets what is left of it.
-    let (document, read_s) = timed_open(input)?;
+    let (document, read_s) = timed_open((input.0, input.1), input.2)?;
     warnings::print(&document.warnings);
     let user_limit_s = params.time_limit_s;
     let mut params = params;
@@ -1409,9 +1437,12 @@ fn solve(
 }
 
 /// The document at `input` and how long opening it took (s).
-fn timed_open(input: (&Path, usize)) -> Result<(Document, f64), Failure> {
+fn timed_open(
+    input: (&Path, usize),
+    compensation: &gcode_input::CompensationArg,
+) -> Result<(Document, f64), Failure> {
     let started = std::time::Instant::now();
-    let document = open(input)?;
+    let document = open(input, compensation)?;
     Ok((document, started.elapsed().as_secs_f64()))
 }
 

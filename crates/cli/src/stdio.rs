@@ -1,8 +1,8 @@
 //! Shell conventions: `-` names standard input (for what is read) or standard output (for what
-//! is written); files are written whole or not at all; a long run shows its progress on a
-//! terminal.
+//! is written); files are written whole or not at all, and never over an input or a device
+//! (`output.rs`); a long run shows its progress on a terminal.
 
-use std::io::{IsTerminal, Read, Write};
+use std::io::{IsTerminal, Read};
 use std::path::Path;
 
 use cutroute_protocol::Progress;
@@ -27,30 +27,8 @@ pub fn read_input(path: &Path) -> Result<(String, Vec<u8>), String> {
     Ok((path.display().to_string(), bytes))
 }
 
-/// Writes `bytes` to `path`, or to standard output for `-`. A file is written beside its
-/// destination and renamed over it only when complete, so a failed write (a full disk, Ctrl-C)
-/// never leaves half a file or destroys the one that was there.
-pub fn write_output(path: &Path, bytes: &[u8]) -> Result<(), String> {
-    if is_standard(path) {
-        let mut out = std::io::stdout().lock();
-        return match out.write_all(bytes).and_then(|()| out.flush()) {
-            // The reader has had enough (`| head`): not an error of ours.
-            Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
-            written => written.map_err(|e| format!("standard output: {e}")),
-        };
-    }
-    let name = path
-        .file_name()
-        .ok_or_else(|| format!("{}: not a file name", path.display()))?;
-    let mut partial = name.to_os_string();
-    partial.push(format!(".cutroute-{}.part", std::process::id()));
-    let partial = path.with_file_name(partial);
-    let written = std::fs::write(&partial, bytes).and_then(|()| std::fs::rename(&partial, path));
-    written.map_err(|e| {
-        let _ = std::fs::remove_file(&partial);
-        format!("{}: {e}", path.display())
-    })
-}
+/// Writes `bytes` to `path`, or to standard output for `-`, destroying nothing (`output.rs`).
+pub use crate::output::write_output;
 
 /// A solver's progress on standard error: a live line with the upper and lower bound and the
 /// gap when standard error is a terminal, else (text reports only) one line a second, which
@@ -123,28 +101,6 @@ fn summary(progress: &Progress) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn a_failed_write_keeps_the_old_file() {
-        let dir = std::env::temp_dir().join(format!("cutroute-stdio-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let file = dir.join("kept.json");
-        write_output(&file, b"first").unwrap();
-        write_output(&file, b"second").unwrap();
-        assert_eq!(std::fs::read(&file).unwrap(), b"second");
-        // A destination that cannot be replaced (a directory): an error, and no part file left.
-        let blocked = dir.join("blocked");
-        std::fs::create_dir_all(blocked.join("inside")).unwrap();
-        assert!(write_output(&blocked, b"x").is_err());
-        assert!(blocked.join("inside").is_dir());
-        let leftovers: Vec<_> = std::fs::read_dir(&dir)
-            .unwrap()
-            .filter_map(|e| e.ok())
-            .filter(|e| e.file_name().to_string_lossy().ends_with(".part"))
-            .collect();
-        assert!(leftovers.is_empty(), "{leftovers:?}");
-        std::fs::remove_dir_all(&dir).unwrap();
-    }
 
     #[test]
     fn the_summary_shows_the_gap() {

@@ -208,10 +208,7 @@ pub fn open_gcode_with(
                 }
                 r.pending.push(span);
                 // Does this span close a loop that began at one of the pending spans?
-                let closes = r
-                    .pending
-                    .iter()
-                    .position(|s| s.start.distance(span.end) <= POINT_TOLERANCE_MM);
+                let closes = cutroute_gcode::closed_loop_start(&r.pending, POINT_TOLERANCE_MM);
                 if let Some(j) = closes {
                     let lead: Vec<Span> = r.pending.drain(..j).collect();
                     let vertices: Vec<Vertex> = r

@@ -54,7 +54,9 @@ mod write;
 use cutroute_geometry::Toolpath;
 
 pub use preset::{GcodePreset, UnknownPreset};
-pub use read::{read_gcode, GcodeReadError, Motion, Program, ReadOptions};
+pub use read::{
+    closed_loop_start, read_gcode, CompensationModel, GcodeReadError, Motion, Program, ReadOptions,
+};
 pub use write::{
     path_route_gcode, route_gcode, write_gcode, ArcOutput, DistanceMode, DwellFormat, GcodeError,
     GcodeOptions, KerfCompensation,

@@ -1,21 +1,36 @@
-//! The reader: the tool motion of a G-code program.
+//! The reader: the tool motion of a G-code program, as a controller runs it.
 //!
 //! It understands what [`crate::write_gcode`] writes and the common variants of hand-written and
-//! other post-processors' programs: `G00`–`G03` (arcs by `I`/`J` or `R`, full circles), `G04`
-//! dwell (`P` or `X` seconds), `G20`/`G21` (inches are converted to mm), `G90`/`G91`,
-//! `G90.1`/`G91.1` (absolute or incremental arc centres), `N` line numbers, `( )` and `;`
-//! comments, `%` tape marks, block delete `/` (the block is executed), modal motion (a line of
-//! bare coordinates continues the last motion). Harmless modal codes (`G17`, `G49`,
-//! `G54`–`G59`, `G61`, `G64`, `G80`, `G94`) are accepted; codes that would change the meaning of
-//! the motion (other planes, canned cycles, homing, …) are refused with their location. Z and the
-//! rotary axes are ignored: the motion is the head's path in the sheet's plane.
+//! other post-processors' programs (DXF2GCODE, SheetCam, LightBurn, Inkscape's gcodetools):
+//! `G00`–`G03` (arcs by `I`/`J` or `R`, full circles), `G04` dwell (`P` or `X` seconds),
+//! `G20`/`G21` (inches are converted to mm), `G90`/`G91`, `G90.1`/`G91.1` (absolute or
+//! incremental arc centres), `G92` (the head's position gets new coordinates: an offset of the
+//! program's frame; the motion is reported in the frame the program started in, so the head's
+//! path stays continuous), `G92.1` (offset cancelled and forgotten), `G92.2` (cancelled, kept),
+//! `G92.3` (the kept one restored), `N` line numbers, `O` program numbers, `( )` comments
+//! (`(MSG,…)` among them) and `;` comments, `%` tape marks, block delete `/` (the block is
+//! executed), modal motion (a line of bare coordinates continues the last motion). Harmless
+//! modal codes (`G17`, `G49`, `G54`–`G59`, `G61`, `G64`, `G80`, `G94`) are accepted; codes that
+//! would change the meaning of the motion (other planes, canned cycles, homing, LinuxCNC's
+//! O-word subroutines and `#` parameters, …) are refused with their location. Z and the rotary
+//! axes are ignored: the motion is the head's path in the sheet's plane.
 //!
-//! Cutter (kerf) compensation is followed as the post-processor writes it: `G41`/`G42` (radius
-//! from [`ReadOptions::compensation_radius`]) or `G41.1`/`G42.1 D<diameter>`, then a straight
-//! start-up move onto a closed contour, the contour (and any overcut), `G40` and a straight
-//! cancel move. The head's path is that contour's offset to the side by the radius (exact for
-//! lines and arcs), entered from where the head stood and left to the cancel move's end.
-//! Compensation on open paths, rapids or torch switches under it are refused with their line.
+//! The torch burns from its on code to its off code. In GRBL laser mode
+//! ([`ReadOptions::laser_mode`], or from a program's `M04`, dynamic power, which only laser
+//! mode has) the beam burns only on feed moves with a power `S` above 0: a rapid or an `S0`
+//! move is travel with the beam off, and the next burning move is a new pierce.
+//!
+//! Cutter (kerf) compensation: `G41`/`G42` take their radius from the controller's tool table,
+//! which the reader is given as [`ReadOptions::compensation_radius`]; `G41.1`/`G42.1
+//! D<diameter>` carry it. [`ReadOptions::compensation_model`] says how the stretch from the
+//! start-up move to the move after `G40` becomes the tool centre's path (see
+//! [`CompensationModel`]). Rapids or torch switches under compensation are refused with their
+//! line.
+
+mod linuxcnc;
+mod loops;
+use linuxcnc::Side;
+pub use loops::closed_loop_start;
 
 use cutroute_geometry::float::Libm;
 use std::f64::consts::{PI, TAU};
@@ -43,6 +58,27 @@ pub struct ReadOptions {
     /// Half the kerf, mm, for `G41 D<n>`/`G42 D<n>` (the controller's tool table holds it;
     /// `G41.1 D<kerf>` carries it in the program).
     pub compensation_radius: Option<f64>,
+    /// GRBL laser mode (`$32=1`) from the first line: the beam burns only on `G01`–`G03` moves
+    /// with a power `S` above 0; a rapid or an `S0` move is travel with the beam off. A
+    /// program's `M04` (dynamic power, which only laser mode has) switches it on as well.
+    pub laser_mode: bool,
+    /// How a `G41`/`G42` … `G40` stretch becomes the tool centre's path.
+    pub compensation_model: CompensationModel,
+}
+
+/// How the reader turns a cutter-compensated stretch into the tool centre's path.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum CompensationModel {
+    /// As cutroute's post-processor intends it: the closed contour programmed after the
+    /// start-up move, offset whole by the radius, entered from where the head stood and left
+    /// to the cancel move's end.
+    #[default]
+    ClosedContour,
+    /// As LinuxCNC's interpreter runs it, move by move: the start-up move ends offset
+    /// perpendicular to itself, convex corners get arcs about the programmed corner, concave
+    /// ones end at the offsets' intersection (or are refused where the tool would gouge), and
+    /// the cancel move is straight from where the tool stands.
+    LinuxCnc,
 }
 
 impl Default for ReadOptions {
@@ -55,6 +91,8 @@ impl Default for ReadOptions {
             arc_tolerance_mm: 0.01,
             dwell_p_milliseconds: false,
             compensation_radius: None,
+            laser_mode: false,
+            compensation_model: CompensationModel::default(),
         }
     }
 }
@@ -444,6 +482,11 @@ pub fn read_gcode(text: &str, options: &ReadOptions) -> Result<Program, GcodeRea
         feed: None,
         motions: Vec::new(),
         compensation: None,
+        offset: Point::new(0.0, 0.0),
+        saved_offset: Point::new(0.0, 0.0),
+        laser: options.laser_mode,
+        enabled: false,
+        power_zero: false,
     };
     let mut lines = 0;
     for (index, raw) in text.lines().enumerate() {
@@ -486,6 +529,13 @@ fn tokenize(raw: &str, line: usize) -> Result<Vec<Word>, GcodeReadError> {
                 while i < chars.len() && chars[i] == ' ' {
                     i += 1;
                 }
+                if i < chars.len() && (chars[i] == '#' || chars[i] == '[') {
+                    return Err(GcodeReadError::UnsupportedCode {
+                        line,
+                        column: i + 1,
+                        code: "parameters and expressions (#, [ ])".into(),
+                    });
+                }
                 let begin = i;
                 if i < chars.len() && (chars[i] == '+' || chars[i] == '-') {
                     i += 1;
@@ -520,6 +570,23 @@ fn tokenize(raw: &str, line: usize) -> Result<Vec<Word>, GcodeReadError> {
                     value,
                     column,
                 });
+                // `O100 sub`, `o101 if [...]`: LinuxCNC's subroutines and loops. A bare
+                // `O1234` is a program number (Fanuc), which changes nothing.
+                let next = chars[i..].iter().find(|c| !c.is_whitespace());
+                if letter == 'O' && next.is_some_and(|c| c.is_ascii_alphabetic()) {
+                    return Err(GcodeReadError::UnsupportedCode {
+                        line,
+                        column,
+                        code: "O-word control flow (sub, call, if, while, repeat)".into(),
+                    });
+                }
+            }
+            '#' | '[' => {
+                return Err(GcodeReadError::UnsupportedCode {
+                    line,
+                    column,
+                    code: "parameters and expressions (#, [ ])".into(),
+                })
             }
             found => {
                 return Err(GcodeReadError::UnexpectedCharacter {
@@ -553,13 +620,30 @@ struct State<'a> {
     motions: Vec<Motion>,
     /// Cutter compensation under way, between its start-up and cancel moves.
     compensation: Option<Compensated>,
+    /// The `G92` offset: a programmed coordinate plus this is where the head goes, in the
+    /// frame the program started in (the head's own motion stays continuous through a `G92`).
+    offset: Point,
+    /// The offset `G92.3` restores (LinuxCNC keeps it in parameters 5211–5212).
+    saved_offset: Point,
+    /// GRBL laser mode: the beam burns only on feed moves with a power above 0.
+    laser: bool,
+    /// The torch or beam is switched on (`M03`/`M04` and no `M05` since).
+    enabled: bool,
+    /// The last `S` was 0 (in laser mode: no beam).
+    power_zero: bool,
 }
 
-/// Which side of the programmed path the controller keeps the tool on.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Side {
-    Left,
-    Right,
+/// `G92` and its companions, as LinuxCNC defines them.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum OffsetCode {
+    /// `G92`: the head's position gets the coordinates of the axis words.
+    Set,
+    /// `G92.1`: no offset, and none kept for `G92.3`.
+    Cancel,
+    /// `G92.2`: no offset; the kept one stays for `G92.3`.
+    Suspend,
+    /// `G92.3`: the kept offset again.
+    Restore,
 }
 
 /// A stretch of program under cutter compensation (`G41`/`G42` … `G40`), gathered whole: the
@@ -649,6 +733,7 @@ enum CompensationCode {
 /// The G codes of one block, sorted by what they change.
 #[derive(Default)]
 struct Codes {
+    offset: Option<(OffsetCode, usize, String)>,
     compensation: Option<(CompensationCode, usize, String)>,
     motion: Option<(MotionMode, usize, String)>,
     dwell: Option<usize>,
@@ -711,28 +796,42 @@ impl State<'_> {
         if let Some(f) = get('F') {
             self.feed = Some(f.value * unit);
         }
+        if let Some(s) = get('S') {
+            self.power_zero = s.value == 0.0;
+        }
         for m in m_codes {
             let number = m.round();
             if number != m || number < 0.0 {
                 continue;
             }
             let number = number as u32;
-            let switches = (self.options.torch_off.contains(&number) && self.tool_on)
-                || (self.options.torch_on.contains(&number) && !self.tool_on);
-            if switches && self.compensation.is_some() {
-                return Err(GcodeReadError::Compensation {
-                    line,
-                    column: 1,
-                    problem: "the torch switches while compensation is on",
-                });
+            let (on, off) = (
+                self.options.torch_on.contains(&number),
+                self.options.torch_off.contains(&number),
+            );
+            // Dynamic power exists only in laser mode.
+            self.laser |= on && number == 4;
+            if on {
+                self.enabled = true;
+            } else if off {
+                self.enabled = false;
             }
-            if self.options.torch_off.contains(&number) && self.tool_on {
-                self.tool_on = false;
-                self.motions.push(Motion::TorchOff { at: self.at, line });
-            } else if self.options.torch_on.contains(&number) && !self.tool_on {
-                self.tool_on = true;
-                self.motions.push(Motion::TorchOn { at: self.at, line });
+            if self.laser {
+                // The beam follows the moves (on at a feed move, off at a rapid); off at once
+                // on M05.
+                if off {
+                    self.switch(false, line)?;
+                }
+                continue;
             }
+            if off {
+                self.switch(false, line)?;
+            } else if on {
+                self.switch(true, line)?;
+            }
+        }
+        if self.laser && (!self.enabled || self.power_zero) {
+            self.switch(false, line)?;
         }
         let axis = ['X', 'Y'].into_iter().filter_map(get).next();
         if let Some(column) = codes.dwell {
@@ -768,6 +867,17 @@ impl State<'_> {
         if let Some((mode, _, _)) = codes.motion {
             self.motion = Some(mode);
         }
+        if let Some((code, column, name)) = codes.offset {
+            if let Some((_, _, motion)) = codes.motion {
+                return Err(GcodeReadError::ConflictingCodes {
+                    line,
+                    column,
+                    first: motion,
+                    second: name,
+                });
+            }
+            return self.offset_code(code, [get('X'), get('Y'), get('Z')], unit, line, column);
+        }
         if let Some((code, column, _)) = codes.compensation {
             self.compensation_code(code, get('D'), unit, line, column)?;
         }
@@ -781,12 +891,20 @@ impl State<'_> {
                 column: first.column,
             });
         };
-        let coordinate = |letter: char, current: f64| match get(letter) {
+        let offset = self.offset;
+        let coordinate = |letter: char, current: f64, offset: f64| match get(letter) {
             Some(w) if self.incremental => current + w.value * unit,
-            Some(w) => w.value * unit,
+            Some(w) => w.value * unit + offset,
             None => current,
         };
-        let to = Point::new(coordinate('X', self.at.x), coordinate('Y', self.at.y));
+        let to = Point::new(
+            coordinate('X', self.at.x, offset.x),
+            coordinate('Y', self.at.y, offset.y),
+        );
+        if self.laser {
+            let burns = self.enabled && !self.power_zero && mode != MotionMode::Rapid;
+            self.switch(burns, line)?;
+        }
         let column = codes.motion.as_ref().map_or(first.column, |m| m.1);
         if let Some(c) = &self.compensation {
             // The start-up move, a rapid and the cancel move are the stretch's own; its
@@ -812,12 +930,15 @@ impl State<'_> {
                         None,
                     )
                 } else if get('I').is_some() || get('J').is_some() {
-                    let offset = |letter: char, current: f64| match get(letter) {
+                    let centre_word = |letter: char, current: f64, offset: f64| match get(letter) {
                         Some(w) if self.incremental_centres => current + w.value * unit,
-                        Some(w) => w.value * unit,
+                        Some(w) => w.value * unit + offset,
                         None => current,
                     };
-                    let centre = Point::new(offset('I', self.at.x), offset('J', self.at.y));
+                    let centre = Point::new(
+                        centre_word('I', self.at.x, offset.x),
+                        centre_word('J', self.at.y, offset.y),
+                    );
                     (
                         self.centre_sweep(to, centre, ccw, line, column)?,
                         Some(centre),
@@ -865,6 +986,10 @@ impl State<'_> {
                 Ok(())
             }
             200 => set(&mut codes.units, true, word, name, line),
+            920 => set(&mut codes.offset, OffsetCode::Set, word, name, line),
+            921 => set(&mut codes.offset, OffsetCode::Cancel, word, name, line),
+            922 => set(&mut codes.offset, OffsetCode::Suspend, word, name, line),
+            923 => set(&mut codes.offset, OffsetCode::Restore, word, name, line),
             210 => set(&mut codes.units, false, word, name, line),
             900 => set(&mut codes.distance, false, word, name, line),
             910 => set(&mut codes.distance, true, word, name, line),
@@ -901,6 +1026,63 @@ impl State<'_> {
                 code: name,
             }),
         }
+    }
+
+    /// The torch (beam) switches on or off where the head stands, if it is not so already.
+    fn switch(&mut self, on: bool, line: usize) -> Result<(), GcodeReadError> {
+        if on == self.tool_on {
+            return Ok(());
+        }
+        if self.compensation.is_some() {
+            return Err(GcodeReadError::Compensation {
+                line,
+                column: 1,
+                problem: "the torch switches while compensation is on",
+            });
+        }
+        self.tool_on = on;
+        self.motions.push(if on {
+            Motion::TorchOn { at: self.at, line }
+        } else {
+            Motion::TorchOff { at: self.at, line }
+        });
+        Ok(())
+    }
+
+    /// `G92` with its axis words (`X`, `Y`, `Z`), `G92.1`, `G92.2` or `G92.3`.
+    fn offset_code(
+        &mut self,
+        code: OffsetCode,
+        [x, y, z]: [Option<Word>; 3],
+        unit: f64,
+        line: usize,
+        column: usize,
+    ) -> Result<(), GcodeReadError> {
+        match code {
+            OffsetCode::Set => {
+                if x.is_none() && y.is_none() && z.is_none() {
+                    return Err(GcodeReadError::UnsupportedCode {
+                        line,
+                        column,
+                        code: "G92 without axis words".into(),
+                    });
+                }
+                if let Some(x) = x {
+                    self.offset.x = self.at.x - x.value * unit;
+                }
+                if let Some(y) = y {
+                    self.offset.y = self.at.y - y.value * unit;
+                }
+                self.saved_offset = self.offset;
+            }
+            OffsetCode::Cancel => {
+                self.offset = Point::new(0.0, 0.0);
+                self.saved_offset = self.offset;
+            }
+            OffsetCode::Suspend => self.offset = Point::new(0.0, 0.0),
+            OffsetCode::Restore => self.offset = self.saved_offset,
+        }
+        Ok(())
     }
 
     fn feed_span(&mut self, span: Span, line: usize) {
@@ -946,7 +1128,7 @@ impl State<'_> {
                 } else {
                     self.options.compensation_radius.ok_or_else(|| {
                         problem(
-                            "G41/G42 take the kerf from the tool table: give the reader the radius",
+                            "G41/G42 take the radius from the controller's tool table: give it (--compensation-radius MM)",
                         )
                     })?
                 };
@@ -998,9 +1180,31 @@ impl State<'_> {
             return Err(problem("the cancel move must be straight"));
         }
         let c = self.compensation.take().expect("compensation on");
-        let path = c.tool_path(to, line).ok_or_else(|| {
-            problem("the compensated moves do not close a contour that can be offset")
-        })?;
+        let path = match self.options.compensation_model {
+            CompensationModel::ClosedContour => c.tool_path(to, line).ok_or_else(|| {
+                problem("the compensated moves do not close a contour that can be offset")
+            })?,
+            CompensationModel::LinuxCnc => {
+                let ((start, start_line), entry) = c
+                    .from
+                    .zip(c.entry)
+                    .ok_or_else(|| problem("G40 before the start-up move"))?;
+                linuxcnc::tool_path(
+                    c.side,
+                    c.radius,
+                    start,
+                    entry,
+                    &c.section,
+                    to,
+                    (start_line, line),
+                )
+                .map_err(|(problem, line)| GcodeReadError::Compensation {
+                    line,
+                    column: 1,
+                    problem,
+                })?
+            }
+        };
         for (span, line) in path {
             self.motions.push(Motion::Feed {
                 span,

@@ -1,0 +1,287 @@
+//! The reader as a controller reads: small programs with the codes that change the motion's
+//! meaning (`G92` and its companions, inches, incremental moves and arc centres, `R` arcs,
+//! cutter compensation as LinuxCNC models it), each checked against numbers derived by hand
+//! and, where it is installed, against LinuxCNC's interpreter `rs274`.
+
+mod reader_rs274;
+
+use cutroute_gcode::{read_gcode, CompensationModel, Motion, Program, ReadOptions};
+use cutroute_geometry::Point;
+use std::f64::consts::PI;
+
+const SQRT2: f64 = std::f64::consts::SQRT_2;
+
+fn linuxcnc(radius: f64) -> ReadOptions {
+    ReadOptions {
+        compensation_radius: Some(radius),
+        compensation_model: CompensationModel::LinuxCnc,
+        ..ReadOptions::default()
+    }
+}
+
+/// The reader's program agrees with rs274's canonical motion, when rs274 is installed.
+fn agrees_with_rs274(name: &str, text: &str, program: &Program, radius: f64) {
+    let Some(rs274) = reader_rs274::rs274() else {
+        return;
+    };
+    let machine = reader_rs274::run(&rs274, text, radius, false);
+    assert_eq!(machine.error, None, "{name}");
+    assert_eq!(machine.pierces.len(), program.pierce_count(), "{name}");
+    for (a, b) in machine.pierces.iter().zip(program.pierce_points()) {
+        assert!(a.distance(b) < 1e-3, "{name}: pierce {a:?} vs {b:?}");
+    }
+    let tolerance = 1e-4 * program.motions.len() as f64;
+    assert!(
+        (machine.cut - program.cut_length()).abs() < tolerance,
+        "{name}: cut {} by rs274, {} read",
+        machine.cut,
+        program.cut_length()
+    );
+    assert!(
+        (machine.idle - program.idle_length()).abs() < tolerance,
+        "{name}: idle {} by rs274, {} read",
+        machine.idle,
+        program.idle_length()
+    );
+}
+
+/// rs274 refuses the program, when it is installed.
+fn refused_by_rs274(name: &str, text: &str, radius: f64) {
+    let Some(rs274) = reader_rs274::rs274() else {
+        return;
+    };
+    let machine = reader_rs274::run(&rs274, text, radius, false);
+    assert!(machine.error.is_some(), "{name}: rs274 accepts it");
+}
+
+#[test]
+fn g92_offsets_the_coordinates_and_the_head_moves_on_continuously() {
+    let text = "\
+G21 G90
+G0 X10 Y10
+G92 X0 Y0
+M3
+G1 X5 F100
+G1 Y5
+M5
+G92.2
+G0 X0 Y0
+G92.3
+G0 X1 Y1
+G92.1
+G0 X2 Y2
+M2
+";
+    let program = read_gcode(text, &ReadOptions::default()).unwrap();
+    assert_eq!(program.pierce_points(), vec![Point::new(10.0, 10.0)]);
+    assert!((program.cut_length() - 10.0).abs() < 1e-9);
+    // 0 → (10, 10); (15, 15) → (0, 0) with no offset; → (11, 11) restored; → (2, 2) cancelled.
+    let idle = 10.0 * SQRT2 + 15.0 * SQRT2 + 11.0 * SQRT2 + 9.0 * SQRT2;
+    assert!((program.idle_length() - idle).abs() < 1e-9);
+    assert_eq!(program.end, Point::new(2.0, 2.0));
+    agrees_with_rs274("g92", text, &program, 1.0);
+    // The common first line of DXF2GCODE and Inkscape's plasma programs reads as no offset.
+    let dxf2gcode = "G21 G90\nG92 X0 Y0\nG0 X10 Y0\nM3\nG1 X20 F100\nM5\n";
+    let program = read_gcode(dxf2gcode, &ReadOptions::default()).unwrap();
+    assert_eq!(program.pierce_points(), vec![Point::new(10.0, 0.0)]);
+    // G92 needs an axis, and cannot share its block with a motion.
+    for (bad, column) in [("G92\nM2\n", 1), ("G0 G92 X0\nM2\n", 4)] {
+        let error = read_gcode(bad, &ReadOptions::default()).unwrap_err();
+        assert_eq!(error.location(), (1, column), "{bad}: {error}");
+        refused_by_rs274(bad, bad, 1.0);
+    }
+}
+
+#[test]
+fn inches_incremental_moves_and_absolute_centres() {
+    let text = "\
+G20 G91 G90.1
+G0 X1 Y0
+M3
+G2 X1 Y-1 I1 J-1 F10
+G1 X-1
+M5
+G90 G91.1
+G0 X0 Y0
+M3
+G3 X0 Y0 I0.5 J0
+M5
+M2
+";
+    let program = read_gcode(text, &ReadOptions::default()).unwrap();
+    let inch = 25.4;
+    // A quarter of radius 1 in, a line of 1 in, then a full circle of radius 0.5 in.
+    let cut = inch * (PI / 2.0 + 1.0 + PI);
+    assert!(
+        (program.cut_length() - cut).abs() < 1e-9,
+        "{}",
+        program.cut_length()
+    );
+    assert_eq!(program.pierce_count(), 2);
+    agrees_with_rs274("inches", text, &program, 1.0);
+}
+
+#[test]
+fn radius_arcs_short_and_long() {
+    let text = "G21 G90\nG0 X0 Y0\nM3\nG2 X10 Y0 R5 F100\nG3 X0 Y0 R-5\nM5\nM2\n";
+    let program = read_gcode(text, &ReadOptions::default()).unwrap();
+    // Half a turn each way (R 5 over a chord of 10 is a half circle whichever sign).
+    assert!((program.cut_length() - 10.0 * PI).abs() < 1e-9);
+    agrees_with_rs274("r arcs", text, &program, 1.0);
+}
+
+/// A programmed outline with a convex start, concave and convex corners, an arc the tool runs
+/// inside, and a straight cancel move.
+const COMPENSATED: &str = "\
+G21 G90
+G0 X-5 Y-5
+M3
+G41 D1 G1 X0 Y0 F100
+G1 X10 Y0
+G1 X10 Y10
+G1 X5 Y5
+G1 X0 Y10
+G3 X0 Y0 I0 J-5
+G40 G1 X-5 Y-5
+M5
+M2
+";
+
+#[test]
+fn compensation_runs_as_linuxcnc_runs_it() {
+    let program = read_gcode(COMPENSATED, &linuxcnc(1.0)).unwrap();
+    let ends: Vec<Point> = program
+        .motions
+        .iter()
+        .filter_map(|m| match m {
+            Motion::Feed { span, .. } => Some(span.end),
+            _ => None,
+        })
+        .collect();
+    // The start-up move ends perpendicular to itself; an arc about (0, 0) joins the bottom
+    // edge's offset; the concave corner at (10, 0) is the offsets' intersection (9, 1).
+    let h = 0.5 * SQRT2;
+    let expected_first = [
+        Point::new(-h, h),
+        Point::new(0.0, 1.0),
+        Point::new(9.0, 1.0),
+    ];
+    for (e, p) in expected_first.iter().zip(&ends) {
+        assert!(e.distance(*p) < 1e-9, "{ends:?}");
+    }
+    assert!(ends.last().unwrap().distance(Point::new(-5.0, -5.0)) < 1e-9);
+    agrees_with_rs274("compensated", COMPENSATED, &program, 1.0);
+    // To the right, and with the diameter in the program (G42.1 D2): the tool runs outside.
+    let right = COMPENSATED.replace("G41 D1", "G42.1 D2");
+    let program = read_gcode(&right, &linuxcnc(0.0)).unwrap();
+    agrees_with_rs274("right", &right, &program, 1.0);
+}
+
+#[test]
+fn compensation_refuses_what_linuxcnc_refuses() {
+    // The start-up move no longer than the radius.
+    let short = COMPENSATED.replace("G0 X-5 Y-5", "G0 X-0.5 Y-0.5");
+    let error = read_gcode(&short, &linuxcnc(1.0)).unwrap_err();
+    assert!(error.to_string().contains("start-up"), "{error}");
+    refused_by_rs274("short entry", &short, 1.0);
+    // A slot narrower than the tool: its concave corners cannot be reached.
+    let notch = "\
+G21 G90
+G0 X-5 Y-5
+M3
+G41 D1 G1 X0 Y0 F100
+G1 X10 Y0
+G1 X10 Y10
+G1 X5.5 Y10
+G1 X5.5 Y15
+G1 X5 Y15
+G1 X5 Y10
+G1 X0 Y10
+G1 X0 Y0
+G40 G1 X-5 Y-5
+M5
+";
+    let error = read_gcode(notch, &linuxcnc(1.0)).unwrap_err();
+    assert!(error.to_string().contains("gouging"), "{error}");
+    refused_by_rs274("notch", notch, 1.0);
+    // An arc the tool cannot run inside: a hole of radius 2 for a tool of radius 3.
+    let hole =
+        "G21 G90\nG0 X0 Y0\nM3\nG41 D1 G1 X10 Y0 F100\nG3 X10 Y0 I-2 J0\nG40 G1 X0 Y0\nM5\nM2\n";
+    let error = read_gcode(hole, &linuxcnc(3.0)).unwrap_err();
+    assert!(error.to_string().contains("arc"), "{error}");
+    refused_by_rs274("hole", hole, 3.0);
+    // Without a radius for G41 D1, the error says where to give it.
+    let error = read_gcode(COMPENSATED, &ReadOptions::default()).unwrap_err();
+    assert!(
+        error.to_string().contains("--compensation-radius"),
+        "{error}"
+    );
+}
+
+#[test]
+fn headers_comments_and_what_the_reader_leaves_to_the_controller() {
+    // A Fanuc program number, `%` tape marks, `(MSG,…)`, `;` comments, N words.
+    let text = "%\nO1234 (bracket)\n(MSG, load the sheet)\nN10 G21 G90 ; metric\nN20 G0 X1 Y1\nN30 M3\nN40 G1 X2 F100\nN50 M5\n%\n";
+    let program = read_gcode(text, &ReadOptions::default()).unwrap();
+    assert_eq!(program.pierce_count(), 1);
+    assert!((program.cut_length() - 1.0).abs() < 1e-9);
+    // LinuxCNC's subroutines, loops and parameters are refused where they stand.
+    for (bad, column) in [
+        ("o100 repeat [3]\n", 1),
+        ("G1 X#1\n", 5),
+        ("G1 X[1+2]\n", 5),
+    ] {
+        let error = read_gcode(bad, &ReadOptions::default()).unwrap_err();
+        assert_eq!(error.location(), (1, column), "{bad}: {error}");
+        assert!(error.to_string().contains("not supported"), "{error}");
+    }
+}
+
+/// Programs the post-processor writes with `G41.1 D<kerf>` and `G41 D1`: the reader's LinuxCNC
+/// model and rs274 accept and refuse the same ones, and agree on what the accepted ones cut.
+#[test]
+fn written_compensated_programs_read_as_rs274_runs_them() {
+    use cutroute_gcode::{route_gcode, GcodeOptions, KerfCompensation};
+    use cutroute_geometry::{generate_nest, KerfSettings, LeadFitter, LeadShape, LeadSpec, Route};
+    let Some(rs274) = reader_rs274::rs274() else {
+        return;
+    };
+    let settings = KerfSettings {
+        kerf: 2.0,
+        pierce_clearance: 3.0,
+        switch_off_clearance: 1.0,
+        lead_in: LeadSpec::new(LeadShape::Line, 4.0),
+        lead_out: LeadSpec::new(LeadShape::Line, 2.0),
+        overcut: 1.0,
+        ..KerfSettings::default()
+    };
+    let mut compared = 0;
+    for seed in [4, 7] {
+        let nest = generate_nest(12, seed);
+        let origin = Point::new(0.0, 0.0);
+        let route = Route::innermost_first(&nest, origin, Some(origin));
+        let route = LeadFitter::new(&nest, settings).attach(&route).unwrap();
+        for compensation in [
+            KerfCompensation::ControllerDiameter,
+            KerfCompensation::ControllerRegister(1),
+        ] {
+            let options = GcodeOptions {
+                kerf_compensation: compensation,
+                ..GcodeOptions::default()
+            };
+            let text = route_gcode(&nest, &route, &options).unwrap();
+            let name = format!("seed {seed} {compensation:?}");
+            let machine = reader_rs274::run(&rs274, &text, 1.0, false);
+            let read = read_gcode(&text, &linuxcnc(1.0));
+            match (&machine.error, &read) {
+                (None, Ok(program)) => {
+                    agrees_with_rs274(&name, &text, program, 1.0);
+                    compared += 1;
+                }
+                (Some(_), Err(_)) => {}
+                (e, r) => panic!("{name}: rs274 {e:?}, reader {:?}", r.as_ref().err()),
+            }
+        }
+    }
+    assert!(compared > 0, "no program was accepted by both");
+}
