@@ -107,7 +107,9 @@ pub use domain::{DomainError, NestDomainError, MAX_BULGE, MAX_COORDINATE, MIN_CO
 pub use forest::ContainmentForest;
 pub use generator::generate_nest;
 pub use kerf::{clearance, equidistant, in_clear_scrap, OffsetError};
-pub use kerf_clearance::{kerf_overlaps, ContourSpans, KerfOverlap, PartsTooClose, TooClose};
+pub use kerf_clearance::{
+    contours_on_one_another, kerf_overlaps, ContourSpans, KerfOverlap, PartsTooClose, TooClose,
+};
 pub use leads::{
     chain_spans, opened_at, place_tabs, KerfField, KerfRange, KerfRangeError, KerfSettings,
     LeadError, LeadFitter, LeadProblem, LeadShape, LeadSpec, StepLeads, Tab, TabSpec,

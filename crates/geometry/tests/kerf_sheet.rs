@@ -1,11 +1,12 @@
 //! Pierce points on the sheet and parts on the right side: the lead fitter keeps M and M* on
 //! the sheet (at least d₁, d₂ inside its border), the route checkers refuse a pierce off it,
-//! contours lying on one another are parts closer than the kerf, and the kerf settings are held
-//! to one table of ranges.
+//! contours lying on one another are found, and the kerf settings are held to one table of
+//! ranges.
 
 use cutroute_geometry::{
-    kerf_overlaps, place_tabs, Contour, ContourRef, KerfField, KerfSettings, LeadFitter,
-    LeadProblem, LeadShape, LeadSpec, Nest, Part, Point, Route, RouteError, TabSpec, Vertex,
+    contours_on_one_another, kerf_overlaps, place_tabs, Contour, ContourRef, KerfField,
+    KerfSettings, LeadFitter, LeadProblem, LeadShape, LeadSpec, Nest, Part, Point, Route,
+    RouteError, TabSpec, Vertex,
 };
 
 /// A clockwise (outer) square with its lower left corner at (x, y).
@@ -163,10 +164,10 @@ fn a_part_on_the_sheets_edge_is_pierced_on_the_sheet() {
 }
 
 /// A part lying exactly in a hole of its own shape, and two identical parts on top of each
-/// other, are parts closer than the kerf: their cut round one runs kerf/2 from the other on
-/// its far side, which the cut's distance alone does not see.
+/// other: the cut round one runs kerf/2 from the other on its far side, which the kerf's own
+/// test does not see; `contours_on_one_another` finds both pairs.
 #[test]
-fn coincident_contours_are_parts_closer_than_the_kerf() {
+fn coincident_contours_are_found() {
     let plate = part(
         "plate",
         vec![square(0.0, 0.0, 100.0), square(30.0, 30.0, 20.0)],
@@ -177,7 +178,9 @@ fn coincident_contours_are_parts_closer_than_the_kerf() {
         parts: vec![plate, slug],
     };
     in_its_hole.normalize_orientation();
-    let pairs = kerf_overlaps(&in_its_hole, 1.0, in_its_hole.check_tolerance());
+    // The kerf's own test does not see it (the cut keeps kerf/2 on the far side).
+    assert!(kerf_overlaps(&in_its_hole, 1.0, in_its_hole.check_tolerance()).is_empty());
+    let pairs = contours_on_one_another(&in_its_hole, 1.0, in_its_hole.check_tolerance());
     assert_eq!(pairs.len(), 1, "{pairs:?}");
     let parts = [pairs[0].contour.part, pairs[0].other.part];
     assert!(parts.contains(&0) && parts.contains(&1), "{pairs:?}");
@@ -191,9 +194,9 @@ fn coincident_contours_are_parts_closer_than_the_kerf() {
         ],
     };
     stacked.normalize_orientation();
-    let pairs = kerf_overlaps(&stacked, 1.0, stacked.check_tolerance());
+    let pairs = contours_on_one_another(&stacked, 1.0, stacked.check_tolerance());
     assert_eq!(pairs.len(), 1, "{pairs:?}");
-    // Apart by more than the kerf, nothing is reported; without kerf, nothing either.
+    // Apart, nothing is reported.
     let mut apart = Nest {
         sheet: None,
         parts: vec![
@@ -203,7 +206,7 @@ fn coincident_contours_are_parts_closer_than_the_kerf() {
     };
     apart.normalize_orientation();
     assert!(kerf_overlaps(&apart, 1.0, apart.check_tolerance()).is_empty());
-    assert!(kerf_overlaps(&stacked, 0.0, stacked.check_tolerance()).is_empty());
+    assert!(contours_on_one_another(&apart, 1.0, apart.check_tolerance()).is_empty());
 }
 
 #[test]
