@@ -827,12 +827,27 @@ impl Job for AoeJob {
             Some(Ok(solved)) => Some(solved),
             _ => None,
         };
-        // A checked route waiting for its plan bound is shown (without the bound): a job
-        // stopped in that step keeps it.
+        // A checked route waiting for its plan bound is shown, so a job stopped in that step
+        // (a long one on large plans) keeps it, with the part of the bound that costs nothing:
+        // the plan's length cut once and the trail pierces, no idle travel.
         let waiting = match (&self.outcome, self.solving.outcome()) {
             (None, Some(Ok(solution))) => Some(solution),
             _ => None,
         };
+        let interim = waiting.and_then(|solution| {
+            let plan = self.solving.plan()?;
+            let edges = plan.graph().edge_count();
+            let length: f64 = (0..edges)
+                .flat_map(|e| plan.edge_spans(e).iter())
+                .map(|s| s.length())
+                .sum();
+            let tolerance = self.options.plan.tolerance;
+            let cut = (length - 4.0 * tolerance * edges as f64).max(0.0);
+            Some(
+                self.objective
+                    .value(&self.machine, cut, 0.0, solution.pierce_lower_bound),
+            )
+        });
         let phase = match &self.outcome {
             None => match self.solving.stage() {
                 AoeStage::Building => Phase::CommonEdgeGraph,
@@ -848,7 +863,10 @@ impl Job for AoeJob {
             },
         };
         let route = solved.map(|(s, _)| &s.route).or(waiting.map(|s| &s.route));
-        let idle_lower_bound = solved.and_then(|(_, b)| b.as_ref()).map(|b| b.idle_length);
+        let idle_lower_bound = solved
+            .and_then(|(_, b)| b.as_ref())
+            .map(|b| b.idle_length)
+            .or(interim.map(|_| 0.0));
         Progress {
             job_id: self.job_id,
             elapsed_s: self.started.elapsed().as_secs_f64(),
@@ -863,7 +881,8 @@ impl Job for AoeJob {
                 }),
                 lower: solved
                     .and_then(|(_, b)| b.as_ref())
-                    .map(|b| b.trail_route(self.objective, &self.machine)),
+                    .map(|b| b.trail_route(self.objective, &self.machine))
+                    .or(interim),
                 unit: self.objective.unit(),
             },
             phase,
