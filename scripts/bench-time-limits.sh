@@ -47,7 +47,8 @@ def contour_file(name, points):
     path = [[x, y, 0] for x, y in points]
     path.append(path[0])
     with open(f"{out}/{name}", "w") as f:
-        json.dump([{"partid": name, "paths": [path]}], f)
+        # (The first element is the sheet: none here.)
+        json.dump([{"partid": "no sheet", "paths": []}, {"partid": name, "paths": [path]}], f)
 for n in (20000, 200000):
     contour_file(f"circle-{n}.dbs.json",
                  [(500 + 400 * math.cos(2 * math.pi * k / n), 500 + 400 * math.sin(2 * math.pi * k / n)) for k in range(n)])
