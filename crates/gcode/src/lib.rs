@@ -53,7 +53,7 @@ mod write;
 #[cfg(doc)]
 use cutroute_geometry::Toolpath;
 
-pub use preset::{GcodePreset, UnknownPreset};
+pub use preset::{GcodePreset, UnknownPreset, UnsupportedCompensation};
 pub use read::{read_gcode, GcodeReadError, Motion, Program, ReadOptions};
 pub use write::{
     path_route_gcode, route_gcode, write_gcode, ArcOutput, DistanceMode, DwellFormat, GcodeError,
