@@ -8,7 +8,8 @@
 #   - trunk and wasm-bindgen-cli at the exact versions the project pins;
 #   - wasm-opt (binaryen from npm, run by Node; the version Trunk.toml pins) for the release build;
 #   - Firefox ESR (Debian) for the single-file page's test in a second browser;
-#   - playwright-core and ws (npm; they drive the system browsers, they never download one).
+#   - playwright-core and ws (npm; they drive the system browsers, they never download one);
+#   - LinuxCNC's standalone interpreter rs274, unpacked outside the clone (scripts/install-rs274.sh).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -72,4 +73,6 @@ if [ ! -d tests/e2e/node_modules/playwright-core ] || [ ! -d tests/e2e/node_modu
   log "npm ci (tests/e2e)"
   (cd tests/e2e && PLAYWRIGHT_SKIP_BROWSER_DOWNLOAD=1 npm ci --no-audit --no-fund --silent)
 fi
+# LinuxCNC's standalone interpreter, the G-code tests' referee (crates/gcode/tests/linuxcnc.rs).
+scripts/install-rs274.sh
 log "ready (wasm std: $wasm_mode)"

@@ -1118,6 +1118,15 @@ impl GcodeArgs {
                 }
             },
         };
+        // The controller of the preset in force must have the compensation code asked for.
+        let preset = self
+            .preset
+            .map(|p| p.0)
+            .or_else(|| profile?.gcode_preset.as_deref()?.parse().ok())
+            .unwrap_or(cutroute_gcode::GcodePreset::Generic);
+        preset
+            .check_compensation(options.kerf_compensation)
+            .map_err(|e| e.to_string())?;
         Ok(options)
     }
 }

@@ -53,7 +53,7 @@ mod write;
 #[cfg(doc)]
 use cutroute_geometry::Toolpath;
 
-pub use preset::{GcodePreset, UnknownPreset};
+pub use preset::{GcodePreset, UnknownPreset, UnsupportedCompensation};
 pub use read::{
     closed_loop_start, read_gcode, CompensationModel, GcodeReadError, Motion, Program, ReadOptions,
 };

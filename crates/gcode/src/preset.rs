@@ -30,7 +30,7 @@
 use cutroute_geometry::MachineParameters;
 
 use crate::read::ReadOptions;
-use crate::write::{ArcOutput, DistanceMode, DwellFormat, GcodeOptions};
+use crate::write::{ArcOutput, DistanceMode, DwellFormat, GcodeOptions, KerfCompensation};
 
 /// A named G-code dialect.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -60,6 +60,14 @@ pub enum GcodePreset {
     /// integer coordinates seem to be 0.1 mm units, but nothing states it, so this preset
     /// writes millimetres with one decimal under an explicit `G21`, which a controller that
     /// does not know `G21` refuses rather than misreads; check the unit on the machine.
+    ///
+    /// One decimal cannot hold most arcs: rounded to 0.1 mm, an arc's end is up to 0.14 mm
+    /// off its circle, beyond what controllers accept (0.002 mm or 0.1 % of the radius, which
+    /// the writer keeps to). Such arcs are written as `G01` chords within 0.05 mm of the arc
+    /// (half the last digit); arcs whose rounded ends still fit a written centre stay arcs.
+    ///
+    /// Like every incremental program, it starts with an absolute `G90 G00 X… Y…` to the
+    /// route's start before `G91`, so the first move does not depend on where the head stands.
     Kometa2p32m,
 }
 
@@ -153,6 +161,43 @@ impl GcodePreset {
         }
     }
 
+    /// The cutter compensation codes the preset's controller has, as written in a program:
+    ///
+    /// | preset | codes | why |
+    /// |---|---|---|
+    /// | generic, qtplasmac | `G41`/`G42 D<n>`, `G41.1`/`G42.1 D<diameter>` | LinuxCNC's |
+    /// | mach3-plasma | `G41`/`G42 D<n>` | Mach3 has no `G41.1` |
+    /// | fanuc | `G41`/`G42 D<n>` | `G41.1` is normal-direction control there, no offset |
+    /// | grbl-laser | none | GRBL 1.1 has no cutter compensation |
+    /// | kometa-2p32m | none | nothing known of the 2P32M's compensation |
+    ///
+    /// The writer uses the left-hand codes (`G41`, `G41.1`): the scrap is left of the cut.
+    pub fn compensation_codes(self) -> &'static [&'static str] {
+        match self {
+            GcodePreset::Generic | GcodePreset::QtPlasmac => &["G41", "G42", "G41.1", "G42.1"],
+            GcodePreset::Mach3Plasma | GcodePreset::Fanuc => &["G41", "G42"],
+            GcodePreset::GrblLaser | GcodePreset::Kometa2p32m => &[],
+        }
+    }
+
+    /// `Ok` when the preset's controller has the code `compensation` writes, else the refusal
+    /// naming the preset.
+    pub fn check_compensation(
+        self,
+        compensation: KerfCompensation,
+    ) -> Result<(), UnsupportedCompensation> {
+        let code = match compensation {
+            KerfCompensation::InProgram => return Ok(()),
+            KerfCompensation::ControllerDiameter => "G41.1",
+            KerfCompensation::ControllerRegister(_) => "G41",
+        };
+        if self.compensation_codes().contains(&code) {
+            Ok(())
+        } else {
+            Err(UnsupportedCompensation { preset: self, code })
+        }
+    }
+
     /// How the project's reader reads this dialect back (torch codes, dwell unit).
     pub fn read_options(self) -> ReadOptions {
         let defaults = ReadOptions::default();
@@ -176,6 +221,23 @@ impl GcodePreset {
 impl std::fmt::Display for GcodePreset {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(self.name())
+    }
+}
+
+/// Controller compensation asked of a preset whose controller lacks its code.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("the {preset} preset's controller has no {code} cutter compensation ({}); compensate the kerf in the program instead", available(*.preset))]
+pub struct UnsupportedCompensation {
+    /// The preset.
+    pub preset: GcodePreset,
+    /// The code the compensation would write.
+    pub code: &'static str,
+}
+
+fn available(preset: GcodePreset) -> String {
+    match preset.compensation_codes() {
+        [] => "it has none".into(),
+        codes => format!("it has {}", codes.join(", ")),
     }
 }
 

@@ -226,6 +226,14 @@ pub enum GcodeError {
         /// Index of the route step.
         step: usize,
     },
+    /// The controller's start-up move cannot bring the compensated tool onto the route's
+    /// lead-in and equidistant (the pierce point is too close to the contour, or the entry is
+    /// not on the scrap side, left of the cut).
+    #[error("route step {step}: kerf compensation by the controller cannot start on the route's lead-in here (the pierce is too close to the contour); compensate in the program instead")]
+    CompensationEntry {
+        /// Index of the route step.
+        step: usize,
+    },
 }
 
 /// Writes `toolpath` as a G-code program.
@@ -328,10 +336,15 @@ fn compensated_toolpath(
             KerfCompensation::ControllerRegister(n) => format!("G41 D{n}"),
             _ => format!("G41.1 D{:.*}", decimals, 2.0 * leads.offset),
         };
-        codes.push((moves.len(), on));
-        push(&mut moves, Span::line(leads.pierce, start));
         let round = cutroute_geometry::opened_at(contour, start, 1e-9);
-        round.iter().for_each(|&span| push(&mut moves, span));
+        let entry = round
+            .first()
+            .and_then(|first| controller_entry(leads.pierce, leads.entry, *first, leads.offset))
+            .ok_or(GcodeError::CompensationEntry { step })?;
+        codes.push((moves.len(), on));
+        push(&mut moves, Span::line(leads.pierce, entry.0));
+        push(&mut moves, entry.1);
+        round[1..].iter().for_each(|&span| push(&mut moves, span));
         if leads.overcut > 0.0 {
             // On along the contour to the point under the exit.
             let along = |p: Point| {
@@ -359,6 +372,91 @@ fn compensated_toolpath(
         },
         codes,
     ))
+}
+
+/// The programmed start-up move's end and the first span that follows it, for a controller
+/// that compensates the kerf, such that the compensated tool runs straight from `pierce` to the
+/// route's `entry` (`radius` left of the contour's `first` span, at its start) and on along the
+/// equidistant.
+///
+/// LinuxCNC keeps the tool `radius` left of each programmed move, and where the start-up move
+/// meets the next move in a concave corner the tool turns where their offsets cross. So the
+/// start-up move ends on the first span extended back before its start (its line, or its
+/// circle), at the point whose start-up line's offset passes through `entry`, and the first
+/// span is programmed from there. `None` when `entry` is not left of the span's start or the
+/// pierce is too close to the contour for such a point.
+fn controller_entry(
+    pierce: Point,
+    entry: Point,
+    first: Span,
+    radius: f64,
+) -> Option<(Point, Span)> {
+    let c = first.start;
+    let t = first.tangent_at(0.0);
+    let norm = t.x.hypot_libm(t.y);
+    if radius <= 0.0 || norm <= 0.0 || first.length() <= 0.0 {
+        return None;
+    }
+    let u = (t.x / norm, t.y / norm);
+    let left = Point::new(c.x - radius * u.1, c.y + radius * u.0);
+    if left.distance(entry) > 1e-6 {
+        return None;
+    }
+    // The point `b` mm back along the first span's own line or circle, and the span from it.
+    let back = |b: f64| -> (Point, Span) {
+        match first.centre() {
+            None => {
+                let p = Point::new(c.x - b * u.0, c.y - b * u.1);
+                (p, Span::line(p, first.end))
+            }
+            Some(o) => {
+                let r = first.radius();
+                let turn = if first.bulge > 0.0 { -b / r } else { b / r };
+                let (dx, dy) = (c.x - o.x, c.y - o.y);
+                let (sin, cos) = turn.sin_cos_libm();
+                let p = Point::new(o.x + dx * cos - dy * sin, o.y + dx * sin + dy * cos);
+                let sweep = first.sweep() - turn;
+                (p, Span::new(p, first.end, (sweep / 4.0).tan_libm()))
+            }
+        }
+    };
+    // Signed distance of the entry left of the start-up line to `back(b)`, less the radius.
+    let miss = |b: f64| {
+        let (p, _) = back(b);
+        let (dx, dy) = (p.x - pierce.x, p.y - pierce.y);
+        let d = dx.hypot_libm(dy);
+        if d <= 2.0 * radius {
+            return f64::NAN;
+        }
+        (dx * (entry.y - p.y) - dy * (entry.x - p.x)) / d - radius
+    };
+    let at_start = miss(0.0);
+    if at_start.is_nan() || at_start > 0.0 {
+        return None;
+    }
+    // Along a circle, at most a quarter of it back; along a line, as far as needed.
+    let limit = first.centre().map_or(1e6, |_| 0.5 * PI * first.radius());
+    let (mut lo, mut hi) = (0.0, radius.min(limit));
+    loop {
+        let m = miss(hi);
+        if m > 0.0 {
+            break;
+        }
+        if m.is_nan() || hi >= limit {
+            return None;
+        }
+        lo = hi;
+        hi = (2.0 * hi).min(limit);
+    }
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if miss(mid) < 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    Some(back(0.5 * (lo + hi)))
 }
 
 /// Writes a route of tool-on paths (segment cutting, AOE-chains), with a comment numbering
@@ -737,7 +835,8 @@ impl<'a> Writer<'a> {
     /// agree within [`ARC_RADIUS_TOLERANCE_MM`] or [`ARC_RADIUS_TOLERANCE_REL`]; `None` when
     /// no such point exists.
     fn written_centre(&self, rounded: (i64, i64), end: (i64, i64)) -> Option<(i64, i64)> {
-        let radius = |p: (i64, i64), c: (i64, i64)| ((p.0 - c.0) as f64).hypot((p.1 - c.1) as f64);
+        let radius =
+            |p: (i64, i64), c: (i64, i64)| ((p.0 - c.0) as f64).hypot_libm((p.1 - c.1) as f64);
         let mismatch = |c: (i64, i64)| {
             let (r1, r2) = (radius(self.at, c), radius(end, c));
             let d = (r1 - r2).abs() / self.scale;
@@ -797,7 +896,7 @@ impl<'a> Writer<'a> {
                 };
                 let r = self.quantize(span.radius())?;
                 let (dx, dy) = (target.0 - self.at.0, target.1 - self.at.1);
-                let half_chord = 0.5 * (dx as f64).hypot(dy as f64);
+                let half_chord = 0.5 * (dx as f64).hypot_libm(dy as f64);
                 if half_chord >= r as f64 {
                     // The rounded radius cannot reach between the rounded ends.
                     return self.chords(span, self.rounding_chord_tolerance());

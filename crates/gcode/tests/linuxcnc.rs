@@ -1,0 +1,427 @@
+//! LinuxCNC's own interpreter (`rs274`, installed by `scripts/install-rs274.sh`) runs the
+//! programs the writer makes, and its tool-centre motion must be the route's: the same pierce
+//! points, cut and rapid lengths, every cut traced within 0.01 mm (plus the written resolution),
+//! whatever the machine's position before the program.
+//!
+//! Every preset whose codes LinuxCNC knows is run as written. The «Комета» preset's torch codes
+//! (`M71`/`M74 T1`) mean other things to LinuxCNC, so its programs run with `M03`/`M05` in
+//! their place: the interpreter still checks its coordinates (one decimal, incremental).
+
+#[path = "support/canon.rs"]
+mod canon;
+
+use std::path::PathBuf;
+
+use cutroute_engine::open_document;
+use cutroute_gcode::{
+    route_gcode, ArcOutput, DistanceMode, GcodeOptions, GcodePreset, KerfCompensation,
+};
+use cutroute_geometry::{
+    generate_nest, BoundingBox, KerfSettings, LeadFitter, LeadShape, LeadSpec, MachineParameters,
+    Nest, Point, Route, Span, ToolMove, Toolpath,
+};
+use cutroute_protocol::Problem;
+
+/// A machine position the programs must not depend on: the interpreter stands here first.
+const ELSEWHERE: &str = "G21 G90 G00 X-41.3 Y27.9\n";
+
+fn data(relative: &str) -> Vec<u8> {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../data")
+        .join(relative);
+    std::fs::read(&path).unwrap_or_else(|e| panic!("missing test file {}: {e}", path.display()))
+}
+
+fn nest_of(relative: &str) -> Option<Nest> {
+    let name = relative.rsplit('/').next().unwrap_or(relative);
+    let document = open_document(name, &data(relative)).ok()?;
+    match document.problem {
+        Problem::Nest { nest, .. } if !nest.parts.is_empty() => Some(nest),
+        _ => None,
+    }
+}
+
+/// The baseline route from the corner of the nest's bounding box (often a contour's vertex,
+/// and so the first pierce point).
+fn route_of(nest: &Nest) -> Route {
+    let mut bbox = BoundingBox::EMPTY;
+    for contour in nest.parts.iter().flat_map(|p| &p.contours) {
+        let b = contour.bounding_box();
+        bbox.min = Point::new(bbox.min.x.min(b.min.x), bbox.min.y.min(b.min.y));
+        bbox.max = Point::new(bbox.max.x.max(b.max.x), bbox.max.y.max(b.max.y));
+    }
+    let start = bbox.min;
+    Route::innermost_first(nest, start, Some(start))
+}
+
+fn with_leads(nest: &Nest, route: &Route, lead_in: LeadShape) -> Option<Route> {
+    let settings = KerfSettings {
+        kerf: 1.0,
+        pierce_clearance: 2.0,
+        switch_off_clearance: 1.0,
+        lead_in: LeadSpec::new(lead_in, 3.0),
+        lead_out: LeadSpec::new(LeadShape::Line, 2.0),
+        overcut: 0.5,
+        ..KerfSettings::default()
+    };
+    LeadFitter::new(nest, settings).attach(route).ok()
+}
+
+/// The groups of cutting spans between torch-ons, and the rapid length after the first
+/// torch-on, of the expected tool-centre path.
+fn expected_groups(path: &Toolpath) -> (Vec<Point>, Vec<Vec<Span>>, f64) {
+    let (mut pierces, mut groups, mut rapid) = (Vec::new(), Vec::<Vec<Span>>::new(), 0.0);
+    for m in &path.moves {
+        match *m {
+            ToolMove::Pierce { at, .. } => {
+                pierces.push(at);
+                groups.push(Vec::new());
+            }
+            ToolMove::Idle { from, to } if !pierces.is_empty() => rapid += from.distance(to),
+            ToolMove::Cut { span, .. } => {
+                if let Some(g) = groups.last_mut() {
+                    g.push(span);
+                }
+            }
+            _ => {}
+        }
+    }
+    (pierces, groups, rapid)
+}
+
+fn run_groups(run: &canon::Run) -> Result<(Vec<Vec<Span>>, f64), String> {
+    let mut groups = vec![Vec::<Span>::new(); run.torch_on_at.len()];
+    let mut rapid = 0.0;
+    for m in &run.motions {
+        if m.rapid {
+            if m.tool_on {
+                return Err(format!("a rapid with the torch on: {:?}", m.span));
+            }
+            if m.torch_ons > 0 {
+                rapid += m.span.length();
+            }
+        } else if m.tool_on {
+            groups[m.torch_ons - 1].push(m.span);
+        } else if m.span.length() > 1e-9 {
+            return Err(format!("a feed move with the torch off: {:?}", m.span));
+        }
+    }
+    Ok((groups, rapid))
+}
+
+fn distance_to(spans: &[Span], p: Point) -> f64 {
+    spans
+        .iter()
+        .map(|s| s.distance_to(p))
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// The largest distance from a point of `a` (sampled every `step` mm) to `b`.
+fn one_sided(a: &[Span], b: &[Span], step: f64) -> f64 {
+    let mut worst: f64 = 0.0;
+    for s in a {
+        let n = (s.length() / step).ceil().max(1.0) as usize;
+        for k in 0..=n {
+            worst = worst.max(distance_to(b, s.point_at(k as f64 / n as f64)));
+        }
+    }
+    worst
+}
+
+/// Compares the interpreter's run of a program with the expected tool-centre path.
+fn agree(path: &Toolpath, run: &canon::Run, tolerance: f64) -> Result<(), String> {
+    let (pierces, expected, rapid) = expected_groups(path);
+    if run.torch_on_at.len() != pierces.len() {
+        return Err(format!(
+            "{} torch-ons, the route has {} pierces",
+            run.torch_on_at.len(),
+            pierces.len()
+        ));
+    }
+    for (k, (a, b)) in run.torch_on_at.iter().zip(&pierces).enumerate() {
+        if a.distance(*b) > tolerance {
+            return Err(format!("pierce {k} at {a:?}, the route's at {b:?}"));
+        }
+    }
+    let (groups, run_rapid) = run_groups(run)?;
+    let cut = |g: &[Vec<Span>]| g.iter().flatten().map(Span::length).sum::<f64>();
+    let (want, got) = (cut(&expected), cut(&groups));
+    if (want - got).abs() > 2e-3 * want + 0.05 {
+        return Err(format!("cuts {got:.4} mm, the route {want:.4} mm"));
+    }
+    if (rapid - run_rapid).abs() > 2e-3 * rapid + 0.05 {
+        return Err(format!("rapids {run_rapid:.4} mm, the route {rapid:.4} mm"));
+    }
+    for (k, (e, g)) in expected.iter().zip(&groups).enumerate() {
+        let step = 1.0;
+        let off = one_sided(g, e, step).max(one_sided(e, g, step));
+        if off > tolerance {
+            return Err(format!(
+                "cut {k} (pierced at {:?}) leaves the route by {off:.4} mm",
+                pierces[k]
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// What a case is: the program's options and the route's expected tool-centre path.
+struct Case {
+    what: String,
+    options: GcodeOptions,
+    route: Route,
+    tool_diameter: f64,
+}
+
+/// The tolerance of the trace: 0.01 mm plus what rounding and chords may add.
+fn tolerance(options: &GcodeOptions) -> f64 {
+    let quantum = 10f64.powi(-(options.decimals as i32));
+    let chords = match options.arcs {
+        ArcOutput::Lines { tolerance_mm } => tolerance_mm,
+        _ => 0.0,
+    };
+    // A written point is within half a quantum of its true place on each axis, and an arc the
+    // resolution cannot hold is written as chords within half a quantum.
+    0.01 + (0.5f64.sqrt() + 0.5) * quantum + chords
+}
+
+/// Runs the cases; returns the failures (refused by the writer counts as agreeing only when it
+/// says why, which every `GcodeError` does).
+fn referee(nest: &Nest, cases: Vec<Case>) -> (usize, usize, Vec<String>) {
+    let rs274 = canon::rs274().expect("rs274");
+    let (mut accepted, mut refused, mut failures) = (0, 0, Vec::new());
+    for case in cases {
+        let program = match route_gcode(nest, &case.route, &case.options) {
+            Ok(p) => p,
+            Err(e) => {
+                refused += 1;
+                eprintln!("{}: refused before writing: {e}", case.what);
+                continue;
+            }
+        };
+        let program = format!("{ELSEWHERE}{program}");
+        let path = Toolpath::new(&case.route, nest).expect("toolpath");
+        let result = canon::run(&rs274, &program, case.tool_diameter, &case.what)
+            .and_then(|run| agree(&path, &run, tolerance(&case.options)));
+        match result {
+            Ok(()) => accepted += 1,
+            Err(e) => failures.push(format!("{}: {e}", case.what)),
+        }
+    }
+    (accepted, refused, failures)
+}
+
+/// The preset's options as LinuxCNC can run them (see the module notes on «Комета»).
+fn runnable(preset: GcodePreset) -> GcodeOptions {
+    let mut options = preset.options(&MachineParameters::default());
+    if preset == GcodePreset::Kometa2p32m {
+        options.torch_on = "M03".into();
+        options.torch_off = "M05".into();
+        options.header.clear();
+        options.footer = vec!["M30".into()];
+    }
+    options
+}
+
+fn option_variants(base: &GcodeOptions) -> Vec<(&'static str, GcodeOptions)> {
+    let with = |f: &dyn Fn(&mut GcodeOptions)| {
+        let mut o = base.clone();
+        f(&mut o);
+        o
+    };
+    vec![
+        ("as is", base.clone()),
+        ("ij", with(&|o| o.arcs = ArcOutput::CentreOffsets)),
+        ("r", with(&|o| o.arcs = ArcOutput::Radius)),
+        (
+            "lines",
+            with(&|o| o.arcs = ArcOutput::Lines { tolerance_mm: 0.01 }),
+        ),
+        (
+            "incremental",
+            with(&|o| o.distance_mode = DistanceMode::Incremental),
+        ),
+        (
+            "absolute",
+            with(&|o| o.distance_mode = DistanceMode::Absolute),
+        ),
+        ("line numbers", with(&|o| o.line_numbers = true)),
+        ("decimals 1", with(&|o| o.decimals = 1)),
+        ("decimals 4", with(&|o| o.decimals = 4)),
+        (
+            "decimals 1 r",
+            with(&|o| {
+                o.decimals = 1;
+                o.arcs = ArcOutput::Radius;
+            }),
+        ),
+    ]
+}
+
+#[test]
+fn every_preset_and_option_runs_on_linuxcnc_as_reported() {
+    if canon::rs274().is_none() {
+        return;
+    }
+    let mut total = (0, 0, Vec::new());
+    for relative in ["nests/dbs/nested.dbs", "nests/dxf/kompas.dxf"] {
+        let nest = nest_of(relative).expect("the nest opens");
+        let bare = route_of(&nest);
+        let leads = with_leads(&nest, &bare, LeadShape::Arc).expect("leads fit");
+        let mut cases = Vec::new();
+        for preset in GcodePreset::ALL {
+            for (name, options) in option_variants(&runnable(preset)) {
+                cases.push(Case {
+                    what: format!("{relative} {preset} {name}"),
+                    options: options.clone(),
+                    route: bare.clone(),
+                    tool_diameter: 1.0,
+                });
+                cases.push(Case {
+                    what: format!("{relative} {preset} {name} kerf+leads"),
+                    options,
+                    route: leads.clone(),
+                    tool_diameter: 1.0,
+                });
+            }
+        }
+        let (a, r, f) = referee(&nest, cases);
+        total.0 += a;
+        total.1 += r;
+        total.2.extend(f);
+    }
+    eprintln!(
+        "rs274: {} agree, {} refused before writing, {} differ",
+        total.0,
+        total.1,
+        total.2.len()
+    );
+    assert!(total.2.is_empty(), "{}", total.2.join("\n"));
+}
+
+#[test]
+fn controller_compensation_runs_on_linuxcnc_as_reported_or_is_refused() {
+    if canon::rs274().is_none() {
+        return;
+    }
+    let mut total = (0, 0, Vec::new());
+    let mut nests: Vec<(String, Nest)> = ["nests/dbs/nested.dbs", "nests/dbs/seven.dbs"]
+        .into_iter()
+        .map(|relative| {
+            (
+                relative.to_string(),
+                nest_of(relative).expect("the nest opens"),
+            )
+        })
+        .collect();
+    // Generated parts: entries on arcs as well as on lines.
+    nests.push(("generated 30/4".into(), generate_nest(30, 4)));
+    for (relative, nest) in &nests {
+        let nest = nest.clone();
+        let bare = route_of(&nest);
+        let Some(leads) = with_leads(&nest, &bare, LeadShape::Line) else {
+            continue;
+        };
+        let mut cases = Vec::new();
+        for preset in GcodePreset::ALL {
+            for (name, code) in [
+                ("g41.1", KerfCompensation::ControllerDiameter),
+                ("g41:1", KerfCompensation::ControllerRegister(1)),
+            ] {
+                if let Err(e) = preset.check_compensation(code) {
+                    total.1 += 1;
+                    eprintln!("{relative} {preset} {name}: refused before writing: {e}");
+                    continue;
+                }
+                let options = GcodeOptions {
+                    kerf_compensation: code,
+                    ..runnable(preset)
+                };
+                cases.push(Case {
+                    what: format!("{relative} {preset} {name}"),
+                    options,
+                    route: leads.clone(),
+                    tool_diameter: 1.0,
+                });
+            }
+        }
+        let (a, r, f) = referee(&nest, cases);
+        total.0 += a;
+        total.1 += r;
+        total.2.extend(f);
+    }
+    eprintln!(
+        "rs274 (compensation): {} agree, {} refused before writing, {} differ",
+        total.0,
+        total.1,
+        total.2.len()
+    );
+    assert!(total.2.is_empty(), "{}", total.2.join("\n"));
+}
+
+#[test]
+fn shipped_nests_and_real_world_files_run_on_linuxcnc_as_reported() {
+    if canon::rs274().is_none() {
+        return;
+    }
+    let mut files: Vec<String> = [
+        "nests/dbs/seven.dbs",
+        "nests/dbs/test0.json.dbs",
+        "nests/dbs-json/E1X_6_01.dbs.json",
+        "nests/dxf/cone.dxf",
+        "nests/dxf/cross.dxf",
+        "nests/dxf/planka.dxf",
+        "nests/dxf/propeller.dxf",
+        "nests/dxf/square.dxf",
+        "nests/svg/plates.svg",
+    ]
+    .map(String::from)
+    .to_vec();
+    // Every fourth real-world file with closed contours.
+    let csv = String::from_utf8(data("realworld/expected.csv")).expect("utf-8");
+    let closed: Vec<String> = csv
+        .lines()
+        .skip(1)
+        .filter_map(|l| {
+            let mut f = l.split(',');
+            let file = f.next()?;
+            let tight: usize = f.nth(2)?.parse().ok()?;
+            (tight > 0).then(|| format!("realworld/{file}"))
+        })
+        .collect();
+    files.extend(closed.into_iter().step_by(4));
+    let mut total = (0, 0, Vec::new());
+    let mut opened = 0;
+    for relative in &files {
+        let Some(nest) = nest_of(relative) else {
+            continue;
+        };
+        opened += 1;
+        let route = route_of(&nest);
+        let base = GcodeOptions::default();
+        let cases = [DistanceMode::Absolute, DistanceMode::Incremental]
+            .into_iter()
+            .map(|distance_mode| Case {
+                what: format!("{relative} {distance_mode:?}"),
+                options: GcodeOptions {
+                    distance_mode,
+                    ..base.clone()
+                },
+                route: route.clone(),
+                tool_diameter: 1.0,
+            })
+            .collect();
+        let (a, r, f) = referee(&nest, cases);
+        total.0 += a;
+        total.1 += r;
+        total.2.extend(f);
+    }
+    assert!(opened >= 15, "only {opened} files opened");
+    eprintln!(
+        "rs274 (files): {} agree, {} refused before writing, {} differ",
+        total.0,
+        total.1,
+        total.2.len()
+    );
+    assert!(total.2.is_empty(), "{}", total.2.join("\n"));
+}
