@@ -147,7 +147,7 @@ fn no_pierce_point_off_the_sheet_on_parts_at_its_edge() {
 #[test]
 fn no_pierce_point_off_the_sheet_on_a_shipped_nest() {
     assert_eq!(
-        every_solver_every_lead("nests/dbs-json/test1.dbs.json"),
+        every_solver_every_lead("nests/dbs-json/E1X_6_01.dbs.json"),
         SolverKind::ALL.len() * options().len()
     );
 }
