@@ -59,7 +59,7 @@ pub fn conversion_losses(nest: &Nest, file_name: &str, written: &[u8]) -> Vec<Re
         ));
     }
     let relative = (after.perimeter - before.perimeter).abs() / before.perimeter.max(1e-300);
-    if !(relative <= 1e-6) {
+    if relative.is_nan() || relative > 1e-6 {
         out.push(format!(
             "{file_name} reads back with a total perimeter of {:.6} mm instead of {:.6} mm ({:+.4} %)",
             after.perimeter,
@@ -78,7 +78,7 @@ pub fn conversion_losses(nest: &Nest, file_name: &str, written: &[u8]) -> Vec<Re
     ]
     .iter()
     .fold(0.0f64, |m, d| m.max(d.abs()));
-    if !(moved <= 1e-6 * size) {
+    if moved.is_nan() || moved > 1e-6 * size {
         out.push(format!(
             "{file_name} reads back with a bounding box ({:.6}, {:.6})–({:.6}, {:.6}) instead of ({:.6}, {:.6})–({:.6}, {:.6})",
             after.bbox.min.x, after.bbox.min.y, after.bbox.max.x, after.bbox.max.y,

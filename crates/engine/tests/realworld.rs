@@ -100,6 +100,11 @@ fn measures(nest: &Nest) -> (usize, f64, BoundingBox) {
     (count, perimeter, bbox)
 }
 
+/// `a` and `b` differ by at most `tolerance` (false for NaN).
+fn within(a: f64, b: f64, tolerance: f64) -> bool {
+    (a - b).abs() <= tolerance
+}
+
 fn nest_of(document: &Document) -> Option<&Nest> {
     match &document.problem {
         Problem::Nest { nest, .. } => Some(nest),
@@ -146,7 +151,7 @@ fn check_row(row: &Row, outcome: &Result<Document, cutroute_engine::OpenError>) 
             if count != expected {
                 wrong.push(format!("{count} contours, expected {expected}"));
             }
-            if !((perimeter - row.perimeter).abs() <= ORACLE_TOLERANCE * row.perimeter) {
+            if !within(perimeter, row.perimeter, ORACLE_TOLERANCE * row.perimeter) {
                 wrong.push(format!(
                     "perimeter {perimeter:.4}, expected {:.4}",
                     row.perimeter
@@ -172,7 +177,7 @@ fn check_row(row: &Row, outcome: &Result<Document, cutroute_engine::OpenError>) 
                 };
                 if pairs
                     .iter()
-                    .any(|(ours, theirs)| !((ours - theirs).abs() <= ORACLE_TOLERANCE * size))
+                    .any(|&(ours, theirs)| !within(ours, theirs, ORACLE_TOLERANCE * size))
                 {
                     wrong.push(format!(
                         "bbox {:.4} {:.4} {:.4} {:.4}, expected {x0:.4} {y0:.4} {x1:.4} {y1:.4}",

@@ -116,7 +116,8 @@ pub(crate) fn span_data(data: Data, a: Point, z: Point, b: f64) -> Data {
     // An arc whose radius lies beyond the coordinate domain is straight to within
     // chord² / (8 · 1e9) mm, and its radius is a number no reader of the domain accepts
     // (a bulge of 1e-13 gives a radius of 1e13 chords): it is written as the line it is.
-    let too_flat = b != 0.0 && !(Span::new(a, z, b).radius() <= cutroute_geometry::MAX_COORDINATE);
+    let radius = Span::new(a, z, b).radius();
+    let too_flat = b != 0.0 && (radius.is_nan() || radius > cutroute_geometry::MAX_COORDINATE);
     if b == 0.0 || a == z || too_flat {
         return if a.x == z.x {
             data.vertical_line_to(z.y)
