@@ -1581,6 +1581,12 @@ fn route_report(
         "proven_optimal": result.proven_optimal,
         "elapsed_s": result.elapsed_s,
         "final_route_rejected": final_route_rejected,
+        // A path solver whose own route failed the checker answers with this contour route.
+        "fallback": result
+            .alternatives
+            .iter()
+            .find(|a| a.name == cutroute_engine::REJECTED_ROUTE)
+            .and_then(|a| a.failure.clone()),
         "stopped": run.stopped,
     }))
 }

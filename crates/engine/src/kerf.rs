@@ -377,6 +377,7 @@ impl KerfJob {
                 settings,
                 request.params.machine,
                 request.params.objective,
+                (*route_start, *route_finish),
                 start(&over_equidistants)?,
             );
             return Ok(KerfJob {

@@ -15,15 +15,32 @@
 //! once its leads are fitted (a cut within the tolerance of an equidistant may come a little
 //! closer than the equidistant itself): the contours it would burn into are named as contours
 //! without room (the checker reports such cuts as `PathRouteError::CutTooClose`).
+//!
+//! A route with leads that fails the path checker is never the answer: the last one that
+//! passed is kept, and until one has, a contour route (nearest neighbour on the nest, its
+//! leads fitted as for the contour solvers) that passes the route checker. The rejected
+//! route's problem is stated as an alternative named [`REJECTED_ROUTE`].
 
 use cutroute_geometry::{
     ContainmentForest, KerfSettings, LeadError, LeadFitter, LeadProblem, MachineParameters, Nest,
-    Objective, PathRoute, PathRouteError, ToolOnPath,
+    Objective, PathRoute, PathRouteError, Point, Route, ToolOnPath,
 };
-use cutroute_protocol::{Bounds, KerfNote, KerfSource, Phase, Progress, Solution};
+use cutroute_protocol::{Bounds, KerfNote, KerfSource, Phase, Progress, RouteSummary, Solution};
 use web_time::{Duration, Instant};
 
-use crate::{Job, JobStatus};
+use crate::{Job, JobStatus, NearestNeighbourJob};
+
+/// The name of the alternative that states why a path solver's route with leads was set
+/// aside for a checked one (its `failure` says what the checker found).
+pub const REJECTED_ROUTE: &str = "rejected route";
+
+/// The route a path job answers with when its own route with leads fails the checker.
+enum Fallback {
+    /// A route with leads of the solver that passed the checker.
+    Paths(PathRoute),
+    /// A contour route with leads that passed the route checker.
+    Contours(Route),
+}
 
 /// Leads attached to a solver's path route, one path at a time.
 struct Attach {
@@ -84,6 +101,15 @@ pub(crate) struct PathLeadsRun {
     fitted: Option<(PathRoute, Result<PathRoute, Vec<LeadError>>)>,
     /// A newer solver route whose leads are being fitted.
     pending: Option<Attach>,
+    start: Point,
+    finish: Option<Point>,
+    /// The last checked route, once a route with leads has failed the checker (`None` inside
+    /// when no checked route could be made).
+    fallback: Option<Option<Fallback>>,
+    /// The last route with leads that passed the path checker.
+    checked: Option<PathRoute>,
+    /// What the checker found in the last rejected route with leads.
+    failure: Option<String>,
 }
 
 impl PathLeadsRun {
@@ -94,6 +120,7 @@ impl PathLeadsRun {
         settings: KerfSettings,
         machine: MachineParameters,
         objective: Objective,
+        (start, finish): (Point, Option<Point>),
         job: Box<dyn Job>,
     ) -> PathLeadsRun {
         PathLeadsRun {
@@ -106,7 +133,56 @@ impl PathLeadsRun {
             solving: true,
             fitted: None,
             pending: None,
+            start,
+            finish,
+            fallback: None,
+            checked: None,
+            failure: None,
         }
+    }
+
+    /// Records a fitted route's check: a passing one is kept; a failing one is set aside for
+    /// the last passing route, or (none yet) a checked contour route.
+    fn check(&mut self, route: &PathRoute) {
+        let problems = route.problems(&self.nest, self.nest.check_tolerance());
+        // Common edges cut twice are standard cutting, as the CLI allows.
+        let failure = problems
+            .iter()
+            .find(|p| !matches!(p, PathRouteError::Overlap { .. }));
+        match failure {
+            None => {
+                self.checked = Some(route.clone());
+                if self.fallback.is_some() {
+                    self.fallback = Some(Some(Fallback::Paths(route.clone())));
+                }
+            }
+            Some(p) => {
+                self.failure = Some(format!("the route with leads fails the checker: {p}"));
+                let fallback = match &self.checked {
+                    Some(c) => Some(Fallback::Paths(c.clone())),
+                    None => match self.fallback.take() {
+                        Some(Some(f)) => Some(f),
+                        _ => self.contour_route().map(Fallback::Contours),
+                    },
+                };
+                self.fallback = Some(fallback);
+            }
+        }
+    }
+
+    /// A nearest-neighbour contour route of the nest with its leads, if it passes the route
+    /// checker.
+    fn contour_route(&self) -> Option<Route> {
+        let mut job =
+            NearestNeighbourJob::new(0, self.nest.clone(), self.start, self.finish).ok()?;
+        while job.step(Duration::from_millis(50)) == JobStatus::Running {}
+        let route = job.progress().route()?.clone();
+        let fitted =
+            crate::kerf::fit_leads(&self.nest, &self.forest, self.settings, &route, false).ok()?;
+        fitted
+            .problems(&self.nest, &self.forest, self.nest.check_tolerance())
+            .is_empty()
+            .then_some(fitted)
     }
 
     pub(crate) fn step(&mut self, budget: Duration) -> JobStatus {
@@ -139,6 +215,9 @@ impl PathLeadsRun {
             if let Some(result) = pending.advance(&fitter, until.max(Instant::now())) {
                 let from = self.pending.take().expect("pending").from;
                 let result = result.and_then(|route| self.clear_of_parts(route));
+                if let Ok(route) = &result {
+                    self.check(route);
+                }
                 self.fitted = Some((from, result));
             }
         }
@@ -219,10 +298,173 @@ impl PathLeadsRun {
         progress.proven_optimal = false;
         progress.alternatives = Vec::new();
         progress.solution = route.map(Solution::PathRoute);
+        if let (Some(Some(fallback)), Some(Ok(rejected))) = (&self.fallback, fitted) {
+            if Some(rejected) != self.checked.as_ref() {
+                self.answer_with(&mut progress, fallback, rejected);
+            }
+        }
         progress.phase = Phase::Kerf {
             base: Box::new(std::mem::take(&mut progress.phase)),
             note,
         };
         progress
+    }
+
+    /// `progress` answering with `fallback` in place of the `rejected` route with leads, the
+    /// checker's finding stated as the alternative [`REJECTED_ROUTE`].
+    fn answer_with(&self, progress: &mut Progress, fallback: &Fallback, rejected: &PathRoute) {
+        let value = |cut: f64, idle: f64, pierces: usize| {
+            self.objective.value(&self.machine, cut, idle, pierces)
+        };
+        let (solution, name, cut, idle, pierces) = match fallback {
+            Fallback::Paths(r) => (
+                Solution::PathRoute(r.clone()),
+                "checked route with leads",
+                r.cut_length(),
+                r.idle_length(),
+                r.pierce_count(),
+            ),
+            Fallback::Contours(r) => (
+                Solution::Route(r.clone()),
+                "contour route",
+                r.cut_length(&self.nest),
+                r.idle_length(),
+                r.pierce_count(),
+            ),
+        };
+        progress.bounds.upper = Some(value(cut, idle, pierces));
+        progress.solution = Some(solution);
+        progress.alternatives = vec![
+            RouteSummary {
+                name: REJECTED_ROUTE.to_string(),
+                pierces: rejected.pierce_count(),
+                idle_length: rejected.idle_length(),
+                cut_length: rejected.cut_length(),
+                time_s: rejected.time(&self.machine),
+                cost: rejected.cost(&self.machine),
+                chosen: false,
+                failure: self
+                    .failure
+                    .as_ref()
+                    .map(|f| format!("{f}; the {name} is reported instead")),
+                idle_lower_bound: None,
+            },
+            RouteSummary {
+                name: name.to_string(),
+                pierces,
+                idle_length: idle,
+                cut_length: cut,
+                time_s: self.machine.time(cut, idle, pierces),
+                cost: self.machine.cost(cut, idle, pierces),
+                chosen: true,
+                failure: None,
+                idle_lower_bound: None,
+            },
+        ];
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use cutroute_geometry::{Contour, LeadShape, LeadSpec, Part, Vertex};
+    use cutroute_protocol::{JobRequest, Problem, SolverKind, SolverParams};
+
+    /// A solver job that answers with a fixed path route.
+    struct Fixed(PathRoute);
+
+    impl Job for Fixed {
+        fn step(&mut self, _: Duration) -> JobStatus {
+            JobStatus::Done
+        }
+
+        fn progress(&self) -> Progress {
+            Progress {
+                solution: Some(Solution::PathRoute(self.0.clone())),
+                ..Progress::default()
+            }
+        }
+    }
+
+    fn square(x: f64, y: f64, side: f64) -> Contour {
+        Contour::new(vec![
+            Vertex::line(x, y),
+            Vertex::line(x, y + side),
+            Vertex::line(x + side, y + side),
+            Vertex::line(x + side, y),
+        ])
+    }
+
+    /// A route with leads the checker rejects (it leaves a contour uncut) gives way to a
+    /// checked contour route, and the rejection is stated.
+    #[test]
+    fn a_rejected_route_with_leads_gives_way_to_a_checked_contour_route() {
+        let part = |name: &str, x: f64| Part {
+            name: name.to_string(),
+            contours: vec![square(x, 20.0, 30.0)],
+        };
+        let nest = Nest {
+            sheet: None,
+            parts: vec![part("a", 20.0), part("b", 100.0)],
+        };
+        let forest = nest.containment_forest();
+        let settings = KerfSettings {
+            kerf: 1.0,
+            lead_in: LeadSpec::new(LeadShape::Line, 4.0),
+            ..KerfSettings::default()
+        };
+        let start = Point::new(0.0, 0.0);
+        // The solver's own route over the equidistants, less its last path.
+        let equidistants = LeadFitter::with_forest(&nest, &forest, settings).kerf_nest();
+        let request = JobRequest {
+            job_id: 1,
+            problem: Problem::Nest {
+                nest: equidistants,
+                start,
+                finish: None,
+            },
+            solver: SolverKind::Sccp,
+            params: SolverParams::default(),
+        };
+        let mut solver = crate::start_job(&request).expect("sccp starts");
+        while solver.step(Duration::from_millis(50)) == JobStatus::Running {}
+        let mut partial = solver
+            .progress()
+            .solution
+            .and_then(Solution::into_path_route)
+            .expect("a route");
+        assert_eq!(partial.paths.len(), 2);
+        partial.paths.pop();
+        let machine = MachineParameters::default();
+        let mut run = PathLeadsRun::new(
+            nest.clone(),
+            forest.clone(),
+            settings,
+            machine,
+            Objective::Time,
+            (start, None),
+            Box::new(Fixed(partial)),
+        );
+        let mut steps = 0;
+        while run.step(Duration::from_millis(50)) == JobStatus::Running {
+            steps += 1;
+            assert!(steps < 1000, "the run ends");
+        }
+        let progress = run.progress();
+        let Some(Solution::Route(route)) = &progress.solution else {
+            panic!("a contour route, not {:?}", progress.solution);
+        };
+        assert_eq!(
+            route.problems(&nest, &forest, nest.check_tolerance()),
+            Vec::new()
+        );
+        assert!(route.steps.iter().all(|s| s.leads.is_some()));
+        let rejected = &progress.alternatives[0];
+        assert_eq!(rejected.name, REJECTED_ROUTE);
+        assert!(!rejected.chosen);
+        let failure = rejected.failure.as_deref().expect("the failure stated");
+        assert!(failure.contains("fails the checker"), "{failure}");
+        assert!(progress.alternatives[1].chosen);
+        assert!(progress.bounds.upper.is_some());
     }
 }

@@ -50,6 +50,7 @@ pub use jobs::{ccp_options, CcpJob, ChainJob, DiscreteJob, DiscreteMode};
 pub use kerf::{
     fit_leads, supports_kerf, validate_kerf, KerfJob, KerfSettingsError, OVERRUN_LIMIT,
 };
+pub use kerf_paths::REJECTED_ROUTE;
 pub use nearest::NearestNeighbourJob;
 pub use open::{format_name, OpenError};
 pub use open_files::{

@@ -23,18 +23,9 @@ use cutroute_protocol::{
     SolverParams, ThermalSettings,
 };
 
-/// Cells that fail on this branch for reasons owned elsewhere (leads of path routes under
-/// tabs or edge/kerf piercing: "a lead does not join its end points"). They are reported,
-/// not asserted; the list is to be emptied once those fixes are merged.
-const KNOWN_FAILURES: &[&str] = &[
-    "E1X_6_01 / kerf + line leads + tabs / sccp",
-    "E1X_6_01 / kerf + line leads + tabs / gsccp",
-    "E1X_6_01 / kerf + line leads + tabs / aoe",
-    "E1X_6_01 / edge/kerf piercing / sccp",
-    "E1X_6_01 / edge/kerf piercing / gsccp",
-    "E1X_6_01 / edge/kerf piercing / aoe",
-    "2-vertex / kerf + line leads + tabs / aoe",
-];
+/// Cells that fail on this branch for reasons owned elsewhere. They are reported, not
+/// asserted; the list is to be emptied once those fixes are merged.
+const KNOWN_FAILURES: &[&str] = &[];
 
 /// Steps a cell runs at least once it has a route, then it is stopped.
 const STEPS_WITH_A_ROUTE: usize = 8;
