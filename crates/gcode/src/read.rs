@@ -29,7 +29,7 @@
 
 mod linuxcnc;
 mod loops;
-use linuxcnc::Side;
+pub(crate) use linuxcnc::{tool_path as linuxcnc_tool_path, Side};
 pub use loops::closed_loop_start;
 
 use cutroute_geometry::float::Libm;

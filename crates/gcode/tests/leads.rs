@@ -403,3 +403,88 @@ fn a_path_route_with_edge_pierces_overcut_and_tabs_reads_back_with_the_same_leng
         assert!((length - written.length()).abs() < 1e-3);
     }
 }
+
+/// A slot narrower than the kerf cannot be followed by the controller's compensation (LinuxCNC
+/// stops there rather than gouge): refused before writing, naming the part and contour; the
+/// same part without the slot is written.
+#[test]
+fn controller_compensation_refuses_a_slot_narrower_than_the_kerf() {
+    use cutroute_gcode::{GcodeError, KerfCompensation};
+    let settings = KerfSettings {
+        kerf: 2.0,
+        pierce_clearance: 3.0,
+        switch_off_clearance: 1.0,
+        lead_in: LeadSpec::new(LeadShape::Line, 4.0),
+        lead_out: LeadSpec::new(LeadShape::Line, 2.0),
+        ..KerfSettings::default()
+    };
+    let square = |slot: bool| {
+        // Clockwise, as the other outlines, starting in the middle of the top edge.
+        let mut outline = vec![
+            Vertex::line(40.0, 60.0),
+            Vertex::line(60.0, 60.0),
+            Vertex::line(60.0, 20.0),
+        ];
+        if slot {
+            // 1.5 mm wide, 10 mm deep, up from the bottom edge.
+            outline.extend([
+                Vertex::line(40.75, 20.0),
+                Vertex::line(40.75, 30.0),
+                Vertex::line(39.25, 30.0),
+                Vertex::line(39.25, 20.0),
+            ]);
+        }
+        outline.extend([Vertex::line(20.0, 20.0), Vertex::line(20.0, 60.0)]);
+        Nest {
+            sheet: Some(Part {
+                name: "sheet".into(),
+                contours: vec![Contour::new(vec![
+                    Vertex::line(0.0, 0.0),
+                    Vertex::line(0.0, 100.0),
+                    Vertex::line(200.0, 100.0),
+                    Vertex::line(200.0, 0.0),
+                ])],
+            }),
+            parts: vec![
+                Part {
+                    name: "first".into(),
+                    contours: vec![Contour::new(vec![
+                        Vertex::line(35.0, 80.0),
+                        Vertex::line(35.0, 90.0),
+                        Vertex::line(45.0, 90.0),
+                        Vertex::line(45.0, 80.0),
+                    ])],
+                },
+                Part {
+                    name: "slotted".into(),
+                    contours: vec![Contour::new(outline)],
+                },
+            ],
+        }
+    };
+    let options = GcodeOptions {
+        decimals: 6,
+        kerf_compensation: KerfCompensation::ControllerDiameter,
+        ..GcodeOptions::default()
+    };
+    let origin = Point::new(0.0, 0.0);
+    for slot in [false, true] {
+        let nest = square(slot);
+        let route = Route::innermost_first(&nest, origin, Some(origin));
+        let route = LeadFitter::new(&nest, settings).attach(&route).unwrap();
+        let written = route_gcode(&nest, &route, &options);
+        if slot {
+            match written {
+                Err(e @ GcodeError::CompensationGouge { .. }) => {
+                    let text = e.to_string();
+                    assert!(text.contains("part 1 contour 0"), "{text}");
+                }
+                other => panic!("the slot is not refused: {other:?}"),
+            }
+        } else {
+            let text = written.unwrap();
+            let program = read_gcode(&text, &ReadOptions::default()).unwrap();
+            assert_eq!(program.pierce_count(), 2);
+        }
+    }
+}
