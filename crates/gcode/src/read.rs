@@ -29,7 +29,7 @@
 
 mod linuxcnc;
 mod loops;
-pub(crate) use linuxcnc::{tool_path as linuxcnc_tool_path, Side};
+use linuxcnc::Side;
 pub use loops::closed_loop_start;
 
 use cutroute_geometry::float::Libm;

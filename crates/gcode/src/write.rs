@@ -234,20 +234,6 @@ pub enum GcodeError {
         /// Index of the route step.
         step: usize,
     },
-    /// The controller's compensation cannot follow the contour: a concave feature (a notch,
-    /// a slot, an inner corner arc) is tighter than the compensation radius, so LinuxCNC
-    /// stops the program there rather than gouge the part.
-    #[error("route step {step} (part {part} contour {contour}): kerf compensation by the controller cannot follow the contour ({problem}: a concave feature is tighter than half the kerf); compensate in the program instead")]
-    CompensationGouge {
-        /// Index of the route step.
-        step: usize,
-        /// The part's index in the nest.
-        part: usize,
-        /// The contour's index in the part.
-        contour: usize,
-        /// What the controller would refuse.
-        problem: &'static str,
-    },
 }
 
 /// Writes `toolpath` as a G-code program.
@@ -356,7 +342,6 @@ fn compensated_toolpath(
             .and_then(|first| controller_entry(leads.pierce, leads.entry, *first, leads.offset))
             .ok_or(GcodeError::CompensationEntry { step })?;
         codes.push((moves.len(), on));
-        let first_move = moves.len();
         push(&mut moves, Span::line(leads.pierce, entry.0));
         push(&mut moves, entry.1);
         round[1..].iter().for_each(|&span| push(&mut moves, span));
@@ -378,31 +363,6 @@ fn compensated_toolpath(
             }
         }
         codes.push((moves.len(), "G40".into()));
-        // Run the stretch as LinuxCNC's compensation does: where it would stop (a concave
-        // feature tighter than the radius), refuse now instead of writing a program that
-        // aborts on the machine.
-        let programmed: Vec<(Span, usize)> = moves[first_move + 1..]
-            .iter()
-            .filter_map(|m| match *m {
-                ToolMove::Cut { span, .. } => Some((span, 0)),
-                _ => None,
-            })
-            .collect();
-        crate::read::linuxcnc_tool_path(
-            crate::read::Side::Left,
-            leads.offset,
-            leads.pierce,
-            entry.0,
-            &programmed,
-            leads.switch_off,
-            (0, 0),
-        )
-        .map_err(|(problem, _)| GcodeError::CompensationGouge {
-            step,
-            part: cut.contour.part,
-            contour: cut.contour.contour,
-            problem,
-        })?;
         push(&mut moves, Span::line(exit, leads.switch_off));
     }
     Ok((

@@ -20,7 +20,7 @@ use std::f64::consts::{PI, TAU};
 
 /// Which side of the programmed path the controller keeps the tool on.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Side {
+pub(super) enum Side {
     Left,
     Right,
 }
@@ -163,12 +163,12 @@ fn cross(a: Point, b: Point) -> f64 {
 }
 
 /// The problem LinuxCNC names, and the line of the move it stops on.
-pub(crate) type Refusal = (&'static str, usize);
+pub(super) type Refusal = (&'static str, usize);
 
 /// The tool centre's path of a compensated stretch: from `start` (where the head stood) by the
 /// start-up move to the programmed `entry`, along the programmed `spans` (each with its line),
 /// and by the cancel move to `to`.
-pub(crate) fn tool_path(
+pub(super) fn tool_path(
     side: Side,
     radius: f64,
     start: Point,
