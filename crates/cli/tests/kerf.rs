@@ -378,7 +378,6 @@ fn tabs_add_a_pierce_and_an_idle_crossing_per_gap() {
 /// `--kerf-compensation g41.1`: the program runs on the contours and the controller offsets
 /// it; read back (the reader offsets it too) it has the route's pierces and cut.
 #[test]
-#[ignore = "the project's reader does not model LinuxCNC's compensation yet: the writer's start-up move now ends on the first span extended back, as LinuxCNC's rule needs (crates/gcode/tests/linuxcnc.rs referees it); re-enable when the reader models LinuxCNC's start-up move"]
 fn controller_compensation_writes_a_program_that_reads_back_as_the_route() {
     let file = data("nests/dbs-json/E1X_6_01.dbs.json");
     let line_leads = [

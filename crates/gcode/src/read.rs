@@ -72,12 +72,13 @@ pub enum CompensationModel {
     /// As cutroute's post-processor intends it: the closed contour programmed after the
     /// start-up move, offset whole by the radius, entered from where the head stood and left
     /// to the cancel move's end.
-    #[default]
     ClosedContour,
     /// As LinuxCNC's interpreter runs it, move by move: the start-up move ends offset
     /// perpendicular to itself, convex corners get arcs about the programmed corner, concave
     /// ones end at the offsets' intersection (or are refused where the tool would gouge), and
-    /// the cancel move is straight from where the tool stands.
+    /// the cancel move is straight from where the tool stands. The default: a program is read
+    /// as the controller the writer's compensated programs are checked against runs it.
+    #[default]
     LinuxCnc,
 }
 

@@ -145,7 +145,6 @@ fn tabs_read_back_as_pierces_and_idle_gaps() {
 /// (or `G41 D<n>` and the tool table's radius) and straight leads as its start-up and cancel
 /// moves; the reader offsets it back and finds the route's own tool path.
 #[test]
-#[ignore = "the project's reader does not model LinuxCNC's compensation yet: the writer's start-up move now ends on the first span extended back, as LinuxCNC's rule needs (tests/linuxcnc.rs referees it); re-enable when the reader models LinuxCNC's start-up move"]
 fn controller_compensation_reads_back_as_the_route() {
     use cutroute_gcode::KerfCompensation;
     let settings = KerfSettings {
