@@ -4,7 +4,9 @@ use cutroute_geometry::float::Libm;
 use std::collections::HashMap;
 
 use cutroute_anytime::{AnytimeSolver, Status};
-use cutroute_geometry::{ContourRef, CutStep, MachineParameters, Nest, Point, Route};
+use cutroute_geometry::{
+    ContainmentForest, ContourRef, CutStep, MachineParameters, Nest, Point, Route,
+};
 use cutroute_protocol::{Bounds, JobId, Phase, Progress, Solution};
 use cutroute_thermal::{HeatModel, Pierce};
 use rstar::primitives::GeomWithData;
@@ -18,6 +20,10 @@ use crate::{EngineError, Job, JobStatus};
 /// penalty ([`NearestNeighbourJob::with_heat`]) "nearest" means the least idle length plus the
 /// weight times the heat the pierce adds to the route's load H (`cutroute-thermal`), on the
 /// machine clock of the route so far.
+///
+/// Two steps: the first builds the containment forest and publishes the forest-order route
+/// ([`forest_order_route`]), linear in vertices, so a limit or Ctrl-C during the greedy pass
+/// on a very large nest still returns a route; the second replaces it by the greedy route.
 pub struct NearestNeighbourJob {
     job_id: JobId,
     nest: Nest,
@@ -27,6 +33,10 @@ pub struct NearestNeighbourJob {
     route: Option<Route>,
     idle_length: f64,
     heat: Option<NearestHeat>,
+    /// Built by the first step, used by the greedy pass.
+    forest: Option<ContainmentForest>,
+    /// Whether `route` is the greedy route (the job's answer) rather than the first route.
+    greedy: bool,
 }
 
 /// The heat penalty of the greedy choice.
@@ -60,6 +70,8 @@ impl NearestNeighbourJob {
             route: None,
             idle_length: 0.0,
             heat: None,
+            forest: None,
+            greedy: false,
         })
     }
 
@@ -79,20 +91,33 @@ impl NearestNeighbourJob {
         self
     }
 
+    /// The first step: the forest and the forest-order route.
+    fn first_route(&mut self) {
+        let forest = self.nest.containment_forest();
+        let route = forest_order_route(&self.nest, &forest, self.start, self.finish);
+        self.idle_length = route_idle_length(&route);
+        self.route = Some(route);
+        self.forest = Some(forest);
+    }
+
     fn solve(&mut self) {
+        let forest = match self.forest.take() {
+            Some(forest) => forest,
+            None => self.nest.containment_forest(),
+        };
         if self.heat.is_some() {
-            self.solve_scan();
+            self.solve_scan(&forest);
         } else {
-            self.solve_indexed();
+            self.solve_indexed(&forest);
         }
+        self.greedy = true;
     }
 
     /// O(V log V) for V vertices: an R-tree holds the vertices of the contours that may be cut
     /// now (every contour inside them cut) and are not cut yet; a contour's vertices enter
     /// when its last inner contour is cut and leave when it is cut (a quadratic scan took 39 s
     /// on 30,000 contours). Ties go to the lowest (part, contour, vertex), so runs repeat.
-    fn solve_indexed(&mut self) {
-        let forest = self.nest.containment_forest();
+    fn solve_indexed(&mut self, forest: &ContainmentForest) {
         let refs: Vec<ContourRef> = self.nest.contour_refs().collect();
         // Contours still to cut inside each contour: it waits for them (inner before outer).
         let mut inner_left: HashMap<ContourRef, usize> = refs
@@ -163,8 +188,7 @@ impl NearestNeighbourJob {
 
     /// The heat-aware choice: a scan of every vertex of every contour that may be cut now
     /// (quadratic; the heat term is not a distance an index could order by).
-    fn solve_scan(&mut self) {
-        let forest = self.nest.containment_forest();
+    fn solve_scan(&mut self, forest: &ContainmentForest) {
         let mut remaining: Vec<ContourRef> = self.nest.contour_refs().collect();
         // Contours still to cut inside each contour: it waits for them (inner before outer).
         let mut inner_left: HashMap<ContourRef, usize> = remaining
@@ -244,6 +268,50 @@ impl NearestNeighbourJob {
     }
 }
 
+/// Every contour with vertices in post-order of the containment forest (each contour after
+/// every contour inside it, roots and children in forest order), pierced at its first vertex:
+/// a valid route in time linear in contours once the forest exists.
+fn forest_order_route(
+    nest: &Nest,
+    forest: &ContainmentForest,
+    start: Point,
+    finish: Option<Point>,
+) -> Route {
+    let mut steps = Vec::with_capacity(forest.len());
+    // (contour, whether its children are already on the stack)
+    let mut stack: Vec<(ContourRef, bool)> =
+        forest.roots().iter().rev().map(|&r| (r, false)).collect();
+    while let Some((r, expanded)) = stack.pop() {
+        if expanded {
+            if let Some(vertex) = nest.contour(r).and_then(|c| c.vertices.first()) {
+                steps.push(CutStep::pierced(r, vertex.point));
+            }
+        } else {
+            stack.push((r, true));
+            stack.extend(forest.children(r).iter().rev().map(|&c| (c, false)));
+        }
+    }
+    Route {
+        start,
+        steps,
+        finish,
+    }
+}
+
+/// Idle length of a route whose every step is a pierce at a vertex (start, pierces, finish).
+fn route_idle_length(route: &Route) -> f64 {
+    let mut position = route.start;
+    let mut idle_length = 0.0;
+    for step in &route.steps {
+        idle_length += distance(position, step.pierce_point);
+        position = step.pierce_point;
+    }
+    if let Some(finish) = route.finish {
+        idle_length += distance(position, finish);
+    }
+    idle_length
+}
+
 /// A vertex of a contour that may be cut now: (contour, vertex index).
 type ReadyVertex = GeomWithData<[f64; 2], (ContourRef, usize)>;
 
@@ -251,12 +319,17 @@ fn distance(a: Point, b: Point) -> f64 {
     (a.x - b.x).hypot_libm(a.y - b.y)
 }
 
-/// The contract of every solver: the greedy route in one step and its idle length.
+/// The contract of every solver: the forest-order route, then the greedy route, and its idle
+/// length.
 impl AnytimeSolver for NearestNeighbourJob {
     type Solution = Route;
 
     fn step(&mut self, _budget: Duration) -> Status {
         if self.route.is_none() {
+            self.first_route();
+            return Status::Running;
+        }
+        if !self.greedy {
             self.solve();
         }
         Status::Finished {
@@ -283,7 +356,7 @@ impl Job for NearestNeighbourJob {
             job_id: self.job_id,
             elapsed_s: self.started.elapsed().as_secs_f64(),
             bounds: Bounds::idle_mm(self.route.as_ref().map(|_| self.idle_length), None),
-            phase: if self.route.is_some() {
+            phase: if self.greedy {
                 Phase::Done
             } else {
                 Phase::Starting
