@@ -362,13 +362,13 @@ pub(crate) fn open_model_file(
             let import = read_dxf(bytes, &DxfOptions::default())
                 .map_err(|e| unreadable(e.to_string(), e.location()))?;
             // The open chains are among the warnings (one each, with their geometry).
-            warnings.extend(import.warnings.into_iter().map(as_read_warning));
+            warnings.extend(import.warnings);
             import.nest
         }
         Format::Svg => {
             let import = read_svg(bytes, &SvgOptions::default())
                 .map_err(|e| unreadable(e.to_string(), e.location()))?;
-            warnings.extend(import.warnings.into_iter().map(as_read_warning));
+            warnings.extend(import.warnings);
             import.nest
         }
         Format::TflexXml => {
@@ -449,15 +449,6 @@ pub(crate) fn open_model_file(
         sheets,
         sheet,
     })
-}
-
-/// A reader's warning as the one warning type: a [`ReadWarning`] is kept as it is; a reader
-/// with a warning type of its own gives its sentence, of kind [`WarningKind::Other`].
-fn as_read_warning<W: std::fmt::Display + 'static>(warning: W) -> ReadWarning {
-    match (&warning as &dyn std::any::Any).downcast_ref::<ReadWarning>() {
-        Some(w) => w.clone(),
-        None => ReadWarning::new(WarningKind::Other, warning.to_string()),
-    }
 }
 
 /// Why a file is of no known format, located: a JSON object that does not parse gets serde's

@@ -83,9 +83,7 @@ fn read_groups(bytes: &[u8], binary: bool, options: &DxfOptions) -> Result<DxfIm
         join_tolerance: options.join_tolerance,
         flatten_tolerance: options.approximation_tolerance,
     };
-    let dropped = |w: crate::assemble::Dropped| {
-        ReadWarning::new(WarningKind::Other, w.message).at_line(w.line, None)
-    };
+    let dropped = ReadWarning::from;
     // Without an open chain, the first refused entity is why nothing was drawn: its warning
     // carries the entity's place.
     let nothing_drawn = |warnings: &[DxfWarning]| {

@@ -218,17 +218,7 @@ pub fn read_svg(bytes: &[u8], options: &SvgOptions) -> Result<SvgImport, SvgErro
         }
         sheet
     };
-    let dropped = |d: crate::assemble::Dropped| {
-        // The assembly says why in words; the kind follows from them.
-        let kind = if d.message.contains("duplicate") {
-            WarningKind::Duplicate
-        } else if d.message.contains("no area") {
-            WarningKind::ZeroArea
-        } else {
-            WarningKind::Other
-        };
-        ReadWarning::new(kind, d.message).at_line(d.line, None)
-    };
+    let dropped = ReadWarning::from;
     let nothing_drawn = |warnings: &[SvgWarning]| match warnings
         .iter()
         .find(|w| matches!(w.kind, WarningKind::Hidden | WarningKind::Skipped))
