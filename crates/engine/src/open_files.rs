@@ -10,8 +10,8 @@ use crate::open::{format_name, open_model_file, OpenError};
 use cutroute_formats::{detect, read_task_json, Format, RmTask};
 use cutroute_gcode::{read_gcode, Motion, ReadOptions};
 use cutroute_geometry::{
-    flatten_spans, Contour, ContourRef, CutStep, Entry, Nest, Part, PathRoute, Point, ReadWarning,
-    Route, RouteError, Span, Toolpath, Vertex, WarningKind,
+    flatten_spans, Contour, ContourFault, ContourRef, CutStep, Entry, Nest, Part, PathRoute, Point,
+    ReadWarning, Route, RouteError, Span, Toolpath, Vertex, WarningKind,
 };
 use cutroute_pcgtsp::{check_tour, Instance, PcglnsResult};
 use cutroute_protocol::{Document, Problem, TaskSpeeds};
@@ -239,7 +239,29 @@ pub fn open_gcode_with(
                         Entry::Link(lead.iter().skip(1).map(|s| s.start).collect())
                     };
                     r.loops_cut += 1;
-                    loops.push((Contour::new(vertices), entry));
+                    let contour = Contour::new(vertices);
+                    // The one meaning of a contour every reader applies: a loop that is no
+                    // cuttable contour (a slit, a bow-tie) is left out, as a drawing's is.
+                    match contour.check_cuttable(POINT_TOLERANCE_MM) {
+                        Ok(()) => loops.push((contour, entry)),
+                        Err(fault) => warnings.push(
+                            ReadWarning::new(
+                                match fault {
+                                    ContourFault::SelfIntersecting { .. } => {
+                                        WarningKind::SelfIntersecting
+                                    }
+                                    _ if fault.is_zero_area() => WarningKind::ZeroArea,
+                                    _ => WarningKind::Other,
+                                },
+                                format!("a tool-on loop is left out: {fault}"),
+                            )
+                            .at_line(r.pending_line, None)
+                            .leaving_out(vec![flatten_spans(
+                                &contour.spans().collect::<Vec<_>>(),
+                                LEFT_OUT_FLATTENING_MM,
+                            )]),
+                        ),
+                    }
                 }
             }
             Motion::Feed { .. } | Motion::Rapid { .. } | Motion::Dwell { .. } => {}
