@@ -394,7 +394,8 @@ fn parts_closer_than_the_kerf_are_refused_up_front_naming_the_pairs() {
             }
             let words = refusal.to_string();
             assert!(
-                words.contains("parts closer than the kerf") && words.contains("ContourRef"),
+                words.contains("parts closer than the kerf") && words.contains("part 0 contour")
+                    || words.contains(" contour "),
                 "{words}"
             );
         }

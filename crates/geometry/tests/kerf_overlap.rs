@@ -240,7 +240,10 @@ fn the_parts_too_close_message_names_the_pairs_and_their_gap() {
     };
     let words = refusal.to_string();
     assert!(words.contains("closer than the kerf of 2 mm"), "{words}");
-    assert!(words.contains("ContourRef { part: 0, contour: 0 } and ContourRef { part: 1, contour: 0 } 0.750 mm apart"), "{words}");
+    assert!(
+        words.contains("part 0 contour 0 and part 1 contour 0 0.750 mm apart"),
+        "{words}"
+    );
 }
 
 proptest! {
