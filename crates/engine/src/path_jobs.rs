@@ -468,8 +468,8 @@ fn nest_of(request: &JobRequest) -> Result<(&Nest, Point, Option<Point>), Engine
 
 /// Segment cutting (`cutroute-segments`' [`GsccpSearch`]): CCP-Relax seeds the orders, then
 /// each ensemble is built and searched in slices; SCCP is the chains ensemble alone, GSCCP
-/// every ensemble, the best by the objective kept. Once CCP-Relax has a route, a step measures
-/// the plan graph for the lower bound (at least the plan's length cut and one pierce per component). Where no two
+/// every ensemble, the best by the objective kept. The first step measures the plan graph for
+/// the lower bound (at least the plan's length cut and one pierce per component). Where no two
 /// contours touch, the next makes the continuous bound of CCP, which then gets half of each
 /// slice while the search runs and tightens the bound ([`PlanBound::any_route_with_ccp`]);
 /// the job ends with the search, once the bound's first stage is done (within the limit).
@@ -602,12 +602,6 @@ impl Job for SegmentJob {
 
     fn step(&mut self, budget: Duration) -> JobStatus {
         if self.bound.is_none() {
-            // A route first (CCP-Relax's, in slices): on a very large contour the plan graph
-            // is a long piece of work, and a limit reached during it must still find a route.
-            if self.search.best().is_none() && !self.search.is_finished() {
-                self.search.step(budget);
-                return JobStatus::Running;
-            }
             // A plan graph: one piece of work, a step of its own.
             self.bound = Some(PlanBound::new(
                 &self.nest,
