@@ -1,6 +1,6 @@
 //! Pierce points on the sheet: with every solver and every lead option, no pierce, switch-off or
 //! tab pierce point of a route lies off the sheet (or closer than d₁, d₂ to its edge), on a nest
-//! of parts 0–5 mm from the sheet's edge (`data/nests/dbs-json/edge.dbs.json`, made for this
+//! of parts 0–5 mm from the sheet's edge (`data/made/edge.dbs.json`, made for this
 //! test) and on shipped nests with a sheet. Every route also passes its own checker, which
 //! holds pierce points to the sheet. What the solvers find is theirs; the property holds for
 //! every route they return, so the time limit only bounds the run.
@@ -142,7 +142,7 @@ fn every_solver_every_lead(file: &str, unchecked: &[(SolverKind, &str)]) -> usiz
 #[test]
 fn no_pierce_point_off_the_sheet_on_parts_at_its_edge() {
     assert_eq!(
-        every_solver_every_lead("nests/dbs-json/edge.dbs.json", &[]),
+        every_solver_every_lead("made/edge.dbs.json", &[]),
         SolverKind::ALL.len() * options().len()
     );
 }
