@@ -113,8 +113,9 @@ pub struct ReadWarning {
     /// Total length (mm) of the geometry left out, when geometry was left out.
     pub length_mm: Option<f64>,
     /// The geometry left out, as polylines in the nest's coordinates (arcs flattened), so a
-    /// view can draw it as a layer. Empty when nothing drawable was left out.
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    /// view can draw it as a layer. Empty when nothing drawable was left out. Always written:
+    /// the worker's messages are bincode, which has no field names to skip a field by.
+    #[serde(default)]
     pub left_out: Vec<Vec<Point>>,
 }
 

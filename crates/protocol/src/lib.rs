@@ -741,6 +741,31 @@ mod tests {
         assert_eq!(bincode::deserialize::<Route>(&bytes).unwrap(), route);
     }
 
+    /// The reader's warnings cross to the page in the worker's codec, with and without the
+    /// geometry they left out, and in JSON.
+    #[test]
+    fn read_warnings_survive_both_codecs() {
+        use cutroute_geometry::{ReadWarning, WarningKind, WarningPlace};
+        let warnings = vec![
+            ReadWarning::new(WarningKind::Units, "no units; millimetres assumed"),
+            ReadWarning::new(WarningKind::OpenChain, "open chain left out")
+                .at_line(12, Some(3))
+                .leaving_out(vec![vec![Point::new(0.0, 0.0), Point::new(3.0, 4.0)]]),
+            ReadWarning::new(WarningKind::Duplicate, "drawn twice")
+                .at(WarningPlace::Byte { offset: 7 }),
+        ];
+        let bytes = bincode::serialize(&warnings).unwrap();
+        assert_eq!(
+            bincode::deserialize::<Vec<ReadWarning>>(&bytes).unwrap(),
+            warnings
+        );
+        let json = serde_json::to_string(&warnings).unwrap();
+        assert_eq!(
+            serde_json::from_str::<Vec<ReadWarning>>(&json).unwrap(),
+            warnings
+        );
+    }
+
     #[test]
     fn kerf_settings_and_notes_survive_both_codecs_and_old_requests_stay_idealised() {
         use cutroute_geometry::{KerfSettings, LeadShape, LeadSpec, TabSpec};
