@@ -165,7 +165,7 @@ test('a nest whose parts touch is refused with kerf, the pairs named in Russian'
   const oracle = cliError(file, 'solve', file, '--solver', 'ccp', '--time-limit', '1', '--kerf', '2',
     '--pierce-clearance', '5', '--switch-off-clearance', '1', '--lead-in', 'arc');
   assert.equal(oracle.status, 1);
-  const named = oracle.message.match(/(\d+) pair\(s\) of contours: ContourRef \{ part: 0, contour: 0 \} and ContourRef \{ part: 1, contour: 0 \} touch/);
+  const named = oracle.message.match(/(\d+) pair\(s\) of contours: part 0 contour 0 and part 1 contour 0 touch/);
   assert.ok(named, oracle.message);
 
   const context = await app.browser.newContext({ locale: 'ru-RU', viewport: { width: 1280, height: 800 } });
