@@ -204,25 +204,27 @@ fn standard_output_file() -> std::io::Result<Box<dyn Write>> {
 mod tests {
     use super::*;
 
-    fn scratch(name: &str) -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("cutroute-output-{}", std::process::id()));
+    /// A file in a folder of the test's own (tests run at once, and one lists its folder).
+    fn scratch(test: &str, name: &str) -> PathBuf {
+        let dir =
+            std::env::temp_dir().join(format!("cutroute-output-{}-{test}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         dir.join(name)
     }
 
     #[test]
     fn a_failed_write_keeps_the_old_file_and_leaves_no_part() {
-        let file = scratch("kept.json");
+        let file = scratch("failed", "kept.json");
         write_output(&file, b"first").unwrap();
         write_output(&file, b"second").unwrap();
         assert_eq!(std::fs::read(&file).unwrap(), b"second");
         // A destination that cannot be replaced (a directory): an error, and no part file left.
-        let blocked = scratch("blocked");
+        let blocked = scratch("failed", "blocked");
         std::fs::create_dir_all(blocked.join("inside")).unwrap();
         assert!(write_output(&blocked, b"x").is_err());
         assert!(blocked.join("inside").is_dir());
         // A folder that does not exist: an error naming the file.
-        let nowhere = scratch("missing-folder").join("out.json");
+        let nowhere = scratch("failed", "missing-folder").join("out.json");
         let error = write_output(&nowhere, b"x").unwrap_err();
         assert!(error.contains("out.json"), "{error}");
         let leftovers: Vec<_> = std::fs::read_dir(file.parent().unwrap())
@@ -235,11 +237,11 @@ mod tests {
 
     #[test]
     fn the_same_file_under_another_name_is_refused() {
-        let file = scratch("same.json");
+        let file = scratch("same", "same.json");
         std::fs::write(&file, b"{}").unwrap();
         let dotted = file.parent().unwrap().join(".").join("same.json");
         assert!(refuse_overwriting_inputs(&dotted, [file.as_path()]).is_err());
-        let other = scratch("other.json");
+        let other = scratch("same", "other.json");
         assert!(refuse_overwriting_inputs(&other, [file.as_path()]).is_ok());
         assert!(refuse_overwriting_inputs(Path::new("-"), [Path::new("-")]).is_ok());
     }
@@ -248,13 +250,13 @@ mod tests {
     #[test]
     fn permissions_and_links_are_kept() {
         use std::os::unix::fs::PermissionsExt;
-        let file = scratch("mode.nc");
+        let file = scratch("modes", "mode.nc");
         std::fs::write(&file, b"old").unwrap();
         std::fs::set_permissions(&file, std::fs::Permissions::from_mode(0o640)).unwrap();
         write_output(&file, b"new").unwrap();
         let mode = std::fs::metadata(&file).unwrap().permissions().mode() & 0o777;
         assert_eq!(mode, 0o640);
-        let link = scratch("link.nc");
+        let link = scratch("modes", "link.nc");
         let _ = std::fs::remove_file(&link);
         std::os::unix::fs::symlink(&file, &link).unwrap();
         write_output(&link, b"through the link").unwrap();
