@@ -544,12 +544,15 @@ fn run_job(job: &mut dyn Job, watch: &Watch, on_progress: &mut dyn FnMut(&Progre
                 if status != cutroute_engine::JobStatus::Done {
                     // The final answer: with what only a final answer carries (CCP's
                     // certificates), whichever of the job and the watch saw the limit first.
+                    // Stopping may take a while (GSCCP checks the route of the ensemble under
+                    // way): not under the lock, which the main thread takes at its grace's end
+                    // to report what was published.
+                    drop(seen);
                     job.stop();
                     let mut last = job.progress();
                     // A job with no route yet makes the one its limit would give (AOE checks
                     // its ordering cut short) in further steps; the main thread reports what
                     // was published if that outlasts its grace.
-                    drop(seen);
                     while last.solution.is_none() {
                         let status = job.step(cutroute_engine::DEFAULT_SLICE);
                         last = job.progress();
