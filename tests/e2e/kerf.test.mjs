@@ -62,13 +62,16 @@ test('kerf and an arc lead-in: leads drawn and animated, G-code reads back with 
 
   await page.click('details.kerf summary');
   await setNumber(page, '#kerf-width', 2);
-  await setNumber(page, '#kerf-d1', 5);
+  // nested.dbs spaces its parts 10 mm apart and 10 mm from the sheet's edges: with d₁ = 5 the
+  // pierce region round the first row is a line (5 mm from both sides), and the engine rightly
+  // finds no room for the leads there. d₁ = 4 leaves a band 2 mm wide.
+  await setNumber(page, '#kerf-d1', 4);
   await setNumber(page, '#kerf-d2', 1);
   await page.selectOption('#lead-in-shape', 'arc');
   await page.dispatchEvent('#lead-in-shape', 'change');
   // The settings ride the share link.
   const link = await page.inputValue('#share-link');
-  assert.match(link, /kerf=2&d1=5&d2=1/);
+  assert.match(link, /kerf=2&d1=4&d2=1/);
   assert.match(link, /lead_in=arc&lead_out=none/);
 
   await runSolver(page, 'ccp', 3);
@@ -158,14 +161,14 @@ test('kerf and an arc lead-in: leads drawn and animated, G-code reads back with 
 
 // Parts closer than the kerf (T-FLEX Nest01: five parts touching in a row): the engine refuses
 // the job before any solver runs, and the page words the refusal in its language, naming each
-// pair of contours by part and contour as the CLI's oracle does by index.
+// pair of contours by part (from 1) and contour as the CLI's oracle does.
 test('a nest whose parts touch is refused with kerf, the pairs named in Russian', async () => {
   const file = path.join(projectRoot, 'data', 'nests', 'tflex', 'Nest01.tfnesting');
   // The oracle: the CLI refuses the same nest and settings, naming the pairs.
   const oracle = cliError(file, 'solve', file, '--solver', 'ccp', '--time-limit', '1', '--kerf', '2',
     '--pierce-clearance', '5', '--switch-off-clearance', '1', '--lead-in', 'arc');
   assert.equal(oracle.status, 1);
-  const named = oracle.message.match(/(\d+) pair\(s\) of contours: part 0 contour 0 and part 1 contour 0 touch/);
+  const named = oracle.message.match(/(\d+) pair\(s\) of contours: part 1 contour 0 and part 2 contour 0 touch/);
   assert.ok(named, oracle.message);
 
   const context = await app.browser.newContext({ locale: 'ru-RU', viewport: { width: 1280, height: 800 } });

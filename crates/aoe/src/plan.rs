@@ -44,7 +44,7 @@ pub enum PlanError {
     #[error("tolerance {0} is not a positive finite length")]
     BadTolerance(f64),
     /// A contour has a non-finite coordinate or bulge.
-    #[error("contour {contour:?} has a non-finite coordinate or bulge")]
+    #[error("{contour} has a non-finite coordinate or bulge")]
     NonFinite {
         /// The contour.
         contour: ContourRef,

@@ -609,7 +609,7 @@ fn parts_closer_than_the_kerf_are_refused_naming_the_pairs() {
             assert!(err.contains("parts closer than the kerf of"), "{err}");
             assert!(err.contains("4 pair(s) of contours"), "{err}");
             assert!(
-                err.contains("part 0 contour 0 and part 1 contour 0 touch near ("),
+                err.contains("part 1 contour 0 and part 2 contour 0 touch near ("),
                 "{err}"
             );
         }

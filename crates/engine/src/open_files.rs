@@ -611,10 +611,7 @@ pub fn open_together(files: &[(String, Vec<u8>)]) -> Result<Document, OpenError>
                 "{tour_name}: drawn as a cutting route of {nest_name} (route checked: every contour of the task once, on its contour, inner before outer)"
             ));
             if !left_out.is_empty() {
-                let names: Vec<String> = left_out
-                    .iter()
-                    .map(|r| format!("part {} contour {}", r.part + 1, r.contour))
-                    .collect();
+                let names: Vec<String> = left_out.iter().map(|r| r.to_string()).collect();
                 notes.push(format!(
                     "{task_name} does not list {} of {nest_name}: not cut",
                     names.join(", ")

@@ -397,7 +397,10 @@ fn parts_closer_than_the_kerf_are_refused_up_front_naming_the_pairs() {
             let first = &refusal.pairs[0];
             let named = format!(
                 "part {} contour {} and part {} contour {}",
-                first.contour.part, first.contour.contour, first.other.part, first.other.contour
+                first.contour.part + 1,
+                first.contour.contour,
+                first.other.part + 1,
+                first.other.contour
             );
             assert!(
                 words.contains("parts closer than the kerf") && words.contains(&named),

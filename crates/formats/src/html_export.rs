@@ -167,12 +167,7 @@ pub fn route_html(
                 .parts
                 .get(s.contour.part)
                 .map_or("?", |p| p.name.as_str());
-            format!(
-                "Step {}: part {} ({name}), contour {}",
-                k + 1,
-                s.contour.part,
-                s.contour.contour
-            )
+            format!("Step {}: {} ({name})", k + 1, s.contour)
         })
         .collect();
     Ok(toolpath_html(nest, &toolpath, &labels, options))

@@ -251,10 +251,7 @@ pub fn route_gcode(
     let label = |step: usize| {
         let contour = route.steps.get(step)?.contour;
         let part = nest.parts.get(contour.part)?;
-        Some(format!(
-            "part {} ({}) contour {}",
-            contour.part, part.name, contour.contour
-        ))
+        Some(format!("{contour} ({})", part.name))
     };
     match options.kerf_compensation {
         KerfCompensation::InProgram => {

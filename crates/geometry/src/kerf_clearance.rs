@@ -291,11 +291,7 @@ impl std::fmt::Display for PartsTooClose {
             if i > 0 {
                 write!(f, "; ")?;
             }
-            write!(
-                f,
-                "part {} contour {} and part {} contour {} ",
-                p.contour.part, p.contour.contour, p.other.part, p.other.contour
-            )?;
+            write!(f, "{} and {} ", p.contour, p.other)?;
             // Touching parts are the common case (nests packed without spacing), and so are
             // parts lying on one another (in a hole of their own shape, or stacked).
             if p.gap < 5e-4 {

@@ -833,13 +833,13 @@ pub(crate) mod vertex_triples {
 #[derive(Clone, Debug, PartialEq, Error)]
 pub enum LeadError {
     /// The nest has no such contour.
-    #[error("the nest has no contour {contour:?}")]
+    #[error("the nest has no {contour}")]
     UnknownContour {
         /// The reference.
         contour: ContourRef,
     },
     /// The contour has no single equidistant at kerf/2.
-    #[error("contour {contour:?} has no equidistant: {source}")]
+    #[error("{contour} has no equidistant: {source}")]
     Offset {
         /// The contour.
         contour: ContourRef,
@@ -847,7 +847,7 @@ pub enum LeadError {
         source: OffsetError,
     },
     /// No lead-in/lead-out pair fits anywhere on the contour.
-    #[error("no lead fits contour {contour:?}: {reason}")]
+    #[error("no lead fits {contour}: {reason}")]
     NoFit {
         /// The contour.
         contour: ContourRef,

@@ -138,7 +138,7 @@ pub enum PathRouteError {
         y: f64,
     },
     /// Part of a contour's boundary is never cut.
-    #[error("{length} mm of contour {contour:?} from ({x}, {y}) are never cut")]
+    #[error("{length} mm of {contour} from ({x}, {y}) are never cut")]
     Gap {
         /// The contour.
         contour: ContourRef,
@@ -151,7 +151,7 @@ pub enum PathRouteError {
     },
     /// Part of a contour's boundary is cut more than once. A common edge cut twice is reported
     /// on both its contours, with the ends swapped when they run opposite ways.
-    #[error("{length} mm of contour {contour:?} from ({x}, {y}) to ({to_x}, {to_y}) are cut more than once")]
+    #[error("{length} mm of {contour} from ({x}, {y}) to ({to_x}, {to_y}) are cut more than once")]
     Overlap {
         /// The contour.
         contour: ContourRef,
@@ -168,7 +168,7 @@ pub enum PathRouteError {
     },
     /// A tool-on piece off every contour crosses a contour: it cuts into a part or across a
     /// scrap boundary.
-    #[error("span {span} of path {path} crosses contour {contour:?} at ({x}, {y}) away from every contour it follows")]
+    #[error("span {span} of path {path} crosses {contour} at ({x}, {y}) away from every contour it follows")]
     CrossesContour {
         /// Index of the path.
         path: usize,
@@ -206,14 +206,14 @@ pub enum PathRouteError {
         path: usize,
     },
     /// With leads: the contour has no equidistant at kerf/2, so no cut keeps the kerf off it.
-    #[error("contour {contour:?} has no equidistant at half the kerf")]
+    #[error("{contour} has no equidistant at half the kerf")]
     NoEquidistant {
         /// The contour.
         contour: ContourRef,
     },
     /// With leads: a tool-on span comes closer than kerf/2 to a contour, so the kerf burns
     /// into it (parts spaced narrower than the kerf, or a cut off the equidistants).
-    #[error("span {span} of path {path} comes {distance} mm from contour {contour:?} at ({x}, {y}), closer than half the kerf")]
+    #[error("span {span} of path {path} comes {distance} mm from {contour} at ({x}, {y}), closer than half the kerf")]
     CutTooClose {
         /// Index of the path.
         path: usize,
@@ -230,7 +230,9 @@ pub enum PathRouteError {
     },
     /// A contour's boundary is completed before that of a contour inside it: the outer piece
     /// would drop (or move) before the inner one is cut out.
-    #[error("contour {outer:?} is completed (path {outer_path}) before contour {inner:?} inside it (path {inner_path})")]
+    #[error(
+        "{outer} is completed (path {outer_path}) before {inner} inside it (path {inner_path})"
+    )]
     PrecedenceViolated {
         /// The contained contour.
         inner: ContourRef,

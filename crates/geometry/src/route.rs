@@ -17,6 +17,14 @@ pub struct ContourRef {
     pub contour: usize,
 }
 
+/// How every message names a contour: parts from 1, as the page lists them, and contours from
+/// 0, the outer contour first.
+impl std::fmt::Display for ContourRef {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "part {} contour {}", self.part + 1, self.contour)
+    }
+}
+
 /// How the tool reaches the contour of a step.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub enum Entry {
@@ -226,7 +234,7 @@ impl Objective {
 #[derive(Clone, Debug, PartialEq, Error)]
 pub enum RouteError {
     /// A step names a contour the nest does not have.
-    #[error("step {step} cuts contour {contour:?}, which the nest does not have")]
+    #[error("step {step} cuts {contour}, which the nest does not have")]
     UnknownContour {
         /// Index of the step.
         step: usize,
@@ -234,7 +242,7 @@ pub enum RouteError {
         contour: ContourRef,
     },
     /// A contour is cut more than once.
-    #[error("contour {contour:?} is cut twice: at steps {first_step} and {second_step}")]
+    #[error("{contour} is cut twice: at steps {first_step} and {second_step}")]
     CutTwice {
         /// The contour.
         contour: ContourRef,
@@ -244,13 +252,13 @@ pub enum RouteError {
         second_step: usize,
     },
     /// A contour is never cut.
-    #[error("contour {contour:?} is never cut")]
+    #[error("{contour} is never cut")]
     NotCut {
         /// The contour.
         contour: ContourRef,
     },
     /// A pierce point is off its contour.
-    #[error("step {step} pierces contour {contour:?} {distance} mm away from it (tolerance {tolerance} mm)")]
+    #[error("step {step} pierces {contour} {distance} mm away from it (tolerance {tolerance} mm)")]
     PierceOffContour {
         /// Index of the step.
         step: usize,
@@ -263,7 +271,9 @@ pub enum RouteError {
     },
     /// A step is pierced in the kerf of a contour that is not cut before it (or not cut with
     /// leads).
-    #[error("step {step} on contour {contour:?} is pierced in the kerf of {kerf_of:?}, which is not cut before it")]
+    #[error(
+        "step {step} on {contour} is pierced in the kerf of {kerf_of}, which is not cut before it"
+    )]
     KerfPierceBeforeCut {
         /// Index of the step.
         step: usize,
@@ -273,7 +283,9 @@ pub enum RouteError {
         kerf_of: ContourRef,
     },
     /// A contour is cut after a contour that contains it.
-    #[error("contour {inner:?} (step {inner_step}) lies inside {outer:?} (step {outer_step}) but is cut after it")]
+    #[error(
+        "{inner} (step {inner_step}) lies inside {outer} (step {outer_step}) but is cut after it"
+    )]
     PrecedenceViolated {
         /// The contained contour.
         inner: ContourRef,
@@ -286,7 +298,7 @@ pub enum RouteError {
     },
     /// A step's full-route elements break the model (M ∉ G_M, M* ∉ G_M*, a lead closer than
     /// kerf/2 to a contour, the entry off the equidistant).
-    #[error("step {step} on contour {contour:?}: {problem}")]
+    #[error("step {step} on {contour}: {problem}")]
     Lead {
         /// Index of the step.
         step: usize,
@@ -299,7 +311,7 @@ pub enum RouteError {
     /// closer than kerf/2 to a contour: the kerf eats into that contour's part (parts closer
     /// than the kerf). Reported once per pair of contours, at the first step that cuts one of
     /// them.
-    #[error("the cut of contour {contour:?} (step {step}) comes {distance} mm from contour {other:?} near ({x}, {y}), closer than kerf/2 = {required} mm (the contours are {gap} mm apart)")]
+    #[error("the cut of {contour} (step {step}) comes {distance} mm from {other} near ({x}, {y}), closer than kerf/2 = {required} mm (the contours are {gap} mm apart)")]
     KerfOverlap {
         /// Index of the step.
         step: usize,
@@ -335,7 +347,7 @@ pub enum RouteError {
         to: ContourRef,
     },
     /// A link crosses a contour (a part or scrap boundary) away from its two end points.
-    #[error("the link into step {step} crosses contour {contour:?} at ({x}, {y})")]
+    #[error("the link into step {step} crosses {contour} at ({x}, {y})")]
     LinkCrossesContour {
         /// Index of the linked step.
         step: usize,

@@ -241,7 +241,7 @@ fn the_parts_too_close_message_names_the_pairs_and_their_gap() {
     let words = refusal.to_string();
     assert!(words.contains("closer than the kerf of 2 mm"), "{words}");
     assert!(
-        words.contains("part 0 contour 0 and part 1 contour 0 0.750 mm apart"),
+        words.contains("part 1 contour 0 and part 2 contour 0 0.750 mm apart"),
         "{words}"
     );
 }
