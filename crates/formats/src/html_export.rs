@@ -10,10 +10,10 @@
 
 use std::fmt::Write as _;
 
+use crate::path_data::PathData;
 use cutroute_geometry::{
     BoundingBox, MachineParameters, Nest, Point, Route, RouteError, ToolClock, ToolMove, Toolpath,
 };
-use svg::node::element::path::Data;
 use svg::node::element::{Circle, Group, Path, Title};
 use svg::Document;
 
@@ -275,7 +275,7 @@ fn drawing(
         .map(|p| (p, "sheet"))
         .chain(nest.parts.iter().map(|p| (p, "part")))
     {
-        let mut data = Data::new();
+        let mut data = PathData::new();
         for contour in &part.contours {
             let mut spans = contour.spans().peekable();
             if let Some(first) = spans.peek() {
@@ -335,9 +335,9 @@ fn drawing(
 
 /// Consecutive moves of one kind form one `<path>`, so a contour's cut is a single element.
 fn route_paths(mut group: Group, toolpath: &Toolpath) -> Group {
-    let mut idle = Data::new();
-    let mut cut: Option<(usize, Data)> = None;
-    let finish = |group: Group, cut: Option<(usize, Data)>| match cut {
+    let mut idle = PathData::new();
+    let mut cut: Option<(usize, PathData)> = None;
+    let finish = |group: Group, cut: Option<(usize, PathData)>| match cut {
         Some((step, data)) => group.add(
             Path::new()
                 .set("class", "cut")
@@ -355,7 +355,7 @@ fn route_paths(mut group: Group, toolpath: &Toolpath) -> Group {
                     Some((s, data)) if s == step => data,
                     other => {
                         group = finish(group, other);
-                        Data::new().move_to(xy(span.start))
+                        PathData::new().move_to(xy(span.start))
                     }
                 };
                 cut = Some((

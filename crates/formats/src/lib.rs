@@ -47,6 +47,7 @@ mod detect;
 mod geometry_json;
 mod html_export;
 mod json;
+mod path_data;
 mod result_json;
 mod svg_export;
 mod task_json;

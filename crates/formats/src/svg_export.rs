@@ -7,8 +7,8 @@
 //! `cut`, `link` (chain cutting's tool-on links between contours), `lead` (lead-in/out),
 //! `pierce`, `start`, `finish`.
 
+use crate::path_data::PathData;
 use cutroute_geometry::{BoundingBox, Contour, Nest, Part, Point, Span};
-use svg::node::element::path::Data;
 use svg::node::element::{Circle, Group, Path, Style, Title};
 use svg::Document;
 
@@ -83,7 +83,7 @@ pub fn nest_svg(nest: &Nest, moves: Option<&[ToolMove]>, options: &SvgOptions) -
 }
 
 fn part_path(part: &Part, class: &str) -> Path {
-    let mut data = Data::new();
+    let mut data = PathData::new();
     for contour in &part.contours {
         data = contour_data(data, contour);
     }
@@ -100,7 +100,7 @@ fn part_path(part: &Part, class: &str) -> Path {
         )))
 }
 
-fn contour_data(mut data: Data, contour: &Contour) -> Data {
+fn contour_data(mut data: PathData, contour: &Contour) -> PathData {
     let Some(first) = contour.vertices.first() else {
         return data;
     };
@@ -112,7 +112,7 @@ fn contour_data(mut data: Data, contour: &Contour) -> Data {
 }
 
 /// Appends one span; `V`/`H`/`L` for straight spans, one or two `A` for arcs.
-pub(crate) fn span_data(data: Data, a: Point, z: Point, b: f64) -> Data {
+pub(crate) fn span_data(data: PathData, a: Point, z: Point, b: f64) -> PathData {
     // An arc whose radius lies beyond the coordinate domain is straight to within
     // chord² / (8 · 1e9) mm, and its radius is a number no reader of the domain accepts
     // (a bulge of 1e-13 gives a radius of 1e13 chords): it is written as the line it is.
@@ -143,11 +143,10 @@ pub(crate) fn span_data(data: Data, a: Point, z: Point, b: f64) -> Data {
     arc(data, a, z, b)
 }
 
-fn arc(data: Data, a: Point, z: Point, b: f64) -> Data {
+fn arc(data: PathData, a: Point, z: Point, b: f64) -> PathData {
     let r = Span::new(a, z, b).radius();
     // Inside the y-flipped group a counter-clockwise arc (b > 0) has sweep flag 1.
-    let sweep = if b > 0.0 { 1 } else { 0 };
-    data.elliptical_arc_to((r, r, 0, 0, sweep, z.x, z.y))
+    data.arc_to(r, b > 0.0, (z.x, z.y))
 }
 
 fn route_group(moves: &[ToolMove], marker: f64) -> Group {
@@ -162,7 +161,7 @@ fn route_group(moves: &[ToolMove], marker: f64) -> Group {
     };
     while i < moves.len() {
         let class = class_of(&moves[i]);
-        let mut data = Data::new().move_to((moves[i].from.x, moves[i].from.y));
+        let mut data = PathData::new().move_to((moves[i].from.x, moves[i].from.y));
         let mut j = i;
         while j < moves.len()
             && class_of(&moves[j]) == class
