@@ -30,8 +30,9 @@ for project in crates/*/fuzz; do
     # Seeds: the real files of the format, when the corpus is new.
     if [[ -z "$(ls -A "$corpus")" ]]; then
       case "$target" in
-        dxf_reader) seeds=(data/nests/dxf/*.dxf) ;;
-        svg_reader) seeds=(data/nests/svg/*.svg) ;;
+        dxf_reader) seeds=(data/nests/dxf/*.dxf data/realworld/files/*.dxf) ;;
+        svg_reader) seeds=(data/nests/svg/*.svg data/realworld/files/*.svg) ;;
+        gcode_reader) seeds=(data/gcode-samples/*) ;;
         tflex_reader) seeds=(data/nests/tflex/*.tfnesting) ;;
         dbs_reader) seeds=(data/nests/dbs/*.dbs data/nests/dbs/*.DBS) ;;
         json_readers) seeds=(data/nests/dbs-json/*.json data/nests/task-json/*.json data/nests/result-json/*.json) ;;

@@ -9,7 +9,8 @@
 #   - wasm-opt (binaryen from npm, run by Node; the version Trunk.toml pins) for the release build;
 #   - Firefox ESR (Debian) for the single-file page's test in a second browser;
 #   - playwright-core and ws (npm; they drive the system browsers, they never download one);
-#   - LinuxCNC's standalone interpreter rs274, unpacked outside the clone (scripts/install-rs274.sh).
+#   - LinuxCNC's standalone interpreter rs274, unpacked outside the clone (scripts/install-rs274.sh);
+#   - ezdxf (PyPI), the independent DXF reader the corpus oracle and the reader benchmark use.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -75,4 +76,11 @@ if [ ! -d tests/e2e/node_modules/playwright-core ] || [ ! -d tests/e2e/node_modu
 fi
 # LinuxCNC's standalone interpreter, the G-code tests' referee (crates/gcode/tests/linuxcnc.rs).
 scripts/install-rs274.sh
+# ezdxf: the second opinion on DXF files (it computed data/realworld/expected.csv; the reader
+# benchmark times it, and scripts/make-dxf-matrix.py writes the made DXF corpus with it).
+if ! python3 -c 'import ezdxf' 2>/dev/null; then
+  log "pip install ezdxf"
+  python3 -m pip install --quiet ezdxf 2>/dev/null \
+    || python3 -m pip install --quiet --user --break-system-packages ezdxf
+fi
 log "ready (wasm std: $wasm_mode)"
