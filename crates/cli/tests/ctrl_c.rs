@@ -10,22 +10,9 @@ use std::path::Path;
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-use common::data;
-use cutroute_geometry::{ContourRef, CutStep, Entry, PathRoute, PathRouteError, Point, Route};
+use common::{data, SOLVERS};
 use cutroute_protocol::Problem;
 use serde_json::Value;
-
-const SOLVERS: [&str; 9] = [
-    "nearest",
-    "ccp",
-    "heuristic",
-    "exact",
-    "discrete",
-    "chain",
-    "sccp",
-    "gsccp",
-    "aoe",
-];
 
 /// Longest a stopped run may take to end (a debug build on a loaded machine; the CLI waits at
 /// most a second for the stopped solver's route).
@@ -94,44 +81,7 @@ fn assert_checked_route(what: &str, input: &Path, report: &Value) {
     let Problem::Nest { nest, start, .. } = &document.problem else {
         panic!("a nest");
     };
-    let tolerance = nest.check_tolerance();
-    if report.get("objective").is_some() {
-        let route: PathRoute = serde_json::from_value(report["route"].clone())
-            .unwrap_or_else(|e| panic!("{what}: no path route ({e}): {report}"));
-        let real: Vec<_> = route
-            .problems(nest, tolerance)
-            .into_iter()
-            .filter(|p| !matches!(p, PathRouteError::Overlap { .. }))
-            .collect();
-        assert!(real.is_empty(), "{what}: {real:?}");
-        return;
-    }
-    let point = |v: &Value| Point::new(v[0].as_f64().unwrap(), v[1].as_f64().unwrap());
-    let steps = report["route"]
-        .as_array()
-        .unwrap_or_else(|| panic!("{what}: no route: {report}"))
-        .iter()
-        .map(|s| CutStep {
-            contour: ContourRef {
-                part: s["contour"][0].as_u64().unwrap() as usize,
-                contour: s["contour"][1].as_u64().unwrap() as usize,
-            },
-            pierce_point: point(&s["pierce"]),
-            entry: match s.get("link").and_then(Value::as_array) {
-                Some(corners) => Entry::Link(corners.iter().map(point).collect()),
-                None => Entry::Pierce,
-            },
-            leads: None,
-        })
-        .collect();
-    let route = Route {
-        start: *start,
-        steps,
-        finish: None,
-    };
-    route
-        .validate(nest, tolerance)
-        .unwrap_or_else(|e| panic!("{what}: invalid route: {e}"));
+    common::assert_report_route(what, nest, *start, report);
 }
 
 fn solve_interrupted(solver: &str, after: Duration) {

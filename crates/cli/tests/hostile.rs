@@ -12,7 +12,6 @@ use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use common::data;
-use cutroute_geometry::{ContourRef, CutStep, Entry, PathRoute, PathRouteError, Point, Route};
 use cutroute_protocol::Problem;
 use serde_json::Value;
 
@@ -143,43 +142,7 @@ fn check_result(args: &[&str], input: &Path, stdout: &str) {
                 .unwrap_or_else(|e| panic!("{args:?}: exit 0 with a bad tour: {e}"));
         }
         Problem::Nest { nest, start, .. } => {
-            let tolerance = nest.check_tolerance();
-            if report.get("objective").is_some() {
-                let route: PathRoute = serde_json::from_value(report["route"].clone()).unwrap();
-                let problems = route.problems(nest, tolerance);
-                let real: Vec<_> = problems
-                    .iter()
-                    .filter(|p| !matches!(p, PathRouteError::Overlap { .. }))
-                    .collect();
-                assert!(real.is_empty(), "{args:?}: exit 0 with {real:?}");
-                return;
-            }
-            let point = |v: &Value| Point::new(v[0].as_f64().unwrap(), v[1].as_f64().unwrap());
-            let steps = report["route"]
-                .as_array()
-                .unwrap_or_else(|| panic!("{args:?}: exit 0 without a route"))
-                .iter()
-                .map(|s| CutStep {
-                    contour: ContourRef {
-                        part: s["contour"][0].as_u64().unwrap() as usize,
-                        contour: s["contour"][1].as_u64().unwrap() as usize,
-                    },
-                    pierce_point: point(&s["pierce"]),
-                    entry: match s.get("link").and_then(Value::as_array) {
-                        Some(corners) => Entry::Link(corners.iter().map(point).collect()),
-                        None => Entry::Pierce,
-                    },
-                    leads: None,
-                })
-                .collect();
-            let route = Route {
-                start: *start,
-                steps,
-                finish: None,
-            };
-            route
-                .validate(nest, tolerance)
-                .unwrap_or_else(|e| panic!("{args:?}: exit 0 with an invalid route: {e}"));
+            common::assert_report_route(&format!("{args:?}: exit 0"), nest, *start, &report);
         }
     }
 }

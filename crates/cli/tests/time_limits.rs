@@ -57,20 +57,7 @@ fn every_solver_returns_within_its_limit_plus_one_second() {
     let nest = nest.to_str().unwrap();
     let (_, code, stderr) = timed(&["generate", "--contours", "10000", "--out", nest]);
     assert_eq!(code, Some(0), "{stderr}");
-    assert_promise_kept(
-        nest,
-        &[
-            "nearest",
-            "ccp",
-            "heuristic",
-            "exact",
-            "discrete",
-            "chain",
-            "sccp",
-            "gsccp",
-            "aoe",
-        ],
-    );
+    assert_promise_kept(nest, &common::SOLVERS);
     let instance = data("pcgtsp/pcgtsplib/kro124p.1.pcglns");
     assert_promise_kept(instance.to_str().unwrap(), &["heuristic", "exact"]);
 }
