@@ -7,7 +7,7 @@ use cutroute_ccp::{
     build_pcgtsp, containment_pairs, route_certificates, solve, CcpOptions, CcpSolver,
     DiscretisationOptions, Status,
 };
-use cutroute_geometry::{generate_nest, Contour, Nest, Part, Point, Route, Vertex};
+use cutroute_geometry::{generate_nest, Contour, Nest, Part, Point, Route};
 
 fn part(name: &str, contours: Vec<Contour>) -> Part {
     Part {
@@ -17,12 +17,7 @@ fn part(name: &str, contours: Vec<Contour>) -> Part {
 }
 
 fn square(x: f64, y: f64, side: f64) -> Contour {
-    Contour::new(vec![
-        Vertex::line(x, y),
-        Vertex::line(x, y + side),
-        Vertex::line(x + side, y + side),
-        Vertex::line(x + side, y),
-    ])
+    Contour::rectangle(x, y, x + side, y + side)
 }
 
 fn quick(start: Point, finish: Option<Point>) -> CcpOptions {

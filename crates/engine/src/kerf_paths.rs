@@ -367,7 +367,7 @@ impl PathLeadsRun {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use cutroute_geometry::{Contour, LeadShape, LeadSpec, Part, Vertex};
+    use cutroute_geometry::{Contour, LeadShape, LeadSpec, Part};
     use cutroute_protocol::{JobRequest, Problem, SolverKind, SolverParams};
 
     /// A solver job that answers with a fixed path route.
@@ -387,12 +387,7 @@ mod tests {
     }
 
     fn square(x: f64, y: f64, side: f64) -> Contour {
-        Contour::new(vec![
-            Vertex::line(x, y),
-            Vertex::line(x, y + side),
-            Vertex::line(x + side, y + side),
-            Vertex::line(x + side, y),
-        ])
+        Contour::rectangle(x, y, x + side, y + side)
     }
 
     /// A route with leads the checker rejects (it leaves a contour uncut) gives way to a

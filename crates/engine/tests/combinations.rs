@@ -33,12 +33,7 @@ const STEPS_WITH_A_ROUTE: usize = 8;
 const MOST_STEPS: usize = 400;
 
 fn square(x: f64, y: f64, side: f64) -> Contour {
-    Contour::new(vec![
-        Vertex::line(x, y),
-        Vertex::line(x, y + side),
-        Vertex::line(x + side, y + side),
-        Vertex::line(x + side, y),
-    ])
+    Contour::rectangle(x, y, x + side, y + side)
 }
 
 fn part(name: &str, contours: Vec<Contour>) -> Part {

@@ -7,7 +7,7 @@ mod common;
 use common::{nest_of, nest_problem, plasma};
 
 use cutroute_engine::{build_full_route_model, run_to_end, start_job};
-use cutroute_geometry::{Contour, Nest, Part, Point, Route, Vertex};
+use cutroute_geometry::{Contour, Nest, Part, Point, Route};
 use cutroute_pcgtsp::Instance;
 use cutroute_protocol::{
     JobRequest, KerfNote, KerfSource, Phase, Problem, Progress, SolverKind, SolverParams,
@@ -53,12 +53,7 @@ fn checked(problem: &Problem, progress: &Progress) -> Route {
 }
 
 fn square(x: f64, y: f64, side: f64) -> Contour {
-    Contour::new(vec![
-        Vertex::line(x, y),
-        Vertex::line(x, y + side),
-        Vertex::line(x + side, y + side),
-        Vertex::line(x + side, y),
-    ])
+    Contour::rectangle(x, y, x + side, y + side)
 }
 
 /// Four contours: a plate with a square hole (the hole first), a square and a disc.
