@@ -15,7 +15,10 @@ fn line(a: (f64, f64), b: (f64, f64)) -> String {
     )
 }
 
-fn lines(points: &[((f64, f64), (f64, f64))]) -> String {
+/// A line from its start to its end.
+type Segment = ((f64, f64), (f64, f64));
+
+fn lines(points: &[Segment]) -> String {
     points.iter().map(|&(a, b)| line(a, b)).collect()
 }
 
