@@ -3,8 +3,18 @@
 //! Pieces (lines, arcs, open polylines, approximated splines) are joined end to end when their
 //! end points lie within the join tolerance. End points live in a uniform grid whose cells are
 //! as wide as the tolerance, so a neighbour search looks at 3 × 3 cells and the whole join is
-//! linear in the number of pieces for real drawings. Where more than two ends meet, the nearest
-//! wins; what cannot be closed is reported as an open chain. Closed contours are then nested by
+//! linear in the number of pieces for real drawings; what cannot be closed is reported as an
+//! open chain.
+//!
+//! Where more than two ends meet (pieces sharing edges, branches, T-junctions at end points),
+//! joining end to end would close an arbitrary loop. Such a group of pieces is read as the
+//! plane graph it draws, and every bounded face of it is a contour of its own: a cutting
+//! machine cuts every line drawn, so each region enclosed by lines falls out as a piece of its
+//! own, and an edge two regions share is one common edge of two parts (which common-edge
+//! cutting cuts once). Reading only the outline would drop the inner lines, and reading the
+//! inner faces as holes would cut the whole part away. The unbounded face of each connected
+//! piece is no contour (its bounded faces draw it); branches that enclose nothing (dangling
+//! pieces, bridges between regions) are reported as open chains. Closed contours are then nested by
 //! containment: even depth (not inside anything, or inside a hole) starts a part, odd depth is a
 //! hole of its container's part. Outer contours are made clockwise, holes counter-clockwise.
 
@@ -318,7 +328,16 @@ pub(crate) fn assemble(pieces: Vec<Piece>, limits: &AssembleLimits) -> Assembled
         .iter()
         .flat_map(|p| [p.spans[0].start, p.spans[p.spans.len() - 1].end])
         .collect();
-    let mut used: Vec<bool> = pieces.iter().map(|p| p.closed).collect();
+    // Pieces of a group with a node where more than two ends meet are not joined end to end
+    // (which loop closes there would be arbitrary) but split into the faces of their plane
+    // graph, after the joiner.
+    let nodes = Nodes::cluster(&pieces, &ends, tolerance);
+    let branched = nodes.branched(&pieces, tolerance);
+    let mut used: Vec<bool> = pieces
+        .iter()
+        .zip(&branched)
+        .map(|(p, &b)| p.closed || b)
+        .collect();
     let mut grid = EndGrid {
         cell: tolerance,
         cells: HashMap::new(),
@@ -326,6 +345,9 @@ pub(crate) fn assemble(pieces: Vec<Piece>, limits: &AssembleLimits) -> Assembled
     for (i, p) in pieces.iter().enumerate() {
         if p.closed {
             contours.push((chain_contour(&[(i, false)], &pieces), p.source.clone()));
+            continue;
+        }
+        if branched[i] {
             continue;
         }
         for side in 0..2u32 {
@@ -392,6 +414,14 @@ pub(crate) fn assemble(pieces: Vec<Piece>, limits: &AssembleLimits) -> Assembled
                     .collect(),
             });
         }
+    }
+
+    let members: Vec<usize> = (0..pieces.len()).filter(|&i| branched[i]).collect();
+    if !members.is_empty() {
+        let (faces, chains, left_out) = faces_of(&pieces, &members, &nodes, limits);
+        contours.extend(faces);
+        open_chains.extend(chains);
+        dropped.extend(left_out);
     }
 
     let parts = group_into_parts(contours, limits, &mut dropped);
@@ -689,4 +719,510 @@ pub(crate) fn is_bounded(t: &Transform) -> bool {
     t.matrix.iter().flatten().all(|v| v.abs() <= 1e6)
         && t.offset.x.abs() <= 1e12
         && t.offset.y.abs() <= 1e12
+}
+
+/// End points of the open pieces merged into nodes: each end joins the nearest node within the
+/// join tolerance (found in a grid of tolerance-wide cells), or starts one.
+struct Nodes {
+    /// Node of each end (piece·2 + side); `u32::MAX` for the ends of closed pieces.
+    of_end: Vec<u32>,
+    /// Where each node is: the first end that started it.
+    at: Vec<Point>,
+}
+
+impl Nodes {
+    fn cluster(pieces: &[Piece], ends: &[Point], tolerance: f64) -> Nodes {
+        let mut of_end = vec![u32::MAX; ends.len()];
+        let mut at: Vec<Point> = Vec::new();
+        let mut cells: HashMap<(i64, i64), Vec<u32>> = HashMap::new();
+        let key = |p: Point| {
+            (
+                (p.x / tolerance).floor() as i64,
+                (p.y / tolerance).floor() as i64,
+            )
+        };
+        for (id, &p) in ends.iter().enumerate() {
+            if pieces[id / 2].closed {
+                continue;
+            }
+            let (kx, ky) = key(p);
+            let mut best: Option<(u32, f64)> = None;
+            let mut examined = 0;
+            'search: for dx in -1..=1 {
+                for dy in -1..=1 {
+                    let Some(cell) = cells.get(&(kx.saturating_add(dx), ky.saturating_add(dy)))
+                    else {
+                        continue;
+                    };
+                    for &n in cell {
+                        let d = p.distance(at[n as usize]);
+                        if d <= tolerance && best.is_none_or(|(_, bd)| d < bd) {
+                            best = Some((n, d));
+                        }
+                        examined += 1;
+                        if examined >= MAX_CANDIDATES {
+                            break 'search;
+                        }
+                    }
+                }
+            }
+            of_end[id] = match best {
+                Some((n, _)) => n,
+                None => {
+                    let n = at.len() as u32;
+                    at.push(p);
+                    cells.entry((kx, ky)).or_default().push(n);
+                    n
+                }
+            };
+        }
+        Nodes { of_end, at }
+    }
+
+    /// Whether the open piece `i` has both ends at one node and cannot enclose anything there:
+    /// a single straight span, or a piece no longer than twice the join tolerance (a closed
+    /// curve of length L fits in a disc of diameter L/2, so it would be narrower than the
+    /// tolerance).
+    fn collapsed(&self, pieces: &[Piece], i: usize, tolerance: f64) -> bool {
+        let spans = &pieces[i].spans;
+        self.of_end[2 * i] == self.of_end[2 * i + 1]
+            && ((spans.len() == 1 && spans[0].bulge == 0.0)
+                || spans.iter().map(Span::length).sum::<f64>() <= 2.0 * tolerance)
+    }
+
+    /// The open pieces whose connected group of pieces has a node where more than two ends
+    /// meet: shared edges and branches, where end-to-end joining is ambiguous.
+    fn branched(&self, pieces: &[Piece], tolerance: f64) -> Vec<bool> {
+        let mut degree = vec![0u32; self.at.len()];
+        let mut sets = UnionFind::new(self.at.len());
+        for i in 0..pieces.len() {
+            if pieces[i].closed || self.collapsed(pieces, i, tolerance) {
+                continue;
+            }
+            let (a, b) = (self.of_end[2 * i], self.of_end[2 * i + 1]);
+            degree[a as usize] += 1;
+            degree[b as usize] += 1;
+            sets.union(a as usize, b as usize);
+        }
+        let mut branching = vec![false; self.at.len()];
+        for (n, &d) in degree.iter().enumerate() {
+            if d > 2 {
+                let root = sets.find(n);
+                branching[root] = true;
+            }
+        }
+        (0..pieces.len())
+            .map(|i| !pieces[i].closed && branching[sets.find(self.of_end[2 * i] as usize)])
+            .collect()
+    }
+}
+
+struct UnionFind {
+    parent: Vec<usize>,
+}
+
+impl UnionFind {
+    fn new(n: usize) -> Self {
+        Self {
+            parent: (0..n).collect(),
+        }
+    }
+
+    fn find(&mut self, mut x: usize) -> usize {
+        while self.parent[x] != x {
+            self.parent[x] = self.parent[self.parent[x]];
+            x = self.parent[x];
+        }
+        x
+    }
+
+    fn union(&mut self, a: usize, b: usize) {
+        let (a, b) = (self.find(a), self.find(b));
+        if a != b {
+            self.parent[a] = b;
+        }
+    }
+}
+
+/// The point `s` mm along the spans from their start (their end when they are shorter).
+fn point_along(spans: impl Iterator<Item = Span>, mut s: f64) -> Option<Point> {
+    let mut last = None;
+    for span in spans {
+        let length = span.length();
+        if length >= s && length > 0.0 {
+            return Some(span.point_at(s / length));
+        }
+        s -= length;
+        last = Some(span.end);
+    }
+    last
+}
+
+/// The faces of the plane graph of the branched pieces (see [`assemble`]): closed contours of
+/// every bounded face, and the pieces that bound none as open chains.
+fn faces_of(
+    pieces: &[Piece],
+    members: &[usize],
+    nodes: &Nodes,
+    limits: &AssembleLimits,
+) -> (Vec<(Contour, SourceRef)>, Vec<OpenChain>, Vec<Dropped>) {
+    let tolerance = limits.join_tolerance;
+    let mut leftover: Vec<usize> = Vec::new();
+    // Edge e runs over piece edges[e] from node ends[2e] to node ends[2e+1]; half-edge h is
+    // edge h/2 forwards when h is even, backwards when odd.
+    let mut edges: Vec<usize> = Vec::new();
+    for &i in members {
+        if nodes.collapsed(pieces, i, tolerance) {
+            leftover.push(i);
+        } else {
+            edges.push(i);
+        }
+    }
+    let origin = |h: usize| nodes.of_end[2 * edges[h / 2] + (h % 2)] as usize;
+    // Direction in which each half-edge leaves its node: towards a point a little way along
+    // it, measured from the node (not from the piece's own end), so that pieces meeting within
+    // the tolerance but offset from each other are ordered as drawn, and tangent pieces by
+    // their curvature.
+    let reach = 10.0 * tolerance;
+    let angle: Vec<f64> = (0..2 * edges.len())
+        .map(|h| {
+            let piece = &pieces[edges[h / 2]];
+            let length: f64 = piece.spans.iter().map(Span::length).sum();
+            let s = (0.5 * length).min(reach);
+            let along = if h % 2 == 0 {
+                point_along(piece.spans.iter().copied(), s)
+            } else {
+                point_along(piece.spans.iter().rev().map(|sp| sp.reversed()), s)
+            };
+            let from = nodes.at[origin(h)];
+            let d = along.unwrap_or(from) - from;
+            d.y.atan2(d.x)
+        })
+        .collect();
+
+    let mut alive = vec![true; edges.len()];
+    let mut dropped = Vec::new();
+    let mut duplicate = vec![false; edges.len()];
+    // Two pieces between the same two nodes that enclose a sliver narrower than the tolerance
+    // (as `check_cuttable` measures thinness) are one edge drawn twice: a hatch line whose
+    // ends touch an outline's corners, an edge redrawn a little off. The first is kept.
+    let mut between: HashMap<(usize, usize), Vec<usize>> = HashMap::new();
+    for e in 0..edges.len() {
+        let (a, b) = (origin(2 * e), origin(2 * e + 1));
+        if a == b {
+            continue;
+        }
+        let list = between.entry((a.min(b), a.max(b))).or_default();
+        let twin = list.iter().copied().find(|&k| {
+            let links = [
+                (edges[k], false),
+                (edges[e], origin(2 * e) == origin(2 * k)),
+            ];
+            let loop_ = chain_contour(&links, pieces);
+            loop_.area() < tolerance * loop_.perimeter() / 2.0
+        });
+        match twin {
+            Some(k) => {
+                alive[e] = false;
+                duplicate[e] = true;
+                let (this, kept) = (&pieces[edges[e]].source, &pieces[edges[k]].source);
+                dropped.push(Dropped {
+                    kind: WarningKind::Duplicate,
+                    line: this.line,
+                    message: format!(
+                        "{} runs along the {} at line {} within the join tolerance, between the \
+                         same end points; ignored",
+                        this.entity, kept.entity, kept.line
+                    ),
+                    left_out: vec![flatten_spans(
+                        &pieces[edges[e]].spans,
+                        limits.flatten_tolerance,
+                    )],
+                });
+            }
+            None => list.push(e),
+        }
+    }
+    // A piece that ends on the inside of another piece of its group (a T-junction away from
+    // the other's ends) makes a plane graph that only splitting that piece would complete;
+    // its faces read without the split would not be the regions drawn, so such a group is
+    // left open, every piece said.
+    let unsplit = t_junction_groups(pieces, &edges, &alive, &origin, nodes, tolerance);
+    for e in 0..edges.len() {
+        if unsplit[e] {
+            alive[e] = false;
+        }
+    }
+    prune_branches(&mut alive, &origin, nodes.at.len());
+    let mut faces = trace_faces(&alive, &origin, &angle, nodes.at.len());
+    // An edge with one face on both sides is a bridge between two pieces (or a branch into a
+    // face): it bounds no region, so it is left out and the faces traced again without it.
+    let mut bridged = false;
+    for (e, live) in alive.iter_mut().enumerate() {
+        if *live && faces.face_of[2 * e] == faces.face_of[2 * e + 1] {
+            *live = false;
+            bridged = true;
+        }
+    }
+    if bridged {
+        prune_branches(&mut alive, &origin, nodes.at.len());
+        faces = trace_faces(&alive, &origin, &angle, nodes.at.len());
+    }
+
+    // Each connected piece of the graph has one unbounded face, the one of least signed area
+    // (clockwise, as the bounded faces come out counter-clockwise): it is that piece's outline
+    // seen from outside, drawn by the bounded faces already, so it is not a contour of its own.
+    let mut sets = UnionFind::new(nodes.at.len());
+    for (e, _) in alive.iter().enumerate().filter(|(_, &live)| live) {
+        sets.union(origin(2 * e), origin(2 * e + 1));
+    }
+    let link = |h: usize| (edges[h / 2], h % 2 == 1);
+    let mut traced: Vec<(usize, Contour, f64)> = Vec::with_capacity(faces.walks.len());
+    let mut outer: HashMap<usize, (usize, f64)> = HashMap::new();
+    for (f, walk) in faces.walks.iter().enumerate() {
+        // Start at the piece that comes first in the file, as the joiner does.
+        let first = (0..walk.len())
+            .min_by_key(|&k| edges[walk[k] / 2])
+            .unwrap_or(0);
+        let links: Vec<(usize, bool)> = walk[first..]
+            .iter()
+            .chain(&walk[..first])
+            .map(|&h| link(h))
+            .collect();
+        let contour = chain_contour(&links, pieces);
+        let area = contour.signed_area();
+        let component = sets.find(origin(walk[0]));
+        let entry = outer.entry(component).or_insert((f, area));
+        if area < entry.1 {
+            *entry = (f, area);
+        }
+        traced.push((links[0].0, contour, area));
+    }
+    let mut covered = duplicate;
+    let mut contours = Vec::new();
+    for (f, (start, contour, _)) in traced.into_iter().enumerate() {
+        let component = sets.find(origin(faces.walks[f][0]));
+        if outer.get(&component).is_some_and(|&(o, _)| o == f) {
+            continue;
+        }
+        for &h in &faces.walks[f] {
+            covered[h / 2] = true;
+        }
+        contours.push((contour, pieces[start].source.clone()));
+    }
+    // Said, never silent: every piece that bounds no face.
+    let mut left: Vec<usize> = (0..edges.len()).filter(|&e| !covered[e]).collect();
+    left.sort_unstable();
+    let open_chains = chain_leftovers(pieces, nodes, &left, &edges, &leftover, limits);
+    (contours, open_chains, dropped)
+}
+
+/// The edges of every connected group in which a node of one live end lies on the inside of
+/// another piece of the group (farther than the tolerance from that piece's ends).
+fn t_junction_groups(
+    pieces: &[Piece],
+    edges: &[usize],
+    alive: &[bool],
+    origin: &impl Fn(usize) -> usize,
+    nodes: &Nodes,
+    tolerance: f64,
+) -> Vec<bool> {
+    let mut degree: HashMap<usize, u32> = HashMap::new();
+    let mut sets = UnionFind::new(nodes.at.len());
+    for e in (0..edges.len()).filter(|&e| alive[e]) {
+        *degree.entry(origin(2 * e)).or_default() += 1;
+        *degree.entry(origin(2 * e + 1)).or_default() += 1;
+        sets.union(origin(2 * e), origin(2 * e + 1));
+    }
+    let spans = rstar::RTree::bulk_load(
+        (0..edges.len())
+            .filter(|&e| alive[e])
+            .flat_map(|e| {
+                pieces[edges[e]]
+                    .spans
+                    .iter()
+                    .enumerate()
+                    .map(move |(k, s)| {
+                        let b = s.bounding_box().expanded(tolerance);
+                        rstar::primitives::GeomWithData::new(
+                            rstar::primitives::Rectangle::from_corners(
+                                [b.min.x, b.min.y],
+                                [b.max.x, b.max.y],
+                            ),
+                            (e, k),
+                        )
+                    })
+            })
+            .collect(),
+    );
+    let mut open_group: HashMap<usize, bool> = HashMap::new();
+    for (&n, _) in degree.iter().filter(|(_, &d)| d == 1) {
+        let p = nodes.at[n];
+        let query = rstar::AABB::from_corners([p.x, p.y], [p.x, p.y]);
+        let on_inside = spans.locate_in_envelope_intersecting(&query).any(|g| {
+            let (e, k) = g.data;
+            let (a, b) = (origin(2 * e), origin(2 * e + 1));
+            a != n
+                && b != n
+                && nodes.at[a].distance(p) > tolerance
+                && nodes.at[b].distance(p) > tolerance
+                && pieces[edges[e]].spans[k].distance_to(p) <= tolerance
+        });
+        if on_inside {
+            open_group.insert(sets.find(n), true);
+        }
+    }
+    (0..edges.len())
+        .map(|e| alive[e] && open_group.contains_key(&sets.find(origin(2 * e))))
+        .collect()
+}
+
+/// Marks dead every edge on a branch that ends in a node of one end: such a branch encloses
+/// nothing, however far it reaches.
+fn prune_branches(alive: &mut [bool], origin: &impl Fn(usize) -> usize, node_count: usize) {
+    let mut degree = vec![0u32; node_count];
+    let mut at: HashMap<usize, Vec<usize>> = HashMap::new();
+    for (e, _) in alive.iter().enumerate().filter(|(_, &live)| live) {
+        for h in [2 * e, 2 * e + 1] {
+            degree[origin(h)] += 1;
+            at.entry(origin(h)).or_default().push(h);
+        }
+    }
+    let mut queue: Vec<usize> = (0..node_count).filter(|&n| degree[n] == 1).collect();
+    while let Some(n) = queue.pop() {
+        if degree[n] != 1 {
+            continue;
+        }
+        let Some(&h) = at[&n].iter().find(|&&h| alive[h / 2]) else {
+            continue;
+        };
+        alive[h / 2] = false;
+        degree[n] -= 1;
+        let other = origin(h ^ 1);
+        degree[other] -= 1;
+        if degree[other] == 1 {
+            queue.push(other);
+        }
+    }
+}
+
+struct Faces {
+    /// The face on the left of each half-edge (`usize::MAX` for dead edges).
+    face_of: Vec<usize>,
+    /// Each face's boundary walk, as half-edges.
+    walks: Vec<Vec<usize>>,
+}
+
+/// Faces of the live edges, each to the left of its walk: at every node the half-edges are
+/// ordered by angle, and a walk arriving at a node leaves by the half-edge next clockwise from
+/// the one it arrived by, so bounded faces run counter-clockwise.
+fn trace_faces(
+    alive: &[bool],
+    origin: &impl Fn(usize) -> usize,
+    angle: &[f64],
+    node_count: usize,
+) -> Faces {
+    let mut out: Vec<Vec<usize>> = vec![Vec::new(); node_count];
+    for e in 0..alive.len() {
+        if alive[e] {
+            out[origin(2 * e)].push(2 * e);
+            out[origin(2 * e + 1)].push(2 * e + 1);
+        }
+    }
+    let mut position = vec![0usize; 2 * alive.len()];
+    for list in &mut out {
+        list.sort_by(|&a, &b| angle[a].total_cmp(&angle[b]).then(a.cmp(&b)));
+        for (k, &h) in list.iter().enumerate() {
+            position[h] = k;
+        }
+    }
+    let mut face_of = vec![usize::MAX; 2 * alive.len()];
+    let mut walks = Vec::new();
+    for start in 0..2 * alive.len() {
+        if !alive[start / 2] || face_of[start] != usize::MAX {
+            continue;
+        }
+        let face = walks.len();
+        let mut walk = Vec::new();
+        let mut h = start;
+        while face_of[h] == usize::MAX {
+            face_of[h] = face;
+            walk.push(h);
+            let twin = h ^ 1;
+            let list = &out[origin(twin)];
+            h = list[(position[twin] + list.len() - 1) % list.len()];
+        }
+        walks.push(walk);
+    }
+    Faces { face_of, walks }
+}
+
+/// The pieces that bound no face, joined through the nodes where exactly two of them meet, as
+/// open chains (in file order of their first pieces).
+fn chain_leftovers(
+    pieces: &[Piece],
+    nodes: &Nodes,
+    left: &[usize],
+    edges: &[usize],
+    collapsed: &[usize],
+    limits: &AssembleLimits,
+) -> Vec<OpenChain> {
+    let mut items: Vec<usize> = left
+        .iter()
+        .map(|&e| edges[e])
+        .chain(collapsed.iter().copied())
+        .collect();
+    items.sort_unstable();
+    let mut at: HashMap<u32, Vec<usize>> = HashMap::new();
+    for &i in &items {
+        at.entry(nodes.of_end[2 * i]).or_default().push(i);
+        if nodes.of_end[2 * i + 1] != nodes.of_end[2 * i] {
+            at.entry(nodes.of_end[2 * i + 1]).or_default().push(i);
+        }
+    }
+    let mut done = vec![false; pieces.len()];
+    let mut chains = Vec::new();
+    for &first in &items {
+        if std::mem::replace(&mut done[first], true) {
+            continue;
+        }
+        let mut chain: std::collections::VecDeque<(usize, bool)> = [(first, false)].into();
+        for forward in [true, false] {
+            loop {
+                let &(p, rev) = if forward {
+                    chain.back().expect("chains are never empty")
+                } else {
+                    chain.front().expect("chains are never empty")
+                };
+                // The node the chain ends at on this side.
+                let node = nodes.of_end[2 * p + usize::from(rev != forward)];
+                let Some(list) = at.get(&node).filter(|l| l.len() == 2) else {
+                    break;
+                };
+                let Some(&next) = list.iter().find(|&&q| !done[q]) else {
+                    break;
+                };
+                done[next] = true;
+                let at_start = nodes.of_end[2 * next] == node;
+                if forward {
+                    chain.push_back((next, !at_start));
+                } else {
+                    chain.push_front((next, at_start));
+                }
+            }
+        }
+        let links: Vec<(usize, bool)> = chain.into_iter().collect();
+        let spans: Vec<Span> = chain_spans(&links, pieces).collect();
+        chains.push(OpenChain {
+            polyline: flatten_spans(&spans, limits.flatten_tolerance),
+            start: spans[0].start,
+            end: spans[spans.len() - 1].end,
+            length: spans.iter().map(Span::length).sum(),
+            entities: links
+                .iter()
+                .map(|&(p, _)| pieces[p].source.clone())
+                .collect(),
+        });
+    }
+    chains
 }

@@ -34,7 +34,9 @@ const READER_OWNED: &[&str] = &[
     "openscad__nothing-decimal-comma-separated.dxf",
     "openscad__polygon-self-intersect.dxf",
     "openscad__example009.dxf",
-    // DXF: not yet read as drawn (shared edges, T-junctions).
+    // DXF: the oracle corrected (shared edges and branches read as the plane graph's faces,
+    // periodic splines, full ellipses whose 2π is rounded).
+    "librecad__tux.dxf",
     "bjnortier-dxf__issue52.dxf",
     "bjnortier-dxf__entities.dxf",
     "bjnortier-dxf__supported_entities.dxf",
