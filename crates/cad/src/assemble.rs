@@ -453,11 +453,7 @@ fn loops_removed(
 ) -> Option<Dropped> {
     let what = repair.describe()?;
     Some(Dropped {
-        kind: if repair.only_slivers() {
-            WarningKind::ZeroArea
-        } else {
-            WarningKind::SelfIntersecting
-        },
+        kind: repair.warning_kind(),
         line: source.line,
         message: format!("closed contour starting with {}: {what}", source.entity),
         left_out: repair.left_out(limits.flatten_tolerance),

@@ -24,7 +24,7 @@
 //! Nest formats (geometry JSON, DBS, result JSON) do not repair: a nesting program never writes
 //! such a contour, so they refuse it with its location.
 
-use crate::{Contour, ContourFault, Point, Span, Vertex};
+use crate::{Contour, ContourFault, Point, Span, Vertex, WarningKind};
 
 /// A sub-loop removed from a contour by [`Contour::without_small_loops`].
 #[derive(Clone, Debug, PartialEq)]
@@ -61,10 +61,20 @@ pub struct LoopRepair {
 }
 
 impl LoopRepair {
-    /// Whether every removed loop was a sliver (a spike or slit drawn out and back), so the
-    /// removal is best told as "no area" rather than as a crossing.
-    pub fn only_slivers(&self) -> bool {
-        !self.removed.is_empty() && self.removed.iter().all(|l| l.reason == LoopReason::Sliver)
+    /// The kind of a reader's warning for the removal: [`WarningKind::ZeroArea`] when every
+    /// removed loop was a sliver (a spike or slit drawn out and back), otherwise
+    /// [`WarningKind::SelfIntersecting`] (repaired, as its message says).
+    pub fn warning_kind(&self) -> WarningKind {
+        if !self.removed.is_empty() && self.removed.iter().all(|l| l.reason == LoopReason::Sliver) {
+            WarningKind::ZeroArea
+        } else {
+            WarningKind::SelfIntersecting
+        }
+    }
+
+    /// Total length (mm) of the removed loops.
+    pub fn removed_length(&self) -> f64 {
+        self.removed.iter().map(|l| l.length).sum()
     }
 
     /// What was removed and where, as a sentence for a reader's warning (without the place in
@@ -74,7 +84,7 @@ impl LoopRepair {
         if n == 0 {
             return None;
         }
-        let length: f64 = self.removed.iter().map(|l| l.length).sum();
+        let length = self.removed_length();
         let mut out = format!(
             "{n} loop{} too small to cut ({length:.3} mm in all) removed where the outline \
              touches or crosses itself: ",
