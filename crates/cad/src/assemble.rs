@@ -475,6 +475,21 @@ fn chain_contour(links: &[(usize, bool)], pieces: &[Piece]) -> Contour {
         .unwrap_or_else(|_| Contour::new(vertices))
 }
 
+/// The warning for the loops [`Contour::without_small_loops`] removed from a contour, if any.
+fn loops_removed(
+    repair: &cutroute_geometry::LoopRepair,
+    source: &SourceRef,
+    limits: &AssembleLimits,
+) -> Option<Dropped> {
+    let what = repair.describe()?;
+    Some(Dropped {
+        kind: repair.warning_kind(),
+        line: source.line,
+        message: format!("closed contour starting with {}: {what}", source.entity),
+        left_out: repair.left_out(limits.flatten_tolerance),
+    })
+}
+
 struct Placed {
     contour: Contour,
     source: SourceRef,
@@ -493,10 +508,19 @@ fn group_into_parts(
     let tolerance = limits.join_tolerance;
     let mut placed: Vec<Placed> = Vec::with_capacity(contours.len());
     for (contour, source) in contours {
+        // The one repair first: loops too small to cut where an outline touches or crosses
+        // itself are removed, said, and the rest of the outline kept.
+        let (contour, fault) = match contour.without_small_loops(tolerance) {
+            Ok(repair) => {
+                dropped.extend(loops_removed(&repair, &source, limits));
+                (repair.contour, None)
+            }
+            Err(fault) => (contour, Some(fault)),
+        };
         let area = contour.signed_area();
         // The one meaning of a contour: a drawing commonly carries lines drawn twice (which
         // join into loops enclosing nothing) and crossing outlines; they are left out, said.
-        if let Err(fault) = contour.check_cuttable(tolerance) {
+        if let Some(fault) = fault {
             let (kind, why) = match &fault {
                 ContourFault::SelfIntersecting { x, y, .. } => (
                     WarningKind::SelfIntersecting,

@@ -131,11 +131,89 @@ fn expect(row: &Row) -> Expect {
             expect.perimeter = 149.546;
             expect.bbox = Some([16.604, 26.775, 104.788 - 92.572]);
         }
+        // Boxes.py draws an inner corner at zero burn as a cubic from the corner back to the
+        // corner: a teardrop about 0.05 mm across that touches the outline there. The oracle
+        // counts its length; the one repair of a contour (`Contour::without_small_loops`)
+        // removes it as too small to cut and keeps the outline (checked below with the
+        // warnings), so the perimeter is the oracle's without those loops, measured here from
+        // the file itself. FlexBox (oracle_unsure = yes: 2 crossings) also has two corners
+        // where a 15 mm rounded corner overshoots into the next 0.1 mm corner arc, crossing
+        // it in a loop of 0.35 mm; the repair removes them too (0.03 % of the perimeter, inside
+        // the tolerance, so not subtracted). GearBox (oracle_unsure = yes) has 12 gears whose
+        // paths end 0.04 mm from their start; the oracle's loose count joins them as the
+        // reader does.
+        f if BURN_LOOP_FILES.contains(&f) => {
+            expect.perimeter -= burn_loops(&row.file).iter().sum::<f64>();
+        }
         _ => {}
     }
     expect.perimeter *= scale;
     expect.bbox = expect.bbox.map(|b| b.map(|v| v * scale));
     expect
+}
+
+/// The Boxes.py files whose inner corners carry zero-burn teardrops.
+const BURN_LOOP_FILES: [&str; 4] = [
+    "boxes__ABox.svg",
+    "boxes__FlexBox.svg",
+    "boxes__GearBox.svg",
+    "boxes__Matrix.svg",
+];
+
+fn number(tokens: &mut std::iter::Peekable<std::str::SplitWhitespace>) -> f64 {
+    tokens.next().expect("a number").parse().expect("a number")
+}
+
+/// The length (mm, user units) of every cubic Bézier of the file's paths that ends where it
+/// starts, each by 2000 chords. Boxes.py writes absolute `M L H V C Z` only; anything else fails
+/// the test rather than being misread.
+fn burn_loops(file: &str) -> Vec<f64> {
+    let text = std::fs::read_to_string(corpus().join("files").join(file)).expect(file);
+    let mut loops = Vec::new();
+    for d in text.split(" d=\"").skip(1) {
+        let d = &d[..d.find('"').expect("a closing quote")];
+        let mut tokens = d.split_whitespace().peekable();
+        let (mut pen, mut command) = ((0.0f64, 0.0f64), "");
+        while let Some(&token) = tokens.peek() {
+            if token.chars().all(|c| c.is_ascii_alphabetic()) {
+                command = token;
+                tokens.next();
+                if command == "Z" {
+                    continue;
+                }
+            }
+            match command {
+                "M" | "L" => pen = (number(&mut tokens), number(&mut tokens)),
+                "H" => pen.0 = number(&mut tokens),
+                "V" => pen.1 = number(&mut tokens),
+                "C" => {
+                    let c: Vec<f64> = (0..6).map(|_| number(&mut tokens)).collect();
+                    let end = (c[4], c[5]);
+                    if end == pen {
+                        let at = |t: f64| {
+                            let u = 1.0 - t;
+                            let [a, b, e, f] =
+                                [u * u * u, 3.0 * u * u * t, 3.0 * u * t * t, t * t * t];
+                            (
+                                a * pen.0 + b * c[0] + e * c[2] + f * end.0,
+                                a * pen.1 + b * c[1] + e * c[3] + f * end.1,
+                            )
+                        };
+                        let length: f64 = (0..2000)
+                            .map(|k| {
+                                let (p, q) = (at(k as f64 / 2000.0), at((k + 1) as f64 / 2000.0));
+                                (q.0 - p.0).hypot(q.1 - p.1)
+                            })
+                            .sum();
+                        loops.push(length);
+                    }
+                    pen = end;
+                }
+                other => panic!("{file}: path command {other:?} is not one Boxes.py writes"),
+            }
+        }
+    }
+    loops
 }
 
 struct Outcome {
@@ -178,7 +256,7 @@ fn every_corpus_svg_reads_as_the_oracle_or_is_refused_accurately() {
     let rows = rows();
     assert_eq!(rows.len(), 23, "the corpus has 23 SVG files");
     let mut failures = Vec::new();
-    let (mut matching, mut refused, mut not_yet) = (0, 0, 0);
+    let (mut matching, mut refused) = (0, 0);
     for row in &rows {
         let want = expect(row);
         let outcome = read(&row.file);
@@ -264,36 +342,33 @@ fn every_corpus_svg_reads_as_the_oracle_or_is_refused_accurately() {
         if row.file == "ezdxf__gear.svg" && !warned(WarningKind::Duplicate) {
             problems.push("no Duplicate warning for the square drawn twice".into());
         }
-        // Boxes.py draws a small relief loop at each inner corner that crosses the outline
-        // there, so by the one meaning of a contour these outlines cross themselves and are
-        // left out, each with a SelfIntersecting warning carrying its geometry. The oracle
-        // counts them. Not yet read as drawn: cutting the loop as a relief while keeping the
-        // part's outline is a repair this reader does not make. The test still holds the
-        // reader to saying so: every contour missing is a SelfIntersecting warning.
-        let relief_loops = [
-            "boxes__ABox.svg",
-            "boxes__FlexBox.svg",
-            "boxes__GearBox.svg",
-            "boxes__Matrix.svg",
-        ];
-        if !problems.is_empty() && relief_loops.contains(&row.file.as_str()) {
-            let crossing = import
+        if BURN_LOOP_FILES.contains(&row.file.as_str()) {
+            // Every removed loop is told, with its geometry, and none is left out unsaid: one
+            // loop per zero-burn teardrop (and FlexBox's two overshooting corners).
+            let removed: usize = import
                 .warnings
                 .iter()
-                .filter(|w| w.kind == WarningKind::SelfIntersecting && !w.left_out.is_empty())
-                .count();
-            if got.contours + crossing >= expected {
-                not_yet += 1;
-                eprintln!(
-                    "{}: not yet read as drawn: {}",
-                    row.file,
-                    problems.join("; ")
-                );
-                continue;
+                .filter(|w| {
+                    matches!(
+                        w.kind,
+                        WarningKind::SelfIntersecting | WarningKind::ZeroArea
+                    ) && w.message.contains("removed where the outline")
+                })
+                .map(|w| w.left_out.len())
+                .sum();
+            let teardrops = burn_loops(&row.file).len();
+            let want = teardrops
+                + if row.file == "boxes__FlexBox.svg" {
+                    2
+                } else {
+                    0
+                };
+            if teardrops == 0 || removed != want {
+                problems.push(format!(
+                    "{removed} loops removed in the warnings, expected {want} ({teardrops} \
+                     zero-burn teardrops in the file)"
+                ));
             }
-            problems.push(format!(
-                "{crossing} SelfIntersecting warnings do not account for the missing contours"
-            ));
         }
         if problems.is_empty() {
             matching += 1;
@@ -307,8 +382,7 @@ fn every_corpus_svg_reads_as_the_oracle_or_is_refused_accurately() {
         }
     }
     eprintln!(
-        "corpus SVG: {matching} matching, {refused} refused accurately, {not_yet} not yet read as \
-         drawn (relief loops), {} failing",
+        "corpus SVG: {matching} matching, {refused} refused accurately, {} failing",
         failures.len()
     );
     assert!(failures.is_empty(), "{}", failures.join("\n"));

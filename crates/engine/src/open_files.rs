@@ -171,6 +171,8 @@ pub fn open_gcode_with(
     let mut warnings = Vec::new();
     // (loop, entry) in cutting order.
     let mut loops: Vec<(Contour, Entry)> = Vec::new();
+    // Tool-on length of the loops' crossings removed by the repair: told, not a lost path.
+    let mut repaired_mm = 0.0;
     let mut run: Option<RunState> = None;
     let finish_run = |run: Option<RunState>, warnings: &mut Vec<ReadWarning>| {
         if let Some(r) = run {
@@ -240,10 +242,24 @@ pub fn open_gcode_with(
                     };
                     r.loops_cut += 1;
                     let contour = Contour::new(vertices);
-                    // The one meaning of a contour every reader applies: a loop that is no
-                    // cuttable contour (a slit, a bow-tie) is left out, as a drawing's is.
-                    match contour.check_cuttable(POINT_TOLERANCE_MM) {
-                        Ok(()) => loops.push((contour, entry)),
+                    // The one meaning of a contour every reader applies, after the one repair
+                    // (loops too small to cut where it crosses itself removed, said): a loop that
+                    // is no cuttable contour (a slit, a bow-tie) is left out, as a drawing's is.
+                    match contour.without_small_loops(POINT_TOLERANCE_MM) {
+                        Ok(repair) => {
+                            if let Some(what) = repair.describe() {
+                                repaired_mm += repair.removed_length();
+                                warnings.push(
+                                    ReadWarning::new(
+                                        repair.warning_kind(),
+                                        format!("a tool-on loop: {what}"),
+                                    )
+                                    .at_line(r.pending_line, None)
+                                    .leaving_out(repair.left_out(LEFT_OUT_FLATTENING_MM)),
+                                );
+                            }
+                            loops.push((repair.contour, entry));
+                        }
                         Err(fault) => warnings.push(
                             ReadWarning::new(
                                 match fault {
@@ -318,7 +334,7 @@ pub fn open_gcode_with(
     };
     // A program that cuts open paths: the nest holds only the loops they close, so the
     // program's own tool-on paths are what to show.
-    let paths = open_paths_note(&nest, &route, &program_paths).map(|note| {
+    let paths = open_paths_note(&nest, &route, &program_paths, repaired_mm).map(|note| {
         warnings.push(ReadWarning::new(WarningKind::Other, note));
         program_paths
     });
@@ -348,14 +364,20 @@ const PROGRAM_LENGTH_NOISE_MM: f64 = 0.05;
 
 /// When the loops of a program (as contours, the rest left out) lose tool-on length or pierces
 /// that the program's own paths have, a note saying the paths are shown instead; `None` when
-/// the loops' route is the whole program.
-fn open_paths_note(nest: &Nest, route: &Route, paths: &PathRoute) -> Option<String> {
+/// the loops' route is the whole program. `repaired_mm` of crossing loops removed (and said so)
+/// by the repair of a contour is no lost path.
+fn open_paths_note(
+    nest: &Nest,
+    route: &Route,
+    paths: &PathRoute,
+    repaired_mm: f64,
+) -> Option<String> {
     let (cut, pierces) = Toolpath::new(route, nest)
         .ok()
         .map_or((0.0, 0), |t| (t.cut_length(), t.pierce_count()));
     // Loops closed within the point tolerance may differ from the program's spans by
     // rounding; what is left out is at least a whole span or path.
-    let lost = paths.cut_length() - cut;
+    let lost = paths.cut_length() - cut - repaired_mm;
     let noise = PROGRAM_LENGTH_NOISE_MM.max(1e-6 * cut);
     (lost > noise || pierces != paths.pierce_count()).then(|| {
         format!(
@@ -1016,6 +1038,44 @@ mod tests {
         assert!((back.cut_length(read) - route.cut_length(&nest)).abs() < 0.01);
         back.validate(read, POINT_TOLERANCE_MM).unwrap();
         assert!(document.warnings.is_empty(), "{:?}", document.warnings);
+    }
+
+    #[test]
+    fn a_gcode_loop_crossing_itself_in_a_loop_too_small_to_cut_is_repaired_and_said() {
+        // A square whose right edge overshoots the corner by 5 µm and comes back across it.
+        let program = "G90 G21\nG00 X0 Y0\nM03\nG01 X10 Y0 F1000\nG01 X10 Y10.005\n\
+                       G01 X10.005 Y10\nG01 X0 Y10\nG01 X0 Y0\nM05\n";
+        let document = open_document("corner.nc", program.as_bytes()).unwrap();
+        let Problem::Nest { nest, .. } = &document.problem else {
+            panic!("a nest")
+        };
+        assert_eq!(nest.parts.len(), 1);
+        let contour = &nest.parts[0].contours[0];
+        assert_eq!(contour.check_cuttable(POINT_TOLERANCE_MM), Ok(()));
+        assert!((contour.area() - 100.0).abs() < 1e-6, "{}", contour.area());
+        let [warning] = &document.warnings[..] else {
+            panic!("one warning: {:?}", document.warnings)
+        };
+        assert_eq!(warning.kind, WarningKind::SelfIntersecting);
+        assert!(warning.message.contains("removed"), "{}", warning.message);
+        assert_eq!(warning.left_out.len(), 1);
+        assert!(document.paths.is_none(), "the loops are the whole program");
+        route_of(&document)
+            .validate(nest, POINT_TOLERANCE_MM)
+            .unwrap();
+
+        // A bow-tie's lobes are no such loop: left out, as before.
+        let bow_tie = "G90 G21\nG00 X0 Y0\nM03\nG01 X10 Y10 F1000\nG01 X10 Y0\n\
+                       G01 X0 Y10\nG01 X0 Y0\nM05\n";
+        let document = open_document("bow.nc", bow_tie.as_bytes()).unwrap();
+        assert!(
+            document
+                .warnings
+                .iter()
+                .any(|w| w.kind == WarningKind::SelfIntersecting && w.message.contains("left out")),
+            "{:?}",
+            document.warnings
+        );
     }
 
     #[test]

@@ -24,7 +24,7 @@ const ORACLE_DISPUTED: &[(&str, &str)] = &[];
 /// Files whose verdict against the oracle lives with their reader's own corpus test, with the
 /// reason written there: the oracle corrected (`crates/cad/tests/dxf_realworld.rs`
 /// `CORRECTIONS`, `crates/cad/tests/svg_realworld.rs` `expect`) or not yet read as drawn (the
-/// DXF test's `NOT_YET`, the SVG test's relief loops). Here `open_document` must open each
+/// DXF test's `NOT_YET`). Here `open_document` must open each
 /// exactly as its reader reads it: the door adds nothing and loses nothing.
 const READER_OWNED: &[&str] = &[
     // DXF: the oracle corrected.
@@ -45,14 +45,13 @@ const READER_OWNED: &[&str] = &[
     "librecad__ga9.dxf",
     "librecad__d3.dxf",
     // SVG: the oracle corrected (user units, Inkscape 0.48's 90 px/in, a square drawn twice,
-    // a text frame counted).
+    // a text frame counted, Boxes.py's zero-burn corner loops removed as too small to cut).
     "ezdxf__gear.svg",
     "openscad__box-w-holes.svg",
     "openscad__size-percent-1.svg",
     "visicut__circle-20mm-red.svg",
     "visicut__inkscape_0.48.svg",
     "visicut__test.svg",
-    // SVG: not yet read as drawn (outlines crossing themselves at corner relief loops).
     "boxes__ABox.svg",
     "boxes__FlexBox.svg",
     "boxes__GearBox.svg",

@@ -92,7 +92,9 @@ pub enum ContourError {
 ///   radius below the tolerance. The tolerance is the reader's (the join tolerance of a drawing,
 ///   the closure tolerance of a nest).
 ///
-/// Readers of CAD drawings (DXF, SVG) leave such a contour out with a
+/// Readers of CAD drawings (DXF, SVG) and of G-code loops first remove the sub-loops too small
+/// to cut where an outline touches or crosses itself ([`Contour::without_small_loops`], with a
+/// warning), then leave a contour that still fails out with a
 /// [`ReadWarning`](crate::ReadWarning) of the matching kind, since drawings commonly carry
 /// them; readers of nest formats (geometry JSON, result JSON, DBS, T-FLEX, G-code) refuse the
 /// file with the contour's location, since a nesting program never writes one on purpose.

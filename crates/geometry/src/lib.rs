@@ -11,7 +11,9 @@
 //!   for β → 0 and right for semicircles (β = ±1) and larger arcs (|β| > 1).
 //! - [`Contour`]: closing raw file points ([`Contour::close_points`]), orientation, area,
 //!   perimeter, reversal by the DBS rule, [`Transform`]s, point-in-contour with true arcs,
-//!   nearest point, length parameterisation, self-intersection check, flattening.
+//!   nearest point, length parameterisation, self-intersection check, flattening; the one
+//!   meaning of a contour ([`Contour::check_cuttable`]) and the one repair of drawn outlines
+//!   that touch or cross themselves in a loop too small to cut ([`Contour::without_small_loops`]).
 //! - [`Nest`] and [`ContainmentForest`]: which contour lies inside which, hence the cutting
 //!   precedence "inner before outer".
 //! - [`Route`]: idle and cut length, time and cost under [`MachineParameters`], and an
@@ -83,6 +85,7 @@ mod generator;
 mod kerf;
 mod kerf_clearance;
 mod leads;
+mod loop_repair;
 mod neighbours;
 mod offset_carrier;
 mod path_leads;
@@ -115,6 +118,7 @@ pub use leads::{
     LeadError, LeadFitter, LeadProblem, LeadShape, LeadSpec, StepLeads, Tab, TabSpec,
     MAX_KERF_LENGTH, MAX_TABS, MIN_KERF_LENGTH,
 };
+pub use loop_repair::{LoopReason, LoopRepair, RemovedLoop};
 pub use neighbours::nearest_groups;
 pub use path_leads::PathLeads;
 pub use path_route::{PathLeadError, PathRoute, PathRouteError, ToolOnPath};
