@@ -219,7 +219,9 @@ fn parts_too_close_ru(refusal: &cutroute_geometry::PartsTooClose) -> String {
         .iter()
         .take(PAIRS_NAMED)
         .map(|p| {
-            let gap = if p.gap < 5e-4 {
+            let gap = if p.on_one_another {
+                "совпадают".to_string()
+            } else if p.gap < 5e-4 {
                 "касаются".to_string()
             } else {
                 format!("в {:.3} мм друг от друга", p.gap)
@@ -491,6 +493,7 @@ mod tests {
                     required: 1.0,
                     gap: if i == 0 { 0.0 } else { 0.25 },
                     at: Point::new(501.0, 0.0),
+                    on_one_another: false,
                 })
                 .collect(),
         }
