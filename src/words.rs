@@ -219,7 +219,9 @@ fn parts_too_close_ru(refusal: &cutroute_geometry::PartsTooClose) -> String {
         .iter()
         .take(PAIRS_NAMED)
         .map(|p| {
-            let gap = if p.gap < 5e-4 {
+            let gap = if p.on_one_another {
+                "совпадают".to_string()
+            } else if p.gap < 5e-4 {
                 "касаются".to_string()
             } else {
                 format!("в {:.3} мм друг от друга", p.gap)
@@ -491,6 +493,7 @@ mod tests {
                     required: 1.0,
                     gap: if i == 0 { 0.0 } else { 0.25 },
                     at: Point::new(501.0, 0.0),
+                    on_one_another: false,
                 })
                 .collect(),
         }
@@ -517,5 +520,25 @@ mod tests {
         );
         assert!(ru.ends_with("и ещё 2"), "{ru}");
         assert!(!ru.chars().any(|c| c.is_ascii_alphabetic()), "{ru}");
+    }
+
+    /// Contours lying on one another (a part in a hole of its own shape) are said to coincide,
+    /// not to touch, in each language.
+    #[test]
+    fn contours_on_one_another_are_said_to_coincide() {
+        let mut coincident = refusal(1);
+        coincident.pairs[0].on_one_another = true;
+        let failure = JobFailure::PartsTooClose(coincident);
+        let en = failure.text(Lang::En);
+        assert!(
+            en.contains("part 1 contour 0 and part 2 contour 0 lie on one another near (501.000"),
+            "{en}"
+        );
+        let ru = failure.text(Lang::Ru);
+        assert!(
+            ru.contains("деталь 1 контур 0 и деталь 2 контур 0 совпадают около (501.000, 0.000)"),
+            "{ru}"
+        );
+        assert!(!ru.contains("касаются"), "{ru}");
     }
 }

@@ -173,6 +173,12 @@ impl Kerf {
         if !self.is_on() {
             return Ok(route);
         }
+        // The kerf job refuses such nests up front; a file's own route is held to the same.
+        if let Some(too_close) =
+            cutroute_geometry::PartsTooClose::of(nest, self.settings.kerf, nest.check_tolerance())
+        {
+            return Err(too_close.to_string());
+        }
         let forest = nest.containment_forest();
         let links = |r: &Route| r.steps.iter().filter(|s| !s.is_pierced()).count();
         let fitted = cutroute_engine::fit_leads(nest, &forest, self.settings, &route, !self.after)

@@ -63,6 +63,41 @@ fn legs(report: &Value) -> f64 {
     legs
 }
 
+/// test1 (a 2000 × 1000 sheet with parts near its border) less the parts lying in a hole of
+/// their own shape, which no kerf cuts right (the kerf refusal names each such pair, the part
+/// in the hole second), written as DBS JSON into a folder of `test`'s own.
+fn test1_without_parts_in_their_holes(test: &str) -> String {
+    let file = data("nests/dbs-json/test1.dbs.json");
+    let mut args = vec!["solve", &file, "--solver", "nearest"];
+    args.extend(PLASMA);
+    let (ok, _, err) = cutroute(&args);
+    assert!(!ok, "test1 is refused with a kerf");
+    let mut in_holes: Vec<usize> = err
+        .split("; ")
+        .filter_map(|pair| {
+            let pair = pair.split(": ").last()?;
+            let (_, second) = pair.split_once(" and part ")?;
+            let (part, rest) = second.split_once(' ')?;
+            rest.contains("lie on one another")
+                .then(|| part.parse().ok())?
+        })
+        .collect();
+    assert_eq!(in_holes.len(), 2, "{err}");
+    let mut parts: Vec<Value> =
+        serde_json::from_slice(&std::fs::read(&file).unwrap()).expect("DBS JSON");
+    // Entry 0 is the sheet; parts are numbered from 1.
+    in_holes.sort_unstable();
+    for &k in in_holes.iter().rev() {
+        assert_eq!(parts[k]["paths"].as_array().unwrap().len(), 1, "part {k}");
+        parts.remove(k);
+    }
+    let dir = std::env::temp_dir().join(format!("cutroute-kerf-{test}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("test1-fit.dbs.json");
+    std::fs::write(&out, serde_json::to_vec(&parts).unwrap()).unwrap();
+    out.to_string_lossy().into_owned()
+}
+
 #[test]
 fn with_leads_every_step_carries_pierce_entry_leads_and_switch_off() {
     let file = data("nests/dbs-json/E1X_6_01.dbs.json");
@@ -112,7 +147,8 @@ fn with_leads_every_step_carries_pierce_entry_leads_and_switch_off() {
 fn chains_pierce_once_with_a_lead_in_and_end_with_a_lead_out() {
     for (file, settings) in [
         ("nests/dbs-json/E1X_6_01.dbs.json", &PLASMA[..]),
-        ("nests/dbs/test0.json.dbs", &LASER[..]),
+        // Not test0: its part lying in a hole of its own shape is refused with any kerf.
+        ("nests/svg/plates.svg", &LASER[..]),
     ] {
         let file = data(file);
         let mut args = vec![
@@ -171,7 +207,29 @@ fn chains_pierce_once_with_a_lead_in_and_end_with_a_lead_out() {
 /// repaired, not an earlier one.
 #[test]
 fn chains_repaired_by_hard_rules_keep_their_leads() {
-    let file = data("nests/dbs/test0.json.dbs");
+    // Not test0: its part lying in a hole of its own shape is refused with any kerf. plates.svg
+    // chains with these leads, and its links break the rules.
+    let file = data("nests/svg/plates.svg");
+    let mut free = vec![
+        "solve",
+        &file,
+        "--solver",
+        "chain",
+        "--time-limit",
+        "3",
+        "--json",
+    ];
+    free.extend(PLASMA);
+    let chained = json(&free);
+    let linked = |r: &Value| {
+        r["route"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|s| s.get("link").is_some())
+            .count()
+    };
+    assert!(linked(&chained) > 0, "{chained}");
     let mut args = vec![
         "solve",
         &file,
@@ -199,6 +257,8 @@ fn chains_repaired_by_hard_rules_keep_their_leads() {
     for rule in ["part", "sheet", "islands"] {
         assert_eq!(report["rule_violations"][rule], 0, "{rule}");
     }
+    // The repair turned links into pierces.
+    assert!(linked(&report) < linked(&chained), "{report}");
 }
 
 #[test]
@@ -287,11 +347,20 @@ fn every_real_nest_routes_with_plasma_leads_or_names_the_contour_without_room() 
             let mut args = vec!["solve", &file, "--solver", solver, "--time-limit", "0.3"];
             args.extend(PLASMA);
             let (ok, _, err) = cutroute(&args);
+            // test0 and test1 have a part lying in a hole of its own shape: refused with any
+            // kerf, the pairs named.
+            let in_its_hole = file.contains("test0") || file.contains("test1");
+            let refused_in_its_hole = |err: &str| {
+                err.contains("parts closer than the kerf of")
+                    && err.contains("lie on one another near (")
+            };
             if file.ends_with("ring.dbs") {
                 assert!(
                     !ok && err.contains("part 1 contour 1 has no equidistant"),
                     "{file}: {err}"
                 );
+            } else if in_its_hole {
+                assert!(!ok && refused_in_its_hole(&err), "{file} {solver}: {err}");
             } else {
                 assert!(ok, "{file} {solver}: {err}");
             }
@@ -299,7 +368,11 @@ fn every_real_nest_routes_with_plasma_leads_or_names_the_contour_without_room() 
             let mut args = vec!["solve", &file, "--solver", solver, "--time-limit", "0.3"];
             args.extend(LASER);
             let (ok, _, err) = cutroute(&args);
-            assert!(ok, "{file} {solver} (laser): {err}");
+            if in_its_hole {
+                assert!(!ok && refused_in_its_hole(&err), "{file} {solver}: {err}");
+            } else {
+                assert!(ok, "{file} {solver} (laser): {err}");
+            }
         }
     }
 }
@@ -467,8 +540,8 @@ fn exact_with_leads_reports_its_model_bound_below_its_route() {
 
 #[test]
 fn edge_pierces_sit_on_the_sheet_border_and_take_the_edge_pierce_time() {
-    // test1: a 2000 × 1000 sheet.
-    let file = data("nests/dbs-json/test1.dbs.json");
+    // test1's 2000 × 1000 sheet (less its parts lying in their holes, refused with a kerf).
+    let file = test1_without_parts_in_their_holes("edge-pierces");
     let mut args = vec![
         "solve",
         &file,
@@ -622,10 +695,105 @@ fn parts_closer_than_the_kerf_are_refused_naming_the_pairs() {
     assert!(ok, "{err}");
 }
 
+/// test0 has a part lying exactly in a hole of its own shape (part 4's contour 2 and part 13):
+/// with a kerf either the hole or the part would come out a kerf off its line. Every way a
+/// kerf reaches a program refuses it as parts closer than the kerf, naming both parts:
+/// `solve` (text and --json), `convert` to G-code with the offsets in the program and with the
+/// controller's compensation (G41.1 and G41 D<n>), for a solved route and for the file's own
+/// (test0's result), and no program is written. Without a kerf it converts as ever.
+#[test]
+fn contours_on_one_another_are_refused_with_a_kerf_naming_both_parts() {
+    let nest = data("nests/dbs-json/test0.dbs.json");
+    let own_route = data("nests/result-json/test0.result.json");
+    let refused = |args: &[&str]| {
+        let (ok, out, err) = cutroute(args);
+        assert!(!ok && out.is_empty(), "{args:?}: {out}");
+        let last = err.trim().lines().last().unwrap_or_default().to_string();
+        assert!(
+            last.contains("parts closer than the kerf of"),
+            "{args:?}: {err}"
+        );
+        assert!(last.contains("1 pair(s) of contours"), "{args:?}: {err}");
+        // The pair by part (from 1) and contour, both parts named.
+        let pair = last
+            .split("1 pair(s) of contours: ")
+            .nth(1)
+            .unwrap_or_default();
+        assert!(
+            pair.starts_with("part ")
+                && pair.contains(" and part ")
+                && pair.contains(" lie on one another near ("),
+            "{args:?}: {err}"
+        );
+        let parts: Vec<&str> = pair
+            .split("part ")
+            .skip(1)
+            .filter_map(|p| p.split(' ').next())
+            .collect();
+        assert_eq!(parts.len(), 2, "{pair}");
+        assert_ne!(parts[0], parts[1], "{pair}");
+    };
+    for machine in [&PLASMA[..], &LASER[..]] {
+        for solver in ["nearest", "ccp", "chain", "sccp"] {
+            for json in [false, true] {
+                let mut args = vec!["solve", &nest, "--solver", solver, "--time-limit", "0.3"];
+                if json {
+                    args.push("--json");
+                }
+                args.extend(machine);
+                refused(&args);
+            }
+        }
+    }
+    let dir = std::env::temp_dir().join(format!(
+        "cutroute-kerf-on-one-another-{}",
+        std::process::id()
+    ));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("test0.nc");
+    let out_s = out.to_string_lossy().into_owned();
+    // The controller's compensation needs straight leads.
+    let straight = [
+        "--kerf",
+        "2",
+        "--pierce-clearance",
+        "5",
+        "--switch-off-clearance",
+        "1",
+        "--lead-in",
+        "line",
+        "--lead-out",
+        "line",
+    ];
+    for input in [&nest, &own_route] {
+        for compensation in ["program", "g41.1", "g41:1"] {
+            let mut args = vec![
+                "convert",
+                input,
+                &out_s,
+                "--kerf-compensation",
+                compensation,
+            ];
+            if input == &nest {
+                args.extend(["--solver", "nearest"]);
+            }
+            args.extend(straight);
+            refused(&args);
+            assert!(
+                !out.exists(),
+                "{input} {compensation}: a program was written"
+            );
+        }
+    }
+    let (ok, _, err) = cutroute(&["convert", &own_route, &out_s]);
+    assert!(ok && out.exists(), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 #[test]
 fn path_solvers_pierce_at_the_sheet_border_overcut_and_tab_and_take_the_edge_pierce_time() {
-    // test1: a 2000 × 1000 sheet.
-    let file = data("nests/dbs-json/test1.dbs.json");
+    // test1's 2000 × 1000 sheet (less its parts lying in their holes, refused with a kerf).
+    let file = test1_without_parts_in_their_holes("path-edge-pierces");
     for solver in ["sccp", "aoe"] {
         let mut args = vec![
             "solve",

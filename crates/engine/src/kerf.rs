@@ -28,7 +28,7 @@
 //! their paths' ends (module `kerf_paths`).
 
 use cutroute_geometry::{
-    kerf_overlaps, ChainedAttach, ContainmentForest, CutStep, KerfSettings, LeadError, LeadFitter,
+    ChainedAttach, ContainmentForest, CutStep, KerfSettings, LeadError, LeadFitter,
     MachineParameters, Nest, PartsTooClose, Route,
 };
 use cutroute_protocol::{
@@ -343,15 +343,10 @@ impl KerfJob {
         validate_kerf(&settings).map_err(|e| refused(e.into()))?;
         // Parts closer than the kerf: every solver's cut there would eat into a neighbour, and
         // the route checkers reject it; say so now, with the pairs, rather than after a search.
-        let pairs = kerf_overlaps(nest, settings.kerf / 2.0, nest.check_tolerance());
-        if !pairs.is_empty() {
-            return Err(refused(
-                PartsTooClose {
-                    kerf: settings.kerf,
-                    pairs,
-                }
-                .into(),
-            ));
+        // So are contours lying on one another (a part in a hole of its own shape, stacked
+        // parts), where the cuts keep kerf/2 off each other yet one part comes out a kerf off.
+        if let Some(too_close) = PartsTooClose::of(nest, settings.kerf, nest.check_tolerance()) {
+            return Err(refused(too_close.into()));
         }
         let forest = nest.containment_forest();
         // The inner requests are idealised: the kerf is this job's.

@@ -66,7 +66,9 @@ fn nearest_with_leads_is_never_longer_than_nearest_then_leads() {
         "nests/dbs-json/E1X_6_01.dbs.json",
         "nests/dbs/seven.dbs",
         "nests/dbs/seven_3717.dbs",
-        "nests/dbs-json/test1.dbs.json",
+        // Parts in holes; not test1, whose part lying in a hole of its own shape no kerf cuts
+        // right (the job refuses it).
+        "nests/dbs/nested.dbs",
     ] {
         let problem = nest_problem(file);
         let mut job_request = request(&problem, SolverKind::NearestNeighbour, plasma(), false);
@@ -410,6 +412,77 @@ fn parts_closer_than_the_kerf_are_refused_up_front_naming_the_pairs() {
     }
 }
 
+/// test0 and test1 each have a part lying exactly in a hole of its own shape: each cut keeps
+/// kerf/2 off the other contour (on its far side), yet one of the two comes out a kerf off its
+/// line. Every solver's kerf job refuses them up front as parts closer than the kerf, each
+/// pair of contours found lying on one another (checked here vertex by vertex), of two
+/// different parts, both named; without a kerf the same nests are cut.
+#[test]
+fn contours_on_one_another_are_refused_up_front_naming_both_parts() {
+    let laser = KerfSettings {
+        kerf: 0.2,
+        pierce_clearance: 1.0,
+        switch_off_clearance: 0.5,
+        ..plasma()
+    };
+    for (file, pairs) in [
+        ("nests/dbs-json/test0.dbs.json", 1),
+        ("nests/dbs/test0.json.dbs", 1),
+        ("nests/dbs-json/test1.dbs.json", 2),
+    ] {
+        let problem = nest_problem(file);
+        let nest = nest_of(&problem);
+        for kerf in [plasma(), laser] {
+            for solver in SolverKind::ALL {
+                let started = start_job(&request(&problem, solver, kerf, false));
+                let Err(EngineError::SolverRefused {
+                    reason: Refusal::PartsTooClose(refusal),
+                    ..
+                }) = started
+                else {
+                    panic!("{file} {solver:?} kerf {}: {:?}", kerf.kerf, started.err());
+                };
+                assert_eq!(refusal.kerf, kerf.kerf);
+                assert_eq!(refusal.pairs.len(), pairs, "{file}: {refusal}");
+                let words = refusal.to_string();
+                for pair in &refusal.pairs {
+                    assert!(pair.on_one_another, "{file}: {pair:?}");
+                    assert_ne!(pair.contour.part, pair.other.part, "{file}: {pair:?}");
+                    let (a, b) = (
+                        nest.contour(pair.contour).unwrap(),
+                        nest.contour(pair.other).unwrap(),
+                    );
+                    let on = |x: &cutroute_geometry::Contour, y: &cutroute_geometry::Contour| {
+                        x.spans().all(|s| {
+                            y.distance_to(s.start) < 1e-6 && y.distance_to(s.point_at(0.5)) < 1e-6
+                        })
+                    };
+                    assert!(on(a, b) && on(b, a), "{file}: {pair:?}");
+                    assert!(brute_gap(a, b) < 1e-9, "{file}: {pair:?}");
+                    let named = format!(
+                        "{} and {} lie on one another near (",
+                        pair.contour, pair.other
+                    );
+                    assert!(words.contains(&named), "{file}: {words}");
+                }
+            }
+        }
+        // Without a kerf a shared line is cut once per contour: the nest is routed.
+        let progress = run_to_end(
+            start_job(&request(
+                &problem,
+                SolverKind::NearestNeighbour,
+                KerfSettings::default(),
+                false,
+            ))
+            .expect("starts")
+            .as_mut(),
+            &mut |_| {},
+        );
+        assert!(progress.route().is_some(), "{file}: {}", progress.phase);
+    }
+}
+
 /// A nest whose parts are 1 mm apart is refused with kerf 2 and cut with kerf 0.2; the route
 /// cut then passes the checker, which holds each cut kerf/2 from every contour.
 #[test]
@@ -461,8 +534,9 @@ fn a_nest_is_refused_only_where_its_gaps_are_narrower_than_the_kerf() {
 
 #[test]
 fn path_solvers_pierce_at_the_edge_overcut_closed_paths_and_tab_whole_contours() {
-    // test1: a 2000 × 1000 sheet with parts near its border.
-    let problem = nest_problem("nests/dbs-json/test1.dbs.json");
+    // nested.dbs: a sheet with parts 10 mm from its border, within the edge reach (not test1,
+    // whose part lying in a hole of its own shape no kerf cuts right: the job refuses it).
+    let problem = nest_problem("nests/dbs/nested.dbs");
     let nest = nest_of(&problem);
     let settings = KerfSettings {
         overcut: 1.5,

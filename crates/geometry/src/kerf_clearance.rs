@@ -142,6 +142,28 @@ impl ContourSpans {
         }
         best
     }
+
+    /// Whether contour `a` lies wholly on contour `b`: the middle of each of its spans is
+    /// within `reach` of `b` (a part in a hole of its own shape, stacked identical parts, however
+    /// each is split into spans). Contours that merely touch, at a point or along a stretch,
+    /// have a span whose middle is off the other. False when either is unknown.
+    pub fn lies_on(&self, a: ContourRef, b: ContourRef, reach: f64) -> bool {
+        let (Ok(ia), Ok(ib)) = (self.refs.binary_search(&a), self.refs.binary_search(&b)) else {
+            return false;
+        };
+        let near_b = |p: Point| {
+            let around = AABB::from_corners([p.x - reach, p.y - reach], [p.x + reach, p.y + reach]);
+            self.tree.locate_in_envelope_intersecting(&around).any(|e| {
+                e.contour == ib
+                    && self.spans[ib][e.span].nearest_point(p).point.distance(p) <= reach
+            })
+        };
+        let mut spans = self.spans[ia]
+            .iter()
+            .filter(|s| s.length() > 0.0)
+            .peekable();
+        spans.peek().is_some() && spans.all(|s| near_b(s.point_at(0.5)))
+    }
 }
 
 /// The cut of `contour` on its equidistant at kerf/2 comes closer than kerf/2 to `other`: the
@@ -162,6 +184,11 @@ pub struct KerfOverlap {
     pub gap: f64,
     /// A point of the cut near where it comes closest to `other`.
     pub at: Point,
+    /// The two contours lie on one another (see [`contours_on_one_another`]): the cut round
+    /// each keeps kerf/2 from the other on its far side, yet one of them comes out a kerf off
+    /// its line.
+    #[serde(default)]
+    pub on_one_another: bool,
 }
 
 /// The contours each cut of `cuts` (contour, its tool-on spans) comes closer than
@@ -203,6 +230,7 @@ pub(crate) fn cut_overlaps<'a>(
                 // within distance + kerf/2 of each other.
                 gap: index.gap(contour, hit.contour, hit.distance + half + tolerance),
                 at: hit.at,
+                on_one_another: false,
             }
         })
         .collect()
@@ -213,13 +241,23 @@ pub(crate) fn cut_overlaps<'a>(
 /// kerf, where no full cutting route exists (the kerf of one eats into its neighbour). Each
 /// pair once; contours without an equidistant at `half` have no cut and are skipped (they have
 /// no room, which the lead fitter reports). Empty for `half` 0. Contours that lie exactly on
-/// one another escape this test ([`contours_on_one_another`] finds them).
+/// one another escape this test ([`contours_on_one_another`] finds them; [`PartsTooClose::of`]
+/// holds a nest to both).
 pub fn kerf_overlaps(nest: &Nest, half: f64, tolerance: f64) -> Vec<KerfOverlap> {
     if !(half > 0.0) {
         return Vec::new();
     }
     let index = ContourSpans::new(nest);
-    let mut seen = std::collections::BTreeSet::new();
+    kerf_overlaps_in(&index, nest, half, tolerance, &mut Default::default())
+}
+
+fn kerf_overlaps_in(
+    index: &ContourSpans,
+    nest: &Nest,
+    half: f64,
+    tolerance: f64,
+    seen: &mut std::collections::BTreeSet<(ContourRef, ContourRef)>,
+) -> Vec<KerfOverlap> {
     let mut overlaps = Vec::new();
     for r in nest.contour_refs() {
         let Some(eq) = nest.contour(r).and_then(|c| equidistant(c, half).ok()) else {
@@ -228,20 +266,21 @@ pub fn kerf_overlaps(nest: &Nest, half: f64, tolerance: f64) -> Vec<KerfOverlap>
         // Its own contour is no neighbour: mark it seen.
         seen.insert((r, r));
         let spans: Vec<Span> = eq.spans().collect();
-        overlaps.extend(cut_overlaps(&index, r, &spans, half, tolerance, &mut seen));
+        overlaps.extend(cut_overlaps(index, r, &spans, half, tolerance, seen));
     }
     overlaps
 }
 
 /// Every pair of distinct contours of `nest` that touch or lie on one another (closer than
 /// `tolerance`), as [`KerfOverlap`]s with gap and distance their own distance and `required`
-/// `half` (kerf/2), each pair once. Where one contour lies exactly on another (a part in a hole
-/// of its own shape, two identical parts stacked) the cut round one runs exactly kerf/2 from
-/// the other, on its far side, so [`kerf_overlaps`] sees no overlap; yet with a kerf the slug
-/// of the hole *is* the part, and either the hole or the part is cut a kerf too large. Without
-/// kerf a line shared by two contours is cut once per contour, which leaves both their shape
-/// (the part in a hole of its shape is cut as the hole's slug and again as itself: one more
-/// pierce and cut, nothing cut wrong).
+/// `half` (kerf/2), each pair once; [`KerfOverlap::on_one_another`] tells those lying wholly on
+/// one another from those that touch. Where one contour lies exactly on another (a part in a
+/// hole of its own shape, two identical parts stacked) the cut round one runs exactly kerf/2
+/// from the other, on its far side, so [`kerf_overlaps`] sees no overlap; yet with a kerf the
+/// slug of the hole *is* the part, and either the hole or the part is cut a kerf too large.
+/// Without kerf a line shared by two contours is cut once per contour, which leaves both their
+/// shape (the part in a hole of its shape is cut as the hole's slug and again as itself: one
+/// more pierce and cut, nothing cut wrong).
 pub fn contours_on_one_another(nest: &Nest, half: f64, tolerance: f64) -> Vec<KerfOverlap> {
     let index = ContourSpans::new(nest);
     let mut seen = std::collections::BTreeSet::new();
@@ -250,19 +289,33 @@ pub fn contours_on_one_another(nest: &Nest, half: f64, tolerance: f64) -> Vec<Ke
         let Some(contour) = nest.contour(r) else {
             continue;
         };
-        seen.insert((r, r));
         let spans: Vec<Span> = contour.spans().collect();
-        overlaps.extend(
-            cut_overlaps(&index, r, &spans, 2.0 * tolerance, tolerance, &mut seen)
-                .into_iter()
-                .map(|touch| KerfOverlap {
-                    required: half,
-                    gap: touch.distance,
-                    ..touch
-                }),
-        );
+        overlaps.extend(touching(&index, r, &spans, half, tolerance, &mut seen));
     }
     overlaps
+}
+
+/// The contours that `contour` (its `spans`) touches or lies on, as [`contours_on_one_another`]
+/// reports them; pairs in `seen` are skipped and the reported ones added to it.
+pub(crate) fn touching(
+    index: &ContourSpans,
+    contour: ContourRef,
+    spans: &[Span],
+    half: f64,
+    tolerance: f64,
+    seen: &mut std::collections::BTreeSet<(ContourRef, ContourRef)>,
+) -> Vec<KerfOverlap> {
+    seen.insert((contour, contour));
+    cut_overlaps(index, contour, spans, 2.0 * tolerance, tolerance, seen)
+        .into_iter()
+        .map(|touch| KerfOverlap {
+            required: half,
+            gap: touch.distance,
+            on_one_another: index.lies_on(touch.contour, touch.other, 2.0 * tolerance)
+                || index.lies_on(touch.other, touch.contour, 2.0 * tolerance),
+            ..touch
+        })
+        .collect()
 }
 
 /// Parts that sit closer than the kerf: no cut on the equidistants keeps kerf/2 off the
@@ -273,6 +326,37 @@ pub struct PartsTooClose {
     pub kerf: f64,
     /// The pairs of contours closer than it (see [`kerf_overlaps`]).
     pub pairs: Vec<KerfOverlap>,
+}
+
+impl PartsTooClose {
+    /// The refusal of `nest` under a kerf of `kerf`: the pairs of contours closer than the kerf
+    /// ([`kerf_overlaps`]), then those that touch or lie on one another and escape that test
+    /// ([`contours_on_one_another`]: a part in a hole of its own shape, stacked parts), each
+    /// pair once. `None` when there are none, or for kerf 0 (without a kerf a shared line is
+    /// cut once per contour, each part keeping its shape).
+    pub fn of(nest: &Nest, kerf: f64, tolerance: f64) -> Option<PartsTooClose> {
+        let half = kerf / 2.0;
+        if !(half > 0.0) {
+            return None;
+        }
+        let index = ContourSpans::new(nest);
+        let mut seen = std::collections::BTreeSet::new();
+        let mut pairs = kerf_overlaps_in(&index, nest, half, tolerance, &mut seen);
+        // Contours lying on one another are found by the touching test below, unless the
+        // offset's precision let the kerf's own test see them first.
+        for p in pairs.iter_mut().filter(|p| p.gap < 2.0 * tolerance) {
+            p.on_one_another = index.lies_on(p.contour, p.other, 2.0 * tolerance)
+                || index.lies_on(p.other, p.contour, 2.0 * tolerance);
+        }
+        for r in nest.contour_refs() {
+            let Some(contour) = nest.contour(r) else {
+                continue;
+            };
+            let spans: Vec<Span> = contour.spans().collect();
+            pairs.extend(touching(&index, r, &spans, half, tolerance, &mut seen));
+        }
+        (!pairs.is_empty()).then_some(PartsTooClose { kerf, pairs })
+    }
 }
 
 /// How many pairs [`PartsTooClose`]'s message names before it counts the rest.
@@ -292,9 +376,11 @@ impl std::fmt::Display for PartsTooClose {
                 write!(f, "; ")?;
             }
             write!(f, "{} and {} ", p.contour, p.other)?;
-            // Touching parts are the common case (nests packed without spacing), and so are
-            // parts lying on one another (in a hole of their own shape, or stacked).
-            if p.gap < 5e-4 {
+            // Touching parts are the common case (nests packed without spacing); parts lying
+            // on one another (in a hole of their own shape, or stacked) are told apart.
+            if p.on_one_another {
+                write!(f, "lie on one another")?;
+            } else if p.gap < 5e-4 {
                 write!(f, "touch")?;
             } else {
                 write!(f, "{:.3} mm apart", p.gap)?;

@@ -3,7 +3,7 @@
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
-use crate::kerf_clearance::cut_overlaps;
+use crate::kerf_clearance::{cut_overlaps, touching};
 use crate::{
     ContainmentForest, Contour, ContourSpans, LeadFitter, LeadProblem, Nest, Point, Span, StepLeads,
 };
@@ -330,6 +330,28 @@ pub enum RouteError {
         /// Its y.
         y: f64,
     },
+    /// With a kerf, the contour of a step and another contour touch or lie on one another (a
+    /// part in a hole of its own shape, stacked parts), which [`RouteError::KerfOverlap`] does
+    /// not see where the cut keeps kerf/2 on the other's far side: one of the two comes out a
+    /// kerf off its line. Reported once per pair of contours, at the first step that cuts one.
+    #[error(
+        "{contour} (step {step}) and {other} {} near ({x}, {y}): with a kerf one of them is cut off its line",
+        if *on_one_another { "lie on one another" } else { "touch" }
+    )]
+    ContoursTouch {
+        /// Index of the step.
+        step: usize,
+        /// The contour it cuts.
+        contour: ContourRef,
+        /// The contour it touches or lies on.
+        other: ContourRef,
+        /// Whether the two lie wholly on one another (else they touch).
+        on_one_another: bool,
+        /// A point of the step's contour near where they touch, x.
+        x: f64,
+        /// Its y.
+        y: f64,
+    },
     /// The first step is entered by a link, but there is no previous cut to link from.
     #[error("step 0 is entered by a tool-on link, but no contour was cut before it")]
     LinkWithoutPrevious,
@@ -636,7 +658,8 @@ impl Route {
     }
 
     /// The steps whose cut on the equidistant comes closer than kerf/2 (less `tolerance`) to
-    /// another contour, once per pair of contours (see [`RouteError::KerfOverlap`]). Steps without
+    /// another contour, once per pair of contours (see [`RouteError::KerfOverlap`]), and those
+    /// whose contour touches or lies on another ([`RouteError::ContoursTouch`]). Steps without
     /// leads (the idealised model: no kerf) and contours without an equidistant (reported as
     /// the entry off the equidistant) are not checked here. Part of [`Route::problems`].
     pub fn kerf_overlap_problems(&self, nest: &Nest, tolerance: f64) -> Vec<RouteError> {
@@ -673,6 +696,23 @@ impl Route {
                         distance: o.distance,
                         required: o.required,
                         gap: o.gap,
+                        x: o.at.x,
+                        y: o.at.y,
+                    }),
+            );
+            // Contours on one another escape the test above (the cut keeps kerf/2 on the
+            // other's far side).
+            let own: Vec<Span> = nest
+                .contour(s.contour)
+                .map_or(Vec::new(), |c| c.spans().collect());
+            problems.extend(
+                touching(index, s.contour, &own, leads.offset, tolerance, &mut seen)
+                    .into_iter()
+                    .map(|o| RouteError::ContoursTouch {
+                        step,
+                        contour: o.contour,
+                        other: o.other,
+                        on_one_another: o.on_one_another,
                         x: o.at.x,
                         y: o.at.y,
                     }),

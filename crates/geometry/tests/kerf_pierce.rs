@@ -380,7 +380,9 @@ fn the_indexed_pass_pierces_exactly_where_scanning_every_earlier_cut_does() {
     };
     let nests = [
         ("nested.dbs", read("dbs/nested.dbs")),
-        ("test1.dbs.json", read("dbs-json/test1.dbs.json")),
+        // Not test1: one of its parts lies in a hole of its own shape, which no kerf cuts right
+        // (the checker rejects every route over it with a kerf).
+        ("E1X_6_01.dbs.json", read("dbs-json/E1X_6_01.dbs.json")),
         (
             "generated 400, seed 1",
             with_room(generate_nest(400, 1), settings),

@@ -5,8 +5,8 @@
 
 use cutroute_geometry::{
     contours_on_one_another, kerf_overlaps, place_tabs, Contour, ContourRef, KerfField,
-    KerfSettings, LeadFitter, LeadProblem, LeadShape, LeadSpec, Nest, Part, Point, Route,
-    RouteError, TabSpec, Vertex,
+    KerfSettings, LeadFitter, LeadProblem, LeadShape, LeadSpec, Nest, Part, PartsTooClose, Point,
+    Route, RouteError, TabSpec, Vertex,
 };
 
 /// A clockwise (outer) square with its lower left corner at (x, y).
@@ -207,6 +207,189 @@ fn coincident_contours_are_found() {
     apart.normalize_orientation();
     assert!(kerf_overlaps(&apart, 1.0, apart.check_tolerance()).is_empty());
     assert!(contours_on_one_another(&apart, 1.0, apart.check_tolerance()).is_empty());
+}
+
+/// A 100 mm plate with a 20 mm hole, and a 20 mm part lying exactly in that hole.
+fn part_in_its_hole() -> Nest {
+    let mut nest = Nest {
+        sheet: None,
+        parts: vec![
+            part(
+                "plate",
+                vec![square(0.0, 0.0, 100.0), square(30.0, 30.0, 20.0)],
+            ),
+            part("slug", vec![square(30.0, 30.0, 20.0)]),
+        ],
+    };
+    nest.normalize_orientation();
+    nest
+}
+
+/// Contours lying on one another are refused with a kerf as parts closer than the kerf are,
+/// the pair named by part (from 1) and contour and said to lie on one another; parts that
+/// merely touch are said to touch; without a kerf nothing is refused.
+#[test]
+fn contours_on_one_another_are_refused_with_a_kerf_naming_both_parts() {
+    let nest = part_in_its_hole();
+    let tolerance = nest.check_tolerance();
+    let refusal = PartsTooClose::of(&nest, 2.0, tolerance).expect("refused");
+    assert_eq!(refusal.kerf, 2.0);
+    assert_eq!(refusal.pairs.len(), 1, "{refusal:?}");
+    let pair = refusal.pairs[0];
+    assert!(pair.on_one_another && pair.gap < 1e-6, "{pair:?}");
+    let mut named = [pair.contour, pair.other];
+    named.sort();
+    assert_eq!(
+        named,
+        [
+            ContourRef {
+                part: 0,
+                contour: 1
+            },
+            ContourRef {
+                part: 1,
+                contour: 0
+            }
+        ]
+    );
+    let message = refusal.to_string();
+    assert!(
+        message.starts_with("parts closer than the kerf of 2 mm")
+            && message.contains("1 pair(s) of contours: ")
+            && message.contains(" lie on one another near ("),
+        "{message}"
+    );
+    assert!(
+        message.contains("part 1 contour 1") && message.contains("part 2 contour 0"),
+        "{message}"
+    );
+    // Any kerf, a laser's too; none without.
+    assert!(PartsTooClose::of(&nest, 0.2, tolerance).is_some());
+    assert!(PartsTooClose::of(&nest, 0.0, tolerance).is_none());
+
+    // Two identical parts stacked, however each is split into spans.
+    let split = Contour::new(vec![
+        Vertex::line(0.0, 0.0),
+        Vertex::line(0.0, 10.0),
+        Vertex::line(0.0, 20.0),
+        Vertex::line(20.0, 20.0),
+        Vertex::line(20.0, 0.0),
+    ]);
+    let mut stacked = Nest {
+        sheet: None,
+        parts: vec![
+            part("a", vec![square(0.0, 0.0, 20.0)]),
+            part("b", vec![split]),
+        ],
+    };
+    stacked.normalize_orientation();
+    let refusal = PartsTooClose::of(&stacked, 2.0, stacked.check_tolerance()).expect("refused");
+    assert_eq!(refusal.pairs.len(), 1, "{refusal:?}");
+    assert!(refusal.pairs[0].on_one_another);
+    assert!(
+        refusal
+            .to_string()
+            .contains("part 1 contour 0 and part 2 contour 0 lie on one another near ("),
+        "{refusal}"
+    );
+
+    // Side by side along an edge, and a smaller part against the wall of a hole: they touch.
+    let mut touching = Nest {
+        sheet: None,
+        parts: vec![
+            part("a", vec![square(0.0, 0.0, 20.0)]),
+            part("b", vec![square(20.0, 0.0, 20.0)]),
+            part(
+                "plate",
+                vec![square(100.0, 0.0, 100.0), square(130.0, 30.0, 20.0)],
+            ),
+            part("small", vec![square(130.0, 30.0, 10.0)]),
+        ],
+    };
+    touching.normalize_orientation();
+    let refusal = PartsTooClose::of(&touching, 2.0, touching.check_tolerance()).expect("refused");
+    assert_eq!(refusal.pairs.len(), 2, "{refusal:?}");
+    assert!(
+        refusal.pairs.iter().all(|p| !p.on_one_another),
+        "{refusal:?}"
+    );
+    let message = refusal.to_string();
+    assert!(
+        message.contains("part 1 contour 0 and part 2 contour 0 touch near (")
+            && !message.contains("lie on one another"),
+        "{message}"
+    );
+    // Apart by more than the kerf: nothing.
+    let mut apart = Nest {
+        sheet: None,
+        parts: vec![
+            part("a", vec![square(0.0, 0.0, 20.0)]),
+            part("b", vec![square(22.5, 0.0, 20.0)]),
+        ],
+    };
+    apart.normalize_orientation();
+    assert!(PartsTooClose::of(&apart, 2.0, apart.check_tolerance()).is_none());
+}
+
+/// The route checker rejects a route with a kerf over a part lying in a hole of its own shape
+/// (and over stacked parts), naming both contours, though each cut keeps kerf/2 off the other;
+/// without a kerf the same order passes.
+#[test]
+fn the_route_checker_rejects_a_kerf_cut_over_contours_on_one_another() {
+    let settings = KerfSettings {
+        kerf: 2.0,
+        ..line_lead()
+    };
+    let stacked = {
+        let mut nest = Nest {
+            sheet: None,
+            parts: vec![
+                part("a", vec![square(0.0, 0.0, 20.0)]),
+                part("b", vec![square(0.0, 0.0, 20.0)]),
+            ],
+        };
+        nest.normalize_orientation();
+        nest
+    };
+    for nest in [part_in_its_hole(), stacked] {
+        let forest = nest.containment_forest();
+        let tolerance = nest.check_tolerance();
+        let order = Route::innermost_first(&nest, Point::new(-50.0, -50.0), None);
+        assert!(order.problems(&nest, &forest, tolerance).is_empty());
+        let route = LeadFitter::new(&nest, settings)
+            .attach(&order)
+            .expect("leads fit");
+        let problems = route.problems(&nest, &forest, tolerance);
+        // The kerf's own clearance test does not see it: the cuts keep kerf/2 off each other.
+        assert!(
+            !problems
+                .iter()
+                .any(|p| matches!(p, RouteError::KerfOverlap { .. })),
+            "{problems:?}"
+        );
+        let touching: Vec<&RouteError> = problems
+            .iter()
+            .filter(|p| matches!(p, RouteError::ContoursTouch { .. }))
+            .collect();
+        assert_eq!(touching.len(), 1, "{problems:?}");
+        let RouteError::ContoursTouch {
+            contour,
+            other,
+            on_one_another,
+            ..
+        } = *touching[0]
+        else {
+            unreachable!()
+        };
+        assert!(on_one_another);
+        assert_ne!(contour.part, other.part);
+        let message = touching[0].to_string();
+        assert!(
+            message.contains(&format!("{contour} (step "))
+                && message.contains(&format!(") and {other} lie on one another near (")),
+            "{message}"
+        );
+    }
 }
 
 #[test]
