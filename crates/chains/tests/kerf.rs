@@ -62,7 +62,8 @@ fn chains_over_the_kerf_nest_come_back_valid_with_leads() {
                 Err(errors) => {
                     assert!(!errors.is_empty());
                     for e in errors {
-                        assert!(e.to_string().contains("ContourRef"), "{e}");
+                        let text = e.to_string();
+                        assert!(text.contains(" part ") && text.contains(" contour "), "{e}");
                     }
                 }
             }
