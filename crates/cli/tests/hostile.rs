@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use common::data;
+use common::{data, SOLVERS};
 use cutroute_protocol::Problem;
 use serde_json::Value;
 
@@ -163,18 +163,6 @@ fn hostile_files() -> Vec<PathBuf> {
     assert!(files.len() >= 15, "the corpus is in data/hostile/");
     files
 }
-
-const SOLVERS: [&str; 9] = [
-    "nearest",
-    "ccp",
-    "heuristic",
-    "exact",
-    "discrete",
-    "chain",
-    "sccp",
-    "gsccp",
-    "aoe",
-];
 
 #[test]
 fn every_corpus_file_gives_a_checked_result_or_a_located_error() {
