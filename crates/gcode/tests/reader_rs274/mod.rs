@@ -13,11 +13,14 @@ use std::process::{Command, Stdio};
 
 use cutroute_geometry::Point;
 
+/// Where scripts/install-rs274.sh unpacks LinuxCNC.
+pub const LINUXCNC_ROOT: &str = "/opt/cutroute/linuxcnc/root";
+
 /// The `rs274` binary, or `None` (with a note) when it is not installed outside CI.
 pub fn rs274() -> Option<PathBuf> {
     let path = std::env::var_os("CUTROUTE_RS274")
         .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from("/opt/cutroute/linuxcnc/usr/bin/rs274"));
+        .unwrap_or_else(|| PathBuf::from(LINUXCNC_ROOT).join("usr/bin/rs274"));
     if path.is_file() {
         return Some(path);
     }
