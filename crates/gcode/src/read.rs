@@ -8,12 +8,31 @@
 //! program's frame; the motion is reported in the frame the program started in, so the head's
 //! path stays continuous), `G92.1` (offset cancelled and forgotten), `G92.2` (cancelled, kept),
 //! `G92.3` (the kept one restored), `N` line numbers, `O` program numbers, `( )` comments
-//! (`(MSG,…)` among them) and `;` comments, `%` tape marks, block delete `/` (the block is
-//! executed), modal motion (a line of bare coordinates continues the last motion). Harmless
-//! modal codes (`G17`, `G49`, `G54`–`G59`, `G61`, `G64`, `G80`, `G94`) are accepted; codes that
-//! would change the meaning of the motion (other planes, canned cycles, homing, LinuxCNC's
-//! O-word subroutines and `#` parameters, …) are refused with their location. Z and the rotary
-//! axes are ignored: the motion is the head's path in the sheet's plane.
+//! (`(MSG,…)` among them) and `;` comments, spaces anywhere (LinuxCNC ignores them), `%` tape
+//! marks, block delete `/` (the block is executed), modal motion (a line of bare coordinates
+//! continues the last motion). Harmless
+//! modal codes (`G17`, `G49`, `G54`–`G59`, `G61`, `G64`, `G80`, `G94`, `G96`/`G97` spindle speed
+//! modes) are accepted; codes that would change the meaning of the motion (other planes, canned
+//! cycles, homing, probing, polar `@`/`^` coordinates, …) are refused with their location. Z
+//! and the rotary axes are ignored: the motion is the head's path in the sheet's plane.
+//!
+//! LinuxCNC's language is read as its interpreter (rs274) runs it:
+//! - parameters (`#1`, `#<local>`, `#<_global>`), expressions (`[ … ]`, operators, functions)
+//!   and what a program may read back of the machine: see the `expr` module; `#n = …`
+//!   assignments take effect after their whole line is read;
+//! - O-word control flow (subroutines in the file, `if`, `while`, `do`, `repeat`, `break`,
+//!   `continue`, `return`): see the `flow` module; `M2`/`M30` end the program there. A call of
+//!   a subroutine not in the file, a loop that runs more than a million lines, recursion
+//!   deeper than 100 calls are refused where they stand.
+//! - Values only a running machine has are refused, naming the item and what it would need:
+//!   `#<_hal[…]>` (rs274 refuses it too), `#<_ini[…]>`, tool data `#5400`–`#5413` (rs274
+//!   answers from its own tool table, the reader has none), positions of Z and rotary axes.
+//! - M codes: user M codes `M100`–`M199` (QtPlasmaC's `M190` material change among them) run a
+//!   program the controller finds in its USER_M_PATH: refused, as rs274 refuses them without
+//!   it. Digital and analog outputs (`M62`–`M65`, `M67`, `M68`), waiting on an input (`M66`;
+//!   `#5399` keeps its value, 0 unless set, as in rs274), adaptive feed and feed hold (`M52`, `M53`) and the other
+//!   M codes besides the torch's change no motion: accepted. A program without `M2`/`M30`
+//!   (which rs274 requires) is read to its last line.
 //!
 //! The torch burns from its on code to its off code. In GRBL laser mode
 //! ([`ReadOptions::laser_mode`], or from a program's `M04`, dynamic power, which only laser
@@ -27,6 +46,8 @@
 //! [`CompensationModel`]). Rapids or torch switches under compensation are refused with their
 //! line.
 
+mod expr;
+mod flow;
 mod linuxcnc;
 mod loops;
 use linuxcnc::Side;
@@ -433,6 +454,50 @@ pub enum GcodeReadError {
         /// What is wrong.
         problem: &'static str,
     },
+    /// A parameter or expression without a value (undefined, division by zero, bad syntax).
+    #[error("line {line}, column {column}: {problem}")]
+    Expression {
+        /// Line.
+        line: usize,
+        /// Column.
+        column: usize,
+        /// What is wrong.
+        problem: String,
+    },
+    /// A value only the running machine knows (a HAL pin, the INI file, the tool table).
+    #[error(
+        "line {line}, column {column}: {item} cannot be known from the program: it needs {needs}"
+    )]
+    UnknownValue {
+        /// Line.
+        line: usize,
+        /// Column.
+        column: usize,
+        /// The parameter (e.g. `#<_hal[plasmac.cut-feed-rate]>`).
+        item: String,
+        /// What would give it a value.
+        needs: &'static str,
+    },
+    /// O-word control flow that does not fit together, or calls what is not in the program.
+    #[error("line {line}, column {column}: {problem}")]
+    ControlFlow {
+        /// Line.
+        line: usize,
+        /// Column.
+        column: usize,
+        /// What is wrong.
+        problem: String,
+    },
+    /// The program runs more lines than any real one (a loop that never ends).
+    #[error("line {line}, column {column}: the program runs more than {limit} lines (a loop that never ends?)")]
+    RunsTooLong {
+        /// Line where the limit was reached.
+        line: usize,
+        /// Column.
+        column: usize,
+        /// The limit.
+        limit: usize,
+    },
 }
 
 impl GcodeReadError {
@@ -453,7 +518,11 @@ impl GcodeReadError {
             | ArcRadiusTooSmall { line, column, .. }
             | ZeroLengthRadiusArc { line, column }
             | InvalidDwell { line, column }
-            | Compensation { line, column, .. } => (line, column),
+            | Compensation { line, column, .. }
+            | Expression { line, column, .. }
+            | UnknownValue { line, column, .. }
+            | ControlFlow { line, column, .. }
+            | RunsTooLong { line, column, .. } => (line, column),
         }
     }
 }
@@ -489,12 +558,7 @@ pub fn read_gcode(text: &str, options: &ReadOptions) -> Result<Program, GcodeRea
         enabled: false,
         power_zero: false,
     };
-    let mut lines = 0;
-    for (index, raw) in text.lines().enumerate() {
-        let words = tokenize(raw, index + 1)?;
-        state.block(&words, index + 1)?;
-        lines = index + 1;
-    }
+    let lines = flow::run(text, &mut state)?;
     if state.compensation.is_some() {
         return Err(GcodeReadError::Compensation {
             line: lines,
@@ -507,98 +571,6 @@ pub fn read_gcode(text: &str, options: &ReadOptions) -> Result<Program, GcodeRea
         motions: state.motions,
         end: state.at,
     })
-}
-
-fn tokenize(raw: &str, line: usize) -> Result<Vec<Word>, GcodeReadError> {
-    let chars: Vec<char> = raw.chars().collect();
-    let mut words = Vec::new();
-    let mut i = 0;
-    while i < chars.len() {
-        let c = chars[i];
-        let column = i + 1;
-        match c {
-            c if c.is_whitespace() => i += 1,
-            '(' => match chars[i..].iter().position(|&d| d == ')') {
-                Some(close) => i += close + 1,
-                None => return Err(GcodeReadError::UnclosedComment { line, column }),
-            },
-            ';' => break,
-            '%' | '/' if words.is_empty() => i += 1,
-            c if c.is_ascii_alphabetic() || c == '$' => {
-                let letter = c.to_ascii_uppercase();
-                i += 1;
-                while i < chars.len() && chars[i] == ' ' {
-                    i += 1;
-                }
-                if i < chars.len() && (chars[i] == '#' || chars[i] == '[') {
-                    return Err(GcodeReadError::UnsupportedCode {
-                        line,
-                        column: i + 1,
-                        code: "parameters and expressions (#, [ ])".into(),
-                    });
-                }
-                let begin = i;
-                if i < chars.len() && (chars[i] == '+' || chars[i] == '-') {
-                    i += 1;
-                }
-                let mut digits = 0;
-                while i < chars.len() && (chars[i].is_ascii_digit() || chars[i] == '.') {
-                    digits += usize::from(chars[i].is_ascii_digit());
-                    i += 1;
-                }
-                let text: String = chars[begin..i].iter().collect();
-                if digits == 0 || text.matches('.').count() > 1 {
-                    return Err(GcodeReadError::MissingNumber {
-                        line,
-                        column,
-                        letter,
-                    });
-                }
-                let value: f64 = text.parse().map_err(|_| GcodeReadError::MissingNumber {
-                    line,
-                    column,
-                    letter,
-                })?;
-                if value.is_nan() || value.abs() > MAX_VALUE {
-                    return Err(GcodeReadError::NumberOutOfRange {
-                        line,
-                        column,
-                        letter,
-                    });
-                }
-                words.push(Word {
-                    letter,
-                    value,
-                    column,
-                });
-                // `O100 sub`, `o101 if [...]`: LinuxCNC's subroutines and loops. A bare
-                // `O1234` is a program number (Fanuc), which changes nothing.
-                let next = chars[i..].iter().find(|c| !c.is_whitespace());
-                if letter == 'O' && next.is_some_and(|c| c.is_ascii_alphabetic()) {
-                    return Err(GcodeReadError::UnsupportedCode {
-                        line,
-                        column,
-                        code: "O-word control flow (sub, call, if, while, repeat)".into(),
-                    });
-                }
-            }
-            '#' | '[' => {
-                return Err(GcodeReadError::UnsupportedCode {
-                    line,
-                    column,
-                    code: "parameters and expressions (#, [ ])".into(),
-                })
-            }
-            found => {
-                return Err(GcodeReadError::UnexpectedCharacter {
-                    line,
-                    column,
-                    found,
-                })
-            }
-        }
-    }
-    Ok(words)
 }
 
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -763,6 +735,19 @@ fn set<T>(
 }
 
 impl State<'_> {
+    /// What a program can read back of the machine through parameters.
+    fn machine(&self) -> expr::Machine {
+        let unit = if self.inches { 25.4 } else { 1.0 };
+        expr::Machine {
+            x: (self.at.x - self.offset.x) / unit,
+            y: (self.at.y - self.offset.y) / unit,
+            g92_x: self.offset.x / unit,
+            g92_y: self.offset.y / unit,
+            metric: !self.inches,
+            absolute: !self.incremental,
+        }
+    }
+
     fn block(&mut self, words: &[Word], line: usize) -> Result<(), GcodeReadError> {
         if words.is_empty() {
             return Ok(());
@@ -773,7 +758,7 @@ impl State<'_> {
         for word in words {
             match word.letter {
                 'G' => self.g_code(word, &mut codes, line)?,
-                'M' => m_codes.push(word.value),
+                'M' => m_codes.push((word.value, word.column)),
                 '$' => {}
                 letter => {
                     let slot = &mut values[(letter as u8 - b'A') as usize];
@@ -800,8 +785,17 @@ impl State<'_> {
         if let Some(s) = get('S') {
             self.power_zero = s.value == 0.0;
         }
-        for m in m_codes {
+        for (m, column) in m_codes {
             let number = m.round();
+            if (100.0..=199.0).contains(&number) {
+                return Err(GcodeReadError::UnsupportedCode {
+                    line,
+                    column,
+                    code: format!(
+                        "M{number} (a user M code: the controller runs the program of that name in its USER_M_PATH)"
+                    ),
+                });
+            }
             if number != m || number < 0.0 {
                 continue;
             }
@@ -1020,7 +1014,8 @@ impl State<'_> {
             }
             // Plane XY, tool length off, work offsets, path control, canned cycle off, feed
             // per minute: nothing changes for the head's XY path.
-            170 | 490 | 540..=590 | 610 | 640 | 800 | 940 => Ok(()),
+            // Spindle speed modes (constant surface speed, RPM) as well.
+            170 | 490 | 540..=590 | 610 | 640 | 800 | 940 | 960 | 970 => Ok(()),
             _ => Err(GcodeReadError::UnsupportedCode {
                 line,
                 column: word.column,

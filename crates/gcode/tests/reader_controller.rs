@@ -225,16 +225,131 @@ fn headers_comments_and_what_the_reader_leaves_to_the_controller() {
     let program = read_gcode(text, &ReadOptions::default()).unwrap();
     assert_eq!(program.pierce_count(), 1);
     assert!((program.cut_length() - 1.0).abs() < 1e-9);
-    // LinuxCNC's subroutines, loops and parameters are refused where they stand.
-    for (bad, column) in [
-        ("o100 repeat [3]\n", 1),
-        ("G1 X#1\n", 5),
-        ("G1 X[1+2]\n", 5),
+}
+
+/// LinuxCNC's parameters, expressions and O-word control flow: a program that uses every kind
+/// reads as rs274 runs it and as worked out by hand.
+#[test]
+fn parameters_expressions_and_o_words_run_as_linuxcnc_runs_them() {
+    let text = "\
+G21 G90
+#<side> = 10
+#<_count> = 0
+o100 sub
+  G0 X#2 Y0 (a square of side #1 at X #2)
+  M3
+  G1 X[#2 + #1] F100
+  G1 Y#1
+  G1 X#2
+  G1 Y0
+  M5
+  #<_count> = [#<_count> + 1]
+o100 endsub
+o101 repeat [3]
+  o100 call [#<side>] [#<_count> * 20]
+o101 endrepeat
+#1 = 0
+o102 while [#1 LT 4]
+  #1 = [#1 + 1]
+  o103 if [#1 EQ 2]
+    o102 continue
+  o103 elseif [#1 EQ 4]
+    o102 break
+  o103 else
+    G0 X[100 + #1 * 10] Y50
+    M3
+    G1 Y[50 + SQRT[25]]
+    M5
+  o103 endif
+o102 endwhile
+o104 do
+  #1 = [#1 - 1]
+o104 while [#1 GT 0]
+#3 = 7 G0 X[#3 + 200] Y#1 (the assignment takes effect after the line)
+G0 X[#3 + 200] Y[2 ** 3 ** 2 / 64]
+M2
+G0 X999 (after the program's end)
+";
+    let program = read_gcode(text, &ReadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+    // Three squares of 40 mm (at X 0, 20, 40: the global counts the calls), and the while
+    // loop's two 5 mm cuts (#1 = 1 and 3; 2 continues, 4 breaks).
+    assert_eq!(
+        program.pierce_points(),
+        [
+            (0.0, 0.0),
+            (20.0, 0.0),
+            (40.0, 0.0),
+            (110.0, 50.0),
+            (130.0, 50.0)
+        ]
+        .map(|(x, y)| Point::new(x, y))
+    );
+    assert!((program.cut_length() - 130.0).abs() < 1e-9);
+    // The do-while runs once (#1 from 4 to 3): after a `break`, LinuxCNC's next do-while end
+    // does not loop back. `#3 = 7` is not seen on its own line.
+    let rapids: Vec<Point> = program
+        .motions
+        .iter()
+        .filter_map(|m| match m {
+            Motion::Rapid { to, .. } => Some(*to),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(
+        rapids[rapids.len() - 2..],
+        [Point::new(200.0, 3.0), Point::new(207.0, 1.0)]
+    );
+    assert_eq!(program.end, Point::new(207.0, 1.0));
+    agrees_with_rs274("o-words", text, &program, 1.0);
+}
+
+/// What the reader cannot know or run is refused where it stands, as rs274 refuses it.
+#[test]
+fn what_only_the_machine_knows_and_what_never_ends_are_refused_where_they_stand() {
+    for (bad, location, says) in [
+        (
+            "F#<_hal[plasmac.cut-feed-rate]>\n",
+            (1, 2),
+            "#<_hal[plasmac.cut-feed-rate]>",
+        ),
+        ("G0 X#<_ini[axis_x]max_limit>\n", (1, 5), "INI file"),
+        ("G0 X#<undefined>\n", (1, 5), "not defined"),
+        ("G0 X[1 / 0]\n", (1, 8), "division by zero"),
+        ("o<touchoff> call [1]\n", (1, 1), "o<touchoff> call"),
+        ("G0 X1\no100 if [0]\nG0 X2\n", (2, 1), "never closed"),
+        ("o100 if [1]\no101 endif\n", (2, 1), "o101 endif"),
+        ("M3\nM190 P1\n", (2, 1), "USER_M_PATH"),
     ] {
         let error = read_gcode(bad, &ReadOptions::default()).unwrap_err();
-        assert_eq!(error.location(), (1, column), "{bad}: {error}");
-        assert!(error.to_string().contains("not supported"), "{error}");
+        assert_eq!(error.location(), location, "{bad}: {error}");
+        assert!(error.to_string().contains(says), "{bad}: {error}");
+        refused_by_rs274(bad, &format!("{bad}M2\n"), 1.0);
     }
+    // A loop that never ends: rs274 would run it forever; the reader stops and says where.
+    let error = read_gcode(
+        "G21\n#1 = 0\no1 while [1]\n#1 = [#1 + 1]\no1 endwhile\nM2\n",
+        &ReadOptions::default(),
+    )
+    .unwrap_err();
+    assert!(error.to_string().contains("never ends"), "{error}");
+    assert!((3..=5).contains(&error.location().0), "{error}");
+    // So does recursion without end.
+    let error = read_gcode(
+        "o1 sub\no1 call\no1 endsub\no1 call\nM2\n",
+        &ReadOptions::default(),
+    )
+    .unwrap_err();
+    assert_eq!(error.location(), (2, 1), "{error}");
+    // G96/G97 (spindle speed modes) and QtPlasmaC's output and feed codes change no motion.
+    let text = "G21 G97 S100\nG96 S10 D100\nM66 P0 L0\nM67 E0 Q5\nM68 E0 Q3\nM62 P1\nM63 P1\nM64 P1\nM65 P1\nM52 P1\nM53 P1\nG0 X#5399 Y1\nM3\nG1 X10 F100\nM5\nM2\n";
+    let program = read_gcode(text, &ReadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(program.pierce_points(), [Point::new(0.0, 1.0)]);
+    agrees_with_rs274("harmless codes", text, &program, 1.0);
+    // Tool data depends on the machine's tool table, which the reader does not have (rs274
+    // answers from its own): refused.
+    let error = read_gcode("G0 X#5400\n", &ReadOptions::default()).unwrap_err();
+    assert_eq!(error.location(), (1, 5), "{error}");
+    assert!(error.to_string().contains("tool table"), "{error}");
 }
 
 /// Programs the post-processor writes with `G41.1 D<kerf>` and `G41 D1`: the reader's LinuxCNC
