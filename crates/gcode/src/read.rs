@@ -13,7 +13,8 @@
 //! continues the last motion). Harmless
 //! modal codes (`G17`, `G49`, `G54`–`G59`, `G61`, `G64`, `G80`, `G94`, `G96`/`G97` spindle speed
 //! modes) are accepted; codes that would change the meaning of the motion (other planes, canned
-//! cycles, homing, probing, polar `@`/`^` coordinates, …) are refused with their location. Z
+//! cycles, homing, probing, …) are refused with their location. LinuxCNC's polar coordinates
+//! (`@` distance, `^` angle) are read on straight moves. Z
 //! and the rotary axes are ignored: the motion is the head's path in the sheet's plane.
 //!
 //! LinuxCNC's language is read as its interpreter (rs274) runs it:
@@ -755,11 +756,24 @@ impl State<'_> {
         let mut codes = Codes::default();
         let mut values: [Option<Word>; 26] = [None; 26];
         let mut m_codes = Vec::new();
+        // LinuxCNC's polar coordinates: `@` distance and `^` angle (degrees) from the origin.
+        let mut polar: [Option<Word>; 2] = [None; 2];
         for word in words {
             match word.letter {
                 'G' => self.g_code(word, &mut codes, line)?,
                 'M' => m_codes.push((word.value, word.column)),
                 '$' => {}
+                '@' | '^' => {
+                    let slot = &mut polar[usize::from(word.letter == '^')];
+                    if slot.is_some() {
+                        return Err(GcodeReadError::DuplicateWord {
+                            line,
+                            column: word.column,
+                            letter: word.letter,
+                        });
+                    }
+                    *slot = Some(*word);
+                }
                 letter => {
                     let slot = &mut values[(letter as u8 - b'A') as usize];
                     if slot.is_some() {
@@ -828,7 +842,17 @@ impl State<'_> {
         if self.laser && (!self.enabled || self.power_zero) {
             self.switch(false, line)?;
         }
-        let axis = ['X', 'Y'].into_iter().filter_map(get).next();
+        let cartesian = ['X', 'Y'].into_iter().filter_map(get).next();
+        let polar_word = polar.iter().flatten().next().copied();
+        if let (Some(x), Some(p)) = (cartesian, polar_word) {
+            return Err(GcodeReadError::ConflictingCodes {
+                line,
+                column: p.column,
+                first: x.letter.to_string(),
+                second: p.letter.to_string(),
+            });
+        }
+        let axis = cartesian.or(polar_word);
         if let Some(column) = codes.dwell {
             if let Some(word) = axis.filter(|w| w.letter == 'Y').or(get('I')).or(get('R')) {
                 return Err(GcodeReadError::ConflictingCodes {
@@ -892,10 +916,21 @@ impl State<'_> {
             Some(w) => w.value * unit + offset,
             None => current,
         };
-        let to = Point::new(
-            coordinate('X', self.at.x, offset.x),
-            coordinate('Y', self.at.y, offset.y),
-        );
+        let to = if polar_word.is_some() {
+            if !matches!(mode, MotionMode::Rapid | MotionMode::Linear) {
+                return Err(GcodeReadError::UnsupportedCode {
+                    line,
+                    column: first.column,
+                    code: "polar coordinates (@, ^) on an arc".into(),
+                });
+            }
+            self.polar_point(polar, unit)
+        } else {
+            Point::new(
+                coordinate('X', self.at.x, offset.x),
+                coordinate('Y', self.at.y, offset.y),
+            )
+        };
         if self.laser {
             let burns = self.enabled && !self.power_zero && mode != MotionMode::Rapid;
             self.switch(burns, line)?;
@@ -946,6 +981,27 @@ impl State<'_> {
         }
         self.at = to;
         Ok(())
+    }
+
+    /// Where `@` (distance) and `^` (angle) take the head: about the program's origin, from
+    /// the head's own distance and angle when one is missing; in `G91` both add to the head's.
+    fn polar_point(&self, [distance, angle]: [Option<Word>; 2], unit: f64) -> Point {
+        let here = (self.at - self.offset) * (1.0 / unit);
+        let r0 = here.x.hypot_libm(here.y);
+        let a0 = here.y.atan2_libm(here.x).to_degrees();
+        let (r, a) = if self.incremental {
+            (
+                r0 + distance.map_or(0.0, |w| w.value),
+                a0 + angle.map_or(0.0, |w| w.value),
+            )
+        } else {
+            (
+                distance.map_or(r0, |w| w.value),
+                angle.map_or(a0, |w| w.value),
+            )
+        };
+        let (sin, cos) = a.to_radians().sin_cos_libm();
+        self.offset + Point::new(r * cos, r * sin) * unit
     }
 
     fn g_code(&self, word: &Word, codes: &mut Codes, line: usize) -> Result<(), GcodeReadError> {

@@ -303,6 +303,22 @@ G0 X999 (after the program's end)
     agrees_with_rs274("o-words", text, &program, 1.0);
 }
 
+/// LinuxCNC's polar coordinates: `@` distance and `^` angle from the origin; in `G91` both add
+/// to the head's own.
+#[test]
+fn polar_coordinates_turn_about_the_origin() {
+    let text = "G21 G90\nM3\nF100 G1 @5 ^90\nG91 ^90\n^90\n^90\n^90\nG90 G0 X0 Y0\nM5\nM2\n";
+    let program = read_gcode(text, &ReadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+    // Up the Y axis to (0, 5), then round a square of corners on the axes.
+    assert!((program.cut_length() - (5.0 + 20.0 * SQRT2)).abs() < 1e-9);
+    assert!(program.end.distance(Point::new(0.0, 0.0)) < 1e-12);
+    agrees_with_rs274("polar", text, &program, 1.0);
+    for (bad, column) in [("G1 X1 @2\n", 7), ("G2 @1 ^90 R1\n", 4)] {
+        let error = read_gcode(bad, &ReadOptions::default()).unwrap_err();
+        assert_eq!(error.location(), (1, column), "{bad}: {error}");
+    }
+}
+
 /// What the reader cannot know or run is refused where it stands, as rs274 refuses it.
 #[test]
 fn what_only_the_machine_knows_and_what_never_ends_are_refused_where_they_stand() {

@@ -17,6 +17,8 @@
 
 use std::collections::HashMap;
 
+use cutroute_geometry::float::Libm;
+
 use super::GcodeReadError;
 
 /// Deepest nesting of brackets and parameter references in one value.
@@ -400,7 +402,7 @@ impl Reader<'_> {
                 if left < 0.0 && right.fract() != 0.0 {
                     return Err(fail("a negative number raised to a non-integer power"));
                 }
-                left.powf(right)
+                left.powf_libm(right)
             }
             Times => left * right,
             Divide if right == 0.0 => return Err(fail("division by zero")),
@@ -450,7 +452,7 @@ impl Reader<'_> {
             let y = self.bracket(depth)?;
             self.expect('/')?;
             let x = self.bracket(depth)?;
-            return Ok(y.atan2(x).to_degrees());
+            return Ok(y.atan2_libm(x).to_degrees());
         }
         // Longer names first where one begins another (`acos` before `cos`? they differ at
         // the first letter; `fix`/`fup` too): the table is tried in order.
@@ -458,20 +460,25 @@ impl Reader<'_> {
         let table: [(&str, Function); 12] = [
             ("abs", |x| Some(x.abs())),
             ("acos", |x| {
-                (-1.0..=1.0).contains(&x).then(|| x.acos().to_degrees())
+                (-1.0..=1.0)
+                    .contains(&x)
+                    .then(|| x.acos_libm().to_degrees())
             }),
             ("asin", |x| {
-                (-1.0..=1.0).contains(&x).then(|| x.asin().to_degrees())
+                (-1.0..=1.0)
+                    .contains(&x)
+                    .then(|| x.asin_libm().to_degrees())
             }),
-            ("cos", |x| Some(x.to_radians().cos())),
-            ("exp", |x| Some(x.exp())),
+            ("cos", |x| Some(x.to_radians().cos_libm())),
+            ("exp", |x| Some(x.exp_libm())),
             ("fix", |x| Some(x.floor())),
             ("fup", |x| Some(x.ceil())),
             ("round", |x| Some(x.round())),
+            // The shared maths has no logarithm yet: the platform's, which may differ in the last bit.
             ("ln", |x| (x > 0.0).then(|| x.ln())),
-            ("sin", |x| Some(x.to_radians().sin())),
+            ("sin", |x| Some(x.to_radians().sin_libm())),
             ("sqrt", |x| (x >= 0.0).then(|| x.sqrt())),
-            ("tan", |x| Some(x.to_radians().tan())),
+            ("tan", |x| Some(x.to_radians().tan_libm())),
         ];
         let Some((name, f)) = table.into_iter().find(|(name, _)| self.eat(name)) else {
             return Err(fail("unknown function or operator"));

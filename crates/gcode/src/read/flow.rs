@@ -15,7 +15,7 @@ pub(super) const MAX_BLOCKS: usize = 1_000_000;
 /// Deepest subroutine nesting.
 pub(super) const MAX_CALLS: usize = 100;
 
-#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+#[derive(Clone, Copy, PartialEq, Eq)]
 enum Keyword {
     Sub,
     Endsub,
@@ -57,6 +57,28 @@ impl Keyword {
             "continue" => Continue,
             _ => return None,
         })
+    }
+
+    /// The keyword as a program writes it.
+    fn name(self) -> &'static str {
+        use Keyword::*;
+        match self {
+            Sub => "sub",
+            Endsub => "endsub",
+            Call => "call",
+            Return => "return",
+            If => "if",
+            Elseif => "elseif",
+            Else => "else",
+            Endif => "endif",
+            While | DoWhile => "while",
+            Endwhile => "endwhile",
+            Do => "do",
+            Repeat => "repeat",
+            Endrepeat => "endrepeat",
+            Break => "break",
+            Continue => "continue",
+        }
     }
 
     fn is_loop(self) -> bool {
@@ -261,7 +283,7 @@ fn structure(text: &str) -> Result<Structure, GcodeReadError> {
                     _ => vec![Repeat],
                 };
                 if !top_is(&opener, &sources) {
-                    return Err(mismatch(&format!("{keyword:?}").to_lowercase()));
+                    return Err(mismatch(keyword.name()));
                 }
                 let t = open.pop().unwrap_or(i);
                 if keyword == Endif {
@@ -296,7 +318,7 @@ fn structure(text: &str) -> Result<Structure, GcodeReadError> {
                         return Err(flow_error(
                             line,
                             column,
-                            format!("o{label} {keyword:?} outside an o{label} loop").to_lowercase(),
+                            format!("o{label} {} outside an o{label} loop", keyword.name()),
                         ))
                     }
                 }
@@ -367,10 +389,10 @@ fn past(o: &OLine, target: usize, line: usize) -> Result<usize, GcodeReadError> 
             line,
             o.column,
             format!(
-                "o{} {:?}: its block is never closed before the program ends",
-                o.label, o.keyword
-            )
-            .to_lowercase(),
+                "o{} {}: its block is never closed before the program ends",
+                o.label,
+                o.keyword.name()
+            ),
         ));
     }
     Ok(target + 1)
@@ -457,8 +479,7 @@ pub(super) fn run(text: &str, state: &mut State) -> Result<usize, GcodeReadError
                 _ => Err(GcodeReadError::Expression {
                     line,
                     column: o.column,
-                    problem: format!("o{} {:?} needs one [condition]", o.label, o.keyword)
-                        .to_lowercase(),
+                    problem: format!("o{} {} needs one [condition]", o.label, o.keyword.name()),
                 }),
             }
         };
@@ -611,7 +632,7 @@ fn read_block(
             assignments.push((target, value, column));
             continue;
         }
-        if !(c.is_ascii_alphabetic() || c == '$') {
+        if !(c.is_ascii_alphabetic() || "$@^".contains(c)) {
             return Err(GcodeReadError::UnexpectedCharacter {
                 line,
                 column,
