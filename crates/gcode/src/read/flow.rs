@@ -98,11 +98,15 @@ struct OLine {
     close: usize,
     /// The next `elseif`/`else`/`endif` of an `if` chain.
     next: usize,
+    /// The `if`/`elseif` this `elseif`/`else`/`endif` follows.
+    previous: usize,
 }
 
+/// A line of the program: a block (stripped again each time it runs, so a long program is not
+/// held twice), or an O-word line.
 enum Source {
-    Block(Vec<Char>),
-    Flow(OLine),
+    Block,
+    Flow(Box<OLine>),
 }
 
 /// A line without its comments and spaces, in lower case, each character with its column.
@@ -200,32 +204,39 @@ fn o_line(chars: &[Char], line: usize) -> Result<Option<OLine>, GcodeReadError> 
         open: usize::MAX,
         close: usize::MAX,
         next: usize::MAX,
+        previous: usize::MAX,
     }))
 }
 
 /// The program's lines, with every construct's opening and closing lines linked.
-struct Structure {
+struct Structure<'a> {
+    lines: Vec<&'a str>,
     sources: Vec<Source>,
     subs: HashMap<String, usize>,
 }
 
-fn structure(text: &str) -> Result<Structure, GcodeReadError> {
-    let mut sources = Vec::new();
-    for (index, raw) in text.lines().enumerate() {
+/// The characters of a block line, without an `O1234` program number.
+fn block_chars(raw: &str, line: usize) -> Result<Vec<Char>, GcodeReadError> {
+    let chars = strip(raw, line)?;
+    if chars.first().map(|c| c.0) != Some('o') {
+        return Ok(chars);
+    }
+    Ok(chars
+        .iter()
+        .skip(1)
+        .skip_while(|c| c.0.is_ascii_digit())
+        .copied()
+        .collect())
+}
+
+fn structure(text: &str) -> Result<Structure<'_>, GcodeReadError> {
+    let lines: Vec<&str> = text.lines().collect();
+    let mut sources = Vec::with_capacity(lines.len());
+    for (index, raw) in lines.iter().enumerate() {
         let chars = strip(raw, index + 1)?;
         sources.push(match o_line(&chars, index + 1)? {
-            Some(o) => Source::Flow(o),
-            None if chars.first().map(|c| c.0) == Some('o') => {
-                // A program number: drop it, keep the rest.
-                let rest = chars
-                    .iter()
-                    .skip(1)
-                    .skip_while(|c| c.0.is_ascii_digit())
-                    .copied()
-                    .collect();
-                Source::Block(rest)
-            }
-            None => Source::Block(chars),
+            Some(o) => Source::Flow(Box::new(o)),
+            None => Source::Block,
         });
     }
     let mut subs = HashMap::new();
@@ -337,14 +348,18 @@ fn structure(text: &str) -> Result<Structure, GcodeReadError> {
             let t = f.open;
             let close = match &sources[t] {
                 Source::Flow(l) => l.close,
-                Source::Block(_) => usize::MAX,
+                Source::Block => usize::MAX,
             };
             if let Source::Flow(f) = &mut sources[i] {
                 f.close = close;
             }
         }
     }
-    Ok(Structure { sources, subs })
+    Ok(Structure {
+        lines,
+        sources,
+        subs,
+    })
 }
 
 /// Links an opening line and its closing line; the closer becomes `keyword`.
@@ -363,22 +378,21 @@ fn chain(sources: &mut [Source], from: usize, next: usize) {
     if let Source::Flow(o) = &mut sources[from] {
         o.next = next;
     }
+    if let Source::Flow(o) = &mut sources[next] {
+        o.previous = from;
+    }
 }
 
 /// Every line of the `if` chain ending at `last` (`endif`) closes there.
 fn close_chain(sources: &mut [Source], last_branch: usize, endif: usize) {
-    // Walk back from the last branch to the `if` through the lines that chain to it.
-    let mut branch = Some(last_branch);
-    while let Some(b) = branch {
-        if let Source::Flow(o) = &mut sources[b] {
-            o.close = endif;
-            if o.keyword == Keyword::If {
-                break;
-            }
+    // Walk back from the last branch to the `if`.
+    let mut branch = last_branch;
+    while let Some(Source::Flow(o)) = sources.get_mut(branch) {
+        o.close = endif;
+        if o.keyword == Keyword::If {
+            break;
         }
-        branch = (0..b)
-            .rev()
-            .find(|&p| matches!(&sources[p], Source::Flow(f) if f.next == b));
+        branch = o.previous;
     }
 }
 
@@ -407,7 +421,11 @@ struct Frame {
 
 /// Runs the program through `state`, line by line as the control flow goes.
 pub(super) fn run(text: &str, state: &mut State) -> Result<usize, GcodeReadError> {
-    let Structure { sources, subs } = structure(text)?;
+    let Structure {
+        lines,
+        sources,
+        subs,
+    } = structure(text)?;
     let mut parameters = Parameters::new();
     let mut frames: Vec<Frame> = Vec::new();
     let mut repeats: HashMap<usize, i64> = HashMap::new();
@@ -429,12 +447,13 @@ pub(super) fn run(text: &str, state: &mut State) -> Result<usize, GcodeReadError
             });
         }
         let o = match &sources[pc] {
-            Source::Block(chars) => {
+            Source::Block => {
+                let chars = block_chars(lines[pc], line)?;
                 if chars.is_empty() {
                     pc += 1;
                     continue;
                 }
-                let (words, assignments) = read_block(chars, line, &parameters, state)?;
+                let (words, assignments) = read_block(&chars, line, &parameters, state)?;
                 for (target, value, column) in assignments {
                     parameters.assign(target, value, line, column)?;
                 }
