@@ -15,7 +15,7 @@ fn sample(name: &str) -> String {
 }
 
 /// (file, GRBL laser mode, pierces, cut length by hand or `None` where only rs274 can tell).
-const SAMPLES: [(&str, bool, usize, Option<f64>); 5] = [
+const SAMPLES: [(&str, bool, usize, Option<f64>); 6] = [
     // G92 X0 Y0 first; a hole of radius 10 in two G2 halves, then a 100 × 50 rectangle.
     ("dxf2gcode-plasma.ngc", false, 2, Some(300.0 + 20.0 * PI)),
     // A hole of radius 5, then a half circle of radius 20 on a 40 × 40 outline (120 mm of lines).
@@ -31,6 +31,13 @@ const SAMPLES: [(&str, bool, usize, Option<f64>); 5] = [
     ("inkscape-gcodetools.ngc", false, 1, Some(20.0 * PI + 120.0)),
     // LinuxCNC's own shipped plasma test (SheetCam's EMC post): 404 lines of letters.
     ("linuxcnc-plasmatest.ngc", false, 15, None),
+    // LinuxCNC's parameters, a subroutine and loops: six holes of radius 5, a 120 × 80 outline.
+    (
+        "linuxcnc-parametric-plasma.ngc",
+        false,
+        7,
+        Some(400.0 + 60.0 * PI),
+    ),
 ];
 
 #[test]
