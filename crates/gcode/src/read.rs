@@ -11,7 +11,7 @@
 //! (`(MSG,…)` among them) and `;` comments, spaces anywhere (LinuxCNC ignores them), `%` tape
 //! marks, block delete `/` (the block is executed), modal motion (a line of bare coordinates
 //! continues the last motion). Harmless
-//! modal codes (`G17`, `G49`, `G54`–`G59`, `G61`, `G64`, `G80`, `G94`, `G96`/`G97` spindle speed
+//! modal codes (`G17`, `G43`/`G43.1`/`G43.2`, `G49`, `G54`–`G59`, `G61`, `G64`, `G80`, `G94`, `G96`/`G97` spindle speed
 //! modes) are accepted; codes that would change the meaning of the motion (other planes, canned
 //! cycles, homing, probing, …) are refused with their location. LinuxCNC's polar coordinates
 //! (`@` distance, `^` angle) are read on straight moves. Z
@@ -1068,10 +1068,10 @@ impl State<'_> {
                     line,
                 )
             }
-            // Plane XY, tool length off, work offsets, path control, canned cycle off, feed
-            // per minute: nothing changes for the head's XY path.
-            // Spindle speed modes (constant surface speed, RPM) as well.
-            170 | 490 | 540..=590 | 610 | 640 | 800 | 940 | 960 | 970 => Ok(()),
+            // Plane XY, tool length offsets (on or off: they move Z only), work offsets, path
+            // control, canned cycle off, feed per minute, spindle speed modes: nothing changes
+            // for the head's XY path.
+            170 | 430 | 431 | 432 | 490 | 540..=590 | 610 | 640 | 800 | 940 | 960 | 970 => Ok(()),
             _ => Err(GcodeReadError::UnsupportedCode {
                 line,
                 column: word.column,

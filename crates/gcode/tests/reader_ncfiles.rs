@@ -1,9 +1,9 @@
 //! LinuxCNC's own example programs (the `ncfiles` its package ships, QtPlasmaC's among them):
 //! every one that rs274 runs with motion in the sheet's plane reads as rs274 computes it
 //! (pierces, cut length, idle length), and every one rs274 refuses is refused by the reader.
-//! Programs that rs274 runs but the reader refuses for what a 2-D cut does not have (other
-//! planes, canned cycles, probing, tool changes) are counted, named and checked to be refused
-//! with a location, not compared.
+//! Programs that rs274 runs but the reader refuses (other planes, canned cycles, probing,
+//! inverse-time feed, and compensated stretches the reader's model of LinuxCNC's compensation
+//! does not follow) are counted, named and checked to be refused with a location.
 
 mod reader_rs274;
 
@@ -112,7 +112,7 @@ fn linuxcncs_example_programs_read_as_rs274_runs_them() {
         }
     }
     eprintln!(
-        "{} ncfiles: {agree} read as rs274 runs them, {both_refuse} refused by both, {} run by rs274 but beyond a 2-D cut:",
+        "{} ncfiles: {agree} read as rs274 runs them, {both_refuse} refused by both, {} run by rs274 and refused by the reader:",
         files.len(),
         beyond_2d.len()
     );
