@@ -38,6 +38,9 @@ fn linuxcncs_example_programs_read_as_rs274_runs_them() {
     files.sort();
     assert!(!files.is_empty(), "no ncfiles under {}", root.display());
     let (mut agree, mut both_refuse, mut beyond_2d) = (0, 0, Vec::new());
+    // Of the programs read as rs274 runs them: with motion in the plane, and lacking a program
+    // end (compared as if they had one).
+    let (mut moving, mut endless) = (0, 0);
     let mut disagree = Vec::new();
     for path in &files {
         let name = path
@@ -65,6 +68,7 @@ fn linuxcncs_example_programs_read_as_rs274_runs_them() {
             .is_some_and(|e| e.starts_with("File ended with no percent sign or program end"))
         {
             machine = reader_rs274::run(&rs274, &format!("{quiet}M2\n"), 1.0, false);
+            endless += usize::from(machine.error.is_none());
         }
         // The harness's tool table holds every tool 1–9 with a radius of 1 mm.
         let options = ReadOptions {
@@ -97,6 +101,7 @@ fn linuxcncs_example_programs_read_as_rs274_runs_them() {
                     && (machine.idle - program.idle_length()).abs() < tolerance;
                 if same {
                     agree += 1;
+                    moving += usize::from(!program.motions.is_empty());
                 } else {
                     disagree.push(format!(
                         "{name}: rs274 {} pierces, cut {:.4}, idle {:.4}; read {}, {:.4}, {:.4}",
@@ -112,7 +117,7 @@ fn linuxcncs_example_programs_read_as_rs274_runs_them() {
         }
     }
     eprintln!(
-        "{} ncfiles: {agree} read as rs274 runs them, {both_refuse} refused by both, {} run by rs274 and refused by the reader:",
+        "{} ncfiles: {agree} read as rs274 runs them ({moving} with motion, {endless} without a program end), {both_refuse} refused by both, {} run by rs274 and refused by the reader:",
         files.len(),
         beyond_2d.len()
     );
