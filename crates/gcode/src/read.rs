@@ -7,7 +7,8 @@
 //! incremental arc centres), `G92` (the head's position gets new coordinates: an offset of the
 //! program's frame; the motion is reported in the frame the program started in, so the head's
 //! path stays continuous), `G92.1` (offset cancelled and forgotten), `G92.2` (cancelled, kept),
-//! `G92.3` (the kept one restored), `N` line numbers, `O` program numbers, `( )` comments
+//! `G92.3` (the kept one restored), `G53` (a `G0`/`G1` move in machine coordinates: the frame
+//! the program started in, the work offsets being zero as in rs274), `N` line numbers, `O` program numbers, `( )` comments
 //! (`(MSG,…)` among them) and `;` comments, spaces anywhere (LinuxCNC ignores them), `%` tape
 //! marks, block delete `/` (the block is executed), modal motion (a line of bare coordinates
 //! continues the last motion). Harmless
@@ -711,6 +712,10 @@ struct Codes {
     compensation: Option<(CompensationCode, usize, String)>,
     motion: Option<(MotionMode, usize, String)>,
     dwell: Option<usize>,
+    /// `G53`: this block's move is in machine coordinates (column of the code).
+    machine: Option<usize>,
+    /// `G80` was in the block.
+    cycle_off: bool,
     distance: Option<(bool, usize, String)>,
     centres: Option<(bool, usize, String)>,
     units: Option<(bool, usize, String)>,
@@ -854,7 +859,10 @@ impl State<'_> {
         }
         let axis = cartesian.or(polar_word);
         if let Some(column) = codes.dwell {
-            if let Some(word) = axis.filter(|w| w.letter == 'Y').or(get('I')).or(get('R')) {
+            // `G04 P… G00 X… Y…`: LinuxCNC dwells, then moves (the axis words are the move's).
+            let then_moves = codes.motion.is_some() && get('P').is_some();
+            let axis_words = axis.filter(|w| w.letter == 'Y' && !then_moves);
+            if let Some(word) = axis_words.or(get('I')).or(get('R')) {
                 return Err(GcodeReadError::ConflictingCodes {
                     line,
                     column: word.column,
@@ -875,7 +883,9 @@ impl State<'_> {
                 Some(s) if s >= 0.0 => self.motions.push(Motion::Dwell { seconds: s, line }),
                 _ => return Err(GcodeReadError::InvalidDwell { line, column }),
             }
-            return Ok(());
+            if !then_moves {
+                return Ok(());
+            }
         }
         if let Some((incremental, _, _)) = codes.distance {
             self.incremental = incremental;
@@ -900,6 +910,29 @@ impl State<'_> {
         if let Some((code, column, _)) = codes.compensation {
             self.compensation_code(code, get('D'), unit, line, column)?;
         }
+        if let Some(column) = codes.machine {
+            // As rs274: a G53 block moves by G0 or G1, in absolute machine coordinates.
+            let moves = axis.is_some() || get('Z').is_some();
+            let straight = matches!(self.motion, Some(MotionMode::Rapid | MotionMode::Linear));
+            let problem = if !moves && !codes.cycle_off {
+                Some("G53 without a G0 or G1 move")
+            } else if moves && !straight {
+                Some("G53 with a motion other than G0 or G1")
+            } else if axis.is_some() && (self.incremental || polar_word.is_some()) {
+                Some("G53 with incremental or polar coordinates")
+            } else if axis.is_some() && self.compensation.is_some() {
+                Some("G53 under cutter compensation")
+            } else {
+                None
+            };
+            if let Some(problem) = problem {
+                return Err(GcodeReadError::UnsupportedCode {
+                    line,
+                    column,
+                    code: problem.into(),
+                });
+            }
+        }
         let arc_words = ['I', 'J', 'R'].into_iter().filter_map(get).next();
         let Some(first) = axis.or(arc_words) else {
             return Ok(());
@@ -910,7 +943,12 @@ impl State<'_> {
                 column: first.column,
             });
         };
-        let offset = self.offset;
+        // Machine coordinates (G53) are the frame the program started in, less no offset.
+        let offset = if codes.machine.is_some() {
+            Point::new(0.0, 0.0)
+        } else {
+            self.offset
+        };
         let coordinate = |letter: char, current: f64, offset: f64| match get(letter) {
             Some(w) if self.incremental => current + w.value * unit,
             Some(w) => w.value * unit + offset,
@@ -1071,7 +1109,15 @@ impl State<'_> {
             // Plane XY, tool length offsets (on or off: they move Z only), work offsets, path
             // control, canned cycle off, feed per minute, spindle speed modes: nothing changes
             // for the head's XY path.
-            170 | 430 | 431 | 432 | 490 | 540..=590 | 610 | 640 | 800 | 940 | 960 | 970 => Ok(()),
+            530 => {
+                codes.machine = Some(word.column);
+                Ok(())
+            }
+            800 => {
+                codes.cycle_off = true;
+                Ok(())
+            }
+            170 | 430 | 431 | 432 | 490 | 540..=590 | 610 | 640 | 940 | 960 | 970 => Ok(()),
             _ => Err(GcodeReadError::UnsupportedCode {
                 line,
                 column: word.column,

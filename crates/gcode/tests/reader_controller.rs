@@ -303,6 +303,41 @@ G0 X999 (after the program's end)
     agrees_with_rs274("o-words", text, &program, 1.0);
 }
 
+/// `G04 P… G00 X… Y…`: the dwell, then the move, in one block.
+#[test]
+fn a_dwell_and_a_move_share_a_block() {
+    let text = "G21 G90\nG04 P0.5 G0 X3 Y4\nM2\n";
+    let program = read_gcode(text, &ReadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(program.dwell_time(), 0.5);
+    assert_eq!(program.end, Point::new(3.0, 4.0));
+    assert!((program.idle_length() - 5.0).abs() < 1e-12);
+    agrees_with_rs274("dwell and move", text, &program, 1.0);
+}
+
+/// `G53`: one G0/G1 move in machine coordinates, past the G92 offset.
+#[test]
+fn g53_moves_in_machine_coordinates() {
+    let text = "G21 G90\nG92 X10 Y10\nG53 G0 X5 Y5\nG0 X1 Y1\nG53 Z0\nM2\n";
+    let program = read_gcode(text, &ReadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+    let rapids: Vec<Point> = program
+        .motions
+        .iter()
+        .filter_map(|m| match m {
+            Motion::Rapid { to, .. } => Some(*to),
+            _ => None,
+        })
+        .collect();
+    // The G92 offset is -10 on both axes: X1 Y1 is (-9, -9) where the program started.
+    assert_eq!(rapids, [Point::new(5.0, 5.0), Point::new(-9.0, -9.0)]);
+    agrees_with_rs274("g53", text, &program, 1.0);
+    for (bad, location) in [("G53\n", (1, 1)), ("G0 X0\nG53 G2 X5 Y5 R5\n", (2, 1))] {
+        let error = read_gcode(bad, &ReadOptions::default()).unwrap_err();
+        assert_eq!(error.location(), location, "{bad}: {error}");
+        assert!(error.to_string().contains("G53"), "{bad}: {error}");
+        refused_by_rs274(bad, &format!("{bad}M2\n"), 1.0);
+    }
+}
+
 /// LinuxCNC's polar coordinates: `@` distance and `^` angle from the origin; in `G91` both add
 /// to the head's own.
 #[test]
