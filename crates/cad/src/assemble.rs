@@ -18,6 +18,7 @@
 //! containment: even depth (not inside anything, or inside a hole) starts a part, odd depth is a
 //! hole of its container's part. Outer contours are made clockwise, holes counter-clockwise.
 
+use std::cell::OnceCell;
 use std::collections::HashMap;
 
 use cutroute_geometry::{
@@ -495,9 +496,18 @@ struct Placed {
     source: SourceRef,
     area: f64,
     bbox: BoundingBox,
-    /// The contour flattened within the flattening tolerance: where containment samples it
-    /// when this contour is the inner one.
-    polygon: Vec<Point>,
+    /// The contour flattened within `flatten_tolerance`, where containment samples it when
+    /// this contour is the inner one: made only then, since most contours of a big drawing
+    /// (an array insert) have no box around them to test against.
+    polygon: OnceCell<Vec<Point>>,
+    flatten_tolerance: f64,
+}
+
+impl Placed {
+    fn polygon(&self) -> &[Point] {
+        self.polygon
+            .get_or_init(|| self.contour.flatten(self.flatten_tolerance))
+    }
 }
 
 fn group_into_parts(
@@ -546,13 +556,13 @@ fn group_into_parts(
             continue;
         }
         let bbox = contour.bounding_box();
-        let polygon = contour.flatten(limits.flatten_tolerance.min(tolerance));
         placed.push(Placed {
             contour,
             source,
             area,
             bbox,
-            polygon,
+            polygon: OnceCell::new(),
+            flatten_tolerance: limits.flatten_tolerance.min(tolerance),
         });
     }
     // Largest first: every container comes before what it contains.
@@ -680,13 +690,14 @@ enum Containment {
 /// midpoints), tested against the outer contour's true arcs and ignoring samples on the outer
 /// boundary: contours that touch stay decidable, identical ones are recognised.
 fn containment(inner: &Placed, outer: &Placed, tolerance: f64) -> Containment {
-    let n = inner.polygon.len();
+    let polygon = inner.polygon();
+    let n = polygon.len();
     let stride = (n / 32).max(1);
     let (mut inside, mut outside) = (0usize, 0usize);
     let mut k = 0;
     while k < n {
-        let a = inner.polygon[k];
-        let b = inner.polygon[(k + 1) % n];
+        let a = polygon[k];
+        let b = polygon[(k + 1) % n];
         for p in [a, a.midpoint(b)] {
             if outer.contour.distance_to(p) <= tolerance {
                 continue;
@@ -700,9 +711,7 @@ fn containment(inner: &Placed, outer: &Placed, tolerance: f64) -> Containment {
         k += stride;
     }
     if inside == 0 && outside == 0 {
-        if (inner.area.abs() - outer.area.abs()).abs()
-            <= tolerance * (inner.polygon.len() as f64).max(1.0) * 10.0
-        {
+        if (inner.area.abs() - outer.area.abs()).abs() <= tolerance * (n as f64).max(1.0) * 10.0 {
             Containment::Same
         } else {
             Containment::Outside

@@ -133,11 +133,16 @@ impl PcgtspBuilder {
         let fixed: usize = prob.shapes.iter().map(|shape| shape.spans.len() + 2).sum();
         let bound = perimeter / options.step + fixed as f64 + 1.0;
         if fixed + 1 >= MAX_DISCRETE_NODES {
+            let contours = prob.shapes.len();
+            let spans = fixed - 2 * contours;
+            let what = if contours == 1 {
+                format!("a contour of {spans} spans needs")
+            } else {
+                format!("{contours} contours of {spans} spans need")
+            };
             return Err(CcpError::InvalidOption(format!(
-                "{} contours of {} spans need more than the {MAX_DISCRETE_NODES} candidate points \
-                 of a dense cost matrix at any step",
-                prob.shapes.len(),
-                fixed - 2 * prob.shapes.len()
+                "{what} more than the {MAX_DISCRETE_NODES} candidate points of a dense cost \
+                 matrix at any step"
             )));
         }
         if bound.is_nan() || bound > MAX_DISCRETE_NODES as f64 {
