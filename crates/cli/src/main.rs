@@ -48,7 +48,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use cutroute_engine::{start_job, AoeJob, Job, SegmentJob};
+use cutroute_engine::{start_job, AoeJob, Job, NearestNeighbourJob, SegmentJob};
 use cutroute_geometry::{
     ContainmentForest, Entry, MachineParameters, Nest, Objective, PathRoute, Route,
 };
@@ -479,6 +479,12 @@ struct JobRun {
     stopped: Option<&'static str>,
     /// The limit it ran under, s (for messages).
     time_limit_s: f64,
+    /// The route a very short limit gives (the nearest solver's first route, in forest
+    /// order), made before the job starts: the answer when the job has none by the limit or
+    /// Ctrl-C.
+    first_route: Option<Progress>,
+    /// Why the report answers with `first_route` (the job made no route of its own).
+    fallback: Option<String>,
 }
 
 /// How many improving routes a run keeps, at least half a second apart.
@@ -574,6 +580,8 @@ fn run_job(job: &mut dyn Job, watch: &Watch, on_progress: &mut dyn FnMut(&Progre
                 earlier_routes: seen.earlier_routes.clone(),
                 stopped: seen.stopped,
                 time_limit_s: seen.time_limit_s,
+                first_route: seen.first_route.clone(),
+                fallback: None,
             };
         }
     }
@@ -787,7 +795,14 @@ fn bounded_job_run(mut request: JobRequest, as_json: bool) -> Result<FinishedRun
     let display = stdio::ProgressDisplay::new(as_json);
     let mut shown = display.clone();
     let job_limit_s = request.params.time_limit_s;
+    let solver = request.solver;
     let outcome = run_bounded(job_limit_s, grace, move |watch| {
+        let first = first_route(&request);
+        watch
+            .seen
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .first_route = first;
         let mut job = SolverJob::start(&request)?;
         let run = run_job(job.job(), watch, &mut |p| shown.show(p));
         let extras = job.report_extras(request.solver, &request.params.machine)?;
@@ -799,7 +814,44 @@ fn bounded_job_run(mut request: JobRequest, as_json: bool) -> Result<FinishedRun
         Err(snapshot) => (snapshot, serde_json::Map::new()),
     };
     run.time_limit_s = time_limit_s;
+    let has_route = run.last.as_ref().is_some_and(|p| p.solution.is_some());
+    if let (false, Some(first)) = (has_route, run.first_route.take()) {
+        let why = match run.stopped {
+            Some(stopped) => format!(
+                "the {} solver made no route before it was stopped ({stopped}): the nearest solver's first route (forest order) instead",
+                solver.name()
+            ),
+            None => format!(
+                "the {} solver made no route: the nearest solver's first route (forest order) instead",
+                solver.name()
+            ),
+        };
+        eprintln!("cutroute: warning: {why}");
+        run.fallback = Some(why);
+        run.last = Some(first);
+    }
     Ok(FinishedRun { run, extras })
+}
+
+/// The route a very short limit gives for `request`'s nest: the nearest solver's first step
+/// (the containment forest and the forest-order route, linear in vertices). `None` for the
+/// nearest solver itself (its first step is this route), a PCGTSP instance, or a kerf job
+/// (whose routes carry leads).
+fn first_route(request: &JobRequest) -> Option<Progress> {
+    let Problem::Nest {
+        nest,
+        start,
+        finish,
+    } = &request.problem
+    else {
+        return None;
+    };
+    if request.solver == SolverKind::NearestNeighbour || !request.params.kerf.is_idealised() {
+        return None;
+    }
+    let mut job = NearestNeighbourJob::new(request.job_id, nest.clone(), *start, *finish).ok()?;
+    job.step(cutroute_engine::DEFAULT_SLICE);
+    Some(job.progress()).filter(|p| p.solution.is_some())
 }
 
 /// The run's route if it passes the checker, else the newest earlier route that does (with
@@ -1376,12 +1428,9 @@ fn solve(
         solver,
         params,
     };
-    // The checker's forest of routes of whole contours (path routes are checked without it).
-    let forest = if solver.gives_path_route() {
-        None
-    } else {
-        forest_in_background(&document.problem)
-    };
+    // The checker's forest of routes of whole contours (path routes are checked without it,
+    // but a path solver with no route of its own answers with a route of whole contours).
+    let forest = forest_in_background(&document.problem);
     let request = kerf.request(request, solver_name)?;
     thermal.warn_unpriced(solver);
     let started = std::time::Instant::now();
@@ -1584,12 +1633,13 @@ fn route_report(
         "proven_optimal": result.proven_optimal,
         "elapsed_s": result.elapsed_s,
         "final_route_rejected": final_route_rejected,
-        // A path solver whose own route failed the checker answers with this contour route.
-        "fallback": result
+        // A solver with no route of its own, or a path solver whose own route failed the
+        // checker, answers with this contour route.
+        "fallback": run.fallback.clone().or_else(|| result
             .alternatives
             .iter()
             .find(|a| a.name == cutroute_engine::REJECTED_ROUTE)
-            .and_then(|a| a.failure.clone()),
+            .and_then(|a| a.failure.clone())),
         "stopped": run.stopped,
     }))
 }
@@ -1797,8 +1847,8 @@ mod tests {
                 ..Progress::default()
             }),
             earlier_routes: earlier,
-            stopped: None,
             time_limit_s: 1.0,
+            ..JobRun::default()
         }
     }
 
