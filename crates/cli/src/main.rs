@@ -766,12 +766,26 @@ struct FinishedRun {
 
 /// The time kept from a job's limit for the report that follows it: about 10 µs per contour
 /// (on 100,000 generated contours the report of a CCP route took 1.0–1.3 s after the job), at
-/// most a quarter of the limit; none on a PCGTSP instance or an unlimited run.
-fn report_reserve_s(problem: &Problem, time_limit_s: f64) -> f64 {
+/// most a quarter of the limit; a path solver's report checks and prints every span of its
+/// route, so it keeps 5 µs more a span, at most half the limit in all; none on a PCGTSP
+/// instance or an unlimited run.
+fn report_reserve_s(problem: &Problem, solver: SolverKind, time_limit_s: f64) -> f64 {
     const PER_CONTOUR_S: f64 = 10e-6;
+    const PER_SPAN_S: f64 = 5e-6;
     match problem {
         Problem::Nest { nest, .. } if time_limit_s.is_finite() => {
-            (nest.contour_count() as f64 * PER_CONTOUR_S).min(time_limit_s / 4.0)
+            let contours = (nest.contour_count() as f64 * PER_CONTOUR_S).min(time_limit_s / 4.0);
+            if solver.gives_path_route() {
+                let spans: usize = nest
+                    .parts
+                    .iter()
+                    .flat_map(|part| &part.contours)
+                    .map(|contour| contour.span_count())
+                    .sum();
+                (contours + spans as f64 * PER_SPAN_S).min(time_limit_s / 2.0)
+            } else {
+                contours
+            }
         }
         _ => 0.0,
     }
@@ -782,7 +796,8 @@ fn bounded_job_run(mut request: JobRequest, as_json: bool) -> Result<FinishedRun
     let time_limit_s = request.params.time_limit_s;
     // The report after the job (the route checked again, its heat and JSON) is part of the
     // promise: the job ends that much earlier.
-    request.params.time_limit_s = time_limit_s - report_reserve_s(&request.problem, time_limit_s);
+    request.params.time_limit_s =
+        time_limit_s - report_reserve_s(&request.problem, request.solver, time_limit_s);
     // A kerf job keeps its leads' time inside the limit where it can (it stops its solvers
     // when the final route's leads would not be ready by then) and ends by itself at most
     // `OVERRUN_LIMIT` past it: a route whose leads are still being fitted is waited for that
@@ -1805,14 +1820,19 @@ mod tests {
             Problem::Nest { nest, .. } => nest.contour_count(),
             _ => unreachable!(),
         };
-        assert!((report_reserve_s(&big, 5.0) - contours as f64 * 10e-6).abs() < 1e-12);
-        assert_eq!(report_reserve_s(&big, 0.4), 0.1);
-        assert_eq!(report_reserve_s(&big, f64::INFINITY), 0.0);
-        assert!(report_reserve_s(&nest(50), 5.0) < 1e-3);
+        let ccp = SolverKind::Ccp;
+        assert!((report_reserve_s(&big, ccp, 5.0) - contours as f64 * 10e-6).abs() < 1e-12);
+        assert_eq!(report_reserve_s(&big, ccp, 0.4), 0.1);
+        assert_eq!(report_reserve_s(&big, ccp, f64::INFINITY), 0.0);
+        assert!(report_reserve_s(&nest(50), ccp, 5.0) < 1e-3);
+        // A path solver keeps more for its spans, never past half the limit.
+        let sccp = SolverKind::Sccp;
+        assert!(report_reserve_s(&big, sccp, 5.0) > report_reserve_s(&big, ccp, 5.0));
+        assert_eq!(report_reserve_s(&big, sccp, 0.4), 0.2);
         let instance = Problem::PcgtspText {
             text: String::new(),
         };
-        assert_eq!(report_reserve_s(&instance, 5.0), 0.0);
+        assert_eq!(report_reserve_s(&instance, SolverKind::Sccp, 5.0), 0.0);
     }
 
     fn square(x: f64) -> Contour {
