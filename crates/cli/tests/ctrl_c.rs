@@ -129,7 +129,8 @@ fn ctrl_c_after_1_s_keeps_every_solver_s_best_route() {
 
 /// On a generated nest of thousands of contours, Ctrl-C comes before the path solvers and
 /// chain have a route of their own: each answers with the first route (the one a very short
-/// limit gives), checked, and says so.
+/// limit gives), checked. (The solvers of a dense cost matrix, heuristic, exact and discrete,
+/// refuse a nest this big before they start: a refusal, not a run to stop.)
 #[test]
 fn ctrl_c_on_a_big_nest_gives_every_solver_a_checked_route() {
     let dir = std::env::temp_dir().join(format!("cutroute-ctrl-c-big-{}", std::process::id()));
@@ -145,7 +146,8 @@ fn ctrl_c_on_a_big_nest_gives_every_solver_a_checked_route() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    for solver in SOLVERS {
+    let dense = ["heuristic", "exact", "discrete"];
+    for solver in SOLVERS.iter().filter(|s| !dense.contains(s)) {
         solve_interrupted_on(&nest, solver, Duration::from_millis(50));
     }
 }
