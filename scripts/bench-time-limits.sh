@@ -62,12 +62,18 @@ try:
 except ImportError:
     sys.exit(0)
 doc = ezdxf.new("R2010")
+# In mm (ezdxf's default drawing unit is the metre: every curve would be 1000 times larger).
+doc.units = ezdxf.units.MM
 msp = doc.modelspace()
+# 24 control points a spline: a drawing of about 2 MB.
+SPLINE_POINTS = 24
 for i in range(1200):
     cx, cy = (i % 40) * 60.0, (i // 40) * 60.0
-    points = [(cx + 20 * math.cos(2 * math.pi * k / 60) * (1 + 0.2 * math.sin(3 * 2 * math.pi * k / 60)),
-               cy + 20 * math.sin(2 * math.pi * k / 60)) for k in range(60)]
-    msp.add_closed_spline(points)
+    points = [(cx + 20 * math.cos(2 * math.pi * k / SPLINE_POINTS) * (1 + 0.2 * math.sin(3 * 2 * math.pi * k / SPLINE_POINTS)),
+               cy + 20 * math.sin(2 * math.pi * k / SPLINE_POINTS)) for k in range(SPLINE_POINTS)]
+    # ezdxf 1.4 has no add_closed_spline: control points interpolating the fit points, the
+    # first repeated at the end, close the curve.
+    msp.add_spline_control_frame(points + [points[0]])
 doc.saveas(f"{out}/splines-1200.dxf")
 PY
 BIG=("$TMP/circle-20000.dbs.json" "$TMP/circle-200000.dbs.json" "$TMP/square-40000.dbs.json" "$TMP/generated-60000.json")

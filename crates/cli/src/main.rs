@@ -48,7 +48,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use cutroute_engine::{start_job, AoeJob, Job, SegmentJob};
+use cutroute_engine::{start_job, AoeJob, Job, NearestNeighbourJob, SegmentJob};
 use cutroute_geometry::{
     ContainmentForest, Entry, MachineParameters, Nest, Objective, PathRoute, Route,
 };
@@ -479,6 +479,12 @@ struct JobRun {
     stopped: Option<&'static str>,
     /// The limit it ran under, s (for messages).
     time_limit_s: f64,
+    /// The route a very short limit gives (the nearest solver's first route, in forest
+    /// order), made before the job starts: the answer when the job has none by the limit or
+    /// Ctrl-C.
+    first_route: Option<Progress>,
+    /// Why the report answers with `first_route` (the job made no route of its own).
+    fallback: Option<String>,
 }
 
 /// How many improving routes a run keeps, at least half a second apart.
@@ -574,6 +580,8 @@ fn run_job(job: &mut dyn Job, watch: &Watch, on_progress: &mut dyn FnMut(&Progre
                 earlier_routes: seen.earlier_routes.clone(),
                 stopped: seen.stopped,
                 time_limit_s: seen.time_limit_s,
+                first_route: seen.first_route.clone(),
+                fallback: None,
             };
         }
     }
@@ -758,12 +766,26 @@ struct FinishedRun {
 
 /// The time kept from a job's limit for the report that follows it: about 10 µs per contour
 /// (on 100,000 generated contours the report of a CCP route took 1.0–1.3 s after the job), at
-/// most a quarter of the limit; none on a PCGTSP instance or an unlimited run.
-fn report_reserve_s(problem: &Problem, time_limit_s: f64) -> f64 {
+/// most a quarter of the limit; a path solver's report checks and prints every span of its
+/// route, so it keeps 5 µs more a span, at most half the limit in all; none on a PCGTSP
+/// instance or an unlimited run.
+fn report_reserve_s(problem: &Problem, solver: SolverKind, time_limit_s: f64) -> f64 {
     const PER_CONTOUR_S: f64 = 10e-6;
+    const PER_SPAN_S: f64 = 5e-6;
     match problem {
         Problem::Nest { nest, .. } if time_limit_s.is_finite() => {
-            (nest.contour_count() as f64 * PER_CONTOUR_S).min(time_limit_s / 4.0)
+            let contours = (nest.contour_count() as f64 * PER_CONTOUR_S).min(time_limit_s / 4.0);
+            if solver.gives_path_route() {
+                let spans: usize = nest
+                    .parts
+                    .iter()
+                    .flat_map(|part| &part.contours)
+                    .map(|contour| contour.span_count())
+                    .sum();
+                (contours + spans as f64 * PER_SPAN_S).min(time_limit_s / 2.0)
+            } else {
+                contours
+            }
         }
         _ => 0.0,
     }
@@ -774,7 +796,8 @@ fn bounded_job_run(mut request: JobRequest, as_json: bool) -> Result<FinishedRun
     let time_limit_s = request.params.time_limit_s;
     // The report after the job (the route checked again, its heat and JSON) is part of the
     // promise: the job ends that much earlier.
-    request.params.time_limit_s = time_limit_s - report_reserve_s(&request.problem, time_limit_s);
+    request.params.time_limit_s =
+        time_limit_s - report_reserve_s(&request.problem, request.solver, time_limit_s);
     // A kerf job keeps its leads' time inside the limit where it can (it stops its solvers
     // when the final route's leads would not be ready by then) and ends by itself at most
     // `OVERRUN_LIMIT` past it: a route whose leads are still being fitted is waited for that
@@ -787,7 +810,14 @@ fn bounded_job_run(mut request: JobRequest, as_json: bool) -> Result<FinishedRun
     let display = stdio::ProgressDisplay::new(as_json);
     let mut shown = display.clone();
     let job_limit_s = request.params.time_limit_s;
+    let solver = request.solver;
     let outcome = run_bounded(job_limit_s, grace, move |watch| {
+        let first = first_route(&request);
+        watch
+            .seen
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .first_route = first;
         let mut job = SolverJob::start(&request)?;
         let run = run_job(job.job(), watch, &mut |p| shown.show(p));
         let extras = job.report_extras(request.solver, &request.params.machine)?;
@@ -799,7 +829,44 @@ fn bounded_job_run(mut request: JobRequest, as_json: bool) -> Result<FinishedRun
         Err(snapshot) => (snapshot, serde_json::Map::new()),
     };
     run.time_limit_s = time_limit_s;
+    let has_route = run.last.as_ref().is_some_and(|p| p.solution.is_some());
+    if let (false, Some(first)) = (has_route, run.first_route.take()) {
+        let why = match run.stopped {
+            Some(stopped) => format!(
+                "the {} solver made no route before it was stopped ({stopped}): the nearest solver's first route (forest order) instead",
+                solver.name()
+            ),
+            None => format!(
+                "the {} solver made no route: the nearest solver's first route (forest order) instead",
+                solver.name()
+            ),
+        };
+        eprintln!("cutroute: warning: {why}");
+        run.fallback = Some(why);
+        run.last = Some(first);
+    }
     Ok(FinishedRun { run, extras })
+}
+
+/// The route a very short limit gives for `request`'s nest: the nearest solver's first step
+/// (the containment forest and the forest-order route, linear in vertices). `None` for the
+/// nearest solver itself (its first step is this route), a PCGTSP instance, or a kerf job
+/// (whose routes carry leads).
+fn first_route(request: &JobRequest) -> Option<Progress> {
+    let Problem::Nest {
+        nest,
+        start,
+        finish,
+    } = &request.problem
+    else {
+        return None;
+    };
+    if request.solver == SolverKind::NearestNeighbour || !request.params.kerf.is_idealised() {
+        return None;
+    }
+    let mut job = NearestNeighbourJob::new(request.job_id, nest.clone(), *start, *finish).ok()?;
+    job.step(cutroute_engine::DEFAULT_SLICE);
+    Some(job.progress()).filter(|p| p.solution.is_some())
 }
 
 /// The run's route if it passes the checker, else the newest earlier route that does (with
@@ -1376,12 +1443,9 @@ fn solve(
         solver,
         params,
     };
-    // The checker's forest of routes of whole contours (path routes are checked without it).
-    let forest = if solver.gives_path_route() {
-        None
-    } else {
-        forest_in_background(&document.problem)
-    };
+    // The checker's forest of routes of whole contours (path routes are checked without it,
+    // but a path solver with no route of its own answers with a route of whole contours).
+    let forest = forest_in_background(&document.problem);
     let request = kerf.request(request, solver_name)?;
     thermal.warn_unpriced(solver);
     let started = std::time::Instant::now();
@@ -1584,12 +1648,13 @@ fn route_report(
         "proven_optimal": result.proven_optimal,
         "elapsed_s": result.elapsed_s,
         "final_route_rejected": final_route_rejected,
-        // A path solver whose own route failed the checker answers with this contour route.
-        "fallback": result
+        // A solver with no route of its own, or a path solver whose own route failed the
+        // checker, answers with this contour route.
+        "fallback": run.fallback.clone().or_else(|| result
             .alternatives
             .iter()
             .find(|a| a.name == cutroute_engine::REJECTED_ROUTE)
-            .and_then(|a| a.failure.clone()),
+            .and_then(|a| a.failure.clone())),
         "stopped": run.stopped,
     }))
 }
@@ -1755,14 +1820,19 @@ mod tests {
             Problem::Nest { nest, .. } => nest.contour_count(),
             _ => unreachable!(),
         };
-        assert!((report_reserve_s(&big, 5.0) - contours as f64 * 10e-6).abs() < 1e-12);
-        assert_eq!(report_reserve_s(&big, 0.4), 0.1);
-        assert_eq!(report_reserve_s(&big, f64::INFINITY), 0.0);
-        assert!(report_reserve_s(&nest(50), 5.0) < 1e-3);
+        let ccp = SolverKind::Ccp;
+        assert!((report_reserve_s(&big, ccp, 5.0) - contours as f64 * 10e-6).abs() < 1e-12);
+        assert_eq!(report_reserve_s(&big, ccp, 0.4), 0.1);
+        assert_eq!(report_reserve_s(&big, ccp, f64::INFINITY), 0.0);
+        assert!(report_reserve_s(&nest(50), ccp, 5.0) < 1e-3);
+        // A path solver keeps more for its spans, never past half the limit.
+        let sccp = SolverKind::Sccp;
+        assert!(report_reserve_s(&big, sccp, 5.0) > report_reserve_s(&big, ccp, 5.0));
+        assert_eq!(report_reserve_s(&big, sccp, 0.4), 0.2);
         let instance = Problem::PcgtspText {
             text: String::new(),
         };
-        assert_eq!(report_reserve_s(&instance, 5.0), 0.0);
+        assert_eq!(report_reserve_s(&instance, SolverKind::Sccp, 5.0), 0.0);
     }
 
     fn square(x: f64) -> Contour {
@@ -1797,8 +1867,8 @@ mod tests {
                 ..Progress::default()
             }),
             earlier_routes: earlier,
-            stopped: None,
             time_limit_s: 1.0,
+            ..JobRun::default()
         }
     }
 

@@ -85,7 +85,10 @@ fn assert_checked_route(what: &str, input: &Path, report: &Value) {
 }
 
 fn solve_interrupted(solver: &str, after: Duration) {
-    let nest = data("nests/dbs/nested.dbs");
+    solve_interrupted_on(&data("nests/dbs/nested.dbs"), solver, after);
+}
+
+fn solve_interrupted_on(nest: &Path, solver: &str, after: Duration) {
     let args = [
         "solve",
         nest.to_str().unwrap(),
@@ -107,7 +110,7 @@ fn solve_interrupted(solver: &str, after: Duration) {
             "{what}: {report}"
         );
     }
-    assert_checked_route(&what, &nest, &report);
+    assert_checked_route(&what, nest, &report);
 }
 
 #[test]
@@ -121,6 +124,31 @@ fn ctrl_c_after_50_ms_gives_every_solver_s_first_route() {
 fn ctrl_c_after_1_s_keeps_every_solver_s_best_route() {
     for solver in SOLVERS {
         solve_interrupted(solver, Duration::from_secs(1));
+    }
+}
+
+/// On a generated nest of thousands of contours, Ctrl-C comes before the path solvers and
+/// chain have a route of their own: each answers with the first route (the one a very short
+/// limit gives), checked. (The solvers of a dense cost matrix, heuristic, exact and discrete,
+/// refuse a nest this big before they start: a refusal, not a run to stop.)
+#[test]
+fn ctrl_c_on_a_big_nest_gives_every_solver_a_checked_route() {
+    let dir = std::env::temp_dir().join(format!("cutroute-ctrl-c-big-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let nest = dir.join("big.json");
+    let out = Command::new(env!("CARGO_BIN_EXE_cutroute"))
+        .args(["generate", "--contours", "5000", "--seed", "1", "--out"])
+        .arg(&nest)
+        .output()
+        .expect("runs");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let dense = ["heuristic", "exact", "discrete"];
+    for solver in SOLVERS.iter().filter(|s| !dense.contains(s)) {
+        solve_interrupted_on(&nest, solver, Duration::from_millis(50));
     }
 }
 
