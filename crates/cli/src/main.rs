@@ -811,6 +811,7 @@ fn bounded_job_run(mut request: JobRequest, as_json: bool) -> Result<FinishedRun
     let mut shown = display.clone();
     let job_limit_s = request.params.time_limit_s;
     let solver = request.solver;
+    let run_started = std::time::Instant::now();
     let outcome = run_bounded(job_limit_s, grace, move |watch| {
         let first = first_route(&request);
         watch
@@ -830,7 +831,9 @@ fn bounded_job_run(mut request: JobRequest, as_json: bool) -> Result<FinishedRun
     };
     run.time_limit_s = time_limit_s;
     let has_route = run.last.as_ref().is_some_and(|p| p.solution.is_some());
-    if let (false, Some(first)) = (has_route, run.first_route.take()) {
+    if let (false, Some(mut first)) = (has_route, run.first_route.take()) {
+        // The report's time is the run's, not the first route's own.
+        first.elapsed_s = first.elapsed_s.max(run_started.elapsed().as_secs_f64());
         let why = match run.stopped {
             Some(stopped) => format!(
                 "the {} solver made no route before it was stopped ({stopped}): the nearest solver's first route (forest order) instead",
