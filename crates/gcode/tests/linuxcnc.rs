@@ -575,10 +575,33 @@ fn matrix_files() -> Vec<(String, Nest)> {
     files
 }
 
+/// Differences of the matrix that are known and not yet fixed, each with why: a case whose
+/// name (file, preset, option) contains every pattern of an entry is counted as open, not as a
+/// failure. Every entry must still match a difference, so a fix makes the test ask for its entry
+/// to be removed; a difference no entry matches fails the test.
+const OPEN_DIFFERENCES: &[(&[&str], &str)] = &[
+    (
+        &[" kometa-2p32m "],
+        "one decimal (0.1 mm) cannot hold small arcs and short chords: the writer should split \
+         them into pieces that round within the controller's tolerance, or refuse them",
+    ),
+    (
+        &["nests/dxf/non-closed.dxf", " g41"],
+        "G41 on a concave corner tighter than the compensation radius: rs274 refuses \
+         (\"concave corner cannot be reached without gouging\"); the writer should refuse it \
+         first, naming the contour",
+    ),
+    (
+        &["nests/dxf/splines.dxf", " g41"],
+        "as above: a concave feature tighter than the compensation radius",
+    ),
+    (
+        &["librecad__Complete-Lib-E.dxf", " g41"],
+        "as above: a concave feature tighter than the compensation radius",
+    ),
+];
+
 #[test]
-#[ignore = "open: one-decimal programs («Комета») leave small arcs by more than 0.01 mm, and \
-            G41 on concave corners tighter than the compensation radius reaches rs274 \
-            instead of being refused before writing"]
 fn the_whole_output_matrix_runs_on_linuxcnc_as_reported_or_is_refused() {
     if canon::rs274().is_none() {
         return;
@@ -627,7 +650,31 @@ fn the_whole_output_matrix_runs_on_linuxcnc_as_reported_or_is_refused() {
         eprintln!("  refused {count:>5} × {reason}");
     }
     assert!(files.len() >= 40, "only {} files open", files.len());
-    assert!(failures.is_empty(), "{}", failures.join("\n"));
+    let open_entry = |failure: &str| {
+        let case = failure.split(": ").next().unwrap_or(failure);
+        let case = format!("{case} ");
+        OPEN_DIFFERENCES
+            .iter()
+            .position(|(patterns, _)| patterns.iter().all(|p| case.contains(p)))
+    };
+    let mut open = vec![0usize; OPEN_DIFFERENCES.len()];
+    let mut new_failures = Vec::new();
+    for failure in &failures {
+        match open_entry(failure) {
+            Some(k) => open[k] += 1,
+            None => new_failures.push(failure.as_str()),
+        }
+    }
+    for ((patterns, why), count) in OPEN_DIFFERENCES.iter().zip(&open) {
+        eprintln!("  open  {count:>5} × {patterns:?}: {why}");
+    }
+    assert!(new_failures.is_empty(), "{}", new_failures.join("\n"));
+    for ((patterns, _), count) in OPEN_DIFFERENCES.iter().zip(&open) {
+        assert!(
+            *count > 0,
+            "{patterns:?} no longer differs: remove it from OPEN_DIFFERENCES"
+        );
+    }
 }
 
 /// Like `referee`, with the writer's refusals returned rather than counted.
