@@ -4,6 +4,7 @@
 
 use std::path::PathBuf;
 use std::process::{Command, Stdio};
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 
 use cutroute_geometry::{Point, Span};
@@ -59,11 +60,13 @@ pub fn run(rs274: &PathBuf, program: &str, tool_diameter: f64, name: &str) -> Re
         .chars()
         .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
         .collect();
-    // The interpreter writes its parameter file into its working folder: one folder per run,
-    // so that runs in parallel tests do not share it.
+    // The interpreter writes its parameter file into its working folder: one folder per run
+    // (numbered: two tests may run a case of the same name at once, and one would remove the
+    // other's folder), so that runs in parallel tests do not share it.
+    static RUNS: AtomicUsize = AtomicUsize::new(0);
     let dir = std::env::temp_dir()
         .join(format!("cutroute-rs274-{}", std::process::id()))
-        .join(&stem);
+        .join(format!("{}-{stem}", RUNS.fetch_add(1, Ordering::Relaxed)));
     std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
     let tool = dir.join(format!("{stem}.tbl"));
     let file = dir.join(format!("{stem}.ngc"));
@@ -84,6 +87,9 @@ pub fn run(rs274: &PathBuf, program: &str, tool_diameter: f64, name: &str) -> Re
             .arg(&tool)
             .arg(&file)
             .current_dir(&dir)
+            // Its own HOME too: the interpreter keeps files there that runs of other test
+            // processes would otherwise share (a run then found another's tool table).
+            .env("HOME", &dir)
             .stdin(Stdio::null())
             .output()
             .map_err(|e| format!("cannot run {}: {e}", rs274.display()))?;
