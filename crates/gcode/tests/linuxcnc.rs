@@ -188,27 +188,11 @@ fn tolerance(options: &GcodeOptions) -> f64 {
 /// Runs the cases; returns the failures (refused by the writer counts as agreeing only when it
 /// says why, which every `GcodeError` does).
 fn referee(nest: &Nest, cases: Vec<Case>) -> (usize, usize, Vec<String>) {
-    let rs274 = canon::rs274().expect("rs274");
-    let (mut accepted, mut refused, mut failures) = (0, 0, Vec::new());
-    for case in cases {
-        let program = match route_gcode(nest, &case.route, &case.options) {
-            Ok(p) => p,
-            Err(e) => {
-                refused += 1;
-                eprintln!("{}: refused before writing: {e}", case.what);
-                continue;
-            }
-        };
-        let program = format!("{ELSEWHERE}{program}");
-        let path = Toolpath::new(&case.route, nest).expect("toolpath");
-        let result = canon::run(&rs274, &program, case.tool_diameter, &case.what)
-            .and_then(|run| agree(&path, &run, tolerance(&case.options)));
-        match result {
-            Ok(()) => accepted += 1,
-            Err(e) => failures.push(format!("{}: {e}", case.what)),
-        }
+    let (accepted, refused, failures) = referee_reasons(nest, cases);
+    for refusal in &refused {
+        eprintln!("refused before writing: {refusal}");
     }
-    (accepted, refused, failures)
+    (accepted, refused.len(), failures)
 }
 
 /// The preset's options as LinuxCNC can run them (see the module notes on «Комета»).

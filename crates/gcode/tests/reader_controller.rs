@@ -287,14 +287,7 @@ G0 X999 (after the program's end)
     assert!((program.cut_length() - 130.0).abs() < 1e-9);
     // The do-while runs once (#1 from 4 to 3): after a `break`, LinuxCNC's next do-while end
     // does not loop back. `#3 = 7` is not seen on its own line.
-    let rapids: Vec<Point> = program
-        .motions
-        .iter()
-        .filter_map(|m| match m {
-            Motion::Rapid { to, .. } => Some(*to),
-            _ => None,
-        })
-        .collect();
+    let rapids = rapid_targets(&program);
     assert_eq!(
         rapids[rapids.len() - 2..],
         [Point::new(200.0, 3.0), Point::new(207.0, 1.0)]
@@ -319,14 +312,7 @@ fn a_dwell_and_a_move_share_a_block() {
 fn g53_moves_in_machine_coordinates() {
     let text = "G21 G90\nG92 X10 Y10\nG53 G0 X5 Y5\nG0 X1 Y1\nG53 Z0\nM2\n";
     let program = read_gcode(text, &ReadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
-    let rapids: Vec<Point> = program
-        .motions
-        .iter()
-        .filter_map(|m| match m {
-            Motion::Rapid { to, .. } => Some(*to),
-            _ => None,
-        })
-        .collect();
+    let rapids = rapid_targets(&program);
     // The G92 offset is -10 on both axes: X1 Y1 is (-9, -9) where the program started.
     assert_eq!(rapids, [Point::new(5.0, 5.0), Point::new(-9.0, -9.0)]);
     agrees_with_rs274("g53", text, &program, 1.0);
@@ -450,4 +436,16 @@ fn written_compensated_programs_read_as_rs274_runs_them() {
         }
     }
     assert!(compared > 0, "no program was accepted by both");
+}
+
+/// Where each rapid of a program goes, in order.
+fn rapid_targets(program: &Program) -> Vec<Point> {
+    program
+        .motions
+        .iter()
+        .filter_map(|m| match m {
+            Motion::Rapid { to, .. } => Some(*to),
+            _ => None,
+        })
+        .collect()
 }
