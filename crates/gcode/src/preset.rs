@@ -64,7 +64,11 @@ pub enum GcodePreset {
     /// One decimal cannot hold most arcs: rounded to 0.1 mm, an arc's end is up to 0.14 mm
     /// off its circle, beyond what controllers accept (0.002 mm or 0.1 % of the radius, which
     /// the writer keeps to). Such arcs are written as `G01` chords within 0.05 mm of the arc
-    /// (half the last digit); arcs whose rounded ends still fit a written centre stay arcs.
+    /// (half the last digit); arcs whose rounded ends still fit a written centre stay arcs
+    /// when the arc so written stays as close to the true one as the chords would (small
+    /// arcs, whose centre must move by a quantum to fit, become chords). What the controller
+    /// cuts is then within 0.13 mm of the route, and its length differs from the route's by up
+    /// to 0.14 mm a move: the 0.1 mm grid is the machine's resolution.
     ///
     /// Like every incremental program, it starts with an absolute `G90 G00 X… Y…` to the
     /// route's start before `G91`, so the first move does not depend on where the head stands.

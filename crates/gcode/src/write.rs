@@ -5,9 +5,12 @@ use std::f64::consts::PI;
 use std::fmt::Write as _;
 
 use cutroute_geometry::{
-    MachineParameters, Nest, PathRoute, Point, Route, RouteError, Span, ToolMove, Toolpath,
+    ContourRef, MachineParameters, Nest, PathRoute, Point, Route, RouteError, Span, ToolMove,
+    Toolpath,
 };
 use thiserror::Error;
+
+use crate::read::{read_gcode, CompensationModel, GcodeReadError, ReadOptions};
 
 /// How coordinates are written.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -234,6 +237,20 @@ pub enum GcodeError {
         /// Index of the route step.
         step: usize,
     },
+    /// The controller would refuse the compensated moves of a step, as LinuxCNC does: a
+    /// concave feature of the contour is tighter than the compensation radius (a corner its
+    /// offsets cannot meet in without gouging, or an inside arc of a smaller radius).
+    #[error("route step {step}, {contour}: kerf compensation by the controller (radius {radius} mm) cannot follow this contour: {problem}, where a concave feature is tighter than the radius; compensate in the program instead")]
+    CompensationGouge {
+        /// Index of the route step.
+        step: usize,
+        /// The contour cut by the step.
+        contour: ContourRef,
+        /// The compensation radius (half the kerf).
+        radius: f64,
+        /// What the controller would refuse.
+        problem: &'static str,
+    },
 }
 
 /// Writes `toolpath` as a G-code program.
@@ -267,9 +284,64 @@ pub fn route_gcode(
                 max_arc_sweep_deg: options.max_arc_sweep_deg.min(180.0),
                 ..options.clone()
             };
-            write_labelled(&toolpath, &centre, &label, &codes, &options)
+            let (text, line_moves) = write_moves(&toolpath, &centre, &label, &codes, &options)?;
+            refuse_what_the_controller_refuses(&text, &line_moves, &toolpath, route)?;
+            Ok(text)
         }
     }
+}
+
+/// Reads a compensated program back as LinuxCNC runs it (move by move, see
+/// [`CompensationModel::LinuxCnc`]) and refuses it where the controller would stop: a concave
+/// feature of the programmed contour tighter than the compensation radius. The written program
+/// is read, not the route, because rounding and the merging of moves below the resolution
+/// decide which corners the controller sees.
+fn refuse_what_the_controller_refuses(
+    text: &str,
+    line_moves: &[usize],
+    toolpath: &Toolpath,
+    route: &Route,
+) -> Result<(), GcodeError> {
+    let Some(radius) = route
+        .steps
+        .iter()
+        .filter_map(|s| s.leads.as_ref())
+        .map(|l| l.offset)
+        .find(|&r| r > 0.0)
+    else {
+        return Ok(());
+    };
+    let options = ReadOptions {
+        start: toolpath.start,
+        compensation_radius: Some(radius),
+        compensation_model: CompensationModel::LinuxCnc,
+        ..ReadOptions::default()
+    };
+    let Err(GcodeReadError::Compensation { line, problem, .. }) = read_gcode(text, &options) else {
+        return Ok(());
+    };
+    let step = line
+        .checked_sub(1)
+        .and_then(|l| line_moves.get(l))
+        .and_then(|&m| toolpath.moves.get(m))
+        .and_then(|m| match *m {
+            ToolMove::Cut { step, .. } | ToolMove::Pierce { step, .. } => Some(step),
+            ToolMove::Idle { .. } => None,
+        })
+        .unwrap_or(0);
+    let contour = route.steps.get(step).map_or(
+        ContourRef {
+            part: 0,
+            contour: 0,
+        },
+        |s| s.contour,
+    );
+    Err(GcodeError::CompensationGouge {
+        step,
+        contour,
+        radius,
+        problem,
+    })
 }
 
 /// The programmed path of a route whose kerf the controller compensates: each step with kerf
@@ -477,6 +549,11 @@ pub fn path_route_gcode(route: &PathRoute, options: &GcodeOptions) -> Result<Str
 /// as straight moves: their centre would be far away and rounding would move it by more than
 /// the arc deviates from its chord.
 const FLAT_ARC_QUANTA: f64 = 0.5;
+/// How far beyond the rounding of its points (half a quantum per axis) and of its chords (half
+/// a quantum) a written arc may run from the route's arc, in mm; an arc that would run further
+/// (a few quanta of radius, where moving the centre to equalise the rounded radii moves the
+/// whole arc) is written as chords instead.
+const TRACE_SLACK_MM: f64 = 0.005;
 /// Upper bound on the chords one arc is flattened into, whatever the tolerance.
 const MAX_CHORDS_PER_ARC: f64 = 100_000.0;
 /// No `R` arc longer than this is written in one move (see [`ArcOutput::Radius`]).
@@ -502,6 +579,17 @@ fn write_labelled(
     codes: &[(usize, String)],
     options: &GcodeOptions,
 ) -> Result<String, GcodeError> {
+    write_moves(toolpath, centre, label, codes, options).map(|(text, _)| text)
+}
+
+/// [`write_labelled`], with the index of the move each written line belongs to.
+fn write_moves(
+    toolpath: &Toolpath,
+    centre: &Toolpath,
+    label: &dyn Fn(usize) -> Option<String>,
+    codes: &[(usize, String)],
+    options: &GcodeOptions,
+) -> Result<(String, Vec<usize>), GcodeError> {
     check(options)?;
     let mut w = Writer::new(options, toolpath.start)?;
     if options.comments {
@@ -573,7 +661,7 @@ fn write_labelled(
     for line in &options.footer {
         w.line(line.clone());
     }
-    Ok(w.out)
+    Ok((w.out, w.line_moves))
 }
 
 fn check(options: &GcodeOptions) -> Result<(), GcodeError> {
@@ -635,6 +723,8 @@ struct Writer<'a> {
     feed_written: bool,
     line_number: u64,
     move_index: usize,
+    /// The move each written line belongs to.
+    line_moves: Vec<usize>,
 }
 
 impl<'a> Writer<'a> {
@@ -650,6 +740,7 @@ impl<'a> Writer<'a> {
             feed_written: false,
             line_number: 0,
             move_index: 0,
+            line_moves: Vec::new(),
         };
         w.at = w.quantize_point(start)?;
         Ok(w)
@@ -695,6 +786,7 @@ impl<'a> Writer<'a> {
         }
         self.out.push_str(&text);
         self.out.push('\n');
+        self.line_moves.push(self.move_index);
     }
 
     fn comment(&mut self, text: &str) {
@@ -858,6 +950,30 @@ impl<'a> Writer<'a> {
         best.map(|(c, _)| c)
     }
 
+    /// Whether the arc the controller runs from the head to `end` (quanta) about the written
+    /// `centre` (quanta) stays as close to `span` as its chords would (see
+    /// [`Writer::rounding_chord_tolerance`]): every written point is off by up to half a
+    /// quantum per axis, and moving the centre to equalise the radii may add more.
+    fn traces(&self, span: Span, centre: (i64, i64), end: (i64, i64)) -> bool {
+        self.traces_about(span, (centre.0 as f64, centre.1 as f64), end)
+    }
+
+    /// [`Writer::traces`] with a centre that need not be on the grid.
+    fn traces_about(&self, span: Span, centre: (f64, f64), end: (i64, i64)) -> bool {
+        let Some(true_centre) = span.centre() else {
+            return false;
+        };
+        let scaled = |p: (f64, f64)| Point::new(p.0 / self.scale, p.1 / self.scale);
+        let grid = |q: (i64, i64)| scaled((q.0 as f64, q.1 as f64));
+        let c = scaled(centre);
+        let r = span.radius();
+        let drift = |p: Point| (p.distance(c) - r).abs();
+        // Every point of the traced arc (or spiral, between its end radii) is within this of
+        // the true circle.
+        let off = c.distance(true_centre) + drift(grid(self.at)).max(drift(grid(end)));
+        off <= TRACE_SLACK_MM + (0.5f64.sqrt() + 0.5) / self.scale
+    }
+
     fn arc(&mut self, span: Span) -> Result<(), GcodeError> {
         let code = if span.bulge > 0.0 { "G03" } else { "G02" };
         match self.options.arcs {
@@ -878,6 +994,9 @@ impl<'a> Writer<'a> {
                     // rounded ends: the controller would refuse the arc.
                     return self.chords(span, self.rounding_chord_tolerance());
                 };
+                if !self.traces(span, c, target) {
+                    return self.chords(span, self.rounding_chord_tolerance());
+                }
                 let (i, j) = (c.0 - self.at.0, c.1 - self.at.1);
                 let f = self.feed_word();
                 let centre_words = format!(" I{} J{}", self.number(i), self.number(j));
@@ -896,6 +1015,21 @@ impl<'a> Writer<'a> {
                 let half_chord = 0.5 * (dx as f64).hypot_libm(dy as f64);
                 if half_chord >= r as f64 {
                     // The rounded radius cannot reach between the rounded ends.
+                    return self.chords(span, self.rounding_chord_tolerance());
+                }
+                // The controller puts the centre on the side of the chord the arc turns to
+                // (`R` positive: never more than half a turn).
+                let h = (r as f64 * r as f64 - half_chord * half_chord).sqrt();
+                let (ux, uy) = (
+                    dx as f64 / (2.0 * half_chord),
+                    dy as f64 / (2.0 * half_chord),
+                );
+                let side = if span.bulge > 0.0 { 1.0 } else { -1.0 };
+                let centre = (
+                    0.5 * (self.at.0 + target.0) as f64 - side * h * uy,
+                    0.5 * (self.at.1 + target.1) as f64 + side * h * ux,
+                );
+                if !self.traces_about(span, centre, target) {
                     return self.chords(span, self.rounding_chord_tolerance());
                 }
                 let f = self.feed_word();

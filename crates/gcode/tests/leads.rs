@@ -403,3 +403,59 @@ fn a_path_route_with_edge_pierces_overcut_and_tabs_reads_back_with_the_same_leng
         assert!((length - written.length()).abs() < 1e-3);
     }
 }
+
+/// A slot narrower than the kerf: the controller's compensation cannot reach its concave
+/// corners (LinuxCNC stops there), so the program is refused before it is written, naming the
+/// contour; compensated in the program, the same route is written.
+#[test]
+fn controller_compensation_refuses_a_slot_narrower_than_the_kerf() {
+    use cutroute_gcode::{GcodeError, KerfCompensation};
+    let outline = [
+        (0.0, 0.0),
+        (0.0, 20.0),
+        (9.75, 20.0),
+        (9.75, 10.0),
+        (10.25, 10.0),
+        (10.25, 20.0),
+        (20.0, 20.0),
+        (20.0, 0.0),
+    ];
+    let nest = Nest {
+        sheet: None,
+        parts: vec![Part {
+            name: "slotted".into(),
+            contours: vec![Contour::new(
+                outline.iter().map(|&(x, y)| Vertex::line(x, y)).collect(),
+            )],
+        }],
+    };
+    let settings = KerfSettings {
+        kerf: 2.0,
+        pierce_clearance: 3.0,
+        switch_off_clearance: 1.0,
+        lead_in: LeadSpec::new(LeadShape::Line, 4.0),
+        lead_out: LeadSpec::new(LeadShape::Line, 2.0),
+        overcut: 1.0,
+        ..KerfSettings::default()
+    };
+    let origin = Point::new(5.0, -10.0);
+    let mut route = Route::innermost_first(&nest, origin, Some(origin));
+    // Entered in the middle of the bottom edge, away from the slot and every corner.
+    route.steps[0].pierce_point = Point::new(5.0, 0.0);
+    let route = LeadFitter::new(&nest, settings).attach(&route).unwrap();
+    route_gcode(&nest, &route, &GcodeOptions::default()).unwrap();
+    let options = GcodeOptions {
+        kerf_compensation: KerfCompensation::ControllerDiameter,
+        ..GcodeOptions::default()
+    };
+    let error = route_gcode(&nest, &route, &options).unwrap_err();
+    assert!(
+        matches!(error, GcodeError::CompensationGouge { step: 0, .. }),
+        "{error}"
+    );
+    let message = error.to_string();
+    assert!(
+        message.contains("part 1 contour 0") && message.contains("gouging"),
+        "{message}"
+    );
+}

@@ -210,6 +210,39 @@ M5
     let error = read_gcode(hole, &linuxcnc(3.0)).unwrap_err();
     assert!(error.to_string().contains("arc"), "{error}");
     refused_by_rs274("hole", hole, 3.0);
+    // A move shorter than its concave corner's retreat runs backwards; the convex corner
+    // after it needs its end again.
+    let backwards = "\
+G21 G90
+G0 X-1040 Y100
+M3
+G41.1 D1 G1 X-1050 Y115 F1000
+G2 X-1072.435 Y118.363 I0.107 J77.239
+G1 X-1072.436
+G1 X-1072.911 Y118.509
+G40 G1 X-1073.651 Y116.121
+M5
+M2
+";
+    let error = read_gcode(backwards, &linuxcnc(0.0)).unwrap_err();
+    assert!(error.to_string().contains("line 7"), "{error}");
+    refused_by_rs274("backwards, then a corner", backwards, 0.5);
+    // Followed by a turn within LinuxCNC's tolerance instead, it stands: the tool backs up.
+    let backs_up = "\
+G21 G90
+G0 X0 Y10
+M3
+G41.1 D1 G1 X0 Y0 F1000
+G1 X10 Y0
+G1 X20 Y-0.7
+G1 X20.014
+G1 X20.514 Y-0.709
+G40 G1 X21 Y5
+M5
+M2
+";
+    let program = read_gcode(backs_up, &linuxcnc(0.0)).unwrap();
+    agrees_with_rs274("backwards, then straight on", backs_up, &program, 0.5);
     // Without a radius for G41 D1, the error says where to give it.
     let error = read_gcode(COMPENSATED, &ReadOptions::default()).unwrap_err();
     assert!(

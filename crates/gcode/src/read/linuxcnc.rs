@@ -10,7 +10,9 @@
 //! - At a corner where the tool is outside the turn (convex), an arc about the programmed
 //!   corner joins the two offsets; where it is inside (concave), both offsets end at their
 //!   intersection, and a corner the tool cannot reach without cutting into the previous move
-//!   is refused, as LinuxCNC refuses it.
+//!   is refused, as LinuxCNC refuses it. A move shorter than its concave corner's retreat then
+//!   runs backwards; LinuxCNC refuses that only where the next corner needs the move's end
+//!   again (a concave corner, or a convex one sharper than its tolerance).
 //! - The move after `G40` is straight and uncompensated: from where the tool stands to the
 //!   programmed point, with no corner.
 
@@ -27,6 +29,10 @@ pub(super) enum Side {
 
 /// Below this (mm, or radians of turn) two directions or points are the same.
 const EPS: f64 = 1e-9;
+/// A convex turn up to this (radians) gets no corner arc from LinuxCNC, and the move before
+/// it is not checked again (its `TOLERANCE_CONCAVE_CORNER`).
+const CONVEX_CORNER_TOLERANCE: f64 = 0.05;
+const GOUGE: &str = "a concave corner the tool cannot reach without gouging";
 
 /// One piece of the tool centre's path.
 #[derive(Clone, Copy, Debug)]
@@ -120,6 +126,33 @@ impl Piece {
         }
     }
 
+    /// Whether `p` (on the piece's line or circle) lies before the piece's end, so that the
+    /// piece from `p` on keeps its direction.
+    fn runs_on_from(&self, p: Point) -> bool {
+        match *self {
+            Piece::Line { a, b } => {
+                let d = b - a;
+                let l2 = d.x * d.x + d.y * d.y;
+                l2 > EPS * EPS && ((b - p).x * d.x + (b - p).y * d.y) / l2 > 1e-9
+            }
+            Piece::Arc {
+                centre,
+                a,
+                b,
+                ccw,
+                full,
+            } => {
+                if full {
+                    return true;
+                }
+                let whole = Piece::sweep(centre, a, b, ccw, false).abs();
+                let to_p = Piece::sweep(centre, a, p, ccw, false).abs();
+                // Past the start (trimmed) and short of the end, or behind the start.
+                to_p < whole - 1e-9 || to_p > PI + 0.5 * whole
+            }
+        }
+    }
+
     /// Whether `p` (on the piece's line or circle) lies on the piece past its start, within
     /// a small tolerance of its end.
     fn reaches(&self, p: Point) -> bool {
@@ -197,6 +230,8 @@ pub(super) fn tool_path(
     )];
     // The last piece that offsets a programmed move (a corner arc is never trimmed).
     let mut last = 0;
+    // That piece runs backwards from its trimmed start.
+    let mut next_backwards = false;
     let mut direction = d0;
     for &(span, line) in spans {
         if span.length() <= EPS {
@@ -228,6 +263,7 @@ pub(super) fn tool_path(
             }
         };
         let corner = span.start;
+        let backwards = std::mem::replace(&mut next_backwards, false);
         let turn = cross(direction, t0);
         let dot = direction.x * t0.x + direction.y * t0.y;
         let concave = match side {
@@ -249,14 +285,21 @@ pub(super) fn tool_path(
             // Tangent: the offsets meet.
             piece.set_start(previous.end());
         } else if concave {
-            const GOUGE: &str = "a concave corner the tool cannot reach without gouging";
             let x = intersection(&previous, &piece, corner).ok_or((GOUGE, line))?;
-            if !previous.reaches(x) {
+            if !previous.reaches(x) || backwards {
                 return Err((GOUGE, line));
             }
+            // A move shorter than the corner's retreat now runs backwards; LinuxCNC lets it
+            // (the tool backs up a little) unless the next corner needs its end again.
+            next_backwards = !piece.runs_on_from(x);
             pieces[last].0.set_end(x);
             piece.set_start(x);
         } else {
+            // A convex corner sharper than LinuxCNC's tolerance flushes the previous move
+            // with its end checked: one that runs backwards is refused.
+            if backwards && cross(direction, t0).atan2_libm(dot).abs() > CONVEX_CORNER_TOLERANCE {
+                return Err((GOUGE, line));
+            }
             pieces.push((
                 Piece::Arc {
                     centre: corner,
