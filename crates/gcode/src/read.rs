@@ -396,6 +396,17 @@ pub enum GcodeReadError {
         /// Column of the first coordinate.
         column: usize,
     },
+    /// A feed move (`G01`–`G03`) with no feed rate set, or a zero one: the controller refuses
+    /// it rather than guess a speed.
+    #[error(
+        "line {line}, column {column}: a feed move (G01–G03) without a feed rate: give F before it"
+    )]
+    FeedMoveWithoutFeed {
+        /// Line.
+        line: usize,
+        /// Column of the motion code or first coordinate.
+        column: usize,
+    },
     /// A `G02`/`G03` move with neither `I`/`J` nor `R`.
     #[error("line {line}, column {column}: arc without centre (I/J) or radius (R)")]
     ArcWithoutCentre {
@@ -515,6 +526,7 @@ impl GcodeReadError {
             | ConflictingCodes { line, column, .. }
             | UnsupportedCode { line, column, .. }
             | MotionWithoutMode { line, column }
+            | FeedMoveWithoutFeed { line, column }
             | ArcWithoutCentre { line, column }
             | ArcRadiusMismatch { line, column, .. }
             | ArcRadiusTooSmall { line, column, .. }
@@ -974,6 +986,9 @@ impl State<'_> {
             self.switch(burns, line)?;
         }
         let column = codes.motion.as_ref().map_or(first.column, |m| m.1);
+        if mode != MotionMode::Rapid && !self.feed.is_some_and(|f| f > 0.0) {
+            return Err(GcodeReadError::FeedMoveWithoutFeed { line, column });
+        }
         if let Some(c) = &self.compensation {
             // The start-up move, a rapid and the cancel move are the stretch's own; its
             // programmed feed moves are gathered by `feed_span` below.

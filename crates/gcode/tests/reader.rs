@@ -73,15 +73,15 @@ fn positive_bulge_is_g03_negative_is_g02() {
 #[test]
 fn r_arcs_full_circles_and_long_arcs() {
     // R > 0: the short arc; R < 0: the long one.
-    let short = spans("G90 G01 X10 Y0\nG03 X0 Y10 R10");
+    let short = spans("G90 G01 X10 Y0 F100\nG03 X0 Y10 R10");
     let total: f64 = short[1..].iter().map(Span::length).sum();
     assert!((total - 5.0 * PI).abs() < 1e-9);
-    let long = spans("G90 G01 X10 Y0\nG03 X0 Y10 R-10");
+    let long = spans("G90 G01 X10 Y0 F100\nG03 X0 Y10 R-10");
     let total: f64 = long[1..].iter().map(Span::length).sum();
     assert!((total - 15.0 * PI).abs() < 1e-9, "{total}");
     assert!(long[1..].iter().all(|s| s.bulge > 0.0));
     // A full circle by I/J: ends coincide, two half-circles.
-    let circle = spans("G0 X5 Y0\nG2 X5 Y0 I-5 J0");
+    let circle = spans("G0 X5 Y0\nG2 X5 Y0 I-5 J0 F100");
     // The G0 to (5, 0) is not a feed move; the circle is two half circles.
     assert_eq!(circle.len(), 2, "{circle:?}");
     let arc_length: f64 = circle.iter().map(Span::length).sum();
@@ -125,17 +125,19 @@ fn modes_units_comments_and_line_numbers() {
 
 #[test]
 fn errors_say_where() {
-    let cases: [(&str, (usize, usize)); 10] = [
+    let cases: [(&str, (usize, usize)); 11] = [
         ("G00 X1\nG01 X2 #", (2, 8)),
         ("G00 X\n", (1, 5)),
-        ("G01 X1\n(open comment", (2, 1)),
+        ("G01 X1 F100\n(open comment", (2, 1)),
         ("G01 X1 X2", (1, 8)),
         ("G00 G01 X1", (1, 5)),
         ("G18\n", (1, 1)),
         ("X10 Y10", (1, 1)),
-        ("G01 X1\nG02 X3 Y1", (2, 1)),
-        ("G01 X10 Y0\nG03 X0 Y10 I-10 J1", (2, 1)),
+        ("G01 X1 F100\nG02 X3 Y1", (2, 1)),
+        ("G01 X10 Y0 F100\nG03 X0 Y10 I-10 J1", (2, 1)),
         ("G00 X1\nG04\n", (2, 1)),
+        // No feed rate for a feed move: the controller refuses it rather than guess one.
+        ("G00 X1\nG01 X2", (2, 1)),
     ];
     for (text, location) in cases {
         match read_gcode(text, &ReadOptions::default()) {
@@ -149,11 +151,11 @@ fn errors_say_where() {
         }
     }
     assert!(matches!(
-        read_gcode("G00 X1\nG03 X3 R0.5", &ReadOptions::default()),
+        read_gcode("G00 X1\nG03 X3 R0.5 F100", &ReadOptions::default()),
         Err(GcodeReadError::ArcRadiusTooSmall { line: 2, .. })
     ));
     assert!(matches!(
-        read_gcode("G02 X0 Y0 R5", &ReadOptions::default()),
+        read_gcode("G02 X0 Y0 R5 F100", &ReadOptions::default()),
         Err(GcodeReadError::ZeroLengthRadiusArc { line: 1, .. })
     ));
     // No exponents in G-code: `X1e5` is X1 and an E5 word (an extruder axis, ignored).
