@@ -320,22 +320,25 @@ fn refuse_what_the_controller_refuses(
     let Err(GcodeReadError::Compensation { line, problem, .. }) = read_gcode(text, &options) else {
         return Ok(());
     };
-    let step = line
+    // The step of the line's move, or of the last move before it that has one (a code line
+    // goes with the move after it, which may be an idle move).
+    let moves_so_far = line
         .checked_sub(1)
         .and_then(|l| line_moves.get(l))
-        .and_then(|&m| toolpath.moves.get(m))
-        .and_then(|m| match *m {
+        .map_or(0, |&m| m + 1)
+        .min(toolpath.moves.len());
+    let step = toolpath.moves[..moves_so_far]
+        .iter()
+        .rev()
+        .find_map(|m| match *m {
             ToolMove::Cut { step, .. } | ToolMove::Pierce { step, .. } => Some(step),
             ToolMove::Idle { .. } => None,
         })
         .unwrap_or(0);
-    let contour = route.steps.get(step).map_or(
-        ContourRef {
-            part: 0,
-            contour: 0,
-        },
-        |s| s.contour,
-    );
+    let contour = route
+        .steps
+        .get(step)
+        .map_or(route.steps[0].contour, |s| s.contour);
     Err(GcodeError::CompensationGouge {
         step,
         contour,
@@ -950,16 +953,11 @@ impl<'a> Writer<'a> {
         best.map(|(c, _)| c)
     }
 
-    /// Whether the arc the controller runs from the head to `end` (quanta) about the written
-    /// `centre` (quanta) stays as close to `span` as its chords would (see
+    /// Whether the arc the controller runs from the head to `end` (quanta) about `centre`
+    /// (quanta, on the grid or, for `R` arcs, where the controller puts it) stays as close to `span` as its chords would (see
     /// [`Writer::rounding_chord_tolerance`]): every written point is off by up to half a
     /// quantum per axis, and moving the centre to equalise the radii may add more.
-    fn traces(&self, span: Span, centre: (i64, i64), end: (i64, i64)) -> bool {
-        self.traces_about(span, (centre.0 as f64, centre.1 as f64), end)
-    }
-
-    /// [`Writer::traces`] with a centre that need not be on the grid.
-    fn traces_about(&self, span: Span, centre: (f64, f64), end: (i64, i64)) -> bool {
+    fn traces(&self, span: Span, centre: (f64, f64), end: (i64, i64)) -> bool {
         let Some(true_centre) = span.centre() else {
             return false;
         };
@@ -994,7 +992,7 @@ impl<'a> Writer<'a> {
                     // rounded ends: the controller would refuse the arc.
                     return self.chords(span, self.rounding_chord_tolerance());
                 };
-                if !self.traces(span, c, target) {
+                if !self.traces(span, (c.0 as f64, c.1 as f64), target) {
                     return self.chords(span, self.rounding_chord_tolerance());
                 }
                 let (i, j) = (c.0 - self.at.0, c.1 - self.at.1);
@@ -1029,7 +1027,7 @@ impl<'a> Writer<'a> {
                     0.5 * (self.at.0 + target.0) as f64 - side * h * uy,
                     0.5 * (self.at.1 + target.1) as f64 + side * h * ux,
                 );
-                if !self.traces_about(span, centre, target) {
+                if !self.traces(span, centre, target) {
                     return self.chords(span, self.rounding_chord_tolerance());
                 }
                 let f = self.feed_word();

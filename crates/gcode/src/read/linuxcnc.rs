@@ -297,7 +297,7 @@ pub(super) fn tool_path(
         } else {
             // A convex corner sharper than LinuxCNC's tolerance flushes the previous move
             // with its end checked: one that runs backwards is refused.
-            if backwards && cross(direction, t0).atan2_libm(dot).abs() > CONVEX_CORNER_TOLERANCE {
+            if backwards && turn.atan2_libm(dot).abs() > CONVEX_CORNER_TOLERANCE {
                 return Err((GOUGE, line));
             }
             pieces.push((
