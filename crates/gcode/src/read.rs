@@ -44,9 +44,10 @@
 //! Cutter (kerf) compensation: `G41`/`G42` take their radius from the controller's tool table,
 //! which the reader is given as [`ReadOptions::compensation_radius`]; `G41.1`/`G42.1
 //! D<diameter>` carry it. [`ReadOptions::compensation_model`] says how the stretch from the
-//! start-up move to the move after `G40` becomes the tool centre's path (see
-//! [`CompensationModel`]). Rapids or torch switches under compensation are refused with their
-//! line.
+//! start-up move to `G40` (or the program's end) becomes the tool centre's path (see
+//! [`CompensationModel`]). As in LinuxCNC, the tool stays at that path's end until the next
+//! move, which must be straight and runs from there to its programmed point; a torch switch
+//! under compensation happens where the compensated move before it ends.
 
 mod expr;
 mod flow;
@@ -96,10 +97,10 @@ pub enum CompensationModel {
     /// start-up move, offset whole by the radius, entered from where the head stood and left
     /// to the cancel move's end.
     ClosedContour,
-    /// As LinuxCNC's interpreter runs it, move by move: the start-up move ends offset
+    /// As LinuxCNC's interpreter runs it, move by move: a straight start-up move ends offset
     /// perpendicular to itself, convex corners get arcs about the programmed corner, concave
     /// ones end at the offsets' intersection (or are refused where the tool would gouge), and
-    /// the cancel move is straight from where the tool stands. The default: a program is read
+    /// the move after `G40` is straight from where the tool stands. The default: a program is read
     /// as the controller the writer's compensated programs are checked against runs it.
     #[default]
     LinuxCnc,
@@ -566,6 +567,8 @@ pub fn read_gcode(text: &str, options: &ReadOptions) -> Result<Program, GcodeRea
         feed: None,
         motions: Vec::new(),
         compensation: None,
+        tool_at: None,
+        after_cancel: false,
         offset: Point::new(0.0, 0.0),
         saved_offset: Point::new(0.0, 0.0),
         laser: options.laser_mode,
@@ -573,17 +576,14 @@ pub fn read_gcode(text: &str, options: &ReadOptions) -> Result<Program, GcodeRea
         power_zero: false,
     };
     let lines = flow::run(text, &mut state)?;
-    if state.compensation.is_some() {
-        return Err(GcodeReadError::Compensation {
-            line: lines,
-            column: 1,
-            problem: "the program ends with compensation on (no G40 and cancel move)",
-        });
-    }
+    // LinuxCNC's program end flushes compensation as G40 does (rs274 wants M2 or M30; the
+    // reader takes the last line for it).
+    state.finish_compensation(lines)?;
+    let end = state.head();
     Ok(Program {
         start: options.start,
         motions: state.motions,
-        end: state.at,
+        end,
     })
 }
 
@@ -605,8 +605,15 @@ struct State<'a> {
     tool_on: bool,
     feed: Option<f64>,
     motions: Vec<Motion>,
-    /// Cutter compensation under way, between its start-up and cancel moves.
+    /// Cutter compensation under way, from `G41`/`G42` to `G40`.
     compensation: Option<Compensated>,
+    /// Where the head stands when that is not the programmed point `at`: after `G40`, at the
+    /// end of the compensated path, until the next move in the plane (LinuxCNC reckons that
+    /// move from the programmed point, and the machine runs it from where the tool stands).
+    tool_at: Option<Point>,
+    /// Compensation has just ended: LinuxCNC refuses an arc before a straight move (the head
+    /// may stand off the programmed point, `tool_at`, only while this holds).
+    after_cancel: bool,
     /// The `G92` offset: a programmed coordinate plus this is where the head goes, in the
     /// frame the program started in (the head's own motion stays continuous through a `G92`).
     offset: Point,
@@ -634,29 +641,36 @@ enum OffsetCode {
 }
 
 /// A stretch of program under cutter compensation (`G41`/`G42` … `G40`), gathered whole: the
-/// tool path is the programmed closed contour offset to the side by the radius, entered by the
-/// start-up move and left by the cancel move, and can only be known once the stretch ends.
+/// tool path can only be known once the stretch ends (LinuxCNC moves a move's end when it
+/// sees the next one), at `G40` or the program's end.
 struct Compensated {
     side: Side,
     radius: f64,
-    /// Where the head stood before the start-up move (not compensated), with its line.
-    from: Option<(Point, usize)>,
-    /// Where the start-up move's programmed end is: the first point of the contour.
-    entry: Option<Point>,
-    /// The programmed moves after the start-up move, with their lines.
-    section: Vec<(Span, usize)>,
-    /// `G40` was read: the next move is the cancel move.
-    cancelling: bool,
+    /// Where the stretch starts: the programmed point the interpreter reckons from and where
+    /// the head stands (they differ right after a `G40`), with the start-up move's line.
+    from: Option<(Point, Point, usize)>,
+    /// How many of `steps` the start-up move made (an arc of more than half a turn makes two).
+    startup: usize,
+    /// The programmed moves, the start-up move's first.
+    steps: Vec<linuxcnc::Step>,
+    /// Torch switches in the stretch: after how many of `steps`, on or off, and the line.
+    /// LinuxCNC queues them behind the move before them, so they happen where its tool path
+    /// ends.
+    switches: Vec<(usize, bool, usize)>,
+    /// The torch when the stretch began.
+    tool_on: bool,
 }
 
 impl Compensated {
-    /// The tool path of the stretch, ended by the cancel move to `to` (on `line`): the start-up
+    /// The tool path of the stretch as cutroute's post-processor intends it: the start-up
     /// move from where the head stood to the contour's offset, the offset contour once round,
-    /// on along it as far as the programmed overcut goes, and the cancel move. `None` when the
-    /// programmed moves do not close a contour or it has no offset.
-    fn tool_path(self, to: Point, line: usize) -> Option<Vec<(Span, usize)>> {
-        let ((start, start_line), first) = (self.from?, self.entry?);
-        let spans = &self.section;
+    /// and on along it as far as the programmed overcut goes, where the tool stays. `None`
+    /// when the programmed moves do not close a contour or it has no offset.
+    fn closed_contour_path(&self) -> Option<Vec<(Span, usize)>> {
+        let (_, start, start_line) = self.from?;
+        let first = self.steps.first()?.span.end;
+        let spans: Vec<(Span, usize)> = self.steps[1..].iter().map(|s| (s.span, s.line)).collect();
+        let spans = &spans;
         let k = spans
             .iter()
             .position(|(span, _)| span.end.distance(first) <= CLOSED)?;
@@ -685,24 +699,19 @@ impl Compensated {
         let round_line = spans[0].1;
         let mut path = vec![(Span::line(start, entry.point), start_line)];
         path.extend(cut.iter().map(|&span| (span, round_line)));
-        let exit = match overcut.last() {
-            None => entry.point,
-            Some((last, last_line)) => {
-                let exit = on_offset(last.end + normal(last.tangent_at(1.0)) * r)?;
-                let mut left = (offset.length_at(exit.position) - offset.length_at(entry.position))
-                    .rem_euclid(offset.perimeter());
-                for span in cut {
-                    let l = span.length();
-                    if left <= 1e-9 || l <= 0.0 {
-                        break;
-                    }
-                    path.push((span.sub_span(0.0, (left / l).min(1.0)), *last_line));
-                    left -= l;
+        if let Some((last, last_line)) = overcut.last() {
+            let exit = on_offset(last.end + normal(last.tangent_at(1.0)) * r)?;
+            let mut left = (offset.length_at(exit.position) - offset.length_at(entry.position))
+                .rem_euclid(offset.perimeter());
+            for span in cut {
+                let l = span.length();
+                if left <= 1e-9 || l <= 0.0 {
+                    break;
                 }
-                exit.point
+                path.push((span.sub_span(0.0, (left / l).min(1.0)), *last_line));
+                left -= l;
             }
-        };
-        path.push((Span::line(exit, to), line));
+        }
         Some(path)
     }
 }
@@ -946,6 +955,36 @@ impl State<'_> {
             }
         }
         let arc_words = ['I', 'J', 'R'].into_iter().filter_map(get).next();
+        let straight = matches!(self.motion, Some(MotionMode::Rapid | MotionMode::Linear));
+        if let (None, None, Some(z), true) = (axis, arc_words, get('Z'), straight) {
+            // A move along Z alone is a straight move to LinuxCNC: as a start-up move it has
+            // no length in the plane; after G40 it allows an arc again, and takes the head
+            // from where compensation left it to the programmed point, which the interpreter
+            // reckons as where it stands.
+            if self
+                .compensation
+                .as_ref()
+                .is_some_and(|c| c.steps.is_empty())
+            {
+                return Err(GcodeReadError::Compensation {
+                    line,
+                    column: z.column,
+                    problem: "the start-up move is not longer than the tool radius",
+                });
+            }
+            self.after_cancel = false;
+            if let Some(from) = self.tool_at.take() {
+                if self.motion == Some(MotionMode::Rapid) {
+                    self.motions.push(Motion::Rapid {
+                        from,
+                        to: self.at,
+                        line,
+                    });
+                } else {
+                    self.feed_span(Span::line(from, self.at), line);
+                }
+            }
+        }
         let Some(first) = axis.or(arc_words) else {
             return Ok(());
         };
@@ -989,23 +1028,26 @@ impl State<'_> {
         if mode != MotionMode::Rapid && !self.feed.is_some_and(|f| f > 0.0) {
             return Err(GcodeReadError::FeedMoveWithoutFeed { line, column });
         }
-        if let Some(c) = &self.compensation {
-            // The start-up move, a rapid and the cancel move are the stretch's own; its
-            // programmed feed moves are gathered by `feed_span` below.
-            if c.entry.is_none() || c.cancelling || mode == MotionMode::Rapid {
-                return self.compensated_move(mode, to, line, column);
-            }
-        }
         match mode {
+            MotionMode::Rapid if self.compensation.is_some() => {
+                self.compensated_step(Span::line(self.at, to), line, true);
+            }
             MotionMode::Rapid => {
                 self.motions.push(Motion::Rapid {
-                    from: self.at,
+                    from: self.head(),
                     to,
                     line,
                 });
             }
-            MotionMode::Linear => self.feed_span(Span::line(self.at, to), line),
+            MotionMode::Linear => self.feed_span(Span::line(self.head(), to), line),
             MotionMode::Clockwise | MotionMode::CounterClockwise => {
+                if self.after_cancel {
+                    return Err(GcodeReadError::Compensation {
+                        line,
+                        column,
+                        problem: "the move after G40 must be straight, not an arc",
+                    });
+                }
                 let ccw = mode == MotionMode::CounterClockwise;
                 let (sweep, centre) = if let Some(r) = get('R') {
                     (
@@ -1032,7 +1074,14 @@ impl State<'_> {
                 self.arc(to, sweep, centre, line);
             }
         }
+        if let Some(c) = self.compensation.as_mut() {
+            if c.startup == 0 {
+                c.startup = c.steps.len();
+            }
+        }
+        self.after_cancel &= !matches!(mode, MotionMode::Rapid | MotionMode::Linear);
         self.at = to;
+        self.tool_at = None;
         Ok(())
     }
 
@@ -1146,18 +1195,16 @@ impl State<'_> {
         if on == self.tool_on {
             return Ok(());
         }
-        if self.compensation.is_some() {
-            return Err(GcodeReadError::Compensation {
-                line,
-                column: 1,
-                problem: "the torch switches while compensation is on",
-            });
-        }
         self.tool_on = on;
+        if let Some(c) = self.compensation.as_mut() {
+            c.switches.push((c.steps.len(), on, line));
+            return Ok(());
+        }
+        let at = self.head();
         self.motions.push(if on {
-            Motion::TorchOn { at: self.at, line }
+            Motion::TorchOn { at, line }
         } else {
-            Motion::TorchOff { at: self.at, line }
+            Motion::TorchOff { at, line }
         });
         Ok(())
     }
@@ -1199,8 +1246,8 @@ impl State<'_> {
     }
 
     fn feed_span(&mut self, span: Span, line: usize) {
-        if let Some(c) = self.compensation.as_mut() {
-            c.section.push((span, line));
+        if self.compensation.is_some() {
+            self.compensated_step(span, line, false);
             return;
         }
         self.motions.push(Motion::Feed {
@@ -1226,11 +1273,8 @@ impl State<'_> {
             problem,
         };
         match code {
-            CompensationCode::Off => match self.compensation.as_mut() {
-                Some(c) if c.entry.is_some() => c.cancelling = true,
-                Some(_) => return Err(problem("G40 before the start-up move")),
-                None => {} // already off: harmless
-            },
+            // Already off, G40 is harmless.
+            CompensationCode::Off => self.finish_compensation(line)?,
             CompensationCode::On { side, dynamic } => {
                 if self.compensation.is_some() {
                     return Err(problem("compensation switched on twice without G40"));
@@ -1252,81 +1296,121 @@ impl State<'_> {
                     side,
                     radius,
                     from: None,
-                    entry: None,
-                    section: Vec::new(),
-                    cancelling: false,
+                    startup: 0,
+                    steps: Vec::new(),
+                    switches: Vec::new(),
+                    tool_on: self.tool_on,
                 });
             }
         }
         Ok(())
     }
 
-    /// A move under compensation: the start-up move, a programmed move of the stretch, or the
-    /// cancel move, which ends the stretch and emits its tool path.
-    fn compensated_move(
-        &mut self,
-        mode: MotionMode,
-        to: Point,
-        line: usize,
-        column: usize,
-    ) -> Result<(), GcodeReadError> {
+    /// Where the head stands.
+    fn head(&self) -> Point {
+        self.tool_at.unwrap_or(self.at)
+    }
+
+    /// A programmed move under compensation, gathered into the stretch.
+    fn compensated_step(&mut self, span: Span, line: usize, rapid: bool) {
+        let (at, head) = (self.at, self.head());
+        let c = self.compensation.as_mut().expect("compensation on");
+        if c.steps.is_empty() {
+            c.from = Some((at, head, line));
+        }
+        c.steps.push(linuxcnc::Step { span, line, rapid });
+    }
+
+    /// Compensation ends (`G40`, or the program's end, on `line`): the stretch becomes the
+    /// tool centre's path, and the tool stays at its end, off the programmed point, until
+    /// the next move. Compensation switched on without a move since ends with no motion.
+    fn finish_compensation(&mut self, line: usize) -> Result<(), GcodeReadError> {
+        let Some(c) = self.compensation.take() else {
+            return Ok(());
+        };
         let problem = |problem| GcodeReadError::Compensation {
             line,
-            column,
+            column: 1,
             problem,
         };
-        let straight = matches!(mode, MotionMode::Linear | MotionMode::Rapid);
-        let c = self.compensation.as_mut().expect("compensation on");
-        if c.entry.is_none() {
-            if !straight {
-                return Err(problem("the start-up move must be straight"));
+        let path: Vec<linuxcnc::ToolSpan> = match (c.from, self.options.compensation_model) {
+            (None, _) => Vec::new(),
+            (Some(_), CompensationModel::ClosedContour) => {
+                let straight = c.startup == 1 && c.steps[0].span.bulge == 0.0;
+                if !straight {
+                    return Err(problem("the start-up move must be straight"));
+                }
+                if c.steps.iter().any(|s| s.rapid) {
+                    return Err(problem("a rapid move while compensation is on"));
+                }
+                if !c.switches.is_empty() {
+                    return Err(problem("the torch switches while compensation is on"));
+                }
+                c.closed_contour_path()
+                    .ok_or_else(|| {
+                        problem("the compensated moves do not close a contour that can be offset")
+                    })?
+                    .into_iter()
+                    .map(|(span, line)| linuxcnc::ToolSpan {
+                        span,
+                        line,
+                        rapid: false,
+                        step: 0,
+                    })
+                    .collect()
             }
-            c.from = Some((self.at, line));
-            c.entry = Some(to);
-            self.at = to;
-            return Ok(());
-        }
-        if !c.cancelling {
-            return Err(problem("a rapid move while compensation is on"));
-        }
-        if !straight {
-            return Err(problem("the cancel move must be straight"));
-        }
-        let c = self.compensation.take().expect("compensation on");
-        let path = match self.options.compensation_model {
-            CompensationModel::ClosedContour => c.tool_path(to, line).ok_or_else(|| {
-                problem("the compensated moves do not close a contour that can be offset")
-            })?,
-            CompensationModel::LinuxCnc => {
-                let ((start, start_line), entry) = c
-                    .from
-                    .zip(c.entry)
-                    .ok_or_else(|| problem("G40 before the start-up move"))?;
-                linuxcnc::tool_path(
-                    c.side,
-                    c.radius,
-                    start,
-                    entry,
-                    &c.section,
-                    to,
-                    (start_line, line),
-                )
-                .map_err(|(problem, line)| GcodeReadError::Compensation {
-                    line,
-                    column: 1,
-                    problem,
-                })?
+            (Some((origin, start, _)), CompensationModel::LinuxCnc) => {
+                linuxcnc::tool_path(c.side, c.radius, (origin, start), &c.steps, c.startup, line)
+                    .map_err(|(problem, line)| GcodeReadError::Compensation {
+                        line,
+                        column: 1,
+                        problem,
+                    })?
             }
         };
-        for (span, line) in path {
-            self.motions.push(Motion::Feed {
-                span,
-                tool_on: self.tool_on,
-                feed: self.feed,
-                line,
+        let mut at = c.from.map_or(self.head(), |(_, head, _)| head);
+        let mut tool_on = c.tool_on;
+        let switch = |on: bool, at: Point, line: usize| {
+            if on {
+                Motion::TorchOn { at, line }
+            } else {
+                Motion::TorchOff { at, line }
+            }
+        };
+        let mut switches = c.switches.iter().peekable();
+        for piece in path {
+            while let Some(&(_, on, switch_line)) = switches.next_if(|s| s.0 <= piece.step) {
+                if on != tool_on {
+                    tool_on = on;
+                    self.motions.push(switch(on, at, switch_line));
+                }
+            }
+            self.motions.push(if piece.rapid {
+                Motion::Rapid {
+                    from: piece.span.start,
+                    to: piece.span.end,
+                    line: piece.line,
+                }
+            } else {
+                Motion::Feed {
+                    span: piece.span,
+                    tool_on,
+                    feed: self.feed,
+                    line: piece.line,
+                }
             });
+            at = piece.span.end;
         }
-        self.at = to;
+        for &(_, on, switch_line) in switches {
+            if on != tool_on {
+                tool_on = on;
+                self.motions.push(switch(on, at, switch_line));
+            }
+        }
+        // Compensation switched off without a move since leaves LinuxCNC's ban on an arc as
+        // it was.
+        self.after_cancel |= c.from.is_some();
+        self.tool_at = (at.distance(self.at) > 0.0).then_some(at);
         Ok(())
     }
 

@@ -1,20 +1,23 @@
 //! Cutter compensation as LinuxCNC's interpreter computes it (`interp_convert.cc`): the
-//! stretch from `G41`/`G42` to the move after `G40`, gathered whole, becomes the tool centre's
-//! path.
+//! stretch from `G41`/`G42` to `G40` (or the program's end), gathered whole, becomes the tool
+//! centre's path, and the tool stays at its end.
 //!
-//! - The start-up move (straight, from where the head stands to the programmed point `P`) ends
-//!   at `P` offset by the radius perpendicular to the move itself, to the compensation side; a
-//!   start-up move not longer than the radius is refused.
+//! - A straight start-up move (feed or rapid, from where the head stands to the programmed
+//!   point `P`) ends at `P` offset by the radius perpendicular to the move itself, to the
+//!   compensation side; one not longer than the radius is refused. An arc start-up move ends
+//!   at `P` offset along the arc's radius, on an arc whose centre lies on that radius, as far
+//!   from its end as from where the head stood.
 //! - Every later programmed line or arc is offset by the radius (an arc's radius grows or
-//!   shrinks; an arc that would vanish is refused).
-//! - At a corner where the tool is outside the turn (convex), an arc about the programmed
-//!   corner joins the two offsets; where it is inside (concave), both offsets end at their
-//!   intersection, and a corner the tool cannot reach without cutting into the previous move
-//!   is refused, as LinuxCNC refuses it. A move shorter than its concave corner's retreat then
-//!   runs backwards; LinuxCNC refuses that only where the next corner needs the move's end
-//!   again (a concave corner, or a convex one sharper than its tolerance).
-//! - The move after `G40` is straight and uncompensated: from where the tool stands to the
-//!   programmed point, with no corner.
+//!   shrinks; an arc that would vanish is refused); rapids as lines. A move without motion in
+//!   the plane leaves the tool where it is.
+//! - A turn within LinuxCNC's tolerance, to either side, is no corner: the next move runs on
+//!   from where the last one ended. At a sharper corner where the tool is outside the turn
+//!   (convex), an arc about the programmed corner joins the two offsets (a straight traverse
+//!   before a rapid); where it is inside (concave), both offsets end at their intersection,
+//!   and a corner the tool cannot reach without cutting into the previous move is refused, as
+//!   LinuxCNC refuses it. A move shorter than its concave corner's retreat then runs
+//!   backwards; LinuxCNC refuses that where its end is needed again (at a concave corner, a
+//!   convex one, or the end of compensation).
 
 use cutroute_geometry::float::Libm;
 use cutroute_geometry::{Point, Span};
@@ -29,9 +32,10 @@ pub(super) enum Side {
 
 /// Below this (mm, or radians of turn) two directions or points are the same.
 const EPS: f64 = 1e-9;
-/// A convex turn up to this (radians) gets no corner arc from LinuxCNC, and the move before
-/// it is not checked again (its `TOLERANCE_CONCAVE_CORNER`).
-const CONVEX_CORNER_TOLERANCE: f64 = 0.05;
+/// A turn up to this (radians), convex or concave, is no corner to LinuxCNC: no corner arc,
+/// no intersection, and the move before it is not checked again (its
+/// `TOLERANCE_CONCAVE_CORNER`).
+const CORNER_TOLERANCE: f64 = 0.05;
 const GOUGE: &str = "a concave corner the tool cannot reach without gouging";
 
 /// One piece of the tool centre's path.
@@ -198,42 +202,81 @@ fn cross(a: Point, b: Point) -> f64 {
 /// The problem LinuxCNC names, and the line of the move it stops on.
 pub(super) type Refusal = (&'static str, usize);
 
-/// The tool centre's path of a compensated stretch: from `start` (where the head stood) by the
-/// start-up move to the programmed `entry`, along the programmed `spans` (each with its line),
-/// and by the cancel move to `to`.
+/// A programmed move of a compensated stretch (a move of more than half a turn comes as two
+/// spans of one line).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Step {
+    pub span: Span,
+    pub line: usize,
+    /// `G0`: offset as a straight feed is, but a convex corner before it is a straight
+    /// traverse (there is no rapid arc).
+    pub rapid: bool,
+}
+
+/// A span of the tool centre's path, with the index of the programmed step it runs for (a
+/// corner before a step is that step's).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct ToolSpan {
+    pub span: Span,
+    pub line: usize,
+    pub rapid: bool,
+    pub step: usize,
+}
+
+/// The tool centre's path of a compensated stretch, as far as LinuxCNC has run it when
+/// compensation ends (`G40` or the program's end, on `end_line`): from `start` (where the head
+/// stands) by the start-up move (its first `startup` steps; `origin` is the programmed point
+/// the interpreter reckons from, which differs from `start` only right after a `G40`) and
+/// along the later steps, each offset by the radius. The tool stays at the last offset end.
 pub(super) fn tool_path(
     side: Side,
     radius: f64,
-    start: Point,
-    entry: Point,
-    spans: &[(Span, usize)],
-    to: Point,
-    lines: (usize, usize),
-) -> Result<Vec<(Span, usize)>, Refusal> {
+    (origin, start): (Point, Point),
+    steps: &[Step],
+    startup: usize,
+    end_line: usize,
+) -> Result<Vec<ToolSpan>, Refusal> {
     let normal = |t: Point| match side {
         Side::Left => t.rotated_quarter(),
         Side::Right => -t.rotated_quarter(),
     };
-    let d0 = unit(entry - start).ok_or(("the start-up move has no length", lines.0))?;
-    if start.distance(entry) <= radius {
+    let first = steps
+        .first()
+        .ok_or(("the start-up move has no length", end_line))?;
+    let startup = startup.clamp(1, steps.len());
+    let last_startup = steps[startup - 1];
+    let entry = last_startup.span.end;
+    let straight_startup = first.span.bulge == 0.0;
+    let d0 = unit(entry - origin).ok_or(("the start-up move has no length", first.line))?;
+    if origin.distance(entry) <= radius {
         return Err((
             "the start-up move is not longer than the tool radius",
-            lines.0,
+            first.line,
         ));
     }
-    let mut pieces: Vec<(Piece, usize)> = vec![(
+    let startup_piece = if straight_startup {
         Piece::Line {
             a: start,
             b: entry + normal(d0) * radius,
-        },
-        lines.0,
-    )];
-    // The last piece that offsets a programmed move (a corner arc is never trimmed).
+        }
+    } else {
+        startup_arc(side, radius, origin, start, &steps[..startup])?
+    };
+    let mut pieces: Vec<(Piece, usize, bool, usize)> =
+        vec![(startup_piece, first.line, first.rapid, 0)];
+    // The last piece that offsets a programmed move (a corner piece is never trimmed).
     let mut last = 0;
     // That piece runs backwards from its trimmed start.
     let mut next_backwards = false;
-    let mut direction = d0;
-    for &(span, line) in spans {
+    let mut direction = if straight_startup {
+        d0
+    } else {
+        tangent(&last_startup.span, 1.0)
+    };
+    for (index, step) in steps.iter().enumerate().skip(startup) {
+        let (span, line) = (step.span, step.line);
+        // A move without motion in the plane (a Z move, or a move to where it is) leaves the
+        // tool where it stands.
         if span.length() <= EPS {
             continue;
         }
@@ -270,19 +313,20 @@ pub(super) fn tool_path(
             Side::Left => turn > EPS,
             Side::Right => turn < -EPS,
         };
-        // The start-up move's offset is the line through its end along the move (its tool
-        // path runs from where the head stood, not along that line).
-        let previous = if last == 0 {
+        // The straight start-up move's offset is the line through its end along the move (its
+        // tool path runs from where the head stood, not along that line).
+        let previous = if last == 0 && straight_startup {
             let end = pieces[0].0.end();
             Piece::Line {
-                a: end - d0 * start.distance(entry),
+                a: end - d0 * origin.distance(entry),
                 b: end,
             }
         } else {
             pieces[last].0
         };
-        if turn.abs() <= EPS && dot > 0.0 {
-            // Tangent: the offsets meet.
+        if dot > 0.0 && turn.atan2_libm(dot).abs() <= CORNER_TOLERANCE {
+            // A turn within LinuxCNC's tolerance, to either side, is no corner: the move runs
+            // on from where the previous one ends, which keeps its end unchecked.
             piece.set_start(previous.end());
         } else if concave {
             let x = intersection(&previous, &piece, corner).ok_or((GOUGE, line))?;
@@ -295,33 +339,101 @@ pub(super) fn tool_path(
             pieces[last].0.set_end(x);
             piece.set_start(x);
         } else {
-            // A convex corner sharper than LinuxCNC's tolerance flushes the previous move
-            // with its end checked: one that runs backwards is refused.
-            if backwards && turn.atan2_libm(dot).abs() > CONVEX_CORNER_TOLERANCE {
+            // A convex corner flushes the previous move with its end checked: one that runs
+            // backwards is refused.
+            if backwards {
                 return Err((GOUGE, line));
             }
-            pieces.push((
+            // There is no rapid arc: before a rapid the corner is a straight traverse.
+            let corner_piece = if step.rapid {
+                Piece::Line {
+                    a: previous.end(),
+                    b: piece.start(),
+                }
+            } else {
                 Piece::Arc {
                     centre: corner,
                     a: previous.end(),
                     b: piece.start(),
                     ccw: side == Side::Right,
                     full: false,
-                },
-                line,
-            ));
+                }
+            };
+            pieces.push((corner_piece, line, step.rapid, index));
         }
-        pieces.push((piece, line));
+        pieces.push((piece, line, step.rapid, index));
         last = pieces.len() - 1;
         direction = t1;
     }
-    let end = pieces[last].0.end();
-    pieces.push((Piece::Line { a: end, b: to }, lines.1));
+    // Ending compensation flushes the last move with its end checked, as a corner would.
+    if next_backwards {
+        return Err((GOUGE, end_line));
+    }
     Ok(pieces
         .iter()
-        .flat_map(|(piece, line)| piece.spans().into_iter().map(move |s| (s, *line)))
-        .filter(|(s, _)| s.length() > EPS)
+        .flat_map(|&(piece, line, rapid, step)| {
+            piece.spans().into_iter().map(move |span| ToolSpan {
+                span,
+                line,
+                rapid,
+                step,
+            })
+        })
+        .filter(|s| s.span.length() > EPS)
         .collect())
+}
+
+/// The tool's arc of an arc start-up move (LinuxCNC's `convert_arc_comp1`): it ends at the
+/// programmed end offset along the arc's radius, and its centre lies on that radius, as far
+/// from the end as from where the head stands.
+fn startup_arc(
+    side: Side,
+    radius: f64,
+    origin: Point,
+    start: Point,
+    spans: &[Step],
+) -> Result<Piece, Refusal> {
+    let (first, line) = (spans[0].span, spans[0].line);
+    let end = spans[spans.len() - 1].span.end;
+    // The interpreter reckons the arc from the programmed point: from anywhere else its arc
+    // would not be circular.
+    if origin.distance(start) > 1e-9 {
+        return Err((
+            "an arc start-up move where the tool does not stand at the programmed point",
+            line,
+        ));
+    }
+    let centre = first.centre().ok_or(("an arc without a centre", line))?;
+    let ccw = first.bulge > 0.0;
+    let inside = ccw == (side == Side::Left);
+    if inside && origin.distance(centre) <= radius {
+        return Err(("the tool radius is not less than an arc's radius", line));
+    }
+    let out = unit(end - centre).ok_or(("an arc without a centre", line))?;
+    let tool_end = if inside {
+        end - out * radius
+    } else {
+        end + out * radius
+    };
+    let (along, back) = (unit(centre - tool_end), unit(start - tool_end));
+    let cos = match (along, back) {
+        (Some(u), Some(v)) => u.x * v.x + u.y * v.y,
+        _ => 0.0,
+    };
+    // LinuxCNC's TOLERANCE_EQUAL: a radius through the end perpendicular to the chord has no
+    // centre equidistant from both ends.
+    if cos.abs() < 1e-4 {
+        return Err(("the tool radius is not less than an arc's radius", line));
+    }
+    let along = along.unwrap_or(Point::new(1.0, 0.0));
+    let tool_centre = tool_end + along * (0.5 * start.distance(tool_end) / cos);
+    Ok(Piece::Arc {
+        centre: tool_centre,
+        a: start,
+        b: tool_end,
+        ccw,
+        full: false,
+    })
 }
 
 /// The intersection of two pieces' lines or circles nearest `near`.
