@@ -33,7 +33,8 @@
 //!   program the controller finds in its USER_M_PATH: refused, as rs274 refuses them without
 //!   it. Digital and analog outputs (`M62`–`M65`, `M67`, `M68`), waiting on an input (`M66`;
 //!   `#5399` keeps its value, 0 unless set, as in rs274), adaptive feed and feed hold (`M52`, `M53`) and the other
-//!   M codes besides the torch's change no motion: accepted. A program without `M2`/`M30`
+//!   M codes besides the torch's change no motion: accepted. A tool change `M6` switches the
+//!   torch off, as LinuxCNC stops the spindle for it, and is refused under compensation. A program without `M2`/`M30`
 //!   (which rs274 requires) is read to its last line.
 //!
 //! The torch burns from its on code to its off code. In GRBL laser mode
@@ -840,9 +841,25 @@ impl State<'_> {
                 continue;
             }
             let number = number as u32;
+            // LinuxCNC's tool change stops the spindle first, and cannot happen while
+            // compensation is on (it would change the radius).
+            let tool_change = number == 6 && !self.options.torch_on.contains(&number);
+            if tool_change && self.compensation.is_some() {
+                return Err(GcodeReadError::Compensation {
+                    line,
+                    column,
+                    problem: "a tool change (M6) while compensation is on",
+                });
+            }
+            // After it the interpreter reads the head's position back from the machine: where
+            // compensation left the tool becomes the programmed point.
+            if tool_change {
+                self.at = self.head();
+                self.tool_at = None;
+            }
             let (on, off) = (
                 self.options.torch_on.contains(&number),
-                self.options.torch_off.contains(&number),
+                self.options.torch_off.contains(&number) || tool_change,
             );
             // Dynamic power exists only in laser mode.
             self.laser |= on && number == 4;
