@@ -251,6 +251,157 @@ M2
     );
 }
 
+/// Compensation ends where LinuxCNC flushes it: at `G40` (the tool stays at its offset end
+/// until the next move, which the interpreter reckons from the programmed point) or at the
+/// program's end. Rapids are compensated as straight moves (a convex corner before one is a
+/// straight traverse), a start-up move may be an arc, and a torch switch waits for the move
+/// before it.
+const FLUSHED: &str = "\
+G21 G90
+G0 X-5 Y-5
+M3
+G41.1 D2
+G0 X0 Y0
+F100
+G1 X10 Y0
+G0 X10 Y10
+G1 X0 Y10
+G1 X0.5 Y5.025
+G1 X0 Y0
+M5
+G40
+G0 Z5
+G0 X-5 Y-5
+G42.1 D2
+G3 X10 Y0 I7.5 J2.5
+G2 X20 Y0 I5 J0
+G1 X20 Y-5
+M3
+G1 X25 Y-5
+M2
+";
+
+#[test]
+fn compensation_ends_where_linuxcnc_flushes_it() {
+    let program = read_gcode(FLUSHED, &linuxcnc(0.0)).unwrap();
+    // The torch goes off where the last compensated move ends, and the move along Z alone
+    // after G40 takes the head from there to the programmed point.
+    let off = program
+        .motions
+        .iter()
+        .find_map(|m| match m {
+            Motion::TorchOff { at, line: 12 } => Some(*at),
+            _ => None,
+        })
+        .unwrap();
+    let back = program
+        .motions
+        .iter()
+        .find_map(|m| match m {
+            Motion::Rapid { from, to, line: 14 } => Some((*from, *to)),
+            _ => None,
+        })
+        .unwrap();
+    assert!(back.0.distance(off) < 1e-9 && back.1.distance(Point::new(0.0, 0.0)) < 1e-9);
+    assert!(off.distance(Point::new(0.0, 0.0)) > 0.9, "{off:?}");
+    // The rapid up the right edge is offset like a feed: from the bottom edge's end (10, 1)
+    // after the concave corner trimmed it, to (9, 9).
+    assert!(rapid_targets(&program)
+        .iter()
+        .any(|p| p.distance(Point::new(9.0, 9.0)) < 1e-9));
+    assert_eq!(program.pierce_count(), 2);
+    agrees_with_rs274("flushed", FLUSHED, &program, 1.0);
+}
+
+#[test]
+fn turns_within_linuxcncs_tolerance_are_no_corners() {
+    // A concave turn of 0.03 rad: LinuxCNC neither trims the moves to their intersection nor
+    // rounds the convex one after it; each move runs on from where the last one ended.
+    let text = "\
+G21 G90
+G0 X0 Y-10
+M3
+G41.1 D2 G1 X0 Y0 F1000
+G1 X10 Y0
+G1 X20 Y0.3
+G1 X30 Y0.3
+G40 G1 X30 Y-10
+M5
+M2
+";
+    let program = read_gcode(text, &linuxcnc(0.0)).unwrap();
+    let ends: Vec<Point> = program
+        .motions
+        .iter()
+        .filter_map(|m| match m {
+            Motion::Feed { span, line: 5, .. } => Some(span.end),
+            _ => None,
+        })
+        .collect();
+    assert!(
+        ends.last().unwrap().distance(Point::new(10.0, 1.0)) < 1e-9,
+        "{ends:?}"
+    );
+    agrees_with_rs274("small turns", text, &program, 1.0);
+}
+
+#[test]
+fn a_tool_change_stops_the_torch_and_takes_the_head_where_it_stands() {
+    // LinuxCNC stops the spindle for M6 and reads the position back: the rapid after it runs
+    // from where compensation left the tool, and the torch pierces again.
+    let text = "\
+G21 G90
+G0 X0 Y-10
+M3
+G41.1 D2 G1 X0 Y0 F100
+G1 X10 Y0
+G40
+T1 M6
+G0 X20 Y0
+M3
+G1 X30 Y0
+M5
+M2
+";
+    let program = read_gcode(text, &linuxcnc(0.0)).unwrap();
+    assert_eq!(program.pierce_count(), 2);
+    assert!(program.motions.iter().any(|m| matches!(
+        m,
+        Motion::Rapid { from, line: 8, .. } if from.distance(Point::new(10.0, 1.0)) < 1e-9
+    )));
+    agrees_with_rs274("tool change", text, &program, 1.0);
+}
+
+#[test]
+fn compensation_refuses_what_linuxcnc_refuses_when_it_ends() {
+    let stretch = "G21 G90\nG0 X0 Y-10\nM3\nG41.1 D2 G1 X0 Y0 F100\nG1 X10 Y0\n";
+    let cases = [
+        // G40 flushes the last move with its end checked: one that runs backwards (shorter
+        // than its concave corner's retreat) is refused there.
+        (
+            "G21 G90\nG0 X0 Y10\nM3\nG41.1 D1 G1 X0 Y0 F1000\nG1 X10 Y0\nG1 X20 Y-0.7\nG1 X20.014\nG40 G1 X21 Y5\nM5\nM2\n".to_string(),
+            "line 8",
+            0.5,
+        ),
+        (format!("{stretch}G40\nG2 X20 Y0 I5 J0\nM5\nM2\n"), "not an arc", 1.0),
+        (format!("{stretch}T1 M6\nG40\nM5\nM2\n"), "tool change", 1.0),
+        (
+            "G21 G90\nG0 X0 Y0\nF100\nG41.1 D2\nG1 Z-1\nG1 X10 Y0\nG40\nM2\n".to_string(),
+            "start-up",
+            1.0,
+        ),
+    ];
+    for (text, says, radius) in &cases {
+        let error = read_gcode(text, &linuxcnc(0.0)).unwrap_err();
+        assert!(error.to_string().contains(says), "{text}: {error}");
+        refused_by_rs274(says, text, *radius);
+    }
+    // Switched on and off without a move, compensation does nothing.
+    let idle = format!("{stretch}G40\nG41.1 D2\nG40\nG1 X20 Y0\nM5\nM2\n");
+    let program = read_gcode(&idle, &linuxcnc(0.0)).unwrap();
+    agrees_with_rs274("on and off", &idle, &program, 1.0);
+}
+
 #[test]
 fn headers_comments_and_what_the_reader_leaves_to_the_controller() {
     // A Fanuc program number, `%` tape marks, `(MSG,…)`, `;` comments, N words.
