@@ -67,7 +67,7 @@
 //! clusters stay the same).
 //!
 //! **Refinement.** A stage builds the instance (row by row, in slices), then runs the exact
-//! solver for a doubling time share. Then the pieces relaxed tours visit are split in order of
+//! solver for a doubling time share (or a doubling share of work, `stage_work`). Then the pieces relaxed tours visit are split in order of
 //! importance until the node limit: with the ng-path bound first the cheapest tours of the
 //! relaxation itself ([`crate::relaxed_tours`]: an iterated local search with the pieces
 //! re-chosen by a layered shortest path, run in every eighth slice; a relaxed tour that enters
@@ -170,6 +170,10 @@ pub struct LowerBoundOptions {
     pub memory_limit_bytes: usize,
     /// Time share of the first stage's exact search; each later stage gets twice the previous.
     pub first_stage: Duration,
+    /// Measure stages by work instead of `first_stage` (`None`: by time). What a stage of
+    /// time finds depends on how much CPU the machine gives it; a stage of work finds the same
+    /// on any machine, which is what tests of the bound's strength assert.
+    pub stage_work: Option<StageWork>,
     /// Seconds the whole computation is expected to run: the exact solver sizes its bounds'
     /// work for it (the lattice of ideals is built only when there is time for it).
     pub budget_seconds: f64,
@@ -232,6 +236,28 @@ pub struct LowerBoundOptions {
     pub ng_max_nodes: usize,
 }
 
+/// The work of a first stage when stages are measured by work ([`LowerBoundOptions::stage_work`]):
+/// the stage ends once each of its searches has done its share, or has ended, or does not run.
+/// Each later stage gets twice the previous one's, as with time shares.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct StageWork {
+    /// States the exact search creates.
+    pub exact_states: u64,
+    /// Passes of the ng-path bound's subgradient.
+    pub ng_passes: usize,
+}
+
+impl StageWork {
+    /// This work times `2^doublings`, divided by `divisor` (at least one state and one pass).
+    fn scaled(self, doublings: usize, divisor: u64) -> StageWork {
+        let times = 1u64 << doublings.min(16);
+        StageWork {
+            exact_states: (self.exact_states.saturating_mul(times) / divisor).max(1),
+            ng_passes: ((self.ng_passes as u64).saturating_mul(times) / divisor).max(1) as usize,
+        }
+    }
+}
+
 /// Prices of the moves between pierce points of chain cutting (`cutroute-chains`), per mm and
 /// per pierce in the unit of the route's cost. A contour is entered either by an idle move and
 /// a pierce, or, from a sibling in one scrap region (children of the sheet or of one hole), by a
@@ -286,6 +312,7 @@ impl Default for LowerBoundOptions {
             max_nodes: 2500,
             memory_limit_bytes: 256 << 20,
             first_stage: Duration::from_millis(500),
+            stage_work: None,
             budget_seconds: 10.0,
             group_size: 16,
             wide_group_size: 90,
@@ -448,6 +475,8 @@ struct Solving {
     solver: Option<ExactSolver>,
     spent: Duration,
     share: Duration,
+    /// The stage's work when stages are measured by work (then `share` is no limit).
+    work: Option<StageWork>,
     /// The ng-path bound on the same instance (large relaxations only), sharing the slices,
     /// and its neighbourhoods' size.
     ng: Option<NgPathBound>,
@@ -465,6 +494,28 @@ struct Solving {
     tours: Option<RelaxedTourSearch>,
     /// Time the stage's matrix took to build (diagnostics).
     build_spent: Duration,
+}
+
+impl Solving {
+    /// Whether the exact search and the ng-path bound have each done the stage's work (false
+    /// when stages are measured by time). A search that ended or does not run has; the ng-path
+    /// bound has not while it is being made.
+    fn work_done(&self) -> (bool, bool) {
+        let Some(work) = self.work else {
+            return (false, false);
+        };
+        let exact = self
+            .solver
+            .as_ref()
+            .is_none_or(|e| self.exact_over || e.states_created() >= work.exact_states);
+        let ng = self.ng_builder.is_none()
+            && (!self.ng_running
+                || self
+                    .ng
+                    .as_ref()
+                    .is_none_or(|ng| ng.iterations() >= work.ng_passes));
+        (exact, ng)
+    }
 }
 
 enum Stage {
@@ -768,6 +819,7 @@ impl CcpLowerBound {
                     Some((o, self.outermost_shapes.get(&o)?.clone()))
                 })
                 .collect();
+            let wide = leaves.len() > self.options.ng_above && self.options.ng_size > 0;
             let options = LowerBoundOptions {
                 // Finer first pieces than the whole relaxation: a group's exact search is
                 // cheap, and its bound is only as good as its pieces.
@@ -776,11 +828,15 @@ impl CcpLowerBound {
                 // get the whole relaxation's first share (Nest02, groups of 90, 60 s of the
                 // bound's own time: 16,932 with a quarter of it, 17,858–18,079 with all of it,
                 // 17,331 with twice it).
-                first_stage: if leaves.len() > self.options.ng_above && self.options.ng_size > 0 {
+                first_stage: if wide {
                     self.options.first_stage
                 } else {
                     (self.options.first_stage / 4).max(Duration::from_millis(100))
                 },
+                stage_work: self
+                    .options
+                    .stage_work
+                    .map(|w| if wide { w } else { w.scaled(0, 4) }),
                 budget_seconds: (2.0 * self.options.budget_seconds / count as f64).max(2.0),
                 group_size: 0,
                 // Groups fit the exact search's keys: the test threshold is the whole relaxation's only.
@@ -911,6 +967,21 @@ impl CcpLowerBound {
         self.stages_done
     }
 
+    /// Stages completed by every relaxation that may still improve: the least of the whole
+    /// relaxation's (while it runs) and each running group's (`usize::MAX` when none runs).
+    /// With stages measured by work, running until this reaches `k` does the same work on any
+    /// machine.
+    pub fn least_stages(&self) -> usize {
+        let own = self.own_running.then_some(self.stages_done);
+        let groups = self
+            .groups
+            .iter()
+            .zip(&self.groups_running)
+            .filter(|(_, &running)| running)
+            .map(|(g, _)| g.least_stages());
+        own.into_iter().chain(groups).min().unwrap_or(usize::MAX)
+    }
+
     /// Nodes (pieces + depot) of the current stage's instance.
     pub fn node_count(&self) -> usize {
         1 + self.pieces.iter().map(Vec::len).sum::<usize>()
@@ -1023,9 +1094,17 @@ impl CcpLowerBound {
         let group = (0..self.groups.len())
             .find(|&g| self.groups_running[g] && self.groups[g].stage.is_some())
             .or_else(|| {
-                (0..self.groups.len())
-                    .filter(|&g| self.groups_running[g])
-                    .min_by_key(|&g| self.groups[g].elapsed())
+                let running = (0..self.groups.len()).filter(|&g| self.groups_running[g]);
+                if self.options.stage_work.is_some() {
+                    // By work: the group with the fewest stages (a pending probe first), so
+                    // that what the groups reach does not depend on the machine either.
+                    running.min_by_key(|&g| {
+                        let group = &self.groups[g];
+                        group.stages_done + usize::from(!group.probe)
+                    })
+                } else {
+                    running.min_by_key(|&g| self.groups[g].elapsed())
+                }
             });
         // With the ng-path bound the whole relaxation is the stronger one (the groups' exact
         // optima saturate within seconds at the loss on their borders): it gets three slices
@@ -1341,6 +1420,19 @@ impl CcpLowerBound {
         } else {
             self.options.first_stage * (1u32 << self.stages_done.min(16))
         };
+        let work = match self.options.stage_work {
+            Some(_) if self.fixed => None,
+            Some(w) if self.probe => Some(w.scaled(0, 16)),
+            Some(w) => Some(w.scaled(self.stages_done, 1)),
+            None => None,
+        };
+        // By work, the time share is no limit (the exact search's budgets are sized for the
+        // whole computation, not for a share that depends on the machine).
+        let share = if work.is_some() {
+            Duration::from_secs(1 << 40)
+        } else {
+            share
+        };
         // The relaxation has no precedence, so its lattice of ideals holds all 2^m subsets of
         // its m contours. Past the lattice's cap the build always fails, and before it failed,
         // sorting one layer of 3.7 million records was one piece of 0.32 s on nested.dbs' 4,000
@@ -1351,7 +1443,7 @@ impl CcpLowerBound {
         let lattice_max_ideals = if lattice_fits { lattice_max_ideals } else { 0 };
         let options = ExactOptions {
             time_limit: Some(share),
-            budget_seconds: Some(if self.fixed {
+            budget_seconds: Some(if self.fixed || work.is_some() {
                 self.options.budget_seconds
             } else {
                 self.options.budget_seconds.max(share.as_secs_f64())
@@ -1389,6 +1481,7 @@ impl CcpLowerBound {
             solver,
             spent: Duration::ZERO,
             share,
+            work,
             ng_running: false,
             ng: None,
             ng_size,
@@ -1487,7 +1580,11 @@ impl CcpLowerBound {
             }
             _ => false,
         };
-        let exact_turn = !s.ng_running || (s.turns.is_multiple_of(8) && !ng_ahead);
+        // By work, a search that has done its share leaves the slices to the other.
+        let (exact_done, ng_done) = s.work_done();
+        let exact_wants = !s.exact_over && !exact_done;
+        let ng_wants = s.ng_running && !ng_done;
+        let exact_turn = exact_wants && (!ng_wants || (s.turns.is_multiple_of(8) && !ng_ahead));
         let tours_turn = s.turns % 8 == 4;
         if let Some(tours) = s.tours.as_mut().filter(|t| tours_turn && t.running()) {
             // A cheaper relaxed tour bounds the ng-path DP's passes better (pruning, level).
@@ -1502,7 +1599,7 @@ impl CcpLowerBound {
                     ng.offer_tour(best);
                 }
             }
-        } else if let Some(solver) = s.solver.as_mut().filter(|_| !s.exact_over && exact_turn) {
+        } else if let Some(solver) = s.solver.as_mut().filter(|_| exact_turn) {
             let status = solver.step(slice.max(Duration::from_millis(1)));
             s.exact_over = status != Status::Running;
             let progress = solver.progress();
@@ -1538,8 +1635,12 @@ impl CcpLowerBound {
         }
         s.spent += now.elapsed();
         // The stage is over when the exact search ended (its bound is then the relaxation's
-        // optimum), when neither search can go on, or when its time is up.
-        s.exact_over || s.spent >= s.share || (s.solver.is_none() && !s.ng_running)
+        // optimum), when neither search can go on, or when its time or work is up.
+        let (exact_done, ng_done) = s.work_done();
+        s.exact_over
+            || s.spent >= s.share
+            || (s.solver.is_none() && !s.ng_running)
+            || (exact_done && ng_done)
     }
 
     /// Splits pieces where the relaxed `tours` (node sequences of the stage's instance, most

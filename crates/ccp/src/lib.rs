@@ -89,7 +89,7 @@ mod route;
 mod search;
 mod solver;
 
-pub use bound::{CcpLowerBound, LinkPrices, LowerBoundOptions, MAX_RELAXATION_ENTRIES};
+pub use bound::{CcpLowerBound, LinkPrices, LowerBoundOptions, StageWork, MAX_RELAXATION_ENTRIES};
 pub use cutroute_anytime::{AnytimeSolver, Bounds, Status};
 pub use discrete::{
     build_pcgtsp, pierce_candidates, DiscreteInstance, DiscreteNode, DiscretisationOptions,

@@ -8,6 +8,7 @@ use std::time::Duration;
 
 use cutroute_ccp::{
     containment_pairs, solve, CcpLowerBound, CcpOptions, CcpResult, LinkPrices, LowerBoundOptions,
+    StageWork,
 };
 use cutroute_geometry::{
     is_scrap_region, Contour, ContourRef, Nest, Part, Point, SplitMix64, Vertex,
@@ -165,37 +166,56 @@ fn ccp_route(nest: &Nest, start: Point, finish: Option<Point>, limit: Duration) 
     solve(nest, options, &mut |_| {}).unwrap()
 }
 
-/// Runs the bound for up to `stages` stages or `limit` of its own time.
-fn run_bound(bound: &mut CcpLowerBound, stages: usize, limit: Duration) -> f64 {
-    run_bound_watched(bound, stages, limit, |_| {})
+/// The first stage's work in these tests: what the bound reaches after some stages is then
+/// the same on a quiet machine and on a loaded one (a stage of time buys what the machine
+/// gives it: under load, two seconds once ended before the ng-path bound's first pass).
+const WORK: StageWork = StageWork {
+    exact_states: 20_000,
+    ng_passes: 8,
+};
+
+/// Options measuring stages by [`WORK`].
+fn by_work(options: LowerBoundOptions) -> LowerBoundOptions {
+    LowerBoundOptions {
+        stage_work: Some(WORK),
+        ..options
+    }
 }
 
-/// Runs the bound until its ng-path bound has run and `stages` stages are done, or it has
+/// Runs the bound until every relaxation that still runs has done `stages` stages, or it has
 /// nothing left to do; a run past ten minutes of its own time fails as a hang.
-fn run_until_ng(bound: &mut CcpLowerBound, stages: usize) -> f64 {
-    while !(bound.ng_bound() > 0.0 && bound.stages() >= stages)
-        && bound.step(Duration::from_millis(50))
-    {
-        assert!(
-            bound.elapsed() < Duration::from_secs(600),
-            "the bound ran 10 minutes"
-        );
-    }
-    bound.lower_bound()
+fn run_bound(bound: &mut CcpLowerBound, stages: usize) -> f64 {
+    run_bound_watched(bound, stages, |_| {})
+}
+
+/// Runs the bound until the whole relaxation has done `stages` stages (the groups beside it
+/// get the slices they get), or it has nothing left to do; fails as a hang past ten minutes.
+fn run_whole_stages(bound: &mut CcpLowerBound, stages: usize) -> f64 {
+    run_until(bound, |b| b.stages() >= stages, |_| {})
 }
 
 /// [`run_bound`], showing the bound to `watch` after every step.
 fn run_bound_watched(
     bound: &mut CcpLowerBound,
     stages: usize,
-    limit: Duration,
+    watch: impl FnMut(&CcpLowerBound),
+) -> f64 {
+    run_until(bound, |b| b.least_stages() >= stages, watch)
+}
+
+/// Steps the bound until `done` holds or it has nothing left to do, showing it to `watch`
+/// after every step; a run past ten minutes of its own time fails as a hang.
+fn run_until(
+    bound: &mut CcpLowerBound,
+    done: impl Fn(&CcpLowerBound) -> bool,
     mut watch: impl FnMut(&CcpLowerBound),
 ) -> f64 {
-    while bound.stages() < stages
-        && bound.elapsed() < limit
-        && bound.step(Duration::from_millis(50))
-    {
+    while !done(bound) && bound.step(Duration::from_millis(50)) {
         watch(bound);
+        assert!(
+            bound.elapsed() < Duration::from_secs(600),
+            "the bound ran 10 minutes"
+        );
     }
     bound.lower_bound()
 }
@@ -211,13 +231,13 @@ fn never_above_brute_force_and_close_to_it_on_random_small_nests() {
             start,
             finish,
             budget_seconds: 2.0,
-            ..LowerBoundOptions::default()
+            ..by_work(LowerBoundOptions::default())
         };
         let mut bound = CcpLowerBound::new(&nest, options).unwrap();
         // The best CCP route guides the refinement, as in the engine's job.
         let ccp = ccp_route(&nest, start, finish, Duration::from_secs(1));
         bound.offer_route(&ccp.route);
-        let lb = run_bound(&mut bound, 8, Duration::from_secs(3));
+        let lb = run_bound(&mut bound, 8);
         assert!(
             lb <= brute + 1e-9,
             "seed {seed}: bound {lb} above the brute-force route {brute}"
@@ -285,10 +305,10 @@ fn with_link_prices_never_above_brute_force_chain_routes() {
             finish,
             budget_seconds: 2.0,
             links: Some(links),
-            ..LowerBoundOptions::default()
+            ..by_work(LowerBoundOptions::default())
         };
         let mut bound = CcpLowerBound::new(&nest, options).unwrap();
-        let lb = run_bound(&mut bound, 8, Duration::from_secs(3));
+        let lb = run_bound(&mut bound, 8);
         assert!(
             lb <= brute + 1e-9,
             "seed {seed} {links:?}: bound {lb} above the brute-force chain route {brute}"
@@ -328,11 +348,11 @@ fn never_above_the_ccp_route_on_the_real_nests() {
                 start,
                 finish,
                 budget_seconds: 2.0,
-                ..LowerBoundOptions::default()
+                ..by_work(LowerBoundOptions::default())
             };
             let mut bound = CcpLowerBound::new(&nest, options).unwrap();
             bound.offer_route(&ccp.route);
-            let lb = run_bound(&mut bound, 4, Duration::from_secs(2));
+            let lb = run_bound(&mut bound, 1);
             let ub = ccp.metrics.idle_length;
             assert!(lb > 0.0, "{path}: no bound");
             assert!(
@@ -568,7 +588,7 @@ fn the_groups_sum_never_above_brute_force() {
                 budget_seconds: 2.0,
                 group_size,
                 decompose_above: 0,
-                ..LowerBoundOptions::default()
+                ..by_work(LowerBoundOptions::default())
             };
             let mut bound = CcpLowerBound::new(&nest, options).unwrap();
             if bound.kept_contours() <= group_size {
@@ -578,7 +598,7 @@ fn the_groups_sum_never_above_brute_force() {
             assert!(bound.group_count() >= 2, "seed {seed}: no groups");
             let ccp = ccp_route(&nest, start, finish, Duration::from_millis(300));
             bound.offer_route(&ccp.route);
-            let lb = run_bound(&mut bound, usize::MAX, Duration::from_secs(2));
+            let lb = run_bound(&mut bound, 3);
             let sum = bound.group_sum();
             cases += 1;
             positive += usize::from(sum > 0.05 * brute);
@@ -620,7 +640,7 @@ fn wide_groups_with_the_ng_path_bound_never_above_brute_force() {
             ng_size: 8,
             ng_above: 0,
             exact_max_kept: 1,
-            ..LowerBoundOptions::default()
+            ..by_work(LowerBoundOptions::default())
         };
         let mut stays_small = CcpLowerBound::new(
             &nest,
@@ -646,7 +666,9 @@ fn wide_groups_with_the_ng_path_bound_never_above_brute_force() {
         let brute = brute_force(&nest, start, finish, h);
         let ccp = ccp_route(&nest, start, finish, Duration::from_millis(300));
         bound.offer_route(&ccp.route);
-        let lb = run_bound(&mut bound, usize::MAX, Duration::from_secs(2));
+        // One stage of every wide group (their ng-path bounds' passes on a group's fine
+        // pieces are the slow part of this test).
+        let lb = run_bound(&mut bound, 1);
         let sum = bound.group_sum();
         assert!(
             !bound.wide_pending() && bound.group_count() >= 2 && bound.group_count() < kept,
@@ -654,7 +676,7 @@ fn wide_groups_with_the_ng_path_bound_never_above_brute_force() {
             bound.group_count()
         );
         stays_small.offer_route(&ccp.route);
-        let small = run_bound(&mut stays_small, usize::MAX, Duration::from_secs(2));
+        let small = run_bound(&mut stays_small, 2);
         assert_eq!(stays_small.group_count(), kept, "seed {seed}: widened");
         assert!(
             small <= brute + 1e-9,
@@ -699,14 +721,12 @@ fn the_ng_path_bound_never_above_brute_force() {
             let options = LowerBoundOptions {
                 start,
                 finish,
-                // The refined neighbourhoods come from the second stage on: that stage is
-                // reached by work, however slow the machine, so its budget is no limit.
-                budget_seconds: if ng_refined_size > 0 { 600.0 } else { 2.0 },
+                budget_seconds: 2.0,
                 group_size: 0,
                 ng_size,
                 ng_refined_size,
                 ng_above: 0,
-                ..LowerBoundOptions::default()
+                ..by_work(LowerBoundOptions::default())
             };
             let mut bound = CcpLowerBound::new(&nest, options).unwrap();
             bound.offer_route(&ccp.route);
@@ -716,10 +736,7 @@ fn the_ng_path_bound_never_above_brute_force() {
                     later.extend(b.ng_neighbourhood());
                 }
             };
-            let mut lb = run_bound_watched(&mut bound, 4, Duration::from_secs(2), &mut watch);
-            if ng_refined_size > 0 {
-                lb = run_bound_watched(&mut bound, 2, Duration::from_secs(600), &mut watch);
-            }
+            let lb = run_bound_watched(&mut bound, 2, &mut watch);
             let ng = bound.ng_bound();
             cases += 1;
             strong += usize::from(ng >= 0.8 * brute);
@@ -774,7 +791,7 @@ fn the_ng_path_bound_without_the_exact_search_never_above_brute_force() {
             ng_above: 0,
             exact_max_kept: 1,
             ng_alone: true,
-            ..LowerBoundOptions::default()
+            ..by_work(LowerBoundOptions::default())
         };
         let mut bound = CcpLowerBound::new(&nest, options).unwrap();
         if bound.kept_contours() <= 2 {
@@ -782,9 +799,7 @@ fn the_ng_path_bound_without_the_exact_search_never_above_brute_force() {
         }
         assert!(bound.group_count() >= 2, "seed {seed}: no groups");
         bound.offer_route(&ccp.route);
-        // Two stages with the ng-path bound run, not two seconds: what a wall-clock budget
-        // buys depends on the machine's load (under load 2 s once ended before its first pass).
-        let lb = run_until_ng(&mut bound, 2);
+        let lb = run_whole_stages(&mut bound, 2);
         let ng = bound.ng_bound();
         cases += 1;
         strong += usize::from(ng >= 0.8 * brute);
