@@ -346,6 +346,49 @@ M2
 }
 
 #[test]
+fn about_a_half_turn_back_linuxcnc_decides_the_corner_by_its_own_rules() {
+    let stretch = |side: &str, from: &str, moves: &str| {
+        format!("G21 G90\nG0 {from}\nM3\n{side} G1 {moves}\nG40 G1 X-10 Y-10\nM5\nM2\n")
+    };
+    let cases = [
+        // A spike back within LinuxCNC's tolerance of a half turn, to the concave side: it
+        // goes round the tip as a convex corner.
+        stretch(
+            "G41.1 D2",
+            "X-5 Y-5",
+            "X0 Y0 F100\nG1 X10 Y0\nG1 X0 Y0.3\nG1 X-5 Y10",
+        ),
+        // Atop an "m": arc to arc, the tool outside both, is a concave corner.
+        stretch(
+            "G41.1 D2",
+            "X-5 Y-5",
+            "X0 Y0 F100\nG2 X10 Y0 I5 J0\nG2 X20 Y0 I5 J0\nG1 X20 Y-5",
+        ),
+        // An "h": over the round part, the tool outside it, then back up beside the stem.
+        stretch(
+            "G42.1 D2",
+            "X15 Y-5",
+            "X10 Y0 F100\nG3 X0 Y0 I-5 J0\nG1 X0 Y10\nG1 X-5 Y10",
+        ),
+        stretch(
+            "G41.1 D2",
+            "X-5 Y15",
+            "X0 Y10 F100\nG1 X0 Y0\nG2 X10 Y0 I5 J0\nG1 X10 Y-5",
+        ),
+    ];
+    for text in &cases {
+        let program = read_gcode(text, &linuxcnc(0.0)).unwrap_or_else(|e| panic!("{text}: {e}"));
+        agrees_with_rs274(text, text, &program, 1.0);
+    }
+    // The tip of the spike is rounded about the programmed corner (10, 0).
+    let program = read_gcode(&cases[0], &linuxcnc(0.0)).unwrap();
+    assert!(program.motions.iter().any(|m| matches!(
+        m,
+        Motion::Feed { span, line: 6, .. } if span.bulge != 0.0 && span.start.distance(Point::new(10.0, 1.0)) < 1e-9
+    )));
+}
+
+#[test]
 fn a_tool_change_stops_the_torch_and_takes_the_head_where_it_stands() {
     // LinuxCNC stops the spindle for M6 and reads the position back: the rapid after it runs
     // from where compensation left the tool, and the torch pierces again.

@@ -13,7 +13,9 @@
 //! - A turn within LinuxCNC's tolerance, to either side, is no corner: the next move runs on
 //!   from where the last one ended. At a sharper corner where the tool is outside the turn
 //!   (convex), an arc about the programmed corner joins the two offsets (a straight traverse
-//!   before a rapid); where it is inside (concave), both offsets end at their intersection,
+//!   before a rapid), also round a spike back; where it is inside (concave), or about a half
+//!   turn back onto an arc the tool runs outside of (atop an "m" or an "h"), both offsets end
+//!   at their intersection,
 //!   and a corner the tool cannot reach without cutting into the previous move is refused, as
 //!   LinuxCNC refuses it. A move shorter than its concave corner's retreat then runs
 //!   backwards; LinuxCNC refuses that where its end is needed again (at a concave corner, a
@@ -21,7 +23,7 @@
 
 use cutroute_geometry::float::Libm;
 use cutroute_geometry::{Point, Span};
-use std::f64::consts::{PI, TAU};
+use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
 /// Which side of the programmed path the controller keeps the tool on.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -309,10 +311,23 @@ pub(super) fn tool_path(
         let backwards = std::mem::replace(&mut next_backwards, false);
         let turn = cross(direction, t0);
         let dot = direction.x * t0.x + direction.y * t0.y;
-        let concave = match side {
-            Side::Left => turn > EPS,
-            Side::Right => turn < -EPS,
+        // LinuxCNC's β: the turn as the tool sees it, convex positive, from −90° to 270°.
+        let angle = turn.atan2_libm(dot);
+        let beta = match side {
+            Side::Left => -angle,
+            Side::Right => angle,
         };
+        let beta = if beta < -FRAC_PI_2 { beta + TAU } else { beta };
+        let tool_outside =
+            |p: &Piece| matches!(*p, Piece::Arc { ccw, .. } if ccw == (side == Side::Right));
+        // About a half turn back, LinuxCNC keeps the tool on its side of an arc the tool runs
+        // outside of (atop an "m" or an "h"): there the corner is concave.
+        let concave = !(-CORNER_TOLERANCE..=PI + CORNER_TOLERANCE).contains(&beta)
+            || if span.bulge == 0.0 {
+                beta > PI - CORNER_TOLERANCE && tool_outside(&pieces[last].0)
+            } else {
+                (beta - PI).abs() < CORNER_TOLERANCE && tool_outside(&piece)
+            };
         // The straight start-up move's offset is the line through its end along the move (its
         // tool path runs from where the head stood, not along that line).
         let previous = if last == 0 && straight_startup {
@@ -324,11 +339,7 @@ pub(super) fn tool_path(
         } else {
             pieces[last].0
         };
-        if dot > 0.0 && turn.atan2_libm(dot).abs() <= CORNER_TOLERANCE {
-            // A turn within LinuxCNC's tolerance, to either side, is no corner: the move runs
-            // on from where the previous one ends, which keeps its end unchecked.
-            piece.set_start(previous.end());
-        } else if concave {
+        if concave {
             let x = intersection(&previous, &piece, corner).ok_or((GOUGE, line))?;
             if !previous.reaches(x) || backwards {
                 return Err((GOUGE, line));
@@ -338,10 +349,14 @@ pub(super) fn tool_path(
             next_backwards = !piece.runs_on_from(x);
             pieces[last].0.set_end(x);
             piece.set_start(x);
+        } else if beta <= CORNER_TOLERANCE {
+            // A turn within LinuxCNC's tolerance, to either side, is no corner: the move runs
+            // on from where the previous one ends, which keeps its end unchecked.
+            piece.set_start(previous.end());
         } else {
-            // A convex corner flushes the previous move with its end checked: one that runs
-            // backwards is refused.
-            if backwards {
+            // A convex corner before a straight move flushes the previous move with its end
+            // checked: one that runs backwards is refused (before an arc it is not checked).
+            if backwards && span.bulge == 0.0 {
                 return Err((GOUGE, line));
             }
             // There is no rapid arc: before a rapid the corner is a straight traverse.
