@@ -15,11 +15,11 @@
 //!   (convex), an arc about the programmed corner joins the two offsets (a straight traverse
 //!   before a rapid), also round a spike back; where it is inside (concave), or about a half
 //!   turn back onto an arc the tool runs outside of (atop an "m" or an "h"), both offsets end
-//!   at their intersection,
-//!   and a corner the tool cannot reach without cutting into the previous move is refused, as
-//!   LinuxCNC refuses it. A move shorter than its concave corner's retreat then runs
-//!   backwards; LinuxCNC refuses that where its end is needed again (at a concave corner, a
-//!   convex one, or the end of compensation).
+//!   at their intersection, and a corner the tool cannot reach without cutting into the
+//!   previous move is refused, as LinuxCNC refuses it. A move shorter than its concave
+//!   corner's retreat then runs backwards; LinuxCNC refuses that where its end is checked
+//!   again (at a concave corner, a convex one before a straight move, or the end of
+//!   compensation).
 
 use cutroute_geometry::float::Libm;
 use cutroute_geometry::{Point, Span};
