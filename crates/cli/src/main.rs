@@ -55,12 +55,14 @@ use cutroute_geometry::{
 use cutroute_protocol::{
     CostUnit, Document, JobRequest, Problem, Progress, Solution, SolverKind, SolverParams,
 };
+use report::Report;
 use serde_json::{json, Value};
 
 mod gcode_input;
 mod inputs;
 mod kerf;
 mod output;
+mod report;
 mod stdio;
 mod thermal;
 mod warnings;
@@ -1426,7 +1428,7 @@ fn solve(
     as_json: bool,
     thermal: &thermal::Thermal,
     kerf: &kerf::Kerf,
-) -> Result<Value, Failure> {
+) -> Result<Report, Failure> {
     let solver = solver_kind(solver_name)?;
     // The limit counts reading the file: the solver gets what is left of it.
     let (document, read_s) = timed_open((input.0, input.1), input.2)?;
@@ -1461,7 +1463,7 @@ fn solve(
         None => solver.gives_path_route(),
     };
     let report = match &document.problem {
-        Problem::PcgtspText { text } => tour_report(solver_name, text, &finished.run)?,
+        Problem::PcgtspText { text } => Report::new(tour_report(solver_name, text, &finished.run)?),
         // Tool-on paths, or none from a path solver (its report says why).
         Problem::Nest { nest, .. } if path_report => {
             let report = PathReport {
@@ -1503,15 +1505,15 @@ fn solve(
                 thermal.report(&mut report, nest, route, &machine, objective)?;
                 kerf.report(&mut report, route, run.last.as_ref().map(|p| &p.phase));
             }
-            report
+            Report::new(report)
         }
     };
     let mut report = report;
-    if let Value::Object(fields) = &mut report {
+    if let Value::Object(fields) = &mut report.fields {
         // Apart from `elapsed_s` (the solver's run): how long opening the file took.
         fields.insert("read_s".into(), json!(read_s));
     }
-    warnings::add_to(&mut report, &document.warnings);
+    warnings::add_to(&mut report.fields, &document.warnings);
     Ok(report)
 }
 
@@ -1537,12 +1539,12 @@ fn limit_after_reading(limit_s: f64, read_s: f64) -> f64 {
 
 /// A solve report, to standard output or `out`: one JSON object, or its keys one per line
 /// without the route or tour.
-fn write_report(report: &Value, as_json: bool, out: Option<&Path>) -> Result<(), String> {
+fn write_report(report: &Report, as_json: bool, out: Option<&Path>) -> Result<(), String> {
     let mut text = String::new();
     if as_json {
-        text = format!("{report}\n");
+        text = report.to_json()? + "\n";
     } else {
-        for (key, value) in report.as_object().into_iter().flatten() {
+        for (key, value) in report.fields.as_object().into_iter().flatten() {
             if key != "route" && key != "tour" {
                 text.push_str(&format!("{key:>18}: {value}\n"));
             }
@@ -1680,7 +1682,7 @@ struct PathReport<'a> {
 }
 
 impl PathReport<'_> {
-    fn of(&self, nest: &Nest, finished: FinishedRun) -> Result<Value, Failure> {
+    fn of(&self, nest: &Nest, finished: FinishedRun) -> Result<Report, Failure> {
         let (solver, solver_name, machine, objective) =
             (self.solver, self.solver_name, self.machine, self.objective);
         // Why the run ended early (the limit, Ctrl-C), as in a route's report; stopped in a
@@ -1762,6 +1764,8 @@ impl PathReport<'_> {
         // Edge pierces (`--edge-pierce`) take the machine's edge-pierce time.
         let time_s = machine.time(cut_length, idle_length, 0)
             + machine.pierce_seconds(pierces, route.edge_pierce_count());
+        // The spans as text (see `report`): as values they took seconds on large routes.
+        let (route_value, spans) = Report::path_route(route).map_err(Failure::Message)?;
         let mut report = json!({
             "solver": solver_name,
             "idle_length": idle_length,
@@ -1772,7 +1776,7 @@ impl PathReport<'_> {
             "cost": machine.cost(cut_length, idle_length, pierces),
             "objective": objective.name(),
             "machine": machine_json(machine),
-            "route": serde_json::to_value(route).map_err(|e| Failure::Message(e.to_string()))?,
+            "route": route_value,
             "ub": ub,
             "lb": lb,
             // The idle bound holds for any route that cuts every contour, a repaired one too;
@@ -1791,7 +1795,7 @@ impl PathReport<'_> {
         self.thermal
             .report_paths(&mut report, nest, route, machine, objective)?;
         self.kerf.report_paths(&mut report, route);
-        Ok(report)
+        Ok(Report::with_spans(report, spans))
     }
 }
 
