@@ -402,6 +402,31 @@ impl Span {
         if self.is_line() {
             return bbox;
         }
+        let b = self.bulge;
+        if b.abs() >= 1e-4 && b.abs() <= 1e4 {
+            // The circle's extreme point in an axis direction lies on the arc when it is on
+            // the arc's side of the chord (the right for a counter-clockwise arc). No angle is
+            // needed; near β = 0 or ∞ the centre is far from the chord or near an end, and the
+            // angles below are the accurate way.
+            let d = self.chord();
+            let centre =
+                self.start.midpoint(self.end) + d.rotated_quarter() * ((1.0 - b * b) / (4.0 * b));
+            let radius = d.norm() * (1.0 + b * b) / (4.0 * b.abs());
+            if centre.is_finite() && radius.is_finite() {
+                for u in [
+                    Point::new(1.0, 0.0),
+                    Point::new(0.0, 1.0),
+                    Point::new(-1.0, 0.0),
+                    Point::new(0.0, -1.0),
+                ] {
+                    let extreme = centre + u * radius;
+                    if d.cross(extreme - self.start) * b < 0.0 {
+                        bbox = bbox.including(extreme);
+                    }
+                }
+                return bbox;
+            }
+        }
         let phi = self.sweep();
         let d = self.chord();
         if d.norm_squared() == 0.0 || !phi.is_finite() {
