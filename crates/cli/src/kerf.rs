@@ -16,6 +16,8 @@ use cutroute_geometry::{
 use cutroute_protocol::{JobRequest, KerfNote, KerfSource, Phase, Progress};
 use serde_json::{json, Value};
 
+use crate::report::{StepReport, TabGap};
+
 /// The full-route flags.
 #[derive(clap::Args, Clone, Debug)]
 pub struct KerfArgs {
@@ -229,7 +231,13 @@ impl Kerf {
     /// Adds the full-route fields to a nest report: `start`, `finish`, the settings, the lead
     /// lengths, and per step `pierce` (M), `entry`, `lead_in`, `lead_out`, `switch_off`.
     /// `phase` is the job's last phase: its kerf note counts the chain links the job broke.
-    pub fn report(&self, report: &mut Value, route: &Route, phase: Option<&Phase>) {
+    pub fn report(
+        &self,
+        report: &mut Value,
+        steps: &mut [StepReport],
+        route: &Route,
+        phase: Option<&Phase>,
+    ) {
         if !self.report_head(report, route.start, route.finish) {
             return;
         }
@@ -266,9 +274,6 @@ impl Kerf {
         }
         report["lead_in_length"] = json!(leads().map(StepLeads::lead_in_length).sum::<f64>());
         report["lead_out_length"] = json!(leads().map(StepLeads::lead_out_length).sum::<f64>());
-        let Some(steps) = report["route"].as_array_mut() else {
-            return;
-        };
         for (k, (step, cut)) in steps.iter_mut().zip(&route.steps).enumerate() {
             let Some(l) = &cut.leads else { continue };
             // In a chain, a step entered by a link is not pierced and one left by a link is
@@ -280,32 +285,29 @@ impl Kerf {
                     .map(|v| [v.point.x, v.point.y, v.bulge])
                     .collect::<Vec<_>>()
             };
-            step["contour_point"] = json!([cut.pierce_point.x, cut.pierce_point.y]);
-            if cut.is_pierced() {
-                step["pierce"] = json!([l.pierce.x, l.pierce.y]);
-            } else if let Some(fields) = step.as_object_mut() {
-                fields.remove("pierce");
-            }
-            step["entry"] = json!([l.entry.x, l.entry.y]);
-            if l.edge_pierce && cut.is_pierced() {
-                step["edge_pierce"] = json!(true);
-            }
-            if let Some(kerf_of) = l.kerf_pierce.filter(|_| cut.is_pierced()) {
-                // In the open kerf of this contour, cut before: [part, contour].
-                step["kerf_pierce"] = json!([kerf_of.part, kerf_of.contour]);
-            }
-            step["lead_in"] = json!(triples(&l.lead_in));
-            step["lead_out"] = json!(triples(&l.lead_out));
-            if !linked_out {
-                step["switch_off"] = json!([l.switch_off.x, l.switch_off.y]);
-            }
+            step.contour_point = Some([cut.pierce_point.x, cut.pierce_point.y]);
+            step.pierce = cut.is_pierced().then_some([l.pierce.x, l.pierce.y]);
+            step.entry = Some([l.entry.x, l.entry.y]);
+            step.edge_pierce = l.edge_pierce && cut.is_pierced();
+            // In the open kerf of this contour, cut before: [part, contour].
+            step.kerf_pierce = l
+                .kerf_pierce
+                .filter(|_| cut.is_pierced())
+                .map(|c| [c.part, c.contour]);
+            step.lead_in = Some(triples(&l.lead_in));
+            step.lead_out = Some(triples(&l.lead_out));
+            step.switch_off = (!linked_out).then_some([l.switch_off.x, l.switch_off.y]);
             if !l.tabs.is_empty() {
                 // Each gap: where the torch stops and where it pierces again.
-                step["tabs"] = json!(l
-                    .tabs
-                    .iter()
-                    .map(|t| json!({ "from": [t.from.x, t.from.y], "to": [t.to.x, t.to.y] }))
-                    .collect::<Vec<_>>());
+                step.tabs = Some(
+                    l.tabs
+                        .iter()
+                        .map(|t| TabGap {
+                            from: [t.from.x, t.from.y],
+                            to: [t.to.x, t.to.y],
+                        })
+                        .collect(),
+                );
             }
         }
     }

@@ -55,7 +55,7 @@ use cutroute_geometry::{
 use cutroute_protocol::{
     CostUnit, Document, JobRequest, Problem, Progress, Solution, SolverKind, SolverParams,
 };
-use report::Report;
+use report::{Report, StepReport};
 use serde_json::{json, Value};
 
 mod gcode_input;
@@ -510,6 +510,14 @@ struct Watch {
     seen: std::sync::Mutex<JobRun>,
 }
 
+impl Watch {
+    /// Whether a route has been published (the solver's or the first route).
+    fn has_route(&self) -> bool {
+        let seen = self.seen.lock().unwrap_or_else(|e| e.into_inner());
+        seen.first_route.is_some() || seen.last.as_ref().is_some_and(|p| p.solution.is_some())
+    }
+}
+
 /// Steps a job until it ends or the watch says stop, publishing each slice's state and, now
 /// and then, an improving route (only checked if the final route fails, see
 /// [`checked_route`]).
@@ -591,12 +599,13 @@ fn run_job(job: &mut dyn Job, watch: &Watch, on_progress: &mut dyn FnMut(&Progre
 
 /// Runs `work` (which builds and steps a solver, see [`run_job`]) on its own thread, so the
 /// CLI keeps its promises whatever the solver does: at `time_limit_s` after the start, or at
-/// the first Ctrl-C, the watch asks the solver to stop; if it has not returned [`GRACE`]
-/// later, the latest state it published is taken (and the thread ends with the process).
+/// the first Ctrl-C, the watch asks the solver to stop; if it has not returned `grace` later
+/// (at least `route_wait` while it has published no route), the latest state it published is
+/// taken (and the thread ends with the process).
 /// Build phases (matrices, lattices, discretisations) count against the limit.
 fn run_bounded<T: Send + 'static>(
     time_limit_s: f64,
-    grace: std::time::Duration,
+    (grace, route_wait): (std::time::Duration, std::time::Duration),
     work: impl FnOnce(&Watch) -> Result<T, Failure> + Send + 'static,
 ) -> Result<Result<T, JobRun>, Failure> {
     use std::sync::atomic::Ordering;
@@ -633,6 +642,11 @@ fn run_bounded<T: Send + 'static>(
             grace
         } else {
             grace.max(CTRL_C_GRACE)
+        };
+        let waited = if stop_at.is_some() && !watch.has_route() {
+            waited.max(route_wait)
+        } else {
+            waited
         };
         if stop_at.is_some_and(|at| at.elapsed() >= waited) {
             let mut seen = watch.seen.lock().unwrap_or_else(|e| e.into_inner());
@@ -766,31 +780,39 @@ struct FinishedRun {
     extras: serde_json::Map<String, Value>,
 }
 
-/// The time kept from a job's limit for the report that follows it: about 10 µs per contour
-/// (on 100,000 generated contours the report of a CCP route took 1.0–1.3 s after the job), at
-/// most a quarter of the limit; a path solver's report checks and prints every span of its
-/// route, so it keeps 5 µs more a span, at most half the limit in all; none on a PCGTSP
-/// instance or an unlimited run.
-fn report_reserve_s(problem: &Problem, solver: SolverKind, time_limit_s: f64) -> f64 {
-    const PER_CONTOUR_S: f64 = 10e-6;
+/// How long the report after a job is expected to take: about 4 µs per contour (twice what
+/// the check, heat and JSON of a contour route take on a quiet machine, for load); a path
+/// solver's report checks and prints every span of its route, so 5 µs more a span; none on a
+/// PCGTSP instance.
+fn report_estimate_s(problem: &Problem, solver: SolverKind) -> f64 {
+    const PER_CONTOUR_S: f64 = 4e-6;
     const PER_SPAN_S: f64 = 5e-6;
-    match problem {
-        Problem::Nest { nest, .. } if time_limit_s.is_finite() => {
-            let contours = (nest.contour_count() as f64 * PER_CONTOUR_S).min(time_limit_s / 4.0);
-            if solver.gives_path_route() {
-                let spans: usize = nest
-                    .parts
-                    .iter()
-                    .flat_map(|part| &part.contours)
-                    .map(|contour| contour.span_count())
-                    .sum();
-                (contours + spans as f64 * PER_SPAN_S).min(time_limit_s / 2.0)
-            } else {
-                contours
-            }
-        }
-        _ => 0.0,
+    let Problem::Nest { nest, .. } = problem else {
+        return 0.0;
+    };
+    let contours = nest.contour_count() as f64 * PER_CONTOUR_S;
+    if solver.gives_path_route() {
+        let spans: usize = nest
+            .parts
+            .iter()
+            .flat_map(|part| &part.contours)
+            .map(|contour| contour.span_count())
+            .sum();
+        contours + spans as f64 * PER_SPAN_S
+    } else {
+        contours
     }
+}
+
+/// The time kept from a job's limit for the report that follows it: its estimate, at most a
+/// quarter of the limit (half for a path solver, whose report is mostly its spans); none on
+/// an unlimited run.
+fn report_reserve_s(problem: &Problem, solver: SolverKind, time_limit_s: f64) -> f64 {
+    if !time_limit_s.is_finite() {
+        return 0.0;
+    }
+    let share = if solver.gives_path_route() { 2.0 } else { 4.0 };
+    report_estimate_s(problem, solver).min(time_limit_s / share)
 }
 
 /// The run of the request's job on the solver's thread, bounded by [`run_bounded`].
@@ -798,8 +820,14 @@ fn bounded_job_run(mut request: JobRequest, as_json: bool) -> Result<FinishedRun
     let time_limit_s = request.params.time_limit_s;
     // The report after the job (the route checked again, its heat and JSON) is part of the
     // promise: the job ends that much earlier.
-    request.params.time_limit_s =
-        time_limit_s - report_reserve_s(&request.problem, request.solver, time_limit_s);
+    let reserve_s = report_reserve_s(&request.problem, request.solver, time_limit_s);
+    request.params.time_limit_s = time_limit_s - reserve_s;
+    // A run with no route at its limit (a first route still being made on a huge nest) waits
+    // for one while the report would still end within the promise: exiting without a route
+    // keeps the promise and gives the user nothing.
+    let route_wait = std::time::Duration::from_secs_f64(
+        (1.0 + reserve_s - report_estimate_s(&request.problem, request.solver)).max(0.0),
+    );
     // A kerf job keeps its leads' time inside the limit where it can (it stops its solvers
     // when the final route's leads would not be ready by then) and ends by itself at most
     // `OVERRUN_LIMIT` past it: a route whose leads are still being fitted is waited for that
@@ -814,7 +842,7 @@ fn bounded_job_run(mut request: JobRequest, as_json: bool) -> Result<FinishedRun
     let job_limit_s = request.params.time_limit_s;
     let solver = request.solver;
     let run_started = std::time::Instant::now();
-    let outcome = run_bounded(job_limit_s, grace, move |watch| {
+    let outcome = run_bounded(job_limit_s, (grace, route_wait), move |watch| {
         let first = first_route(&request);
         watch
             .seen
@@ -1500,12 +1528,17 @@ fn solve(
                     }));
                 }
             }
-            let mut report = route_report(solver_name, nest, &machine, run, &forest)?;
+            let (mut report, mut steps) = route_report(solver_name, nest, &machine, run, &forest)?;
             if let Some(route) = run.last.as_ref().and_then(Progress::route) {
-                thermal.report(&mut report, nest, route, &machine, objective)?;
-                kerf.report(&mut report, route, run.last.as_ref().map(|p| &p.phase));
+                thermal.report(&mut report, &mut steps, nest, route, &machine, objective)?;
+                kerf.report(
+                    &mut report,
+                    &mut steps,
+                    route,
+                    run.last.as_ref().map(|p| &p.phase),
+                );
             }
-            Report::new(report)
+            Report::with_steps(report, &steps)?
         }
     };
     let mut report = report;
@@ -1604,7 +1637,7 @@ fn route_report(
     machine: &MachineParameters,
     run: &JobRun,
     forest: &ContainmentForest,
-) -> Result<Value, String> {
+) -> Result<(Value, Vec<StepReport>), String> {
     let (route, final_route_rejected) = checked_route(run, nest, forest)?;
     let result = run.last.as_ref().ok_or("the solver found no route")?;
     let route = &route;
@@ -1618,7 +1651,7 @@ fn route_report(
             pierces,
             route.edge_pierce_count() + route.kerf_pierce_count(),
         );
-    Ok(json!({
+    let fields = json!({
         "solver": solver,
         "idle_length": idle_length,
         "cut_length": cut_length,
@@ -1627,16 +1660,8 @@ fn route_report(
         "time_s": time_s,
         "cost": machine.cost(cut_length, idle_length, pierces),
         "machine": machine_json(machine),
-        "route": route.steps.iter().map(|s| {
-            let mut step = json!({
-                "contour": [s.contour.part, s.contour.contour],
-                "pierce": [s.pierce_point.x, s.pierce_point.y],
-            });
-            if let Entry::Link(corners) = &s.entry {
-                step["link"] = json!(corners.iter().map(|c| [c.x, c.y]).collect::<Vec<_>>());
-            }
-            step
-        }).collect::<Vec<_>>(),
+        // The steps, written apart (`Report::with_steps`).
+        "route": null,
         "certified_contours": result.certified.iter().filter(|c| **c).count(),
         // In the job's unit: idle mm, or (chain) the route's cost.
         "ub": if final_route_rejected.is_some() {
@@ -1661,7 +1686,21 @@ fn route_report(
             .find(|a| a.name == cutroute_engine::REJECTED_ROUTE)
             .and_then(|a| a.failure.clone())),
         "stopped": run.stopped,
-    }))
+    });
+    let steps = route
+        .steps
+        .iter()
+        .map(|s| StepReport {
+            contour: [s.contour.part, s.contour.contour],
+            pierce: Some([s.pierce_point.x, s.pierce_point.y]),
+            link: match &s.entry {
+                Entry::Link(corners) => Some(corners.iter().map(|c| [c.x, c.y]).collect()),
+                _ => None,
+            },
+            ..StepReport::default()
+        })
+        .collect();
+    Ok((fields, steps))
 }
 
 /// The report of a path route (sccp, gsccp, aoe: the engine's path-route jobs, the app's code
@@ -1813,7 +1852,7 @@ mod tests {
     use super::*;
     use cutroute_geometry::{Contour, ContourRef, CutStep, Part, Point, Vertex};
 
-    /// The report's share of the limit grows with the nest (10 µs a contour), never past a
+    /// The report's share of the limit grows with the nest (its estimate), never past a
     /// quarter of the limit, and is nothing for instances and unlimited runs.
     #[test]
     fn the_report_reserve_follows_the_nest_size() {
@@ -1828,18 +1867,64 @@ mod tests {
             _ => unreachable!(),
         };
         let ccp = SolverKind::Ccp;
-        assert!((report_reserve_s(&big, ccp, 5.0) - contours as f64 * 10e-6).abs() < 1e-12);
-        assert_eq!(report_reserve_s(&big, ccp, 0.4), 0.1);
+        let estimate = report_estimate_s(&big, ccp);
+        assert!(estimate > 0.0 && estimate > 0.5 * report_estimate_s(&nest(10_000), ccp));
+        assert!((report_reserve_s(&big, ccp, 5.0) - estimate).abs() < 1e-12);
+        assert!(contours > 0);
+        let tight = 2.0 * estimate;
+        assert_eq!(report_reserve_s(&big, ccp, tight), tight / 4.0);
         assert_eq!(report_reserve_s(&big, ccp, f64::INFINITY), 0.0);
         assert!(report_reserve_s(&nest(50), ccp, 5.0) < 1e-3);
         // A path solver keeps more for its spans, never past half the limit.
         let sccp = SolverKind::Sccp;
         assert!(report_reserve_s(&big, sccp, 5.0) > report_reserve_s(&big, ccp, 5.0));
-        assert_eq!(report_reserve_s(&big, sccp, 0.4), 0.2);
+        assert_eq!(report_reserve_s(&big, sccp, tight), tight / 2.0);
         let instance = Problem::PcgtspText {
             text: String::new(),
         };
         assert_eq!(report_reserve_s(&instance, SolverKind::Sccp, 5.0), 0.0);
+    }
+
+    /// A solver with no route at its limit is waited for while its first route may still
+    /// come within the promise (`route_wait`), and no longer.
+    #[test]
+    fn a_run_without_a_route_waits_for_its_first() {
+        use std::time::Duration;
+        let late_first_route = |watch: &Watch| -> Result<(), Failure> {
+            std::thread::sleep(Duration::from_millis(150));
+            watch.seen.lock().unwrap().first_route = Some(Progress::default());
+            std::thread::sleep(Duration::from_secs(5));
+            Ok(())
+        };
+        let started = std::time::Instant::now();
+        let waited = run_bounded(
+            0.01,
+            (Duration::from_millis(20), Duration::from_secs(2)),
+            late_first_route,
+        );
+        let Ok(Err(run)) = waited else {
+            panic!("the run was not cut at its limit")
+        };
+        assert!(
+            run.first_route.is_some(),
+            "the first route was not waited for"
+        );
+        assert!(
+            started.elapsed() < Duration::from_secs(2),
+            "waited on after the route came"
+        );
+        let cut = run_bounded(
+            0.01,
+            (Duration::from_millis(20), Duration::ZERO),
+            late_first_route,
+        );
+        let Ok(Err(run)) = cut else {
+            panic!("the run was not cut at its limit")
+        };
+        assert!(
+            run.first_route.is_none(),
+            "waited past the grace without a route wait"
+        );
     }
 
     fn square(x: f64) -> Contour {

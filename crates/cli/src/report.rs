@@ -1,12 +1,14 @@
-//! A `solve` report as it is written: its fields as a JSON value, and a path route's spans as
-//! JSON text of their own.
+//! A `solve` report as it is written: its fields as a JSON value, and what there can be
+//! hundreds of thousands of — a path route's spans, a contour route's steps — as JSON text of
+//! their own.
 //!
 //! The fields are edited after they are made (warnings, heat, leads per path), so they are a
-//! [`Value`]. The spans are not edited, and there can be hundreds of thousands of them: as
-//! values (three maps a span) the report of a 200,000-span route took seconds to make, write
-//! and free, as text it takes milliseconds. They are put back in their place, each path's
-//! `spans`, when the report is written; the output is the same JSON (inside a span, the keys
-//! come in the span's field order, not sorted).
+//! [`Value`]. As values (a map or three each) the spans of a 200,000-span route, or the steps
+//! of a 160,000-contour route, took seconds to make, write and free; as text, milliseconds.
+//! The steps are made as [`StepReport`]s, which the thermal and kerf reports fill in, and
+//! written once. Both are put back in their place (each path's `spans`, the `route`) when
+//! the report is written; the output is the same JSON (inside a span, the keys come in the
+//! span's field order, not sorted).
 
 use serde::ser::{Serialize, SerializeMap, SerializeSeq, Serializer};
 use serde_json::value::RawValue;
@@ -16,10 +18,62 @@ use cutroute_geometry::PathRoute;
 
 /// A report ready to write.
 pub struct Report {
-    /// Every field; a path route's `route.paths[i]` without its `spans`.
+    /// Every field; a path route's `route.paths[i]` without its `spans`, a contour route's
+    /// `route` a placeholder for its steps.
     pub fields: Value,
-    /// Path `i`'s spans (empty: the fields are the whole report).
+    /// Path `i`'s spans (empty: no path route, or its paths are in the fields).
     spans: Vec<Box<RawValue>>,
+    /// A contour route's steps, written as `route`.
+    steps: Option<Box<RawValue>>,
+}
+
+/// One step of a contour route's report: the contour cut, where it is pierced, the link into
+/// it (chains); with the thermal report its pierce time `t`, with kerf its leads. The fields
+/// are in the JSON's key order (sorted, as a value's map writes them); an absent one is not
+/// written.
+#[derive(serde::Serialize, Debug, Default)]
+pub struct StepReport {
+    /// [part, contour].
+    pub contour: [usize; 2],
+    /// Kerf: where the lead-in meets the contour.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub contour_point: Option<[f64; 2]>,
+    /// Kerf: pierced at the sheet's border.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub edge_pierce: bool,
+    /// Kerf: where the lead-in starts the cut.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub entry: Option<[f64; 2]>,
+    /// Kerf: pierced in the open kerf of this [part, contour], cut before.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub kerf_pierce: Option<[usize; 2]>,
+    /// Kerf: the leads as [x, y, bulge] vertices.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lead_in: Option<Vec<[f64; 3]>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lead_out: Option<Vec<[f64; 3]>>,
+    /// A chain's link into the contour: its corners.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub link: Option<Vec<[f64; 2]>>,
+    /// The pierce point (absent for a step a chain's link enters).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pierce: Option<[f64; 2]>,
+    /// Kerf: where the torch is switched off.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub switch_off: Option<[f64; 2]>,
+    /// The pierce's time on the machine's clock (s).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub t: Option<f64>,
+    /// Kerf: each tab's gap, where the torch stops and where it pierces again.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tabs: Option<Vec<TabGap>>,
+}
+
+/// A tab's gap in a step's report.
+#[derive(serde::Serialize, Debug)]
+pub struct TabGap {
+    pub from: [f64; 2],
+    pub to: [f64; 2],
 }
 
 impl Report {
@@ -28,7 +82,19 @@ impl Report {
         Report {
             fields,
             spans: Vec::new(),
+            steps: None,
         }
+    }
+
+    /// A report of `fields` whose `route` is `steps`.
+    pub fn with_steps(mut fields: Value, steps: &[StepReport]) -> Result<Report, String> {
+        fields["route"] = Value::Null;
+        let steps = serde_json::value::to_raw_value(steps).map_err(|e| e.to_string())?;
+        Ok(Report {
+            fields,
+            spans: Vec::new(),
+            steps: Some(steps),
+        })
     }
 
     /// The JSON value of `route` without its paths' spans, and each path's spans as text: the
@@ -54,7 +120,11 @@ impl Report {
 
     /// A report of `fields` whose `route.paths` lack the `spans` given here.
     pub fn with_spans(fields: Value, spans: Vec<Box<RawValue>>) -> Report {
-        Report { fields, spans }
+        Report {
+            fields,
+            spans,
+            steps: None,
+        }
     }
 
     /// The report as one line of JSON.
@@ -68,15 +138,17 @@ impl Serialize for Report {
         let Value::Object(fields) = &self.fields else {
             return self.fields.serialize(serializer);
         };
-        if self.spans.is_empty() {
+        if self.spans.is_empty() && self.steps.is_none() {
             return self.fields.serialize(serializer);
         }
         let mut map = serializer.serialize_map(Some(fields.len()))?;
         for (key, value) in fields {
-            if key == "route" {
-                map.serialize_entry(key, &RouteWithSpans(value, &self.spans))?;
-            } else {
-                map.serialize_entry(key, value)?;
+            match &self.steps {
+                Some(steps) if key == "route" => map.serialize_entry(key, steps)?,
+                _ if key == "route" => {
+                    map.serialize_entry(key, &RouteWithSpans(value, &self.spans))?
+                }
+                _ => map.serialize_entry(key, value)?,
             }
         }
         map.end()

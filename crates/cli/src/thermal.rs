@@ -8,6 +8,8 @@ use cutroute_protocol::{SolverKind, ThermalSettings};
 use cutroute_thermal::{check_rules, route_pierces, HeatModel, RuleParams, RuleSet, ThermalError};
 use serde_json::{json, Value};
 
+use crate::report::StepReport;
+
 /// The thermal flags of `solve`.
 #[derive(clap::Args, Clone, Debug)]
 pub struct ThermalArgs {
@@ -183,10 +185,11 @@ impl Thermal {
         Ok(())
     }
 
-    /// Adds `heat`, `thermal`, `rule_violations` and each step's `t` to a route report.
+    /// Adds `heat`, `thermal` and `rule_violations` to a route report, and each step's `t`.
     pub fn report(
         &self,
         report: &mut Value,
+        steps: &mut [StepReport],
         nest: &Nest,
         route: &Route,
         machine: &MachineParameters,
@@ -211,10 +214,8 @@ impl Thermal {
             "sheet": counts.sheet,
             "islands": counts.islands,
         });
-        if let Some(steps) = report["route"].as_array_mut() {
-            for (step, pierce) in steps.iter_mut().zip(&pierces) {
-                step["t"] = json!(pierce.time);
-            }
+        for (step, pierce) in steps.iter_mut().zip(&pierces) {
+            step.t = Some(pierce.time);
         }
         Ok(())
     }
