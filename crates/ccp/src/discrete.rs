@@ -142,7 +142,7 @@ impl PcgtspBuilder {
             };
             return Err(CcpError::InvalidOption(format!(
                 "{what} more than the {MAX_DISCRETE_NODES} candidate points of a dense cost \
-                 matrix at any step"
+                 matrix at any step (the ccp, chain, nearest and path solvers route any size)"
             )));
         }
         if bound.is_nan() || bound > MAX_DISCRETE_NODES as f64 {
