@@ -115,13 +115,9 @@ impl RTreeObject for BoxEntry {
 
 fn summarize(contour: &Contour) -> ContourSummary {
     let bbox = contour.bounding_box();
-    let area = contour.area();
-    // Probe with the middle of the first span rather than a vertex: vertices of neighbouring
-    // parts are more often placed exactly on each other's edges.
-    let probe = contour
-        .span(0)
-        .map(|s| s.point_at(0.5))
-        .filter(|p| p.is_finite());
+    let signed_area = contour.signed_area();
+    let area = signed_area.abs();
+    let probe = interior_probe(contour, signed_area).filter(|p| p.is_finite());
     let usable = probe.is_some()
         && area.is_finite()
         && !bbox.is_empty()
@@ -132,6 +128,41 @@ fn summarize(contour: &Contour) -> ContourSummary {
         area: if usable { area } else { f64::NAN },
         probe: if usable { probe } else { None },
     }
+}
+
+/// The point that stands for `contour` in point-in-contour tests: just inside it, off the
+/// middle of its longest span, so it lies on no other contour of a nest whose contours do not
+/// cross. A span's own middle is not enough: a part fitted into another's notch, or placed in
+/// a hole, shares spans with it, and a point on a shared span reads as inside either way.
+/// The offset shrinks until the point is inside (a thin contour); a contour with no inside
+/// (zero area) gets its first span's middle. `signed_area` is the contour's.
+fn interior_probe(contour: &Contour, signed_area: f64) -> Option<Point> {
+    let middle = || contour.span(0).map(|s| s.point_at(0.5));
+    // The longest chord: no trigonometry, and an arc's tangent at its middle is its chord's
+    // direction.
+    let longest = contour.spans().max_by(|a, b| {
+        a.chord()
+            .norm_squared()
+            .total_cmp(&b.chord().norm_squared())
+    })?;
+    let length = longest.chord().norm();
+    if !(signed_area != 0.0 && length > 0.0 && length.is_finite()) {
+        return middle();
+    }
+    let tangent = longest.chord() * (1.0 / length);
+    // The inside is to the left of a counter-clockwise contour's direction of travel.
+    let side = signed_area.signum();
+    let inward = Point::new(-tangent.y, tangent.x) * side;
+    let on = longest.point_at(0.5);
+    let mut offset = 1e-3 * length;
+    for _ in 0..6 {
+        let probe = on + inward * offset;
+        if contour.contains(probe) {
+            return Some(probe);
+        }
+        offset *= 0.25;
+    }
+    middle()
 }
 
 /// Does contour `outer` contain contour `inner`? Strictly larger area (which keeps the

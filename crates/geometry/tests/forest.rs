@@ -254,3 +254,97 @@ fn a_part_touching_the_hole_it_sits_in_is_inside_it_within_the_tolerance() {
         assert_eq!(forest.parent(r(1, 0)), Some(r(0, 0)));
     }
 }
+
+/// A part fitted into another part's notch shares three sides with it (its first span among
+/// them), and its fourth closes the notch: it lies beside the other part, not inside it,
+/// in every forest. The same part fitted into a hole of that shape, sharing the same three
+/// sides, lies inside the hole.
+#[test]
+fn a_part_sharing_its_first_spans_with_a_neighbour_is_inside_it_only_when_it_is() {
+    // A U open at the top: its notch is x 10..20, y 10..30.
+    let u = Contour::new(
+        [
+            (0.0, 0.0),
+            (30.0, 0.0),
+            (30.0, 30.0),
+            (20.0, 30.0),
+            (20.0, 10.0),
+            (10.0, 10.0),
+            (10.0, 30.0),
+            (0.0, 30.0),
+        ]
+        .map(|(x, y)| Vertex::line(x, y))
+        .to_vec(),
+    );
+    // The notch's filler, starting on the notch's bottom edge, its longest spans on the
+    // notch's sides, an arc closing it at the top.
+    let filler = |bulge: f64, first: usize| {
+        let mut vertices = vec![
+            Vertex::line(10.0, 10.0),
+            Vertex::line(20.0, 10.0),
+            Vertex::arc(20.0, 30.0, bulge),
+            Vertex::line(10.0, 30.0),
+        ];
+        vertices.rotate_left(first);
+        Contour::new(vertices)
+    };
+    // A plate with a hole the filler fits in, its sides along the hole's, y 10..40.
+    let hole = Contour::new(
+        [(10.0, 10.0), (20.0, 10.0), (20.0, 40.0), (10.0, 40.0)]
+            .map(|(x, y)| Vertex::line(x, y))
+            .to_vec(),
+    );
+    let plate = Part {
+        name: "plate".into(),
+        contours: vec![square(-100.0, -100.0, 300.0, true), hole],
+    };
+    for (bulge, first, reversed) in (0..4)
+        .flat_map(|first| [(0.0, first), (0.5, first), (-0.5, first)])
+        .flat_map(|(bulge, first)| [(bulge, first, false), (bulge, first, true)])
+    {
+        let filler = |bulge: f64| match reversed {
+            false => filler(bulge, first),
+            true => filler(bulge, first).reversed(),
+        };
+        let case = format!("bulge {bulge}, first vertex {first}, reversed {reversed}");
+        let nest = Nest {
+            parts: vec![
+                Part {
+                    name: "u".into(),
+                    contours: vec![u.clone()],
+                },
+                Part {
+                    name: "filler".into(),
+                    contours: vec![filler(bulge)],
+                },
+            ],
+            ..Nest::default()
+        };
+        let tolerance = nest.check_tolerance();
+        for forest in [
+            ContainmentForest::new(&nest),
+            ContainmentForest::brute_force(&nest),
+            ContainmentForest::with_tolerance(&nest, tolerance),
+            ContainmentForest::brute_force_with_tolerance(&nest, tolerance),
+        ] {
+            assert_eq!(forest.parent(r(1, 0)), None, "{case}");
+            assert_eq!(forest.parent(r(0, 0)), None, "{case}");
+        }
+        let nest = Nest {
+            parts: vec![
+                plate.clone(),
+                Part {
+                    name: "filler".into(),
+                    contours: vec![filler(bulge)],
+                },
+            ],
+            ..Nest::default()
+        };
+        for forest in [
+            ContainmentForest::new(&nest),
+            ContainmentForest::brute_force(&nest),
+        ] {
+            assert_eq!(forest.parent(r(1, 0)), Some(r(0, 1)), "{case}");
+        }
+    }
+}
