@@ -720,6 +720,9 @@ impl SolverJob {
                     );
                     extra.insert("components".into(), json!(solution.components));
                 }
+                // AOE failed and the job answers with a checked contour route: the report's
+                // `fallback` says why (from the job's rejected-route alternative).
+                Some(Err(_)) if job.fallback_route().is_some() => {}
                 Some(Err(e)) => {
                     return Err(Failure::Aoe {
                         solver: solver.name(),

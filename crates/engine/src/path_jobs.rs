@@ -10,7 +10,9 @@ use cutroute_aoe::{
 };
 use cutroute_ccp::CcpLowerBound;
 use cutroute_geometry::float::Libm;
-use cutroute_geometry::{BoundingBox, MachineParameters, Nest, Objective, PathRoute, Point, Span};
+use cutroute_geometry::{
+    BoundingBox, MachineParameters, Nest, Objective, PathRoute, Point, Route, Span,
+};
 use cutroute_protocol::{
     Bounds, Ensemble, JobId, JobRequest, Phase, Problem, Progress, RouteSummary, Solution,
     SolverKind,
@@ -24,7 +26,7 @@ use std::collections::HashMap;
 use web_time::{Duration, Instant};
 
 use crate::jobs::continuous_lower_bound;
-use crate::{EngineError, Job, JobStatus};
+use crate::{EngineError, Job, JobStatus, NearestNeighbourJob};
 
 /// Why a [`PlanBound`] could not be measured: the nest gives no plane graph.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -737,7 +739,52 @@ pub struct AoeJob {
     objective: Objective,
     solving: AoeSolving,
     outcome: Option<Result<(AoeSolution, Option<PlanBound>), AoeSolveError>>,
+    /// When AOE made no checked route: the contour route it answers with instead.
+    fallback: Option<ContourFallback>,
+    /// The job's limit, or when it was stopped.
+    deadline: Option<Instant>,
     started: Instant,
+}
+
+/// The answer of an AOE job whose own route failed (a nest its plan graph cannot take, or a
+/// route a checker rejected): the nearest solver's contour route, stepped like any job and
+/// taken once it passes the route checker. Every pierce then cuts one whole contour, and no
+/// common edge is shared.
+struct ContourFallback {
+    job: NearestNeighbourJob,
+    checked: Option<Route>,
+    done: bool,
+}
+
+impl ContourFallback {
+    fn new(nest: &Nest, (start, finish): (Point, Option<Point>)) -> Option<Self> {
+        Some(ContourFallback {
+            job: NearestNeighbourJob::new(0, nest.clone(), start, finish).ok()?,
+            checked: None,
+            done: false,
+        })
+    }
+
+    /// One slice of the contour route; at `deadline` its route so far is taken (the first
+    /// step makes one), checked against `nest`.
+    fn step(&mut self, budget: Duration, deadline: Option<Instant>, nest: &Nest) -> JobStatus {
+        if self.done {
+            return JobStatus::Done;
+        }
+        let finished = self.job.step(budget) == JobStatus::Done;
+        let over = deadline.is_some_and(|end| Instant::now() >= end);
+        let progress = self.job.progress();
+        let Some(route) = progress.route().filter(|_| finished || over) else {
+            return JobStatus::Running;
+        };
+        let forest = nest.containment_forest();
+        self.checked = route
+            .problems(nest, &forest, nest.check_tolerance())
+            .is_empty()
+            .then(|| route.clone());
+        self.done = true;
+        JobStatus::Done
+    }
 }
 
 impl AoeJob {
@@ -765,9 +812,10 @@ impl AoeJob {
         };
         let mut solving = AoeSolving::new(nest, &options);
         // The job's wall-clock end: the ordering stops there with its best so far.
-        if let Some(end) = Instant::now().checked_add(Duration::from_secs_f64(
+        let deadline = Instant::now().checked_add(Duration::from_secs_f64(
             request.params.time_limit_s.clamp(0.0, 1.0e7),
-        )) {
+        ));
+        if let Some(end) = deadline {
             solving.stop_at(end);
         }
         Ok(AoeJob {
@@ -779,6 +827,8 @@ impl AoeJob {
             objective: request.params.objective,
             solving,
             outcome: None,
+            fallback: None,
+            deadline,
             started: Instant::now(),
         })
     }
@@ -787,6 +837,21 @@ impl AoeJob {
     pub fn outcome(&self) -> Option<&Result<(AoeSolution, Option<PlanBound>), AoeSolveError>> {
         self.outcome.as_ref()
     }
+
+    /// The checked contour route the job answers with, when AOE's own route failed.
+    pub fn fallback_route(&self) -> Option<&Route> {
+        self.fallback.as_ref()?.checked.as_ref()
+    }
+
+    /// What the job does once AOE has failed with `error`: it makes the contour route.
+    fn failed(&mut self, error: AoeSolveError) -> JobStatus {
+        self.outcome = Some(Err(error));
+        self.fallback = ContourFallback::new(&self.nest, self.finish_bound);
+        match self.fallback {
+            Some(_) => JobStatus::Running,
+            None => JobStatus::Done,
+        }
+    }
 }
 
 impl Job for AoeJob {
@@ -794,9 +859,13 @@ impl Job for AoeJob {
         // As the limit reached now: the ordering ends with its best so far, and the next steps
         // check its route (the build, if under way, still runs to its end).
         self.solving.stop_at(Instant::now());
+        self.deadline = Some(Instant::now());
     }
 
     fn step(&mut self, budget: Duration) -> JobStatus {
+        if let Some(fallback) = self.fallback.as_mut() {
+            return fallback.step(budget, self.deadline, &self.nest);
+        }
         if self.outcome.is_some() {
             return JobStatus::Done;
         }
@@ -816,13 +885,16 @@ impl Job for AoeJob {
                 JobStatus::Done
             }
             Some(Err(e)) => {
-                self.outcome = Some(Err(e.clone()));
-                JobStatus::Done
+                let e = e.clone();
+                self.failed(e)
             }
         }
     }
 
     fn progress(&self) -> Progress {
+        if let (Some(Err(error)), Some(route)) = (&self.outcome, self.fallback_route()) {
+            return self.answer_with_contours(error, route);
+        }
         let solved = match &self.outcome {
             Some(Ok(solved)) => Some(solved),
             _ => None,
@@ -904,6 +976,61 @@ impl Job for AoeJob {
     }
 }
 
+impl AoeJob {
+    /// The progress of a job answering with the contour `route` because AOE failed with
+    /// `error`: the failure stated as the alternative [`crate::REJECTED_ROUTE`], no lower
+    /// bound (the plan bound belongs to AOE's plan graph, which the job no longer has).
+    fn answer_with_contours(&self, error: &AoeSolveError, route: &Route) -> Progress {
+        let (cut, idle, pierces) = (
+            route.cut_length(&self.nest),
+            route.idle_length(),
+            route.pierce_count(),
+        );
+        let rejected = RouteSummary {
+            name: crate::REJECTED_ROUTE.to_string(),
+            pierces: 0,
+            idle_length: 0.0,
+            cut_length: 0.0,
+            time_s: 0.0,
+            cost: 0.0,
+            chosen: false,
+            failure: Some(format!(
+                "the AOE route failed ({error}); the contour route is reported instead"
+            )),
+            idle_lower_bound: None,
+        };
+        let contours = RouteSummary {
+            name: "contour route".to_string(),
+            pierces,
+            idle_length: idle,
+            cut_length: cut,
+            time_s: self.machine.time(cut, idle, pierces),
+            cost: self.machine.cost(cut, idle, pierces),
+            chosen: true,
+            failure: None,
+            idle_lower_bound: None,
+        };
+        Progress {
+            job_id: self.job_id,
+            elapsed_s: self.started.elapsed().as_secs_f64(),
+            bounds: Bounds {
+                upper: Some(self.objective.value(&self.machine, cut, idle, pierces)),
+                lower: None,
+                unit: self.objective.unit(),
+            },
+            phase: Phase::CommonEdgeFailed {
+                error: error.to_string(),
+            },
+            solution: Some(Solution::Route(route.clone())),
+            proven_optimal: false,
+            states: None,
+            certified: Vec::new(),
+            alternatives: vec![rejected, contours],
+            ..Progress::default()
+        }
+    }
+}
+
 /// Segment cutting's stage in the protocol's words.
 fn segments_phase(search: &GsccpSearch) -> Phase {
     let ensemble = |kind: EnsembleKind| match kind {
@@ -932,5 +1059,79 @@ fn segments_phase(search: &GsccpSearch) -> Phase {
             best: best.map(ensemble),
         },
         GsccpStage::NoValidRoute => Phase::SegmentsNoRoute,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use cutroute_geometry::{Contour, Part};
+    use cutroute_protocol::SolverParams;
+
+    /// When AOE fails (here: its route rejected by a checker, as a bug would have it), the
+    /// job answers with the nearest solver's contour route, checked, and states the failure.
+    #[test]
+    fn a_failed_aoe_route_gives_way_to_a_checked_contour_route() {
+        let part = |name: &str, x: f64| Part {
+            name: name.to_string(),
+            contours: vec![
+                Contour::rectangle(x, 0.0, x + 40.0, 40.0),
+                Contour::rectangle(x + 10.0, 10.0, x + 20.0, 20.0),
+            ],
+        };
+        let nest = Nest {
+            sheet: None,
+            parts: vec![part("a", 0.0), part("b", 60.0)],
+        };
+        let request = JobRequest {
+            job_id: 7,
+            problem: Problem::Nest {
+                nest: nest.clone(),
+                start: Point::new(0.0, 0.0),
+                finish: None,
+            },
+            solver: SolverKind::Aoe,
+            params: SolverParams::default(),
+        };
+        let mut job = AoeJob::from_request(&request).expect("aoe starts");
+        let rejected = cutroute_geometry::PathRouteError::EmptyPath {
+            path: 0,
+            x: 1.0,
+            y: 2.0,
+        };
+        assert_eq!(
+            job.failed(AoeSolveError::Route(rejected)),
+            JobStatus::Running
+        );
+        let mut steps = 0;
+        while job.step(Duration::from_millis(50)) == JobStatus::Running {
+            steps += 1;
+            assert!(steps < 1000, "the job ends");
+        }
+        let progress = job.progress();
+        let Some(Solution::Route(route)) = &progress.solution else {
+            panic!("a contour route, not {:?}", progress.solution);
+        };
+        let forest = nest.containment_forest();
+        assert_eq!(
+            route.problems(&nest, &forest, nest.check_tolerance()),
+            Vec::new()
+        );
+        assert_eq!(route.pierce_count(), 4);
+        assert_eq!(progress.bounds.lower, None, "no bound of AOE's plan");
+        assert!(progress.bounds.upper.is_some());
+        assert_eq!(progress.job_id, 7);
+        let failure = progress.alternatives[0].failure.as_deref().expect("stated");
+        assert_eq!(progress.alternatives[0].name, crate::REJECTED_ROUTE);
+        assert!(
+            failure.contains("pierces at (1, 2) but cuts nothing"),
+            "{failure}"
+        );
+        assert!(
+            failure.contains("contour route is reported instead"),
+            "{failure}"
+        );
+        assert!(progress.alternatives[1].chosen);
+        assert!(matches!(progress.phase, Phase::CommonEdgeFailed { .. }));
     }
 }
