@@ -23,6 +23,7 @@
 use cutroute_geometry::{BoundingBox, MachineParameters, ToolClock, ToolMove, ToolState, Toolpath};
 use leptos::prelude::*;
 
+use crate::clock::hms_tenths;
 use crate::drawing::{travel_chunks, ChunkLimits, Travel};
 use crate::i18n::{tr, use_language, Lang};
 
@@ -271,12 +272,6 @@ fn run_frames(animation: Animation, last_ms: f64) {
     });
 }
 
-/// Seconds as `m:ss.s`.
-pub fn format_clock(seconds: f64) -> String {
-    let tenths = (seconds.max(0.0) * 10.0).round() as u64;
-    format!("{}:{:02}.{}", tenths / 600, tenths / 10 % 60, tenths % 10)
-}
-
 /// Play/pause, contour steps, scrub slider, speed and clock.
 #[component]
 pub fn AnimationControls(animation: Animation) -> impl IntoView {
@@ -429,7 +424,7 @@ fn TimeControls(animation: Animation) -> impl IntoView {
             data-time=move || format!("{:.3}", shown())
             data-total=move || format!("{:.3}", total())
         >
-            {move || format!("{} / {}", format_clock(shown()), format_clock(total()))}
+            {move || format!("{} / {}", hms_tenths(shown()), hms_tenths(total()))}
         </output>
     }
 }
@@ -749,12 +744,6 @@ mod tests {
         assert_eq!(end.chunk, Some(tl.travel.chunks.len() - 1));
         let last = tl.travel.chunks.last().unwrap();
         assert!((end.chunk_travelled - last.length).abs() < 1e-9);
-    }
-
-    #[test]
-    fn the_clock_reads_minutes_seconds_tenths() {
-        assert_eq!(format_clock(0.0), "0:00.0");
-        assert_eq!(format_clock(75.34), "1:15.3");
     }
 
     #[test]

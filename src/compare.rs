@@ -208,7 +208,7 @@ fn KeptRow(
             <td>{tr(e.label.0, e.label.1)}</td>
             <td class="kept-idle">{format!("{:.1}", e.idle_length)}</td>
             <td>{excess}</td>
-            <td class="kept-time">{format!("{:.1}", e.time_s)}</td>
+            <td class="kept-time" data-s=format!("{:.3}", e.time_s)>{crate::clock::hms(e.time_s)}</td>
             <td class="kept-cost">{format!("{:.2}", e.cost)}</td>
             <td class="kept-heat">{e.heat.map_or_else(|| "—".into(), |h| format!("{h:.4}"))}</td>
             <td class="kept-pierces">{e.pierces}</td>

@@ -135,7 +135,7 @@ pub fn StatsPanel(
             <dd id="pierces">{cell(|f| f.2.to_string())}</dd>
             <dt>{tr("Machine time", "Время работы станка")}</dt>
             // `data-s` / `data-value` keep the unrounded figures for checks by tools.
-            <dd id="machine-time" data-s=cell(|f| format!("{:.3}", f.3))>{cell(|f| format_duration(f.3))}</dd>
+            <dd id="machine-time" data-s=cell(|f| format!("{:.3}", f.3))>{cell(|f| crate::clock::hms(f.3))}</dd>
             <dt>{tr("Cost", "Стоимость")}</dt>
             <dd id="route-cost" data-value=cell(|f| format!("{:.3}", f.4))>{cell(|f| format!("{:.2}", f.4))}</dd>
         </dl>
@@ -201,7 +201,7 @@ pub fn AlternativesTable(alternatives: Signal<Vec<RouteSummary>>) -> impl IntoVi
                                             <td class="alt-pierces">{r.pierces}</td>
                                             <td class="alt-idle">{format!("{:.1}", r.idle_length)}</td>
                                             <td class="alt-cut">{format!("{:.1}", r.cut_length)}</td>
-                                            <td class="alt-time" data-s=format!("{:.3}", r.time_s)>{format!("{:.1}", r.time_s)}</td>
+                                            <td class="alt-time" data-s=format!("{:.3}", r.time_s)>{crate::clock::hms(r.time_s)}</td>
                                             <td class="alt-cost" data-value=format!("{:.3}", r.cost)>{format!("{:.2}", r.cost)}</td>
                                         </tr>
                                     }
@@ -227,13 +227,4 @@ fn candidate_name(name: &str, lang: Lang) -> String {
         (Lang::Ru, "junctions") => "стыки".into(),
         _ => name.to_string(),
     }
-}
-
-/// `h:mm:ss` for people reading machine time.
-fn format_duration(seconds: f64) -> String {
-    if !seconds.is_finite() {
-        return "—".into();
-    }
-    let total = seconds.round() as u64;
-    format!("{}:{:02}:{:02}", total / 3600, total / 60 % 60, total % 60)
 }
