@@ -10,6 +10,7 @@ use crate::drawing::{
     link_path, nest_bounds, path_route_idle_path, toolpath_bounds,
 };
 use crate::i18n::{tr, use_language, Lang};
+use crate::order_labels::OrderLabels;
 use crate::pan_zoom::{fitted_view, view_box_attribute, PanZoom};
 use crate::state::{DocumentState, Shown, SolverSettings, ViewSettings};
 use crate::thermal::{HeatMapLayer, ThermalView, ViolationMarks};
@@ -37,6 +38,20 @@ pub fn NestView() -> impl IntoView {
     });
     let view_box = move || pan_zoom.current().map(view_box_attribute);
     let view_width = Signal::derive(move || pan_zoom.current().map_or(100.0, |v| v.longer_side()));
+    // Marks are sized for the fitted view; zoomed, they are scaled back to that screen size.
+    let mark_scale = move || format!("--mark-scale:{}", view_width.get() / extent.get());
+    let svg = NodeRef::<leptos::svg::Svg>::new();
+    let size = element_size(svg);
+    let current = Signal::derive(move || pan_zoom.current());
+    let px_per_unit = Signal::derive(move || {
+        let (w, h) = size.get();
+        match pan_zoom.current() {
+            // "xMidYMid meet": the view box is fitted into the element.
+            Some(v) if w > 0.0 && h > 0.0 => (w / v.width).min(h / v.height),
+            // Not laid out yet: as if 1,000 pixels wide.
+            _ => 1000.0 / view_width.get(),
+        }
+    });
     let classes = move || {
         hidden_layers.with(|hidden| {
             let mut c = String::from("nest");
@@ -51,6 +66,7 @@ pub fn NestView() -> impl IntoView {
         <div class="canvas">
         <svg
             id="nest-view"
+            node_ref=svg
             xmlns="http://www.w3.org/2000/svg"
             class=classes
             viewBox=view_box
@@ -69,7 +85,7 @@ pub fn NestView() -> impl IntoView {
             on:keydown=move |ev| pan_zoom.on_key(ev)
         >
             <defs><HatchPattern extent=extent /></defs>
-            <g transform="scale(1,-1)">
+            <g transform="scale(1,-1)" style=mark_scale>
                 <NestShapes extent=extent />
                 <CertificateLayer />
                 <RouteLayers extent=extent />
@@ -79,13 +95,48 @@ pub fn NestView() -> impl IntoView {
                     <ViolationMarks thermal=thermal nest=nest route=route extent=extent />
                 </g>
             </g>
-            <g class="order" font-size=move || view_width.get() / 70.0><OrderLabels /></g>
+            <OrderLabels view=current px_per_unit=px_per_unit />
         </svg>
         // A second SVG stacked on the view: its own layer, so an animation frame repaints and
         // rasters the tool head only, not the nest (src/animation.rs).
         <AnimationOverlay scale=view_width view_box=Signal::derive(view_box) />
         </div>
     }
+}
+
+/// The size of `node`'s element in CSS pixels (its layout box, which a gesture's transform
+/// does not change), kept up to date as the page's layout changes it.
+fn element_size(node: NodeRef<leptos::svg::Svg>) -> ReadSignal<(f64, f64)> {
+    use wasm_bindgen::{closure::Closure, JsCast};
+    let (size, set_size) = signal((0.0, 0.0));
+    let observer = StoredValue::new_local(None::<web_sys::ResizeObserver>);
+    Effect::new(move |_| {
+        let Some(svg) = node.get() else {
+            return;
+        };
+        if observer.with_value(Option::is_some) {
+            return;
+        }
+        let element: web_sys::Element = svg.into();
+        let measure = {
+            let element = element.clone();
+            move || {
+                set_size.set((
+                    f64::from(element.client_width()),
+                    f64::from(element.client_height()),
+                ))
+            }
+        };
+        measure();
+        let callback = Closure::<dyn FnMut()>::new(measure);
+        if let Ok(o) = web_sys::ResizeObserver::new(callback.as_ref().unchecked_ref()) {
+            o.observe(&element);
+            observer.set_value(Some(o));
+        }
+        // The observer lives as long as the page's drawing.
+        callback.forget();
+    });
+    size
 }
 
 /// The box the drawing fits at first: the nest's; for a nest with nothing to draw (a G-code
@@ -427,43 +478,6 @@ fn EndMarkers(extent: Memo<f64>) -> impl IntoView {
     };
     view! {
         {ends}
-    }
-}
-
-/// The position of each cut in the order.
-#[component]
-fn OrderLabels() -> impl IntoView {
-    let Shown { route, paths, .. } = expect_context::<Shown>();
-    // Order numbers live outside the flipped group (text must not be mirrored): (x, −y).
-    // Numbered by step (contour) or by tool-on path.
-    let order_labels = move || {
-        let points: Vec<Point> = route
-            .with(|r| {
-                r.as_ref()
-                    .map(|r| r.steps.iter().map(|s| s.pierce_point).collect())
-            })
-            .or_else(|| {
-                paths.with(|p| {
-                    p.as_ref()
-                        .map(|p| p.paths.iter().map(|p| p.pierce).collect())
-                })
-            })?;
-        Some(
-            points
-                .into_iter()
-                .enumerate()
-                .map(|(k, p)| {
-                    view! {
-                        <text x=p.x y=-p.y dx="0.4em" dy="-0.3em">
-                            {(k + 1).to_string()}
-                        </text>
-                    }
-                })
-                .collect_view(),
-        )
-    };
-    view! {
-        {order_labels}
     }
 }
 

@@ -76,7 +76,7 @@ test('kerf and an arc lead-in: leads drawn and animated, G-code reads back with 
 
   await runSolver(page, 'ccp', 3);
   assert.match(await page.textContent('#phase'), /leads/, 'the job says it fitted leads');
-  const steps = await page.locator('#nest-view .order text').count();
+  const steps = await page.locator('#nest-view .route circle.pierce').count();
   assert.ok(steps > 0);
   const pierces = Number(await page.textContent('#pierces'));
   assert.equal(pierces, steps, 'one pierce per step (no tabs, no links)');

@@ -185,3 +185,145 @@ test('ccp on nested.dbs reports a certified lower bound: the chart draws both bo
   assert.ok((await page.locator('.chart-lb').getAttribute('d')).startsWith('M'), 'lower bound drawn');
   assert.deepEqual(errors, []);
 });
+
+/** WCAG 2 contrast ratio of two computed CSS colours (`rgb(r, g, b)`). */
+function contrast(a, b) {
+  const luminance = (css) => {
+    const [r, g, bl] = css.match(/[\d.]+/g).slice(0, 3).map((v) => {
+      const c = Number(v) / 255;
+      return c <= 0.03928 ? c / 12.92 : ((c + 0.055) / 1.055) ** 2.4;
+    });
+    return 0.2126 * r + 0.7152 * g + 0.0722 * bl;
+  };
+  const [hi, lo] = [luminance(a), luminance(b)].sort((x, y) => y - x);
+  return (hi + 0.05) / (lo + 0.05);
+}
+
+test('every theme keeps cut against outline, idle and leads against part fill at 3:1 or more', async () => {
+  const page = await app.browser.newPage({ viewport: { width: 1280, height: 720 } });
+  await page.goto(app.baseUrl);
+  await fileShown(page, 'E1X_6_01');
+  const themes = await page.locator('#theme option').evaluateAll((options) => options.map((o) => o.value));
+  for (const theme of themes) {
+    await page.selectOption('#theme', theme);
+    // The colours the drawing's own classes compute to, on elements of those classes.
+    const colours = await page.evaluate(() => {
+      const svg = document.querySelector('#nest-view');
+      const probe = (tag, cls, property) => {
+        const el = document.createElementNS('http://www.w3.org/2000/svg', tag);
+        el.setAttribute('class', cls);
+        svg.appendChild(el);
+        const value = getComputedStyle(el)[property];
+        el.remove();
+        return value;
+      };
+      return {
+        outline: probe('path', 'part', 'stroke'),
+        fill: probe('rect', 'hatch-bg', 'fill'),
+        cut: probe('path', 'cut', 'stroke'),
+        idle: probe('path', 'idle', 'stroke'),
+        lead: probe('path', 'lead', 'stroke'),
+      };
+    });
+    for (const [a, b] of [['cut', 'outline'], ['idle', 'fill'], ['lead', 'fill']]) {
+      const ratio = contrast(colours[a], colours[b]);
+      assert.ok(ratio >= 3, `${theme}: ${a} ${colours[a]} against ${b} ${colours[b]}: ${ratio.toFixed(2)}:1`);
+    }
+  }
+});
+
+/** The order numbers drawn: their screen boxes and font size in CSS pixels. */
+async function orderLabels(page) {
+  return page.evaluate(() => [...document.querySelectorAll('#nest-view .order text')].map((t) => {
+    const r = t.getBoundingClientRect();
+    const scale = t.getScreenCTM().a;
+    return { n: Number(t.textContent), box: [r.left, r.top, r.right, r.bottom],
+      at: [Number(t.getAttribute('x')), Number(t.getAttribute('y'))],
+      px: parseFloat(t.closest('g').getAttribute('font-size')) * scale };
+  }));
+}
+
+test('order numbers on nested.dbs after ccp read from the back row and never overlap, normal and presentation mode', async () => {
+  const context = await app.browser.newContext({ viewport: { width: 1280, height: 720 } });
+  const page = await context.newPage();
+  const errors = watchErrors(page);
+  await page.goto(`${app.baseUrl}?sample=nested.dbs`);
+  await fileShown(page, 'nested');
+  await page.selectOption('#solver', 'ccp');
+  await page.fill('#time-limit', '1');
+  await page.dispatchEvent('#time-limit', 'change');
+  await page.click('#start');
+  await page.waitForFunction(() => /^(finished|cancelled)/.test(document.querySelector('#job-status')?.textContent ?? ''),
+    null, { timeout: 30000 });
+  const pierces = Number(await page.textContent('#pierces'));
+  for (const mode of ['normal', 'presentation']) {
+    if (mode === 'presentation') {
+      await page.locator('#nest-view').focus();
+      await page.keyboard.press('f');
+      await page.waitForFunction(() => document.documentElement.hasAttribute('data-presentation'));
+    }
+    // The layout follows the drawing's new size.
+    await page.waitForTimeout(300);
+    const labels = await orderLabels(page);
+    assert.ok(labels.length >= Math.min(10, pierces), `${mode}: ${labels.length} of ${pierces} numbers drawn`);
+    assert.equal(labels[0].n, 1, `${mode}: the first cut is numbered`);
+    for (const l of labels) assert.ok(l.px >= 18 - 1e-6, `${mode}: number ${l.n} is ${l.px.toFixed(1)} px`);
+    let overlapping = 0;
+    for (let i = 0; i < labels.length; i++) {
+      for (let j = i + 1; j < labels.length; j++) {
+        const [a, b] = [labels[i].box, labels[j].box];
+        if (a[0] < b[2] && b[0] < a[2] && a[1] < b[3] && b[1] < a[3]) overlapping++;
+      }
+    }
+    assert.equal(overlapping, 0, `${mode}: overlapping number pairs`);
+    await screenshot(page, `order-labels-${mode}.png`);
+  }
+  // Zoomed in, the numbers keep their screen size and more of the contours in view get one.
+  await page.keyboard.press('f');
+  await page.waitForFunction(() => !document.documentElement.hasAttribute('data-presentation'));
+  await page.waitForTimeout(300);
+  const fitted = await orderLabels(page);
+  await page.locator('#nest-view').focus();
+  for (let k = 0; k < 6; k++) await page.keyboard.press('+');
+  await page.waitForTimeout(300);
+  const zoomed = await orderLabels(page);
+  const [vx, vy, vw, vh] = (await page.getAttribute('#nest-view', 'viewBox')).split(' ').map(Number);
+  const inView = ([x, y]) => x >= vx && x <= vx + vw && y >= vy && y <= vy + vh;
+  const fittedInView = fitted.filter((l) => inView(l.at)).length;
+  const piercesInView = await page.evaluate(([x0, y0, w, h]) => [...document.querySelectorAll('#nest-view .route circle.pierce')]
+    .filter((c) => { const [x, y] = [Number(c.getAttribute('cx')), -Number(c.getAttribute('cy'))];
+      return x >= x0 && x <= x0 + w && y >= y0 && y <= y0 + h; }).length, [vx, vy, vw, vh]);
+  assert.ok(zoomed.every((l) => l.px >= 18 - 1e-6), 'zoomed: the same screen size');
+  assert.ok(zoomed.length > fittedInView || fittedInView === piercesInView,
+    `zoomed: ${zoomed.length} numbers, ${fittedInView} of the ${piercesInView} pierces in view had one fitted`);
+  assert.deepEqual(errors, []);
+  await context.close();
+});
+
+test('zoomed ×8, marks keep their screen size: a 5 mm lead-in is longer than 3 pierce-mark radii', async () => {
+  const page = await app.browser.newPage({ viewport: { width: 1280, height: 720 } });
+  await page.goto(app.baseUrl);
+  await fileShown(page, 'E1X_6_01');
+  await page.selectOption('#solver', 'nearest');
+  await page.click('#start');
+  await page.waitForFunction(() => document.querySelector('#job-status')?.textContent === 'finished');
+  const radius = () => page.evaluate(() => document.querySelector('#nest-view .route circle.pierce').getBoundingClientRect().width / 2);
+  const fitted = await radius();
+  const view = page.locator('#nest-view');
+  const width = async () => Number((await view.getAttribute('viewBox')).split(' ')[2]);
+  const fittedWidth = await width();
+  await view.focus();
+  // 1.25⁹ ≈ 7.5, 1.25¹⁰ ≈ 9.3: ten key presses zoom past ×8.
+  for (let k = 0; k < 10; k++) await page.keyboard.press('+');
+  const zoom = fittedWidth / (await width());
+  assert.ok(zoom >= 8, `zoom ×${zoom}`);
+  const zoomed = await radius();
+  assert.ok(Math.abs(zoomed - fitted) <= 0.05 * fitted + 0.5, `pierce mark radius ${fitted} px fitted, ${zoomed} px zoomed`);
+  // A 5 mm lead-in on screen at this zoom, from the view box's scale ("meet" fitting).
+  const pixelsPerMm = await page.evaluate(() => {
+    const svg = document.querySelector('#nest-view');
+    const [, , w, h] = svg.getAttribute('viewBox').split(' ').map(Number);
+    return Math.min(svg.clientWidth / w, svg.clientHeight / h);
+  });
+  assert.ok(5 * pixelsPerMm > 3 * zoomed, `a 5 mm lead-in is ${(5 * pixelsPerMm).toFixed(1)} px, 3 mark radii ${(3 * zoomed).toFixed(1)} px`);
+});
