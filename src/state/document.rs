@@ -31,6 +31,9 @@ pub struct DocumentState {
     pub kept: RwSignal<Vec<Kept>>,
     /// The single file shown last, kept so another of its sheets can be opened.
     opened_file: StoredValue<Option<(String, Vec<u8>)>>,
+    /// The local files sent to the worker and not yet shown: they become `last_file` once
+    /// shown, never when refused.
+    pending_local: StoredValue<Option<String>>,
     worker: WorkerLink,
 }
 
@@ -46,6 +49,7 @@ impl DocumentState {
             file_url: RwSignal::new(settings.file_url.clone()),
             kept: RwSignal::new(Vec::new()),
             opened_file: StoredValue::new(None),
+            pending_local: StoredValue::new(None),
             worker,
         }
     }
@@ -72,6 +76,7 @@ impl DocumentState {
         let request_id = self.worker.take_id();
         self.sample.set(file_name.clone());
         self.file_url.set(None);
+        self.pending_local.set_value(None);
         leptos::task::spawn_local(async move {
             let url = format!("./assets/samples/{file_name}");
             match fetch_bytes(&url).await {
@@ -95,6 +100,7 @@ impl DocumentState {
         let request_id = self.worker.take_id();
         self.file_url.set(Some(url.clone()));
         self.last_file.set(None);
+        self.pending_local.set_value(None);
         leptos::task::spawn_local(async move {
             match fetch_bytes(&url).await {
                 Ok(bytes) => {
@@ -140,8 +146,7 @@ impl DocumentState {
                 return;
             }
             let names: Vec<String> = batch.iter().map(|(n, _)| n.clone()).collect();
-            this.last_file.set(Some(names.join(" + ")));
-            this.file_url.set(None);
+            this.pending_local.set_value(Some(names.join(" + ")));
             this.opened_file
                 .set_value((batch.len() == 1).then(|| batch[0].clone()));
             let request_id = this.worker.take_id();
@@ -164,9 +169,20 @@ impl DocumentState {
         }
     }
 
+    /// The worker refused the files sent: the page says why and keeps what it showed (the
+    /// refused files are not "the last file open").
+    pub fn refuse(&self, error: cutroute_protocol::OpenError) {
+        self.pending_local.set_value(None);
+        self.open_error.set(Some(PageError::Open(error)));
+    }
+
     /// Shows what the worker opened. Kept results stay only while the nest is the same one.
     pub fn show(&self, mut opened: Document) {
         self.open_error.set(None);
+        if let Some(names) = self.pending_local.try_update_value(Option::take).flatten() {
+            self.last_file.set(Some(names));
+            self.file_url.set(None);
+        }
         let same_nest = self
             .document
             .with_untracked(|d| d.as_ref().map(|d| &d.problem) == Some(&opened.problem));

@@ -33,7 +33,7 @@ use crate::compare::Kept;
 use crate::i18n::Lang;
 use crate::settings::Settings;
 use crate::thermal::ThermalView;
-use crate::words::{solver_label, PageError};
+use crate::words::solver_label;
 
 /// The whole page's state, and the operations that touch several of its parts.
 #[derive(Clone, Copy)]
@@ -68,9 +68,7 @@ impl Page {
                     job.clear();
                     document.show(opened);
                 }
-                FromWorker::OpenFailed { error, .. } => {
-                    document.open_error.set(Some(PageError::Open(error)))
-                }
+                FromWorker::OpenFailed { error, .. } => document.refuse(error),
                 about_job => job.hear(about_job),
             },
             move |death| job.after_worker_death(&death),

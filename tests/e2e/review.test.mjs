@@ -276,6 +276,16 @@ test('settings and layers survive a reload; a link opens a sample with solver se
   await page.reload();
   await fileShown(page, 'test1');
   assert.match(await page.locator('#last-file').textContent(), /Last time nested\.dbs was open/);
+  // A file the reader refuses is not "the file open last time": the note still names the
+  // last file shown, after a reload too.
+  const broken = path.join(os.tmpdir(), `refused-${process.pid}.dbs`);
+  fs.writeFileSync(broken, fs.readFileSync(local).subarray(0, 777));
+  await page.setInputFiles('#file-input', broken);
+  await page.locator('.error[role=alert]').waitFor({ timeout: 10000 });
+  assert.match(await page.locator('#last-file').textContent(), /Last time nested\.dbs was open/);
+  await page.reload();
+  await fileShown(page, 'test1');
+  assert.match(await page.locator('#last-file').textContent(), /Last time nested\.dbs was open/);
   await page.selectOption('#sample', 'E1X_6_01.dbs.json');
   await fileShown(page, 'E1X_6_01');
   assert.equal(await page.locator('#last-file').count(), 0, 'choosing a sample forgets the file');
