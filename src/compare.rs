@@ -168,7 +168,7 @@ fn CompareHead(objective: RwSignal<Objective>) -> impl IntoView {
                         }
                     ),
                 }}</th>
-                <th scope="col">{tr("Time, s", "Время, с")}</th>
+                <th scope="col">{tr("Time, h:mm:ss", "Время, ч:мм:сс")}</th>
                 <th scope="col">{tr("Cost", "Стоимость")}</th>
                 <th scope="col" title=tr("Thermal load H under the heat panel's σ and τ", "Тепловая нагрузка H при σ и τ из тепловой панели")>"H"</th>
                 <th scope="col">{tr("Pierces", "Врезки")}</th>

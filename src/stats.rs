@@ -175,7 +175,7 @@ pub fn AlternativesTable(alternatives: Signal<Vec<RouteSummary>>) -> impl IntoVi
                             <th scope="col" title=lang.pick("Pierces", "Врезки")>{lang.pick("Pierc.", "Врез.")}</th>
                             <th scope="col" title=lang.pick("Idle length, mm", "Длина холостого хода, мм")>{lang.pick("Idle", "Хол.")}</th>
                             <th scope="col" title=lang.pick("Cut length, mm", "Длина резки, мм")>{lang.pick("Cut", "Рез")}</th>
-                            <th scope="col" title=lang.pick("Machine time, s", "Время работы станка, с")>{lang.pick("Time", "Время")}</th>
+                            <th scope="col" title=lang.pick("Machine time, h:mm:ss", "Время работы станка, ч:мм:сс")>{lang.pick("Time", "Время")}</th>
                             <th scope="col">{lang.pick("Cost", "Стоим.")}</th>
                         </tr>
                     </thead>
