@@ -350,15 +350,8 @@ impl PathLeadsRun {
                 idle_lower_bound: None,
             },
             RouteSummary {
-                name: name.to_string(),
-                pierces,
-                idle_length: idle,
-                cut_length: cut,
-                time_s: self.machine.time(cut, idle, pierces),
-                cost: self.machine.cost(cut, idle, pierces),
                 chosen: true,
-                failure: None,
-                idle_lower_bound: None,
+                ..RouteSummary::measured(name, (cut, idle, pierces), &self.machine)
             },
         ];
     }

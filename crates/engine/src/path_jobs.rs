@@ -1000,15 +1000,8 @@ impl AoeJob {
             idle_lower_bound: None,
         };
         let contours = RouteSummary {
-            name: "contour route".to_string(),
-            pierces,
-            idle_length: idle,
-            cut_length: cut,
-            time_s: self.machine.time(cut, idle, pierces),
-            cost: self.machine.cost(cut, idle, pierces),
             chosen: true,
-            failure: None,
-            idle_lower_bound: None,
+            ..RouteSummary::measured("contour route", (cut, idle, pierces), &self.machine)
         };
         Progress {
             job_id: self.job_id,

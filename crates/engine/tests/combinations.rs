@@ -321,6 +321,18 @@ fn cell(
     })
 }
 
+/// [`cell`], a panic reported as what went wrong.
+fn guarded_cell(
+    problem: &Problem,
+    request: &JobRequest,
+    steps_with_route: usize,
+) -> Result<Outcome, String> {
+    catch_unwind(AssertUnwindSafe(|| {
+        cell(problem, request, steps_with_route)
+    }))
+    .unwrap_or_else(|_| Err("panicked".into()))
+}
+
 /// Every solver × every option family × every nest.
 #[test]
 fn every_solver_under_every_option_routes_checked_or_refuses() {
@@ -350,12 +362,9 @@ fn every_solver_under_every_option_routes_checked_or_refuses() {
                     },
                 };
                 let what = format!("{nest_name} / {option_name} / {}", solver.name());
-                match catch_unwind(AssertUnwindSafe(|| {
-                    cell(problem, &request, STEPS_WITH_A_ROUTE)
-                })) {
-                    Ok(Ok(outcome)) => outcomes.push((solver, outcome)),
-                    Ok(Err(e)) => failures.push(format!("{what}: {e}")),
-                    Err(_) => failures.push(format!("{what}: panicked")),
+                match guarded_cell(problem, &request, STEPS_WITH_A_ROUTE) {
+                    Ok(outcome) => outcomes.push((solver, outcome)),
+                    Err(e) => failures.push(format!("{what}: {e}")),
                 }
             }
             if option_name == "no kerf" {
@@ -432,10 +441,8 @@ fn every_solver_routes_every_real_file_checked_or_refuses() {
                                 },
                             };
                             let what = format!("{file} / {}", solver.name());
-                            match catch_unwind(AssertUnwindSafe(|| {
-                                cell(problem, &request, CORPUS_STEPS_WITH_A_ROUTE)
-                            })) {
-                                Ok(Ok(outcome)) => {
+                            match guarded_cell(problem, &request, CORPUS_STEPS_WITH_A_ROUTE) {
+                                Ok(outcome) => {
                                     // Without kerf a route is set aside only when the
                                     // solver's own route failed a checker: a bug.
                                     if let Outcome::Route {
@@ -447,8 +454,7 @@ fn every_solver_routes_every_real_file_checked_or_refuses() {
                                     }
                                     outcomes.push((solver, outcome));
                                 }
-                                Ok(Err(e)) => failures.push(format!("{what}: {e}")),
-                                Err(_) => failures.push(format!("{what}: panicked")),
+                                Err(e) => failures.push(format!("{what}: {e}")),
                             }
                         }
                         failures.extend(

@@ -433,6 +433,24 @@ pub struct RouteSummary {
 }
 
 impl RouteSummary {
+    /// The summary of a route that was made, from its cut and idle lengths and pierces, its time
+    /// and cost under `machine` (not chosen, no failure, no bound).
+    pub fn measured(
+        name: &str,
+        (cut, idle, pierces): (f64, f64, usize),
+        machine: &MachineParameters,
+    ) -> Self {
+        RouteSummary {
+            name: name.to_string(),
+            pierces,
+            idle_length: idle,
+            cut_length: cut,
+            time_s: machine.time(cut, idle, pierces),
+            cost: machine.cost(cut, idle, pierces),
+            ..RouteSummary::default()
+        }
+    }
+
     /// The relative gap `(idle − idle LB) / idle` of this candidate's idle length, when the
     /// bound is known.
     pub fn idle_gap(&self) -> Option<f64> {
